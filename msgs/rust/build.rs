@@ -1,0 +1,65 @@
+//! Generates the Rust message types from `.msg` / `.srv` files at build time.
+//!
+//! Inputs: the suite's own interface package (`msgs/msg`, `msgs/srv`, package `mobil_msgs`) and
+//! the standard ROS 2 Jazzy definitions the suite uses, vendored unchanged under `msgs/rust/ros`.
+//! Output: `$OUT_DIR/generated.rs`, one module per package (`geometry_msgs::msg::Twist`, …),
+//! with serde layouts that match the CDR encoding rmw implementations use (field order, fixed
+//! arrays without a length prefix, sequences with one).
+//!
+//! The parser and code generator live in `src/idl.rs`, which is also compiled into the library
+//! so that it is unit-tested like the rest of the code.
+
+#[path = "src/idl.rs"]
+mod idl;
+
+use std::path::{Path, PathBuf};
+
+fn main() {
+    let manifest = PathBuf::from(std::env::var_os("CARGO_MANIFEST_DIR").expect("cargo sets CARGO_MANIFEST_DIR"));
+    let own_package = manifest.join("..");
+    let vendored = manifest.join("ros");
+
+    let mut sources: Vec<(String, PathBuf)> = Vec::new();
+    collect(&own_package, "mobil_msgs", &mut sources);
+    let mut std_packages: Vec<_> = std::fs::read_dir(&vendored)
+        .expect("msgs/rust/ros exists")
+        .filter_map(|e| e.ok())
+        .filter(|e| e.path().is_dir())
+        .map(|e| e.file_name().to_string_lossy().into_owned())
+        .collect();
+    std_packages.sort();
+    for pkg in &std_packages {
+        collect(&vendored.join(pkg), pkg, &mut sources);
+    }
+
+    let mut packages = idl::Packages::default();
+    for (pkg, path) in &sources {
+        println!("cargo:rerun-if-changed={}", path.display());
+        let text = std::fs::read_to_string(path).unwrap_or_else(|e| panic!("reading {}: {e}", path.display()));
+        let name = path.file_stem().and_then(|s| s.to_str()).expect("utf-8 file name").to_owned();
+        let result = match path.extension().and_then(|e| e.to_str()) {
+            Some("msg") => packages.add_message(pkg, &name, &text),
+            Some("srv") => packages.add_service(pkg, &name, &text),
+            _ => continue,
+        };
+        if let Err(e) = result {
+            panic!("{}: {e}", path.display());
+        }
+    }
+    let code = packages.generate().unwrap_or_else(|e| panic!("generating message types: {e}"));
+    let out = PathBuf::from(std::env::var_os("OUT_DIR").expect("cargo sets OUT_DIR")).join("generated.rs");
+    std::fs::write(&out, code).expect("writing generated.rs");
+    println!("cargo:rerun-if-changed=src/idl.rs");
+    println!("cargo:rerun-if-changed=ros");
+    println!("cargo:rerun-if-changed=../msg");
+    println!("cargo:rerun-if-changed=../srv");
+}
+
+fn collect(package_dir: &Path, pkg: &str, out: &mut Vec<(String, PathBuf)>) {
+    for sub in ["msg", "srv"] {
+        let Ok(entries) = std::fs::read_dir(package_dir.join(sub)) else { continue };
+        let mut files: Vec<PathBuf> = entries.filter_map(|e| e.ok()).map(|e| e.path()).collect();
+        files.sort();
+        out.extend(files.into_iter().map(|p| (pkg.to_owned(), p)));
+    }
+}

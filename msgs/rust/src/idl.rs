@@ -1,0 +1,502 @@
+//! A parser for ROS 2 `.msg` / `.srv` files and the Rust code generator behind this crate.
+//!
+//! Used by `build.rs` (the same file is included there with `#[path]`) and unit-tested here.
+//! Supported: every primitive type, bounded and unbounded strings, fixed (`T[N]`), bounded
+//! (`T[<=N]`) and unbounded (`T[]`) arrays, nested messages (same package or `pkg/Type`),
+//! constants (`TYPE NAME=VALUE`) and default values (`TYPE name VALUE`). `wstring` is refused.
+#![allow(dead_code)]
+
+use std::collections::BTreeMap;
+use std::fmt::{self, Write as _};
+
+/// A primitive ROS type and its Rust counterpart.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Primitive {
+    Bool,
+    Byte,
+    Char,
+    Float32,
+    Float64,
+    Int8,
+    Uint8,
+    Int16,
+    Uint16,
+    Int32,
+    Uint32,
+    Int64,
+    Uint64,
+}
+
+impl Primitive {
+    fn parse(s: &str) -> Option<Self> {
+        Some(match s {
+            "bool" => Self::Bool,
+            "byte" => Self::Byte,
+            "char" => Self::Char,
+            "float32" => Self::Float32,
+            "float64" => Self::Float64,
+            "int8" => Self::Int8,
+            "uint8" => Self::Uint8,
+            "int16" => Self::Int16,
+            "uint16" => Self::Uint16,
+            "int32" => Self::Int32,
+            "uint32" => Self::Uint32,
+            "int64" => Self::Int64,
+            "uint64" => Self::Uint64,
+            _ => return None,
+        })
+    }
+
+    /// The Rust type (`byte` and `char` are octets in ROS 2).
+    pub fn rust(self) -> &'static str {
+        match self {
+            Self::Bool => "bool",
+            Self::Byte | Self::Char | Self::Uint8 => "u8",
+            Self::Float32 => "f32",
+            Self::Float64 => "f64",
+            Self::Int8 => "i8",
+            Self::Int16 => "i16",
+            Self::Uint16 => "u16",
+            Self::Int32 => "i32",
+            Self::Uint32 => "u32",
+            Self::Int64 => "i64",
+            Self::Uint64 => "u64",
+        }
+    }
+
+    /// Renders a literal of this type, checking that it parses and fits.
+    fn literal(self, value: &str) -> Result<String, String> {
+        let v = value.trim();
+        match self {
+            Self::Bool => match v {
+                "true" | "True" | "1" => Ok("true".into()),
+                "false" | "False" | "0" => Ok("false".into()),
+                _ => Err(format!("`{v}` is not a bool")),
+            },
+            Self::Float32 | Self::Float64 => {
+                let f: f64 = v.parse().map_err(|_| format!("`{v}` is not a number"))?;
+                if !f.is_finite() {
+                    return Err(format!("`{v}` is not finite"));
+                }
+                Ok(format!("{f:?}"))
+            }
+            _ => {
+                let i: i128 = v.parse().map_err(|_| format!("`{v}` is not an integer"))?;
+                let (lo, hi): (i128, i128) = match self {
+                    Self::Int8 => (i8::MIN.into(), i8::MAX.into()),
+                    Self::Byte | Self::Char | Self::Uint8 => (0, u8::MAX.into()),
+                    Self::Int16 => (i16::MIN.into(), i16::MAX.into()),
+                    Self::Uint16 => (0, u16::MAX.into()),
+                    Self::Int32 => (i32::MIN.into(), i32::MAX.into()),
+                    Self::Uint32 => (0, u32::MAX.into()),
+                    Self::Int64 => (i64::MIN.into(), i64::MAX.into()),
+                    _ => (0, u64::MAX.into()),
+                };
+                if i < lo || i > hi {
+                    return Err(format!("{i} does not fit in {}", self.rust()));
+                }
+                Ok(i.to_string())
+            }
+        }
+    }
+}
+
+/// The element type of a field.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum BaseType {
+    Primitive(Primitive),
+    /// `string` or `string<=N` (the bound is documentation on the Rust side).
+    String { bound: Option<usize> },
+    /// A nested message, always with its package resolved.
+    Message { package: String, name: String },
+}
+
+/// How many elements a field holds.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ArrayKind {
+    Single,
+    Fixed(usize),
+    Bounded(usize),
+    Unbounded,
+}
+
+/// A field's full type.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct FieldType {
+    pub base: BaseType,
+    pub array: ArrayKind,
+}
+
+/// One field of a message.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Field {
+    pub name: String,
+    pub ty: FieldType,
+    pub default: Option<String>,
+}
+
+/// One constant of a message.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Constant {
+    pub name: String,
+    pub ty: BaseType,
+    pub value: String,
+}
+
+/// A parsed message definition.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct MsgSpec {
+    pub package: String,
+    pub name: String,
+    pub fields: Vec<Field>,
+    pub constants: Vec<Constant>,
+}
+
+/// An error in a definition, with the 1-based line it was found on (0: the file as a whole).
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct IdlError {
+    pub line: usize,
+    pub message: String,
+}
+
+impl fmt::Display for IdlError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        if self.line == 0 {
+            write!(f, "{}", self.message)
+        } else {
+            write!(f, "line {}: {}", self.line, self.message)
+        }
+    }
+}
+
+fn err(line: usize, message: impl Into<String>) -> IdlError {
+    IdlError { line, message: message.into() }
+}
+
+fn is_identifier(s: &str) -> bool {
+    let mut chars = s.chars();
+    matches!(chars.next(), Some(c) if c.is_ascii_alphabetic()) && chars.all(|c| c.is_ascii_alphanumeric() || c == '_')
+}
+
+fn parse_type(package: &str, text: &str, line: usize) -> Result<FieldType, IdlError> {
+    let (base_text, array) = match text.find('[') {
+        None => (text, ArrayKind::Single),
+        Some(open) => {
+            let inner = text[open + 1..]
+                .strip_suffix(']')
+                .ok_or_else(|| err(line, format!("unclosed array bracket in `{text}`")))?;
+            let array = if inner.is_empty() {
+                ArrayKind::Unbounded
+            } else if let Some(bound) = inner.strip_prefix("<=") {
+                ArrayKind::Bounded(bound.parse().map_err(|_| err(line, format!("bad array bound `{inner}`")))?)
+            } else {
+                ArrayKind::Fixed(inner.parse().map_err(|_| err(line, format!("bad array size `{inner}`")))?)
+            };
+            (&text[..open], array)
+        }
+    };
+    let base = if let Some(p) = Primitive::parse(base_text) {
+        BaseType::Primitive(p)
+    } else if base_text == "string" {
+        BaseType::String { bound: None }
+    } else if let Some(bound) = base_text.strip_prefix("string<=") {
+        BaseType::String { bound: Some(bound.parse().map_err(|_| err(line, format!("bad string bound `{base_text}`")))?) }
+    } else if base_text.starts_with("wstring") {
+        return Err(err(line, "wstring is not supported"));
+    } else {
+        let parts: Vec<&str> = base_text.split('/').collect();
+        let (pkg, name) = match parts.as_slice() {
+            [name] => (package, *name),
+            [pkg, name] | [pkg, "msg", name] => (*pkg, *name),
+            _ => return Err(err(line, format!("bad type `{base_text}`"))),
+        };
+        if !is_identifier(pkg) || !is_identifier(name) {
+            return Err(err(line, format!("bad type `{base_text}`")));
+        }
+        BaseType::Message { package: pkg.to_owned(), name: name.to_owned() }
+    };
+    Ok(FieldType { base, array })
+}
+
+/// Parses one `.msg` body (or one half of a `.srv`).
+pub fn parse_msg(package: &str, name: &str, text: &str) -> Result<MsgSpec, IdlError> {
+    let mut spec = MsgSpec { package: package.to_owned(), name: name.to_owned(), ..Default::default() };
+    for (index, raw) in text.lines().enumerate() {
+        let line_no = index + 1;
+        let trimmed = raw.trim();
+        if trimmed.is_empty() || trimmed.starts_with('#') {
+            continue;
+        }
+        let (type_text, rest) = trimmed
+            .split_once(char::is_whitespace)
+            .ok_or_else(|| err(line_no, format!("expected `TYPE NAME`, found `{trimmed}`")))?;
+        let rest = rest.trim_start();
+        let ty = parse_type(package, type_text, line_no)?;
+        // Constants: `TYPE NAME=VALUE`; a string constant's value runs to the end of the line.
+        let name_end = rest.find(|c: char| c.is_whitespace() || c == '=').unwrap_or(rest.len());
+        let field_name = &rest[..name_end];
+        let after = rest[name_end..].trim_start();
+        if !is_identifier(field_name) {
+            return Err(err(line_no, format!("bad name `{field_name}`")));
+        }
+        if let Some(value) = after.strip_prefix('=') {
+            if ty.array != ArrayKind::Single || matches!(ty.base, BaseType::Message { .. }) {
+                return Err(err(line_no, "constants must be of a primitive or string type"));
+            }
+            let value = match ty.base {
+                BaseType::String { .. } => unquote(value.trim()),
+                _ => strip_comment(value).trim().to_owned(),
+            };
+            spec.constants.push(Constant { name: field_name.to_owned(), ty: ty.base, value });
+        } else {
+            let default = strip_comment(after).trim();
+            if spec.fields.iter().any(|f| f.name == field_name) {
+                return Err(err(line_no, format!("duplicate field `{field_name}`")));
+            }
+            spec.fields.push(Field {
+                name: field_name.to_owned(),
+                ty,
+                default: (!default.is_empty()).then(|| default.to_owned()),
+            });
+        }
+    }
+    Ok(spec)
+}
+
+/// Removes a trailing `# comment`, leaving `#` inside quotes alone.
+fn strip_comment(s: &str) -> &str {
+    let mut quote: Option<char> = None;
+    for (i, c) in s.char_indices() {
+        match (quote, c) {
+            (None, '#') => return &s[..i],
+            (None, '"' | '\'') => quote = Some(c),
+            (Some(q), c) if c == q => quote = None,
+            _ => {}
+        }
+    }
+    s
+}
+
+fn unquote(s: &str) -> String {
+    let bytes = s.as_bytes();
+    if bytes.len() >= 2 && (bytes[0] == b'"' || bytes[0] == b'\'') && bytes[bytes.len() - 1] == bytes[0] {
+        s[1..s.len() - 1].to_owned()
+    } else {
+        s.to_owned()
+    }
+}
+
+/// Splits a `.srv` into its request and response halves.
+pub fn split_srv(text: &str) -> Result<(&str, &str), IdlError> {
+    let mut offset = 0;
+    for line in text.split_inclusive('\n') {
+        if line.trim() == "---" {
+            return Ok((&text[..offset], &text[offset + line.len()..]));
+        }
+        offset += line.len();
+    }
+    Err(err(0, "a service needs a `---` line between request and response"))
+}
+
+#[derive(Debug, Default)]
+struct Package {
+    msgs: Vec<MsgSpec>,
+    /// Service name → (request, response), both also in `msgs` of the `srv` module.
+    srvs: Vec<(String, MsgSpec, MsgSpec)>,
+}
+
+/// All definitions to generate, grouped by package.
+#[derive(Debug, Default)]
+pub struct Packages {
+    packages: BTreeMap<String, Package>,
+}
+
+const RUST_KEYWORDS: &[&str] = &[
+    "as", "async", "await", "break", "const", "continue", "crate", "dyn", "else", "enum", "extern", "false", "fn",
+    "for", "if", "impl", "in", "let", "loop", "match", "mod", "move", "mut", "pub", "ref", "return", "self", "static",
+    "struct", "super", "trait", "true", "type", "unsafe", "use", "where", "while", "abstract", "become", "box", "do",
+    "final", "macro", "override", "priv", "typeof", "unsized", "virtual", "yield", "try", "gen",
+];
+
+fn rust_field_name(name: &str) -> String {
+    if RUST_KEYWORDS.contains(&name) {
+        format!("r#{name}")
+    } else {
+        name.to_owned()
+    }
+}
+
+impl Packages {
+    /// Adds a message definition.
+    pub fn add_message(&mut self, package: &str, name: &str, text: &str) -> Result<(), IdlError> {
+        let spec = parse_msg(package, name, text)?;
+        self.packages.entry(package.to_owned()).or_default().msgs.push(spec);
+        Ok(())
+    }
+
+    /// Adds a service definition (`Name.srv` → `NameRequest`, `NameResponse`).
+    pub fn add_service(&mut self, package: &str, name: &str, text: &str) -> Result<(), IdlError> {
+        let (req, resp) = split_srv(text)?;
+        let request = parse_msg(package, &format!("{name}_Request"), req)?;
+        let response = parse_msg(package, &format!("{name}_Response"), resp)?;
+        self.packages.entry(package.to_owned()).or_default().srvs.push((name.to_owned(), request, response));
+        Ok(())
+    }
+
+    fn message_exists(&self, package: &str, name: &str) -> bool {
+        self.packages.get(package).is_some_and(|p| p.msgs.iter().any(|m| m.name == name))
+    }
+
+    fn rust_type(&self, ty: &FieldType, context: &str) -> Result<String, IdlError> {
+        let element = match &ty.base {
+            BaseType::Primitive(p) => p.rust().to_owned(),
+            BaseType::String { .. } => "::std::string::String".to_owned(),
+            BaseType::Message { package, name } => {
+                if !self.message_exists(package, name) {
+                    return Err(err(0, format!("{context}: unknown message type {package}/{name}")));
+                }
+                format!("crate::{package}::msg::{name}")
+            }
+        };
+        Ok(match ty.array {
+            ArrayKind::Single => element,
+            ArrayKind::Fixed(n) => format!("[{element}; {n}]"),
+            ArrayKind::Bounded(_) | ArrayKind::Unbounded => format!("::std::vec::Vec<{element}>"),
+        })
+    }
+
+    fn default_expr(&self, field: &Field, context: &str) -> Result<String, IdlError> {
+        let ctx = |m: String| err(0, format!("{context}.{}: {m}", field.name));
+        let Some(value) = &field.default else {
+            return Ok(match field.ty.array {
+                ArrayKind::Fixed(_) => "::std::array::from_fn(|_| ::std::default::Default::default())".to_owned(),
+                _ => "::std::default::Default::default()".to_owned(),
+            });
+        };
+        let scalar = |v: &str| -> Result<String, IdlError> {
+            match &field.ty.base {
+                BaseType::Primitive(p) => p.literal(v).map_err(ctx),
+                BaseType::String { .. } => Ok(format!("{:?}.to_owned()", unquote(v.trim()))),
+                BaseType::Message { .. } => Err(ctx("messages cannot have default values".into())),
+            }
+        };
+        match field.ty.array {
+            ArrayKind::Single => scalar(value),
+            array => {
+                let inner = value
+                    .trim()
+                    .strip_prefix('[')
+                    .and_then(|v| v.strip_suffix(']'))
+                    .ok_or_else(|| ctx(format!("array default `{value}` must be written [a, b, …]")))?;
+                let items: Vec<String> = inner
+                    .split(',')
+                    .map(str::trim)
+                    .filter(|s| !s.is_empty())
+                    .map(scalar)
+                    .collect::<Result<_, _>>()?;
+                match array {
+                    ArrayKind::Fixed(n) if items.len() != n => {
+                        Err(ctx(format!("default has {} values, the array {n}", items.len())))
+                    }
+                    ArrayKind::Fixed(_) => Ok(format!("[{}]", items.join(", "))),
+                    ArrayKind::Bounded(n) if items.len() > n => {
+                        Err(ctx(format!("default has {} values, the bound is {n}", items.len())))
+                    }
+                    _ => Ok(format!("vec![{}]", items.join(", "))),
+                }
+            }
+        }
+    }
+
+    fn generate_struct(&self, out: &mut String, spec: &MsgSpec, module: &str) -> Result<(), IdlError> {
+        let context = format!("{}/{}", spec.package, spec.name);
+        let rust_name = spec.name.replace('_', "");
+        let _ = writeln!(out, "    /// `{}/{module}/{}`, generated from its definition.", spec.package, spec.name);
+        let _ = writeln!(out, "    #[derive(Debug, Clone, PartialEq, ::serde::Serialize, ::serde::Deserialize)]");
+        let _ = writeln!(out, "    pub struct {rust_name} {{");
+        let mut defaults = Vec::new();
+        if spec.fields.is_empty() {
+            // The IDL mapping gives an empty structure one octet so it can be encoded.
+            let _ = writeln!(out, "        pub structure_needs_at_least_one_member: u8,");
+            defaults.push(("structure_needs_at_least_one_member".to_owned(), "0".to_owned()));
+        }
+        for field in &spec.fields {
+            let ty = self.rust_type(&field.ty, &context)?;
+            if matches!(field.ty.array, ArrayKind::Fixed(n) if n > 32) {
+                let _ = writeln!(out, "        #[serde(with = \"::serde_big_array::BigArray\")]");
+            }
+            let name = rust_field_name(&field.name);
+            let _ = writeln!(out, "        pub {name}: {ty},");
+            defaults.push((name, self.default_expr(field, &context)?));
+        }
+        let _ = writeln!(out, "    }}\n");
+        let _ = writeln!(out, "    impl ::std::default::Default for {rust_name} {{");
+        let _ = writeln!(out, "        fn default() -> Self {{");
+        let _ = writeln!(out, "            Self {{");
+        for (name, expr) in defaults {
+            let _ = writeln!(out, "                {name}: {expr},");
+        }
+        let _ = writeln!(out, "            }}\n        }}\n    }}\n");
+        if !spec.constants.is_empty() {
+            let _ = writeln!(out, "    impl {rust_name} {{");
+            for c in &spec.constants {
+                let (ty, value) = match &c.ty {
+                    BaseType::Primitive(p) => {
+                        (p.rust().to_owned(), p.literal(&c.value).map_err(|m| err(0, format!("{context}.{}: {m}", c.name)))?)
+                    }
+                    BaseType::String { .. } => ("&'static str".to_owned(), format!("{:?}", c.value)),
+                    BaseType::Message { .. } => {
+                        return Err(err(0, format!("{context}.{}: constants must be primitive", c.name)))
+                    }
+                };
+                let _ = writeln!(out, "        pub const {}: {ty} = {value};", c.name);
+            }
+            let _ = writeln!(out, "    }}\n");
+        }
+        let _ = writeln!(out, "    impl ::ros2_client::Message for {rust_name} {{}}\n");
+        let _ = writeln!(out, "    impl crate::RosMessage for {rust_name} {{");
+        let _ = writeln!(out, "        const PACKAGE: &'static str = {:?};", spec.package);
+        let _ = writeln!(out, "        const NAME: &'static str = {:?};", spec.name);
+        let _ = writeln!(out, "    }}\n");
+        Ok(())
+    }
+
+    /// Generates the Rust source for every package.
+    pub fn generate(&self) -> Result<String, IdlError> {
+        let mut out = String::from("// Generated by msgs/rust/build.rs from .msg/.srv files. Do not edit.\n\n");
+        for (package, contents) in &self.packages {
+            let _ = writeln!(out, "/// Types of the ROS 2 package `{package}`.");
+            let _ = writeln!(out, "pub mod {package} {{");
+            if !contents.msgs.is_empty() {
+                let _ = writeln!(out, "/// Messages of `{package}`.");
+                let _ = writeln!(out, "pub mod msg {{");
+                let mut msgs: Vec<&MsgSpec> = contents.msgs.iter().collect();
+                msgs.sort_by(|a, b| a.name.cmp(&b.name));
+                for spec in msgs {
+                    self.generate_struct(&mut out, spec, "msg")?;
+                }
+                let _ = writeln!(out, "}}");
+            }
+            if !contents.srvs.is_empty() {
+                let _ = writeln!(out, "/// Services of `{package}`.");
+                let _ = writeln!(out, "pub mod srv {{");
+                for (name, request, response) in &contents.srvs {
+                    self.generate_struct(&mut out, request, "srv")?;
+                    self.generate_struct(&mut out, response, "srv")?;
+                    let _ = writeln!(out, "    /// The `{package}/srv/{name}` service.");
+                    let _ = writeln!(out, "    #[derive(Debug, Clone, Copy, Default)]");
+                    let _ = writeln!(out, "    pub struct {name};\n");
+                    let _ = writeln!(out, "    impl crate::RosService for {name} {{");
+                    let _ = writeln!(out, "        type Request = {name}Request;");
+                    let _ = writeln!(out, "        type Response = {name}Response;");
+                    let _ = writeln!(out, "        const PACKAGE: &'static str = {package:?};");
+                    let _ = writeln!(out, "        const NAME: &'static str = {name:?};");
+                    let _ = writeln!(out, "    }}\n");
+                }
+                let _ = writeln!(out, "}}");
+            }
+            let _ = writeln!(out, "}}\n");
+        }
+        Ok(out)
+    }
+}
