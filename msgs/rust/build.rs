@@ -36,7 +36,11 @@ fn main() {
     for (pkg, path) in &sources {
         println!("cargo:rerun-if-changed={}", path.display());
         let text = std::fs::read_to_string(path).unwrap_or_else(|e| panic!("reading {}: {e}", path.display()));
-        let name = path.file_stem().and_then(|s| s.to_str()).expect("utf-8 file name").to_owned();
+        let name = path
+            .file_stem()
+            .and_then(|s| s.to_str())
+            .expect("utf-8 file name")
+            .to_owned();
         let result = match path.extension().and_then(|e| e.to_str()) {
             Some("msg") => packages.add_message(pkg, &name, &text),
             Some("srv") => packages.add_service(pkg, &name, &text),
@@ -46,7 +50,9 @@ fn main() {
             panic!("{}: {e}", path.display());
         }
     }
-    let code = packages.generate().unwrap_or_else(|e| panic!("generating message types: {e}"));
+    let code = packages
+        .generate()
+        .unwrap_or_else(|e| panic!("generating message types: {e}"));
     let out = PathBuf::from(std::env::var_os("OUT_DIR").expect("cargo sets OUT_DIR")).join("generated.rs");
     std::fs::write(&out, code).expect("writing generated.rs");
     println!("cargo:rerun-if-changed=src/idl.rs");
@@ -57,7 +63,9 @@ fn main() {
 
 fn collect(package_dir: &Path, pkg: &str, out: &mut Vec<(String, PathBuf)>) {
     for sub in ["msg", "srv"] {
-        let Ok(entries) = std::fs::read_dir(package_dir.join(sub)) else { continue };
+        let Ok(entries) = std::fs::read_dir(package_dir.join(sub)) else {
+            continue;
+        };
         let mut files: Vec<PathBuf> = entries.filter_map(|e| e.ok()).map(|e| e.path()).collect();
         files.sort();
         out.extend(files.into_iter().map(|p| (pkg.to_owned(), p)));

@@ -106,9 +106,14 @@ impl Primitive {
 pub enum BaseType {
     Primitive(Primitive),
     /// `string` or `string<=N` (the bound is documentation on the Rust side).
-    String { bound: Option<usize> },
+    String {
+        bound: Option<usize>,
+    },
     /// A nested message, always with its package resolved.
-    Message { package: String, name: String },
+    Message {
+        package: String,
+        name: String,
+    },
 }
 
 /// How many elements a field holds.
@@ -170,7 +175,10 @@ impl fmt::Display for IdlError {
 }
 
 fn err(line: usize, message: impl Into<String>) -> IdlError {
-    IdlError { line, message: message.into() }
+    IdlError {
+        line,
+        message: message.into(),
+    }
 }
 
 fn is_identifier(s: &str) -> bool {
@@ -188,9 +196,17 @@ fn parse_type(package: &str, text: &str, line: usize) -> Result<FieldType, IdlEr
             let array = if inner.is_empty() {
                 ArrayKind::Unbounded
             } else if let Some(bound) = inner.strip_prefix("<=") {
-                ArrayKind::Bounded(bound.parse().map_err(|_| err(line, format!("bad array bound `{inner}`")))?)
+                ArrayKind::Bounded(
+                    bound
+                        .parse()
+                        .map_err(|_| err(line, format!("bad array bound `{inner}`")))?,
+                )
             } else {
-                ArrayKind::Fixed(inner.parse().map_err(|_| err(line, format!("bad array size `{inner}`")))?)
+                ArrayKind::Fixed(
+                    inner
+                        .parse()
+                        .map_err(|_| err(line, format!("bad array size `{inner}`")))?,
+                )
             };
             (&text[..open], array)
         }
@@ -200,7 +216,13 @@ fn parse_type(package: &str, text: &str, line: usize) -> Result<FieldType, IdlEr
     } else if base_text == "string" {
         BaseType::String { bound: None }
     } else if let Some(bound) = base_text.strip_prefix("string<=") {
-        BaseType::String { bound: Some(bound.parse().map_err(|_| err(line, format!("bad string bound `{base_text}`")))?) }
+        BaseType::String {
+            bound: Some(
+                bound
+                    .parse()
+                    .map_err(|_| err(line, format!("bad string bound `{base_text}`")))?,
+            ),
+        }
     } else if base_text.starts_with("wstring") {
         return Err(err(line, "wstring is not supported"));
     } else {
@@ -213,14 +235,21 @@ fn parse_type(package: &str, text: &str, line: usize) -> Result<FieldType, IdlEr
         if !is_identifier(pkg) || !is_identifier(name) {
             return Err(err(line, format!("bad type `{base_text}`")));
         }
-        BaseType::Message { package: pkg.to_owned(), name: name.to_owned() }
+        BaseType::Message {
+            package: pkg.to_owned(),
+            name: name.to_owned(),
+        }
     };
     Ok(FieldType { base, array })
 }
 
 /// Parses one `.msg` body (or one half of a `.srv`).
 pub fn parse_msg(package: &str, name: &str, text: &str) -> Result<MsgSpec, IdlError> {
-    let mut spec = MsgSpec { package: package.to_owned(), name: name.to_owned(), ..Default::default() };
+    let mut spec = MsgSpec {
+        package: package.to_owned(),
+        name: name.to_owned(),
+        ..Default::default()
+    };
     for (index, raw) in text.lines().enumerate() {
         let line_no = index + 1;
         let trimmed = raw.trim();
@@ -247,7 +276,11 @@ pub fn parse_msg(package: &str, name: &str, text: &str) -> Result<MsgSpec, IdlEr
                 BaseType::String { .. } => unquote(value.trim()),
                 _ => strip_comment(value).trim().to_owned(),
             };
-            spec.constants.push(Constant { name: field_name.to_owned(), ty: ty.base, value });
+            spec.constants.push(Constant {
+                name: field_name.to_owned(),
+                ty: ty.base,
+                value,
+            });
         } else {
             let default = strip_comment(after).trim();
             if spec.fields.iter().any(|f| f.name == field_name) {
@@ -339,12 +372,18 @@ impl Packages {
         let (req, resp) = split_srv(text)?;
         let request = parse_msg(package, &format!("{name}_Request"), req)?;
         let response = parse_msg(package, &format!("{name}_Response"), resp)?;
-        self.packages.entry(package.to_owned()).or_default().srvs.push((name.to_owned(), request, response));
+        self.packages
+            .entry(package.to_owned())
+            .or_default()
+            .srvs
+            .push((name.to_owned(), request, response));
         Ok(())
     }
 
     fn message_exists(&self, package: &str, name: &str) -> bool {
-        self.packages.get(package).is_some_and(|p| p.msgs.iter().any(|m| m.name == name))
+        self.packages
+            .get(package)
+            .is_some_and(|p| p.msgs.iter().any(|m| m.name == name))
     }
 
     fn rust_type(&self, ty: &FieldType, context: &str) -> Result<String, IdlError> {
@@ -411,8 +450,15 @@ impl Packages {
     fn generate_struct(&self, out: &mut String, spec: &MsgSpec, module: &str) -> Result<(), IdlError> {
         let context = format!("{}/{}", spec.package, spec.name);
         let rust_name = spec.name.replace('_', "");
-        let _ = writeln!(out, "    /// `{}/{module}/{}`, generated from its definition.", spec.package, spec.name);
-        let _ = writeln!(out, "    #[derive(Debug, Clone, PartialEq, ::serde::Serialize, ::serde::Deserialize)]");
+        let _ = writeln!(
+            out,
+            "    /// `{}/{module}/{}`, generated from its definition.",
+            spec.package, spec.name
+        );
+        let _ = writeln!(
+            out,
+            "    #[derive(Debug, Clone, PartialEq, ::serde::Serialize, ::serde::Deserialize)]"
+        );
         let _ = writeln!(out, "    pub struct {rust_name} {{");
         let mut defaults = Vec::new();
         if spec.fields.is_empty() {
@@ -441,9 +487,11 @@ impl Packages {
             let _ = writeln!(out, "    impl {rust_name} {{");
             for c in &spec.constants {
                 let (ty, value) = match &c.ty {
-                    BaseType::Primitive(p) => {
-                        (p.rust().to_owned(), p.literal(&c.value).map_err(|m| err(0, format!("{context}.{}: {m}", c.name)))?)
-                    }
+                    BaseType::Primitive(p) => (
+                        p.rust().to_owned(),
+                        p.literal(&c.value)
+                            .map_err(|m| err(0, format!("{context}.{}: {m}", c.name)))?,
+                    ),
                     BaseType::String { .. } => ("&'static str".to_owned(), format!("{:?}", c.value)),
                     BaseType::Message { .. } => {
                         return Err(err(0, format!("{context}.{}: constants must be primitive", c.name)))

@@ -13,7 +13,10 @@ use mobil_msgs::RosMessage;
 use serde::{de::DeserializeOwned, Serialize};
 
 fn hex(s: &str) -> Vec<u8> {
-    (0..s.len()).step_by(2).map(|i| u8::from_str_radix(&s[i..i + 2], 16).unwrap()).collect()
+    (0..s.len())
+        .step_by(2)
+        .map(|i| u8::from_str_radix(&s[i..i + 2], 16).unwrap())
+        .collect()
 }
 
 /// Decodes rclpy's bytes, checks every byte was consumed, and that our encoding has the same size.
@@ -21,7 +24,12 @@ fn decode<T: Serialize + DeserializeOwned + RosMessage>(body_hex: &str) -> T {
     let bytes = hex(body_hex);
     let (msg, used): (T, usize) = cdr_encoding::from_bytes::<T, LittleEndian>(&bytes).unwrap();
     // Fast DDS pads the body (to a multiple of 8 here); everything before that padding is the message.
-    assert!(bytes.len() - used < 8, "{}: decoded {used} of {} bytes", T::NAME, bytes.len());
+    assert!(
+        bytes.len() - used < 8,
+        "{}: decoded {used} of {} bytes",
+        T::NAME,
+        bytes.len()
+    );
     let ours = cdr_encoding::to_vec::<T, LittleEndian>(&msg).unwrap();
     assert_eq!(ours.len(), used, "{}: re-encoded length", T::NAME);
     let (again, _): (T, usize) = cdr_encoding::from_bytes::<T, LittleEndian>(&ours).unwrap();
@@ -31,9 +39,8 @@ fn decode<T: Serialize + DeserializeOwned + RosMessage>(body_hex: &str) -> T {
 
 #[test]
 fn twist_from_rclpy() {
-    let t: Twist = decode(concat!(
-        "000000000000e03f0000000000000000000000000000000000000000000000000000000000000000000000000000d0bf"
-    ));
+    let t: Twist =
+        decode("000000000000e03f0000000000000000000000000000000000000000000000000000000000000000000000000000d0bf");
     assert_eq!((t.linear.x, t.linear.y, t.angular.z), (0.5, 0.0, -0.25));
 }
 
@@ -84,7 +91,10 @@ fn laser_scan_with_inf_from_rclpy() {
         "030000000000803f0000807f0000204000000000"
     ));
     assert_eq!(s.header.frame_id, "laser");
-    assert_eq!((s.angle_min, s.angle_max, s.angle_increment, s.range_max), (-1.0, 1.0, 0.5, 10.0));
+    assert_eq!(
+        (s.angle_min, s.angle_max, s.angle_increment, s.range_max),
+        (-1.0, 1.0, 0.5, 10.0)
+    );
     assert_eq!(s.ranges[0], 1.0);
     assert!(s.ranges[1].is_infinite());
     assert_eq!(s.ranges[2], 2.5);

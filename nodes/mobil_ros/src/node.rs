@@ -1,0 +1,420 @@
+//! A ROS 2 node as every executable of the suite runs it: command line, parameters, names,
+//! DDS domain, spinner (parameter services, graph, `/clock`) and clean shutdown.
+//!
+//! ```no_run
+//! # async fn demo() -> anyhow::Result<()> {
+//! use mobil_ros::{NodeDecl, ParamSpec, RosNode, qos};
+//! use mobil_msgs::geometry_msgs::msg::Twist;
+//! let decl = NodeDecl::new("teleop", "Publishes a constant twist")
+//!     .param(ParamSpec::double("speed", 0.2, "forward speed [m/s]").above(0.0));
+//! let Some(args) = decl.parse_command_line(std::env::args())? else { return Ok(()) };
+//! let mut node = RosNode::start(&decl, &args)?;
+//! let cmd = node.publisher::<Twist>("cmd_vel", &qos::default_qos())?;
+//! let mut t = Twist::default();
+//! t.linear.x = node.params().f64("speed").map_err(anyhow::Error::msg)?;
+//! cmd.publish(t)?;
+//! node.shutdown().await;
+//! # Ok(()) }
+//! ```
+
+use crate::args::{split_ros_args, RosArgs, ROS_ARGS_HELP};
+use crate::names::NameResolver;
+use crate::params::{initial_params, type_name, ParamSpec, ParamValues};
+use anyhow::{anyhow, bail, Context as _};
+use mobil_msgs::builtin_interfaces::msg::Time;
+use mobil_msgs::{RosMessage, RosService};
+use ros2_client::{
+    Context, ContextOptions, Name, Node, NodeName, NodeOptions, ParameterValue, Publisher, QosProfile, Server,
+    ServiceMapping, Subscription,
+};
+use std::fmt::Write as _;
+use std::sync::{Arc, Mutex, PoisonError};
+use std::time::Duration;
+use tokio::sync::mpsc;
+use tracing::{info, warn};
+
+/// A cross-parameter check: typically the node's configuration parser, run on the full set of
+/// candidate values before any change is accepted.
+pub type ConfigCheck = Arc<dyn Fn(&ParamValues) -> Result<(), String> + Send + Sync>;
+
+/// What a node is: its default name, what it does, and its parameters.
+#[derive(Clone)]
+pub struct NodeDecl {
+    pub default_name: String,
+    pub about: String,
+    pub params: Vec<ParamSpec>,
+    pub check: ConfigCheck,
+}
+
+impl NodeDecl {
+    /// A node with no parameters yet.
+    pub fn new(default_name: &str, about: &str) -> Self {
+        NodeDecl {
+            default_name: default_name.to_owned(),
+            about: about.to_owned(),
+            params: Vec::new(),
+            check: Arc::new(|_| Ok(())),
+        }
+    }
+
+    /// Declares a parameter.
+    pub fn param(mut self, spec: ParamSpec) -> Self {
+        self.params.push(spec);
+        self
+    }
+
+    /// Declares several parameters.
+    pub fn params(mut self, specs: impl IntoIterator<Item = ParamSpec>) -> Self {
+        self.params.extend(specs);
+        self
+    }
+
+    /// Sets the cross-parameter check.
+    pub fn check(mut self, check: impl Fn(&ParamValues) -> Result<(), String> + Send + Sync + 'static) -> Self {
+        self.check = Arc::new(check);
+        self
+    }
+
+    /// The parameter table for `--help`.
+    pub fn params_help(&self) -> String {
+        let mut s = String::from("Parameters (set with -p NAME:=VALUE or a --params-file):\n");
+        for p in &self.params {
+            let default = match &p.default {
+                ParameterValue::String(v) => format!("\"{v}\""),
+                ParameterValue::Double(v) => format!("{v}"),
+                ParameterValue::Integer(v) => format!("{v}"),
+                ParameterValue::Boolean(v) => format!("{v}"),
+                ParameterValue::DoubleArray(v) => format!("{v:?}"),
+                other => format!("{other:?}"),
+            };
+            let ro = if p.read_only { " (read-only)" } else { "" };
+            let _ = writeln!(
+                s,
+                "  {:<28} {:<10} {}{ro} [default {default}]",
+                p.name,
+                type_name(&p.default),
+                p.description
+            );
+        }
+        s
+    }
+
+    /// Parses the process arguments. `Ok(None)` means `--help`/`--version` was answered and the
+    /// program should exit successfully.
+    pub fn parse_command_line<I, S>(&self, argv: I) -> anyhow::Result<Option<RosArgs>>
+    where
+        I: IntoIterator<Item = S>,
+        S: Into<String>,
+    {
+        let mut argv = argv.into_iter().map(Into::into);
+        let program = argv
+            .next()
+            .and_then(|p| {
+                std::path::Path::new(&p)
+                    .file_name()
+                    .map(|f| f.to_string_lossy().into_owned())
+            })
+            .unwrap_or_else(|| self.default_name.clone());
+        let (own, ros) = split_ros_args(argv)?;
+        let command = clap::Command::new(program)
+            .about(self.about.clone())
+            .version(env!("CARGO_PKG_VERSION"))
+            .after_help(format!("{}\n{}", self.params_help(), ROS_ARGS_HELP));
+        match command.try_get_matches_from(std::iter::once(String::from("node")).chain(own)) {
+            Ok(_) => Ok(Some(ros)),
+            Err(e)
+                if matches!(
+                    e.kind(),
+                    clap::error::ErrorKind::DisplayHelp | clap::error::ErrorKind::DisplayVersion
+                ) =>
+            {
+                print!("{e}");
+                Ok(None)
+            }
+            Err(e) => Err(anyhow!("{e}")),
+        }
+    }
+}
+
+/// The DDS domain from `ROS_DOMAIN_ID` (default 0), which ros2-client does not read by itself.
+pub fn domain_id_from_env() -> anyhow::Result<u16> {
+    match std::env::var("ROS_DOMAIN_ID") {
+        Err(_) => Ok(0),
+        Ok(s) if s.trim().is_empty() => Ok(0),
+        Ok(s) => {
+            let id: u16 = s
+                .trim()
+                .parse()
+                .with_context(|| format!("ROS_DOMAIN_ID=`{s}` is not a number"))?;
+            if id > 232 {
+                bail!("ROS_DOMAIN_ID={id} is out of range (0..=232)");
+            }
+            Ok(id)
+        }
+    }
+}
+
+/// A running node.
+pub struct RosNode {
+    // Field order is drop order: the node before its context, so the participant leaves last.
+    node: Node,
+    context: Context,
+    names: NameResolver,
+    params: Arc<Mutex<ParamValues>>,
+    changes: mpsc::UnboundedReceiver<ParamValues>,
+    spinner: Option<tokio::task::JoinHandle<()>>,
+}
+
+fn lock(values: &Mutex<ParamValues>) -> std::sync::MutexGuard<'_, ParamValues> {
+    values.lock().unwrap_or_else(PoisonError::into_inner)
+}
+
+impl RosNode {
+    /// Starts the node: resolves name and parameters, joins the DDS domain and spawns the
+    /// spinner on the current tokio runtime. Invalid parameters stop it here, with the reason.
+    pub fn start(decl: &NodeDecl, args: &RosArgs) -> anyhow::Result<RosNode> {
+        let node_name = args.node_name.clone().unwrap_or_else(|| decl.default_name.clone());
+        let names = NameResolver::new(args.namespace.as_deref().unwrap_or("/"), &node_name, &args.remaps)?;
+        let fqn = names.fully_qualified_node();
+
+        let mut files = Vec::new();
+        for path in &args.params_files {
+            let text = std::fs::read_to_string(path).with_context(|| format!("cannot read parameter file {path}"))?;
+            files.push((path.clone(), text));
+        }
+        let initial = initial_params(&decl.params, &files, &args.params, &fqn, &node_name)?;
+        for w in &initial.warnings {
+            warn!("{w}");
+        }
+        (decl.check)(&initial.values).map_err(|e| anyhow!("parameters of {fqn} are inconsistent: {e}"))?;
+
+        let params = Arc::new(Mutex::new(initial.values.clone()));
+        let (change_tx, changes) = mpsc::unbounded_channel();
+        let mut options = NodeOptions::new().enable_rosout(true).start_parameter_services(true);
+        for (name, value) in initial.values.iter() {
+            options = options.declare_parameter(name, value.clone());
+        }
+        if initial.use_sim_time {
+            options = options.declare_parameter("use_sim_time", ParameterValue::Boolean(true));
+        }
+        let specs = decl.params.clone();
+        let check = decl.check.clone();
+        let validator_values = params.clone();
+        options = options.parameter_validator(Box::new(move |name, value| {
+            let Some(spec) = specs.iter().find(|s| s.name == name) else {
+                return Err(format!("`{name}` is not a parameter of this node"));
+            };
+            if matches!(value, ParameterValue::NotSet) {
+                return Err(format!("`{name}` cannot be unset"));
+            }
+            let value = spec.check(value).map_err(|e| format!("`{name}`: {e}"))?;
+            let mut candidate = lock(&validator_values).clone();
+            if spec.read_only && candidate.get(name) != Some(&value) {
+                return Err(format!("`{name}` is read-only; restart the node to change it"));
+            }
+            candidate.set(name, value);
+            check(&candidate)
+        }));
+        let action_values = params.clone();
+        options = options.parameter_set_action(Box::new(move |name, value| {
+            let mut values = lock(&action_values);
+            if values.get(name) != Some(value) {
+                values.set(name, value.clone());
+                info!("parameter {name} = {value:?}");
+                // The receiver only disappears while the node shuts down.
+                let _ = change_tx.send(values.clone());
+            }
+            Ok(())
+        }));
+
+        let domain = domain_id_from_env()?;
+        let context = Context::with_options(ContextOptions::new().domain_id(domain))
+            .map_err(|e| anyhow!("cannot join DDS domain {domain}: {e:?}"))?;
+        let ns = names.namespace().to_owned();
+        let mut node = context
+            .new_node(
+                NodeName::new(&ns, &node_name).map_err(|e| anyhow!("bad node name {ns}/{node_name}: {e:?}"))?,
+                options,
+            )
+            .map_err(|e| anyhow!("cannot create node {fqn}: {e:?}"))?;
+        let spinner = node.spinner().map_err(|e| anyhow!("cannot start the spinner: {e:?}"))?;
+        let handle = tokio::spawn(async move {
+            if let Err(e) = spinner.spin().await {
+                warn!("spinner stopped: {e:?}");
+            }
+        });
+        info!("{fqn} up on ROS_DOMAIN_ID {domain}");
+        Ok(RosNode {
+            node,
+            context,
+            names,
+            params,
+            changes,
+            spinner: Some(handle),
+        })
+    }
+
+    /// The name resolver (namespace, node name, remaps).
+    pub fn names(&self) -> &NameResolver {
+        &self.names
+    }
+
+    /// The underlying ros2-client node.
+    pub fn inner(&mut self) -> &mut Node {
+        &mut self.node
+    }
+
+    /// The current parameter values.
+    pub fn params(&self) -> ParamValues {
+        lock(&self.params).clone()
+    }
+
+    /// Waits for the next accepted parameter change; yields the full new set of values.
+    pub async fn param_changed(&mut self) -> Option<ParamValues> {
+        self.changes.recv().await
+    }
+
+    fn topic_name(&self, topic: &str) -> anyhow::Result<Name> {
+        let full = self.names.resolve(topic)?;
+        Name::parse(&full).map_err(|e| anyhow!("bad topic name {full}: {e:?}"))
+    }
+
+    /// A publisher on `topic` (resolved and remapped).
+    pub fn publisher<M: RosMessage>(&mut self, topic: &str, qos: &QosProfile) -> anyhow::Result<Publisher<M>> {
+        let name = self.topic_name(topic)?;
+        let t = self
+            .node
+            .create_topic(&name, M::type_name(), qos)
+            .map_err(|e| anyhow!("cannot create topic {name}: {e:?}"))?;
+        self.node
+            .create_publisher(&t, Some(qos.clone()))
+            .map_err(|e| anyhow!("cannot publish {name}: {e:?}"))
+    }
+
+    /// A subscription to `topic` (resolved and remapped).
+    pub fn subscription<M: RosMessage>(&mut self, topic: &str, qos: &QosProfile) -> anyhow::Result<Subscription<M>> {
+        let name = self.topic_name(topic)?;
+        let t = self
+            .node
+            .create_topic(&name, M::type_name(), qos)
+            .map_err(|e| anyhow!("cannot create topic {name}: {e:?}"))?;
+        self.node
+            .create_subscription(&t, Some(qos.clone()))
+            .map_err(|e| anyhow!("cannot subscribe {name}: {e:?}"))
+    }
+
+    /// A service server on `service` (resolved and remapped), rclpy/rclcpp compatible.
+    pub fn service<S: RosService>(&mut self, service: &str) -> anyhow::Result<Server<S::Request, S::Response>> {
+        let name = self.topic_name(service)?;
+        let qos = crate::qos::reliable(10);
+        self.node
+            .create_server(ServiceMapping::Enhanced, &name, &S::type_name(), qos.clone(), qos)
+            .map_err(|e| anyhow!("cannot serve {name}: {e:?}"))
+    }
+
+    /// Nanoseconds of the node's clock (`/clock` when `use_sim_time` is true).
+    pub fn now_nanos(&self) -> i64 {
+        self.node.time_now().to_nanos()
+    }
+
+    /// The node's clock as a message stamp.
+    pub fn stamp(&self) -> Time {
+        crate::time::stamp_from_nanos(self.now_nanos())
+    }
+
+    /// The DDS domain the node is on.
+    pub fn domain_id(&self) -> u16 {
+        self.context.domain_id()
+    }
+
+    /// Stops the spinner and leaves the DDS domain (the participant announces its departure).
+    pub async fn shutdown(mut self) {
+        self.node.stop_spinner();
+        if let Some(handle) = self.spinner.take() {
+            if tokio::time::timeout(Duration::from_secs(2), handle).await.is_err() {
+                warn!("spinner did not stop within 2 s");
+            }
+        }
+        info!("{} shut down", self.names.fully_qualified_node());
+    }
+}
+
+/// Resolves when SIGINT (Ctrl-C) or SIGTERM arrives.
+pub async fn shutdown_signal() {
+    #[cfg(unix)]
+    {
+        use tokio::signal::unix::{signal, SignalKind};
+        match (signal(SignalKind::interrupt()), signal(SignalKind::terminate())) {
+            (Ok(mut int), Ok(mut term)) => {
+                tokio::select! {
+                    _ = int.recv() => info!("SIGINT: shutting down"),
+                    _ = term.recv() => info!("SIGTERM: shutting down"),
+                }
+            }
+            _ => {
+                let _ = tokio::signal::ctrl_c().await;
+            }
+        }
+    }
+    #[cfg(not(unix))]
+    {
+        let _ = tokio::signal::ctrl_c().await;
+    }
+}
+
+/// Process set-up shared by every executable: quiets ros2-client's warning about an unset
+/// `ROS_DISTRO` (this build speaks Jazzy) and installs logging.
+pub fn init_process(args: &RosArgs) {
+    if std::env::var_os("ROS_DISTRO").is_none() {
+        // Safe: called at the top of main, before any other thread exists.
+        std::env::set_var("ROS_DISTRO", "jazzy");
+    }
+    crate::log::init(args.log_level.as_deref());
+}
+
+/// The future a node's body returns.
+pub type NodeBody<'a> = std::pin::Pin<Box<dyn std::future::Future<Output = anyhow::Result<()>> + 'a>>;
+
+/// Runs an executable: command line (`--help` answered), logging, a tokio runtime, the node,
+/// the body (which returns when a shutdown signal arrives or it fails), then a clean shutdown.
+/// Returns the process exit code: 0, or 1 with the error logged.
+pub fn run_node<F>(decl: &NodeDecl, body: F) -> std::process::ExitCode
+where
+    F: for<'a> FnOnce(&'a mut RosNode) -> NodeBody<'a>,
+{
+    let args = match decl.parse_command_line(std::env::args()) {
+        Ok(Some(args)) => args,
+        Ok(None) => return std::process::ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("{}: {e:#}", decl.default_name);
+            return std::process::ExitCode::from(2);
+        }
+    };
+    init_process(&args);
+    let runtime = match tokio::runtime::Builder::new_multi_thread()
+        .worker_threads(2)
+        .enable_all()
+        .build()
+    {
+        Ok(rt) => rt,
+        Err(e) => {
+            tracing::error!("cannot start the async runtime: {e}");
+            return std::process::ExitCode::FAILURE;
+        }
+    };
+    let result = runtime.block_on(async {
+        let mut node = RosNode::start(decl, &args)?;
+        let result = body(&mut node).await;
+        node.shutdown().await;
+        result
+    });
+    // Give DDS background threads a bounded time to wind down, then leave.
+    runtime.shutdown_timeout(Duration::from_secs(2));
+    match result {
+        Ok(()) => std::process::ExitCode::SUCCESS,
+        Err(e) => {
+            tracing::error!("{e:#}");
+            std::process::ExitCode::FAILURE
+        }
+    }
+}
