@@ -1,0 +1,370 @@
+//! `chassis_node`: the LOW-LEVEL of the suite (SPEC §1). `cmd_vel` → limits → inverse kinematics
+//! → `wheel_commands`; `joint_states` → forward kinematics → exact arc odometry → `odom` + `tf`;
+//! a cmd_vel watchdog and a feedback watchdog; `~/status` reports both and every clamp.
+
+use futures::StreamExt;
+use mobil_chassis::controller::{ChassisController, Command, ControllerConfig, Safety};
+use mobil_chassis::joints::{joints_from_wheel_state, wheel_state_from_joints};
+use mobil_chassis::kinematics::BodyTwist;
+use mobil_chassis::model::ChassisModel;
+use mobil_chassis::odometry::OdometryNoise;
+use mobil_chassis::ros_params::{chassis_from_params, chassis_param_specs};
+use mobil_msgs::geometry_msgs::msg::{Quaternion, Transform, TransformStamped, Twist, Vector3};
+use mobil_msgs::mobil_msgs::msg::ChassisStatus;
+use mobil_msgs::nav_msgs::msg::Odometry;
+use mobil_msgs::sensor_msgs::msg::JointState;
+use mobil_msgs::std_msgs::msg::Header;
+use mobil_msgs::tf2_msgs::msg::TFMessage;
+use mobil_ros::params::ParamValues;
+use mobil_ros::time::{is_zero, secs_from_stamp, stamp_from_secs};
+use mobil_ros::{qos, run_node, shutdown_signal, warn_throttled, LogThrottle, NodeDecl, ParamSpec, RosNode};
+use std::process::ExitCode;
+use std::time::Duration;
+use tracing::{info, warn};
+
+/// Everything the node is configured with, parsed from its parameters in one place (used both at
+/// start-up and to vet every parameter change).
+#[derive(Debug, Clone, PartialEq)]
+struct NodeConfig {
+    controller: ControllerConfig,
+    control_rate_hz: f64,
+    odom_frame: String,
+    base_frame: String,
+    publish_tf: bool,
+}
+
+fn decl() -> NodeDecl {
+    let noise = OdometryNoise::default();
+    NodeDecl::new(
+        "chassis",
+        "LOW-LEVEL chassis control: kinematics, command limits, odometry, cmd_vel watchdog",
+    )
+    .params(chassis_param_specs())
+    .param(
+        ParamSpec::double(
+            "cmd_vel_timeout_s",
+            0.5,
+            "zero command after this long without cmd_vel (0: off)",
+        )
+        .min(0.0),
+    )
+    .param(
+        ParamSpec::double(
+            "feedback_timeout_s",
+            0.5,
+            "zero command after this long without joint_states (0: off)",
+        )
+        .min(0.0),
+    )
+    .param(ParamSpec::double("control_rate_hz", 50.0, "wheel_commands and status rate").within(1.0, 1000.0))
+    .param(ParamSpec::string("odom_frame", "odom", "odometry frame"))
+    .param(ParamSpec::string(
+        "base_frame",
+        "base_link",
+        "robot frame (at the reference point)",
+    ))
+    .param(ParamSpec::boolean("publish_tf", true, "publish odom → base_link on tf"))
+    .param(ParamSpec::double("odom.along_track_var_per_m", noise.along_track_var_per_m, "[m²/m]").min(0.0))
+    .param(ParamSpec::double("odom.cross_track_var_per_m", noise.cross_track_var_per_m, "[m²/m]").min(0.0))
+    .param(ParamSpec::double("odom.heading_var_per_rad", noise.heading_var_per_rad, "[rad²/rad]").min(0.0))
+    .param(ParamSpec::double("odom.heading_var_per_m", noise.heading_var_per_m, "[rad²/m]").min(0.0))
+    .param(ParamSpec::doubles("odom.twist_variance", &noise.twist_variance, "vx, vy, ω variances").length(3))
+    .check(|p| node_config(p).map(|_| ()))
+}
+
+fn node_config(p: &ParamValues) -> Result<NodeConfig, String> {
+    let tv = p.f64s("odom.twist_variance")?;
+    let noise = OdometryNoise {
+        along_track_var_per_m: p.f64("odom.along_track_var_per_m")?,
+        cross_track_var_per_m: p.f64("odom.cross_track_var_per_m")?,
+        heading_var_per_rad: p.f64("odom.heading_var_per_rad")?,
+        heading_var_per_m: p.f64("odom.heading_var_per_m")?,
+        twist_variance: [tv[0], tv[1], tv[2]],
+    };
+    noise.validate().map_err(|e| e.to_string())?;
+    Ok(NodeConfig {
+        controller: ControllerConfig {
+            params: chassis_from_params(p)?,
+            cmd_vel_timeout_s: p.f64("cmd_vel_timeout_s")?,
+            feedback_timeout_s: p.f64("feedback_timeout_s")?,
+            noise,
+        },
+        control_rate_hz: p.f64("control_rate_hz")?,
+        odom_frame: p.string("odom_frame")?,
+        base_frame: p.string("base_frame")?,
+        publish_tf: p.bool("publish_tf")?,
+    })
+}
+
+fn main() -> ExitCode {
+    run_node(&decl(), |node| Box::pin(run(node)))
+}
+
+fn yaw_quaternion(yaw: f64) -> Quaternion {
+    Quaternion {
+        x: 0.0,
+        y: 0.0,
+        z: (0.5 * yaw).sin(),
+        w: (0.5 * yaw).cos(),
+    }
+}
+
+/// Places a 3×3 (x, y, yaw) covariance into a 6×6 (x, y, z, roll, pitch, yaw) row-major one; the
+/// planar robot's z, roll and pitch are known, with a tiny variance.
+fn covariance_6x6(c: &nalgebra::Matrix3<f64>) -> [f64; 36] {
+    let mut out = [0.0; 36];
+    let idx = [0usize, 1, 5];
+    for (i, &r) in idx.iter().enumerate() {
+        for (j, &k) in idx.iter().enumerate() {
+            out[r * 6 + k] = c[(i, j)];
+        }
+    }
+    for d in [2usize, 3, 4] {
+        out[d * 6 + d] = 1e-9;
+    }
+    out
+}
+
+fn model_code(m: ChassisModel) -> u8 {
+    match m {
+        ChassisModel::Tricycle => ChassisStatus::MODEL_TRICYCLE,
+        ChassisModel::CarLike => ChassisStatus::MODEL_CAR_LIKE,
+        ChassisModel::Omni => ChassisStatus::MODEL_OMNI,
+    }
+}
+
+async fn run(node: &mut RosNode) -> anyhow::Result<()> {
+    let mut config = node_config(&node.params()).map_err(anyhow::Error::msg)?;
+    let mut controller = ChassisController::new(config.controller)?;
+    info!(
+        "model {}, effective steering limit {:.1}°, v_max {} m/s, watchdog {} s",
+        config.controller.params.model().as_str(),
+        config.controller.params.effective_steering_limit().to_degrees(),
+        config.controller.params.v_max(),
+        config.controller.cmd_vel_timeout_s
+    );
+
+    let q = qos::default_qos();
+    let cmd_sub = node.subscription::<Twist>("cmd_vel", &q)?;
+    let joints_sub = node.subscription::<JointState>("joint_states", &q)?;
+    let wheel_pub = node.publisher::<JointState>("wheel_commands", &q)?;
+    let odom_pub = node.publisher::<Odometry>("odom", &q)?;
+    let tf_pub = node.publisher::<TFMessage>("tf", &qos::reliable(100))?;
+    let status_pub = node.publisher::<ChassisStatus>("~/status", &q)?;
+
+    let cmds = cmd_sub.async_stream();
+    let joints = joints_sub.async_stream();
+    let shutdown = shutdown_signal();
+    let mut tick = tokio::time::interval(Duration::from_secs_f64(1.0 / config.control_rate_hz));
+    tick.set_missed_tick_behavior(tokio::time::MissedTickBehavior::Delay);
+    tokio::pin!(cmds, joints, shutdown);
+
+    let mut throttle = LogThrottle::default();
+    let mut rejected: u64 = 0;
+    let mut last_safety = Safety {
+        cmd_vel_expired: true,
+        feedback_stale: true,
+    };
+    let now_s = |node: &RosNode| node.now_nanos() as f64 * 1e-9;
+
+    loop {
+        tokio::select! {
+            _ = &mut shutdown => break,
+            Some(changed) = node.param_changed() => {
+                match node_config(&changed) {
+                    Ok(new) => {
+                        if let Err(e) = controller.reconfigure(new.controller) {
+                            warn!("parameter change not applied: {e}");
+                        } else {
+                            if new.control_rate_hz != config.control_rate_hz {
+                                tick = tokio::time::interval(Duration::from_secs_f64(1.0 / new.control_rate_hz));
+                            }
+                            config = new;
+                        }
+                    }
+                    // The validator vetted the change, so this only happens if it raced another.
+                    Err(e) => warn!("parameter change not applied: {e}"),
+                }
+            }
+            Some(msg) = cmds.next() => match msg {
+                Ok((twist, _)) => {
+                    let request = BodyTwist::new(twist.linear.x, twist.linear.y, twist.angular.z);
+                    let cmd = controller.on_cmd_vel(request, now_s(node));
+                    if !request.is_finite() {
+                        rejected += 1;
+                        warn_throttled!(throttle, "cmd_nan", "cmd_vel with NaN/inf ({:?}): wheels stopped", request);
+                    } else if !cmd.reasons.is_empty() {
+                        warn_throttled!(throttle, "clamp", "cmd_vel {:?} clamped to {:?}: {}", request, cmd.twist, cmd.reasons);
+                    }
+                    publish_wheels(&wheel_pub, node, &cmd);
+                }
+                Err(e) => {
+                    rejected += 1;
+                    warn_throttled!(throttle, "cmd_decode", "undecodable cmd_vel dropped: {e:?}");
+                }
+            },
+            Some(msg) = joints.next() => match msg {
+                Ok((js, _)) => {
+                    let now = now_s(node);
+                    let model = config.controller.params.model();
+                    let parsed = wheel_state_from_joints(model, &js.name, &js.position, &js.velocity);
+                    let stamp = if is_zero(&js.header.stamp) { Some(now) } else { secs_from_stamp(&js.header.stamp) };
+                    match (parsed, stamp) {
+                        (Ok(wheels), Some(stamp)) => match controller.on_feedback(&wheels, stamp, now) {
+                            Ok(()) => {
+                                publish_odometry(&odom_pub, &tf_pub, &config, &controller, &js.header);
+                            }
+                            Err(e) => {
+                                rejected += 1;
+                                warn_throttled!(throttle, "feedback", "joint_states dropped: {e}");
+                            }
+                        },
+                        (Err(e), _) => {
+                            rejected += 1;
+                            warn_throttled!(throttle, "joints", "joint_states dropped: {e}");
+                        }
+                        (_, None) => {
+                            rejected += 1;
+                            warn_throttled!(throttle, "stamp", "joint_states dropped: invalid stamp {:?}", js.header.stamp);
+                        }
+                    }
+                }
+                Err(e) => {
+                    rejected += 1;
+                    warn_throttled!(throttle, "joints_decode", "undecodable joint_states dropped: {e:?}");
+                }
+            },
+            _ = tick.tick() => {
+                let now = now_s(node);
+                let (cmd, safety) = controller.on_tick(now);
+                if safety != last_safety {
+                    if safety.cmd_vel_expired && !last_safety.cmd_vel_expired {
+                        warn!("no cmd_vel for {} s: wheels stopped", config.controller.cmd_vel_timeout_s);
+                    }
+                    if safety.feedback_stale && !last_safety.feedback_stale {
+                        warn!("no valid joint_states for {} s: odometry stale, wheels stopped", config.controller.feedback_timeout_s);
+                    }
+                    last_safety = safety;
+                }
+                publish_wheels(&wheel_pub, node, &cmd);
+                let status = ChassisStatus {
+                    header: Header { stamp: node.stamp(), frame_id: config.base_frame.clone() },
+                    model: model_code(config.controller.params.model()),
+                    watchdog_expired: safety.cmd_vel_expired,
+                    feedback_stale: safety.feedback_stale,
+                    clamped: cmd.reasons.bits(),
+                    commanded: Twist {
+                        linear: Vector3 { x: cmd.twist.vx, y: cmd.twist.vy, z: 0.0 },
+                        angular: Vector3 { x: 0.0, y: 0.0, z: cmd.twist.wz },
+                    },
+                    rejected_messages: rejected,
+                };
+                let _ = status_pub.publish(status);
+            }
+        }
+    }
+    // Leave the wheels stopped.
+    let stop = controller.on_cmd_vel(BodyTwist::ZERO, now_s(node));
+    publish_wheels(&wheel_pub, node, &stop);
+    Ok(())
+}
+
+fn publish_wheels(publisher: &ros2_client::Publisher<JointState>, node: &RosNode, cmd: &Command) {
+    let (name, position, velocity) = joints_from_wheel_state(&cmd.wheels);
+    let msg = JointState {
+        header: Header {
+            stamp: node.stamp(),
+            frame_id: String::new(),
+        },
+        name,
+        position,
+        velocity,
+        effort: Vec::new(),
+    };
+    if let Err(e) = publisher.publish(msg) {
+        warn!("cannot publish wheel_commands: {e:?}");
+    }
+}
+
+fn publish_odometry(
+    odom_pub: &ros2_client::Publisher<Odometry>,
+    tf_pub: &ros2_client::Publisher<TFMessage>,
+    config: &NodeConfig,
+    controller: &ChassisController,
+    feedback_header: &Header,
+) {
+    let odo = controller.odometry();
+    let pose = odo.reference_pose();
+    let twist = odo.reference_twist();
+    let stamp = match odo.last_stamp() {
+        Some(t) => stamp_from_secs(t),
+        None => feedback_header.stamp.clone(),
+    };
+    let header = Header {
+        stamp,
+        frame_id: config.odom_frame.clone(),
+    };
+    let mut msg = Odometry {
+        header: header.clone(),
+        child_frame_id: config.base_frame.clone(),
+        ..Default::default()
+    };
+    msg.pose.pose.position.x = pose.x;
+    msg.pose.pose.position.y = pose.y;
+    msg.pose.pose.orientation = yaw_quaternion(pose.z);
+    msg.pose.covariance = covariance_6x6(&odo.reference_covariance());
+    msg.twist.twist.linear.x = twist.vx;
+    msg.twist.twist.linear.y = twist.vy;
+    msg.twist.twist.angular.z = twist.wz;
+    msg.twist.covariance = covariance_6x6(&odo.reference_twist_covariance());
+    if let Err(e) = odom_pub.publish(msg) {
+        warn!("cannot publish odom: {e:?}");
+    }
+    if config.publish_tf {
+        let tf = TransformStamped {
+            header,
+            child_frame_id: config.base_frame.clone(),
+            transform: Transform {
+                translation: Vector3 {
+                    x: pose.x,
+                    y: pose.y,
+                    z: 0.0,
+                },
+                rotation: yaw_quaternion(pose.z),
+            },
+        };
+        if let Err(e) = tf_pub.publish(TFMessage { transforms: vec![tf] }) {
+            warn!("cannot publish tf: {e:?}");
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn mobil2_params_file_configures_this_node() {
+        let text = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/../../params/mobil2.yaml")).unwrap();
+        let d = decl();
+        let p =
+            mobil_ros::params::initial_params(&d.params, &[("mobil2.yaml".into(), text)], &[], "/chassis", "chassis")
+                .unwrap();
+        assert!(p.warnings.is_empty(), "{:?}", p.warnings);
+        let c = node_config(&p.values).unwrap();
+        assert_eq!(c.controller.params.model(), ChassisModel::CarLike);
+        // SPEC §1 Decision: δ_eff = atan(0.60 / 0.73) = 39.42°.
+        assert!((c.controller.params.effective_steering_limit().to_degrees() - 39.42).abs() < 0.01);
+        assert_eq!(c.controller.params.reference_offset(), 0.30);
+    }
+
+    #[test]
+    fn covariance_lands_on_x_y_yaw() {
+        let c = nalgebra::Matrix3::new(1.0, 2.0, 3.0, 2.0, 4.0, 5.0, 3.0, 5.0, 6.0);
+        let m = covariance_6x6(&c);
+        assert_eq!(
+            (m[0], m[1], m[5], m[7], m[11], m[35], m[30]),
+            (1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 3.0)
+        );
+    }
+}

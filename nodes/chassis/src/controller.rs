@@ -1,0 +1,311 @@
+//! The LOW-LEVEL chassis controller, ROS-free: commands in, wheel commands out; wheel feedback
+//! in, odometry out; watchdogs on both streams. Time is always an input (seconds on the node's
+//! clock for commands, message stamps for feedback), so tests and replays are deterministic.
+//!
+//! Command path: a body twist at the reference point (`cmd_vel` in `base_link`) → the twist at
+//! the kinematic origin → [`clamp_command`] → [`inverse`] kinematics → wheel commands. A
+//! non-holonomic chassis takes `linear.x` and `angular.z`; the sideways velocity its reference
+//! point has when turning (ω·d) is implied, and any *requested* `linear.y` is dropped (logged as
+//! lateral). The wheels are commanded to zero when no valid `cmd_vel` arrived within
+//! `cmd_vel_timeout_s`, and when wheel feedback is stale (no valid `joint_states` within
+//! `feedback_timeout_s`): a robot is never left moving on stale data.
+
+use crate::error::{ChassisError, OdometryError};
+use crate::kinematics::{forward, inverse, pre_steer, twist_at_origin, twist_at_reference, BodyTwist, WheelState};
+use crate::limits::{clamp_command, ClampReason, ClampReasons};
+use crate::model::ChassisParams;
+use crate::odometry::{Odometry, OdometryNoise};
+use crate::watchdog::CmdVelWatchdog;
+
+/// Settings of the controller beyond the chassis geometry.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ControllerConfig {
+    /// Geometry and limits.
+    pub params: ChassisParams,
+    /// Zero command after this long without a valid `cmd_vel` [s]; 0 disables.
+    pub cmd_vel_timeout_s: f64,
+    /// Zero command after this long without valid wheel feedback [s]; 0 disables.
+    pub feedback_timeout_s: f64,
+    /// Odometry covariance model.
+    pub noise: OdometryNoise,
+}
+
+/// What to send to the wheels.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Command {
+    /// Joint targets.
+    pub wheels: WheelState,
+    /// The feasible twist at the reference point.
+    pub twist: BodyTwist,
+    /// What the limits changed in the last request.
+    pub reasons: ClampReasons,
+}
+
+impl Command {
+    fn stop(params: &ChassisParams) -> Self {
+        Command {
+            wheels: WheelState::zero(params.model()),
+            twist: BodyTwist::ZERO,
+            reasons: ClampReasons::NONE,
+        }
+    }
+}
+
+/// The state of the two watchdogs at a tick.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Safety {
+    /// No valid `cmd_vel` within the timeout.
+    pub cmd_vel_expired: bool,
+    /// No valid wheel feedback within the timeout.
+    pub feedback_stale: bool,
+}
+
+/// Why a feedback sample was not used.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum FeedbackError {
+    /// The joint values do not fit the chassis.
+    #[error(transparent)]
+    Kinematics(#[from] ChassisError),
+    /// The stamp or twist was refused by the odometry.
+    #[error(transparent)]
+    Odometry(#[from] OdometryError),
+}
+
+/// Command limits, watchdogs and odometry of one chassis.
+#[derive(Debug, Clone)]
+pub struct ChassisController {
+    config: ControllerConfig,
+    cmd_watchdog: CmdVelWatchdog,
+    feedback_watchdog: CmdVelWatchdog,
+    odometry: Odometry,
+    requested: Command,
+}
+
+impl ChassisController {
+    /// A controller at the odometry origin, stopped until the first command.
+    pub fn new(config: ControllerConfig) -> Result<Self, ChassisError> {
+        Ok(ChassisController {
+            cmd_watchdog: CmdVelWatchdog::new(config.cmd_vel_timeout_s)?,
+            feedback_watchdog: CmdVelWatchdog::new(config.feedback_timeout_s)?,
+            odometry: Odometry::new(config.params.reference_offset(), config.noise)?,
+            requested: Command::stop(&config.params),
+            config,
+        })
+    }
+
+    /// Applies new settings (same model), keeping the odometry pose and the watchdogs' history.
+    pub fn reconfigure(&mut self, config: ControllerConfig) -> Result<(), ChassisError> {
+        if config.params.model() != self.config.params.model() {
+            return Err(ChassisError::ModelMismatch {
+                expected: self.config.params.model(),
+                got: config.params.model(),
+            });
+        }
+        let mut cmd = CmdVelWatchdog::new(config.cmd_vel_timeout_s)?;
+        let mut fb = CmdVelWatchdog::new(config.feedback_timeout_s)?;
+        self.odometry.set_reference_offset(config.params.reference_offset())?;
+        self.odometry.set_noise(config.noise)?;
+        if let Some(t) = self.cmd_watchdog.last_feed() {
+            cmd.feed(t);
+        }
+        if let Some(t) = self.feedback_watchdog.last_feed() {
+            fb.feed(t);
+        }
+        self.cmd_watchdog = cmd;
+        self.feedback_watchdog = fb;
+        self.config = config;
+        Ok(())
+    }
+
+    /// The settings in force.
+    pub fn config(&self) -> &ControllerConfig {
+        &self.config
+    }
+
+    /// A `cmd_vel` (twist of the reference point, body frame) received at `now` [s].
+    /// A non-finite request stops the chassis at once and does not feed the watchdog.
+    pub fn on_cmd_vel(&mut self, requested_at_reference: BodyTwist, now: f64) -> Command {
+        let params = &self.config.params;
+        let d = params.reference_offset();
+        let mut lateral = false;
+        let at_origin = if !requested_at_reference.is_finite() {
+            requested_at_reference
+        } else if params.model().is_nonholonomic() {
+            lateral = requested_at_reference.vy.abs() > 1e-9;
+            BodyTwist::new(requested_at_reference.vx, 0.0, requested_at_reference.wz)
+        } else {
+            twist_at_origin(requested_at_reference, d)
+        };
+        let clamped = clamp_command(params, at_origin);
+        let mut reasons = clamped.reasons;
+        if lateral {
+            reasons.insert(ClampReason::Lateral);
+        }
+        let wheels = match clamped.pre_steer {
+            Some(delta) => pre_steer(params, delta),
+            None => inverse(params, clamped.twist),
+        };
+        let twist = if params.model().is_nonholonomic() {
+            // Report what the user commands: speed and turn rate (the implied ω·d is not a request).
+            BodyTwist::new(clamped.twist.vx, 0.0, clamped.twist.wz)
+        } else {
+            twist_at_reference(clamped.twist, d)
+        };
+        self.requested = Command { wheels, twist, reasons };
+        if reasons.contains(ClampReason::NonFinite) {
+            self.cmd_watchdog.reset();
+        } else {
+            self.cmd_watchdog.feed(now);
+        }
+        self.requested
+    }
+
+    /// The command to send at `now` [s] and the watchdogs' state: the last request, or a stop
+    /// when either watchdog has expired.
+    pub fn on_tick(&mut self, now: f64) -> (Command, Safety) {
+        let safety = Safety {
+            cmd_vel_expired: self.cmd_watchdog.expired(now),
+            feedback_stale: self.feedback_watchdog.expired(now),
+        };
+        if safety.cmd_vel_expired || safety.feedback_stale {
+            let mut stop = Command::stop(&self.config.params);
+            stop.reasons = self.requested.reasons;
+            (stop, safety)
+        } else {
+            (self.requested, safety)
+        }
+    }
+
+    /// Wheel feedback measured at `stamp` [s], received at `now` [s] (node clock, for the
+    /// feedback watchdog). Refused samples leave the odometry unchanged.
+    pub fn on_feedback(&mut self, wheels: &WheelState, stamp: f64, now: f64) -> Result<(), FeedbackError> {
+        let twist = forward(&self.config.params, wheels)?;
+        self.odometry.update_at(twist, stamp)?;
+        self.feedback_watchdog.feed(now);
+        Ok(())
+    }
+
+    /// The odometry (pose, twist and covariances; see [`Odometry::reference_pose`]).
+    pub fn odometry(&self) -> &Odometry {
+        &self.odometry
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::model::ChassisConfig;
+    use approx::assert_relative_eq;
+
+    fn controller(config: ChassisConfig) -> ChassisController {
+        ChassisController::new(ControllerConfig {
+            params: ChassisParams::new(config).unwrap(),
+            cmd_vel_timeout_s: 0.5,
+            feedback_timeout_s: 0.5,
+            noise: OdometryNoise::default(),
+        })
+        .unwrap()
+    }
+
+    fn feed_feedback(c: &mut ChassisController, t: f64) {
+        let zero = WheelState::zero(c.config().params.model());
+        c.on_feedback(&zero, t, t).unwrap();
+    }
+
+    #[test]
+    fn watchdog_zeroes_after_timeout_and_nan_stops_at_once() {
+        let mut c = controller(ChassisConfig::omr3());
+        feed_feedback(&mut c, 0.0);
+        let cmd = c.on_cmd_vel(BodyTwist::new(0.3, 0.0, 0.0), 0.0);
+        // Pure body-x translation at 0.3 m/s with r = 0.05: Ω = 6·[1, −½, −½] (SPEC §1).
+        for (got, want) in cmd.wheels.values().iter().zip([6.0, -3.0, -3.0]) {
+            assert_relative_eq!(*got, want, epsilon = 1e-12);
+        }
+        feed_feedback(&mut c, 0.4);
+        assert_eq!(c.on_tick(0.4).0.wheels, cmd.wheels);
+        feed_feedback(&mut c, 0.6);
+        let (stopped, safety) = c.on_tick(0.6);
+        assert!(safety.cmd_vel_expired && !safety.feedback_stale);
+        assert_eq!(stopped.wheels, WheelState::Omni { wheels: [0.0; 3] });
+
+        c.on_cmd_vel(BodyTwist::new(0.3, 0.0, 0.0), 0.7);
+        let nan = c.on_cmd_vel(BodyTwist::new(f64::NAN, 0.0, 0.0), 0.71);
+        assert_eq!(nan.wheels, WheelState::Omni { wheels: [0.0; 3] });
+        assert!(nan.reasons.contains(ClampReason::NonFinite));
+        assert!(
+            c.on_tick(0.72).1.cmd_vel_expired,
+            "a NaN does not keep the watchdog alive"
+        );
+    }
+
+    #[test]
+    fn stale_feedback_stops_the_wheels() {
+        let mut c = controller(ChassisConfig::omr3());
+        feed_feedback(&mut c, 0.0);
+        c.on_cmd_vel(BodyTwist::new(0.3, 0.0, 0.0), 0.55);
+        let (cmd, safety) = c.on_tick(0.55);
+        assert!(safety.feedback_stale && !safety.cmd_vel_expired);
+        assert_eq!(cmd.wheels, WheelState::Omni { wheels: [0.0; 3] });
+    }
+
+    #[test]
+    fn car_like_drops_requested_lateral_but_not_the_implied_one() {
+        let mut config = ChassisConfig::mobil2();
+        config.reference_offset = 0.3;
+        let mut c = controller(config);
+        // v = 0.4, ω = 0.2: radius 2 m ≥ 0.73 m, feasible; no lateral request.
+        let cmd = c.on_cmd_vel(BodyTwist::new(0.4, 0.0, 0.2), 0.0);
+        assert!(cmd.reasons.is_empty(), "{:?}", cmd.reasons);
+        assert_relative_eq!(cmd.twist.wz, 0.2, epsilon = 1e-12);
+        // Rear wheels: (v ∓ B·ω/2)/r = (0.4 ∓ 0.062)/0.1.
+        match cmd.wheels {
+            WheelState::CarLike {
+                rear_left, rear_right, ..
+            } => {
+                assert_relative_eq!(rear_left, 3.38, epsilon = 1e-12);
+                assert_relative_eq!(rear_right, 4.62, epsilon = 1e-12);
+            }
+            other => panic!("{other:?}"),
+        }
+        let lateral = c.on_cmd_vel(BodyTwist::new(0.4, 0.1, 0.0), 0.1);
+        assert!(lateral.reasons.contains(ClampReason::Lateral));
+        assert_eq!(lateral.twist.vy, 0.0);
+    }
+
+    #[test]
+    fn omni_command_at_an_offset_reference_point() {
+        let mut config = ChassisConfig::omr3();
+        config.reference_offset = 0.1;
+        let mut c = controller(config);
+        // Pure rotation about the reference point 0.1 m ahead: the centre moves sideways at
+        // vy = −ω·d = −0.1 m/s, so each wheel gets r·ω_i = sin θ_i·(−0.1) + R·ω.
+        let cmd = c.on_cmd_vel(BodyTwist::new(0.0, 0.0, 1.0), 0.0);
+        let s = 3f64.sqrt() / 2.0;
+        match cmd.wheels {
+            WheelState::Omni { wheels } => {
+                assert_relative_eq!(wheels[0], 0.2 / 0.05, epsilon = 1e-12);
+                assert_relative_eq!(wheels[1], (-0.1 * s + 0.2) / 0.05, epsilon = 1e-12);
+                assert_relative_eq!(wheels[2], (0.1 * s + 0.2) / 0.05, epsilon = 1e-12);
+            }
+            other => panic!("{other:?}"),
+        }
+        assert_relative_eq!(cmd.twist.vy, 0.0, epsilon = 1e-12);
+    }
+
+    #[test]
+    fn feedback_drives_odometry_and_refuses_time_going_backwards() {
+        let mut c = controller(ChassisConfig::omr3());
+        let forward = WheelState::Omni {
+            wheels: [6.0, -3.0, -3.0],
+        }; // 0.3 m/s along x
+        c.on_feedback(&forward, 10.0, 10.0).unwrap();
+        c.on_feedback(&forward, 11.0, 11.0).unwrap();
+        assert_relative_eq!(c.odometry().reference_pose().x, 0.3, epsilon = 1e-12);
+        assert!(c.on_feedback(&forward, 10.5, 11.1).is_err());
+        assert_relative_eq!(c.odometry().reference_pose().x, 0.3, epsilon = 1e-12);
+        let bad = WheelState::Omni {
+            wheels: [f64::NAN, 0.0, 0.0],
+        };
+        assert!(c.on_feedback(&bad, 12.0, 12.0).is_err());
+    }
+}
