@@ -131,12 +131,14 @@ pub struct Odometry {
 }
 
 impl Odometry {
-    /// Odometry at the origin with zero covariance; `reference_offset` is d (m) (finite).
+    /// Odometry with zero covariance whose published reference point (`base_link`) starts at
+    /// the odom origin, as REP-105 expects (the kinematic origin then sits at (−d, 0));
+    /// `reference_offset` is d (m) (finite).
     pub fn new(reference_offset: f64, noise: OdometryNoise) -> Result<Self, ChassisError> {
         check_offset(reference_offset)?;
         noise.validate()?;
         Ok(Self {
-            pose: Vector3::zeros(),
+            pose: Vector3::new(-reference_offset, 0.0, 0.0),
             covariance: Matrix3::zeros(),
             twist: BodyTwist::ZERO,
             last_stamp: None,
@@ -211,9 +213,9 @@ impl Odometry {
         self.twist = twist;
     }
 
-    /// Back to the origin pose, zero covariance, zero twist, no stamp.
+    /// Back to the start: reference point at the odom origin, zero covariance, zero twist, no stamp.
     pub fn reset(&mut self) {
-        self.reset_to(Vector3::zeros());
+        self.reset_to(Vector3::new(-self.reference_offset, 0.0, 0.0));
     }
 
     /// Restarts at `pose_of_origin` [x, y, ϑ] (ϑ wrapped) with zero covariance, zero twist, no stamp.

@@ -162,14 +162,16 @@ fn covariance_of_a_rotation_in_place() {
 
 #[test]
 fn reference_point_pose_twist_and_covariance() {
-    // d = 0.3; drive 0.5 m straight then turn in place by π/2: origin (0.5, 0, π/2),
-    // reference (0.5, 0.3, π/2).
+    // d = 0.3; the reference point starts at the odom origin, so the kinematic origin starts at
+    // (−0.3, 0). Drive 0.5 m straight then turn in place by π/2: origin (0.2, 0, π/2),
+    // reference (0.2, 0.3, π/2).
     let mut o = Odometry::new(0.3, OdometryNoise::default()).unwrap();
     o.update(BodyTwist::new(0.5, 0.0, 0.0), 1.0).unwrap();
     o.update(BodyTwist::new(0.0, 0.0, 1.0), FRAC_PI_2).unwrap();
-    assert_relative_eq!(o.reference_pose(), Vector3::new(0.5, 0.3, FRAC_PI_2), epsilon = 1e-12);
+    assert_relative_eq!(o.pose(), Vector3::new(0.2, 0.0, FRAC_PI_2), epsilon = 1e-12);
+    assert_relative_eq!(o.reference_pose(), Vector3::new(0.2, 0.3, FRAC_PI_2), epsilon = 1e-12);
     let iso = o.odom_from_base();
-    assert_relative_eq!(iso.translation.vector.x, 0.5, epsilon = 1e-12);
+    assert_relative_eq!(iso.translation.vector.x, 0.2, epsilon = 1e-12);
     assert_relative_eq!(iso.translation.vector.y, 0.3, epsilon = 1e-12);
     assert_relative_eq!(iso.rotation.angle(), FRAC_PI_2, epsilon = 1e-12);
     // Twist at the reference: vy = ω·d = 0.3.
