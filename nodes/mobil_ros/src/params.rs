@@ -402,13 +402,23 @@ fn flatten(prefix: &str, v: &Value, out: &mut Vec<(String, Value)>) {
     }
 }
 
+/// One `name: value` of a parameter file that applies to a node.
+#[derive(Debug, Clone, PartialEq)]
+pub struct FileEntry {
+    pub name: String,
+    pub value: Value,
+    /// From a wildcard section (`/**`, `*`): shared by every node of a robot, so a node that
+    /// does not declare the name ignores it quietly.
+    pub shared: bool,
+}
+
 /// The parameter entries of a parameter file's text that apply to a node, in file order.
 pub fn file_entries(
     path: &str,
     text: &str,
     fully_qualified: &str,
     base_name: &str,
-) -> Result<Vec<(String, Value)>, ParamError> {
+) -> Result<Vec<FileEntry>, ParamError> {
     let doc: Value = serde_norway::from_str(text).map_err(|source| ParamError::Yaml {
         path: path.to_owned(),
         source,
@@ -431,7 +441,10 @@ pub fn file_entries(
         let params = body
             .get("ros__parameters")
             .ok_or_else(|| format(&format!("`{key}` has no `ros__parameters` section")))?;
-        flatten("", params, &mut entries);
+        let mut flat = Vec::new();
+        flatten("", params, &mut flat);
+        let shared = key.contains('*');
+        entries.extend(flat.into_iter().map(|(name, value)| FileEntry { name, value, shared }));
     }
     Ok(entries)
 }
@@ -457,7 +470,7 @@ pub fn initial_params(
     let mut values = ParamValues::defaults(specs);
     let mut use_sim_time = false;
     let mut warnings = Vec::new();
-    let mut apply = |name: &str, value: ParameterValue, origin: &str| -> Result<(), ParamError> {
+    let mut apply = |name: &str, value: ParameterValue, origin: &str, shared: bool| -> Result<(), ParamError> {
         let invalid = |reason: String| ParamError::Invalid {
             name: name.to_owned(),
             origin: origin.to_owned(),
@@ -472,18 +485,19 @@ pub fn initial_params(
         }
         match specs.iter().find(|s| s.name == name) {
             Some(spec) => values.set(name, spec.check(&value).map_err(invalid)?),
+            None if shared => {}
             None => warnings.push(format!("unknown parameter `{name}` from {origin} ignored")),
         }
         Ok(())
     };
     for (path, text) in files {
-        for (name, raw) in file_entries(path, text, fully_qualified, base_name)? {
-            let value = yaml_to_param(&raw).map_err(|reason| ParamError::Invalid {
-                name: name.clone(),
+        for entry in file_entries(path, text, fully_qualified, base_name)? {
+            let value = yaml_to_param(&entry.value).map_err(|reason| ParamError::Invalid {
+                name: entry.name.clone(),
                 origin: path.clone(),
                 reason,
             })?;
-            apply(&name, value, path)?;
+            apply(&entry.name, value, path, entry.shared)?;
         }
     }
     for p in overrides
@@ -495,7 +509,7 @@ pub fn initial_params(
             origin: "-p".into(),
             reason,
         })?;
-        apply(&p.name, value, "-p")?;
+        apply(&p.name, value, "-p", false)?;
     }
     Ok(InitialParams {
         values,
@@ -527,6 +541,7 @@ mod tests {
   ros__parameters:
     use_sim_time: true
     beams: 100
+    planner_only: 1
 chassis:
   ros__parameters:
     model: omni

@@ -36,7 +36,7 @@ fn drive(config: ChassisConfig, slip: f64, route: &[(f64, f64, f64)]) -> (f64, f
         let steps = (duration / dt).round() as u64;
         for _ in 0..steps {
             let t = step as f64 * dt;
-            if step % 4 == 0 {
+            if step.is_multiple_of(4) {
                 // 50 Hz: cmd_vel, wheel_commands, joint_states.
                 let cmd = controller.on_cmd_vel(BodyTwist::new(v, 0.0, w), t);
                 plant.command(&cmd.wheels);

@@ -10,7 +10,7 @@ pub struct Segment {
 
 /// Parses `[v, ω, duration, v, ω, duration, …]`; durations must be positive, values finite.
 pub fn parse_route(flat: &[f64]) -> Result<Vec<Segment>, String> {
-    if flat.is_empty() || flat.len() % 3 != 0 {
+    if flat.is_empty() || !flat.len().is_multiple_of(3) {
         return Err(format!(
             "a route is a list of (v, omega, duration) triples, got {} numbers",
             flat.len()
