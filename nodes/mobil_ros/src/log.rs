@@ -14,16 +14,21 @@ pub fn init(level: Option<&str>) {
         Some(l) => l,
         None => std::env::var("RUST_LOG").unwrap_or_else(|_| "info".to_owned()),
     };
-    // The DDS stack is chatty at info; keep it at warn unless asked for explicitly.
+    // The DDS stack is chatty at info; keep it at warn unless asked for explicitly. RustDDS's
+    // discovery database reports an "inconsistent topic" error for /clock in every process:
+    // ros2-client's spinner subscribes to it as builtin_interfaces/Time while rclpy, Gazebo and
+    // sim_node publish rosgraph_msgs/Clock (same bytes). Only that module is silenced.
+    const QUIET: &str = "rustdds=warn,ros2_client=warn,rustdds::discovery::discovery_db=off";
     let spec = if base.contains('=') {
         base
     } else {
-        format!("{base},rustdds=warn,ros2_client=warn")
+        format!("{base},{QUIET}")
     };
-    let filter = EnvFilter::try_new(&spec).unwrap_or_else(|_| EnvFilter::new("info,rustdds=warn,ros2_client=warn"));
+    let filter = EnvFilter::try_new(&spec).unwrap_or_else(|_| EnvFilter::new(format!("info,{QUIET}")));
     let _ = tracing_subscriber::fmt()
         .with_env_filter(filter)
         .with_writer(std::io::stderr)
+        .with_ansi(std::io::IsTerminal::is_terminal(&std::io::stderr()))
         .with_target(false)
         .try_init();
 }

@@ -328,14 +328,23 @@ impl RosNode {
     }
 
     /// Stops the spinner and leaves the DDS domain (the participant announces its departure).
-    pub async fn shutdown(mut self) {
-        self.node.stop_spinner();
-        if let Some(handle) = self.spinner.take() {
+    pub async fn shutdown(self) {
+        let RosNode {
+            node,
+            context,
+            names,
+            spinner,
+            ..
+        } = self;
+        // Dropping the node tells its spinner to stop; then the context (participant) goes.
+        drop(node);
+        if let Some(handle) = spinner {
             if tokio::time::timeout(Duration::from_secs(2), handle).await.is_err() {
                 warn!("spinner did not stop within 2 s");
             }
         }
-        info!("{} shut down", self.names.fully_qualified_node());
+        drop(context);
+        info!("{} shut down", names.fully_qualified_node());
     }
 }
 

@@ -3,8 +3,8 @@
 //! a cmd_vel watchdog and a feedback watchdog; `~/status` reports both and every clamp.
 
 use futures::StreamExt;
-use mobil_chassis::controller::{ChassisController, Command, ControllerConfig, Safety};
-use mobil_chassis::joints::{joints_from_wheel_state, wheel_state_from_joints};
+use mobil_chassis::controller::{ChassisController, Command, ControllerConfig, FeedbackError, Safety};
+use mobil_chassis::joints::{joints_from_wheel_state, wheel_state_from_joints, JointStateError};
 use mobil_chassis::kinematics::BodyTwist;
 use mobil_chassis::model::ChassisModel;
 use mobil_chassis::odometry::OdometryNoise;
@@ -216,12 +216,23 @@ async fn run(node: &mut RosNode) -> anyhow::Result<()> {
                             }
                             Err(e) => {
                                 rejected += 1;
-                                warn_throttled!(throttle, "feedback", "joint_states dropped: {e}");
+                                let key = match e {
+                                    FeedbackError::Kinematics(_) => "feedback_kinematics",
+                                    FeedbackError::Odometry(_) => "feedback_time",
+                                };
+                                warn_throttled!(throttle, key, "joint_states dropped: {e}");
                             }
                         },
                         (Err(e), _) => {
                             rejected += 1;
-                            warn_throttled!(throttle, "joints", "joint_states dropped: {e}");
+                            // One throttle per kind of fault, so each kind is reported.
+                            let key = match e {
+                                JointStateError::MismatchedLengths { .. } => "joints_lengths",
+                                JointStateError::MissingJoint(_) => "joints_missing",
+                                JointStateError::MissingField { .. } => "joints_field",
+                                JointStateError::NonFinite { .. } => "joints_nan",
+                            };
+                            warn_throttled!(throttle, key, "joint_states dropped: {e}");
                         }
                         (_, None) => {
                             rejected += 1;

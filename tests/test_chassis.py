@@ -1,0 +1,308 @@
+"""chassis_node and sim_node driven by real rclpy (ROS 2 Jazzy, Fast DDS).
+
+Every expected number is worked out by hand from the SPEC's formulas (see the comments), not
+taken from the nodes' output.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import signal
+import subprocess
+import time
+
+import pytest
+
+import harness
+from harness import collect, param_get, param_list, param_set, publish_until, subscribe, wait_for_message
+
+from geometry_msgs.msg import Twist
+from mobil_msgs.msg import ChassisStatus
+from nav_msgs.msg import Odometry
+from sensor_msgs.msg import JointState, LaserScan
+
+ROBOTS = ["mobil2", "omr3", "tricycle"]
+# No LIDAR where a test does not look at scans: keeps the 2-core test machine unloaded.
+NO_LIDAR = ("-p", "lidar.enabled:=false")
+
+
+def twist(vx: float = 0.0, vy: float = 0.0, wz: float = 0.0) -> Twist:
+    t = Twist()
+    t.linear.x, t.linear.y, t.angular.z = float(vx), float(vy), float(wz)
+    return t
+
+
+def yaw(msg: Odometry) -> float:
+    q = msg.pose.pose.orientation
+    return math.atan2(2.0 * (q.w * q.z + q.x * q.y), 1.0 - 2.0 * (q.y * q.y + q.z * q.z))
+
+
+def xy(msg: Odometry) -> tuple[float, float]:
+    return msg.pose.pose.position.x, msg.pose.pose.position.y
+
+
+def start_robot(start_node, robot: str, *extra: str, lidar: bool = False):
+    params = f"params/{robot}.yaml"
+    sim_args = extra if lidar else (*NO_LIDAR, *extra)
+    sim = start_node("sim_node", *sim_args, params_file=params)
+    chassis = start_node("chassis_node", *extra, params_file=params)
+    return sim, chassis
+
+
+# Commanded twist per robot and what the kinematics make of it at steady state.
+# mobil2: v = 0.3, ω = 0.2 → radius 1.5 m ≥ 0.73 m: feasible, kept.
+# omr3: vx = 0.2, vy = 0.1, ω = 0.3: an omni chassis follows all three.
+# tricycle: v = 0.3, ω = 0.4 → radius 0.75 m ≥ 0.25 m and δ = atan(0.5·0.4/0.3) = 33.7° < 60°.
+COMMANDS = {"mobil2": (0.3, 0.0, 0.2), "omr3": (0.2, 0.1, 0.3), "tricycle": (0.3, 0.0, 0.4)}
+
+
+@pytest.mark.parametrize("robot", ROBOTS)
+def test_cmd_vel_moves_odom_as_the_kinematics_predict(robot, start_node, ros_node):
+    start_robot(start_node, robot)
+    vx, vy, wz = COMMANDS[robot]
+    cmd = ros_node.create_publisher(Twist, "cmd_vel", 10)
+    with subscribe(ros_node, Odometry, "odom") as odom, subscribe(ros_node, Odometry, "ground_truth") as truth:
+        # Drive until the wheels have settled on the command (motor lag τ = 0.05 s).
+        publish_until(ros_node, cmd, twist(vx, vy, wz),
+                      lambda: odom.latest is not None and abs(odom.latest.twist.twist.angular.z - wz) < 0.01,
+                      rate_hz=20, timeout=15)
+        start_odom, start_truth = odom.latest, truth.latest
+        t0 = time.monotonic()
+        while time.monotonic() - t0 < 3.0:
+            cmd.publish(twist(vx, vy, wz))
+            time.sleep(0.05)
+        end_odom, end_truth = odom.latest, truth.latest
+        cmd.publish(twist())
+
+    # Steady-state twist at base_link equals the command (body frame).
+    tw = end_odom.twist.twist
+    assert tw.linear.x == pytest.approx(vx, abs=0.01)
+    assert tw.angular.z == pytest.approx(wz, abs=0.01)
+    if robot == "omr3":
+        assert tw.linear.y == pytest.approx(vy, abs=0.01)
+    # Over the window, heading changes by ω·Δt and the odometry displacement matches the truth.
+    dt = (end_odom.header.stamp.sec + end_odom.header.stamp.nanosec * 1e-9) - (
+        start_odom.header.stamp.sec + start_odom.header.stamp.nanosec * 1e-9)
+    dyaw = math.remainder(yaw(end_odom) - yaw(start_odom), math.tau)
+    assert dyaw == pytest.approx(wz * dt, rel=0.03)
+    (ox0, oy0), (ox1, oy1) = xy(start_odom), xy(end_odom)
+    (gx0, gy0), (gx1, gy1) = xy(start_truth), xy(end_truth)
+    odom_step, truth_step = math.hypot(ox1 - ox0, oy1 - oy0), math.hypot(gx1 - gx0, gy1 - gy0)
+    # Chord of an arc of radius R = |v|/ω over angle ω·Δt: 2R·sin(ωΔt/2).
+    speed = math.hypot(vx, vy)
+    chord = 2 * speed / wz * math.sin(wz * dt / 2)
+    assert odom_step == pytest.approx(chord, rel=0.03)
+    assert truth_step == pytest.approx(chord, rel=0.03)
+
+
+def test_car_like_turn_tighter_than_the_minimum_radius_is_clamped(start_node, ros_node):
+    start_robot(start_node, "mobil2")
+    cmd = ros_node.create_publisher(Twist, "cmd_vel", 10)
+    # v = 0.3 with ω = 1.0 asks for a 0.3 m radius. MOBIL-II's effective limit is R_min = 0.73 m
+    # (δ_eff = atan(0.60/0.73) = 39.4°, SPEC §1), so ω becomes 0.3/0.73 = 0.41096 rad/s.
+    with subscribe(ros_node, ChassisStatus, "chassis/status") as status, subscribe(ros_node, Odometry, "odom") as odom:
+        publish_until(ros_node, cmd, twist(0.3, 0.0, 1.0),
+                      lambda: odom.latest is not None and odom.latest.twist.twist.angular.z > 0.40
+                      and abs(odom.latest.twist.twist.angular.z - 0.41096) < 0.005,
+                      rate_hz=20, timeout=15)
+        st = status.wait_for(lambda s: s.clamped & ChassisStatus.CLAMP_MIN_RADIUS, timeout=5)
+        assert st.commanded.angular.z == pytest.approx(0.3 / 0.73, abs=1e-6)
+        assert st.commanded.linear.x == pytest.approx(0.3, abs=1e-9)
+        # A lateral request on a car is dropped and flagged.
+        publish_until(ros_node, cmd, twist(0.2, 0.2, 0.0),
+                      lambda: status.latest is not None and status.latest.clamped & ChassisStatus.CLAMP_LATERAL,
+                      rate_hz=20, timeout=5)
+        assert status.latest.commanded.linear.y == 0.0
+        cmd.publish(twist())
+
+
+def test_odometry_within_2_percent_of_ground_truth_over_a_5_m_route(start_node, ros_node):
+    """An rclpy program drives the simulated MOBIL-II over 5 m with cmd_vel (no noise)."""
+    start_robot(start_node, "mobil2")
+    cmd = ros_node.create_publisher(Twist, "cmd_vel", 10)
+    # 2 m straight, a quarter turn on a 1 m radius (π/2 m), then straight to 5 m in all.
+    route = [(0.4, 0.0, 2.0 / 0.4), (0.4, 0.4, (math.pi / 2) / 0.4), (0.4, 0.0, (3.0 - math.pi / 2) / 0.4)]
+    with subscribe(ros_node, Odometry, "odom") as odom, subscribe(ros_node, Odometry, "ground_truth") as truth:
+        odom.wait_for(None, 10)
+        truth.wait_for(None, 10)
+        for v, w, duration in route:
+            t0 = time.monotonic()
+            while time.monotonic() - t0 < duration:
+                cmd.publish(twist(v, 0.0, w))
+                time.sleep(0.02)
+        t0 = time.monotonic()
+        while time.monotonic() - t0 < 1.0:
+            cmd.publish(twist())
+            time.sleep(0.05)
+        path = [xy(m) for m in truth.snapshot()]
+        final_odom, final_truth = xy(odom.latest), xy(truth.latest)
+    driven = sum(math.dist(a, b) for a, b in zip(path, path[1:]))
+    assert driven == pytest.approx(5.0, rel=0.05)
+    error = math.dist(final_odom, final_truth)
+    assert error < 0.02 * driven, f"odometry off by {error:.3f} m over {driven:.2f} m"
+
+
+def test_watchdog_zeroes_wheel_commands_when_cmd_vel_stops(start_node, ros_node):
+    # chassis_node alone, as on a robot whose feedback is not wired yet: the feedback watchdog
+    # off, the cmd_vel watchdog at its 0.5 s default.
+    start_node("chassis_node", "-p", "feedback_timeout_s:=0.0", params_file="params/omr3.yaml")
+    cmd = ros_node.create_publisher(Twist, "cmd_vel", 10)
+    with subscribe(ros_node, JointState, "wheel_commands") as wheels:
+        # OMR-III, body-x at 0.3 m/s with r = 0.05: Ω = (0.3/0.05)·[1, −½, −½] = [6, −3, −3] rad/s.
+        publish_until(ros_node, cmd, twist(0.3), lambda: wheels.latest is not None
+                      and wheels.latest.velocity[0] == pytest.approx(6.0, abs=1e-9), rate_hz=20, timeout=10)
+        assert list(wheels.latest.velocity) == pytest.approx([6.0, -3.0, -3.0], abs=1e-9)
+        last_cmd = time.monotonic()
+        start = len(wheels)
+        stopped = wheels.wait_for(lambda m: all(v == 0.0 for v in m.velocity), timeout=3, start=start)
+        elapsed = time.monotonic() - last_cmd
+        assert stopped.name == ["wheel_1", "wheel_2", "wheel_3"]
+    # 0.5 s timeout checked at the 50 Hz control rate, plus DDS latency.
+    assert 0.45 < elapsed < 0.9, f"wheels stopped {elapsed:.3f} s after the last cmd_vel"
+    st = wait_for_message(ros_node, ChassisStatus, "chassis/status", lambda s: s.watchdog_expired, timeout=5)
+    assert st.commanded.linear.x == 0.0
+
+
+def test_nan_twist_stops_at_once_and_is_counted(start_node, ros_node):
+    chassis = start_node("chassis_node", "-p", "feedback_timeout_s:=0.0", params_file="params/omr3.yaml")
+    cmd = ros_node.create_publisher(Twist, "cmd_vel", 10)
+    with subscribe(ros_node, JointState, "wheel_commands") as wheels, \
+            subscribe(ros_node, ChassisStatus, "chassis/status") as status:
+        publish_until(ros_node, cmd, twist(0.3), lambda: wheels.latest is not None
+                      and wheels.latest.velocity[0] > 5.9, rate_hz=20, timeout=10)
+        start = len(wheels)
+        cmd.publish(twist(float("nan"), 0.0, 0.1))
+        stopped = wheels.wait_for(lambda m: all(v == 0.0 for v in m.velocity), timeout=0.3, start=start)
+        assert all(math.isfinite(v) for v in stopped.velocity)
+        st = status.wait_for(lambda s: s.rejected_messages >= 1 and s.clamped & ChassisStatus.CLAMP_NON_FINITE, timeout=3)
+        assert st.commanded.linear.x == 0.0
+        cmd.publish(twist(float("inf")))
+    assert chassis.running
+    chassis.wait_for_log("NaN/inf", timeout=5)
+
+
+def joint_state(stamp_s: float, names, positions, velocities) -> JointState:
+    js = JointState()
+    js.header.stamp.sec = int(stamp_s)
+    js.header.stamp.nanosec = int(round((stamp_s - int(stamp_s)) * 1e9))
+    js.name = list(names)
+    js.position = [float(p) for p in positions]
+    js.velocity = [float(v) for v in velocities]
+    return js
+
+
+def test_bad_joint_states_are_dropped_and_do_not_move_odometry(start_node, ros_node):
+    """rclpy plays the robot: valid feedback, then mismatched arrays and time going backwards."""
+    chassis = start_node("chassis_node", params_file="params/omr3.yaml")
+    names = ["wheel_1", "wheel_2", "wheel_3"]
+    fb = ros_node.create_publisher(JointState, "joint_states", 10)
+    with subscribe(ros_node, Odometry, "odom", qos=harness.qos_default()) as odom, \
+            subscribe(ros_node, ChassisStatus, "chassis/status") as status:
+        # At rest until the chassis node answers (stamps 99.00, 99.01, …), then at rest at
+        # t = 100 s, then body-x at 0.3 m/s (Ω = [6, −3, −3]) for 1 s in 0.1 s steps: x = 0.3 m.
+        stamps = iter(99.0 + 0.01 * k for k in range(100))
+        publish_until(ros_node, fb, lambda: joint_state(next(stamps), names, [], [0.0, 0.0, 0.0]),
+                      lambda: odom.latest is not None, rate_hz=10, timeout=9)
+        t = 100.0
+        fb.publish(joint_state(t, names, [], [0.0, 0.0, 0.0]))
+        for i in range(1, 11):
+            fb.publish(joint_state(t + 0.1 * i, names, [], [6.0, -3.0, -3.0]))
+        good = odom.wait_for(lambda m: m.header.stamp.sec == 101 and m.header.stamp.nanosec == 0, timeout=5)
+        assert good.pose.pose.position.x == pytest.approx(0.3, abs=1e-9)
+        rejected_before = status.wait_for(None, timeout=5).rejected_messages
+        count_before = len(odom)
+        # Three arrays of different lengths, a missing joint, NaN, then time going backwards.
+        fb.publish(joint_state(101.1, names, [0.0], [6.0, -3.0, -3.0]))
+        fb.publish(joint_state(101.2, names[:2], [], [6.0, -3.0]))
+        fb.publish(joint_state(101.3, names, [], [float("nan"), -3.0, -3.0]))
+        fb.publish(joint_state(100.5, names, [], [6.0, -3.0, -3.0]))
+        status.wait_for(lambda s: s.rejected_messages >= rejected_before + 4, timeout=5)
+        assert len(odom) == count_before, "a rejected sample published odometry"
+        assert odom.latest.pose.pose.position.x == pytest.approx(0.3, abs=1e-9)
+    assert chassis.running
+    log = chassis.log_text()
+    for reason in ("mismatched array lengths", "is missing", "non-finite value", "is not after the previous"):
+        assert reason in log, f"no log line for {reason!r}"
+
+
+def test_parameters_list_get_set_and_invalid_set_refused(start_node, ros_node, ros2cli):
+    start_robot(start_node, "mobil2")
+    assert harness.wait_for_node(ros_node, "/chassis", timeout=10)
+    assert harness.wait_for_node(ros_node, "/sim", timeout=10)
+    names = param_list(ros_node, "/chassis")
+    for expected in ("model", "v_max", "cmd_vel_timeout_s", "wheelbase", "use_sim_time"):
+        assert expected in names
+    # params/mobil2.yaml sets v_max 0.5 and the wheelbase 0.60.
+    assert param_get(ros_node, "/chassis", "v_max") == 0.5
+    assert param_get(ros_node, "/chassis", "wheelbase") == 0.6
+    ok = param_set(ros_node, "/chassis", "v_max", 0.3)
+    assert ok.successful, ok.reason
+    assert param_get(ros_node, "/chassis", "v_max") == 0.3
+    for name, value, why in [("v_max", -1.0, "minimum"), ("v_max", "fast", "type"),
+                             ("model", "omni", "read-only"), ("no_such_parameter", 1.0, "")]:
+        res = param_set(ros_node, "/chassis", name, value)
+        assert not res.successful, f"{name}={value!r} was accepted"
+        assert why.lower() in res.reason.lower() or not why, res.reason
+    assert param_get(ros_node, "/chassis", "v_max") == 0.3
+    assert param_get(ros_node, "/chassis", "model") == "car_like"
+    # The new limit is in force: 0.45 m/s is clamped to 0.3.
+    cmd = ros_node.create_publisher(Twist, "cmd_vel", 10)
+    with subscribe(ros_node, ChassisStatus, "chassis/status") as status:
+        publish_until(ros_node, cmd, twist(0.45), lambda: status.latest is not None
+                      and status.latest.commanded.linear.x == pytest.approx(0.3), rate_hz=20, timeout=10)
+        assert status.latest.clamped & ChassisStatus.CLAMP_SPEED
+        cmd.publish(twist())
+    # The command-line tool does the same as `ros2 param get/set`.
+    out = ros2cli("param", "get", "/chassis", "v_max")
+    assert out.returncode == 0 and "0.3" in out.stdout, out.stdout + out.stderr
+    out = ros2cli("param", "set", "/chassis", "cmd_vel_timeout_s", "-2")
+    assert out.returncode == 1 and "failed" in out.stdout.lower() + out.stderr.lower()
+
+
+def test_sim_scan_sees_the_built_in_world(start_node, ros_node):
+    start_robot(start_node, "mobil2", lidar=True)
+    scan = wait_for_message(ros_node, LaserScan, "scan", timeout=10)
+    assert len(scan.ranges) == 1081
+    assert scan.angle_min == pytest.approx(-math.radians(135), abs=1e-6)
+    assert scan.angle_increment == pytest.approx(math.radians(0.25), abs=1e-7)
+    assert scan.header.frame_id == "laser"
+
+    def beam(angle_deg: float) -> float:
+        return scan.ranges[round((math.radians(angle_deg) - scan.angle_min) / scan.angle_increment)]
+
+    # Robot at the origin facing +x (params/worlds/default.yaml): the box's west face at x = 4.5,
+    # the north wall's inner face at y = 5.5, and the pillar of radius 0.3 at (1.0, 1.5) seen at
+    # atan2(1.5, 1.0) = 56.31° from √(1 + 2.25) − 0.3 = 1.5028 m.
+    assert beam(0.0) == pytest.approx(4.5, abs=1e-3)
+    assert beam(90.0) == pytest.approx(5.5, abs=1e-3)
+    assert beam(math.degrees(math.atan2(1.5, 1.0))) == pytest.approx(math.sqrt(3.25) - 0.3, abs=0.01)
+
+
+def test_namespace_remap_moves_every_topic(start_node, ros_node):
+    start_robot(start_node, "omr3", "-r", "__ns:=/robot1")
+    odom = wait_for_message(ros_node, Odometry, "/robot1/odom", timeout=10)
+    assert odom.child_frame_id == "base_link"
+    assert harness.wait_for_node(ros_node, "/robot1/chassis", timeout=10)
+    assert param_get(ros_node, "/robot1/chassis", "model") == "omni"
+
+
+def test_help_lists_parameters_and_bad_arguments_fail():
+    for exe in ("chassis_node", "sim_node"):
+        out = subprocess.run([str(harness.resolve_executable(exe)), "--help"], capture_output=True, text=True, timeout=10)
+        assert out.returncode == 0
+        assert "--params-file" in out.stdout and "v_max" in out.stdout
+    out = subprocess.run([str(harness.resolve_executable("chassis_node")), "--ros-args", "-p", "v_max:=-3"],
+                         capture_output=True, text=True, timeout=10, env=harness.rosutil.ros_environ())
+    assert out.returncode != 0 and "v_max" in out.stderr
+
+
+def test_sigint_and_sigterm_stop_cleanly(start_node, ros_node):
+    sim, chassis = start_robot(start_node, "mobil2")
+    wait_for_message(ros_node, Odometry, "odom", timeout=10)
+    chassis.proc.send_signal(signal.SIGTERM)
+    assert chassis.wait(5) == 0
+    sim.proc.send_signal(signal.SIGINT)
+    assert sim.wait(5) == 0
+    # The participants announced their departure: rclpy forgets the nodes.
+    assert harness.wait_until(lambda: "/chassis" not in harness.rosutil.node_names(ros_node), timeout=5)
