@@ -306,3 +306,21 @@ def test_sigint_and_sigterm_stop_cleanly(start_node, ros_node):
     assert sim.wait(5) == 0
     # The participants announced their departure: rclpy forgets the nodes.
     assert harness.wait_until(lambda: "/chassis" not in harness.rosutil.node_names(ros_node), timeout=5)
+
+
+def test_use_sim_time_follows_a_clock_published_by_rclpy(start_node, ros_node):
+    """A simulator's /clock (rosgraph_msgs/Clock from Fast DDS) drives the node's time."""
+    from rosgraph_msgs.msg import Clock
+    start_node("chassis_node", "-p", "use_sim_time:=true", params_file="params/omr3.yaml")
+    clock = ros_node.create_publisher(Clock, "/clock", 10)
+
+    def at(sec: int) -> Clock:
+        c = Clock()
+        c.clock.sec = sec
+        return c
+
+    with subscribe(ros_node, ChassisStatus, "chassis/status") as status:
+        publish_until(ros_node, clock, at(1000), lambda: status.latest is not None
+                      and status.latest.header.stamp.sec == 1000, rate_hz=20, timeout=10)
+        publish_until(ros_node, clock, at(2000), lambda: status.latest.header.stamp.sec == 2000,
+                      rate_hz=20, timeout=10)

@@ -22,12 +22,14 @@ use crate::names::NameResolver;
 use crate::params::{initial_params, type_name, ParamSpec, ParamValues};
 use anyhow::{anyhow, bail, Context as _};
 use mobil_msgs::builtin_interfaces::msg::Time;
+use mobil_msgs::rosgraph_msgs::msg::Clock;
 use mobil_msgs::{RosMessage, RosService};
 use ros2_client::{
     Context, ContextOptions, Name, Node, NodeName, NodeOptions, ParameterValue, Publisher, QosProfile, Server,
     ServiceMapping, Subscription,
 };
 use std::fmt::Write as _;
+use std::sync::atomic::{AtomicI64, Ordering};
 use std::sync::{Arc, Mutex, PoisonError};
 use std::time::Duration;
 use tokio::sync::mpsc;
@@ -163,6 +165,10 @@ pub struct RosNode {
     params: Arc<Mutex<ParamValues>>,
     changes: mpsc::UnboundedReceiver<ParamValues>,
     spinner: Option<tokio::task::JoinHandle<()>>,
+    /// `/clock`, read when the time is asked for (see [`RosNode::now_nanos`]).
+    clock: Option<Subscription<Clock>>,
+    /// Latest `/clock` [ns].
+    sim_clock: AtomicI64,
 }
 
 fn lock(values: &Mutex<ParamValues>) -> std::sync::MutexGuard<'_, ParamValues> {
@@ -244,14 +250,18 @@ impl RosNode {
             }
         });
         info!("{fqn} up on ROS_DOMAIN_ID {domain}");
-        Ok(RosNode {
+        let mut ros_node = RosNode {
             node,
             context,
             names,
             params,
             changes,
             spinner: Some(handle),
-        })
+            clock: None,
+            sim_clock: AtomicI64::new(0),
+        };
+        ros_node.clock = Some(ros_node.subscription::<Clock>("/clock", &crate::qos::sensor_data())?);
+        Ok(ros_node)
     }
 
     /// The name resolver (namespace, node name, remaps).
@@ -312,9 +322,26 @@ impl RosNode {
             .map_err(|e| anyhow!("cannot serve {name}: {e:?}"))
     }
 
-    /// Nanoseconds of the node's clock (`/clock` when `use_sim_time` is true).
+    /// Nanoseconds of the node's clock: the latest `/clock` when `use_sim_time` is true (0 until
+    /// one arrives), else the system clock.
+    ///
+    /// `/clock` is read here as `rosgraph_msgs/Clock`, the type every ROS 2 simulator publishes
+    /// (ros2-client's own sim time subscribes to it as `builtin_interfaces/Time`, which Fast DDS
+    /// and Cyclone DDS publishers do not match). Best effort, as rclcpp's clock QoS.
     pub fn now_nanos(&self) -> i64 {
-        self.node.time_now().to_nanos()
+        match self.node.get_parameter("use_sim_time") {
+            Some(ParameterValue::Boolean(true)) => {
+                if let Some(clock) = &self.clock {
+                    while let Ok(Some((c, _))) = clock.take() {
+                        if let Some(nanos) = crate::time::nanos_from_stamp(&c.clock) {
+                            self.sim_clock.store(nanos, Ordering::Relaxed);
+                        }
+                    }
+                }
+                self.sim_clock.load(Ordering::Relaxed)
+            }
+            _ => self.node.time_now_not_simulated().to_nanos(),
+        }
     }
 
     /// The node's clock as a message stamp.
@@ -334,8 +361,11 @@ impl RosNode {
             context,
             names,
             spinner,
+            clock,
             ..
         } = self;
+        // Readers and writers must go while their participant exists.
+        drop(clock);
         // Dropping the node tells its spinner to stop; then the context (participant) goes.
         drop(node);
         if let Some(handle) = spinner {

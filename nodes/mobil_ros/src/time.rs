@@ -24,6 +24,11 @@ pub fn secs_from_stamp(t: &Time) -> Option<f64> {
     (t.nanosec < 1_000_000_000).then(|| f64::from(t.sec) + f64::from(t.nanosec) * 1e-9)
 }
 
+/// Nanoseconds of a stamp, exactly; `None` when `nanosec` is out of range.
+pub fn nanos_from_stamp(t: &Time) -> Option<i64> {
+    (t.nanosec < 1_000_000_000).then(|| i64::from(t.sec) * 1_000_000_000 + i64::from(t.nanosec))
+}
+
 /// Whether a stamp is all zero (publishers that do not stamp).
 pub fn is_zero(t: &Time) -> bool {
     t.sec == 0 && t.nanosec == 0
