@@ -1,0 +1,128 @@
+"""pytest fixtures for mobil's ROS 2 tests (see harness.py for the helpers).
+
+Fixtures:
+* ``ros_domain_id`` (session): the ROS_DOMAIN_ID of this run, random in 100..199 unless
+  MOBIL_TEST_DOMAIN_ID is set; it is put in os.environ before rclpy starts and is inherited by
+  every child process.
+* ``rclpy_context`` (session): one ``rclpy.init()`` for the run.
+* ``spinner``: a background executor for the test; fails the test if a callback raised.
+* ``ros_node``: a fresh rclpy node per test, spun by ``spinner``.
+* ``start_node``: factory ``start_node(exe, *ros_args, params_file=None, name=None, ...)`` that
+  launches a node executable and stops it at teardown (SIGINT, 5 s, else kill and fail).
+* ``ros2cli``: ``ros2cli(*args, timeout=30)`` runs tests/ros2cli.py in the test's domain.
+
+Environment: MOBIL_BIN_DIR (default target/release), MOBIL_TEST_DOMAIN_ID; the Fast DDS profile,
+RMW implementation and mobil_msgs paths are set here (rosutil.setup_process_environment).
+"""
+
+from __future__ import annotations
+
+import itertools
+import os
+import random
+from collections.abc import Iterator
+from pathlib import Path
+from typing import Any, Callable
+
+import pytest
+
+import harness
+import rosutil
+
+
+def _choose_domain_id() -> int:
+    value = os.environ.get("MOBIL_TEST_DOMAIN_ID")
+    if value:
+        return int(value)
+    return random.SystemRandom().randrange(100, 200)
+
+
+# Before anything can start rclpy: the domain and the process environment.
+DOMAIN_ID = _choose_domain_id()
+os.environ["ROS_DOMAIN_ID"] = str(DOMAIN_ID)
+rosutil.setup_process_environment()
+
+_node_counter = itertools.count(1)
+
+
+def pytest_report_header(config: pytest.Config) -> list[str]:
+    return [f"mobil: ROS_DOMAIN_ID={DOMAIN_ID} RMW={os.environ.get('RMW_IMPLEMENTATION')} "
+            f"bin dir={harness.BIN_DIR}",
+            f"mobil: FASTRTPS_DEFAULT_PROFILES_FILE={os.environ.get('FASTRTPS_DEFAULT_PROFILES_FILE')}"]
+
+
+@pytest.hookimpl(hookwrapper=True)
+def pytest_runtest_makereport(item: pytest.Item, call: pytest.CallInfo) -> Iterator[None]:
+    """On failure, attach the log tail of every node process the test started."""
+    outcome = yield
+    report = outcome.get_result()
+    setattr(item, f"rep_{report.when}", report)
+    if report.failed:
+        for proc in getattr(item, "_mobil_node_processes", []):
+            report.sections.append((f"node log: {proc.name} ({proc.log_path})",
+                                    proc.log_tail(60)))
+
+
+@pytest.fixture(scope="session")
+def ros_domain_id() -> int:
+    return DOMAIN_ID
+
+
+@pytest.fixture(scope="session")
+def rclpy_context(ros_domain_id: int) -> Iterator[Any]:
+    import rclpy
+    from rclpy.signals import SignalHandlerOptions
+    # No rclpy signal handlers: Ctrl-C stays pytest's KeyboardInterrupt.
+    rclpy.init(signal_handler_options=SignalHandlerOptions.NO)
+    from rclpy.utilities import get_default_context
+    yield get_default_context()
+    rclpy.try_shutdown()
+
+
+@pytest.fixture
+def spinner(rclpy_context: Any) -> Iterator[rosutil.Spinner]:
+    spin = rosutil.Spinner(context=rclpy_context).start()
+    yield spin
+    spin.stop()
+    if spin.errors:
+        raise AssertionError(f"{len(spin.errors)} rclpy callback(s) raised: "
+                             + "; ".join(repr(e) for e in spin.errors))
+
+
+@pytest.fixture
+def ros_node(spinner: rosutil.Spinner) -> Any:
+    """A fresh rclpy node, spun in the background; other nodes: ``spinner.add_node(n, own=True)``."""
+    import rclpy
+    node = rclpy.create_node(f"mobil_test_{next(_node_counter)}")
+    return spinner.add_node(node, own=True)
+
+
+@pytest.fixture
+def start_node(request: pytest.FixtureRequest, tmp_path: Path) -> Iterator[Callable[..., harness.NodeProcess]]:
+    """``start_node(exe, *ros_args, params_file=None, name=None, args=(), env=None,
+    check_exit_code=True) -> NodeProcess``; every started process is stopped at teardown."""
+    started: list[harness.NodeProcess] = []
+    request.node._mobil_node_processes = started
+
+    def start(exe: str, *ros_args: str, params_file: Any = None, name: str | None = None,
+              **kwargs: Any) -> harness.NodeProcess:
+        proc = harness.launch_node(exe, *ros_args, log_dir=tmp_path / "logs",
+                                   params_file=params_file, name=name, **kwargs)
+        started.append(proc)
+        return proc
+
+    yield start
+    errors = []
+    for proc in reversed(started):
+        try:
+            proc.stop()
+        except harness.NodeProcessError as exc:
+            errors.append(str(exc))
+    if errors:
+        pytest.fail("\n\n".join(errors), pytrace=False)
+
+
+@pytest.fixture
+def ros2cli() -> Callable[..., Any]:
+    """``ros2cli('topic', 'echo', '/odom', '--once', timeout=30) -> CompletedProcess``."""
+    return harness.run_ros2cli

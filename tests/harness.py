@@ -1,0 +1,337 @@
+"""Test harness for mobil's ROS 2 nodes: processes, topics, parameters.
+
+The pytest fixtures in conftest.py wrap these; they can also be used on their own (a script that
+called ``rosutil.setup_process_environment()``, ``rclpy.init()`` and spins its node with
+``rosutil.Spinner``).
+
+* ``NodeProcess`` / ``launch_node``: run an executable (a Rust node from ``MOBIL_BIN_DIR``) with
+  ``--ros-args``, log its output to a file, stop it with SIGINT and check that it exits.
+* ``wait_for_message``, ``collect``, ``subscribe``, ``publish_until``: topic helpers that wait
+  for actual messages, never for a fixed time.
+* ``param_get``, ``param_set``, ``param_list``: the rcl_interfaces parameter services, with
+  retries (shared with tests/ros2cli.py through rosutil).
+* ``run_ros2cli``: run tests/ros2cli.py as a subprocess in the test's ROS domain.
+"""
+
+from __future__ import annotations
+
+import atexit
+import os
+import re
+import shutil
+import signal
+import subprocess
+import sys
+import time
+from collections.abc import Callable, Sequence
+from pathlib import Path
+from typing import Any, Optional, Union
+
+import rosutil
+from rosutil import (  # noqa: F401  (re-exported for tests)
+    ROOT, TESTS_DIR, ServiceUnavailable, TopicRecorder, import_type, make_qos, message_to_yaml,
+    qos_default, qos_latched, qos_sensor, set_message_fields, wait_for_node, wait_until)
+
+__all__ = [
+    "BIN_DIR", "CLEAN_EXIT_CODES", "NodeProcess", "NodeProcessError", "ROOT", "ROS2CLI",
+    "ServiceUnavailable", "TESTS_DIR", "TopicRecorder", "collect", "import_type", "launch_node",
+    "make_qos", "message_to_yaml", "param_get", "param_list", "param_set", "publish_until",
+    "qos_default", "qos_latched", "qos_sensor", "resolve_executable", "run_ros2cli",
+    "set_message_fields", "subscribe", "wait_for_message", "wait_for_node", "wait_until",
+]
+
+BIN_DIR = Path(os.environ.get("MOBIL_BIN_DIR", str(ROOT / "target" / "release")))
+ROS2CLI = TESTS_DIR / "ros2cli.py"
+
+# Exit codes accepted after SIGINT: a clean exit, or death by the signal itself.
+CLEAN_EXIT_CODES = (0, -signal.SIGINT, 128 + signal.SIGINT)
+STOP_TIMEOUT = 5.0
+
+_live_processes: list["NodeProcess"] = []
+
+
+class NodeProcessError(AssertionError):
+    """A node process misbehaved: did not stop on SIGINT, crashed, or exited early."""
+
+
+class NodeProcess:
+    """A running node executable with its output in a log file.
+
+    Use ``stop()`` (SIGINT, then wait up to 5 s; SIGKILL only as a last resort, which is an
+    error) or ``wait()`` for a process expected to exit by itself. ``stop()`` raises
+    ``NodeProcessError`` if the process had to be killed, exited with an unclean code, or had
+    already exited by itself before (a crash) unless the test collected it with ``wait()``.
+    """
+
+    def __init__(self, cmd: Sequence[str], log_path: Path, env: dict[str, str],
+                 name: str, check_exit_code: bool = True, cwd: Optional[Path] = None) -> None:
+        self.cmd = list(cmd)
+        self.name = name
+        self.log_path = log_path
+        self.check_exit_code = check_exit_code
+        self.returncode: Optional[int] = None
+        self.stopped = False  # stop() or wait() has collected the process
+        self.killed = False
+        log_path.parent.mkdir(parents=True, exist_ok=True)
+        self._log = open(log_path, "wb")
+        prefix: list[str] = []
+        if shutil.which("setpriv"):
+            # Killed with pytest even if pytest itself is killed (no orphans).
+            prefix = ["setpriv", "--pdeathsig", "KILL", "--"]
+        self.proc = subprocess.Popen(
+            prefix + self.cmd, stdin=subprocess.DEVNULL, stdout=self._log,
+            stderr=subprocess.STDOUT, env=env, cwd=str(cwd or ROOT), start_new_session=True)
+        self.pid = self.proc.pid
+        self.started_at = time.monotonic()
+        _live_processes.append(self)
+
+    def __repr__(self) -> str:
+        state = "running" if self.running else f"exited {self.proc.returncode}"
+        return f"<NodeProcess {self.name} pid {self.pid} {state}>"
+
+    @property
+    def running(self) -> bool:
+        return self.proc.poll() is None
+
+    def log_text(self) -> str:
+        return self.log_path.read_text(errors="replace")
+
+    def log_tail(self, lines: int = 40) -> str:
+        text = self.log_text().splitlines()
+        return "\n".join(text[-lines:])
+
+    def wait_for_log(self, pattern: str, timeout: float = 10.0) -> re.Match:
+        """Wait until the output matches the regex ``pattern``; raise TimeoutError otherwise
+        (or at once if the process exits without printing it)."""
+        regex = re.compile(pattern, re.MULTILINE)
+        deadline = time.monotonic() + timeout
+        while True:
+            match = regex.search(self.log_text())
+            if match:
+                return match
+            if not self.running:
+                raise NodeProcessError(f"{self.name} exited ({self.proc.returncode}) without "
+                                       f"printing /{pattern}/\n{self._tail_block()}")
+            if time.monotonic() >= deadline:
+                raise TimeoutError(f"{self.name} did not print /{pattern}/ within {timeout:g} s"
+                                   f"\n{self._tail_block()}")
+            time.sleep(0.05)
+
+    def wait(self, timeout: float = 10.0) -> int:
+        """Wait for a process that is expected to exit by itself; return its exit code."""
+        try:
+            self.returncode = self.proc.wait(timeout)
+        except subprocess.TimeoutExpired:
+            raise TimeoutError(f"{self.name} still running after {timeout:g} s\n"
+                               f"{self._tail_block()}") from None
+        self._finish()
+        return self.returncode
+
+    def stop(self, timeout: float = STOP_TIMEOUT) -> int:
+        """SIGINT, wait up to ``timeout``; return the exit code (see class doc for errors)."""
+        if self.stopped:
+            assert self.returncode is not None
+            return self.returncode
+        problems: list[str] = []
+        early = self.proc.poll()
+        if early is not None:
+            problems.append(f"exited by itself with code {early} "
+                            f"{time.monotonic() - self.started_at:.1f} s after start, before "
+                            "it was stopped")
+        else:
+            self.proc.send_signal(signal.SIGINT)
+            try:
+                self.proc.wait(timeout)
+            except subprocess.TimeoutExpired:
+                self.proc.kill()
+                self.proc.wait(5.0)
+                self.killed = True
+                problems.append(f"did not exit within {timeout:g} s of SIGINT: killed (SIGKILL)")
+        self.returncode = self.proc.returncode
+        if (self.check_exit_code and not self.killed and early is None
+                and self.returncode not in CLEAN_EXIT_CODES):
+            problems.append(f"exited with code {self.returncode} after SIGINT")
+        self._finish()
+        if problems:
+            raise NodeProcessError(f"{self.name} (pid {self.pid}): {'; '.join(problems)}\n"
+                                   f"{self._tail_block()}")
+        return self.returncode
+
+    def kill(self) -> None:
+        """SIGKILL without checks (used at interpreter exit)."""
+        if self.proc.poll() is None:
+            self.proc.kill()
+            self.proc.wait(5.0)
+        self._finish()
+
+    def _finish(self) -> None:
+        self.stopped = True
+        self.returncode = self.proc.returncode
+        if not self._log.closed:
+            self._log.close()
+        if self in _live_processes:
+            _live_processes.remove(self)
+
+    def _tail_block(self, lines: int = 40) -> str:
+        return (f"--- last {lines} lines of {self.log_path} ---\n{self.log_tail(lines)}\n"
+                f"--- end of {self.name} log ---")
+
+
+@atexit.register
+def _kill_leftovers() -> None:
+    for proc in list(_live_processes):
+        print(f"harness: killing leftover {proc}", file=sys.stderr)
+        proc.kill()
+
+
+def resolve_executable(exe: Union[str, Path]) -> Path:
+    """A bare name is looked up in MOBIL_BIN_DIR; a path is used as it is."""
+    path = Path(exe)
+    if path.parent == Path("."):
+        path = BIN_DIR / path
+    if not path.is_file() or not os.access(path, os.X_OK):
+        raise FileNotFoundError(
+            f"node executable {path} not found (build it with `cargo build --release`, or set "
+            f"MOBIL_BIN_DIR)")
+    return path
+
+
+def launch_node(exe: Union[str, Path], *ros_args: str, log_dir: Path,
+                params_file: Union[str, Path, None] = None, name: Optional[str] = None,
+                args: Sequence[str] = (), env: Optional[dict[str, str]] = None,
+                check_exit_code: bool = True) -> NodeProcess:
+    """Start ``exe [args] --ros-args ROS_ARGS [--params-file F] [-r __node:=NAME]``.
+
+    ``params_file`` relative paths are relative to the repository root. ``env`` entries are
+    added to the ROS environment (domain id, Fast DDS profile, RUST_BACKTRACE=1).
+    """
+    path = resolve_executable(exe)
+    ros = list(ros_args)
+    if ros and ros[0] == "--ros-args":
+        ros = ros[1:]
+    if params_file is not None:
+        pf = Path(params_file)
+        pf = pf if pf.is_absolute() else ROOT / pf
+        if not pf.is_file():
+            raise FileNotFoundError(f"parameter file {pf} not found")
+        ros += ["--params-file", str(pf)]
+    if name is not None:
+        ros += ["-r", f"__node:={name}"]
+    cmd = [str(path), *args] + (["--ros-args", *ros] if ros else [])
+    child_env = rosutil.ros_environ()
+    child_env.setdefault("RUST_BACKTRACE", "1")
+    child_env.update(env or {})
+    label = name or path.name
+    log_path = log_dir / f"{label}-{int(time.time() * 1000) % 100000:05d}.log"
+    return NodeProcess(cmd, log_path, child_env, label, check_exit_code=check_exit_code)
+
+
+# --------------------------------------------------------------------------------------------
+# Topics
+# --------------------------------------------------------------------------------------------
+
+def subscribe(node: Any, msg_type: type, topic: str, qos: Any = None,
+              discovery_timeout: float = 10.0) -> TopicRecorder:
+    """Record every message of ``topic`` (close it, or use it as a context manager).
+
+    ``qos=None`` matches the publishers' QoS, waiting up to ``discovery_timeout`` for one.
+    """
+    return TopicRecorder(node, msg_type, topic, qos, discovery_timeout=discovery_timeout)
+
+
+def wait_for_message(node: Any, msg_type: type, topic: str,
+                     predicate: Optional[Callable[[Any], bool]] = None, timeout: float = 10.0,
+                     qos: Any = None) -> Any:
+    """First message on ``topic`` (received after the call) that satisfies ``predicate``.
+
+    ``qos=None`` matches the publishers (best effort if any is, transient local if all are),
+    waiting for a publisher to be discovered within the same ``timeout``; pass a profile (e.g.
+    ``qos_sensor()``, ``qos_latched()``) to subscribe at once. Raises TimeoutError describing what
+    was received and who publishes.
+    """
+    deadline = time.monotonic() + timeout
+    with TopicRecorder(node, msg_type, topic, qos, discovery_timeout=timeout) as rec:
+        return rec.wait_for(predicate, max(0.0, deadline - time.monotonic()))
+
+
+def collect(node: Any, msg_type: type, topic: str, duration: float, qos: Any = None,
+            first_timeout: float = 10.0, wait_first: bool = True) -> list[Any]:
+    """Messages of ``topic`` over ``duration`` seconds.
+
+    With ``wait_first`` (the default) the window starts at the first message, which must come
+    within ``first_timeout`` (TimeoutError otherwise), so discovery time does not shorten it;
+    without, the window starts now and the list may be empty.
+    """
+    with TopicRecorder(node, msg_type, topic, qos, discovery_timeout=first_timeout) as rec:
+        if wait_first:
+            rec.wait_for(None, first_timeout)
+            start = rec.times[0]
+        else:
+            start = time.monotonic()
+        time.sleep(max(0.0, start + duration - time.monotonic()))
+        return [m for m, t in zip(rec.snapshot(), list(rec.times)) if t <= start + duration]
+
+
+def publish_until(node: Any, pub: Any, msg: Union[Any, Callable[[], Any]],
+                  until_predicate: Callable[[], Any], rate_hz: float = 10.0,
+                  timeout: float = 10.0) -> int:
+    """Publish ``msg`` (or ``msg()`` each time, for fresh stamps) at ``rate_hz`` until
+    ``until_predicate()`` is truthy; return how many were published. Raises TimeoutError.
+
+    Typical use: keep sending a command until the node under test shows it acted on it, e.g.
+    ``publish_until(node, cmd_pub, twist, lambda: odom.latest and odom.latest.twist.twist.linear.x
+    > 0.1)`` with ``odom = subscribe(node, Odometry, 'odom')``.
+    """
+    period = 1.0 / rate_hz
+    deadline = time.monotonic() + timeout
+    count = 0
+    next_time = time.monotonic()
+    while True:
+        if until_predicate():
+            return count
+        now = time.monotonic()
+        if now >= deadline:
+            raise TimeoutError(f"condition not met within {timeout:g} s after publishing "
+                               f"{count} message(s) on {pub.topic_name} "
+                               f"({pub.get_subscription_count()} matched subscription(s))")
+        if now >= next_time:
+            pub.publish(msg() if callable(msg) else msg)
+            count += 1
+            next_time += period
+            if next_time < now:
+                next_time = now + period
+        time.sleep(max(0.0, min(0.01, next_time - time.monotonic())))
+
+
+# --------------------------------------------------------------------------------------------
+# Parameters
+# --------------------------------------------------------------------------------------------
+
+def param_get(node: Any, target_node: str, name: str, timeout: float = 10.0) -> Any:
+    """Value of ``target_node``'s parameter ``name`` as a Python value (None if not set)."""
+    values = rosutil.get_parameters(node, target_node, [name], timeout=timeout)
+    return rosutil.parameter_value_to_python(values[0]) if values else None
+
+
+def param_set(node: Any, target_node: str, name: str, value: Any, timeout: float = 10.0) -> Any:
+    """Set one parameter (Python value: bool/int/float/str/list); return the
+    rcl_interfaces/SetParametersResult (``.successful``, ``.reason``)."""
+    return rosutil.set_parameters(node, target_node, {name: value}, timeout=timeout)[0]
+
+
+def param_list(node: Any, target_node: str, timeout: float = 10.0) -> list[str]:
+    """Sorted names of ``target_node``'s parameters."""
+    return rosutil.list_parameters(node, target_node, timeout=timeout)
+
+
+# --------------------------------------------------------------------------------------------
+# The command-line tool
+# --------------------------------------------------------------------------------------------
+
+def run_ros2cli(*args: str, timeout: float = 30.0,
+                env: Optional[dict[str, str]] = None) -> subprocess.CompletedProcess:
+    """Run ``tests/ros2cli.py ARGS`` in this ROS domain; return the completed process (text)."""
+    child_env = rosutil.ros_environ()
+    child_env.update(env or {})
+    return subprocess.run([sys.executable, str(ROS2CLI), *args], env=child_env,
+                          capture_output=True, text=True, timeout=timeout, cwd=str(ROOT))
