@@ -286,7 +286,7 @@ def cmd_topic_pub(args: argparse.Namespace) -> int:
 
         try:
             build()
-        except (rosutil.MessageFieldError, ValueError, TypeError) as exc:
+        except (ValueError, TypeError, AttributeError) as exc:
             raise CliError(f"failed to populate the message: {exc}")
         topic = rosutil.resolve_topic(s.node, args.topic)
         pub = s.node.create_publisher(msg_type, topic, qos)
@@ -413,7 +413,7 @@ def cmd_service_call(args: argparse.Namespace) -> int:
     try:
         values = yaml.safe_load(args.values) if args.values else {}
         request = rosutil.set_message_fields(srv_type.Request(), values)
-    except (yaml.YAMLError, rosutil.MessageFieldError, ValueError, TypeError) as exc:
+    except (yaml.YAMLError, ValueError, TypeError, AttributeError) as exc:
         raise CliError(f"failed to populate the request: {exc}")
     with Session("service_call") as s:
         print(f"requester: making request: {request!r}\n", flush=True)

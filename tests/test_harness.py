@@ -324,6 +324,7 @@ def test_start_node_with_ros_args(start_node, ros_node, fake_exe, tmp_path, ros_
 
 def test_child_gets_the_domain(start_node, fake_exe, ros_domain_id):
     proc = start_node(str(fake_exe))
+    proc.wait_for_log("up as")  # exec'd: /proc/PID/environ is the child's own now
     # The environment the child was started with (the domain is how tests stay isolated).
     environ = Path(f"/proc/{proc.pid}/environ").read_bytes().split(b"\0")
     assert f"ROS_DOMAIN_ID={ros_domain_id}".encode() in environ
@@ -383,20 +384,20 @@ def test_publish_until(ros_node):
 # --------------------------------------------------------------------------------------------
 
 def test_set_message_fields_nested_arrays_and_stamps():
-    odom = rosutil.set_message_fields(Odometry(), {
+    odom = rosutil.fill_message(Odometry(), {
         "header": "auto", "child_frame_id": "base_link",
         "pose": {"pose": {"position": {"x": 1, "y": 2.5}}, "covariance": [0] * 36}})
     assert odom.header.stamp.sec > 0
     assert odom.pose.pose.position.x == 1.0 and odom.child_frame_id == "base_link"
-    path = rosutil.set_message_fields(PathMsg(), {
+    path = rosutil.fill_message(PathMsg(), {
         "header": {"frame_id": "odom", "stamp": "now"},
         "poses": [{"pose": {"position": {"x": 1.0}}}, {"pose": {"orientation": {"w": 1}}}]})
     assert len(path.poses) == 2 and path.poses[1].pose.orientation.w == 1.0
     assert path.header.stamp.sec > 0
     with pytest.raises(rosutil.MessageFieldError, match="36"):
-        rosutil.set_message_fields(Odometry(), {"pose": {"covariance": [0.0]}})
+        rosutil.fill_message(Odometry(), {"pose": {"covariance": [0.0]}})
     with pytest.raises(rosutil.MessageFieldError, match="integer"):
-        rosutil.set_message_fields(Odometry(), {"header": {"stamp": {"sec": 1.5}}})
+        rosutil.fill_message(Odometry(), {"header": {"stamp": {"sec": 1.5}}})
 
 
 def test_message_to_yaml_round_trip():

@@ -9,9 +9,10 @@
 //!   shutdown on SIGINT/SIGTERM;
 //! - [`qos`]: the QoS presets of the interface contract;
 //! - [`log`]: `tracing` set-up and rate-limited warnings;
-//! - [`time`]: message stamps.
+//! - [`time`]: message stamps; [`geometry`]: planar poses in messages.
 
 pub mod args;
+pub mod geometry;
 pub mod log;
 pub mod names;
 pub mod node;

@@ -1,19 +1,14 @@
-//! Budgets: one 1081-beam scan of the built-in world well under 1 ms; one plant step (200 Hz
-//! physics) well under 10 µs.
+//! Budget: one plant step (200 Hz physics) well under 10 µs. The LIDAR has its own bench
+//! (`benches/lidar.rs`).
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use mobil_chassis::{inverse, BodyTwist, ChassisParams};
-use mobil_sim::lidar::{Lidar, LidarConfig};
 use mobil_sim::plant::{Plant, PlantConfig};
 use mobil_sim::world::World;
 use std::hint::black_box;
 
 fn bench(c: &mut Criterion) {
     let world = World::builtin();
-    let mut lidar = Lidar::new(LidarConfig::default(), 1);
-    c.bench_function("lidar_scan_1081_beams_builtin_world", |b| {
-        b.iter(|| lidar.scan(black_box(&world), black_box((0.5, 0.2, 0.3))))
-    });
     let params = ChassisParams::mobil2();
     let mut plant = Plant::new(
         PlantConfig {

@@ -9,12 +9,13 @@ use mobil_chassis::kinematics::BodyTwist;
 use mobil_chassis::model::ChassisModel;
 use mobil_chassis::odometry::OdometryNoise;
 use mobil_chassis::ros_params::{chassis_from_params, chassis_param_specs};
-use mobil_msgs::geometry_msgs::msg::{Quaternion, Transform, TransformStamped, Twist, Vector3};
+use mobil_msgs::geometry_msgs::msg::{Transform, TransformStamped, Twist, Vector3};
 use mobil_msgs::mobil_msgs::msg::ChassisStatus;
 use mobil_msgs::nav_msgs::msg::Odometry;
 use mobil_msgs::sensor_msgs::msg::JointState;
 use mobil_msgs::std_msgs::msg::Header;
 use mobil_msgs::tf2_msgs::msg::TFMessage;
+use mobil_ros::geometry::{planar_odometry, yaw_quaternion};
 use mobil_ros::params::ParamValues;
 use mobil_ros::time::{is_zero, secs_from_stamp, stamp_from_secs};
 use mobil_ros::{qos, run_node, shutdown_signal, warn_throttled, LogThrottle, NodeDecl, ParamSpec, RosNode};
@@ -98,15 +99,6 @@ fn node_config(p: &ParamValues) -> Result<NodeConfig, String> {
 
 fn main() -> ExitCode {
     run_node(&decl(), |node| Box::pin(run(node)))
-}
-
-fn yaw_quaternion(yaw: f64) -> Quaternion {
-    Quaternion {
-        x: 0.0,
-        y: 0.0,
-        z: (0.5 * yaw).sin(),
-        w: (0.5 * yaw).cos(),
-    }
 }
 
 /// Places a 3×3 (x, y, yaw) covariance into a 6×6 (x, y, z, roll, pitch, yaw) row-major one; the
@@ -315,18 +307,13 @@ fn publish_odometry(
         stamp,
         frame_id: config.odom_frame.clone(),
     };
-    let mut msg = Odometry {
-        header: header.clone(),
-        child_frame_id: config.base_frame.clone(),
-        ..Default::default()
-    };
-    msg.pose.pose.position.x = pose.x;
-    msg.pose.pose.position.y = pose.y;
-    msg.pose.pose.orientation = yaw_quaternion(pose.z);
+    let mut msg = planar_odometry(
+        header.clone(),
+        &config.base_frame,
+        pose.into(),
+        [twist.vx, twist.vy, twist.wz],
+    );
     msg.pose.covariance = covariance_6x6(&odo.reference_covariance());
-    msg.twist.twist.linear.x = twist.vx;
-    msg.twist.twist.linear.y = twist.vy;
-    msg.twist.twist.angular.z = twist.wz;
     msg.twist.covariance = covariance_6x6(&odo.reference_twist_covariance());
     if let Err(e) = odom_pub.publish(msg) {
         warn!("cannot publish odom: {e:?}");

@@ -7,12 +7,13 @@
 use futures::StreamExt;
 use mobil_chassis::joints::wheel_state_from_joints;
 use mobil_chassis::ros_params::{chassis_from_params, chassis_param_specs};
-use mobil_msgs::geometry_msgs::msg::{Quaternion, Transform, TransformStamped, Vector3};
+use mobil_msgs::geometry_msgs::msg::{Transform, TransformStamped, Vector3};
 use mobil_msgs::nav_msgs::msg::Odometry;
 use mobil_msgs::rosgraph_msgs::msg::Clock;
 use mobil_msgs::sensor_msgs::msg::{JointState, LaserScan};
 use mobil_msgs::std_msgs::msg::Header;
 use mobil_msgs::tf2_msgs::msg::TFMessage;
+use mobil_ros::geometry::{planar_odometry, yaw_quaternion};
 use mobil_ros::params::ParamValues;
 use mobil_ros::time::{stamp_from_nanos, stamp_from_secs};
 use mobil_ros::{qos, run_node, shutdown_signal, warn_throttled, LogThrottle, NodeDecl, ParamSpec, RosNode};
@@ -146,15 +147,6 @@ fn main() -> ExitCode {
     run_node(&decl(), |node| Box::pin(run(node)))
 }
 
-fn yaw_quaternion(yaw: f64) -> Quaternion {
-    Quaternion {
-        x: 0.0,
-        y: 0.0,
-        z: (0.5 * yaw).sin(),
-        w: (0.5 * yaw).cos(),
-    }
-}
-
 async fn run(node: &mut RosNode) -> anyhow::Result<()> {
     let mut config = sim_config(&node.params()).map_err(anyhow::Error::msg)?;
     let mut plant = Plant::new(config.plant, config.initial_pose, config.seed);
@@ -270,17 +262,12 @@ async fn run(node: &mut RosNode) -> anyhow::Result<()> {
                     });
                     let pose = plant.reference_pose();
                     let twist = plant.reference_twist();
-                    let mut truth = Odometry {
-                        header: Header { stamp, frame_id: config.world_frame.clone() },
-                        child_frame_id: config.base_frame.clone(),
-                        ..Default::default()
-                    };
-                    truth.pose.pose.position.x = pose.x;
-                    truth.pose.pose.position.y = pose.y;
-                    truth.pose.pose.orientation = yaw_quaternion(pose.z);
-                    truth.twist.twist.linear.x = twist.vx;
-                    truth.twist.twist.linear.y = twist.vy;
-                    truth.twist.twist.angular.z = twist.wz;
+                    let truth = planar_odometry(
+                        Header { stamp, frame_id: config.world_frame.clone() },
+                        &config.base_frame,
+                        pose.into(),
+                        [twist.vx, twist.vy, twist.wz],
+                    );
                     let _ = truth_pub.publish(truth);
                 }
                 if let (Some(l), Some(cfg)) = (lidar.as_mut(), config.lidar.as_ref()) {

@@ -6,6 +6,7 @@ use futures::StreamExt;
 use mobil_chassis::angles::wrap;
 use mobil_msgs::geometry_msgs::msg::Twist;
 use mobil_msgs::nav_msgs::msg::Odometry;
+use mobil_ros::geometry::yaw_of;
 use mobil_ros::params::ParamValues;
 use mobil_ros::{qos, run_node, shutdown_signal, NodeDecl, ParamSpec, RosNode};
 use mobil_sim::plot::{write_svg, Track};
@@ -45,9 +46,11 @@ fn main() -> ExitCode {
 }
 
 fn pose(m: &Odometry) -> (f64, f64, f64) {
-    let q = &m.pose.pose.orientation;
-    let yaw = (2.0 * (q.w * q.z + q.x * q.y)).atan2(1.0 - 2.0 * (q.y * q.y + q.z * q.z));
-    (m.pose.pose.position.x, m.pose.pose.position.y, yaw)
+    (
+        m.pose.pose.position.x,
+        m.pose.pose.position.y,
+        yaw_of(&m.pose.pose.orientation),
+    )
 }
 
 async fn drive(node: &mut RosNode) -> anyhow::Result<()> {

@@ -1,0 +1,88 @@
+"""The launch scripts a user runs: one per robot (all nodes up, all gone on Ctrl-C) and the demo."""
+
+from __future__ import annotations
+
+import os
+import re
+import signal
+import subprocess
+import time
+from pathlib import Path
+
+import pytest
+
+import harness
+from harness import ROOT, param_get, wait_for_message
+
+from nav_msgs.msg import Odometry
+from rcl_interfaces.srv import DescribeParameters
+
+
+def _pids_of(name: str) -> set[int]:
+    out = subprocess.run(["pgrep", "-x", name], capture_output=True, text=True)
+    return {int(p) for p in out.stdout.split()}
+
+
+def _script_env() -> dict[str, str]:
+    env = harness.rosutil.ros_environ()
+    env["MOBIL_SKIP_BUILD"] = "1"  # tests/run_all built the executables already
+    env["MOBIL_BIN_DIR"] = str(harness.BIN_DIR)
+    return env
+
+
+@pytest.mark.parametrize("robot,model", [("omr3", "omni"), ("tricycle", "tricycle")])
+def test_robot_script_starts_its_nodes_and_ctrl_c_stops_them_all(robot, model, ros_node, tmp_path):
+    before = _pids_of("sim_node") | _pids_of("chassis_node")
+    log = open(tmp_path / "launch.log", "wb")
+    script = subprocess.Popen([str(ROOT / "launch_scripts" / robot), "-r", "__ns:=/launch_test"],
+                              env=_script_env(), stdout=log, stderr=subprocess.STDOUT, start_new_session=True)
+    try:
+        odom = wait_for_message(ros_node, Odometry, "/launch_test/odom", timeout=20)
+        assert odom.header.frame_id == "odom"
+        assert param_get(ros_node, "/launch_test/chassis", "model") == model
+        assert param_get(ros_node, "/launch_test/sim", "model") == model
+        started = (_pids_of("sim_node") | _pids_of("chassis_node")) - before
+        assert len(started) == 2, started
+        # Ctrl-C in a terminal signals the whole foreground process group.
+        os.killpg(script.pid, signal.SIGINT)
+        assert script.wait(timeout=10) in (0, 130)
+        assert harness.wait_until(lambda: not (started & (_pids_of("sim_node") | _pids_of("chassis_node"))),
+                                  timeout=5), "nodes left running"
+    finally:
+        if script.poll() is None:
+            os.killpg(script.pid, signal.SIGKILL)
+        log.close()
+
+
+@pytest.mark.timeout(120)
+def test_demo_drives_the_route_and_plots_it(tmp_path):
+    out = subprocess.run([str(ROOT / "launch_scripts" / "demo")], env=_script_env(), capture_output=True,
+                         text=True, timeout=110)
+    assert out.returncode == 0, out.stdout + out.stderr
+    m = re.search(r"demo: drove ([\d.]+) m; final odometry error ([\d.]+) m", out.stdout)
+    assert m, out.stdout
+    driven, error = float(m.group(1)), float(m.group(2))
+    # The loop: 2·2 m + 2·1 m straights and four quarter circles of radius 1 m = 6 + 2π = 12.28 m at
+    # the rear axle; the reference point 0.30 m ahead runs slightly longer through the corners.
+    assert 12.2 < driven < 12.8
+    assert error < 0.01 * driven
+    svg = (ROOT / "demo_out" / "mobil2_run.svg").read_text()
+    assert "ground truth" in svg and "odometry" in svg and svg.count("<polyline") >= 2
+
+
+def test_describe_parameters_answers_a_stock_client(start_node, ros_node):
+    start_node("chassis_node", params_file="params/mobil2.yaml")
+    client = ros_node.create_client(DescribeParameters, "/chassis/describe_parameters")
+    assert client.wait_for_service(timeout_sec=10)
+    req = DescribeParameters.Request(names=["v_max", "model"])
+    for _ in range(5):  # the first call after discovery can be lost (ROS2-NOTES)
+        future = client.call_async(req)
+        deadline = time.monotonic() + 2
+        while not future.done() and time.monotonic() < deadline:
+            time.sleep(0.01)
+        if future.done():
+            break
+    result = future.result()
+    assert [d.name for d in result.descriptors] == ["v_max", "model"]
+    # rcl_interfaces/ParameterType: PARAMETER_DOUBLE = 3, PARAMETER_STRING = 4.
+    assert [d.type for d in result.descriptors] == [3, 4]
