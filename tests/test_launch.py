@@ -55,7 +55,7 @@ def test_robot_script_starts_its_nodes_and_ctrl_c_stops_them_all(robot, model, r
 
 
 @pytest.mark.timeout(120)
-def test_demo_drives_the_route_and_plots_it(tmp_path):
+def test_demo_drives_the_route_and_plots_it():
     out = subprocess.run([str(ROOT / "launch_scripts" / "demo")], env=_script_env(), capture_output=True,
                          text=True, timeout=110)
     assert out.returncode == 0, out.stdout + out.stderr
@@ -65,7 +65,8 @@ def test_demo_drives_the_route_and_plots_it(tmp_path):
     # The loop: 2·2 m + 2·1 m straights and four quarter circles of radius 1 m = 6 + 2π = 12.28 m at
     # the rear axle; the reference point 0.30 m ahead runs slightly longer through the corners.
     assert 12.2 < driven < 12.8
-    assert error < 0.01 * driven
+    # Encoders in the demo read 0.5 % fast with 2 % noise: drift of a few centimetres.
+    assert error < 0.02 * driven
     svg = (ROOT / "demo_out" / "mobil2_run.svg").read_text()
     assert "ground truth" in svg and "odometry" in svg and svg.count("<polyline") >= 2
 
