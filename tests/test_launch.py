@@ -30,8 +30,8 @@ def _script_env() -> dict[str, str]:
     return env
 
 
-@pytest.mark.parametrize("robot,model", [("omr3", "omni"), ("tricycle", "tricycle")])
-def test_robot_script_starts_its_nodes_and_ctrl_c_stops_them_all(robot, model, ros_node, tmp_path):
+@pytest.mark.parametrize("robot,model,how", [("omr3", "omni", "ctrl-c"), ("tricycle", "tricycle", "sigterm")])
+def test_robot_script_starts_its_nodes_and_stopping_it_stops_them_all(robot, model, how, ros_node, tmp_path):
     before = _pids_of("sim_node") | _pids_of("chassis_node")
     log = open(tmp_path / "launch.log", "wb")
     script = subprocess.Popen([str(ROOT / "launch_scripts" / robot), "-r", "__ns:=/launch_test"],
@@ -43,9 +43,15 @@ def test_robot_script_starts_its_nodes_and_ctrl_c_stops_them_all(robot, model, r
         assert param_get(ros_node, "/launch_test/sim", "model") == model
         started = (_pids_of("sim_node") | _pids_of("chassis_node")) - before
         assert len(started) == 2, started
-        # Ctrl-C in a terminal signals the whole foreground process group.
-        os.killpg(script.pid, signal.SIGINT)
-        assert script.wait(timeout=10) in (0, 130)
+        if how == "ctrl-c":
+            # Ctrl-C in a terminal signals the whole foreground process group.
+            os.killpg(script.pid, signal.SIGINT)
+        else:
+            # A process manager stops the script alone; it must take its nodes with it.
+            script.send_signal(signal.SIGTERM)
+        assert script.wait(timeout=10) in (0, 130, 143)
+        # Cleanly: each node logged its own shutdown (no SIGKILL was needed).
+        assert harness.wait_until(lambda: (tmp_path / "launch.log").read_text().count("shut down") == 2, timeout=5)
         assert harness.wait_until(lambda: not (started & (_pids_of("sim_node") | _pids_of("chassis_node"))),
                                   timeout=5), "nodes left running"
     finally:
