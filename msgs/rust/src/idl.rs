@@ -548,3 +548,107 @@ impl Packages {
         Ok(out)
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn parses_fields_arrays_constants_and_defaults() {
+        let text = "\
+# a comment
+uint8 FLAT=0   # trailing comment
+string GREETING=hello # not a comment in a string constant
+std_msgs/Header header
+float64[36] covariance
+int32[] counts
+uint8[<=4] small
+string<=8 name \"x#y\"
+float64 w 1
+bool[2] flags [true, false]
+Point[] points
+";
+        let m = parse_msg("pkg", "Demo", text).unwrap();
+        assert_eq!(m.constants.len(), 2);
+        assert_eq!(m.constants[0].value, "0");
+        assert_eq!(m.constants[1].value, "hello # not a comment in a string constant");
+        let ty = |i: usize| &m.fields[i].ty;
+        assert_eq!(
+            ty(0).base,
+            BaseType::Message {
+                package: "std_msgs".into(),
+                name: "Header".into()
+            }
+        );
+        assert_eq!(ty(1).array, ArrayKind::Fixed(36));
+        assert_eq!(ty(2).array, ArrayKind::Unbounded);
+        assert_eq!(ty(3).array, ArrayKind::Bounded(4));
+        assert_eq!(ty(4).base, BaseType::String { bound: Some(8) });
+        assert_eq!(m.fields[4].default.as_deref(), Some("\"x#y\""));
+        assert_eq!(m.fields[5].default.as_deref(), Some("1"));
+        assert_eq!(
+            ty(7).base,
+            BaseType::Message {
+                package: "pkg".into(),
+                name: "Point".into()
+            }
+        );
+    }
+
+    #[test]
+    fn refuses_malformed_definitions() {
+        assert!(parse_msg("p", "M", "float64").is_err());
+        assert!(parse_msg("p", "M", "float64[x] a").is_err());
+        assert!(parse_msg("p", "M", "float64[3 a").is_err());
+        assert!(parse_msg("p", "M", "wstring a").is_err());
+        assert!(parse_msg("p", "M", "int32 a\nint32 a").is_err());
+        assert!(parse_msg("p", "M", "Point[] P=3").is_err());
+        assert!(parse_msg("p", "M", "int32 9a").is_err());
+        assert!(split_srv("int32 a\nint32 b").is_err());
+        let e = parse_msg("p", "M", "int32 ok\nbad").unwrap_err();
+        assert_eq!(e.line, 2);
+    }
+
+    #[test]
+    fn literals_are_checked_against_their_type() {
+        assert_eq!(Primitive::Uint8.literal("255").unwrap(), "255");
+        assert!(Primitive::Uint8.literal("256").is_err());
+        assert!(Primitive::Int8.literal("-129").is_err());
+        assert_eq!(Primitive::Float64.literal("1").unwrap(), "1.0");
+        assert!(Primitive::Float32.literal("nan").is_err());
+        assert_eq!(Primitive::Bool.literal("True").unwrap(), "true");
+    }
+
+    #[test]
+    fn generates_keyword_safe_fields_defaults_and_big_arrays() {
+        let mut p = Packages::default();
+        p.add_message("pkg", "Inner", "float64 w 1\n").unwrap();
+        p.add_message("pkg", "Outer", "int32 type\nfloat64[40] big\nInner inner\nint32 K=-3\n")
+            .unwrap();
+        p.add_service("pkg", "Do", "Inner a\n---\nbool ok\n").unwrap();
+        let code = p.generate().unwrap();
+        assert!(code.contains("pub r#type: i32,"));
+        assert!(code.contains("#[serde(with = \"::serde_big_array::BigArray\")]"));
+        assert!(code.contains("w: 1.0,"));
+        assert!(code.contains("pub const K: i32 = -3;"));
+        assert!(code.contains("pub struct DoRequest") && code.contains("type Response = DoResponse;"));
+        // An unknown nested type is an error, not code that fails to compile later.
+        let mut bad = Packages::default();
+        bad.add_message("pkg", "M", "Missing m\n").unwrap();
+        assert!(bad
+            .generate()
+            .unwrap_err()
+            .message
+            .contains("unknown message type pkg/Missing"));
+    }
+
+    #[test]
+    fn empty_messages_get_the_idl_dummy_member() {
+        let mut p = Packages::default();
+        p.add_message("pkg", "Empty", "# nothing\n").unwrap();
+        assert!(p
+            .generate()
+            .unwrap()
+            .contains("pub structure_needs_at_least_one_member: u8,"));
+    }
+}
