@@ -113,15 +113,20 @@ def cmd_node_list(args: argparse.Namespace) -> int:
     return 0
 
 
+def print_names_and_types(entries, include_hidden: bool, show_types: bool) -> int:
+    """Print a `ros2 topic list` / `ros2 service list` style listing."""
+    for name, types in entries:
+        if not include_hidden and any(p.startswith("_") for p in name.split("/")):
+            continue
+        print(f"{name} [{', '.join(types)}]" if show_types else name)
+    return 0
+
+
 def cmd_topic_list(args: argparse.Namespace) -> int:
     with Session("topic_list") as s:
         topics = settle_graph(s.node, lambda: sorted(
             (n, tuple(t)) for n, t in s.node.get_topic_names_and_types()), args.spin_time)
-    for name, types in topics:
-        if not args.include_hidden_topics and any(p.startswith("_") for p in name.split("/")):
-            continue
-        print(f"{name} [{', '.join(types)}]" if args.show_types else name)
-    return 0
+    return print_names_and_types(topics, args.include_hidden_topics, args.show_types)
 
 
 def cmd_topic_info(args: argparse.Namespace) -> int:
@@ -400,11 +405,7 @@ def cmd_service_list(args: argparse.Namespace) -> int:
     with Session("service_list") as s:
         services = settle_graph(s.node, lambda: sorted(
             (n, tuple(t)) for n, t in s.node.get_service_names_and_types()), args.spin_time)
-    for name, types in services:
-        if not args.include_hidden_services and any(p.startswith("_") for p in name.split("/")):
-            continue
-        print(f"{name} [{', '.join(types)}]" if args.show_types else name)
-    return 0
+    return print_names_and_types(services, args.include_hidden_services, args.show_types)
 
 
 def cmd_service_call(args: argparse.Namespace) -> int:

@@ -289,13 +289,19 @@ impl RosNode {
         Name::parse(&full).map_err(|e| anyhow!("bad topic name {full}: {e:?}"))
     }
 
-    /// A publisher on `topic` (resolved and remapped).
-    pub fn publisher<M: RosMessage>(&mut self, topic: &str, qos: &QosProfile) -> anyhow::Result<Publisher<M>> {
+    /// The DDS topic of `topic` (resolved and remapped) for messages of type `M`.
+    fn topic<M: RosMessage>(&mut self, topic: &str, qos: &QosProfile) -> anyhow::Result<(rustdds::Topic, Name)> {
         let name = self.topic_name(topic)?;
         let t = self
             .node
             .create_topic(&name, M::type_name(), qos)
             .map_err(|e| anyhow!("cannot create topic {name}: {e:?}"))?;
+        Ok((t, name))
+    }
+
+    /// A publisher on `topic` (resolved and remapped).
+    pub fn publisher<M: RosMessage>(&mut self, topic: &str, qos: &QosProfile) -> anyhow::Result<Publisher<M>> {
+        let (t, name) = self.topic::<M>(topic, qos)?;
         self.node
             .create_publisher(&t, Some(qos.clone()))
             .map_err(|e| anyhow!("cannot publish {name}: {e:?}"))
@@ -303,11 +309,7 @@ impl RosNode {
 
     /// A subscription to `topic` (resolved and remapped).
     pub fn subscription<M: RosMessage>(&mut self, topic: &str, qos: &QosProfile) -> anyhow::Result<Subscription<M>> {
-        let name = self.topic_name(topic)?;
-        let t = self
-            .node
-            .create_topic(&name, M::type_name(), qos)
-            .map_err(|e| anyhow!("cannot create topic {name}: {e:?}"))?;
+        let (t, name) = self.topic::<M>(topic, qos)?;
         self.node
             .create_subscription(&t, Some(qos.clone()))
             .map_err(|e| anyhow!("cannot subscribe {name}: {e:?}"))
