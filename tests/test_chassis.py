@@ -212,11 +212,12 @@ def test_bad_joint_states_are_dropped_and_do_not_move_odometry(start_node, ros_n
         assert good.pose.pose.position.x == pytest.approx(0.3, abs=1e-9)
         rejected_before = status.wait_for(None, timeout=5).rejected_messages
         count_before = len(odom)
-        # Three arrays of different lengths, a missing joint, NaN, then time going backwards.
+        # Three arrays of different lengths, a missing joint, NaN, then time going backwards
+        # (0.2 s: an out-of-order sample; a jump beyond the feedback timeout restarts the clock).
         fb.publish(joint_state(101.1, names, [0.0], [6.0, -3.0, -3.0]))
         fb.publish(joint_state(101.2, names[:2], [], [6.0, -3.0]))
         fb.publish(joint_state(101.3, names, [], [float("nan"), -3.0, -3.0]))
-        fb.publish(joint_state(100.5, names, [], [6.0, -3.0, -3.0]))
+        fb.publish(joint_state(100.8, names, [], [6.0, -3.0, -3.0]))
         status.wait_for(lambda s: s.rejected_messages >= rejected_before + 4, timeout=5)
         assert len(odom) == count_before, "a rejected sample published odometry"
         assert odom.latest.pose.pose.position.x == pytest.approx(0.3, abs=1e-9)
@@ -324,3 +325,24 @@ def test_use_sim_time_follows_a_clock_published_by_rclpy(start_node, ros_node):
                       and status.latest.header.stamp.sec == 1000, rate_hz=20, timeout=10)
         publish_until(ros_node, clock, at(2000), lambda: status.latest.header.stamp.sec == 2000,
                       rate_hz=20, timeout=10)
+
+
+def test_a_stamp_far_in_the_future_costs_one_sample_not_the_odometry(start_node, ros_node):
+    start_node("chassis_node", params_file="params/omr3.yaml")
+    names = ["wheel_1", "wheel_2", "wheel_3"]
+    fb = ros_node.create_publisher(JointState, "joint_states", 10)
+    with subscribe(ros_node, Odometry, "odom", qos=harness.qos_default()) as odom:
+        stamps = iter(50.0 + 0.01 * k for k in range(100))
+        publish_until(ros_node, fb, lambda: joint_state(next(stamps), names, [], [0.0, 0.0, 0.0]),
+                      lambda: odom.latest is not None, rate_hz=10, timeout=9)
+        fb.publish(joint_state(60.0, names, [], [0.0, 0.0, 0.0]))
+        # 0.3 m/s for 0.5 s, one sample stamped 1e6 s ahead, then 0.5 s more on the real clock.
+        for i in range(1, 6):
+            fb.publish(joint_state(60.0 + 0.1 * i, names, [], [6.0, -3.0, -3.0]))
+        fb.publish(joint_state(1e6, names, [], [6.0, -3.0, -3.0]))
+        fb.publish(joint_state(60.6, names, [], [6.0, -3.0, -3.0]))
+        for i in range(7, 12):
+            fb.publish(joint_state(60.0 + 0.1 * i, names, [], [6.0, -3.0, -3.0]))
+        last = odom.wait_for(lambda m: m.header.stamp.sec == 61 and m.header.stamp.nanosec == 100_000_000, timeout=5)
+    # 0.15 m before the bad stamp; after it the clock restarts at 60.6 and 60.7…61.1 add 0.15 m.
+    assert last.pose.pose.position.x == pytest.approx(0.30, abs=1e-6)

@@ -9,6 +9,13 @@
 //! lateral). The wheels are commanded to zero when no valid `cmd_vel` arrived within
 //! `cmd_vel_timeout_s`, and when wheel feedback is stale (no valid `joint_states` within
 //! `feedback_timeout_s`): a robot is never left moving on stale data.
+//!
+//! Feedback time: a sample is integrated over the interval since the previous one. A gap longer
+//! than the feedback timeout (a dropout, or a stamp far in the future) is not integrated across —
+//! the odometry restarts its clock there and reports it; a stamp more than that far in the past is
+//! taken as a clock reset (a restarted simulation) and handled the same way. A stamp slightly in
+//! the past (an out-of-order sample) is refused. So one bad stamp costs one sample, never the
+//! odometry.
 
 use crate::error::{ChassisError, OdometryError};
 use crate::kinematics::{forward, inverse, pre_steer, twist_at_origin, twist_at_reference, BodyTwist, WheelState};
@@ -79,6 +86,21 @@ pub struct ChassisController {
     feedback_watchdog: CmdVelWatchdog,
     odometry: Odometry,
     requested: Command,
+    /// The last finite `cmd_vel` (at the reference point), re-clamped when the limits change.
+    request: Option<BodyTwist>,
+}
+
+/// What happened to a feedback sample that was used.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum FeedbackOutcome {
+    /// Integrated over the interval since the previous sample.
+    Integrated,
+    /// The first sample, or one after a gap or clock jump of this many seconds (negative: the
+    /// clock went back): its stamp starts a new interval, nothing was integrated.
+    Restarted {
+        /// The jump since the previous sample, `None` for the first sample.
+        gap_s: Option<f64>,
+    },
 }
 
 impl ChassisController {
@@ -89,6 +111,7 @@ impl ChassisController {
             feedback_watchdog: CmdVelWatchdog::new(config.feedback_timeout_s)?,
             odometry: Odometry::new(config.params.reference_offset(), config.noise)?,
             requested: Command::stop(&config.params),
+            request: None,
             config,
         })
     }
@@ -114,6 +137,11 @@ impl ChassisController {
         self.cmd_watchdog = cmd;
         self.feedback_watchdog = fb;
         self.config = config;
+        // The running command was worked out under the old limits: work it out again.
+        self.requested = match self.request {
+            Some(request) => self.command_for(request),
+            None => Command::stop(&self.config.params),
+        };
         Ok(())
     }
 
@@ -125,6 +153,19 @@ impl ChassisController {
     /// A `cmd_vel` (twist of the reference point, body frame) received at `now` [s].
     /// A non-finite request stops the chassis at once and does not feed the watchdog.
     pub fn on_cmd_vel(&mut self, requested_at_reference: BodyTwist, now: f64) -> Command {
+        self.requested = self.command_for(requested_at_reference);
+        if self.requested.reasons.contains(ClampReason::NonFinite) {
+            self.request = None;
+            self.cmd_watchdog.reset();
+        } else {
+            self.request = Some(requested_at_reference);
+            self.cmd_watchdog.feed(now);
+        }
+        self.requested
+    }
+
+    /// The feasible command for a request (limits, then inverse kinematics).
+    fn command_for(&self, requested_at_reference: BodyTwist) -> Command {
         let params = &self.config.params;
         let d = params.reference_offset();
         let mut lateral = false;
@@ -151,13 +192,7 @@ impl ChassisController {
         } else {
             twist_at_reference(clamped.twist, d)
         };
-        self.requested = Command { wheels, twist, reasons };
-        if reasons.contains(ClampReason::NonFinite) {
-            self.cmd_watchdog.reset();
-        } else {
-            self.cmd_watchdog.feed(now);
-        }
-        self.requested
+        Command { wheels, twist, reasons }
     }
 
     /// The command to send at `now` [s] and the watchdogs' state: the last request, or a stop
@@ -168,9 +203,7 @@ impl ChassisController {
             feedback_stale: self.feedback_watchdog.expired(now),
         };
         if safety.cmd_vel_expired || safety.feedback_stale {
-            let mut stop = Command::stop(&self.config.params);
-            stop.reasons = self.requested.reasons;
-            (stop, safety)
+            (Command::stop(&self.config.params), safety)
         } else {
             (self.requested, safety)
         }
@@ -178,11 +211,29 @@ impl ChassisController {
 
     /// Wheel feedback measured at `stamp` [s], received at `now` [s] (node clock, for the
     /// feedback watchdog). Refused samples leave the odometry unchanged.
-    pub fn on_feedback(&mut self, wheels: &WheelState, stamp: f64, now: f64) -> Result<(), FeedbackError> {
+    pub fn on_feedback(&mut self, wheels: &WheelState, stamp: f64, now: f64) -> Result<FeedbackOutcome, FeedbackError> {
         let twist = forward(&self.config.params, wheels)?;
+        let max_gap = if self.config.feedback_timeout_s > 0.0 {
+            self.config.feedback_timeout_s
+        } else {
+            1.0
+        };
+        let gap = self.odometry.last_stamp().map(|previous| stamp - previous);
+        let restart = match gap {
+            None => true,
+            Some(dt) if !dt.is_finite() => false, // refused by update_at below
+            Some(dt) => dt > max_gap || dt < -max_gap,
+        };
+        if restart {
+            self.odometry.restart_stamp();
+        }
         self.odometry.update_at(twist, stamp)?;
         self.feedback_watchdog.feed(now);
-        Ok(())
+        Ok(if restart {
+            FeedbackOutcome::Restarted { gap_s: gap }
+        } else {
+            FeedbackOutcome::Integrated
+        })
     }
 
     /// The odometry (pose, twist and covariances; see [`Odometry::reference_pose`]).
@@ -293,19 +344,76 @@ mod tests {
     }
 
     #[test]
+    fn a_future_stamp_or_a_clock_reset_costs_one_sample_not_the_odometry() {
+        let mut c = controller(ChassisConfig::omr3());
+        let forward = WheelState::Omni {
+            wheels: [6.0, -3.0, -3.0],
+        }; // 0.3 m/s along x
+        c.on_feedback(&forward, 10.0, 10.0).unwrap();
+        assert_eq!(
+            c.on_feedback(&forward, 10.1, 10.1).unwrap(),
+            FeedbackOutcome::Integrated
+        );
+        // A stamp 1e6 s ahead: not integrated across (it would be 300 km).
+        let jump = c.on_feedback(&forward, 1e6, 10.2).unwrap();
+        assert_eq!(
+            jump,
+            FeedbackOutcome::Restarted {
+                gap_s: Some(1e6 - 10.1)
+            }
+        );
+        assert_relative_eq!(c.odometry().reference_pose().x, 0.03, epsilon = 1e-12);
+        // Back to the real clock: a jump back, restarted again, then normal integration.
+        assert!(matches!(
+            c.on_feedback(&forward, 10.3, 10.3).unwrap(),
+            FeedbackOutcome::Restarted { .. }
+        ));
+        assert_eq!(
+            c.on_feedback(&forward, 10.4, 10.4).unwrap(),
+            FeedbackOutcome::Integrated
+        );
+        assert_relative_eq!(c.odometry().reference_pose().x, 0.06, epsilon = 1e-12);
+        // A 0.6 s dropout (> the 0.5 s feedback timeout) is not integrated either.
+        assert!(matches!(
+            c.on_feedback(&forward, 11.0, 11.0).unwrap(),
+            FeedbackOutcome::Restarted { .. }
+        ));
+        assert_relative_eq!(c.odometry().reference_pose().x, 0.06, epsilon = 1e-12);
+        // A sample slightly out of order is refused.
+        assert!(c.on_feedback(&forward, 10.95, 11.0).is_err());
+    }
+
+    #[test]
+    fn a_new_limit_applies_to_the_command_already_running() {
+        let mut c = controller(ChassisConfig::omr3());
+        feed_feedback(&mut c, 0.0);
+        c.on_cmd_vel(BodyTwist::new(0.5, 0.0, 0.0), 0.0);
+        let mut config = *c.config();
+        let mut slower = *config.params.config();
+        slower.v_max = 0.1;
+        config.params = ChassisParams::new(slower).unwrap();
+        c.reconfigure(config).unwrap();
+        // v_max 0.1 with r = 0.05: wheel 1 at 0.1/0.05 = 2 rad/s, not the 10 rad/s asked for before.
+        let (cmd, _) = c.on_tick(0.1);
+        assert_relative_eq!(cmd.wheels.values()[0], 2.0, epsilon = 1e-12);
+        assert!(cmd.reasons.contains(ClampReason::Speed));
+    }
+
+    #[test]
     fn feedback_drives_odometry_and_refuses_time_going_backwards() {
         let mut c = controller(ChassisConfig::omr3());
         let forward = WheelState::Omni {
             wheels: [6.0, -3.0, -3.0],
         }; // 0.3 m/s along x
         c.on_feedback(&forward, 10.0, 10.0).unwrap();
-        c.on_feedback(&forward, 11.0, 11.0).unwrap();
-        assert_relative_eq!(c.odometry().reference_pose().x, 0.3, epsilon = 1e-12);
-        assert!(c.on_feedback(&forward, 10.5, 11.1).is_err());
-        assert_relative_eq!(c.odometry().reference_pose().x, 0.3, epsilon = 1e-12);
+        c.on_feedback(&forward, 10.5, 10.5).unwrap();
+        // 0.3 m/s for 0.5 s.
+        assert_relative_eq!(c.odometry().reference_pose().x, 0.15, epsilon = 1e-12);
+        assert!(c.on_feedback(&forward, 10.25, 10.6).is_err());
+        assert_relative_eq!(c.odometry().reference_pose().x, 0.15, epsilon = 1e-12);
         let bad = WheelState::Omni {
             wheels: [f64::NAN, 0.0, 0.0],
         };
-        assert!(c.on_feedback(&bad, 12.0, 12.0).is_err());
+        assert!(c.on_feedback(&bad, 10.7, 10.7).is_err());
     }
 }

@@ -49,7 +49,7 @@ pub mod odometry;
 pub mod ros_params;
 pub mod watchdog;
 
-pub use controller::{ChassisController, Command, ControllerConfig, Safety};
+pub use controller::{ChassisController, Command, ControllerConfig, FeedbackOutcome, Safety};
 pub use error::{ChassisError, OdometryError};
 pub use kinematics::{forward, inverse, pre_steer, BodyTwist, Joint, JointKind, WheelState};
 pub use limits::{clamp_command, ClampReason, ClampReasons, Clamped};

@@ -213,6 +213,12 @@ impl Odometry {
         self.twist = twist;
     }
 
+    /// Forgets the previous stamp, keeping pose and covariance: the next [`Odometry::update_at`]
+    /// only records its stamp. For a gap in the feedback, or a clock that jumped.
+    pub fn restart_stamp(&mut self) {
+        self.last_stamp = None;
+    }
+
     /// Back to the start: reference point at the odom origin, zero covariance, zero twist, no stamp.
     pub fn reset(&mut self) {
         self.reset_to(Vector3::new(-self.reference_offset, 0.0, 0.0));

@@ -3,12 +3,13 @@
 //! a cmd_vel watchdog and a feedback watchdog; `~/status` reports both and every clamp.
 
 use futures::StreamExt;
-use mobil_chassis::controller::{ChassisController, Command, ControllerConfig, FeedbackError, Safety};
+use mobil_chassis::controller::{ChassisController, Command, ControllerConfig, FeedbackError, FeedbackOutcome, Safety};
 use mobil_chassis::joints::{joints_from_wheel_state, wheel_state_from_joints, JointStateError};
 use mobil_chassis::kinematics::BodyTwist;
 use mobil_chassis::model::ChassisModel;
 use mobil_chassis::odometry::OdometryNoise;
 use mobil_chassis::ros_params::{chassis_from_params, chassis_param_specs};
+use mobil_msgs::builtin_interfaces::msg::Time;
 use mobil_msgs::geometry_msgs::msg::{Transform, TransformStamped, Twist, Vector3};
 use mobil_msgs::mobil_msgs::msg::ChassisStatus;
 use mobil_msgs::nav_msgs::msg::Odometry;
@@ -17,7 +18,7 @@ use mobil_msgs::std_msgs::msg::Header;
 use mobil_msgs::tf2_msgs::msg::TFMessage;
 use mobil_ros::geometry::{planar_odometry, yaw_quaternion};
 use mobil_ros::params::ParamValues;
-use mobil_ros::time::{is_zero, secs_from_stamp, stamp_from_secs};
+use mobil_ros::time::{is_zero, secs_from_stamp};
 use mobil_ros::{qos, run_node, shutdown_signal, warn_throttled, LogThrottle, NodeDecl, ParamSpec, RosNode};
 use std::process::ExitCode;
 use std::time::Duration;
@@ -142,7 +143,7 @@ async fn run(node: &mut RosNode) -> anyhow::Result<()> {
     let wheel_pub = node.publisher::<JointState>("wheel_commands", &q)?;
     let odom_pub = node.publisher::<Odometry>("odom", &q)?;
     let tf_pub = node.publisher::<TFMessage>("tf", &qos::reliable(100))?;
-    let status_pub = node.publisher::<ChassisStatus>("~/status", &q)?;
+    let status_pub = node.publisher::<ChassisStatus>("~/status", &qos::latched())?;
 
     let cmds = cmd_sub.async_stream();
     let joints = joints_sub.async_stream();
@@ -157,7 +158,10 @@ async fn run(node: &mut RosNode) -> anyhow::Result<()> {
         cmd_vel_expired: true,
         feedback_stale: true,
     };
-    let now_s = |node: &RosNode| node.now_nanos() as f64 * 1e-9;
+    // The watchdogs run on the steady clock: a stalled or reset /clock must not keep the wheels
+    // turning. Odometry runs on the feedback's own stamps.
+    let steady = std::time::Instant::now();
+    let now_s = |_: &RosNode| steady.elapsed().as_secs_f64();
 
     loop {
         tokio::select! {
@@ -200,11 +204,19 @@ async fn run(node: &mut RosNode) -> anyhow::Result<()> {
                     let now = now_s(node);
                     let model = config.controller.params.model();
                     let parsed = wheel_state_from_joints(model, &js.name, &js.position, &js.velocity);
-                    let stamp = if is_zero(&js.header.stamp) { Some(now) } else { secs_from_stamp(&js.header.stamp) };
-                    match (parsed, stamp) {
+                    // An unstamped sample is stamped on arrival (node clock).
+                    let stamp_msg = if is_zero(&js.header.stamp) { node.stamp() } else { js.header.stamp.clone() };
+                    match (parsed, secs_from_stamp(&stamp_msg)) {
                         (Ok(wheels), Some(stamp)) => match controller.on_feedback(&wheels, stamp, now) {
-                            Ok(()) => {
-                                publish_odometry(&odom_pub, &tf_pub, &config, &controller, &js.header);
+                            Ok(outcome) => {
+                                if let FeedbackOutcome::Restarted { gap_s: Some(gap) } = outcome {
+                                    warn_throttled!(
+                                        throttle,
+                                        "feedback_gap",
+                                        "joint_states stamps jumped by {gap:.3} s (dropout or clock reset): odometry not integrated across the gap"
+                                    );
+                                }
+                                publish_odometry(&odom_pub, &tf_pub, &config, &controller, stamp_msg);
                             }
                             Err(e) => {
                                 rejected += 1;
@@ -294,15 +306,12 @@ fn publish_odometry(
     tf_pub: &ros2_client::Publisher<TFMessage>,
     config: &NodeConfig,
     controller: &ChassisController,
-    feedback_header: &Header,
+    stamp: Time,
 ) {
     let odo = controller.odometry();
     let pose = odo.reference_pose();
     let twist = odo.reference_twist();
-    let stamp = match odo.last_stamp() {
-        Some(t) => stamp_from_secs(t),
-        None => feedback_header.stamp.clone(),
-    };
+    // The feedback's own stamp, unchanged, so odom and tf line up with joint_states exactly.
     let header = Header {
         stamp,
         frame_id: config.odom_frame.clone(),
