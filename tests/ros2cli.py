@@ -10,8 +10,8 @@ Run it through ``launch_scripts/ros2cli`` (which prepares the venv and the envir
     ros2cli topic pub cmd_vel geometry_msgs/msg/Twist '{linear: {x: 0.2}}' --rate 10
     ros2cli topic hz scan
     ros2cli param list /chassis
-    ros2cli param get /chassis max_speed
-    ros2cli param set /chassis max_speed 0.8
+    ros2cli param get /chassis v_max
+    ros2cli param set /chassis v_max 0.3
 
 Exit codes: 0 success, 1 failure or timeout (2 for usage errors, from argparse).
 ROS_DOMAIN_ID is honoured as by any ROS 2 program.

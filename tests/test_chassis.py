@@ -346,3 +346,30 @@ def test_a_stamp_far_in_the_future_costs_one_sample_not_the_odometry(start_node,
         last = odom.wait_for(lambda m: m.header.stamp.sec == 61 and m.header.stamp.nanosec == 100_000_000, timeout=5)
     # 0.15 m before the bad stamp; after it the clock restarts at 60.6 and 60.7…61.1 add 0.15 m.
     assert last.pose.pose.position.x == pytest.approx(0.30, abs=1e-6)
+
+
+def test_an_atomic_set_inconsistent_as_a_whole_leaves_a_consistent_node(start_node, ros_node):
+    """Each value alone is valid; together (R_min 0.35 with track 1.2: the inner front wheel would
+    steer past 90°, R_min must exceed B/2) they are not."""
+    from rcl_interfaces.msg import Parameter, ParameterType, ParameterValue
+    from rcl_interfaces.srv import SetParametersAtomically
+    start_node("chassis_node", params_file="params/mobil2.yaml")
+    client = ros_node.create_client(SetParametersAtomically, "/chassis/set_parameters_atomically")
+    assert client.wait_for_service(timeout_sec=10)
+
+    def double(name: str, v: float) -> Parameter:
+        return Parameter(name=name, value=ParameterValue(type=ParameterType.PARAMETER_DOUBLE, double_value=v))
+
+    req = SetParametersAtomically.Request(parameters=[double("min_turning_radius", 0.35), double("track", 1.2)])
+    future = None
+    for _ in range(5):  # the first call after discovery can be lost (ROS2-NOTES)
+        future = client.call_async(req)
+        if harness.wait_until(future.done, timeout=2):
+            break
+    assert not future.result().result.successful
+    # Whatever was applied, the node is consistent: R_min > B/2, and later sets still work.
+    r_min = param_get(ros_node, "/chassis", "min_turning_radius")
+    track = param_get(ros_node, "/chassis", "track")
+    assert track == 0.62 and r_min > track / 2
+    ok = param_set(ros_node, "/chassis", "v_max", 0.4)
+    assert ok.successful, ok.reason

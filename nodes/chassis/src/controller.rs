@@ -203,7 +203,10 @@ impl ChassisController {
             feedback_stale: self.feedback_watchdog.expired(now),
         };
         if safety.cmd_vel_expired || safety.feedback_stale {
-            (Command::stop(&self.config.params), safety)
+            // `reasons` keeps describing the last cmd_vel (ChassisStatus.clamped), e.g. a NaN.
+            let mut stop = Command::stop(&self.config.params);
+            stop.reasons = self.requested.reasons;
+            (stop, safety)
         } else {
             (self.requested, safety)
         }

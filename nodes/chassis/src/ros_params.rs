@@ -42,8 +42,9 @@ pub fn chassis_param_specs() -> Vec<ParamSpec> {
         ParamSpec::double(
             "reference_offset",
             m.reference_offset,
-            "published reference point ahead of the kinematic origin [m]",
-        ),
+            "published reference point ahead of the kinematic origin [m] (moving it would make the pose jump)",
+        )
+        .read_only(),
     ]
 }
 

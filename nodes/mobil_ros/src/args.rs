@@ -44,6 +44,27 @@ pub struct RosArgs {
     pub log_level: Option<String>,
 }
 
+impl RosArgs {
+    /// The namespace for a node whose default name is `default_node` (`-r __ns:=` or
+    /// `-r default_node:__ns:=`, the latter winning).
+    pub fn namespace_for(&self, default_node: &str) -> Option<&str> {
+        self.scoped("__ns", default_node).or(self.namespace.as_deref())
+    }
+
+    /// The name for a node whose default name is `default_node`.
+    pub fn node_name_for(&self, default_node: &str) -> Option<&str> {
+        self.scoped("__node", default_node).or(self.node_name.as_deref())
+    }
+
+    fn scoped(&self, key: &str, node: &str) -> Option<&str> {
+        self.remaps
+            .iter()
+            .rev()
+            .find(|r| r.from == key && r.node.as_deref() == Some(node))
+            .map(|r| r.to.as_str())
+    }
+}
+
 /// A malformed ROS argument.
 #[derive(Debug, Error, PartialEq, Eq)]
 pub enum ArgsError {
@@ -88,9 +109,16 @@ where
             "-r" | "--remap" => {
                 let v = value_of(&arg)?;
                 let (node, from, to) = assignment(&arg, &v)?;
-                match from.as_str() {
-                    "__ns" => ros.namespace = Some(to),
-                    "__node" | "__name" => ros.node_name = Some(to),
+                // `__ns`/`__node` for every node go to their fields; node-scoped ones
+                // (`chassis:__ns:=/r1`) stay rules, applied by the node they name.
+                match (from.as_str(), &node) {
+                    ("__ns", None) => ros.namespace = Some(to),
+                    ("__node" | "__name", None) => ros.node_name = Some(to),
+                    ("__name", Some(_)) => ros.remaps.push(Remap {
+                        node,
+                        from: "__node".into(),
+                        to,
+                    }),
                     _ => ros.remaps.push(Remap { node, from, to }),
                 }
             }
@@ -194,6 +222,24 @@ mod tests {
         assert_eq!(ros.namespace.as_deref(), Some("/robot1"));
         assert_eq!(ros.node_name.as_deref(), Some("base"));
         assert_eq!(ros.log_level.as_deref(), Some("debug"));
+    }
+
+    #[test]
+    fn node_scoped_namespace_and_name() {
+        let (_, ros) = split_ros_args([
+            "--ros-args",
+            "-r",
+            "chassis:__ns:=/r1",
+            "-r",
+            "sim:__node:=plant",
+            "-r",
+            "__ns:=/all",
+        ])
+        .unwrap();
+        assert_eq!(ros.namespace_for("chassis"), Some("/r1"));
+        assert_eq!(ros.namespace_for("sim"), Some("/all"));
+        assert_eq!(ros.node_name_for("sim"), Some("plant"));
+        assert_eq!(ros.node_name_for("chassis"), None);
     }
 
     #[test]

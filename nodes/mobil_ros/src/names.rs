@@ -82,7 +82,8 @@ impl NameResolver {
             node: node.to_owned(),
             remaps: Vec::new(),
         };
-        for rule in remaps.iter().filter(|r| r.node.as_deref().is_none_or(|n| n == node)) {
+        let topic_rules = remaps.iter().filter(|r| !r.from.starts_with("__"));
+        for rule in topic_rules.filter(|r| r.node.as_deref().is_none_or(|n| n == node)) {
             let from = resolver.expand(&rule.from)?;
             let to = resolver.expand(&rule.to)?;
             resolver.remaps.push((from, to));
@@ -107,9 +108,14 @@ impl NameResolver {
 
     /// Expands a name to its fully qualified form, without remapping.
     pub fn expand(&self, name: &str) -> Result<String, NameError> {
-        let name = name
-            .replace("{node}", &self.node)
-            .replace("{ns}", self.namespace.trim_start_matches('/'));
+        let mut name = name.replace("{node}", &self.node);
+        for key in ["{ns}", "{namespace}"] {
+            name = if self.namespace == "/" {
+                name.replace(&format!("{key}/"), "/").replace(key, "/")
+            } else {
+                name.replace(key, &self.namespace)
+            };
+        }
         let full = if name == "~" {
             self.fully_qualified_node()
         } else if let Some(rest) = name.strip_prefix("~/") {
@@ -163,10 +169,13 @@ mod tests {
         assert_eq!(r.resolve("/cmd_vel").unwrap(), "/cmd_vel");
         assert_eq!(r.resolve("~/status").unwrap(), "/robot1/chassis/status");
         assert_eq!(r.resolve("{node}/status").unwrap(), "/robot1/chassis/status");
+        assert_eq!(r.resolve("{ns}/scan").unwrap(), "/robot1/scan");
+        assert_eq!(r.resolve("{namespace}/a/b").unwrap(), "/robot1/a/b");
         let root = NameResolver::new("", "sim", &[]).unwrap();
         assert_eq!(root.resolve("scan").unwrap(), "/scan");
         assert_eq!(root.resolve("~/markers").unwrap(), "/sim/markers");
         assert_eq!(root.fully_qualified_node(), "/sim");
+        assert_eq!(root.resolve("{ns}/scan").unwrap(), "/scan");
     }
 
     #[test]

@@ -179,8 +179,12 @@ impl RosNode {
     /// Starts the node: resolves name and parameters, joins the DDS domain and spawns the
     /// spinner on the current tokio runtime. Invalid parameters stop it here, with the reason.
     pub fn start(decl: &NodeDecl, args: &RosArgs) -> anyhow::Result<RosNode> {
-        let node_name = args.node_name.clone().unwrap_or_else(|| decl.default_name.clone());
-        let names = NameResolver::new(args.namespace.as_deref().unwrap_or("/"), &node_name, &args.remaps)?;
+        let node_name = args
+            .node_name_for(&decl.default_name)
+            .unwrap_or(&decl.default_name)
+            .to_owned();
+        let namespace = args.namespace_for(&decl.default_name).unwrap_or("/");
+        let names = NameResolver::new(namespace, &node_name, &args.remaps)?;
         let fqn = names.fully_qualified_node();
 
         let mut files = Vec::new();
@@ -222,10 +226,19 @@ impl RosNode {
             check(&candidate)
         }));
         let action_values = params.clone();
+        // The whole configuration is checked again as each value is applied: ros2-client validates
+        // the parameters of a `set_parameters_atomically` call one by one against the current
+        // values, so a batch whose parts are valid alone but not together would otherwise slip
+        // through. Refusing here stops the batch at its first inconsistent value, and the node's
+        // values and the parameter services never disagree.
+        let action_check = decl.check.clone();
         options = options.parameter_set_action(Box::new(move |name, value| {
             let mut values = lock(&action_values);
             if values.get(name) != Some(value) {
-                values.set(name, value.clone());
+                let mut candidate = values.clone();
+                candidate.set(name, value.clone());
+                action_check(&candidate).map_err(|e| format!("`{name}`: {e}"))?;
+                *values = candidate;
                 info!("parameter {name} = {value:?}");
                 // The receiver only disappears while the node shuts down.
                 let _ = change_tx.send(values.clone());

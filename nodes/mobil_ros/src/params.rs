@@ -430,23 +430,47 @@ pub fn file_entries(
     let Value::Mapping(nodes) = doc else {
         return Err(format("expected a map of node names"));
     };
+    // Node keys may nest (`robot1: chassis: ros__parameters:` is `/robot1/chassis`).
+    let mut sections = Vec::new();
+    collect_sections("", &nodes, &mut sections).map_err(|reason| format(&reason))?;
     let mut entries = Vec::new();
-    for (key, body) in &nodes {
-        let Some(key) = key.as_str() else {
-            return Err(format("node names must be strings"));
-        };
-        if !key_matches(key, fully_qualified, base_name) {
+    for (key, params) in sections {
+        if !key_matches(&key, fully_qualified, base_name) {
             continue;
         }
-        let params = body
-            .get("ros__parameters")
-            .ok_or_else(|| format(&format!("`{key}` has no `ros__parameters` section")))?;
         let mut flat = Vec::new();
         flatten("", params, &mut flat);
         let shared = key.contains('*');
         entries.extend(flat.into_iter().map(|(name, value)| FileEntry { name, value, shared }));
     }
     Ok(entries)
+}
+
+/// The `ros__parameters` sections of a file with their (possibly nested) node keys.
+fn collect_sections<'a>(
+    prefix: &str,
+    map: &'a serde_norway::Mapping,
+    out: &mut Vec<(String, &'a Value)>,
+) -> Result<(), String> {
+    for (key, body) in map {
+        let Some(key) = key.as_str() else {
+            return Err("node names must be strings".into());
+        };
+        let full = if prefix.is_empty() {
+            key.to_owned()
+        } else {
+            format!("{}/{}", prefix, key.trim_start_matches('/'))
+        };
+        match body {
+            Value::Mapping(inner) => match inner.get("ros__parameters") {
+                Some(params) => out.push((full, params)),
+                None if inner.is_empty() => return Err(format!("`{full}` has no `ros__parameters` section")),
+                None => collect_sections(&full, inner, out)?,
+            },
+            _ => return Err(format!("`{full}` has no `ros__parameters` section")),
+        }
+    }
+    Ok(())
 }
 
 /// Start-up values: the outcome of defaults, files and `-p` overrides.
@@ -608,6 +632,20 @@ other:
         assert!(bad("chassis: [1, 2]").is_err());
         assert!(bad("chassis:\n  params: {}\n").is_err());
         assert!(bad(": : :").is_err());
+    }
+
+    #[test]
+    fn nested_node_keys_are_namespaces() {
+        let file = "/robot1:\n  chassis:\n    ros__parameters:\n      beams: 42\nrobot2:\n  chassis:\n    ros__parameters:\n      beams: 7\n";
+        let p = initial_params(
+            &specs(),
+            &[("f".into(), file.into())],
+            &[],
+            "/robot1/chassis",
+            "chassis",
+        )
+        .unwrap();
+        assert_eq!(p.values.i64("beams").unwrap(), 42);
     }
 
     #[test]

@@ -148,7 +148,11 @@ impl Lidar {
             y + s * c.mount[0] + co * c.mount[1],
         );
         let heading = yaw + c.mount[2];
-        let increment = if c.beams >= 2 {
+        // A full circle must not measure ±π twice: N beams then split 2π into N gaps.
+        let full_circle = (c.fov - std::f64::consts::TAU).abs() < 1e-9;
+        let increment = if full_circle {
+            c.fov / c.beams.max(1) as f64
+        } else if c.beams >= 2 {
             c.fov / (c.beams - 1) as f64
         } else {
             0.0

@@ -28,7 +28,6 @@ use tracing::{info, warn};
 #[derive(Debug, Clone)]
 struct SimConfig {
     plant: PlantConfig,
-    world: World,
     seed: u64,
     initial_pose: V3<f64>,
     physics_rate_hz: f64,
@@ -96,13 +95,18 @@ fn decl() -> NodeDecl {
         .check(|p| sim_config(p).map(|_| ()))
 }
 
-fn sim_config(p: &ParamValues) -> Result<SimConfig, String> {
+/// The world named by `world_file` (read-only, so read once at start-up).
+fn load_world(p: &ParamValues) -> Result<World, String> {
     let world_file = p.string("world_file")?;
-    let world = if world_file.is_empty() {
-        World::builtin()
+    if world_file.is_empty() {
+        Ok(World::builtin())
     } else {
-        World::load(&world_file).map_err(|e| e.to_string())?
-    };
+        World::load(&world_file).map_err(|e| e.to_string())
+    }
+}
+
+/// Everything but the world, so that vetting a parameter change does no file I/O.
+fn sim_config(p: &ParamValues) -> Result<SimConfig, String> {
     let pose = p.f64s("initial_pose")?;
     let mount = p.f64s("lidar.mount")?;
     let lidar = LidarConfig {
@@ -124,12 +128,8 @@ fn sim_config(p: &ParamValues) -> Result<SimConfig, String> {
         robot_radius: p.f64("robot_radius")?,
     };
     let initial_pose = V3::new(pose[0], pose[1], pose[2]);
-    if world.collides(nalgebra::Point2::new(pose[0], pose[1]), plant.robot_radius) {
-        return Err(format!("initial_pose {pose:?} collides with the world"));
-    }
     Ok(SimConfig {
         plant,
-        world,
         seed: u64::try_from(p.i64("seed")?).map_err(|e| e.to_string())?,
         initial_pose,
         physics_rate_hz: p.f64("physics_rate_hz")?,
@@ -149,12 +149,17 @@ fn main() -> ExitCode {
 
 async fn run(node: &mut RosNode) -> anyhow::Result<()> {
     let mut config = sim_config(&node.params()).map_err(anyhow::Error::msg)?;
+    let world = load_world(&node.params()).map_err(anyhow::Error::msg)?;
+    let start = config.initial_pose;
+    if world.collides(nalgebra::Point2::new(start.x, start.y), config.plant.robot_radius) {
+        anyhow::bail!("initial_pose {start:?} collides with the world");
+    }
     let mut plant = Plant::new(config.plant, config.initial_pose, config.seed);
     let mut lidar = config.lidar.map(|c| Lidar::new(c, config.seed.wrapping_add(1)));
     info!(
         "simulating a {} chassis in a world of {} obstacles; lidar {}",
         config.plant.params.model().as_str(),
-        config.world.obstacles.len(),
+        world.obstacles.len(),
         match &config.lidar {
             Some(l) => format!("{} beams over {:.0}° at {} Hz", l.beams, l.fov.to_degrees(), l.rate_hz),
             None => "off".into(),
@@ -240,7 +245,7 @@ async fn run(node: &mut RosNode) -> anyhow::Result<()> {
                 Err(e) => warn_throttled!(throttle, "decode", "undecodable wheel_commands dropped: {e:?}"),
             },
             _ = tick.tick() => {
-                plant.step(dt, &config.world);
+                plant.step(dt, &world);
                 let t = plant.time();
                 if plant.collided() && !reported_collision {
                     warn!("the robot hit an obstacle at {:?}", plant.reference_pose());
@@ -274,7 +279,7 @@ async fn run(node: &mut RosNode) -> anyhow::Result<()> {
                     if t + 1e-9 >= next_scan {
                         next_scan += 1.0 / cfg.rate_hz;
                         let pose = plant.reference_pose();
-                        let scan = l.scan(&config.world, (pose.x, pose.y, pose.z));
+                        let scan = l.scan(&world, (pose.x, pose.y, pose.z));
                         let _ = scan_pub.publish(LaserScan {
                             header: Header { stamp: stamp_at(t, config.publish_clock), frame_id: config.laser_frame.clone() },
                             angle_min: scan.angle_min as f32,
