@@ -373,3 +373,21 @@ def test_an_atomic_set_inconsistent_as_a_whole_leaves_a_consistent_node(start_no
     assert track == 0.62 and r_min > track / 2
     ok = param_set(ros_node, "/chassis", "v_max", 0.4)
     assert ok.successful, ok.reason
+
+
+def test_position_only_encoders_are_differentiated(start_node, ros_node):
+    """A driver that publishes wheel angles only (no velocity array): SPEC §1 allows either."""
+    start_node("chassis_node", params_file="params/omr3.yaml")
+    names = ["wheel_1", "wheel_2", "wheel_3"]
+    fb = ros_node.create_publisher(JointState, "joint_states", 10)
+    with subscribe(ros_node, Odometry, "odom", qos=harness.qos_default()) as odom:
+        stamps = iter(20.0 + 0.01 * k for k in range(100))
+        publish_until(ros_node, fb, lambda: joint_state(next(stamps), names, [0.0, 0.0, 0.0], []),
+                      lambda: odom.latest is not None, rate_hz=10, timeout=9)
+        fb.publish(joint_state(30.0, names, [0.0, 0.0, 0.0], []))
+        # Wheel angles growing at Ω = [6, −3, −3] rad/s (body-x at 0.3 m/s) for 1 s in 0.1 s steps.
+        for i in range(1, 11):
+            fb.publish(joint_state(30.0 + 0.1 * i, names, [0.6 * i, -0.3 * i, -0.3 * i], []))
+        last = odom.wait_for(lambda m: m.header.stamp.sec == 31 and m.header.stamp.nanosec == 0, timeout=5)
+    assert last.pose.pose.position.x == pytest.approx(0.3, abs=1e-6)
+    assert last.twist.twist.linear.x == pytest.approx(0.3, abs=1e-6)

@@ -6,6 +6,9 @@
 //! a wheel joint its speed in `velocity` [rad/s]. `position` and `velocity` must each be empty
 //! or as long as `name`, as the message definition requires.
 //!
+//! Feedback may carry wheel speeds (`velocity`) or only encoder angles (`position`, as many
+//! drivers publish): [`FeedbackDecoder`] then differentiates the angles between samples.
+//!
 //! Commands (`wheel_commands`) list every joint of the model; steering joints get the angle in
 //! `position` and 0 in `velocity`, wheel joints the speed in `velocity` and 0 in `position`.
 
@@ -90,6 +93,64 @@ pub fn wheel_state_from_joints(
         positions: positions.len(),
         velocities: velocities.len(),
     })
+}
+
+/// Turns successive `joint_states` into [`WheelState`]s, from wheel speeds when the message has
+/// them, else from the change of the wheel angles since the previous sample.
+#[derive(Debug, Clone, Default)]
+pub struct FeedbackDecoder {
+    /// Stamp [s] and wheel-joint angles of the previous position-only sample.
+    previous: Option<(f64, Vec<f64>)>,
+}
+
+impl FeedbackDecoder {
+    /// Decodes one sample stamped `stamp` [s]. `Ok(None)`: a position-only sample that only sets
+    /// the baseline (the first one, or one not after the previous stamp).
+    pub fn decode(
+        &mut self,
+        model: ChassisModel,
+        names: &[String],
+        positions: &[f64],
+        velocities: &[f64],
+        stamp: f64,
+    ) -> Result<Option<WheelState>, JointStateError> {
+        if !velocities.is_empty() || positions.is_empty() {
+            self.previous = None;
+            return wheel_state_from_joints(model, names, positions, velocities).map(Some);
+        }
+        // Positions only: read every joint's angle, then differentiate the wheels'.
+        let angles = wheel_state_from_joints(model, names, positions, positions)?.values();
+        let wheel_angles: Vec<f64> = model
+            .joints()
+            .iter()
+            .zip(&angles)
+            .filter(|(j, _)| j.kind == JointKind::Wheel)
+            .map(|(_, a)| *a)
+            .collect();
+        let previous = self.previous.replace((stamp, wheel_angles.clone()));
+        let Some((t0, before)) = previous else { return Ok(None) };
+        let dt = stamp - t0;
+        if !(dt > 0.0 && dt.is_finite()) {
+            return Ok(None);
+        }
+        let mut speeds = wheel_angles.iter().zip(&before).map(|(a, b)| (a - b) / dt);
+        let values: Vec<f64> = model
+            .joints()
+            .iter()
+            .zip(angles)
+            .map(|(j, angle)| match j.kind {
+                JointKind::Steering => angle,
+                JointKind::Wheel => speeds.next().unwrap_or(0.0),
+            })
+            .collect();
+        WheelState::from_values(model, &values)
+            .map(Some)
+            .map_err(|_| JointStateError::MismatchedLengths {
+                names: names.len(),
+                positions: positions.len(),
+                velocities: velocities.len(),
+            })
+    }
 }
 
 /// The `(name, position, velocity)` arrays of a `wheel_commands` message.
@@ -193,6 +254,41 @@ mod tests {
             wheel_state_from_joints(m, &n, &[0.0, f64::NAN], &[0.0, 1.0]).is_ok(),
             "unused fields may be NaN"
         );
+    }
+
+    #[test]
+    fn position_only_feedback_is_differentiated() {
+        let n = names(&[
+            "front_left_steering",
+            "front_right_steering",
+            "rear_left_wheel",
+            "rear_right_wheel",
+        ]);
+        let mut d = FeedbackDecoder::default();
+        let m = ChassisModel::CarLike;
+        assert_eq!(d.decode(m, &n, &[0.1, 0.08, 10.0, 20.0], &[], 5.0).unwrap(), None);
+        // Rear wheels turned 0.6 and 0.7 rad in 0.1 s: 6 and 7 rad/s; steering read as is.
+        let s = d.decode(m, &n, &[0.1, 0.08, 10.6, 20.7], &[], 5.1).unwrap().unwrap();
+        match s {
+            WheelState::CarLike {
+                front_left_steering,
+                front_right_steering,
+                rear_left,
+                rear_right,
+            } => {
+                assert_eq!((front_left_steering, front_right_steering), (0.1, 0.08));
+                assert!((rear_left - 6.0).abs() < 1e-9 && (rear_right - 7.0).abs() < 1e-9);
+            }
+            other => panic!("{other:?}"),
+        }
+        // A stamp not after the previous one only resets the baseline.
+        assert_eq!(d.decode(m, &n, &[0.1, 0.08, 10.6, 20.7], &[], 5.1).unwrap(), None);
+        // With velocities present they are used as they are.
+        let v = d
+            .decode(m, &n, &[0.0, 0.0, 0.0, 0.0], &[0.0, 0.0, 1.0, 1.0], 5.2)
+            .unwrap()
+            .unwrap();
+        assert_eq!(v.values()[2], 1.0);
     }
 
     #[test]

@@ -4,7 +4,7 @@
 
 use futures::StreamExt;
 use mobil_chassis::controller::{ChassisController, Command, ControllerConfig, FeedbackError, FeedbackOutcome, Safety};
-use mobil_chassis::joints::{joints_from_wheel_state, wheel_state_from_joints, JointStateError};
+use mobil_chassis::joints::{joints_from_wheel_state, FeedbackDecoder, JointStateError};
 use mobil_chassis::kinematics::BodyTwist;
 use mobil_chassis::model::ChassisModel;
 use mobil_chassis::odometry::OdometryNoise;
@@ -153,6 +153,7 @@ async fn run(node: &mut RosNode) -> anyhow::Result<()> {
     tokio::pin!(cmds, joints, shutdown);
 
     let mut throttle = LogThrottle::default();
+    let mut decoder = FeedbackDecoder::default();
     let mut rejected: u64 = 0;
     let mut last_safety = Safety {
         cmd_vel_expired: true,
@@ -203,11 +204,14 @@ async fn run(node: &mut RosNode) -> anyhow::Result<()> {
                 Ok((js, _)) => {
                     let now = now_s(node);
                     let model = config.controller.params.model();
-                    let parsed = wheel_state_from_joints(model, &js.name, &js.position, &js.velocity);
                     // An unstamped sample is stamped on arrival (node clock).
                     let stamp_msg = if is_zero(&js.header.stamp) { node.stamp() } else { js.header.stamp.clone() };
-                    match (parsed, secs_from_stamp(&stamp_msg)) {
-                        (Ok(wheels), Some(stamp)) => match controller.on_feedback(&wheels, stamp, now) {
+                    let stamp = secs_from_stamp(&stamp_msg);
+                    let parsed = decoder.decode(model, &js.name, &js.position, &js.velocity, stamp.unwrap_or(f64::NAN));
+                    match (parsed, stamp) {
+                        // A position-only sample that only set the baseline.
+                        (Ok(None), Some(_)) => {}
+                        (Ok(Some(wheels)), Some(stamp)) => match controller.on_feedback(&wheels, stamp, now) {
                             Ok(outcome) => {
                                 if let FeedbackOutcome::Restarted { gap_s: Some(gap) } = outcome {
                                     warn_throttled!(
