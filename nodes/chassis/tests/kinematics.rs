@@ -65,6 +65,25 @@ fn car_like_straight_and_stopped() {
 }
 
 #[test]
+fn car_like_forward_from_a_parallel_not_ackermann_steering_pair() {
+    // Both front wheels at 0.3 rad (a worn linkage: not an Ackermann pair). Each wheel alone
+    // implies tan δ_c: from the left tan δ / (1 + k·tan δ), from the right tan δ / (1 − k·tan δ),
+    // k = B/(2L) = 0.62/1.2; their mean is 0.317444944008083 (worked out separately).
+    // Rear wheels 4 and 5 rad/s with r = 0.1: v = 0.45 m/s, ω = v·tan δ_c / L = 0.238083708006063.
+    let params = ChassisParams::mobil2();
+    let wheels = WheelState::CarLike {
+        front_left_steering: 0.3,
+        front_right_steering: 0.3,
+        rear_left: 4.0,
+        rear_right: 5.0,
+    };
+    let t = forward(&params, &wheels).unwrap();
+    assert_relative_eq!(t.vx, 0.45, epsilon = 1e-12);
+    assert_relative_eq!(t.wz, 0.238_083_708_006_062_57, epsilon = 1e-12);
+    assert_eq!(t.vy, 0.0);
+}
+
+#[test]
 fn tricycle_golden() {
     // L = 0.5, v = 0.4, ω = 0.4: δ = atan(0.5·0.4/0.4) = atan(0.5) = 0.463648;
     // front ground speed v / cos δ = hypot(0.4, 0.2) = 0.447214 → 4.472136 rad/s (r = 0.1).
