@@ -391,3 +391,26 @@ def test_position_only_encoders_are_differentiated(start_node, ros_node):
         last = odom.wait_for(lambda m: m.header.stamp.sec == 31 and m.header.stamp.nanosec == 0, timeout=5)
     assert last.pose.pose.position.x == pytest.approx(0.3, abs=1e-6)
     assert last.twist.twist.linear.x == pytest.approx(0.3, abs=1e-6)
+
+
+def test_topics_use_the_qos_of_the_interface_contract(start_node, ros_node):
+    """Subscribe with the QoS INTERFACES.md promises (not the publishers' own): every topic
+    delivers, and the latched status reaches a subscriber that joins late."""
+    start_robot(start_node, "mobil2", lidar=True)
+    reliable, sensor, latched = harness.qos_default(), harness.qos_sensor(), harness.qos_latched()
+    for msg_type, topic, qos in [(Odometry, "odom", reliable), (Odometry, "ground_truth", reliable),
+                                 (JointState, "joint_states", reliable), (JointState, "wheel_commands", reliable),
+                                 (LaserScan, "scan", sensor), (ChassisStatus, "chassis/status", latched)]:
+        wait_for_message(ros_node, msg_type, topic, timeout=10, qos=qos)
+
+
+def test_watchdog_holds_under_use_sim_time_without_a_clock(start_node, ros_node):
+    """With use_sim_time and no /clock at all, the cmd_vel watchdog still stops the wheels."""
+    start_node("chassis_node", "-p", "use_sim_time:=true", "-p", "feedback_timeout_s:=0.0",
+               params_file="params/omr3.yaml")
+    cmd = ros_node.create_publisher(Twist, "cmd_vel", 10)
+    with subscribe(ros_node, JointState, "wheel_commands") as wheels:
+        publish_until(ros_node, cmd, twist(0.3), lambda: wheels.latest is not None
+                      and wheels.latest.velocity[0] > 5.9, rate_hz=20, timeout=10)
+        start = len(wheels)
+        wheels.wait_for(lambda m: all(v == 0.0 for v in m.velocity), timeout=3, start=start)
