@@ -414,3 +414,15 @@ def test_watchdog_holds_under_use_sim_time_without_a_clock(start_node, ros_node)
                       and wheels.latest.velocity[0] > 5.9, rate_hz=20, timeout=10)
         start = len(wheels)
         wheels.wait_for(lambda m: all(v == 0.0 for v in m.velocity), timeout=3, start=start)
+
+
+def test_sim_publishes_the_world_for_rviz(start_node, ros_node):
+    from visualization_msgs.msg import Marker, MarkerArray
+    start_node("sim_node", *NO_LIDAR, params_file="params/mobil2.yaml")
+    # Latched: a subscriber that joins after start-up still gets it.
+    markers = wait_for_message(ros_node, MarkerArray, "sim/markers", timeout=10, qos=harness.qos_latched())
+    # params/worlds/default.yaml: 4 walls, 3 pillars, a box, an L-shaped block, a triangle.
+    kinds = [m.type for m in markers.markers]
+    assert kinds.count(Marker.CYLINDER) == 3 and kinds.count(Marker.LINE_STRIP) == 7
+    pillar = next(m for m in markers.markers if m.type == Marker.CYLINDER)
+    assert (pillar.pose.position.x, pillar.pose.position.y, pillar.scale.x) == (1.0, 1.5, pytest.approx(0.6))

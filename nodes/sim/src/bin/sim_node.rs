@@ -7,19 +7,21 @@
 use futures::StreamExt;
 use mobil_chassis::joints::wheel_state_from_joints;
 use mobil_chassis::ros_params::{chassis_from_params, chassis_param_specs};
-use mobil_msgs::geometry_msgs::msg::{Transform, TransformStamped, Vector3};
+use mobil_msgs::geometry_msgs::msg::{Point, Transform, TransformStamped, Vector3};
 use mobil_msgs::nav_msgs::msg::Odometry;
 use mobil_msgs::rosgraph_msgs::msg::Clock;
 use mobil_msgs::sensor_msgs::msg::{JointState, LaserScan};
+use mobil_msgs::std_msgs::msg::ColorRGBA;
 use mobil_msgs::std_msgs::msg::Header;
 use mobil_msgs::tf2_msgs::msg::TFMessage;
+use mobil_msgs::visualization_msgs::msg::{Marker, MarkerArray};
 use mobil_ros::geometry::{planar_odometry, yaw_quaternion};
 use mobil_ros::params::ParamValues;
 use mobil_ros::time::{stamp_from_nanos, stamp_from_secs};
 use mobil_ros::{qos, run_node, shutdown_signal, warn_throttled, LogThrottle, NodeDecl, ParamSpec, RosNode};
 use mobil_sim::lidar::{Lidar, LidarConfig};
 use mobil_sim::plant::{Plant, PlantConfig};
-use mobil_sim::world::World;
+use mobil_sim::world::{Obstacle, World};
 use nalgebra::Vector3 as V3;
 use std::process::ExitCode;
 use std::time::Duration;
@@ -143,6 +145,73 @@ fn sim_config(p: &ParamValues) -> Result<SimConfig, String> {
     })
 }
 
+/// The stamp of simulated t = 0.
+fn stamp_at_start(config: &SimConfig, node: &RosNode) -> mobil_msgs::builtin_interfaces::msg::Time {
+    if config.publish_clock {
+        stamp_from_secs(0.0)
+    } else {
+        node.stamp()
+    }
+}
+
+/// The world's obstacles for RViz: circles as 0.5 m high cylinders, polygons as closed outlines.
+fn world_markers(world: &World, frame: &str, stamp: mobil_msgs::builtin_interfaces::msg::Time) -> MarkerArray {
+    let grey = ColorRGBA {
+        r: 0.6,
+        g: 0.6,
+        b: 0.6,
+        a: 1.0,
+    };
+    let markers = world
+        .obstacles
+        .iter()
+        .enumerate()
+        .map(|(i, o)| {
+            let mut m = Marker {
+                header: Header {
+                    stamp: stamp.clone(),
+                    frame_id: frame.to_owned(),
+                },
+                ns: "world".into(),
+                id: i32::try_from(i).unwrap_or(i32::MAX),
+                action: Marker::ADD,
+                color: grey.clone(),
+                ..Default::default()
+            };
+            match o {
+                Obstacle::Circle { center, radius } => {
+                    m.r#type = Marker::CYLINDER;
+                    m.pose.position = Point {
+                        x: center[0],
+                        y: center[1],
+                        z: 0.25,
+                    };
+                    m.scale = Vector3 {
+                        x: 2.0 * radius,
+                        y: 2.0 * radius,
+                        z: 0.5,
+                    };
+                }
+                Obstacle::Polygon { points } => {
+                    m.r#type = Marker::LINE_STRIP;
+                    m.scale.x = 0.03;
+                    m.points = points
+                        .iter()
+                        .chain(points.first())
+                        .map(|p| Point {
+                            x: p[0],
+                            y: p[1],
+                            z: 0.0,
+                        })
+                        .collect();
+                }
+            }
+            m
+        })
+        .collect();
+    MarkerArray { markers }
+}
+
 fn main() -> ExitCode {
     run_node(&decl(), |node| Box::pin(run(node)))
 }
@@ -172,6 +241,12 @@ async fn run(node: &mut RosNode) -> anyhow::Result<()> {
     let truth_pub = node.publisher::<Odometry>("ground_truth", &q)?;
     let scan_pub = node.publisher::<LaserScan>("scan", &qos::sensor_data())?;
     let static_pub = node.publisher::<TFMessage>("tf_static", &qos::latched())?;
+    let markers_pub = node.publisher::<MarkerArray>("~/markers", &qos::latched())?;
+    let _ = markers_pub.publish(world_markers(
+        &world,
+        &config.world_frame,
+        stamp_at_start(&config, node),
+    ));
     let clock_pub = if config.publish_clock {
         Some(node.publisher::<Clock>("/clock", &qos::reliable(1))?)
     } else {
@@ -298,4 +373,27 @@ async fn run(node: &mut RosNode) -> anyhow::Result<()> {
         }
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn every_obstacle_becomes_one_marker() {
+        let world = World::from_yaml_str(
+            "obstacles:\n  - circle: { center: [2.0, 1.0], radius: 0.3 }\n  - polygon: { points: [[0, 0], [1, 0], [1, 1]] }\n",
+        )
+        .unwrap();
+        let m = world_markers(&world, "odom", Default::default()).markers;
+        assert_eq!(m.len(), 2);
+        assert_eq!(
+            (m[0].r#type, m[0].scale.x, m[0].pose.position.x),
+            (Marker::CYLINDER, 0.6, 2.0)
+        );
+        assert_eq!(m[1].r#type, Marker::LINE_STRIP);
+        assert_eq!(m[1].points.len(), 4, "closed: the first point repeated");
+        assert_eq!((m[1].points[3].x, m[1].points[3].y), (0.0, 0.0));
+        assert_eq!(m[0].pose.orientation.w, 1.0);
+    }
 }
