@@ -29,9 +29,9 @@ use crate::watchdog::CmdVelWatchdog;
 pub struct ControllerConfig {
     /// Geometry and limits.
     pub params: ChassisParams,
-    /// Zero command after this long without a valid `cmd_vel` [s]; 0 disables.
+    /// Zero command after this long without a valid `cmd_vel` (s); 0 disables.
     pub cmd_vel_timeout_s: f64,
-    /// Zero command after this long without valid wheel feedback [s]; 0 disables.
+    /// Zero command after this long without valid wheel feedback (s); 0 disables.
     pub feedback_timeout_s: f64,
     /// Odometry covariance model.
     pub noise: OdometryNoise,
@@ -150,7 +150,7 @@ impl ChassisController {
         &self.config
     }
 
-    /// A `cmd_vel` (twist of the reference point, body frame) received at `now` [s].
+    /// A `cmd_vel` (twist of the reference point, body frame) received at `now` (s).
     /// A non-finite request stops the chassis at once and does not feed the watchdog.
     pub fn on_cmd_vel(&mut self, requested_at_reference: BodyTwist, now: f64) -> Command {
         self.requested = self.command_for(requested_at_reference);
@@ -195,7 +195,7 @@ impl ChassisController {
         Command { wheels, twist, reasons }
     }
 
-    /// The command to send at `now` [s] and the watchdogs' state: the last request, or a stop
+    /// The command to send at `now` (s) and the watchdogs' state: the last request, or a stop
     /// when either watchdog has expired.
     pub fn on_tick(&mut self, now: f64) -> (Command, Safety) {
         let safety = Safety {
@@ -212,7 +212,7 @@ impl ChassisController {
         }
     }
 
-    /// Wheel feedback measured at `stamp` [s], received at `now` [s] (node clock, for the
+    /// Wheel feedback measured at `stamp` (s), received at `now` (s) (node clock, for the
     /// feedback watchdog). Refused samples leave the odometry unchanged.
     pub fn on_feedback(&mut self, wheels: &WheelState, stamp: f64, now: f64) -> Result<FeedbackOutcome, FeedbackError> {
         let twist = forward(&self.config.params, wheels)?;

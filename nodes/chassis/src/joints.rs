@@ -3,7 +3,7 @@
 //!
 //! Joints are matched by name ([`ChassisModel::joints`]), in any order; other joints in the
 //! message (an arm, a pan-tilt) are ignored. A steering joint carries its angle in `position`,
-//! a wheel joint its speed in `velocity` [rad/s]. `position` and `velocity` must each be empty
+//! a wheel joint its speed in `velocity` (rad/s). `position` and `velocity` must each be empty
 //! or as long as `name`, as the message definition requires.
 //!
 //! Feedback may carry wheel speeds (`velocity`) or only encoder angles (`position`, as many
@@ -99,12 +99,12 @@ pub fn wheel_state_from_joints(
 /// them, else from the change of the wheel angles since the previous sample.
 #[derive(Debug, Clone, Default)]
 pub struct FeedbackDecoder {
-    /// Stamp [s] and wheel-joint angles of the previous position-only sample.
+    /// Stamp (s) and wheel-joint angles of the previous position-only sample.
     previous: Option<(f64, Vec<f64>)>,
 }
 
 impl FeedbackDecoder {
-    /// Decodes one sample stamped `stamp` [s]. `Ok(None)`: a position-only sample that only sets
+    /// Decodes one sample stamped `stamp` (s). `Ok(None)`: a position-only sample that only sets
     /// the baseline (the first one, or one not after the previous stamp).
     pub fn decode(
         &mut self,

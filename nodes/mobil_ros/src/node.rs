@@ -167,7 +167,7 @@ pub struct RosNode {
     spinner: Option<tokio::task::JoinHandle<()>>,
     /// `/clock`, read when the time is asked for (see [`RosNode::now_nanos`]).
     clock: Option<Subscription<Clock>>,
-    /// Latest `/clock` [ns].
+    /// Latest `/clock` (ns).
     sim_clock: AtomicI64,
 }
 

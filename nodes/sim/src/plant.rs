@@ -24,15 +24,15 @@ use crate::world::World;
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct PlantConfig {
     pub params: ChassisParams,
-    /// First-order lag of wheel speeds and steering angles [s]; 0 = they follow at once.
+    /// First-order lag of wheel speeds and steering angles (s); 0 = they follow at once.
     pub motor_time_constant: f64,
     /// Relative standard deviation of the measured wheel speeds.
     pub wheel_speed_noise: f64,
     /// Relative bias of the measured wheel speeds (measured = true · (1 + slip)).
     pub wheel_slip: f64,
-    /// The drivers stop the wheels after this long without a command [s]; 0 = never.
+    /// The drivers stop the wheels after this long without a command (s); 0 = never.
     pub command_timeout: f64,
-    /// Radius of the robot's footprint around the reference point, for collisions [m].
+    /// Radius of the robot's footprint around the reference point, for collisions (m).
     pub robot_radius: f64,
 }
 
@@ -40,9 +40,9 @@ pub struct PlantConfig {
 #[derive(Debug, Clone, PartialEq)]
 pub struct Feedback {
     pub names: Vec<String>,
-    /// Steering angle, or accumulated wheel angle [rad].
+    /// Steering angle, or accumulated wheel angle (rad).
     pub positions: Vec<f64>,
-    /// Steering rate, or wheel speed [rad/s].
+    /// Steering rate, or wheel speed (rad/s).
     pub velocities: Vec<f64>,
 }
 
@@ -195,7 +195,7 @@ impl Plant {
         twist_at_reference(self.twist, self.config.params.reference_offset())
     }
 
-    /// Simulated time since start [s].
+    /// Simulated time since start (s).
     pub fn time(&self) -> f64 {
         self.time
     }
