@@ -426,3 +426,16 @@ def test_sim_publishes_the_world_for_rviz(start_node, ros_node):
     assert kinds.count(Marker.CYLINDER) == 3 and kinds.count(Marker.LINE_STRIP) == 7
     pillar = next(m for m in markers.markers if m.type == Marker.CYLINDER)
     assert (pillar.pose.position.x, pillar.pose.position.y, pillar.scale.x) == (1.0, 1.5, pytest.approx(0.6))
+
+
+def test_sim_runs_faster_than_real_time_on_a_simulated_clock(start_node, ros_node):
+    from rosgraph_msgs.msg import Clock
+    start_node("sim_node", *NO_LIDAR, "-p", "publish_clock:=true", "-p", "real_time_factor:=4.0",
+               params_file="params/mobil2.yaml")
+    with subscribe(ros_node, Clock, "/clock", qos=harness.qos_sensor()) as clock:
+        clock.wait_for(None, timeout=10)
+        t0, c0 = time.monotonic(), clock.latest.clock
+        time.sleep(2.0)
+        t1, c1 = time.monotonic(), clock.latest.clock
+    sim_dt = (c1.sec - c0.sec) + (c1.nanosec - c0.nanosec) * 1e-9
+    assert sim_dt / (t1 - t0) == pytest.approx(4.0, rel=0.15)
