@@ -192,6 +192,21 @@ def joint_state(stamp_s: float, names, positions, velocities) -> JointState:
     return js
 
 
+OMNI_WHEELS = ["wheel_1", "wheel_2", "wheel_3"]
+
+
+def prime_feedback(ros_node, fb, odom, t0: float, positions_only: bool = False) -> None:
+    """Play an OMR-III at rest (stamps t0−1, t0−0.99, …) until chassis_node answers on odom,
+    then one sample at rest stamped exactly t0, so that motion can start from there."""
+    def rest(t: float) -> JointState:
+        zeros = [0.0, 0.0, 0.0]
+        return joint_state(t, OMNI_WHEELS, zeros, []) if positions_only else joint_state(t, OMNI_WHEELS, [], zeros)
+
+    stamps = iter(t0 - 1.0 + 0.01 * k for k in range(100))
+    publish_until(ros_node, fb, lambda: rest(next(stamps)), lambda: odom.latest is not None, rate_hz=10, timeout=9)
+    fb.publish(rest(t0))
+
+
 def test_bad_joint_states_are_dropped_and_do_not_move_odometry(start_node, ros_node):
     """rclpy plays the robot: valid feedback, then mismatched arrays and time going backwards."""
     chassis = start_node("chassis_node", params_file="params/omr3.yaml")
@@ -199,13 +214,10 @@ def test_bad_joint_states_are_dropped_and_do_not_move_odometry(start_node, ros_n
     fb = ros_node.create_publisher(JointState, "joint_states", 10)
     with subscribe(ros_node, Odometry, "odom", qos=harness.qos_default()) as odom, \
             subscribe(ros_node, ChassisStatus, "chassis/status") as status:
-        # At rest until the chassis node answers (stamps 99.00, 99.01, …), then at rest at
-        # t = 100 s, then body-x at 0.3 m/s (Ω = [6, −3, −3]) for 1 s in 0.1 s steps: x = 0.3 m.
-        stamps = iter(99.0 + 0.01 * k for k in range(100))
-        publish_until(ros_node, fb, lambda: joint_state(next(stamps), names, [], [0.0, 0.0, 0.0]),
-                      lambda: odom.latest is not None, rate_hz=10, timeout=9)
+        # At rest until t = 100 s, then body-x at 0.3 m/s (Ω = [6, −3, −3]) for 1 s in 0.1 s
+        # steps: x = 0.3 m.
         t = 100.0
-        fb.publish(joint_state(t, names, [], [0.0, 0.0, 0.0]))
+        prime_feedback(ros_node, fb, odom, t)
         for i in range(1, 11):
             fb.publish(joint_state(t + 0.1 * i, names, [], [6.0, -3.0, -3.0]))
         good = odom.wait_for(lambda m: m.header.stamp.sec == 101 and m.header.stamp.nanosec == 0, timeout=5)
@@ -332,10 +344,7 @@ def test_a_stamp_far_in_the_future_costs_one_sample_not_the_odometry(start_node,
     names = ["wheel_1", "wheel_2", "wheel_3"]
     fb = ros_node.create_publisher(JointState, "joint_states", 10)
     with subscribe(ros_node, Odometry, "odom", qos=harness.qos_default()) as odom:
-        stamps = iter(50.0 + 0.01 * k for k in range(100))
-        publish_until(ros_node, fb, lambda: joint_state(next(stamps), names, [], [0.0, 0.0, 0.0]),
-                      lambda: odom.latest is not None, rate_hz=10, timeout=9)
-        fb.publish(joint_state(60.0, names, [], [0.0, 0.0, 0.0]))
+        prime_feedback(ros_node, fb, odom, 60.0)
         # 0.3 m/s for 0.5 s, one sample stamped 1e6 s ahead, then 0.5 s more on the real clock.
         for i in range(1, 6):
             fb.publish(joint_state(60.0 + 0.1 * i, names, [], [6.0, -3.0, -3.0]))
@@ -381,10 +390,7 @@ def test_position_only_encoders_are_differentiated(start_node, ros_node):
     names = ["wheel_1", "wheel_2", "wheel_3"]
     fb = ros_node.create_publisher(JointState, "joint_states", 10)
     with subscribe(ros_node, Odometry, "odom", qos=harness.qos_default()) as odom:
-        stamps = iter(20.0 + 0.01 * k for k in range(100))
-        publish_until(ros_node, fb, lambda: joint_state(next(stamps), names, [0.0, 0.0, 0.0], []),
-                      lambda: odom.latest is not None, rate_hz=10, timeout=9)
-        fb.publish(joint_state(30.0, names, [0.0, 0.0, 0.0], []))
+        prime_feedback(ros_node, fb, odom, 30.0, positions_only=True)
         # Wheel angles growing at Ω = [6, −3, −3] rad/s (body-x at 0.3 m/s) for 1 s in 0.1 s steps.
         for i in range(1, 11):
             fb.publish(joint_state(30.0 + 0.1 * i, names, [0.6 * i, -0.3 * i, -0.3 * i], []))
