@@ -445,3 +445,18 @@ def test_sim_runs_faster_than_real_time_on_a_simulated_clock(start_node, ros_nod
         t1, c1 = time.monotonic(), clock.latest.clock
     sim_dt = (c1.sec - c0.sec) + (c1.nanosec - c0.nanosec) * 1e-9
     assert sim_dt / (t1 - t0) == pytest.approx(4.0, rel=0.15)
+
+
+def test_node_logs_reach_rosout(start_node, ros_node):
+    """rqt_console and `ros2 topic echo /rosout` see the nodes' log lines, as rclcpp's."""
+    from rcl_interfaces.msg import Log
+    start_node("chassis_node", "-p", "feedback_timeout_s:=0.0", params_file="params/mobil2.yaml")
+    cmd = ros_node.create_publisher(Twist, "cmd_vel", 10)
+    with subscribe(ros_node, Log, "/rosout") as rosout:
+        publish_until(ros_node, cmd, twist(0.3, 0.0, 2.0),
+                      lambda: any(m.name == "chassis" and "clamped" in m.msg for m in rosout.snapshot()),
+                      rate_hz=10, timeout=10)
+        line = next(m for m in rosout.snapshot() if "clamped" in m.msg)
+        cmd.publish(twist())
+    assert line.level == Log.WARN
+    assert line.file.endswith("chassis_node.rs") and line.line > 0

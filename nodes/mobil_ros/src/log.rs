@@ -1,13 +1,26 @@
-//! Logging: `tracing` to stderr (also capturing ros2-client's and RustDDS's `log` records), with
+//! Logging: `tracing` to stderr and `/rosout` (also capturing ros2-client's and RustDDS's `log`
+//! records on stderr), with
 //! the level from `--log-level` or `RUST_LOG`, and a throttle so that a flood of bad input
 //! produces one clear line per period, with a count of what was suppressed.
 
+use ros2_client::log::LogLevel;
+use ros2_client::{NodeLoggingHandle, RosoutRaw};
 use std::collections::HashMap;
+use std::sync::Mutex;
 use std::time::{Duration, Instant};
-use tracing_subscriber::EnvFilter;
+use tracing::field::{Field, Visit};
+use tracing::{Event, Level, Subscriber};
+use tracing_subscriber::layer::{self, Layer, SubscriberExt};
+use tracing_subscriber::registry::{LookupSpan, SpanRef};
+use tracing_subscriber::util::SubscriberInitExt;
+use tracing_subscriber::{filter, EnvFilter};
 
 /// Installs the global subscriber. `level` is `--log-level` (`debug`, `info`, …), if given.
 /// Calling it twice is harmless (the second call does nothing).
+///
+/// Besides stderr, the suite's own events at info and above go to `/rosout` (as rclcpp's logs
+/// do, so rqt_console and `ros2 topic echo /rosout` show them) once a node is attached with
+/// [`attach_rosout`].
 pub fn init(level: Option<&str>) {
     let base = match level.map(|l| l.rsplit(":=").next().unwrap_or(l).to_ascii_lowercase()) {
         Some(l) if l == "fatal" => "error".to_owned(),
@@ -25,12 +38,92 @@ pub fn init(level: Option<&str>) {
         format!("{base},{QUIET}")
     };
     let filter = EnvFilter::try_new(&spec).unwrap_or_else(|_| EnvFilter::new(format!("info,{QUIET}")));
-    let _ = tracing_subscriber::fmt()
-        .with_env_filter(filter)
+    // ros2-client echoes every /rosout publication as a tracing event inside a `rosout_raw` span;
+    // the console already has the original line.
+    let not_an_echo = filter::dynamic_filter_fn(|_, cx| !in_rosout_echo(cx.lookup_current()));
+    let fmt = tracing_subscriber::fmt::layer()
         .with_writer(std::io::stderr)
         .with_ansi(std::io::IsTerminal::is_terminal(&std::io::stderr()))
         .with_target(false)
+        .with_filter(not_an_echo);
+    let _ = tracing_subscriber::registry()
+        .with(filter)
+        .with(fmt)
+        .with(RosoutLayer)
         .try_init();
+}
+
+fn in_rosout_echo<S: for<'a> LookupSpan<'a>>(span: Option<SpanRef<'_, S>>) -> bool {
+    span.is_some_and(|s| s.scope().any(|s| s.name() == "rosout_raw"))
+}
+
+/// Where [`RosoutLayer`] publishes: the running node's `/rosout` writer.
+static ROSOUT: Mutex<Option<NodeLoggingHandle>> = Mutex::new(None);
+
+/// Sends the process's log lines to this node's `/rosout` from now on.
+pub fn attach_rosout(handle: NodeLoggingHandle) {
+    if let Ok(mut slot) = ROSOUT.lock() {
+        *slot = Some(handle);
+    }
+}
+
+/// Stops sending to `/rosout` (before the node's writers go away at shutdown).
+pub fn detach_rosout() {
+    if let Ok(mut slot) = ROSOUT.lock() {
+        *slot = None;
+    }
+}
+
+/// Forwards the suite's own events (info and above) to `/rosout`.
+struct RosoutLayer;
+
+impl<S: Subscriber + for<'a> LookupSpan<'a>> Layer<S> for RosoutLayer {
+    fn on_event(&self, event: &Event<'_>, cx: layer::Context<'_, S>) {
+        let meta = event.metadata();
+        let level = match *meta.level() {
+            Level::ERROR => LogLevel::Error,
+            Level::WARN => LogLevel::Warn,
+            Level::INFO => LogLevel::Info,
+            _ => return,
+        };
+        if meta.target().starts_with("rustdds") || meta.target().starts_with("ros2_client") {
+            return;
+        }
+        if in_rosout_echo(cx.event_span(event)) || in_rosout_echo(cx.lookup_current()) {
+            return;
+        }
+        // try_lock: an event raised while publishing (nested) is not forwarded again.
+        let Ok(slot) = ROSOUT.try_lock() else { return };
+        let Some(handle) = slot.as_ref() else { return };
+        let mut text = MessageText(String::new());
+        event.record(&mut text);
+        handle.rosout_raw(
+            ros2_client::builtin_interfaces::Time::now(),
+            level,
+            handle.base_name(),
+            &text.0,
+            meta.file().unwrap_or(""),
+            meta.module_path().unwrap_or(""),
+            meta.line().unwrap_or(0),
+        );
+    }
+}
+
+/// The `message` field of an event.
+struct MessageText(String);
+
+impl Visit for MessageText {
+    fn record_debug(&mut self, field: &Field, value: &dyn std::fmt::Debug) {
+        if field.name() == "message" {
+            self.0 = format!("{value:?}");
+        }
+    }
+
+    fn record_str(&mut self, field: &Field, value: &str) {
+        if field.name() == "message" {
+            self.0 = value.to_owned();
+        }
+    }
 }
 
 /// Rate limit for log lines, per key.

@@ -274,6 +274,7 @@ impl RosNode {
             sim_clock: AtomicI64::new(0),
         };
         ros_node.clock = Some(ros_node.subscription::<Clock>("/clock", &crate::qos::sensor_data())?);
+        crate::log::attach_rosout(ros_node.node.logging_handle());
         Ok(ros_node)
     }
 
@@ -380,6 +381,7 @@ impl RosNode {
             ..
         } = self;
         // Readers and writers must go while their participant exists.
+        crate::log::detach_rosout();
         drop(clock);
         // Dropping the node tells its spinner to stop; then the context (participant) goes.
         drop(node);
