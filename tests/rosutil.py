@@ -31,9 +31,11 @@ from typing import Any, Optional
 
 ROOT = Path(__file__).resolve().parent.parent
 TESTS_DIR = ROOT / "tests"
-MSGS_INSTALL = ROOT / "target" / "msgs-install"
+PY_VERSION = f"{sys.version_info.major}.{sys.version_info.minor}"
+# Built by tests/setup_env.sh, one per Python version (the type support is a C extension).
+MSGS_INSTALL = ROOT / "target" / f"msgs-install-py{PY_VERSION}"
 MSGS_LIB = MSGS_INSTALL / "lib"
-MSGS_PYTHONPATH = MSGS_INSTALL / "lib" / f"python{sys.version_info.major}.{sys.version_info.minor}" / "site-packages"
+MSGS_PYTHONPATH = MSGS_INSTALL / "lib" / f"python{PY_VERSION}" / "site-packages"
 FASTDDS_PROFILE = TESTS_DIR / "fastdds_profile.xml"
 RMW_IMPLEMENTATION = "rmw_fastrtps_cpp"
 

@@ -6,9 +6,27 @@
 set -euo pipefail
 ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 VENV="${MOBIL_VENV:-$ROOT/.venv}"
-BUILD="$ROOT/target/msgs-build"
-INSTALL="$ROOT/target/msgs-install"
-PY="${PYTHON:-python3}"
+# The Pythons that ROS 2 Jazzy's wheels exist for.
+SUPPORTED="3.11 3.12"
+
+py_version() { "$1" -c 'import sys; print(f"{sys.version_info[0]}.{sys.version_info[1]}")' 2>/dev/null; }
+# PYTHON=... chooses the interpreter (the venv is recreated if it has another version); without
+# it an existing venv keeps its Python, and a new one is made with python3.
+if [ -n "${PYTHON:-}" ]; then
+  PY="$PYTHON"
+elif [ -x "$VENV/bin/python" ] && case " $SUPPORTED " in *" $(py_version "$VENV/bin/python") "*) true ;; *) false ;; esac; then
+  PY="$VENV/bin/python"
+else
+  PY=python3
+fi
+want_ver="$(py_version "$PY")" || { echo "setup_env: cannot run Python '$PY' (set PYTHON=... to one of: $SUPPORTED)" >&2; exit 1; }
+case " $SUPPORTED " in
+  *" $want_ver "*) ;;
+  *) echo "setup_env: Python $want_ver ($PY) is not supported: ROS 2 Jazzy's rclpy wheels exist for Python $SUPPORTED only (set PYTHON=...)" >&2; exit 1 ;;
+esac
+# The type support is compiled against one Python, so each version has its own build.
+BUILD="$ROOT/target/msgs-build-py$want_ver"
+INSTALL="$ROOT/target/msgs-install-py$want_ver"
 
 PIP_PACKAGES=(
   "ros-jazzy-rclpy[fastrtps]" ros-jazzy-common-interfaces
@@ -20,8 +38,12 @@ PIP_PACKAGES=(
 )
 stamp_pip="$VENV/.mobil-pip-stamp"
 want_pip="$(printf '%s\n' "${PIP_PACKAGES[@]}" | sha256sum | cut -d' ' -f1)"
+if [ -x "$VENV/bin/python" ] && [ "$(py_version "$VENV/bin/python")" != "$want_ver" ]; then
+  echo "setup_env: $VENV has Python $(py_version "$VENV/bin/python"), $want_ver wanted: recreating it" >&2
+  rm -rf "$VENV"
+fi
 if [ ! -x "$VENV/bin/python" ]; then
-  echo "setup_env: creating venv $VENV" >&2
+  echo "setup_env: creating venv $VENV (Python $want_ver)" >&2
   "$PY" -m venv "$VENV"
 fi
 if [ "$(cat "$stamp_pip" 2>/dev/null)" != "$want_pip" ]; then
@@ -31,16 +53,21 @@ if [ "$(cat "$stamp_pip" 2>/dev/null)" != "$want_pip" ]; then
 fi
 
 # The wheels' CMake exports name the include dir of the interpreter they were built with
-# (/opt/python/...); point them at this venv's interpreter headers instead (venv-local, idempotent).
+# (/opt/python/cpXY-cpXY/..., one per Python version); point them at this venv's interpreter
+# headers and site-packages instead (venv-local, idempotent).
 py_inc="$("$VENV/bin/python" -c 'import sysconfig; print(sysconfig.get_paths()["include"])')"
 py_site="$("$VENV/bin/python" -c 'import sysconfig; print(sysconfig.get_paths()["purelib"])')"
 # (grep exits 1 once nothing is left to patch: not an error.)
-{ grep -rlZ --include='*.cmake' '/opt/python/cp311-cp311/' "$VENV/share" 2>/dev/null || true; } \
-  | xargs -0 -r sed -i -e "s|/opt/python/cp311-cp311/include/python3.11|$py_inc|g" \
-      -e "s|/opt/python/cp311-cp311/lib/python3.11/site-packages|$py_site|g"
+{ grep -rlZ --include='*.cmake' '/opt/python/cp3' "$VENV/share" 2>/dev/null || true; } \
+  | xargs -0 -r sed -i -E -e "s|/opt/python/cp3[0-9]+-cp3[0-9]+/include/python3\.[0-9]+|$py_inc|g" \
+      -e "s|/opt/python/cp3[0-9]+-cp3[0-9]+/lib/python3\.[0-9]+/site-packages|$py_site|g"
+if left="$(grep -rl --include='*.cmake' '/opt/python/' "$VENV/share" 2>/dev/null | head -3)" && [ -n "$left" ]; then
+  echo "setup_env: CMake exports still name /opt/python (a wheel layout this script does not know): $left" >&2
+  exit 1
+fi
 
 # mobil_msgs Python type support, from the same CMakeLists.txt colcon uses.
-want_msgs="$(cd "$ROOT/msgs" && find . -path ./rust -prune -o -type f \( -name '*.msg' -o -name '*.srv' -o -name CMakeLists.txt -o -name package.xml \) -print | sort | xargs sha256sum | sha256sum | cut -d' ' -f1)"
+want_msgs="$want_ver $(cd "$ROOT/msgs" && find . -path ./rust -prune -o -type f \( -name '*.msg' -o -name '*.srv' -o -name CMakeLists.txt -o -name package.xml \) -print | sort | xargs sha256sum | sha256sum | cut -d' ' -f1)"
 stamp_msgs="$INSTALL/.mobil-msgs-stamp"
 if [ "$(cat "$stamp_msgs" 2>/dev/null)" != "$want_msgs" ]; then
   echo "setup_env: building mobil_msgs Python type support (about 15 s)" >&2
