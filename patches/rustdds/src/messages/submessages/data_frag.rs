@@ -301,8 +301,12 @@ impl<C: Context> Writable<C> for DataFrag {
     writer.write_value(&self.fragments_in_submessage)?;
     writer.write_value(&self.fragment_size)?;
     writer.write_value(&self.data_size)?;
-    if self.inline_qos.is_some() && !self.inline_qos.as_ref().unwrap().parameters.is_empty() {
-      writer.write_value(&self.inline_qos)?;
+    // Write the ParameterList itself, not the Option: speedy would prefix an
+    // Option with a one-byte tag, which is not part of the RTPS wire format.
+    if let Some(inline_qos) = self.inline_qos.as_ref() {
+      if !inline_qos.parameters.is_empty() {
+        writer.write_value(inline_qos)?;
+      }
     }
     writer.write_bytes(&self.serialized_payload)?;
     Ok(())
@@ -325,7 +329,10 @@ mod tests {
   use speedy::{Endianness, Writable};
 
   use super::*;
-  use crate::messages::submessages::submessages::DATAFRAG_Flags;
+  use crate::{
+    messages::submessages::{elements::parameter::Parameter, submessages::DATAFRAG_Flags},
+    structure::parameter_id::ParameterId,
+  };
 
   fn serialize_body(df: &DataFrag) -> Bytes {
     let mut buf = Vec::new();
@@ -381,6 +388,46 @@ mod tests {
     };
     let bytes = serialize_body(&df);
     assert!(DataFrag::deserialize(&bytes, BitFlags::<DATAFRAG_Flags>::empty()).is_err());
+  }
+
+  // A service reply (or any sample written with a related sample identity) that
+  // needs fragmenting carries its inline QoS in every DATA_FRAG. The inline QoS
+  // must follow sampleSize directly, and the body must be exactly
+  // len_serialized() bytes long, since that becomes octetsToNextHeader.
+  #[test]
+  fn inline_qos_is_written_as_parameter_list_right_after_header() {
+    let identity: Vec<u8> = (1..=24).collect(); // a SampleIdentity is 24 bytes
+    let payload = Bytes::from(vec![0xAB; 8]);
+    let df = DataFrag {
+      writer_sn: SequenceNumber::new(3),
+      fragment_starting_num: FragmentNumber::new(1),
+      fragments_in_submessage: 1,
+      fragment_size: 8,
+      data_size: 16,
+      inline_qos: Some(ParameterList {
+        parameters: vec![Parameter::new(
+          ParameterId::PID_RELATED_SAMPLE_IDENTITY,
+          identity.clone(),
+        )],
+      }),
+      serialized_payload: payload.clone(),
+      ..Default::default()
+    };
+    let bytes = serialize_body(&df);
+
+    // 32 bytes of fixed fields, inline QoS of 4 + 24 bytes plus a 4-byte
+    // sentinel, then the 8 payload bytes.
+    assert_eq!(bytes.len(), 32 + 4 + 24 + 4 + 8);
+    assert_eq!(bytes.len(), df.len_serialized());
+    assert_eq!(&bytes[2..4], &[28, 0]); // octetsToInlineQos
+    assert_eq!(&bytes[32..36], &[0x83, 0x00, 24, 0]); // PID 0x0083, length 24
+    assert_eq!(&bytes[36..60], identity.as_slice());
+    assert_eq!(&bytes[60..64], &[0x01, 0x00, 0x00, 0x00]); // PID_SENTINEL
+    assert_eq!(&bytes[64..], payload.as_ref());
+
+    let flags = DATAFRAG_Flags::Endianness | DATAFRAG_Flags::InlineQos;
+    let read_back = DataFrag::deserialize(&bytes, flags).expect("deserialize DataFrag");
+    assert_eq!(read_back, df);
   }
 
   #[test]
