@@ -296,6 +296,8 @@ pub struct Plant {
     measured_velocities: Vec<f64>,
     /// True twist of the kinematic origin.
     twist: BodyTwist,
+    /// The joint values `twist` was solved for (a sub-step starts where the last one ended).
+    twist_joints: Vec<f64>,
     slip_residual: f64,
     time: f64,
     last_command: Option<f64>,
@@ -319,8 +321,9 @@ impl Plant {
             actual: zero.clone(),
             target: zero.clone(),
             measured_positions: zero.clone(),
-            measured_velocities: zero,
+            measured_velocities: zero.clone(),
             twist: BodyTwist::ZERO,
+            twist_joints: zero,
             slip_residual: 0.0,
             time: 0.0,
             last_command: None,
@@ -337,6 +340,8 @@ impl Plant {
             self.config = config;
             self.geometry = WheelGeometry::new(&config.params);
             self.limit_targets();
+            // New geometry: the twist of the current joints is solved afresh.
+            self.twist_joints.clear();
         }
     }
 
@@ -438,7 +443,11 @@ impl Plant {
         for _ in 0..substeps {
             self.joints_after(&self.actual, 0.5 * h, &mut mid);
             self.joints_after(&self.actual, h, &mut end);
-            let t0 = self.solve(&self.actual).twist;
+            let t0 = if self.twist_joints == self.actual {
+                self.twist
+            } else {
+                self.solve(&self.actual).twist
+            };
             let t_mid = self.solve(&mid).twist;
             let solution = self.solve(&end);
             // Classical RK4 on the pose; the twist depends on time only (through the joints).
@@ -454,7 +463,6 @@ impl Plant {
             let finite = next.iter().all(|v| v.is_finite());
             if !finite || world.collides(Point2::new(reference.x, reference.y), self.config.robot_radius) {
                 self.collided |= finite;
-                self.twist = BodyTwist::ZERO;
                 self.slip_residual = 0.0;
                 // Stalled against the obstacle: the wheels stop too.
                 for (actual, joint) in self.actual.iter_mut().zip(joints) {
@@ -462,10 +470,14 @@ impl Plant {
                         *actual = 0.0;
                     }
                 }
+                // Stopped wheels drive nothing: the twist is zero whatever the steering.
+                self.twist = BodyTwist::ZERO;
+                self.twist_joints.clone_from(&self.actual);
                 break;
             }
             self.pose = next;
             self.twist = solution.twist;
+            self.twist_joints.clone_from(&self.actual);
             self.slip_residual = solution.slip_residual;
         }
         self.time += dt;
