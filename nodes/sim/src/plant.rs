@@ -105,6 +105,9 @@ pub struct TwistSolution {
     pub slip_residual: f64,
 }
 
+/// Most joints of any chassis (car-like: two steering angles, two wheel speeds).
+const MAX_JOINTS: usize = 4;
+
 /// Most constraint rows of any chassis (car-like: two rolling and four no-sideslip rows).
 const MAX_ROWS: usize = 8;
 
@@ -431,7 +434,10 @@ impl Plant {
         if timed_out {
             self.stop();
         }
-        let before = self.actual.clone();
+        // At most four joints (car-like): scratch space on the stack, no allocation per step.
+        let n = self.actual.len().min(MAX_JOINTS);
+        let mut before = [0.0; MAX_JOINTS];
+        before[..n].copy_from_slice(&self.actual[..n]);
         if self.config.motor_time_constant <= 0.0 {
             // Ideal motors: the joints are at their commands from the start of the step.
             self.actual.clone_from(&self.target);
@@ -439,17 +445,18 @@ impl Plant {
         let substeps = (dt / MAX_SUBSTEP).ceil().max(1.0) as usize;
         let h = dt / substeps as f64;
         let d = self.config.params.reference_offset();
-        let (mut mid, mut end) = (self.actual.clone(), self.actual.clone());
+        let (mut mid_buffer, mut end_buffer) = ([0.0; MAX_JOINTS], [0.0; MAX_JOINTS]);
+        let (mid, end) = (&mut mid_buffer[..n], &mut end_buffer[..n]);
         for _ in 0..substeps {
-            self.joints_after(&self.actual, 0.5 * h, &mut mid);
-            self.joints_after(&self.actual, h, &mut end);
+            self.joints_after(&self.actual, 0.5 * h, mid);
+            self.joints_after(&self.actual, h, end);
             let t0 = if self.twist_joints == self.actual {
                 self.twist
             } else {
                 self.solve(&self.actual).twist
             };
-            let t_mid = self.solve(&mid).twist;
-            let solution = self.solve(&end);
+            let t_mid = self.solve(mid).twist;
+            let solution = self.solve(end);
             // Classical RK4 on the pose; the twist depends on time only (through the joints).
             let p = self.pose;
             let k1 = pose_rate(p.z, &t0);
@@ -458,7 +465,7 @@ impl Plant {
             let k4 = pose_rate(p.z + h * k3.z, &solution.twist);
             let mut next = p + (k1 + 2.0 * k2 + 2.0 * k3 + k4) * (h / 6.0);
             next.z = wrap(next.z);
-            self.actual.copy_from_slice(&end);
+            self.actual[..n].copy_from_slice(end);
             let reference = ahead(&next, d);
             let finite = next.iter().all(|v| v.is_finite());
             if !finite || world.collides(Point2::new(reference.x, reference.y), self.config.robot_radius) {
