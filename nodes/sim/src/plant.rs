@@ -858,6 +858,30 @@ mod tests {
         }
     }
 
+    proptest::proptest! {
+        /// Two independently written models agree: the plant's least squares, fed the wheels
+        /// the chassis' inverse kinematics commands for a feasible twist, returns that twist
+        /// with no slip (omni: any twist; car-like and tricycle: v ≠ 0, no sideways part).
+        #[test]
+        fn plant_recovers_every_twist_the_chassis_commands(
+            v in -0.5f64..0.5, vy in -0.5f64..0.5, w in -1.0f64..1.0, k in -1.0f64..1.0
+        ) {
+            let omni = ChassisParams::omr3();
+            let s = twist_of(&omni, &inverse(&omni, BodyTwist::new(v, vy, w)).values());
+            proptest::prop_assert!((s.twist.vx - v).abs() < 1e-9 && (s.twist.vy - vy).abs() < 1e-9);
+            proptest::prop_assert!((s.twist.wz - w).abs() < 1e-9 && s.slip_residual < 1e-9);
+            proptest::prop_assume!(v.abs() > 0.01);
+            for params in [ChassisParams::mobil2(), ChassisParams::tricycle()] {
+                // A curvature within the chassis' limit: ω = k·v·κ_max.
+                let w = k * v * params.max_curvature();
+                let s = twist_of(&params, &inverse(&params, BodyTwist::new(v, 0.0, w)).values());
+                proptest::prop_assert!((s.twist.vx - v).abs() < 1e-9, "{:?} {:?}", params.model(), s);
+                proptest::prop_assert!(s.twist.vy.abs() < 1e-9 && (s.twist.wz - w).abs() < 1e-9);
+                proptest::prop_assert!(s.slip_residual < 1e-9);
+            }
+        }
+    }
+
     #[test]
     fn a_command_for_another_model_changes_nothing() {
         let mut p = plant(ChassisConfig::omr3(), 0.0, 0.0);
