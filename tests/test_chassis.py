@@ -50,11 +50,28 @@ def start_robot(start_node, robot: str, *extra: str, lidar: bool = False):
     return sim, chassis
 
 
-# Commanded twist per robot and what the kinematics make of it at steady state.
+# Commanded twist per robot (at base_link) and what the kinematics make of it at steady state.
 # mobil2: v = 0.3, ω = 0.2 → radius 1.5 m ≥ 0.73 m: feasible, kept.
 # omr3: vx = 0.2, vy = 0.1, ω = 0.3: an omni chassis follows all three.
 # tricycle: v = 0.3, ω = 0.4 → radius 0.75 m ≥ 0.25 m and δ = atan(0.5·0.4/0.3) = 33.7° < 60°.
 COMMANDS = {"mobil2": (0.3, 0.0, 0.2), "omr3": (0.2, 0.1, 0.3), "tricycle": (0.3, 0.0, 0.4)}
+# Radius of the circle base_link (the point the topics report) then runs on, by hand:
+# mobil2: a car-like chassis drops the sideways part, so its rear-axle centre runs at v = 0.3 on
+#   R = v/ω = 1.5 m; base_link sits d = 0.30 m ahead of the axle, on the radius through the
+#   rear axle's normal: R_ref = sqrt(R² + d²) = sqrt(2.25 + 0.09) = 1.52971 m (2 % more than R),
+#   and moves sideways at ω·d = 0.06 m/s in its own frame;
+# omr3: |v| / ω = sqrt(0.2² + 0.1²) / 0.3 = 0.223607 / 0.3 = 0.745356 m;
+# tricycle: base_link is the rear-axle centre: 0.3 / 0.4 = 0.75 m.
+RADIUS = {"mobil2": 1.529706, "omr3": 0.745356, "tricycle": 0.75}
+SIDEWAYS = {"mobil2": 0.06, "omr3": 0.1, "tricycle": 0.0}
+
+
+def stamp(msg) -> tuple[int, int]:
+    return msg.header.stamp.sec, msg.header.stamp.nanosec
+
+
+def seconds(msg) -> float:
+    return msg.header.stamp.sec + msg.header.stamp.nanosec * 1e-9
 
 
 @pytest.mark.parametrize("robot", ROBOTS)
@@ -63,37 +80,46 @@ def test_cmd_vel_moves_odom_as_the_kinematics_predict(robot, start_node, ros_nod
     vx, vy, wz = COMMANDS[robot]
     cmd = ros_node.create_publisher(Twist, "cmd_vel", 10)
     with subscribe(ros_node, Odometry, "odom") as odom, subscribe(ros_node, Odometry, "ground_truth") as truth:
-        # Drive until the wheels have settled on the command (motor lag τ = 0.05 s).
+        # Drive until the wheels have settled on the command (motor lag τ = 0.05 s: within
+        # 1e-4 after about 0.4 s; without noise the odometry's twist converges exactly).
         publish_until(ros_node, cmd, twist(vx, vy, wz),
-                      lambda: odom.latest is not None and abs(odom.latest.twist.twist.angular.z - wz) < 0.01,
+                      lambda: odom.latest is not None
+                      and abs(odom.latest.twist.twist.angular.z - wz) < 1e-4
+                      and abs(odom.latest.twist.twist.linear.x - vx) < 1e-4,
                       rate_hz=20, timeout=15)
-        start_odom, start_truth = odom.latest, truth.latest
+        start_odom = odom.latest
         t0 = time.monotonic()
         while time.monotonic() - t0 < 3.0:
             cmd.publish(twist(vx, vy, wz))
             time.sleep(0.05)
-        end_odom, end_truth = odom.latest, truth.latest
+        end_odom = odom.latest
         cmd.publish(twist())
+        # The truth at the same instants: sim_node stamps joint_states and ground_truth alike,
+        # and the odometry republishes the feedback's stamps.
+        start_truth = truth.wait_for(lambda m: stamp(m) == stamp(start_odom), timeout=5)
+        end_truth = truth.wait_for(lambda m: stamp(m) == stamp(end_odom), timeout=5)
 
-    # Steady-state twist at base_link equals the command (body frame).
+    # Steady-state twist at base_link equals the command ahead and in rotation (body frame);
+    # sideways it is the command for the omni chassis, ω·d for MOBIL-II.
     tw = end_odom.twist.twist
-    assert tw.linear.x == pytest.approx(vx, abs=0.01)
-    assert tw.angular.z == pytest.approx(wz, abs=0.01)
-    if robot == "omr3":
-        assert tw.linear.y == pytest.approx(vy, abs=0.01)
-    # Over the window, heading changes by ω·Δt and the odometry displacement matches the truth.
-    dt = (end_odom.header.stamp.sec + end_odom.header.stamp.nanosec * 1e-9) - (
-        start_odom.header.stamp.sec + start_odom.header.stamp.nanosec * 1e-9)
+    assert tw.linear.x == pytest.approx(vx, abs=1e-3)
+    assert tw.angular.z == pytest.approx(wz, abs=1e-3)
+    assert tw.linear.y == pytest.approx(SIDEWAYS[robot], abs=1e-3)
+    assert end_truth.twist.twist.linear.y == pytest.approx(SIDEWAYS[robot], abs=1e-3)
+    # Over the window, heading changes by ω·Δt and base_link moves along the chord of its
+    # circle, 2·R_ref·sin(ω·Δt / 2), in the odometry and in the truth alike. Without noise both
+    # agree to about 1e-5; 0.1 % catches a 1 % error in the model (or MOBIL-II's rear-axle
+    # radius, 2 % short).
+    dt = seconds(end_odom) - seconds(start_odom)
+    assert dt > 2.5
     dyaw = math.remainder(yaw(end_odom) - yaw(start_odom), math.tau)
-    assert dyaw == pytest.approx(wz * dt, rel=0.03)
+    assert dyaw == pytest.approx(wz * dt, rel=0.001)
     (ox0, oy0), (ox1, oy1) = xy(start_odom), xy(end_odom)
     (gx0, gy0), (gx1, gy1) = xy(start_truth), xy(end_truth)
     odom_step, truth_step = math.hypot(ox1 - ox0, oy1 - oy0), math.hypot(gx1 - gx0, gy1 - gy0)
-    # Chord of an arc of radius R = |v|/ω over angle ω·Δt: 2R·sin(ωΔt/2).
-    speed = math.hypot(vx, vy)
-    chord = 2 * speed / wz * math.sin(wz * dt / 2)
-    assert odom_step == pytest.approx(chord, rel=0.03)
-    assert truth_step == pytest.approx(chord, rel=0.03)
+    chord = 2 * RADIUS[robot] * math.sin(wz * dt / 2)
+    assert odom_step == pytest.approx(chord, rel=0.001)
+    assert truth_step == pytest.approx(chord, rel=0.001)
 
 
 def test_car_like_turn_tighter_than_the_minimum_radius_is_clamped(start_node, ros_node):
@@ -117,8 +143,26 @@ def test_car_like_turn_tighter_than_the_minimum_radius_is_clamped(start_node, ro
         cmd.publish(twist())
 
 
-def test_odometry_within_2_percent_of_ground_truth_over_a_5_m_route(start_node, ros_node):
-    """An rclpy program drives the simulated MOBIL-II over 5 m with cmd_vel (no noise)."""
+def circle_through(a, b, c) -> tuple[float, float, float]:
+    """Centre (x, y) and radius of the circle through three points."""
+    (ax, ay), (bx, by), (cx, cy) = a, b, c
+    d = 2 * (ax * (by - cy) + bx * (cy - ay) + cx * (ay - by))
+    ux = ((ax * ax + ay * ay) * (by - cy) + (bx * bx + by * by) * (cy - ay) + (cx * cx + cy * cy) * (ay - by)) / d
+    uy = ((ax * ax + ay * ay) * (cx - bx) + (bx * bx + by * by) * (ax - cx) + (cx * cx + cy * cy) * (bx - ax)) / d
+    return ux, uy, math.hypot(ax - ux, ay - uy)
+
+
+def test_odometry_within_half_a_percent_of_ground_truth_over_a_5_m_route(start_node, ros_node):
+    """An rclpy program drives the simulated MOBIL-II over 5 m with cmd_vel (no noise).
+
+    By hand: the rear-axle centre runs 2 m straight along y = 0, a quarter turn of radius
+    R = v/ω = 0.4/0.4 = 1 m about a centre 1 m to its left (y = 1), then straight on. base_link,
+    the point the topics report, sits d = 0.30 m ahead of the axle: on the turn it keeps
+    R_ref = sqrt(R² + d²) = sqrt(1.09) = 1.04403 m from the same centre (not R: 4.4 % more), so
+    it drives 2 + (π/2)·1.04403 + (3 − π/2) = 5.0691 m in all, plus the little it covers before
+    the test sees it move. The turn's circle does not depend on timing, so it is checked
+    tightly, on the truth and on the odometry: 0.3 % on the radius, 3 mm on the centre line.
+    """
     start_robot(start_node, "mobil2")
     cmd = ros_node.create_publisher(Twist, "cmd_vel", 10)
     # 2 m straight, a quarter turn on a 1 m radius (π/2 m), then straight to 5 m in all.
@@ -126,6 +170,11 @@ def test_odometry_within_2_percent_of_ground_truth_over_a_5_m_route(start_node, 
     with subscribe(ros_node, Odometry, "odom") as odom, subscribe(ros_node, Odometry, "ground_truth") as truth:
         odom.wait_for(None, 10)
         truth.wait_for(None, 10)
+        # The route starts once the commands demonstrably arrive (the first ones may be lost
+        # while discovery completes).
+        publish_until(ros_node, cmd, twist(0.4, 0.0, 0.0),
+                      lambda: truth.latest is not None and truth.latest.pose.pose.position.x > 0.01,
+                      rate_hz=50, timeout=15)
         for v, w, duration in route:
             t0 = time.monotonic()
             while time.monotonic() - t0 < duration:
@@ -135,12 +184,26 @@ def test_odometry_within_2_percent_of_ground_truth_over_a_5_m_route(start_node, 
         while time.monotonic() - t0 < 1.0:
             cmd.publish(twist())
             time.sleep(0.05)
-        path = [xy(m) for m in truth.snapshot()]
+        truths, odoms = truth.snapshot(), odom.snapshot()
         final_odom, final_truth = xy(odom.latest), xy(truth.latest)
+    path = [xy(m) for m in truths]
     driven = sum(math.dist(a, b) for a, b in zip(path, path[1:]))
-    assert driven == pytest.approx(5.0, rel=0.05)
+    # Timing-dependent (Python's sleeps, DDS latency): a sanity check only.
+    assert driven == pytest.approx(5.07, rel=0.05)
+    # On the turn, well clear of the steering transients (0.5 s = 10 τ after its start and
+    # before its end, at ω = 0.4 rad/s: headings 0.2 to π/2 − 0.2), base_link stays on the
+    # hand-worked circle.
+    for name, msgs in (("ground_truth", truths), ("odom", odoms)):
+        turn = [xy(m) for m in msgs if 0.2 < yaw(m) < math.pi / 2 - 0.2]
+        assert len(turn) > 50, f"{name}: {len(turn)} samples on the turn"
+        cx, cy, radius = circle_through(turn[0], turn[len(turn) // 2], turn[-1])
+        assert radius == pytest.approx(math.sqrt(1.0 + 0.3 ** 2), rel=0.001), name
+        assert cy == pytest.approx(1.0, abs=0.001), name
+        assert max(abs(math.dist(p, (cx, cy)) - radius) for p in turn) < 0.001, name
+    # Noise-free odometry ends where the truth does, within 0.5 % of the distance (in-process
+    # it is within 0.15 %; see nodes/sim/tests/odometry_vs_truth.rs).
     error = math.dist(final_odom, final_truth)
-    assert error < 0.02 * driven, f"odometry off by {error:.3f} m over {driven:.2f} m"
+    assert error < 0.005 * driven, f"odometry off by {error:.4f} m over {driven:.2f} m"
 
 
 def test_watchdog_zeroes_wheel_commands_when_cmd_vel_stops(start_node, ros_node):

@@ -3,8 +3,10 @@
 //!
 //! - [`world`]: 2D obstacles (circles, polygons) from YAML, or the built-in world;
 //! - [`lidar`]: a planar LIDAR simulated by ray casting (LaserScan conventions);
-//! - [`plant`]: the chassis as a plant: wheel commands → motor lag → forward kinematics → exact
-//!   pose integration, and encoder feedback with noise and slip;
+//! - [`plant`]: the chassis as a plant, the simulation's ground truth: wheel commands held to the
+//!   chassis' limits → motor lag → the body twist that best fits every wheel's rolling and
+//!   no-sideslip constraints (least squares; the residual is the slip) → RK4 pose integration,
+//!   and encoder feedback with noise and slip;
 //! - [`plot`]: SVG plots of runs over the world.
 
 pub mod lidar;

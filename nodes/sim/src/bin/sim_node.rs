@@ -1,7 +1,8 @@
 //! `sim_node`: a simulated robot for demos and tests. Consumes `wheel_commands`, publishes wheel
 //! feedback on `joint_states` (optional noise and slip), the true pose on `ground_truth`, and a
 //! simulated LIDAR on `scan`, in a 2D world from a YAML file (or the built-in one).
-//! Deterministic for a given seed. Real time by default; with `publish_clock` it publishes
+//! Wheel commands are held to the chassis' limits; a malformed one, or one with NaN or infinity,
+//! stops the wheels. Deterministic for a given seed. Real time by default; with `publish_clock` it publishes
 //! `/clock` and may run faster (`real_time_factor`) for nodes started with `use_sim_time:=true`.
 
 use futures::StreamExt;
@@ -20,7 +21,7 @@ use mobil_ros::params::ParamValues;
 use mobil_ros::time::{stamp_from_nanos, stamp_from_secs};
 use mobil_ros::{qos, run_node, shutdown_signal, warn_throttled, LogThrottle, NodeDecl, ParamSpec, RosNode};
 use mobil_sim::lidar::{Lidar, LidarConfig};
-use mobil_sim::plant::{Plant, PlantConfig};
+use mobil_sim::plant::{CommandOutcome, Plant, PlantConfig};
 use mobil_sim::world::{Obstacle, World};
 use nalgebra::Vector3 as V3;
 use std::process::ExitCode;
@@ -130,6 +131,9 @@ fn sim_config(p: &ParamValues) -> Result<SimConfig, String> {
         robot_radius: p.f64("robot_radius")?,
     };
     let initial_pose = V3::new(pose[0], pose[1], pose[2]);
+    if !initial_pose.iter().all(|v| v.is_finite()) {
+        return Err(format!("initial_pose must be finite, got {pose:?}"));
+    }
     Ok(SimConfig {
         plant,
         seed: u64::try_from(p.i64("seed")?).map_err(|e| e.to_string())?,
@@ -313,11 +317,28 @@ async fn run(node: &mut RosNode) -> anyhow::Result<()> {
                 Err(e) => warn!("parameter change not applied: {e}"),
             },
             Some(msg) = commands.next() => match msg {
+                // A bad command stops the wheels, as real motor drivers do: the previous
+                // command must not keep them turning until the driver timeout.
                 Ok((js, _)) => match wheel_state_from_joints(config.plant.params.model(), &js.name, &js.position, &js.velocity) {
-                    Ok(wheels) => plant.command(&wheels),
-                    Err(e) => warn_throttled!(throttle, "cmd", "wheel_commands dropped: {e}"),
+                    Ok(wheels) => match plant.command(&wheels) {
+                        Ok(CommandOutcome::Accepted) => {}
+                        Ok(CommandOutcome::Limited) => warn_throttled!(
+                            throttle,
+                            "limit",
+                            "wheel_commands beyond the chassis limits (max_wheel_speed, max_steering) held to them: {:?}",
+                            plant.commanded()
+                        ),
+                        Err(e) => warn_throttled!(throttle, "cmd", "wheel_commands refused: {e}"),
+                    },
+                    Err(e) => {
+                        plant.stop();
+                        warn_throttled!(throttle, "cmd", "wheel_commands dropped, wheels stopped: {e}");
+                    }
                 },
-                Err(e) => warn_throttled!(throttle, "decode", "undecodable wheel_commands dropped: {e:?}"),
+                Err(e) => {
+                    plant.stop();
+                    warn_throttled!(throttle, "decode", "undecodable wheel_commands dropped, wheels stopped: {e:?}");
+                }
             },
             _ = tick.tick() => {
                 plant.step(dt, &world);
