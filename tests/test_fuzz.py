@@ -163,7 +163,8 @@ class Fuzz:
             return out
         return check
 
-    def status_monotonic(self) -> Callable[[Any], list[str]]:
+    def status_checks(self) -> Callable[[Any], list[str]]:
+        """The rejected count never decreases; with a watchdog expired nothing is commanded."""
         last = [0]
 
         def check(msg: ChassisStatus) -> list[str]:
@@ -171,6 +172,10 @@ class Fuzz:
             if msg.rejected_messages < last[0]:
                 out.append(f"rejected_messages went back from {last[0]} to {msg.rejected_messages}")
             last[0] = max(last[0], msg.rejected_messages)
+            c = msg.commanded
+            if (msg.watchdog_expired or msg.feedback_stale) and (c.linear.x, c.linear.y, c.angular.z) != (0, 0, 0):
+                out.append(f"commanded {message_to_dict(c)} with watchdog_expired {msg.watchdog_expired}, "
+                           f"feedback_stale {msg.feedback_stale}")
             return out
         return check
 
@@ -265,7 +270,7 @@ def test_fuzz_cmd_vel_every_bad_command_stops_the_wheels(start_node, ros_node, t
     fuzz.watch(ros_node, JointState, "wheel_commands", fuzz.wheel_limits("mobil2"))
     fuzz.watch(ros_node, Odometry, "odom")
     fuzz.watch(ros_node, Odometry, "ground_truth")
-    fuzz.watch(ros_node, ChassisStatus, "chassis/status", fuzz.status_monotonic())
+    fuzz.watch(ros_node, ChassisStatus, "chassis/status", fuzz.status_checks())
     cmd = ros_node.create_publisher(Twist, "cmd_vel", 10)
     with subscribe(ros_node, JointState, "wheel_commands", qos=harness.make_qos(depth=1000)) as wheels, \
             subscribe(ros_node, ChassisStatus, "chassis/status", qos=harness.qos_latched()) as status:
@@ -410,9 +415,12 @@ def test_fuzz_joint_states_never_poison_the_odometry(start_node, ros_node):
     chassis = start_node("chassis_node", params_file="params/omr3.yaml")
     fuzz.watch(ros_node, Odometry, "odom")
     fuzz.watch(ros_node, JointState, "wheel_commands", fuzz.wheel_limits("omr3"))
-    fuzz.watch(ros_node, ChassisStatus, "chassis/status", fuzz.status_monotonic())
+    fuzz.watch(ros_node, ChassisStatus, "chassis/status", fuzz.status_checks())
     fb = ros_node.create_publisher(JointState, "joint_states", 10)
-    with subscribe(ros_node, Odometry, "odom", qos=harness.make_qos(depth=1000)) as odom:
+    cmd = ros_node.create_publisher(Twist, "cmd_vel", 10)
+    with subscribe(ros_node, Odometry, "odom", qos=harness.make_qos(depth=1000)) as odom, \
+            subscribe(ros_node, JointState, "wheel_commands", qos=harness.make_qos(depth=1000)) as wheels, \
+            subscribe(ros_node, ChassisStatus, "chassis/status", qos=harness.qos_latched()) as status:
         fuzz.case = "first feedback"
         stamps = iter(1000.0 + 0.01 * k for k in range(1000))
         publish_until(ros_node, fb, lambda: at(next(stamps), OMNI_JOINTS, [], [0.0] * 3),
@@ -434,6 +442,26 @@ def test_fuzz_joint_states_never_poison_the_odometry(start_node, ros_node):
             # A breath between blocks, so the chassis's keep-last queue drains.
             time.sleep(0.02)
         fuzz.count("joint_states sent", sent)
+        # Only broken feedback for longer than feedback_timeout_s (0.5 s): the odometry is
+        # stale, so good commands must not turn the wheels, neither on the control tick nor in
+        # the immediate answer to each cmd_vel.
+        fuzz.case = "good cmd_vel on broken feedback"
+        try:
+            status.wait_for(lambda st: st.feedback_stale, timeout=3, start=len(status))
+            start = len(wheels)
+            for i in range(60):
+                t += 0.01
+                cmd.publish(good_twist(rng))
+                fb.publish(at(t, OMNI_JOINTS, [], [NAN, 1.0, 1.0]))
+                time.sleep(0.01)
+            time.sleep(0.05)
+            turning = [list(m.velocity) for m in wheels.snapshot()[start:] if nonzero(m)]
+            fuzz.check(not turning, f"{len(turning)} of {len(wheels) - start} wheel_commands turn the wheels "
+                       f"on stale feedback, e.g. {turning[:1]}")
+            fuzz.count("cmd_vel on stale feedback", 60)
+        except TimeoutError as exc:
+            fuzz.fail(f"status never reported the feedback stale: {exc}")
+        cmd.publish(twist())
         # Good motion from rest: Ω = [6, −3, −3] rad/s with r = 0.05 is body-x 0.3 m/s
         # (v = r·(2/3)·(Ω1 − Ω2/2 − Ω3/2) = 0.05·(2/3)·9).
         fuzz.case = "good motion after the fuzz"
@@ -543,7 +571,7 @@ def test_fuzz_raw_cdr_buffers_are_refused_safely(start_node, ros_node, tmp_path)
                          params_file="params/omr3.yaml")
     fuzz.watch(ros_node, JointState, "/wheel_commands", fuzz.wheel_limits("omr3"))
     fuzz.watch(ros_node, Odometry, "/odom")
-    fuzz.watch(ros_node, ChassisStatus, "/chassis/status", fuzz.status_monotonic())
+    fuzz.watch(ros_node, ChassisStatus, "/chassis/status", fuzz.status_checks())
     fuzz.watch(ros_node, Odometry, "/fuzzsim/ground_truth")
     fuzz.watch(ros_node, JointState, "/fuzzsim/joint_states")
     cmd = ros_node.create_publisher(Twist, "/cmd_vel", 10)
@@ -667,7 +695,7 @@ def test_fuzz_parameter_sets_refused_leave_the_old_value(start_node, ros_node, t
     fuzz.watch(ros_node, JointState, "wheel_commands")
     fuzz.watch(ros_node, Odometry, "odom")
     fuzz.watch(ros_node, Odometry, "ground_truth")
-    fuzz.watch(ros_node, ChassisStatus, "chassis/status", fuzz.status_monotonic())
+    fuzz.watch(ros_node, ChassisStatus, "chassis/status", fuzz.status_checks())
     # The robot drives during the fuzz, so that accepted values are used at once.
     cmd = ros_node.create_publisher(Twist, "cmd_vel", 10)
     driving = ros_node.create_timer(0.1, lambda: cmd.publish(twist(0.2, 0.0, 0.1)))
