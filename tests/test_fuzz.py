@@ -50,7 +50,7 @@ OMNI_JOINTS = ["wheel_1", "wheel_2", "wheel_3"]
 # params/mobil2.yaml and params/omr3.yaml: wheel speed and (mechanical) steering limits.
 LIMITS = {"mobil2": (7.5, 1.2217), "omr3": (12.0, 0.0)}
 NO_LIDAR = ("-p", "lidar.enabled:=false")
-PER_CALL_TIMEOUT = 4.0
+PER_CALL_TIMEOUT = 5.0
 
 
 def rng_for(test: str) -> random.Random:
@@ -217,6 +217,11 @@ def stamp_s(msg: Any) -> float:
 REACTION = 0.1
 
 
+def status_after(status: Any, t: float) -> ChassisStatus:
+    """The first chassis status published after the time ``t`` (the host's clock)."""
+    return status.wait_for(lambda st: stamp_s(st) > t, timeout=2.0, start=max(0, len(status) - 5))
+
+
 def zero(msg: JointState) -> bool:
     return all(v == 0.0 for v in msg.velocity)
 
@@ -226,8 +231,10 @@ def nonzero(msg: JointState) -> bool:
 
 
 def answers_parameter_get(fuzz: Fuzz, ros_node: Any, node: str, name: str, expected: Any) -> None:
+    """Called once at start-up too: the service client is then matched before the fuzz (a new
+    client's matching can take seconds while the nodes are busy)."""
     try:
-        value = param_get(ros_node, node, name, timeout=PER_CALL_TIMEOUT)
+        value = param_get(ros_node, node, name, timeout=10.0)
         fuzz.check(value == expected, f"{node} {name} = {value!r}, expected {expected!r}")
     except TimeoutError as exc:
         fuzz.fail(f"{node} no longer answers get_parameters: {exc}")
@@ -267,6 +274,8 @@ def test_fuzz_cmd_vel_every_bad_command_stops_the_wheels(start_node, ros_node, t
     sim = start_node("sim_node", *NO_LIDAR, "-p", f"world_file:={world}", params_file="params/mobil2.yaml")
     # The cmd_vel watchdog far off, so that only the bad command can have stopped the wheels.
     chassis = start_node("chassis_node", "-p", "cmd_vel_timeout_s:=5.0", params_file="params/mobil2.yaml")
+    answers_parameter_get(fuzz, ros_node, "/chassis", "v_max", 0.5)
+    answers_parameter_get(fuzz, ros_node, "/sim", "wheel_radius", 0.1)
     fuzz.watch(ros_node, JointState, "wheel_commands", fuzz.wheel_limits("mobil2"))
     fuzz.watch(ros_node, Odometry, "odom")
     fuzz.watch(ros_node, Odometry, "ground_truth")
@@ -319,7 +328,7 @@ def test_fuzz_cmd_vel_every_bad_command_stops_the_wheels(start_node, ros_node, t
         bursts, burst_size = 8, 300
         for b in range(bursts):
             fuzz.case = f"burst {b}"
-            rejected_before = status.wait_for(None, timeout=5).rejected_messages
+            rejected_before = status_after(status, time.time()).rejected_messages
             bad_count = 0
             for _ in range(burst_size):
                 t, bad = fuzz_twist(rng)
@@ -338,8 +347,7 @@ def test_fuzz_cmd_vel_every_bad_command_stops_the_wheels(start_node, ros_node, t
                 fuzz.fail(f"after the burst the wheels are not {'stopped' if last_bad else 'turning'}"
                           f" (last command {message_to_dict(last)})")
             # Keep-last queues may drop part of a burst, never count more than was sent.
-            st = status.wait_for(lambda s: s.rejected_messages > rejected_before, timeout=2.0) \
-                if bad_count else status.latest
+            st = status_after(status, time.time())
             fuzz.check(rejected_before < st.rejected_messages <= rejected_before + bad_count,
                        f"rejected_messages {rejected_before} → {st.rejected_messages} for {bad_count} bad")
         # Still alive: a good command still turns the wheels.
@@ -413,6 +421,7 @@ def test_fuzz_joint_states_never_poison_the_odometry(start_node, ros_node):
     rng = rng_for("joint_states")
     fuzz = Fuzz("joint_states")
     chassis = start_node("chassis_node", params_file="params/omr3.yaml")
+    answers_parameter_get(fuzz, ros_node, "/chassis", "model", "omni")
     fuzz.watch(ros_node, Odometry, "odom")
     fuzz.watch(ros_node, JointState, "wheel_commands", fuzz.wheel_limits("omr3"))
     fuzz.watch(ros_node, ChassisStatus, "chassis/status", fuzz.status_checks())
@@ -495,6 +504,7 @@ def test_fuzz_wheel_commands_keep_the_simulation_finite(start_node, ros_node, tm
     fuzz = Fuzz("wheel_commands")
     sim = start_node("sim_node", *NO_LIDAR, "-p", f"world_file:={empty_world(tmp_path)}",
                      params_file="params/mobil2.yaml")
+    answers_parameter_get(fuzz, ros_node, "/sim", "model", "car_like")
     fuzz.watch(ros_node, Odometry, "ground_truth")
     fuzz.watch(ros_node, JointState, "joint_states")
     pub = ros_node.create_publisher(JointState, "wheel_commands", 10)
@@ -569,6 +579,8 @@ def test_fuzz_raw_cdr_buffers_are_refused_safely(start_node, ros_node, tmp_path)
                      params_file="params/omr3.yaml")
     chassis = start_node("chassis_node", "-p", "feedback_timeout_s:=0.0", "-p", "cmd_vel_timeout_s:=5.0",
                          params_file="params/omr3.yaml")
+    answers_parameter_get(fuzz, ros_node, "/chassis", "model", "omni")
+    answers_parameter_get(fuzz, ros_node, "/fuzzsim/sim", "model", "omni")
     fuzz.watch(ros_node, JointState, "/wheel_commands", fuzz.wheel_limits("omr3"))
     fuzz.watch(ros_node, Odometry, "/odom")
     fuzz.watch(ros_node, ChassisStatus, "/chassis/status", fuzz.status_checks())
@@ -700,12 +712,12 @@ def test_fuzz_parameter_sets_refused_leave_the_old_value(start_node, ros_node, t
     cmd = ros_node.create_publisher(Twist, "cmd_vel", 10)
     driving = ros_node.create_timer(0.1, lambda: cmd.publish(twist(0.2, 0.0, 0.1)))
 
-    def get_all(node: str, names: list[str]) -> dict[str, Any]:
+    def get_all(node: str, names: list[str], timeout: float = PER_CALL_TIMEOUT) -> dict[str, Any]:
         # A few names a request keeps each reply small (large replies are a matter of their own).
         out = {}
         for k in range(0, len(names), 6):
             chunk = names[k:k + 6]
-            values = get_parameters(ros_node, node, chunk, timeout=PER_CALL_TIMEOUT)
+            values = get_parameters(ros_node, node, chunk, timeout=timeout)
             out.update({n: parameter_value_to_python(v) for n, v in zip(chunk, values)})
         return out
 
@@ -723,7 +735,7 @@ def test_fuzz_parameter_sets_refused_leave_the_old_value(start_node, ros_node, t
         for node in ("/chassis", "/sim"):
             assert harness.wait_for_node(ros_node, node, timeout=10)
             names = harness.param_list(ros_node, node, timeout=10)
-            old = get_all(node, names)
+            old = get_all(node, names, timeout=10.0)
             cases: list[tuple[str, Any, Optional[bool]]] = []  # (name, value, must be refused?)
             for name, value in old.items():
                 for wrong in rng.sample(WRONG_TYPES, 3):
