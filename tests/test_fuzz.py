@@ -508,8 +508,14 @@ def test_fuzz_wheel_commands_keep_the_simulation_finite(start_node, ros_node, tm
     fuzz.watch(ros_node, Odometry, "ground_truth")
     fuzz.watch(ros_node, JointState, "joint_states")
     pub = ros_node.create_publisher(JointState, "wheel_commands", 10)
-    with subscribe(ros_node, Odometry, "ground_truth", qos=harness.make_qos(depth=1000)) as truth:
+    with subscribe(ros_node, Odometry, "ground_truth", qos=harness.make_qos(depth=1000)) as truth, \
+            subscribe(ros_node, JointState, "joint_states", qos=harness.make_qos(depth=1000)) as feedback:
         truth.wait_for(None, timeout=10)
+        # The sim hears this publisher: it steers the front wheels to 0.1 rad when asked.
+        fuzz.case = "first command"
+        publish_until(ros_node, pub, at(50.0, MOBIL2_JOINTS, [0.1, 0.1, 0.0, 0.0], [0.0] * 4),
+                      lambda: feedback.latest is not None and abs(feedback.latest.position[0] - 0.1) < 1e-3,
+                      rate_hz=20, timeout=10)
         sent, t = 0, 100.0
         for b in range(10):
             fuzz.case = f"block {b}"
@@ -596,6 +602,15 @@ def test_fuzz_raw_cdr_buffers_are_refused_safely(start_node, ros_node, tmp_path)
         fuzz.case = "first good command"
         publish_until(ros_node, cmd, twist(0.2), lambda: wheels.latest is not None and nonzero(wheels.latest),
                       rate_hz=20, timeout=15)
+        # Both other publishers are heard: the chassis answers feedback with odometry, the sim
+        # turns its wheels on a command (OMR-III turning in place at Ω = 1 rad/s each).
+        stamps = iter(70.0 + 0.01 * k for k in range(1000))
+        with subscribe(ros_node, Odometry, "/odom", qos=harness.make_qos(depth=100)) as odom, \
+                subscribe(ros_node, JointState, "/fuzzsim/joint_states", qos=harness.make_qos(depth=100)) as sim_fb:
+            publish_until(ros_node, fb, lambda: at(next(stamps), OMNI_JOINTS, [], [0.0] * 3),
+                          lambda: odom.latest is not None, rate_hz=20, timeout=10)
+            publish_until(ros_node, sim_cmd, at(1.0, OMNI_JOINTS, [], [1.0] * 3),
+                          lambda: sim_fb.latest is not None and sim_fb.latest.velocity[0] > 0.5, rate_hz=20, timeout=10)
         truth.wait_for(None, timeout=10)
         # One by one: a good command, then a cmd_vel cut short (a Twist is 4 + 48 bytes): it
         # cannot be decoded, so the chassis must stop the wheels as for any bad command.
