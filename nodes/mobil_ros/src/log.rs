@@ -27,17 +27,7 @@ pub fn init(level: Option<&str>) {
         Some(l) => l,
         None => std::env::var("RUST_LOG").unwrap_or_else(|_| "info".to_owned()),
     };
-    // The DDS stack is chatty at info; keep it at warn unless asked for explicitly. RustDDS's
-    // discovery database reports an "inconsistent topic" error for /clock in every process:
-    // ros2-client's spinner subscribes to it as builtin_interfaces/Time while rclpy, Gazebo and
-    // sim_node publish rosgraph_msgs/Clock (same bytes). Only that module is silenced.
-    const QUIET: &str = "rustdds=warn,ros2_client=warn,rustdds::discovery::discovery_db=off";
-    let spec = if base.contains('=') {
-        base
-    } else {
-        format!("{base},{QUIET}")
-    };
-    let filter = EnvFilter::try_new(&spec).unwrap_or_else(|_| EnvFilter::new(format!("info,{QUIET}")));
+    let filter = env_filter(&base);
     // ros2-client echoes every /rosout publication as a tracing event inside a `rosout_raw` span;
     // the console already has the original line.
     let not_an_echo = filter::dynamic_filter_fn(|_, cx| !in_rosout_echo(cx.lookup_current()));
@@ -51,6 +41,26 @@ pub fn init(level: Option<&str>) {
         .with(fmt)
         .with(RosoutLayer)
         .try_init();
+}
+
+/// The filter for a base level (`info`, …), or exactly the directives given when `base` holds
+/// any (`RUST_LOG=rustdds=debug`).
+///
+/// The DDS stack is chatty at info; it is kept at warn unless asked for explicitly. RustDDS's
+/// discovery database reports an "inconsistent topic" error for /clock in every process:
+/// ros2-client's spinner subscribes to it as builtin_interfaces/Time while rclpy, Gazebo and
+/// sim_node publish rosgraph_msgs/Clock (same bytes). Only that module is silenced. The CDR
+/// decoder warns once per malformed sample, unthrottled, about a fault the node reports itself
+/// (rate-limited, with the same reason), so a flood of bad input would flood the log and
+/// `/rosout`: it is kept at error.
+fn env_filter(base: &str) -> EnvFilter {
+    const QUIET: &str = "rustdds=warn,ros2_client=warn,rustdds::discovery::discovery_db=off,cdr_encoding=error";
+    let spec = if base.contains('=') {
+        base.to_owned()
+    } else {
+        format!("{base},{QUIET}")
+    };
+    EnvFilter::try_new(&spec).unwrap_or_else(|_| EnvFilter::new(format!("info,{QUIET}")))
 }
 
 fn in_rosout_echo<S: for<'a> LookupSpan<'a>>(span: Option<SpanRef<'_, S>>) -> bool {
@@ -188,6 +198,55 @@ macro_rules! warn_throttled {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use std::sync::Arc;
+
+    /// Records the level and target of every event that passes the filter.
+    struct Count(Arc<Mutex<Vec<String>>>);
+
+    impl<S: Subscriber> Layer<S> for Count {
+        fn on_event(&self, event: &Event<'_>, _: layer::Context<'_, S>) {
+            if let Ok(mut seen) = self.0.lock() {
+                seen.push(format!("{} {}", event.metadata().level(), event.metadata().target()));
+            }
+        }
+    }
+
+    #[test]
+    fn the_cdr_decoder_does_not_log_each_malformed_sample() {
+        let seen = Arc::new(Mutex::new(Vec::new()));
+        let subscriber = tracing_subscriber::registry()
+            .with(env_filter("info"))
+            .with(Count(seen.clone()));
+        tracing::subscriber::with_default(subscriber, || {
+            for _ in 0..100 {
+                tracing::warn!(target: "cdr_encoding::cdr_deserializer", "deserialize_str: Expected string null terminator");
+            }
+            tracing::error!(target: "cdr_encoding::cdr_deserializer", "an error is still shown");
+            tracing::warn!(target: "rustdds::dds::reader", "so is RustDDS at warn");
+            tracing::info!(target: "rustdds::dds::reader", "but not at info");
+            tracing::warn!(target: "chassis_node", "undecodable cmd_vel dropped");
+            tracing::info!(target: "chassis_node", "and the node's own info");
+        });
+        let seen = seen.lock().map(|s| s.clone()).unwrap_or_default();
+        assert_eq!(
+            seen,
+            [
+                "ERROR cdr_encoding::cdr_deserializer",
+                "WARN rustdds::dds::reader",
+                "WARN chassis_node",
+                "INFO chassis_node"
+            ]
+        );
+        // Directives given in full are taken as they are.
+        let seen_all = Arc::new(Mutex::new(Vec::new()));
+        let subscriber = tracing_subscriber::registry()
+            .with(env_filter("cdr_encoding=warn"))
+            .with(Count(seen_all.clone()));
+        tracing::subscriber::with_default(subscriber, || {
+            tracing::warn!(target: "cdr_encoding::cdr_deserializer", "shown when asked for");
+        });
+        assert_eq!(seen_all.lock().map(|s| s.len()).unwrap_or_default(), 1);
+    }
 
     #[test]
     fn throttles_per_key_and_counts_suppressed() {

@@ -55,7 +55,16 @@ pub enum WorldError {
     /// The text is not YAML of the expected shape.
     #[error("world is not valid YAML: {0}")]
     Yaml(#[from] serde_norway::Error),
-    /// An obstacle has invalid geometry (non-finite, radius ≤ 0, fewer than 3 points).
+    /// A world file whose text was refused (by [`WorldError::Yaml`] or [`WorldError::Invalid`]).
+    #[error("world file {path}: {source}")]
+    File {
+        /// The file.
+        path: String,
+        /// Why its text was refused.
+        source: Box<WorldError>,
+    },
+    /// An obstacle has invalid geometry (non-finite, beyond ±[`World::MAX_COORDINATE`],
+    /// radius ≤ 0, fewer than 3 points).
     #[error("obstacle {index}: {reason}")]
     Invalid {
         /// Position of the obstacle in the list (from 0).
@@ -112,8 +121,10 @@ impl Obstacle {
         (0..n).map(move |i| (point(points[i]), point(points[(i + 1) % n])))
     }
 
-    /// Checks the geometry: finite numbers, a positive radius, at least 3 polygon points.
+    /// Checks the geometry: finite numbers within ±[`World::MAX_COORDINATE`], a positive
+    /// radius, at least 3 polygon points.
     fn check(&self) -> Result<(), String> {
+        let within = |x: &f64| x.abs() <= World::MAX_COORDINATE;
         match self {
             Obstacle::Circle { center, radius } => {
                 if !(center.iter().all(|c| c.is_finite()) && radius.is_finite()) {
@@ -122,6 +133,12 @@ impl Obstacle {
                 if *radius <= 0.0 {
                     return Err(format!("circle radius {radius} must be positive"));
                 }
+                if !(center.iter().all(within) && within(radius)) {
+                    return Err(format!(
+                        "circle center {center:?} and radius {radius} must lie within ±{:e} m",
+                        World::MAX_COORDINATE
+                    ));
+                }
             }
             Obstacle::Polygon { points } => {
                 if points.len() < 3 {
@@ -129,6 +146,12 @@ impl Obstacle {
                 }
                 if let Some(p) = points.iter().find(|p| !(p[0].is_finite() && p[1].is_finite())) {
                     return Err(format!("polygon point {p:?} must be finite"));
+                }
+                if let Some(p) = points.iter().find(|p| !p.iter().all(within)) {
+                    return Err(format!(
+                        "polygon point {p:?} must lie within ±{:e} m",
+                        World::MAX_COORDINATE
+                    ));
                 }
             }
         }
@@ -190,6 +213,11 @@ impl Obstacle {
 }
 
 impl World {
+    /// The largest coordinate or radius magnitude accepted (m): a world of ±1000 km. Near the
+    /// limits of `f64` (1e308) the differences and squares of coordinates overflow, so bounding
+    /// boxes become infinite and distances meaningless; no map needs more than this.
+    pub const MAX_COORDINATE: f64 = 1e6;
+
     /// Parses a world from YAML text, refusing invalid geometry.
     pub fn from_yaml_str(text: &str) -> Result<World, WorldError> {
         let world: World = serde_norway::from_str(text)?;
@@ -197,17 +225,21 @@ impl World {
         Ok(world)
     }
 
-    /// Reads a world file (YAML, see the module documentation).
+    /// Reads a world file (YAML, see the module documentation). Every error names the file.
     pub fn load(path: impl AsRef<std::path::Path>) -> Result<World, WorldError> {
         let path = path.as_ref();
         let text = std::fs::read_to_string(path).map_err(|source| WorldError::Read {
             path: path.display().to_string(),
             source,
         })?;
-        Self::from_yaml_str(&text)
+        Self::from_yaml_str(&text).map_err(|e| WorldError::File {
+            path: path.display().to_string(),
+            source: Box::new(e),
+        })
     }
 
-    /// Checks every obstacle's geometry: finite numbers, radius > 0, at least 3 polygon points.
+    /// Checks every obstacle's geometry: finite numbers within ±[`World::MAX_COORDINATE`],
+    /// radius > 0, at least 3 polygon points.
     pub fn validate(&self) -> Result<(), WorldError> {
         for (index, o) in self.obstacles.iter().enumerate() {
             o.check().map_err(|reason| WorldError::Invalid { index, reason })?;
@@ -425,11 +457,29 @@ mod tests {
         assert!(err("obstacles:\n  - circle: { center: [.nan, 0], radius: 1 }\n").contains("finite"));
         assert!(err("obstacles:\n  - polygon: { points: [[0, 0], [1, .inf], [1, 1]] }\n").contains("finite"));
         assert!(err("obstacles:\n  - circle: { center: [0, 0], radius: .nan }\n").contains("finite"));
+        // Finite but beyond ±1e6 m: 1e308 − (−1e308) would overflow.
+        let e = err("obstacles:\n  - polygon: { points: [[-1e308, 0], [1e308, 0], [0, 1]] }\n");
+        assert!(
+            e.contains("obstacle 0") && e.contains("[-1e308, 0.0]") && e.contains("±1e6 m"),
+            "{e}"
+        );
+        let e = err("obstacles:\n  - circle: { center: [0, 0], radius: 1.5e6 }\n");
+        assert!(e.contains("radius 1500000") && e.contains("±1e6 m"), "{e}");
+        assert!(World::from_yaml_str("obstacles:\n  - circle: { center: [-1e6, 1e6], radius: 1e6 }\n").is_ok());
         // Shape errors: not a list, an unknown kind, a misspelt field.
         assert!(err("obstacles: 3").contains("YAML"));
         assert!(err("obstacles:\n  - square: { side: 1 }\n").contains("YAML"));
         assert!(err("obstacles:\n  - circle: { centre: [0, 0], radius: 1 }\n").contains("YAML"));
         assert!(err("obstacle: []\n").contains("YAML"));
+        // A file's errors name the file.
+        let path = std::env::temp_dir().join(format!("mobil_world_test_{}.yaml", std::process::id()));
+        std::fs::write(&path, "obstacles:\n  - circle: { center: [0, 0], radius: 0 }\n").unwrap();
+        let e = World::load(&path).unwrap_err().to_string();
+        let _ = std::fs::remove_file(&path);
+        assert!(
+            e.starts_with(&format!("world file {}: obstacle 0: ", path.display())),
+            "{e}"
+        );
         let e = World::load("/nonexistent/world.yaml").unwrap_err();
         assert!(matches!(e, WorldError::Read { .. }) && e.to_string().contains("/nonexistent/world.yaml"));
     }
