@@ -460,3 +460,112 @@ def test_node_logs_reach_rosout(start_node, ros_node):
         cmd.publish(twist())
     assert line.level == Log.WARN
     assert line.file.endswith("chassis_node.rs") and line.line > 0
+
+
+CAR_JOINTS = ["front_left_steering", "front_right_steering", "rear_left_wheel", "rear_right_wheel"]
+
+
+def stamp_s(msg) -> float:
+    return msg.header.stamp.sec + msg.header.stamp.nanosec * 1e-9
+
+
+@pytest.mark.parametrize("robot", ["omr3", "mobil2"])
+def test_cmd_vel_without_any_joint_states_never_turns_a_wheel(robot, start_node, ros_node):
+    """No joint_states at all: the odometry is blind, so no cmd_vel may reach the wheels."""
+    start_node("chassis_node", params_file=f"params/{robot}.yaml")
+    cmd = ros_node.create_publisher(Twist, "cmd_vel", 10)
+    with subscribe(ros_node, JointState, "wheel_commands") as wheels, \
+            subscribe(ros_node, ChassisStatus, "chassis/status") as status:
+        # 0.8 m/s is above v_max (0.5 m/s on both robots): CLAMP_SPEED in the status proves that
+        # the node has the request.
+        publish_until(ros_node, cmd, twist(0.8), lambda: status.latest is not None
+                      and status.latest.clamped & ChassisStatus.CLAMP_SPEED, rate_hz=10, timeout=10)
+        start = len(wheels)
+        # 2 s more of cmd_vel at 10 Hz (each one used to be sent to the wheels as it was).
+        t0 = time.monotonic()
+        while time.monotonic() - t0 < 2.0:
+            cmd.publish(twist(0.8))
+            time.sleep(0.1)
+        received = wheels.snapshot()
+        assert status.latest.feedback_stale
+        assert status.latest.commanded.linear.x == 0.0
+    # The 50 Hz tick alone gives about 100 messages in 2 s.
+    assert len(received) - start >= 60, f"only {len(received) - start} wheel_commands in 2 s"
+    moving = [m for m in received if any(v != 0.0 for v in m.velocity)]
+    assert not moving, f"{len(moving)} of {len(received)} wheel_commands were not zero: {moving[0]}"
+    # Decision (README): a stop holds the steering angles last sent; never sent, they are straight.
+    assert all(p == 0.0 for m in received for p in m.position)
+
+
+def test_wheels_stop_within_the_feedback_timeout_when_joint_states_stop(start_node, ros_node):
+    """MOBIL-II driving on a curve; joint_states stop while cmd_vel goes on: the rear wheels stop
+    within feedback_timeout_s (0.5 s) + one control period (20 ms) of the last feedback, and the
+    steering holds its angles."""
+    start_node("chassis_node", params_file="params/mobil2.yaml")
+    cmd = ros_node.create_publisher(Twist, "cmd_vel", 10)
+    fb = ros_node.create_publisher(JointState, "joint_states", 10)
+    # v = 0.3, ω = 0.2: R = 1.5 m (≥ 0.73 m). Ackermann (L 0.60, B 0.62): inner (left) wheel
+    # atan(0.6/(1.5 − 0.31)) = 0.467003 rad, outer atan(0.6/(1.5 + 0.31)) = 0.320092 rad; rear
+    # wheels (0.3 ∓ 0.2·0.31)/0.1 = 2.38 and 3.62 rad/s.
+    left, right = math.atan(0.6 / (1.5 - 0.31)), math.atan(0.6 / (1.5 + 0.31))
+    assert (left, right) == (pytest.approx(0.467003, abs=1e-6), pytest.approx(0.320092, abs=1e-6))
+
+    def feedback() -> JointState:
+        # Stamped with the system clock, as the node stamps wheel_commands (no use_sim_time).
+        return joint_state(time.time(), CAR_JOINTS, [0.0] * 4, [0.0] * 4)
+
+    with subscribe(ros_node, JointState, "wheel_commands") as wheels:
+        k = 0
+
+        def drive() -> JointState:
+            nonlocal k
+            k += 1
+            if k % 5 == 0:
+                cmd.publish(twist(0.3, 0.0, 0.2))
+            return feedback()
+
+        publish_until(ros_node, fb, drive, lambda: wheels.latest is not None
+                      and wheels.latest.velocity[2] == pytest.approx(2.38, abs=1e-9), rate_hz=50, timeout=10)
+        moving = wheels.latest
+        assert list(moving.position[:2]) == pytest.approx([left, right], abs=1e-9)
+        assert list(moving.velocity[2:]) == pytest.approx([2.38, 3.62], abs=1e-9)
+        # The feedback stops; cmd_vel goes on at 10 Hz for 1.5 s.
+        last = feedback()
+        fb.publish(last)
+        start = len(wheels)
+        t0 = time.monotonic()
+        while time.monotonic() - t0 < 1.5:
+            cmd.publish(twist(0.3, 0.0, 0.2))
+            time.sleep(0.1)
+        after = wheels.snapshot()[start:]
+    stopped_at = next(i for i, m in enumerate(after) if m.velocity[2] == 0.0 and m.velocity[3] == 0.0)
+    delay = stamp_s(after[stopped_at]) - stamp_s(last)
+    assert 0.49 < delay < 0.5 + 0.02 + 0.1, f"wheels stopped {delay:.3f} s after the last joint_states"
+    # From then on every command is a stop, with the steering held where it was.
+    for m in after[stopped_at:]:
+        assert list(m.velocity[2:]) == [0.0, 0.0]
+        assert list(m.position[:2]) == pytest.approx([left, right], abs=1e-9)
+    assert len(after) - stopped_at >= 30, "too few wheel_commands after the stop to judge"
+
+
+def test_a_nan_cmd_vel_is_logged_as_a_nan_not_as_a_timeout(start_node, ros_node):
+    chassis = start_node("chassis_node", "-p", "feedback_timeout_s:=0.0", params_file="params/omr3.yaml")
+    cmd = ros_node.create_publisher(Twist, "cmd_vel", 10)
+    with subscribe(ros_node, JointState, "wheel_commands") as wheels, \
+            subscribe(ros_node, ChassisStatus, "chassis/status") as status:
+        # Drive until the control tick has seen the running command (watchdog not expired).
+        publish_until(ros_node, cmd, twist(0.3), lambda: status.latest is not None
+                      and not status.latest.watchdog_expired and status.latest.commanded.linear.x == 0.3,
+                      rate_hz=20, timeout=10)
+        cmd.publish(twist(float("nan")))
+        status.wait_for(lambda s: s.clamped & ChassisStatus.CLAMP_NON_FINITE, timeout=3)
+        # 75 more status messages at 50 Hz: 1.5 s, three times the 0.5 s cmd_vel timeout.
+        status.wait_for(None, timeout=5, start=len(status) + 75)
+        st = status.latest
+    # The status still reports the stop.
+    assert st.watchdog_expired and st.clamped & ChassisStatus.CLAMP_NON_FINITE
+    assert (st.commanded.linear.x, st.commanded.angular.z) == (0.0, 0.0)
+    assert all(v == 0.0 for v in wheels.latest.velocity)
+    chassis.wait_for_log("NaN/inf", timeout=5)
+    log = chassis.log_text()
+    assert "no cmd_vel for" not in log, chassis.log_tail()

@@ -3,12 +3,20 @@
 //! clock for commands, message stamps for feedback), so tests and replays are deterministic.
 //!
 //! Command path: a body twist at the reference point (`cmd_vel` in `base_link`) → the twist at
-//! the kinematic origin → [`clamp_command`] → [`inverse`] kinematics → wheel commands. A
+//! the kinematic origin → [`clamp_command`] → [`inverse`] kinematics → the request. A
 //! non-holonomic chassis takes `linear.x` and `angular.z`; the sideways velocity its reference
 //! point has when turning (ω·d) is implied, and any *requested* `linear.y` is dropped (logged as
-//! lateral). The wheels are commanded to zero when no valid `cmd_vel` arrived within
-//! `cmd_vel_timeout_s`, and when wheel feedback is stale (no valid `joint_states` within
-//! `feedback_timeout_s`): a robot is never left moving on stale data.
+//! lateral).
+//!
+//! **One safety gate**: wheel commands come only out of [`ChassisController::gate`] (which
+//! [`ChassisController::on_cmd_vel`] and [`ChassisController::stop`] also end in), as a
+//! [`GatedCommand`] that nothing else can build. It passes the request only while a valid
+//! `cmd_vel` arrived within `cmd_vel_timeout_s`, valid wheel feedback within
+//! `feedback_timeout_s` (else the odometry is stale), the last `cmd_vel` was finite and the
+//! wheel values are finite; otherwise it stops. A stop sets every driven wheel to zero and
+//! **holds the steering angles last sent** (straight before any command): a safety stop starts
+//! no new motion, and steering a standing car-like chassis only scrubs its tyres. A requested
+//! zero twist is a command, not a stop: it straightens the wheels as the kinematics say.
 //!
 //! Feedback time: a sample is integrated over the interval since the previous one. A gap longer
 //! than the feedback timeout (a dropout, or a stamp far in the future) is not integrated across —
@@ -16,6 +24,8 @@
 //! taken as a clock reset (a restarted simulation) and handled the same way. A stamp slightly in
 //! the past (an out-of-order sample) is refused. So one bad stamp costs one sample, never the
 //! odometry.
+
+use std::ops::Deref;
 
 use crate::error::{ChassisError, OdometryError};
 use crate::kinematics::{forward, inverse, pre_steer, twist_at_origin, twist_at_reference, BodyTwist, WheelState};
@@ -37,7 +47,7 @@ pub struct ControllerConfig {
     pub noise: OdometryNoise,
 }
 
-/// What to send to the wheels.
+/// Wheel targets with the twist they give and what the limits changed.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Command {
     /// Joint targets.
@@ -58,13 +68,50 @@ impl Command {
     }
 }
 
-/// The state of the two watchdogs at a tick.
+/// A command that went through [`ChassisController::gate`], the only thing to send to the
+/// wheels; it reads as a [`Command`] and says why it may be a stop.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct GatedCommand {
+    command: Command,
+    safety: Safety,
+}
+
+impl GatedCommand {
+    /// The watchdogs' state when the command was gated.
+    pub fn safety(&self) -> Safety {
+        self.safety
+    }
+}
+
+impl Deref for GatedCommand {
+    type Target = Command;
+
+    fn deref(&self) -> &Command {
+        &self.command
+    }
+}
+
+/// The state of the watchdogs when a command was gated.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct Safety {
-    /// No valid `cmd_vel` within the timeout.
+    /// No valid `cmd_vel` within the timeout (a non-finite one does not count as valid).
     pub cmd_vel_expired: bool,
+    /// The last `cmd_vel` was non-finite: the chassis stopped for that, not for a timeout.
+    pub cmd_vel_refused: bool,
     /// No valid wheel feedback within the timeout.
     pub feedback_stale: bool,
+}
+
+impl Safety {
+    /// True if `cmd_vel` stopped arriving (the timeout, not a refused `cmd_vel`).
+    pub fn cmd_vel_timed_out(&self) -> bool {
+        self.cmd_vel_expired && !self.cmd_vel_refused
+    }
+
+    /// True if the gate stops the wheels for a watchdog or a refused `cmd_vel`.
+    pub fn stops(&self) -> bool {
+        self.cmd_vel_expired || self.cmd_vel_refused || self.feedback_stale
+    }
 }
 
 /// Why a feedback sample was not used.
@@ -86,8 +133,13 @@ pub struct ChassisController {
     feedback_watchdog: CmdVelWatchdog,
     odometry: Odometry,
     requested: Command,
-    /// The last finite `cmd_vel` (at the reference point), re-clamped when the limits change.
+    /// The last finite `cmd_vel` (at the reference point), re-clamped when the limits change;
+    /// `None` before the first, after a non-finite one and after [`ChassisController::stop`].
     request: Option<BodyTwist>,
+    /// The last `cmd_vel` was non-finite.
+    refused: bool,
+    /// The wheels last let through the gate (their steering angles are held by a stop).
+    sent: WheelState,
 }
 
 /// What happened to a feedback sample that was used.
@@ -112,6 +164,8 @@ impl ChassisController {
             odometry: Odometry::new(config.params.reference_offset(), config.noise)?,
             requested: Command::stop(&config.params),
             request: None,
+            refused: false,
+            sent: WheelState::zero(config.params.model()),
             config,
         })
     }
@@ -138,10 +192,9 @@ impl ChassisController {
         self.feedback_watchdog = fb;
         self.config = config;
         // The running command was worked out under the old limits: work it out again.
-        self.requested = match self.request {
-            Some(request) => self.command_for(request),
-            None => Command::stop(&self.config.params),
-        };
+        if let Some(request) = self.request {
+            self.requested = self.command_for(request);
+        }
         Ok(())
     }
 
@@ -150,18 +203,35 @@ impl ChassisController {
         &self.config
     }
 
-    /// A `cmd_vel` (twist of the reference point, body frame) received at `now` (s).
-    /// A non-finite request stops the chassis at once and does not feed the watchdog.
-    pub fn on_cmd_vel(&mut self, requested_at_reference: BodyTwist, now: f64) -> Command {
+    /// A `cmd_vel` (twist of the reference point, body frame) received at `now` (s): becomes the
+    /// request, and the result of [`ChassisController::gate`] at `now` is returned. A non-finite
+    /// request stops the chassis at once and does not feed the watchdog.
+    pub fn on_cmd_vel(&mut self, requested_at_reference: BodyTwist, now: f64) -> GatedCommand {
         self.requested = self.command_for(requested_at_reference);
         if self.requested.reasons.contains(ClampReason::NonFinite) {
             self.request = None;
+            self.refused = true;
             self.cmd_watchdog.reset();
         } else {
             self.request = Some(requested_at_reference);
+            self.refused = false;
             self.cmd_watchdog.feed(now);
         }
-        self.requested
+        self.gate(now)
+    }
+
+    /// The last `cmd_vel` after the limits, as requested (for logs); what reaches the wheels is
+    /// [`ChassisController::gate`]'s.
+    pub fn requested(&self) -> &Command {
+        &self.requested
+    }
+
+    /// Forgets the request (at shutdown) and returns the stop the gate then gives at `now`.
+    pub fn stop(&mut self, now: f64) -> GatedCommand {
+        self.request = None;
+        self.requested.twist = BodyTwist::ZERO;
+        self.cmd_watchdog.reset();
+        self.gate(now)
     }
 
     /// The feasible command for a request (limits, then inverse kinematics).
@@ -195,21 +265,27 @@ impl ChassisController {
         Command { wheels, twist, reasons }
     }
 
-    /// The command to send at `now` (s) and the watchdogs' state: the last request, or a stop
-    /// when either watchdog has expired.
-    pub fn on_tick(&mut self, now: f64) -> (Command, Safety) {
+    /// The safety gate: the command to send at `now` (s). The request, or a stop (driven wheels
+    /// zero, steering held as last sent) when the cmd_vel watchdog has expired, the feedback is
+    /// stale, the last `cmd_vel` was non-finite, there is no request, or the request's wheel
+    /// values are not finite. `reasons` keeps describing the last `cmd_vel`
+    /// (`ChassisStatus.clamped`), e.g. a NaN.
+    pub fn gate(&mut self, now: f64) -> GatedCommand {
         let safety = Safety {
             cmd_vel_expired: self.cmd_watchdog.expired(now),
+            cmd_vel_refused: self.refused,
             feedback_stale: self.feedback_watchdog.expired(now),
         };
-        if safety.cmd_vel_expired || safety.feedback_stale {
-            // `reasons` keeps describing the last cmd_vel (ChassisStatus.clamped), e.g. a NaN.
-            let mut stop = Command::stop(&self.config.params);
-            stop.reasons = self.requested.reasons;
-            (stop, safety)
-        } else {
-            (self.requested, safety)
+        let mut command = self.requested;
+        if safety.stops() || self.request.is_none() || !command.wheels.is_finite() || !command.twist.is_finite() {
+            if !(command.wheels.is_finite() && command.twist.is_finite()) {
+                command.reasons.insert(ClampReason::NonFinite);
+            }
+            command.wheels = self.sent.stopped();
+            command.twist = BodyTwist::ZERO;
         }
+        self.sent = command.wheels;
+        GatedCommand { command, safety }
     }
 
     /// Wheel feedback measured at `stamp` (s), received at `now` (s) (node clock, for the
@@ -248,7 +324,7 @@ impl ChassisController {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::model::ChassisConfig;
+    use crate::model::{ChassisConfig, ChassisModel};
     use approx::assert_relative_eq;
 
     fn controller(config: ChassisConfig) -> ChassisController {
@@ -276,19 +352,22 @@ mod tests {
             assert_relative_eq!(*got, want, epsilon = 1e-12);
         }
         feed_feedback(&mut c, 0.4);
-        assert_eq!(c.on_tick(0.4).0.wheels, cmd.wheels);
+        assert_eq!(c.gate(0.4).wheels, cmd.wheels);
         feed_feedback(&mut c, 0.6);
-        let (stopped, safety) = c.on_tick(0.6);
-        assert!(safety.cmd_vel_expired && !safety.feedback_stale);
+        let stopped = c.gate(0.6);
+        let safety = stopped.safety();
+        assert!(safety.cmd_vel_expired && safety.cmd_vel_timed_out() && !safety.feedback_stale);
         assert_eq!(stopped.wheels, WheelState::Omni { wheels: [0.0; 3] });
 
         c.on_cmd_vel(BodyTwist::new(0.3, 0.0, 0.0), 0.7);
         let nan = c.on_cmd_vel(BodyTwist::new(f64::NAN, 0.0, 0.0), 0.71);
         assert_eq!(nan.wheels, WheelState::Omni { wheels: [0.0; 3] });
         assert!(nan.reasons.contains(ClampReason::NonFinite));
+        let after = c.gate(0.72).safety();
+        assert!(after.cmd_vel_expired, "a NaN does not keep the watchdog alive");
         assert!(
-            c.on_tick(0.72).1.cmd_vel_expired,
-            "a NaN does not keep the watchdog alive"
+            after.cmd_vel_refused && !after.cmd_vel_timed_out(),
+            "the stop is for the NaN, not a timeout"
         );
     }
 
@@ -296,8 +375,8 @@ mod tests {
     fn stale_feedback_stops_the_wheels() {
         let mut c = controller(ChassisConfig::omr3());
         feed_feedback(&mut c, 0.0);
-        c.on_cmd_vel(BodyTwist::new(0.3, 0.0, 0.0), 0.55);
-        let (cmd, safety) = c.on_tick(0.55);
+        let cmd = c.on_cmd_vel(BodyTwist::new(0.3, 0.0, 0.0), 0.55);
+        let safety = cmd.safety();
         assert!(safety.feedback_stale && !safety.cmd_vel_expired);
         assert_eq!(cmd.wheels, WheelState::Omni { wheels: [0.0; 3] });
     }
@@ -307,6 +386,7 @@ mod tests {
         let mut config = ChassisConfig::mobil2();
         config.reference_offset = 0.3;
         let mut c = controller(config);
+        feed_feedback(&mut c, 0.0);
         // v = 0.4, ω = 0.2: radius 2 m ≥ 0.73 m, feasible; no lateral request.
         let cmd = c.on_cmd_vel(BodyTwist::new(0.4, 0.0, 0.2), 0.0);
         assert!(cmd.reasons.is_empty(), "{:?}", cmd.reasons);
@@ -331,6 +411,7 @@ mod tests {
         let mut config = ChassisConfig::omr3();
         config.reference_offset = 0.1;
         let mut c = controller(config);
+        feed_feedback(&mut c, 0.0);
         // Pure rotation about the reference point 0.1 m ahead: the centre moves sideways at
         // vy = −ω·d = −0.1 m/s, so each wheel gets r·ω_i = sin θ_i·(−0.1) + R·ω.
         let cmd = c.on_cmd_vel(BodyTwist::new(0.0, 0.0, 1.0), 0.0);
@@ -397,7 +478,7 @@ mod tests {
         config.params = ChassisParams::new(slower).unwrap();
         c.reconfigure(config).unwrap();
         // v_max 0.1 with r = 0.05: wheel 1 at 0.1/0.05 = 2 rad/s, not the 10 rad/s asked for before.
-        let (cmd, _) = c.on_tick(0.1);
+        let cmd = c.gate(0.1);
         assert_relative_eq!(cmd.wheels.values()[0], 2.0, epsilon = 1e-12);
         assert!(cmd.reasons.contains(ClampReason::Speed));
     }
@@ -418,5 +499,132 @@ mod tests {
             wheels: [f64::NAN, 0.0, 0.0],
         };
         assert!(c.on_feedback(&bad, 10.7, 10.7).is_err());
+    }
+
+    fn is_zero_omni(cmd: &GatedCommand) -> bool {
+        cmd.wheels == WheelState::Omni { wheels: [0.0; 3] }
+    }
+
+    #[test]
+    fn without_any_feedback_no_command_reaches_the_wheels() {
+        // OMR-III, cmd_vel 0.2 m/s at 10 Hz for 4 s, and the 50 Hz tick, with no joint_states at
+        // all: the odometry would be blind, so every command is zero.
+        let mut c = controller(ChassisConfig::omr3());
+        for k in 0..200 {
+            let t = 0.02 * f64::from(k);
+            if k % 5 == 0 {
+                let cmd = c.on_cmd_vel(BodyTwist::new(0.2, 0.0, 0.0), t);
+                assert!(is_zero_omni(&cmd), "cmd_vel at {t} s sent {:?}", cmd.wheels);
+                assert!(cmd.safety().feedback_stale && !cmd.safety().cmd_vel_expired);
+            }
+            assert!(is_zero_omni(&c.gate(t)), "tick at {t} s");
+        }
+        // The request itself stands: 0.2 m/s along x, Ω = (0.2/0.05)·[1, −½, −½] = [4, −2, −2].
+        assert_eq!(
+            c.requested().wheels,
+            WheelState::Omni {
+                wheels: [4.0, -2.0, -2.0]
+            }
+        );
+    }
+
+    #[test]
+    fn feedback_stopping_mid_run_stops_the_wheels_after_its_timeout() {
+        let mut c = controller(ChassisConfig::omr3());
+        // Feedback at 50 Hz up to t = 1.0 s, cmd_vel at 10 Hz up to 3 s: wheels turn until the
+        // feedback is 0.5 s old, i.e. through t = 1.5 s, and are zero after.
+        for k in 0..=150 {
+            let t = 0.02 * f64::from(k);
+            if t <= 1.0 + 1e-9 {
+                feed_feedback(&mut c, t);
+            }
+            let cmd = if k % 5 == 0 {
+                c.on_cmd_vel(BodyTwist::new(0.2, 0.0, 0.0), t)
+            } else {
+                c.gate(t)
+            };
+            if t <= 1.5 - 1e-9 {
+                assert_eq!(
+                    cmd.wheels,
+                    WheelState::Omni {
+                        wheels: [4.0, -2.0, -2.0]
+                    },
+                    "at {t} s"
+                );
+            } else if t > 1.5 + 1e-9 {
+                assert!(is_zero_omni(&cmd), "at {t} s: {:?}", cmd.wheels);
+                assert!(cmd.safety().feedback_stale);
+            }
+        }
+    }
+
+    #[test]
+    fn a_stop_holds_the_steering_angles_last_sent() {
+        let mut c = controller(ChassisConfig::mobil2());
+        // Before any command a stop is straight.
+        assert_eq!(c.gate(0.0).wheels, WheelState::zero(ChassisModel::CarLike));
+        feed_feedback(&mut c, 0.0);
+        // v = 0.3, ω = 0.2: R = 1.5 m; δ_l = atan(0.6/(1.5 − 0.31)) = 0.467003,
+        // δ_r = atan(0.6/(1.5 + 0.31)) = 0.320092; rear (0.3 ∓ 0.062)/0.1 = 2.38, 3.62 rad/s.
+        let moving = c.on_cmd_vel(BodyTwist::new(0.3, 0.0, 0.2), 0.0);
+        let WheelState::CarLike {
+            front_left_steering: left,
+            front_right_steering: right,
+            rear_left,
+            rear_right,
+        } = moving.wheels
+        else {
+            panic!("{moving:?}")
+        };
+        assert_relative_eq!(left, 0.467_003_301, epsilon = 1e-9);
+        assert_relative_eq!(right, 0.320_092_181, epsilon = 1e-9);
+        assert_relative_eq!(rear_left, 2.38, epsilon = 1e-12);
+        assert_relative_eq!(rear_right, 3.62, epsilon = 1e-12);
+        // cmd_vel stops: at 0.6 s the watchdog has expired; the rear wheels stop, the steering
+        // stays where it was.
+        feed_feedback(&mut c, 0.6);
+        let stopped = c.gate(0.6);
+        assert!(stopped.safety().cmd_vel_timed_out());
+        assert_eq!(
+            stopped.wheels,
+            WheelState::CarLike {
+                front_left_steering: left,
+                front_right_steering: right,
+                rear_left: 0.0,
+                rear_right: 0.0
+            }
+        );
+        assert_eq!(stopped.twist, BodyTwist::ZERO);
+        // A NaN holds it as well; an explicit zero twist is a command and straightens the wheels.
+        assert_eq!(
+            c.on_cmd_vel(BodyTwist::new(f64::NAN, 0.0, 0.0), 0.61).wheels,
+            stopped.wheels
+        );
+        assert_eq!(
+            c.on_cmd_vel(BodyTwist::ZERO, 0.62).wheels,
+            WheelState::zero(ChassisModel::CarLike)
+        );
+    }
+
+    #[test]
+    fn the_shutdown_stop_goes_through_the_gate_even_with_both_watchdogs_off() {
+        let mut c = ChassisController::new(ControllerConfig {
+            params: ChassisParams::omr3(),
+            cmd_vel_timeout_s: 0.0,
+            feedback_timeout_s: 0.0,
+            noise: OdometryNoise::default(),
+        })
+        .unwrap();
+        // Watchdogs off: the request passes, and only the gate's "no request" stops it.
+        let moving = c.on_cmd_vel(BodyTwist::new(0.2, 0.0, 0.0), 0.0);
+        assert_eq!(
+            moving.wheels,
+            WheelState::Omni {
+                wheels: [4.0, -2.0, -2.0]
+            }
+        );
+        assert!(!moving.safety().stops());
+        assert!(is_zero_omni(&c.stop(100.0)));
+        assert!(is_zero_omni(&c.gate(100.02)), "the stop lasts");
     }
 }

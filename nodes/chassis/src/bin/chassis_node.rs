@@ -1,9 +1,15 @@
 //! `chassis_node`: the LOW-LEVEL of the suite (SPEC §1). `cmd_vel` → limits → inverse kinematics
 //! → `wheel_commands`; `joint_states` → forward kinematics → exact arc odometry → `odom` + `tf`;
 //! a cmd_vel watchdog and a feedback watchdog; `~/status` reports both and every clamp.
+//!
+//! Every `wheel_commands` message is a [`GatedCommand`]: it comes out of the controller's one
+//! safety gate (watchdogs, refused `cmd_vel`, non-finite values), on `cmd_vel`, on the control
+//! tick and at shutdown alike.
 
 use futures::StreamExt;
-use mobil_chassis::controller::{ChassisController, Command, ControllerConfig, FeedbackError, FeedbackOutcome, Safety};
+use mobil_chassis::controller::{
+    ChassisController, ControllerConfig, FeedbackError, FeedbackOutcome, GatedCommand, Safety,
+};
 use mobil_chassis::joints::{joints_from_wheel_state, FeedbackDecoder, JointStateError};
 use mobil_chassis::kinematics::BodyTwist;
 use mobil_chassis::model::ChassisModel;
@@ -155,8 +161,10 @@ async fn run(node: &mut RosNode) -> anyhow::Result<()> {
     let mut throttle = LogThrottle::default();
     let mut decoder = FeedbackDecoder::default();
     let mut rejected: u64 = 0;
+    // Start-up counts as stopped, so neither stop line is logged before the first command.
     let mut last_safety = Safety {
         cmd_vel_expired: true,
+        cmd_vel_refused: false,
         feedback_stale: true,
     };
     // The watchdogs run on the steady clock: a stalled or reset /clock must not keep the wheels
@@ -186,14 +194,15 @@ async fn run(node: &mut RosNode) -> anyhow::Result<()> {
             Some(msg) = cmds.next() => match msg {
                 Ok((twist, _)) => {
                     let request = BodyTwist::new(twist.linear.x, twist.linear.y, twist.angular.z);
-                    let cmd = controller.on_cmd_vel(request, now_s(node));
+                    let gated = controller.on_cmd_vel(request, now_s(node));
+                    let requested = controller.requested();
                     if !request.is_finite() {
                         rejected += 1;
                         warn_throttled!(throttle, "cmd_nan", "cmd_vel with NaN/inf ({:?}): wheels stopped", request);
-                    } else if !cmd.reasons.is_empty() {
-                        warn_throttled!(throttle, "clamp", "cmd_vel {:?} clamped to {:?}: {}", request, cmd.twist, cmd.reasons);
+                    } else if !requested.reasons.is_empty() {
+                        warn_throttled!(throttle, "clamp", "cmd_vel {:?} clamped to {:?}: {}", request, requested.twist, requested.reasons);
                     }
-                    publish_wheels(&wheel_pub, node, &cmd);
+                    publish_wheels(&wheel_pub, node, &gated);
                 }
                 Err(e) => {
                     rejected += 1;
@@ -255,21 +264,21 @@ async fn run(node: &mut RosNode) -> anyhow::Result<()> {
             },
             _ = tick.tick() => {
                 let now = now_s(node);
-                let (cmd, safety) = controller.on_tick(now);
-                if safety != last_safety {
-                    if safety.cmd_vel_expired && !last_safety.cmd_vel_expired {
-                        warn!("no cmd_vel for {} s: wheels stopped", config.controller.cmd_vel_timeout_s);
-                    }
-                    if safety.feedback_stale && !last_safety.feedback_stale {
-                        warn!("no valid joint_states for {} s: odometry stale, wheels stopped", config.controller.feedback_timeout_s);
-                    }
-                    last_safety = safety;
+                let cmd = controller.gate(now);
+                let safety = cmd.safety();
+                // A refused (NaN) cmd_vel stops the wheels too, but was logged as what it is.
+                if safety.cmd_vel_timed_out() && !last_safety.cmd_vel_timed_out() {
+                    warn!("no cmd_vel for {} s: wheels stopped", config.controller.cmd_vel_timeout_s);
                 }
+                if safety.feedback_stale && !last_safety.feedback_stale {
+                    warn!("no valid joint_states for {} s: odometry stale, wheels stopped", config.controller.feedback_timeout_s);
+                }
+                last_safety = safety;
                 publish_wheels(&wheel_pub, node, &cmd);
                 let status = ChassisStatus {
                     header: Header { stamp: node.stamp(), frame_id: config.base_frame.clone() },
                     model: model_code(config.controller.params.model()),
-                    watchdog_expired: safety.cmd_vel_expired,
+                    watchdog_expired: safety.cmd_vel_expired || safety.cmd_vel_refused,
                     feedback_stale: safety.feedback_stale,
                     clamped: cmd.reasons.bits(),
                     commanded: Twist {
@@ -283,12 +292,13 @@ async fn run(node: &mut RosNode) -> anyhow::Result<()> {
         }
     }
     // Leave the wheels stopped.
-    let stop = controller.on_cmd_vel(BodyTwist::ZERO, now_s(node));
+    let stop = controller.stop(now_s(node));
     publish_wheels(&wheel_pub, node, &stop);
     Ok(())
 }
 
-fn publish_wheels(publisher: &ros2_client::Publisher<JointState>, node: &RosNode, cmd: &Command) {
+/// The only way to `wheel_commands`: it takes nothing but the safety gate's output.
+fn publish_wheels(publisher: &ros2_client::Publisher<JointState>, node: &RosNode, cmd: &GatedCommand) {
     let (name, position, velocity) = joints_from_wheel_state(&cmd.wheels);
     let msg = JointState {
         header: Header {
