@@ -569,3 +569,49 @@ def test_a_nan_cmd_vel_is_logged_as_a_nan_not_as_a_timeout(start_node, ros_node)
     chassis.wait_for_log("NaN/inf", timeout=5)
     log = chassis.log_text()
     assert "no cmd_vel for" not in log, chassis.log_tail()
+
+
+@pytest.mark.parametrize("robot,huge", [("omr3", [1e308, -1e308, 0.0]), ("mobil2", [0.0, 0.0, 1e308, 0.0])])
+def test_impossible_wheel_speeds_are_refused_and_odometry_stays_finite(robot, huge, start_node, ros_node):
+    chassis = start_node("chassis_node", params_file=f"params/{robot}.yaml")
+    names = OMNI_WHEELS if robot == "omr3" else CAR_JOINTS
+    rest = [0.0] * len(names)
+    fb = ros_node.create_publisher(JointState, "joint_states", 10)
+    with subscribe(ros_node, Odometry, "odom", qos=harness.qos_default()) as odom, \
+            subscribe(ros_node, ChassisStatus, "chassis/status") as status:
+        stamps = iter(50.0 + 0.02 * k for k in range(1000))
+        publish_until(ros_node, fb, lambda: joint_state(next(stamps), names, rest, rest),
+                      lambda: odom.latest is not None, rate_hz=20, timeout=10)
+        # One marker sample: once its odom is in, no earlier one can follow (reliable, in order).
+        mark = next(stamps)
+        fb.publish(joint_state(mark, names, rest, rest))
+        before = odom.wait_for(lambda m: stamp_s(m) == pytest.approx(mark, abs=1e-6), timeout=5)
+        count = len(odom)
+        status.wait_for(None, timeout=5)
+        rejected = status.latest.rejected_messages
+        t = next(stamps)
+        fb.publish(joint_state(t, names, rest, huge))
+        status.wait_for(lambda s: s.rejected_messages >= rejected + 1, timeout=5)
+        # An ordinary sample after it is used again: the odometry is where it was, and finite.
+        fb.publish(joint_state(t + 0.02, names, rest, rest))
+        after = odom.wait_for(lambda m: stamp_s(m) == pytest.approx(t + 0.02, abs=1e-6), timeout=5, start=count)
+    assert stamp_s(odom.snapshot()[count]) == pytest.approx(t + 0.02, abs=1e-6), "the huge sample published odom"
+    assert (after.pose.pose.position.x, after.pose.pose.position.y) == (before.pose.pose.position.x,
+                                                                        before.pose.pose.position.y)
+    assert all(math.isfinite(v) for v in after.pose.covariance)
+    assert list(after.pose.covariance) == list(before.pose.covariance)
+    chassis.wait_for_log("beyond what the chassis can do", timeout=5)
+
+
+def test_position_only_encoders_keep_the_distance_driven_during_a_dropout(start_node, ros_node):
+    """OMR-III publishing wheel angles only; 2 s without joint_states while it drives 1 m along x:
+    wheel 1 (rolling along x) turns 1/0.05 = 20 rad, wheels 2 and 3 −10 rad each."""
+    chassis = start_node("chassis_node", params_file="params/omr3.yaml")
+    fb = ros_node.create_publisher(JointState, "joint_states", 10)
+    with subscribe(ros_node, Odometry, "odom", qos=harness.qos_default()) as odom:
+        prime_feedback(ros_node, fb, odom, 40.0, positions_only=True)
+        fb.publish(joint_state(42.0, OMNI_WHEELS, [20.0, -10.0, -10.0], []))
+        last = odom.wait_for(lambda m: m.header.stamp.sec == 42 and m.header.stamp.nanosec == 0, timeout=5)
+    assert last.pose.pose.position.x == pytest.approx(1.0, abs=1e-6)
+    assert last.pose.pose.position.y == pytest.approx(0.0, abs=1e-6)
+    chassis.wait_for_log("cover the gap", timeout=5)

@@ -18,21 +18,35 @@
 //! no new motion, and steering a standing car-like chassis only scrubs its tyres. A requested
 //! zero twist is a command, not a stop: it straightens the wheels as the kinematics say.
 //!
-//! Feedback time: a sample is integrated over the interval since the previous one. A gap longer
-//! than the feedback timeout (a dropout, or a stamp far in the future) is not integrated across —
-//! the odometry restarts its clock there and reports it; a stamp more than that far in the past is
-//! taken as a clock reset (a restarted simulation) and handled the same way. A stamp slightly in
-//! the past (an out-of-order sample) is refused. So one bad stamp costs one sample, never the
-//! odometry.
+//! Feedback: a sample is refused if a wheel turns faster than the chassis physically can
+//! (`max_feedback_wheel_speed_factor` × `max_wheel_speed`) or a steering angle is beyond ±90°;
+//! the odometry itself refuses any update that would make it non-finite. Wheel speeds are
+//! integrated over the interval since the previous sample; a gap longer than the feedback
+//! timeout (a dropout, or a stamp far in the future) is not integrated across — the odometry
+//! restarts its clock there and reports it; a stamp more than that far in the past is taken as
+//! a clock reset (a restarted simulation) and handled the same way. A stamp slightly in the past
+//! (an out-of-order sample) is refused. So one bad stamp costs one sample, never the odometry.
+//! Encoder angles are different: their change over a gap is a distance really travelled, so it
+//! is integrated however long the gap — unless the encoder wraps and the gap is long enough for
+//! a wheel to turn π (see [`crate::joints::FeedbackDecoder`]), when the change is ambiguous.
 
+use std::f64::consts::{FRAC_PI_2, PI};
 use std::ops::Deref;
 
 use crate::error::{ChassisError, OdometryError};
-use crate::kinematics::{forward, inverse, pre_steer, twist_at_origin, twist_at_reference, BodyTwist, WheelState};
+use crate::joints::FeedbackSample;
+use crate::kinematics::{
+    forward, inverse, pre_steer, twist_at_origin, twist_at_reference, BodyTwist, JointKind, WheelState,
+};
 use crate::limits::{clamp_command, ClampReason, ClampReasons};
 use crate::model::ChassisParams;
 use crate::odometry::{Odometry, OdometryNoise};
 use crate::watchdog::CmdVelWatchdog;
+
+/// Default of [`ChassisController::feedback_speed_factor`]: feedback wheel speeds up to 3 ×
+/// `max_wheel_speed` are believed (a wheel spinning free or pushed downhill can exceed the
+/// command limit; an encoder glitch reads orders of magnitude more).
+pub const DEFAULT_FEEDBACK_SPEED_FACTOR: f64 = 3.0;
 
 /// Settings of the controller beyond the chassis geometry.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -123,12 +137,23 @@ pub enum FeedbackError {
     /// The stamp or twist was refused by the odometry.
     #[error(transparent)]
     Odometry(#[from] OdometryError),
+    /// A joint value the chassis cannot physically reach.
+    #[error("joint `{joint}` at {value} is beyond what the chassis can do (limit ±{limit})")]
+    Implausible {
+        /// The joint.
+        joint: &'static str,
+        /// Its value (rad/s for a wheel, rad for a steering angle).
+        value: f64,
+        /// The limit it exceeds.
+        limit: f64,
+    },
 }
 
 /// Command limits, watchdogs and odometry of one chassis.
 #[derive(Debug, Clone)]
 pub struct ChassisController {
     config: ControllerConfig,
+    feedback_speed_factor: f64,
     cmd_watchdog: CmdVelWatchdog,
     feedback_watchdog: CmdVelWatchdog,
     odometry: Odometry,
@@ -153,6 +178,18 @@ pub enum FeedbackOutcome {
         /// The jump since the previous sample, `None` for the first sample.
         gap_s: Option<f64>,
     },
+    /// Encoder angles spanning a gap longer than the feedback timeout: the distance they give
+    /// was integrated across it.
+    Bridged {
+        /// The gap (s).
+        gap_s: f64,
+    },
+    /// Wrapped encoder angles over a gap in which a wheel could turn π or more: the change is
+    /// ambiguous (modulo 2π), so it was not integrated and the clock restarts here.
+    Ambiguous {
+        /// The gap (s).
+        gap_s: f64,
+    },
 }
 
 impl ChassisController {
@@ -166,6 +203,7 @@ impl ChassisController {
             request: None,
             refused: false,
             sent: WheelState::zero(config.params.model()),
+            feedback_speed_factor: DEFAULT_FEEDBACK_SPEED_FACTOR,
             config,
         })
     }
@@ -201,6 +239,30 @@ impl ChassisController {
     /// The settings in force.
     pub fn config(&self) -> &ControllerConfig {
         &self.config
+    }
+
+    /// Sets k: wheel feedback faster than k × `max_wheel_speed` is refused as impossible
+    /// (default [`DEFAULT_FEEDBACK_SPEED_FACTOR`]); k must be finite and at least 1.
+    pub fn set_feedback_speed_factor(&mut self, factor: f64) -> Result<(), ChassisError> {
+        if !(factor.is_finite() && factor >= 1.0) {
+            return Err(ChassisError::InvalidParameter {
+                name: "max_feedback_wheel_speed_factor",
+                value: factor,
+                reason: "must be finite and at least 1",
+            });
+        }
+        self.feedback_speed_factor = factor;
+        Ok(())
+    }
+
+    /// k of [`ChassisController::set_feedback_speed_factor`].
+    pub fn feedback_speed_factor(&self) -> f64 {
+        self.feedback_speed_factor
+    }
+
+    /// The fastest wheel feedback believed (rad/s): k × `max_wheel_speed`.
+    pub fn max_feedback_wheel_speed(&self) -> f64 {
+        self.feedback_speed_factor * self.config.params.max_wheel_speed()
     }
 
     /// A `cmd_vel` (twist of the reference point, body frame) received at `now` (s): becomes the
@@ -288,15 +350,42 @@ impl ChassisController {
         GatedCommand { command, safety }
     }
 
-    /// Wheel feedback measured at `stamp` (s), received at `now` (s) (node clock, for the
-    /// feedback watchdog). Refused samples leave the odometry unchanged.
-    pub fn on_feedback(&mut self, wheels: &WheelState, stamp: f64, now: f64) -> Result<FeedbackOutcome, FeedbackError> {
-        let twist = forward(&self.config.params, wheels)?;
-        let max_gap = if self.config.feedback_timeout_s > 0.0 {
+    /// Refuses joint values the chassis cannot physically reach: a wheel faster than
+    /// [`ChassisController::max_feedback_wheel_speed`], a steering angle beyond ±90°.
+    fn check_plausible(&self, wheels: &WheelState) -> Result<(), FeedbackError> {
+        let max_speed = self.max_feedback_wheel_speed();
+        let joints = self.config.params.model().joints();
+        for (joint, value) in joints.iter().zip(wheels.values()) {
+            let limit = match joint.kind {
+                JointKind::Wheel => max_speed,
+                JointKind::Steering => FRAC_PI_2,
+            };
+            if value.is_nan() || value.abs() > limit {
+                return Err(FeedbackError::Implausible {
+                    joint: joint.name,
+                    value,
+                    limit,
+                });
+            }
+        }
+        Ok(())
+    }
+
+    /// The longest gap (s) integrated across for wheel-speed feedback.
+    fn max_gap(&self) -> f64 {
+        if self.config.feedback_timeout_s > 0.0 {
             self.config.feedback_timeout_s
         } else {
             1.0
-        };
+        }
+    }
+
+    /// Wheel speeds measured at `stamp` (s), received at `now` (s) (node clock, for the
+    /// feedback watchdog). Refused samples leave the odometry unchanged.
+    pub fn on_feedback(&mut self, wheels: &WheelState, stamp: f64, now: f64) -> Result<FeedbackOutcome, FeedbackError> {
+        let twist = forward(&self.config.params, wheels)?;
+        self.check_plausible(wheels)?;
+        let max_gap = self.max_gap();
         let gap = self.odometry.last_stamp().map(|previous| stamp - previous);
         let restart = match gap {
             None => true,
@@ -304,15 +393,58 @@ impl ChassisController {
             Some(dt) => dt > max_gap || dt < -max_gap,
         };
         if restart {
-            self.odometry.restart_stamp();
+            // On a copy: a refused sample must not restart the clock.
+            let mut odometry = self.odometry.clone();
+            odometry.restart_stamp();
+            odometry.update_at(twist, stamp)?;
+            self.odometry = odometry;
+        } else {
+            self.odometry.update_at(twist, stamp)?;
         }
-        self.odometry.update_at(twist, stamp)?;
         self.feedback_watchdog.feed(now);
         Ok(if restart {
             FeedbackOutcome::Restarted { gap_s: gap }
         } else {
             FeedbackOutcome::Integrated
         })
+    }
+
+    /// A decoded feedback sample (see [`FeedbackSample`]), received at `now` (s) (node clock,
+    /// for the feedback watchdog). Refused samples leave the odometry unchanged.
+    ///
+    /// Measured speeds go through [`ChassisController::on_feedback`]. Travelled samples (encoder
+    /// angles) are integrated over their own interval however long: the clock restarts at its
+    /// start if needed (first sample, clock reset). A wrapped one whose interval is long enough
+    /// for a wheel at `max_wheel_speed` to turn π is ambiguous and only restarts the clock.
+    pub fn on_feedback_sample(&mut self, sample: &FeedbackSample, now: f64) -> Result<FeedbackOutcome, FeedbackError> {
+        let (wheels, since, stamp, wrapped) = match *sample {
+            FeedbackSample::Measured { ref wheels, stamp } => return self.on_feedback(wheels, stamp, now),
+            FeedbackSample::Travelled {
+                wheels,
+                since,
+                stamp,
+                wrapped,
+            } => (wheels, since, stamp, wrapped),
+        };
+        let twist = forward(&self.config.params, &wheels)?;
+        self.check_plausible(&wheels)?;
+        let gap = stamp - since;
+        let outcome = if wrapped && gap * self.config.params.max_wheel_speed() >= PI {
+            let mut odometry = self.odometry.clone();
+            odometry.restart_stamp();
+            odometry.update_at(twist, stamp)?;
+            self.odometry = odometry;
+            FeedbackOutcome::Ambiguous { gap_s: gap }
+        } else {
+            self.odometry.update_over(twist, since, stamp)?;
+            if gap > self.max_gap() {
+                FeedbackOutcome::Bridged { gap_s: gap }
+            } else {
+                FeedbackOutcome::Integrated
+            }
+        };
+        self.feedback_watchdog.feed(now);
+        Ok(outcome)
     }
 
     /// The odometry (pose, twist and covariances; see [`Odometry::reference_pose`]).
@@ -324,6 +456,7 @@ impl ChassisController {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::angles::wrap;
     use crate::model::{ChassisConfig, ChassisModel};
     use approx::assert_relative_eq;
 
@@ -626,5 +759,135 @@ mod tests {
         assert!(!moving.safety().stops());
         assert!(is_zero_omni(&c.stop(100.0)));
         assert!(is_zero_omni(&c.gate(100.02)), "the stop lasts");
+    }
+
+    #[test]
+    fn impossible_wheel_speeds_are_refused_and_leave_the_odometry_as_it_was() {
+        let forward = WheelState::Omni {
+            wheels: [6.0, -3.0, -3.0],
+        };
+        let mut c = controller(ChassisConfig::omr3());
+        c.on_feedback(&forward, 1.0, 1.0).unwrap();
+        c.on_feedback(&forward, 1.1, 1.1).unwrap();
+        let before = c.odometry().clone();
+        // OMR-III: max_wheel_speed 12 rad/s, so feedback is believed up to 3 × 12 = 36 rad/s.
+        assert_relative_eq!(c.max_feedback_wheel_speed(), 36.0);
+        let huge = WheelState::Omni {
+            wheels: [1e308, -1e308, 0.0],
+        };
+        assert!(matches!(
+            c.on_feedback(&huge, 1.2, 1.2),
+            Err(FeedbackError::Implausible {
+                joint: "wheel_1",
+                limit: 36.0,
+                ..
+            })
+        ));
+        let just_over = WheelState::Omni {
+            wheels: [0.0, 36.001, 0.0],
+        };
+        assert!(c.on_feedback(&just_over, 1.2, 1.2).is_err());
+        assert_eq!(c.odometry(), &before);
+        assert_relative_eq!(c.odometry().reference_pose().x, 0.03, epsilon = 1e-12);
+        // At the limit it is believed.
+        let at_limit = WheelState::Omni {
+            wheels: [36.0, -18.0, -18.0],
+        };
+        assert_eq!(c.on_feedback(&at_limit, 1.2, 1.2).unwrap(), FeedbackOutcome::Integrated);
+
+        // MOBIL-II: max_wheel_speed 7.5, limit 22.5 rad/s; the rear-left wheel at 1e308.
+        let mut car = controller(ChassisConfig::mobil2());
+        let rest = WheelState::zero(ChassisModel::CarLike);
+        car.on_feedback(&rest, 1.0, 1.0).unwrap();
+        let before = car.odometry().clone();
+        let huge = WheelState::from_values(ChassisModel::CarLike, &[0.0, 0.0, 1e308, 0.0]).unwrap();
+        assert!(matches!(
+            car.on_feedback(&huge, 1.1, 1.1),
+            Err(FeedbackError::Implausible {
+                joint: "rear_left_wheel",
+                ..
+            })
+        ));
+        // A steering angle past 90° is not a real reading either.
+        let bent = WheelState::from_values(ChassisModel::CarLike, &[1.6, 0.0, 1.0, 1.0]).unwrap();
+        assert!(matches!(
+            car.on_feedback(&bent, 1.1, 1.1),
+            Err(FeedbackError::Implausible {
+                joint: "front_left_steering",
+                ..
+            })
+        ));
+        assert_eq!(car.odometry(), &before);
+        let cov = car.odometry().covariance();
+        assert!(cov.iter().all(|v| v.is_finite()));
+        // A lower factor applies at once: 2 × 7.5 = 15 rad/s.
+        car.set_feedback_speed_factor(2.0).unwrap();
+        let fast = WheelState::from_values(ChassisModel::CarLike, &[0.0, 0.0, 16.0, 16.0]).unwrap();
+        assert!(car.on_feedback(&fast, 1.1, 1.1).is_err());
+        assert!(car.set_feedback_speed_factor(0.5).is_err());
+        assert!(car.set_feedback_speed_factor(f64::NAN).is_err());
+    }
+
+    /// Position-only samples of OMR-III (wheel angles) decoded and fed at their stamps.
+    fn feed_angles(
+        c: &mut ChassisController,
+        d: &mut crate::joints::FeedbackDecoder,
+        t: f64,
+        angles: [f64; 3],
+    ) -> Option<Result<FeedbackOutcome, FeedbackError>> {
+        let names: Vec<String> = ["wheel_1", "wheel_2", "wheel_3"]
+            .iter()
+            .map(|s| (*s).to_owned())
+            .collect();
+        let sample = d.decode(ChassisModel::Omni, &names, &angles, &[], t).unwrap()?;
+        Some(c.on_feedback_sample(&sample, t))
+    }
+
+    #[test]
+    fn encoder_angles_across_a_dropout_are_a_real_distance() {
+        let mut c = controller(ChassisConfig::omr3());
+        let mut d = crate::joints::FeedbackDecoder::default();
+        // At rest, 50 Hz, until t = 1 s.
+        for k in 0..=50 {
+            feed_angles(&mut c, &mut d, 0.02 * f64::from(k), [0.0; 3]);
+        }
+        // 2 s without feedback, in which the robot drives 1 m along x: wheel 1 (rolling along x)
+        // turns 1/0.05 = 20 rad, wheels 2 and 3 −½ of that.
+        let outcome = feed_angles(&mut c, &mut d, 3.0, [20.0, -10.0, -10.0]).unwrap().unwrap();
+        assert!(matches!(outcome, FeedbackOutcome::Bridged { gap_s } if (gap_s - 2.0).abs() < 1e-9));
+        assert_relative_eq!(c.odometry().reference_pose().x, 1.0, epsilon = 1e-9);
+        assert_relative_eq!(c.odometry().reference_pose().y, 0.0, epsilon = 1e-9);
+        // And on from there at 50 Hz: 0.02 s at 0.3 m/s (6 rad/s on wheel 1) adds 6 mm.
+        let next = feed_angles(&mut c, &mut d, 3.02, [20.12, -10.06, -10.06])
+            .unwrap()
+            .unwrap();
+        assert_eq!(next, FeedbackOutcome::Integrated);
+        assert_relative_eq!(c.odometry().reference_pose().x, 1.006, epsilon = 1e-9);
+    }
+
+    #[test]
+    fn wrapped_encoder_angles_integrate_without_a_spike_and_refuse_an_ambiguous_gap() {
+        let mut c = controller(ChassisConfig::omr3());
+        let mut d = crate::joints::FeedbackDecoder::default();
+        // 0.3 m/s along x for 1 s at 50 Hz: wheel angles 6t, −3t, −3t (rad), reported wrapped to
+        // (−π, π]: wheel 1 wraps at t = π/6 = 0.52 s. Odometry: x = 0.3 m, no spike.
+        for k in 0..=50 {
+            let t = 0.02 * f64::from(k);
+            feed_angles(&mut c, &mut d, t, [wrap(6.0 * t), wrap(-3.0 * t), wrap(-3.0 * t)]);
+        }
+        assert_relative_eq!(c.odometry().reference_pose().x, 0.3, epsilon = 1e-9);
+        assert_relative_eq!(c.odometry().twist().vx, 0.3, epsilon = 1e-9);
+        // A 0.5 s gap: at max_wheel_speed 12 rad/s a wheel could turn 6 rad > π in it, so the
+        // wrapped difference says nothing: not integrated, the clock restarts.
+        let outcome = feed_angles(&mut c, &mut d, 1.5, [wrap(9.0), wrap(-4.5), wrap(-4.5)])
+            .unwrap()
+            .unwrap();
+        assert!(matches!(outcome, FeedbackOutcome::Ambiguous { gap_s } if (gap_s - 0.5).abs() < 1e-9));
+        assert_relative_eq!(c.odometry().reference_pose().x, 0.3, epsilon = 1e-9);
+        // The next 20 ms integrate normally (6 mm).
+        feed_angles(&mut c, &mut d, 1.52, [wrap(9.12), wrap(-4.56), wrap(-4.56)])
+            .unwrap()
+            .unwrap();
+        assert_relative_eq!(c.odometry().reference_pose().x, 0.306, epsilon = 1e-9);
     }
 }

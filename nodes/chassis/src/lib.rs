@@ -51,6 +51,7 @@ pub mod watchdog;
 
 pub use controller::{ChassisController, Command, ControllerConfig, FeedbackOutcome, GatedCommand, Safety};
 pub use error::{ChassisError, OdometryError};
+pub use joints::{FeedbackDecoder, FeedbackSample};
 pub use kinematics::{forward, inverse, pre_steer, BodyTwist, Joint, JointKind, WheelState};
 pub use limits::{clamp_command, ClampReason, ClampReasons, Clamped};
 pub use model::{ChassisConfig, ChassisModel, ChassisParams};

@@ -9,6 +9,7 @@
 use futures::StreamExt;
 use mobil_chassis::controller::{
     ChassisController, ControllerConfig, FeedbackError, FeedbackOutcome, GatedCommand, Safety,
+    DEFAULT_FEEDBACK_SPEED_FACTOR,
 };
 use mobil_chassis::joints::{joints_from_wheel_state, FeedbackDecoder, JointStateError};
 use mobil_chassis::kinematics::BodyTwist;
@@ -35,6 +36,7 @@ use tracing::{info, warn};
 #[derive(Debug, Clone, PartialEq)]
 struct NodeConfig {
     controller: ControllerConfig,
+    feedback_speed_factor: f64,
     control_rate_hz: f64,
     odom_frame: String,
     base_frame: String,
@@ -63,6 +65,14 @@ fn decl() -> NodeDecl {
             "zero command after this long without joint_states (0: off)",
         )
         .min(0.0),
+    )
+    .param(
+        ParamSpec::double(
+            "max_feedback_wheel_speed_factor",
+            DEFAULT_FEEDBACK_SPEED_FACTOR,
+            "joint_states wheel speeds above this × max_wheel_speed are refused as impossible (bad encoder data)",
+        )
+        .within(1.0, 100.0),
     )
     .param(ParamSpec::double("control_rate_hz", 50.0, "wheel_commands and status rate").within(1.0, 1000.0))
     .param(ParamSpec::string("odom_frame", "odom", "odometry frame"))
@@ -97,6 +107,7 @@ fn node_config(p: &ParamValues) -> Result<NodeConfig, String> {
             feedback_timeout_s: p.f64("feedback_timeout_s")?,
             noise,
         },
+        feedback_speed_factor: p.f64("max_feedback_wheel_speed_factor")?,
         control_rate_hz: p.f64("control_rate_hz")?,
         odom_frame: p.string("odom_frame")?,
         base_frame: p.string("base_frame")?,
@@ -135,6 +146,7 @@ fn model_code(m: ChassisModel) -> u8 {
 async fn run(node: &mut RosNode) -> anyhow::Result<()> {
     let mut config = node_config(&node.params()).map_err(anyhow::Error::msg)?;
     let mut controller = ChassisController::new(config.controller)?;
+    controller.set_feedback_speed_factor(config.feedback_speed_factor)?;
     info!(
         "model {}, effective steering limit {:.1}°, v_max {} m/s, watchdog {} s",
         config.controller.params.model().as_str(),
@@ -178,7 +190,10 @@ async fn run(node: &mut RosNode) -> anyhow::Result<()> {
             Some(changed) = node.param_changed() => {
                 match node_config(&changed) {
                     Ok(new) => {
-                        if let Err(e) = controller.reconfigure(new.controller) {
+                        let applied = controller
+                            .reconfigure(new.controller)
+                            .and_then(|()| controller.set_feedback_speed_factor(new.feedback_speed_factor));
+                        if let Err(e) = applied {
                             warn!("parameter change not applied: {e}");
                         } else {
                             if new.control_rate_hz != config.control_rate_hz {
@@ -220,14 +235,25 @@ async fn run(node: &mut RosNode) -> anyhow::Result<()> {
                     match (parsed, stamp) {
                         // A position-only sample that only set the baseline.
                         (Ok(None), Some(_)) => {}
-                        (Ok(Some(wheels)), Some(stamp)) => match controller.on_feedback(&wheels, stamp, now) {
+                        (Ok(Some(sample)), Some(_)) => match controller.on_feedback_sample(&sample, now) {
                             Ok(outcome) => {
-                                if let FeedbackOutcome::Restarted { gap_s: Some(gap) } = outcome {
-                                    warn_throttled!(
+                                match outcome {
+                                    FeedbackOutcome::Restarted { gap_s: Some(gap) } => warn_throttled!(
                                         throttle,
                                         "feedback_gap",
                                         "joint_states stamps jumped by {gap:.3} s (dropout or clock reset): odometry not integrated across the gap"
-                                    );
+                                    ),
+                                    FeedbackOutcome::Ambiguous { gap_s } => warn_throttled!(
+                                        throttle,
+                                        "feedback_ambiguous",
+                                        "wrapped encoder angles {gap_s:.3} s apart are ambiguous (a wheel may have turned more than π): odometry not integrated across the gap"
+                                    ),
+                                    FeedbackOutcome::Bridged { gap_s } => warn_throttled!(
+                                        throttle,
+                                        "feedback_bridged",
+                                        "joint_states resumed after {gap_s:.3} s: the encoder angles cover the gap, odometry integrated across it"
+                                    ),
+                                    FeedbackOutcome::Integrated | FeedbackOutcome::Restarted { gap_s: None } => {}
                                 }
                                 publish_odometry(&odom_pub, &tf_pub, &config, &controller, stamp_msg);
                             }
@@ -236,6 +262,7 @@ async fn run(node: &mut RosNode) -> anyhow::Result<()> {
                                 let key = match e {
                                     FeedbackError::Kinematics(_) => "feedback_kinematics",
                                     FeedbackError::Odometry(_) => "feedback_time",
+                                    FeedbackError::Implausible { .. } => "feedback_implausible",
                                 };
                                 warn_throttled!(throttle, key, "joint_states dropped: {e}");
                             }
