@@ -365,13 +365,16 @@ impl Odometry {
 
 /// True if the pose, its covariance and both at the reference point `d` ahead are all finite.
 fn state_is_finite(pose: &Vector3<f64>, covariance: &Matrix3<f64>, d: f64) -> bool {
-    let reference = pose_at_reference(pose, d);
+    if !(pose.iter().all(|v| v.is_finite()) && covariance.iter().all(|v| v.is_finite())) {
+        return false;
+    }
+    // As reference_pose and reference_covariance work them out.
     let (sin, cos) = pose.z.sin_cos();
+    let reference = [pose.x + d * cos, pose.y + d * sin];
     let j = Matrix3::new(1.0, 0.0, -d * sin, 0.0, 1.0, d * cos, 0.0, 0.0, 1.0);
     let reference_covariance = j * covariance * j.transpose();
-    pose.iter()
-        .chain(reference.iter())
-        .chain(covariance.iter())
+    reference
+        .iter()
         .chain(reference_covariance.iter())
         .all(|v| v.is_finite())
 }
