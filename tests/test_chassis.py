@@ -523,3 +523,158 @@ def test_node_logs_reach_rosout(start_node, ros_node):
         cmd.publish(twist())
     assert line.level == Log.WARN
     assert line.file.endswith("chassis_node.rs") and line.line > 0
+
+
+CAR_JOINTS = ["front_left_steering", "front_right_steering", "rear_left_wheel", "rear_right_wheel"]
+
+
+def stamp_s(msg) -> float:
+    return msg.header.stamp.sec + msg.header.stamp.nanosec * 1e-9
+
+
+@pytest.mark.parametrize("robot", ["omr3", "mobil2"])
+def test_cmd_vel_without_any_joint_states_never_turns_a_wheel(robot, start_node, ros_node):
+    """No joint_states at all: the odometry is blind, so no cmd_vel may reach the wheels."""
+    start_node("chassis_node", params_file=f"params/{robot}.yaml")
+    cmd = ros_node.create_publisher(Twist, "cmd_vel", 10)
+    with subscribe(ros_node, JointState, "wheel_commands") as wheels, \
+            subscribe(ros_node, ChassisStatus, "chassis/status") as status:
+        # 0.8 m/s is above v_max (0.5 m/s on both robots): CLAMP_SPEED in the status proves that
+        # the node has the request.
+        publish_until(ros_node, cmd, twist(0.8), lambda: status.latest is not None
+                      and status.latest.clamped & ChassisStatus.CLAMP_SPEED, rate_hz=10, timeout=10)
+        start = len(wheels)
+        # 2 s more of cmd_vel at 10 Hz (each one used to be sent to the wheels as it was).
+        t0 = time.monotonic()
+        while time.monotonic() - t0 < 2.0:
+            cmd.publish(twist(0.8))
+            time.sleep(0.1)
+        received = wheels.snapshot()
+        assert status.latest.feedback_stale
+        assert status.latest.commanded.linear.x == 0.0
+    # The 50 Hz tick alone gives about 100 messages in 2 s.
+    assert len(received) - start >= 60, f"only {len(received) - start} wheel_commands in 2 s"
+    moving = [m for m in received if any(v != 0.0 for v in m.velocity)]
+    assert not moving, f"{len(moving)} of {len(received)} wheel_commands were not zero: {moving[0]}"
+    # Decision (README): a stop holds the steering angles last sent; never sent, they are straight.
+    assert all(p == 0.0 for m in received for p in m.position)
+
+
+def test_wheels_stop_within_the_feedback_timeout_when_joint_states_stop(start_node, ros_node):
+    """MOBIL-II driving on a curve; joint_states stop while cmd_vel goes on: the rear wheels stop
+    within feedback_timeout_s (0.5 s) + one control period (20 ms) of the last feedback, and the
+    steering holds its angles."""
+    start_node("chassis_node", params_file="params/mobil2.yaml")
+    cmd = ros_node.create_publisher(Twist, "cmd_vel", 10)
+    fb = ros_node.create_publisher(JointState, "joint_states", 10)
+    # v = 0.3, ω = 0.2: R = 1.5 m (≥ 0.73 m). Ackermann (L 0.60, B 0.62): inner (left) wheel
+    # atan(0.6/(1.5 − 0.31)) = 0.467003 rad, outer atan(0.6/(1.5 + 0.31)) = 0.320092 rad; rear
+    # wheels (0.3 ∓ 0.2·0.31)/0.1 = 2.38 and 3.62 rad/s.
+    left, right = math.atan(0.6 / (1.5 - 0.31)), math.atan(0.6 / (1.5 + 0.31))
+    assert (left, right) == (pytest.approx(0.467003, abs=1e-6), pytest.approx(0.320092, abs=1e-6))
+
+    def feedback() -> JointState:
+        # Stamped with the system clock, as the node stamps wheel_commands (no use_sim_time).
+        return joint_state(time.time(), CAR_JOINTS, [0.0] * 4, [0.0] * 4)
+
+    with subscribe(ros_node, JointState, "wheel_commands") as wheels:
+        k = 0
+
+        def drive() -> JointState:
+            nonlocal k
+            k += 1
+            if k % 5 == 0:
+                cmd.publish(twist(0.3, 0.0, 0.2))
+            return feedback()
+
+        publish_until(ros_node, fb, drive, lambda: wheels.latest is not None
+                      and wheels.latest.velocity[2] == pytest.approx(2.38, abs=1e-9), rate_hz=50, timeout=10)
+        moving = wheels.latest
+        assert list(moving.position[:2]) == pytest.approx([left, right], abs=1e-9)
+        assert list(moving.velocity[2:]) == pytest.approx([2.38, 3.62], abs=1e-9)
+        # The feedback stops; cmd_vel goes on at 10 Hz for 1.5 s.
+        last = feedback()
+        fb.publish(last)
+        start = len(wheels)
+        t0 = time.monotonic()
+        while time.monotonic() - t0 < 1.5:
+            cmd.publish(twist(0.3, 0.0, 0.2))
+            time.sleep(0.1)
+        after = wheels.snapshot()[start:]
+    stopped_at = next(i for i, m in enumerate(after) if m.velocity[2] == 0.0 and m.velocity[3] == 0.0)
+    delay = stamp_s(after[stopped_at]) - stamp_s(last)
+    assert 0.49 < delay < 0.5 + 0.02 + 0.1, f"wheels stopped {delay:.3f} s after the last joint_states"
+    # From then on every command is a stop, with the steering held where it was.
+    for m in after[stopped_at:]:
+        assert list(m.velocity[2:]) == [0.0, 0.0]
+        assert list(m.position[:2]) == pytest.approx([left, right], abs=1e-9)
+    assert len(after) - stopped_at >= 30, "too few wheel_commands after the stop to judge"
+
+
+def test_a_nan_cmd_vel_is_logged_as_a_nan_not_as_a_timeout(start_node, ros_node):
+    chassis = start_node("chassis_node", "-p", "feedback_timeout_s:=0.0", params_file="params/omr3.yaml")
+    cmd = ros_node.create_publisher(Twist, "cmd_vel", 10)
+    with subscribe(ros_node, JointState, "wheel_commands") as wheels, \
+            subscribe(ros_node, ChassisStatus, "chassis/status") as status:
+        # Drive until the control tick has seen the running command (watchdog not expired).
+        publish_until(ros_node, cmd, twist(0.3), lambda: status.latest is not None
+                      and not status.latest.watchdog_expired and status.latest.commanded.linear.x == 0.3,
+                      rate_hz=20, timeout=10)
+        cmd.publish(twist(float("nan")))
+        status.wait_for(lambda s: s.clamped & ChassisStatus.CLAMP_NON_FINITE, timeout=3)
+        # 75 more status messages at 50 Hz: 1.5 s, three times the 0.5 s cmd_vel timeout.
+        status.wait_for(None, timeout=5, start=len(status) + 75)
+        st = status.latest
+    # The status still reports the stop.
+    assert st.watchdog_expired and st.clamped & ChassisStatus.CLAMP_NON_FINITE
+    assert (st.commanded.linear.x, st.commanded.angular.z) == (0.0, 0.0)
+    assert all(v == 0.0 for v in wheels.latest.velocity)
+    chassis.wait_for_log("NaN/inf", timeout=5)
+    log = chassis.log_text()
+    assert "no cmd_vel for" not in log, chassis.log_tail()
+
+
+@pytest.mark.parametrize("robot,huge", [("omr3", [1e308, -1e308, 0.0]), ("mobil2", [0.0, 0.0, 1e308, 0.0])])
+def test_impossible_wheel_speeds_are_refused_and_odometry_stays_finite(robot, huge, start_node, ros_node):
+    chassis = start_node("chassis_node", params_file=f"params/{robot}.yaml")
+    names = OMNI_WHEELS if robot == "omr3" else CAR_JOINTS
+    rest = [0.0] * len(names)
+    fb = ros_node.create_publisher(JointState, "joint_states", 10)
+    with subscribe(ros_node, Odometry, "odom", qos=harness.qos_default()) as odom, \
+            subscribe(ros_node, ChassisStatus, "chassis/status") as status:
+        stamps = iter(50.0 + 0.02 * k for k in range(1000))
+        publish_until(ros_node, fb, lambda: joint_state(next(stamps), names, rest, rest),
+                      lambda: odom.latest is not None, rate_hz=20, timeout=10)
+        # One marker sample: once its odom is in, no earlier one can follow (reliable, in order).
+        mark = next(stamps)
+        fb.publish(joint_state(mark, names, rest, rest))
+        before = odom.wait_for(lambda m: stamp_s(m) == pytest.approx(mark, abs=1e-6), timeout=5)
+        count = len(odom)
+        status.wait_for(None, timeout=5)
+        rejected = status.latest.rejected_messages
+        t = next(stamps)
+        fb.publish(joint_state(t, names, rest, huge))
+        status.wait_for(lambda s: s.rejected_messages >= rejected + 1, timeout=5)
+        # An ordinary sample after it is used again: the odometry is where it was, and finite.
+        fb.publish(joint_state(t + 0.02, names, rest, rest))
+        after = odom.wait_for(lambda m: stamp_s(m) == pytest.approx(t + 0.02, abs=1e-6), timeout=5, start=count)
+    assert stamp_s(odom.snapshot()[count]) == pytest.approx(t + 0.02, abs=1e-6), "the huge sample published odom"
+    assert (after.pose.pose.position.x, after.pose.pose.position.y) == (before.pose.pose.position.x,
+                                                                        before.pose.pose.position.y)
+    assert all(math.isfinite(v) for v in after.pose.covariance)
+    assert list(after.pose.covariance) == list(before.pose.covariance)
+    chassis.wait_for_log("beyond what the chassis can do", timeout=5)
+
+
+def test_position_only_encoders_keep_the_distance_driven_during_a_dropout(start_node, ros_node):
+    """OMR-III publishing wheel angles only; 2 s without joint_states while it drives 1 m along x:
+    wheel 1 (rolling along x) turns 1/0.05 = 20 rad, wheels 2 and 3 −10 rad each."""
+    chassis = start_node("chassis_node", params_file="params/omr3.yaml")
+    fb = ros_node.create_publisher(JointState, "joint_states", 10)
+    with subscribe(ros_node, Odometry, "odom", qos=harness.qos_default()) as odom:
+        prime_feedback(ros_node, fb, odom, 40.0, positions_only=True)
+        fb.publish(joint_state(42.0, OMNI_WHEELS, [20.0, -10.0, -10.0], []))
+        last = odom.wait_for(lambda m: m.header.stamp.sec == 42 and m.header.stamp.nanosec == 0, timeout=5)
+    assert last.pose.pose.position.x == pytest.approx(1.0, abs=1e-6)
+    assert last.pose.pose.position.y == pytest.approx(0.0, abs=1e-6)
+    chassis.wait_for_log("cover the gap", timeout=5)

@@ -3,26 +3,50 @@
 //! clock for commands, message stamps for feedback), so tests and replays are deterministic.
 //!
 //! Command path: a body twist at the reference point (`cmd_vel` in `base_link`) → the twist at
-//! the kinematic origin → [`clamp_command`] → [`inverse`] kinematics → wheel commands. A
+//! the kinematic origin → [`clamp_command`] → [`inverse`] kinematics → the request. A
 //! non-holonomic chassis takes `linear.x` and `angular.z`; the sideways velocity its reference
 //! point has when turning (ω·d) is implied, and any *requested* `linear.y` is dropped (logged as
-//! lateral). The wheels are commanded to zero when no valid `cmd_vel` arrived within
-//! `cmd_vel_timeout_s`, and when wheel feedback is stale (no valid `joint_states` within
-//! `feedback_timeout_s`): a robot is never left moving on stale data.
+//! lateral).
 //!
-//! Feedback time: a sample is integrated over the interval since the previous one. A gap longer
-//! than the feedback timeout (a dropout, or a stamp far in the future) is not integrated across —
-//! the odometry restarts its clock there and reports it; a stamp more than that far in the past is
-//! taken as a clock reset (a restarted simulation) and handled the same way. A stamp slightly in
-//! the past (an out-of-order sample) is refused. So one bad stamp costs one sample, never the
-//! odometry.
+//! **One safety gate**: wheel commands come only out of [`ChassisController::gate`] (which
+//! [`ChassisController::on_cmd_vel`] and [`ChassisController::stop`] also end in), as a
+//! [`GatedCommand`] that nothing else can build. It passes the request only while a valid
+//! `cmd_vel` arrived within `cmd_vel_timeout_s`, valid wheel feedback within
+//! `feedback_timeout_s` (else the odometry is stale), the last `cmd_vel` was finite and the
+//! wheel values are finite; otherwise it stops. A stop sets every driven wheel to zero and
+//! **holds the steering angles last sent** (straight before any command): a safety stop starts
+//! no new motion, and steering a standing car-like chassis only scrubs its tyres. A requested
+//! zero twist is a command, not a stop: it straightens the wheels as the kinematics say.
+//!
+//! Feedback: a sample is refused if a wheel turns faster than the chassis physically can
+//! (`max_feedback_wheel_speed_factor` × `max_wheel_speed`) or a steering angle is beyond ±90°;
+//! the odometry itself refuses any update that would make it non-finite. Wheel speeds are
+//! integrated over the interval since the previous sample; a gap longer than the feedback
+//! timeout (a dropout, or a stamp far in the future) is not integrated across — the odometry
+//! restarts its clock there and reports it; a stamp more than that far in the past is taken as
+//! a clock reset (a restarted simulation) and handled the same way. A stamp slightly in the past
+//! (an out-of-order sample) is refused. So one bad stamp costs one sample, never the odometry.
+//! Encoder angles are different: their change over a gap is a distance really travelled, so it
+//! is integrated however long the gap — unless the encoder wraps and the gap is long enough for
+//! a wheel to turn π (see [`crate::joints::FeedbackDecoder`]), when the change is ambiguous.
+
+use std::f64::consts::{FRAC_PI_2, PI};
+use std::ops::Deref;
 
 use crate::error::{ChassisError, OdometryError};
-use crate::kinematics::{forward, inverse, pre_steer, twist_at_origin, twist_at_reference, BodyTwist, WheelState};
+use crate::joints::FeedbackSample;
+use crate::kinematics::{
+    forward, inverse, pre_steer, twist_at_origin, twist_at_reference, BodyTwist, JointKind, WheelState,
+};
 use crate::limits::{clamp_command, ClampReason, ClampReasons};
 use crate::model::ChassisParams;
 use crate::odometry::{Odometry, OdometryNoise};
 use crate::watchdog::CmdVelWatchdog;
+
+/// Default of [`ChassisController::feedback_speed_factor`]: feedback wheel speeds up to 3 ×
+/// `max_wheel_speed` are believed (a wheel spinning free or pushed downhill can exceed the
+/// command limit; an encoder glitch reads orders of magnitude more).
+pub const DEFAULT_FEEDBACK_SPEED_FACTOR: f64 = 3.0;
 
 /// Settings of the controller beyond the chassis geometry.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -37,7 +61,7 @@ pub struct ControllerConfig {
     pub noise: OdometryNoise,
 }
 
-/// What to send to the wheels.
+/// Wheel targets with the twist they give and what the limits changed.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Command {
     /// Joint targets.
@@ -58,13 +82,50 @@ impl Command {
     }
 }
 
-/// The state of the two watchdogs at a tick.
+/// A command that went through [`ChassisController::gate`], the only thing to send to the
+/// wheels; it reads as a [`Command`] and says why it may be a stop.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct GatedCommand {
+    command: Command,
+    safety: Safety,
+}
+
+impl GatedCommand {
+    /// The watchdogs' state when the command was gated.
+    pub fn safety(&self) -> Safety {
+        self.safety
+    }
+}
+
+impl Deref for GatedCommand {
+    type Target = Command;
+
+    fn deref(&self) -> &Command {
+        &self.command
+    }
+}
+
+/// The state of the watchdogs when a command was gated.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct Safety {
-    /// No valid `cmd_vel` within the timeout.
+    /// No valid `cmd_vel` within the timeout (a non-finite one does not count as valid).
     pub cmd_vel_expired: bool,
+    /// The last `cmd_vel` was non-finite: the chassis stopped for that, not for a timeout.
+    pub cmd_vel_refused: bool,
     /// No valid wheel feedback within the timeout.
     pub feedback_stale: bool,
+}
+
+impl Safety {
+    /// True if `cmd_vel` stopped arriving (the timeout, not a refused `cmd_vel`).
+    pub fn cmd_vel_timed_out(&self) -> bool {
+        self.cmd_vel_expired && !self.cmd_vel_refused
+    }
+
+    /// True if the gate stops the wheels for a watchdog or a refused `cmd_vel`.
+    pub fn stops(&self) -> bool {
+        self.cmd_vel_expired || self.cmd_vel_refused || self.feedback_stale
+    }
 }
 
 /// Why a feedback sample was not used.
@@ -76,18 +137,34 @@ pub enum FeedbackError {
     /// The stamp or twist was refused by the odometry.
     #[error(transparent)]
     Odometry(#[from] OdometryError),
+    /// A joint value the chassis cannot physically reach.
+    #[error("joint `{joint}` at {value} is beyond what the chassis can do (limit ±{limit})")]
+    Implausible {
+        /// The joint.
+        joint: &'static str,
+        /// Its value (rad/s for a wheel, rad for a steering angle).
+        value: f64,
+        /// The limit it exceeds.
+        limit: f64,
+    },
 }
 
 /// Command limits, watchdogs and odometry of one chassis.
 #[derive(Debug, Clone)]
 pub struct ChassisController {
     config: ControllerConfig,
+    feedback_speed_factor: f64,
     cmd_watchdog: CmdVelWatchdog,
     feedback_watchdog: CmdVelWatchdog,
     odometry: Odometry,
     requested: Command,
-    /// The last finite `cmd_vel` (at the reference point), re-clamped when the limits change.
+    /// The last finite `cmd_vel` (at the reference point), re-clamped when the limits change;
+    /// `None` before the first, after a non-finite one and after [`ChassisController::stop`].
     request: Option<BodyTwist>,
+    /// The last `cmd_vel` was non-finite.
+    refused: bool,
+    /// The wheels last let through the gate (their steering angles are held by a stop).
+    sent: WheelState,
 }
 
 /// What happened to a feedback sample that was used.
@@ -101,6 +178,18 @@ pub enum FeedbackOutcome {
         /// The jump since the previous sample, `None` for the first sample.
         gap_s: Option<f64>,
     },
+    /// Encoder angles spanning a gap longer than the feedback timeout: the distance they give
+    /// was integrated across it.
+    Bridged {
+        /// The gap (s).
+        gap_s: f64,
+    },
+    /// Wrapped encoder angles over a gap in which a wheel could turn π or more: the change is
+    /// ambiguous (modulo 2π), so it was not integrated and the clock restarts here.
+    Ambiguous {
+        /// The gap (s).
+        gap_s: f64,
+    },
 }
 
 impl ChassisController {
@@ -112,6 +201,9 @@ impl ChassisController {
             odometry: Odometry::new(config.params.reference_offset(), config.noise)?,
             requested: Command::stop(&config.params),
             request: None,
+            refused: false,
+            sent: WheelState::zero(config.params.model()),
+            feedback_speed_factor: DEFAULT_FEEDBACK_SPEED_FACTOR,
             config,
         })
     }
@@ -138,10 +230,9 @@ impl ChassisController {
         self.feedback_watchdog = fb;
         self.config = config;
         // The running command was worked out under the old limits: work it out again.
-        self.requested = match self.request {
-            Some(request) => self.command_for(request),
-            None => Command::stop(&self.config.params),
-        };
+        if let Some(request) = self.request {
+            self.requested = self.command_for(request);
+        }
         Ok(())
     }
 
@@ -150,18 +241,59 @@ impl ChassisController {
         &self.config
     }
 
-    /// A `cmd_vel` (twist of the reference point, body frame) received at `now` (s).
-    /// A non-finite request stops the chassis at once and does not feed the watchdog.
-    pub fn on_cmd_vel(&mut self, requested_at_reference: BodyTwist, now: f64) -> Command {
+    /// Sets k: wheel feedback faster than k × `max_wheel_speed` is refused as impossible
+    /// (default [`DEFAULT_FEEDBACK_SPEED_FACTOR`]); k must be finite and at least 1.
+    pub fn set_feedback_speed_factor(&mut self, factor: f64) -> Result<(), ChassisError> {
+        if !(factor.is_finite() && factor >= 1.0) {
+            return Err(ChassisError::InvalidParameter {
+                name: "max_feedback_wheel_speed_factor",
+                value: factor,
+                reason: "must be finite and at least 1",
+            });
+        }
+        self.feedback_speed_factor = factor;
+        Ok(())
+    }
+
+    /// k of [`ChassisController::set_feedback_speed_factor`].
+    pub fn feedback_speed_factor(&self) -> f64 {
+        self.feedback_speed_factor
+    }
+
+    /// The fastest wheel feedback believed (rad/s): k × `max_wheel_speed`.
+    pub fn max_feedback_wheel_speed(&self) -> f64 {
+        self.feedback_speed_factor * self.config.params.max_wheel_speed()
+    }
+
+    /// A `cmd_vel` (twist of the reference point, body frame) received at `now` (s): becomes the
+    /// request, and the result of [`ChassisController::gate`] at `now` is returned. A non-finite
+    /// request stops the chassis at once and does not feed the watchdog.
+    pub fn on_cmd_vel(&mut self, requested_at_reference: BodyTwist, now: f64) -> GatedCommand {
         self.requested = self.command_for(requested_at_reference);
         if self.requested.reasons.contains(ClampReason::NonFinite) {
             self.request = None;
+            self.refused = true;
             self.cmd_watchdog.reset();
         } else {
             self.request = Some(requested_at_reference);
+            self.refused = false;
             self.cmd_watchdog.feed(now);
         }
-        self.requested
+        self.gate(now)
+    }
+
+    /// The last `cmd_vel` after the limits, as requested (for logs); what reaches the wheels is
+    /// [`ChassisController::gate`]'s.
+    pub fn requested(&self) -> &Command {
+        &self.requested
+    }
+
+    /// Forgets the request (at shutdown) and returns the stop the gate then gives at `now`.
+    pub fn stop(&mut self, now: f64) -> GatedCommand {
+        self.request = None;
+        self.requested.twist = BodyTwist::ZERO;
+        self.cmd_watchdog.reset();
+        self.gate(now)
     }
 
     /// The feasible command for a request (limits, then inverse kinematics).
@@ -195,32 +327,65 @@ impl ChassisController {
         Command { wheels, twist, reasons }
     }
 
-    /// The command to send at `now` (s) and the watchdogs' state: the last request, or a stop
-    /// when either watchdog has expired.
-    pub fn on_tick(&mut self, now: f64) -> (Command, Safety) {
+    /// The safety gate: the command to send at `now` (s). The request, or a stop (driven wheels
+    /// zero, steering held as last sent) when the cmd_vel watchdog has expired, the feedback is
+    /// stale, the last `cmd_vel` was non-finite, there is no request, or the request's wheel
+    /// values are not finite. `reasons` keeps describing the last `cmd_vel`
+    /// (`ChassisStatus.clamped`), e.g. a NaN.
+    pub fn gate(&mut self, now: f64) -> GatedCommand {
         let safety = Safety {
             cmd_vel_expired: self.cmd_watchdog.expired(now),
+            cmd_vel_refused: self.refused,
             feedback_stale: self.feedback_watchdog.expired(now),
         };
-        if safety.cmd_vel_expired || safety.feedback_stale {
-            // `reasons` keeps describing the last cmd_vel (ChassisStatus.clamped), e.g. a NaN.
-            let mut stop = Command::stop(&self.config.params);
-            stop.reasons = self.requested.reasons;
-            (stop, safety)
-        } else {
-            (self.requested, safety)
+        let mut command = self.requested;
+        if safety.stops() || self.request.is_none() || !command.wheels.is_finite() || !command.twist.is_finite() {
+            if !(command.wheels.is_finite() && command.twist.is_finite()) {
+                command.reasons.insert(ClampReason::NonFinite);
+            }
+            command.wheels = self.sent.stopped();
+            command.twist = BodyTwist::ZERO;
         }
+        self.sent = command.wheels;
+        GatedCommand { command, safety }
     }
 
-    /// Wheel feedback measured at `stamp` (s), received at `now` (s) (node clock, for the
-    /// feedback watchdog). Refused samples leave the odometry unchanged.
-    pub fn on_feedback(&mut self, wheels: &WheelState, stamp: f64, now: f64) -> Result<FeedbackOutcome, FeedbackError> {
-        let twist = forward(&self.config.params, wheels)?;
-        let max_gap = if self.config.feedback_timeout_s > 0.0 {
+    /// Refuses joint values the chassis cannot physically reach: a wheel faster than
+    /// [`ChassisController::max_feedback_wheel_speed`], a steering angle beyond ±90°.
+    fn check_plausible(&self, wheels: &WheelState) -> Result<(), FeedbackError> {
+        let max_speed = self.max_feedback_wheel_speed();
+        let joints = self.config.params.model().joints();
+        for (joint, value) in joints.iter().zip(wheels.values()) {
+            let limit = match joint.kind {
+                JointKind::Wheel => max_speed,
+                JointKind::Steering => FRAC_PI_2,
+            };
+            if value.is_nan() || value.abs() > limit {
+                return Err(FeedbackError::Implausible {
+                    joint: joint.name,
+                    value,
+                    limit,
+                });
+            }
+        }
+        Ok(())
+    }
+
+    /// The longest gap (s) integrated across for wheel-speed feedback.
+    fn max_gap(&self) -> f64 {
+        if self.config.feedback_timeout_s > 0.0 {
             self.config.feedback_timeout_s
         } else {
             1.0
-        };
+        }
+    }
+
+    /// Wheel speeds measured at `stamp` (s), received at `now` (s) (node clock, for the
+    /// feedback watchdog). Refused samples leave the odometry unchanged.
+    pub fn on_feedback(&mut self, wheels: &WheelState, stamp: f64, now: f64) -> Result<FeedbackOutcome, FeedbackError> {
+        let twist = forward(&self.config.params, wheels)?;
+        self.check_plausible(wheels)?;
+        let max_gap = self.max_gap();
         let gap = self.odometry.last_stamp().map(|previous| stamp - previous);
         let restart = match gap {
             None => true,
@@ -228,15 +393,58 @@ impl ChassisController {
             Some(dt) => dt > max_gap || dt < -max_gap,
         };
         if restart {
-            self.odometry.restart_stamp();
+            // On a copy: a refused sample must not restart the clock.
+            let mut odometry = self.odometry.clone();
+            odometry.restart_stamp();
+            odometry.update_at(twist, stamp)?;
+            self.odometry = odometry;
+        } else {
+            self.odometry.update_at(twist, stamp)?;
         }
-        self.odometry.update_at(twist, stamp)?;
         self.feedback_watchdog.feed(now);
         Ok(if restart {
             FeedbackOutcome::Restarted { gap_s: gap }
         } else {
             FeedbackOutcome::Integrated
         })
+    }
+
+    /// A decoded feedback sample (see [`FeedbackSample`]), received at `now` (s) (node clock,
+    /// for the feedback watchdog). Refused samples leave the odometry unchanged.
+    ///
+    /// Measured speeds go through [`ChassisController::on_feedback`]. Travelled samples (encoder
+    /// angles) are integrated over their own interval however long: the clock restarts at its
+    /// start if needed (first sample, clock reset). A wrapped one whose interval is long enough
+    /// for a wheel at `max_wheel_speed` to turn π is ambiguous and only restarts the clock.
+    pub fn on_feedback_sample(&mut self, sample: &FeedbackSample, now: f64) -> Result<FeedbackOutcome, FeedbackError> {
+        let (wheels, since, stamp, wrapped) = match *sample {
+            FeedbackSample::Measured { ref wheels, stamp } => return self.on_feedback(wheels, stamp, now),
+            FeedbackSample::Travelled {
+                wheels,
+                since,
+                stamp,
+                wrapped,
+            } => (wheels, since, stamp, wrapped),
+        };
+        let twist = forward(&self.config.params, &wheels)?;
+        self.check_plausible(&wheels)?;
+        let gap = stamp - since;
+        let outcome = if wrapped && gap * self.config.params.max_wheel_speed() >= PI {
+            let mut odometry = self.odometry.clone();
+            odometry.restart_stamp();
+            odometry.update_at(twist, stamp)?;
+            self.odometry = odometry;
+            FeedbackOutcome::Ambiguous { gap_s: gap }
+        } else {
+            self.odometry.update_over(twist, since, stamp)?;
+            if gap > self.max_gap() {
+                FeedbackOutcome::Bridged { gap_s: gap }
+            } else {
+                FeedbackOutcome::Integrated
+            }
+        };
+        self.feedback_watchdog.feed(now);
+        Ok(outcome)
     }
 
     /// The odometry (pose, twist and covariances; see [`Odometry::reference_pose`]).
@@ -248,7 +456,8 @@ impl ChassisController {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::model::ChassisConfig;
+    use crate::angles::wrap;
+    use crate::model::{ChassisConfig, ChassisModel};
     use approx::assert_relative_eq;
 
     fn controller(config: ChassisConfig) -> ChassisController {
@@ -276,19 +485,22 @@ mod tests {
             assert_relative_eq!(*got, want, epsilon = 1e-12);
         }
         feed_feedback(&mut c, 0.4);
-        assert_eq!(c.on_tick(0.4).0.wheels, cmd.wheels);
+        assert_eq!(c.gate(0.4).wheels, cmd.wheels);
         feed_feedback(&mut c, 0.6);
-        let (stopped, safety) = c.on_tick(0.6);
-        assert!(safety.cmd_vel_expired && !safety.feedback_stale);
+        let stopped = c.gate(0.6);
+        let safety = stopped.safety();
+        assert!(safety.cmd_vel_expired && safety.cmd_vel_timed_out() && !safety.feedback_stale);
         assert_eq!(stopped.wheels, WheelState::Omni { wheels: [0.0; 3] });
 
         c.on_cmd_vel(BodyTwist::new(0.3, 0.0, 0.0), 0.7);
         let nan = c.on_cmd_vel(BodyTwist::new(f64::NAN, 0.0, 0.0), 0.71);
         assert_eq!(nan.wheels, WheelState::Omni { wheels: [0.0; 3] });
         assert!(nan.reasons.contains(ClampReason::NonFinite));
+        let after = c.gate(0.72).safety();
+        assert!(after.cmd_vel_expired, "a NaN does not keep the watchdog alive");
         assert!(
-            c.on_tick(0.72).1.cmd_vel_expired,
-            "a NaN does not keep the watchdog alive"
+            after.cmd_vel_refused && !after.cmd_vel_timed_out(),
+            "the stop is for the NaN, not a timeout"
         );
     }
 
@@ -296,8 +508,8 @@ mod tests {
     fn stale_feedback_stops_the_wheels() {
         let mut c = controller(ChassisConfig::omr3());
         feed_feedback(&mut c, 0.0);
-        c.on_cmd_vel(BodyTwist::new(0.3, 0.0, 0.0), 0.55);
-        let (cmd, safety) = c.on_tick(0.55);
+        let cmd = c.on_cmd_vel(BodyTwist::new(0.3, 0.0, 0.0), 0.55);
+        let safety = cmd.safety();
         assert!(safety.feedback_stale && !safety.cmd_vel_expired);
         assert_eq!(cmd.wheels, WheelState::Omni { wheels: [0.0; 3] });
     }
@@ -307,6 +519,7 @@ mod tests {
         let mut config = ChassisConfig::mobil2();
         config.reference_offset = 0.3;
         let mut c = controller(config);
+        feed_feedback(&mut c, 0.0);
         // v = 0.4, ω = 0.2: radius 2 m ≥ 0.73 m, feasible; no lateral request.
         let cmd = c.on_cmd_vel(BodyTwist::new(0.4, 0.0, 0.2), 0.0);
         assert!(cmd.reasons.is_empty(), "{:?}", cmd.reasons);
@@ -331,6 +544,7 @@ mod tests {
         let mut config = ChassisConfig::omr3();
         config.reference_offset = 0.1;
         let mut c = controller(config);
+        feed_feedback(&mut c, 0.0);
         // Pure rotation about the reference point 0.1 m ahead: the centre moves sideways at
         // vy = −ω·d = −0.1 m/s, so each wheel gets r·ω_i = sin θ_i·(−0.1) + R·ω.
         let cmd = c.on_cmd_vel(BodyTwist::new(0.0, 0.0, 1.0), 0.0);
@@ -397,7 +611,7 @@ mod tests {
         config.params = ChassisParams::new(slower).unwrap();
         c.reconfigure(config).unwrap();
         // v_max 0.1 with r = 0.05: wheel 1 at 0.1/0.05 = 2 rad/s, not the 10 rad/s asked for before.
-        let (cmd, _) = c.on_tick(0.1);
+        let cmd = c.gate(0.1);
         assert_relative_eq!(cmd.wheels.values()[0], 2.0, epsilon = 1e-12);
         assert!(cmd.reasons.contains(ClampReason::Speed));
     }
@@ -418,5 +632,262 @@ mod tests {
             wheels: [f64::NAN, 0.0, 0.0],
         };
         assert!(c.on_feedback(&bad, 10.7, 10.7).is_err());
+    }
+
+    fn is_zero_omni(cmd: &GatedCommand) -> bool {
+        cmd.wheels == WheelState::Omni { wheels: [0.0; 3] }
+    }
+
+    #[test]
+    fn without_any_feedback_no_command_reaches_the_wheels() {
+        // OMR-III, cmd_vel 0.2 m/s at 10 Hz for 4 s, and the 50 Hz tick, with no joint_states at
+        // all: the odometry would be blind, so every command is zero.
+        let mut c = controller(ChassisConfig::omr3());
+        for k in 0..200 {
+            let t = 0.02 * f64::from(k);
+            if k % 5 == 0 {
+                let cmd = c.on_cmd_vel(BodyTwist::new(0.2, 0.0, 0.0), t);
+                assert!(is_zero_omni(&cmd), "cmd_vel at {t} s sent {:?}", cmd.wheels);
+                assert!(cmd.safety().feedback_stale && !cmd.safety().cmd_vel_expired);
+            }
+            assert!(is_zero_omni(&c.gate(t)), "tick at {t} s");
+        }
+        // The request itself stands: 0.2 m/s along x, Ω = (0.2/0.05)·[1, −½, −½] = [4, −2, −2].
+        assert_eq!(
+            c.requested().wheels,
+            WheelState::Omni {
+                wheels: [4.0, -2.0, -2.0]
+            }
+        );
+    }
+
+    #[test]
+    fn feedback_stopping_mid_run_stops_the_wheels_after_its_timeout() {
+        let mut c = controller(ChassisConfig::omr3());
+        // Feedback at 50 Hz up to t = 1.0 s, cmd_vel at 10 Hz up to 3 s: wheels turn until the
+        // feedback is 0.5 s old, i.e. through t = 1.5 s, and are zero after.
+        for k in 0..=150 {
+            let t = 0.02 * f64::from(k);
+            if t <= 1.0 + 1e-9 {
+                feed_feedback(&mut c, t);
+            }
+            let cmd = if k % 5 == 0 {
+                c.on_cmd_vel(BodyTwist::new(0.2, 0.0, 0.0), t)
+            } else {
+                c.gate(t)
+            };
+            if t <= 1.5 - 1e-9 {
+                assert_eq!(
+                    cmd.wheels,
+                    WheelState::Omni {
+                        wheels: [4.0, -2.0, -2.0]
+                    },
+                    "at {t} s"
+                );
+            } else if t > 1.5 + 1e-9 {
+                assert!(is_zero_omni(&cmd), "at {t} s: {:?}", cmd.wheels);
+                assert!(cmd.safety().feedback_stale);
+            }
+        }
+    }
+
+    #[test]
+    fn a_stop_holds_the_steering_angles_last_sent() {
+        let mut c = controller(ChassisConfig::mobil2());
+        // Before any command a stop is straight.
+        assert_eq!(c.gate(0.0).wheels, WheelState::zero(ChassisModel::CarLike));
+        feed_feedback(&mut c, 0.0);
+        // v = 0.3, ω = 0.2: R = 1.5 m; δ_l = atan(0.6/(1.5 − 0.31)) = 0.467003,
+        // δ_r = atan(0.6/(1.5 + 0.31)) = 0.320092; rear (0.3 ∓ 0.062)/0.1 = 2.38, 3.62 rad/s.
+        let moving = c.on_cmd_vel(BodyTwist::new(0.3, 0.0, 0.2), 0.0);
+        let WheelState::CarLike {
+            front_left_steering: left,
+            front_right_steering: right,
+            rear_left,
+            rear_right,
+        } = moving.wheels
+        else {
+            panic!("{moving:?}")
+        };
+        assert_relative_eq!(left, 0.467_003_301, epsilon = 1e-9);
+        assert_relative_eq!(right, 0.320_092_181, epsilon = 1e-9);
+        assert_relative_eq!(rear_left, 2.38, epsilon = 1e-12);
+        assert_relative_eq!(rear_right, 3.62, epsilon = 1e-12);
+        // cmd_vel stops: at 0.6 s the watchdog has expired; the rear wheels stop, the steering
+        // stays where it was.
+        feed_feedback(&mut c, 0.6);
+        let stopped = c.gate(0.6);
+        assert!(stopped.safety().cmd_vel_timed_out());
+        assert_eq!(
+            stopped.wheels,
+            WheelState::CarLike {
+                front_left_steering: left,
+                front_right_steering: right,
+                rear_left: 0.0,
+                rear_right: 0.0
+            }
+        );
+        assert_eq!(stopped.twist, BodyTwist::ZERO);
+        // A NaN holds it as well; an explicit zero twist is a command and straightens the wheels.
+        assert_eq!(
+            c.on_cmd_vel(BodyTwist::new(f64::NAN, 0.0, 0.0), 0.61).wheels,
+            stopped.wheels
+        );
+        assert_eq!(
+            c.on_cmd_vel(BodyTwist::ZERO, 0.62).wheels,
+            WheelState::zero(ChassisModel::CarLike)
+        );
+    }
+
+    #[test]
+    fn the_shutdown_stop_goes_through_the_gate_even_with_both_watchdogs_off() {
+        let mut c = ChassisController::new(ControllerConfig {
+            params: ChassisParams::omr3(),
+            cmd_vel_timeout_s: 0.0,
+            feedback_timeout_s: 0.0,
+            noise: OdometryNoise::default(),
+        })
+        .unwrap();
+        // Watchdogs off: the request passes, and only the gate's "no request" stops it.
+        let moving = c.on_cmd_vel(BodyTwist::new(0.2, 0.0, 0.0), 0.0);
+        assert_eq!(
+            moving.wheels,
+            WheelState::Omni {
+                wheels: [4.0, -2.0, -2.0]
+            }
+        );
+        assert!(!moving.safety().stops());
+        assert!(is_zero_omni(&c.stop(100.0)));
+        assert!(is_zero_omni(&c.gate(100.02)), "the stop lasts");
+    }
+
+    #[test]
+    fn impossible_wheel_speeds_are_refused_and_leave_the_odometry_as_it_was() {
+        let forward = WheelState::Omni {
+            wheels: [6.0, -3.0, -3.0],
+        };
+        let mut c = controller(ChassisConfig::omr3());
+        c.on_feedback(&forward, 1.0, 1.0).unwrap();
+        c.on_feedback(&forward, 1.1, 1.1).unwrap();
+        let before = c.odometry().clone();
+        // OMR-III: max_wheel_speed 12 rad/s, so feedback is believed up to 3 × 12 = 36 rad/s.
+        assert_relative_eq!(c.max_feedback_wheel_speed(), 36.0);
+        let huge = WheelState::Omni {
+            wheels: [1e308, -1e308, 0.0],
+        };
+        assert!(matches!(
+            c.on_feedback(&huge, 1.2, 1.2),
+            Err(FeedbackError::Implausible {
+                joint: "wheel_1",
+                limit: 36.0,
+                ..
+            })
+        ));
+        let just_over = WheelState::Omni {
+            wheels: [0.0, 36.001, 0.0],
+        };
+        assert!(c.on_feedback(&just_over, 1.2, 1.2).is_err());
+        assert_eq!(c.odometry(), &before);
+        assert_relative_eq!(c.odometry().reference_pose().x, 0.03, epsilon = 1e-12);
+        // At the limit it is believed.
+        let at_limit = WheelState::Omni {
+            wheels: [36.0, -18.0, -18.0],
+        };
+        assert_eq!(c.on_feedback(&at_limit, 1.2, 1.2).unwrap(), FeedbackOutcome::Integrated);
+
+        // MOBIL-II: max_wheel_speed 7.5, limit 22.5 rad/s; the rear-left wheel at 1e308.
+        let mut car = controller(ChassisConfig::mobil2());
+        let rest = WheelState::zero(ChassisModel::CarLike);
+        car.on_feedback(&rest, 1.0, 1.0).unwrap();
+        let before = car.odometry().clone();
+        let huge = WheelState::from_values(ChassisModel::CarLike, &[0.0, 0.0, 1e308, 0.0]).unwrap();
+        assert!(matches!(
+            car.on_feedback(&huge, 1.1, 1.1),
+            Err(FeedbackError::Implausible {
+                joint: "rear_left_wheel",
+                ..
+            })
+        ));
+        // A steering angle past 90° is not a real reading either.
+        let bent = WheelState::from_values(ChassisModel::CarLike, &[1.6, 0.0, 1.0, 1.0]).unwrap();
+        assert!(matches!(
+            car.on_feedback(&bent, 1.1, 1.1),
+            Err(FeedbackError::Implausible {
+                joint: "front_left_steering",
+                ..
+            })
+        ));
+        assert_eq!(car.odometry(), &before);
+        let cov = car.odometry().covariance();
+        assert!(cov.iter().all(|v| v.is_finite()));
+        // A lower factor applies at once: 2 × 7.5 = 15 rad/s.
+        car.set_feedback_speed_factor(2.0).unwrap();
+        let fast = WheelState::from_values(ChassisModel::CarLike, &[0.0, 0.0, 16.0, 16.0]).unwrap();
+        assert!(car.on_feedback(&fast, 1.1, 1.1).is_err());
+        assert!(car.set_feedback_speed_factor(0.5).is_err());
+        assert!(car.set_feedback_speed_factor(f64::NAN).is_err());
+    }
+
+    /// Position-only samples of OMR-III (wheel angles) decoded and fed at their stamps.
+    fn feed_angles(
+        c: &mut ChassisController,
+        d: &mut crate::joints::FeedbackDecoder,
+        t: f64,
+        angles: [f64; 3],
+    ) -> Option<Result<FeedbackOutcome, FeedbackError>> {
+        let names: Vec<String> = ["wheel_1", "wheel_2", "wheel_3"]
+            .iter()
+            .map(|s| (*s).to_owned())
+            .collect();
+        let sample = d.decode(ChassisModel::Omni, &names, &angles, &[], t).unwrap()?;
+        Some(c.on_feedback_sample(&sample, t))
+    }
+
+    #[test]
+    fn encoder_angles_across_a_dropout_are_a_real_distance() {
+        let mut c = controller(ChassisConfig::omr3());
+        let mut d = crate::joints::FeedbackDecoder::default();
+        // At rest, 50 Hz, until t = 1 s.
+        for k in 0..=50 {
+            feed_angles(&mut c, &mut d, 0.02 * f64::from(k), [0.0; 3]);
+        }
+        // 2 s without feedback, in which the robot drives 1 m along x: wheel 1 (rolling along x)
+        // turns 1/0.05 = 20 rad, wheels 2 and 3 −½ of that.
+        let outcome = feed_angles(&mut c, &mut d, 3.0, [20.0, -10.0, -10.0]).unwrap().unwrap();
+        assert!(matches!(outcome, FeedbackOutcome::Bridged { gap_s } if (gap_s - 2.0).abs() < 1e-9));
+        assert_relative_eq!(c.odometry().reference_pose().x, 1.0, epsilon = 1e-9);
+        assert_relative_eq!(c.odometry().reference_pose().y, 0.0, epsilon = 1e-9);
+        // And on from there at 50 Hz: 0.02 s at 0.3 m/s (6 rad/s on wheel 1) adds 6 mm.
+        let next = feed_angles(&mut c, &mut d, 3.02, [20.12, -10.06, -10.06])
+            .unwrap()
+            .unwrap();
+        assert_eq!(next, FeedbackOutcome::Integrated);
+        assert_relative_eq!(c.odometry().reference_pose().x, 1.006, epsilon = 1e-9);
+    }
+
+    #[test]
+    fn wrapped_encoder_angles_integrate_without_a_spike_and_refuse_an_ambiguous_gap() {
+        let mut c = controller(ChassisConfig::omr3());
+        let mut d = crate::joints::FeedbackDecoder::default();
+        // 0.3 m/s along x for 1 s at 50 Hz: wheel angles 6t, −3t, −3t (rad), reported wrapped to
+        // (−π, π]: wheel 1 wraps at t = π/6 = 0.52 s. Odometry: x = 0.3 m, no spike.
+        for k in 0..=50 {
+            let t = 0.02 * f64::from(k);
+            feed_angles(&mut c, &mut d, t, [wrap(6.0 * t), wrap(-3.0 * t), wrap(-3.0 * t)]);
+        }
+        assert_relative_eq!(c.odometry().reference_pose().x, 0.3, epsilon = 1e-9);
+        assert_relative_eq!(c.odometry().twist().vx, 0.3, epsilon = 1e-9);
+        // A 0.5 s gap: at max_wheel_speed 12 rad/s a wheel could turn 6 rad > π in it, so the
+        // wrapped difference says nothing: not integrated, the clock restarts.
+        let outcome = feed_angles(&mut c, &mut d, 1.5, [wrap(9.0), wrap(-4.5), wrap(-4.5)])
+            .unwrap()
+            .unwrap();
+        assert!(matches!(outcome, FeedbackOutcome::Ambiguous { gap_s } if (gap_s - 0.5).abs() < 1e-9));
+        assert_relative_eq!(c.odometry().reference_pose().x, 0.3, epsilon = 1e-9);
+        // The next 20 ms integrate normally (6 mm).
+        feed_angles(&mut c, &mut d, 1.52, [wrap(9.12), wrap(-4.56), wrap(-4.56)])
+            .unwrap()
+            .unwrap();
+        assert_relative_eq!(c.odometry().reference_pose().x, 0.306, epsilon = 1e-9);
     }
 }

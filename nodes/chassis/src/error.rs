@@ -62,6 +62,17 @@ pub enum OdometryError {
     /// A timestamp is NaN or infinite.
     #[error("timestamp {0} s is not finite")]
     NonFiniteTime(f64),
+    /// The update would make the pose or its covariance non-finite (an absurd, if finite, twist).
+    #[error("twist {twist:?} over {dt} s would make the pose or its covariance non-finite")]
+    NonFiniteResult {
+        /// The refused twist.
+        twist: BodyTwist,
+        /// Over this interval (s).
+        dt: f64,
+    },
+    /// A pose to restart from is not finite.
+    #[error("pose {0:?} is not finite")]
+    NonFinitePose([f64; 3]),
     /// A timestamp is not after the previous one (time went backwards or repeated).
     #[error("timestamp {now} s is not after the previous {previous} s")]
     TimeNotIncreasing {

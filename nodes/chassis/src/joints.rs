@@ -7,13 +7,15 @@
 //! or as long as `name`, as the message definition requires.
 //!
 //! Feedback may carry wheel speeds (`velocity`) or only encoder angles (`position`, as many
-//! drivers publish): [`FeedbackDecoder`] then differentiates the angles between samples.
+//! drivers publish): [`FeedbackDecoder`] then differentiates the angles between samples, wrapped
+//! or not.
 //!
 //! Commands (`wheel_commands`) list every joint of the model; steering joints get the angle in
 //! `position` and 0 in `velocity`, wheel joints the speed in `velocity` and 0 in `position`.
 
 use thiserror::Error;
 
+use crate::angles::wrap;
 use crate::kinematics::{JointKind, WheelState};
 use crate::model::ChassisModel;
 
@@ -95,12 +97,70 @@ pub fn wheel_state_from_joints(
     })
 }
 
-/// Turns successive `joint_states` into [`WheelState`]s, from wheel speeds when the message has
-/// them, else from the change of the wheel angles since the previous sample.
+/// One decoded wheel-feedback sample.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum FeedbackSample {
+    /// Wheel speeds as measured at `stamp` (the message's `velocity`).
+    Measured {
+        /// Steering angles and wheel speeds.
+        wheels: WheelState,
+        /// Measurement time (s).
+        stamp: f64,
+    },
+    /// Wheel speeds averaged over (`since`, `stamp`] from the change of the encoder angles: the
+    /// distance they imply was really travelled, however long the interval (a dropout of the
+    /// feedback does not lose it).
+    Travelled {
+        /// Steering angles at `stamp` and the mean wheel speeds over the interval.
+        wheels: WheelState,
+        /// Stamp (s) of the previous position sample.
+        since: f64,
+        /// Stamp (s) of this sample.
+        stamp: f64,
+        /// True if a wheel's angle difference was unwrapped to the shortest angle (its encoder
+        /// reads wrapped angles): the difference is then only known modulo 2π, see
+        /// [`FeedbackDecoder`].
+        wrapped: bool,
+    },
+}
+
+impl FeedbackSample {
+    /// Steering angles and wheel speeds.
+    pub fn wheels(&self) -> &WheelState {
+        match self {
+            Self::Measured { wheels, .. } | Self::Travelled { wheels, .. } => wheels,
+        }
+    }
+
+    /// Stamp (s) of the sample.
+    pub fn stamp(&self) -> f64 {
+        match *self {
+            Self::Measured { stamp, .. } | Self::Travelled { stamp, .. } => stamp,
+        }
+    }
+}
+
+/// Readings of a wheel angle beyond ±2π prove that its encoder counts continuously.
+const WRAPPED_RANGE: f64 = 2.0 * std::f64::consts::PI;
+
+/// Turns successive `joint_states` into [`FeedbackSample`]s, from wheel speeds when the message
+/// has them, else from the change of the wheel angles since the previous sample.
+///
+/// Wrapped encoders: many drivers report a wheel angle wrapped to (−π, π] (or [0, 2π)). While
+/// every reading of a wheel has stayed within ±2π, its angle difference is unwrapped to the
+/// shortest angle, so a wrap from +π to −π is a small step forward, not a 2π spike; once a
+/// reading lies beyond ±2π the encoder is known to count continuously and differences are taken
+/// as they are. The shortest angle is the true one only if the wheel turned less than π between
+/// the two samples, i.e. samples closer than π / ω_max (at `max_wheel_speed` ω_max: 0.42 s for
+/// MOBIL-II's 7.5 rad/s, 0.26 s for OMR-III's 12 rad/s); such a sample is marked
+/// [`FeedbackSample::Travelled::wrapped`] so that the odometry can refuse to integrate a longer,
+/// ambiguous gap.
 #[derive(Debug, Clone, Default)]
 pub struct FeedbackDecoder {
     /// Stamp (s) and wheel-joint angles of the previous position-only sample.
     previous: Option<(f64, Vec<f64>)>,
+    /// Per wheel joint: a reading beyond ±2π was seen (the encoder does not wrap).
+    continuous: Vec<bool>,
 }
 
 impl FeedbackDecoder {
@@ -113,27 +173,54 @@ impl FeedbackDecoder {
         positions: &[f64],
         velocities: &[f64],
         stamp: f64,
-    ) -> Result<Option<WheelState>, JointStateError> {
+    ) -> Result<Option<FeedbackSample>, JointStateError> {
         if !velocities.is_empty() || positions.is_empty() {
             self.previous = None;
-            return wheel_state_from_joints(model, names, positions, velocities).map(Some);
+            let wheels = wheel_state_from_joints(model, names, positions, velocities)?;
+            return Ok(Some(FeedbackSample::Measured { wheels, stamp }));
         }
         // Positions only: read every joint's angle, then differentiate the wheels'.
         let angles = wheel_state_from_joints(model, names, positions, positions)?.values();
-        let wheel_angles: Vec<f64> = model
+        let wheel_joints: Vec<(&'static str, f64)> = model
             .joints()
             .iter()
             .zip(&angles)
             .filter(|(j, _)| j.kind == JointKind::Wheel)
-            .map(|(_, a)| *a)
+            .map(|(j, a)| (j.name, *a))
             .collect();
-        let previous = self.previous.replace((stamp, wheel_angles.clone()));
-        let Some((t0, before)) = previous else { return Ok(None) };
-        let dt = stamp - t0;
+        if self.continuous.len() != wheel_joints.len() {
+            self.continuous = vec![false; wheel_joints.len()];
+        }
+        for (continuous, (_, angle)) in self.continuous.iter_mut().zip(&wheel_joints) {
+            *continuous |= angle.abs() > WRAPPED_RANGE;
+        }
+        let wheel_angles: Vec<f64> = wheel_joints.iter().map(|(_, a)| *a).collect();
+        let previous = self.previous.replace((stamp, wheel_angles));
+        let Some((since, before)) = previous else {
+            return Ok(None);
+        };
+        let dt = stamp - since;
         if !(dt > 0.0 && dt.is_finite()) {
             return Ok(None);
         }
-        let mut speeds = wheel_angles.iter().zip(&before).map(|(a, b)| (a - b) / dt);
+        let mut wrapped = false;
+        let mut speeds = Vec::with_capacity(wheel_joints.len());
+        for (((name, angle), before), continuous) in wheel_joints.iter().zip(&before).zip(&self.continuous) {
+            let mut change = angle - before;
+            if !continuous {
+                wrapped = true;
+                change = wrap(change);
+            }
+            let speed = change / dt;
+            if !speed.is_finite() {
+                return Err(JointStateError::NonFinite {
+                    joint: name,
+                    value: speed,
+                });
+            }
+            speeds.push(speed);
+        }
+        let mut speeds = speeds.into_iter();
         let values: Vec<f64> = model
             .joints()
             .iter()
@@ -143,13 +230,17 @@ impl FeedbackDecoder {
                 JointKind::Wheel => speeds.next().unwrap_or(0.0),
             })
             .collect();
-        WheelState::from_values(model, &values)
-            .map(Some)
-            .map_err(|_| JointStateError::MismatchedLengths {
-                names: names.len(),
-                positions: positions.len(),
-                velocities: velocities.len(),
-            })
+        let wheels = WheelState::from_values(model, &values).map_err(|_| JointStateError::MismatchedLengths {
+            names: names.len(),
+            positions: positions.len(),
+            velocities: velocities.len(),
+        })?;
+        Ok(Some(FeedbackSample::Travelled {
+            wheels,
+            since,
+            stamp,
+            wrapped,
+        }))
     }
 }
 
@@ -268,8 +359,17 @@ mod tests {
         let m = ChassisModel::CarLike;
         assert_eq!(d.decode(m, &n, &[0.1, 0.08, 10.0, 20.0], &[], 5.0).unwrap(), None);
         // Rear wheels turned 0.6 and 0.7 rad in 0.1 s: 6 and 7 rad/s; steering read as is.
-        let s = d.decode(m, &n, &[0.1, 0.08, 10.6, 20.7], &[], 5.1).unwrap().unwrap();
-        match s {
+        let sample = d.decode(m, &n, &[0.1, 0.08, 10.6, 20.7], &[], 5.1).unwrap().unwrap();
+        assert!(matches!(
+            sample,
+            FeedbackSample::Travelled {
+                since: 5.0,
+                stamp: 5.1,
+                wrapped: false,
+                ..
+            }
+        ));
+        match *sample.wheels() {
             WheelState::CarLike {
                 front_left_steering,
                 front_right_steering,
@@ -288,7 +388,64 @@ mod tests {
             .decode(m, &n, &[0.0, 0.0, 0.0, 0.0], &[0.0, 0.0, 1.0, 1.0], 5.2)
             .unwrap()
             .unwrap();
-        assert_eq!(v.values()[2], 1.0);
+        assert_eq!(v.wheels().values()[2], 1.0);
+        assert!(matches!(v, FeedbackSample::Measured { stamp: 5.2, .. }));
+    }
+
+    fn omni_speeds(sample: Option<FeedbackSample>) -> [f64; 3] {
+        match sample {
+            Some(FeedbackSample::Travelled {
+                wheels: WheelState::Omni { wheels },
+                ..
+            }) => wheels,
+            other => panic!("{other:?}"),
+        }
+    }
+
+    #[test]
+    fn wrapped_encoder_angles_make_no_two_pi_spike() {
+        let n = names(&["wheel_1", "wheel_2", "wheel_3"]);
+        let m = ChassisModel::Omni;
+        let mut d = FeedbackDecoder::default();
+        assert_eq!(d.decode(m, &n, &[3.0, -3.0, 0.0], &[], 1.0).unwrap(), None);
+        // In 0.1 s wheel 1 turns +0.4 rad across +π (3.0 → 3.4 − 2π = −2.883185), wheel 2 turns
+        // −0.4 rad across −π (−3.0 → −3.4 + 2π = 2.883185), wheel 3 +0.4 rad: 4, −4, 4 rad/s, not
+        // the ±58.8 rad/s of the raw differences.
+        let spike_free = omni_speeds(
+            d.decode(m, &n, &[-2.883_185_307, 2.883_185_307, 0.4], &[], 1.1)
+                .unwrap(),
+        );
+        for (got, want) in spike_free.iter().zip([4.0, -4.0, 4.0]) {
+            assert!((got - want).abs() < 1e-6, "{spike_free:?}");
+        }
+    }
+
+    #[test]
+    fn continuous_encoder_is_taken_as_it_is() {
+        let n = names(&["wheel_1", "wheel_2", "wheel_3"]);
+        let m = ChassisModel::Omni;
+        let mut d = FeedbackDecoder::default();
+        assert_eq!(d.decode(m, &n, &[0.0, 0.0, 0.0], &[], 1.0).unwrap(), None);
+        // A 2 s dropout, then wheel 1 is 20 rad further (beyond ±2π: a continuous count), wheels
+        // 2 and 3 −10 rad: OMR-III driving 1 m along x (r = 0.05: 1/0.05 = 20 rad); mean speeds
+        // 10, −5, −5 rad/s, not wrapped.
+        let sample = d.decode(m, &n, &[20.0, -10.0, -10.0], &[], 3.0).unwrap().unwrap();
+        assert_eq!(
+            sample,
+            FeedbackSample::Travelled {
+                wheels: WheelState::Omni {
+                    wheels: [10.0, -5.0, -5.0]
+                },
+                since: 1.0,
+                stamp: 3.0,
+                wrapped: false,
+            }
+        );
+        // Later differences of more than π on those wheels are real too (0.1 s at 40 rad/s).
+        let fast = omni_speeds(d.decode(m, &n, &[24.0, -14.0, -14.0], &[], 3.1).unwrap());
+        for (got, want) in fast.iter().zip([40.0, -40.0, -40.0]) {
+            assert!((got - want).abs() < 1e-9, "{fast:?}");
+        }
     }
 
     #[test]

@@ -171,6 +171,34 @@ impl WheelState {
         }
     }
 
+    /// The same steering angles with every driven wheel at rest: a stop that starts no
+    /// steering motion.
+    pub fn stopped(&self) -> Self {
+        match *self {
+            Self::Tricycle { steering, .. } => Self::Tricycle {
+                steering,
+                traction: 0.0,
+            },
+            Self::CarLike {
+                front_left_steering,
+                front_right_steering,
+                ..
+            } => Self::CarLike {
+                front_left_steering,
+                front_right_steering,
+                rear_left: 0.0,
+                rear_right: 0.0,
+            },
+            Self::Omni { .. } => Self::Omni { wheels: [0.0; 3] },
+        }
+    }
+
+    /// True if every joint value is finite.
+    pub fn is_finite(&self) -> bool {
+        let (array, len) = self.value_array();
+        array[..len].iter().all(|v| v.is_finite())
+    }
+
     /// The model this state belongs to.
     pub fn model(&self) -> ChassisModel {
         match self {

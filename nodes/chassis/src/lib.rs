@@ -14,7 +14,7 @@
 //! - [`angles`]: [`angles::wrap`] to (−π, π].
 //! - [`joints`]: the `sensor_msgs/JointState` layout of wheel commands and feedback, parsed once.
 //! - [`controller`]: [`ChassisController`], the LOW-LEVEL loop (limits, watchdogs, odometry)
-//!   that `chassis_node` wraps.
+//!   that `chassis_node` wraps, with the one safety gate every wheel command comes out of.
 //! - [`ros_params`]: the chassis geometry as ROS parameters, shared by every node that models it.
 //!
 //! Frames: the *kinematic origin* is the rear-axle midpoint for the tricycle and the car-like
@@ -49,8 +49,9 @@ pub mod odometry;
 pub mod ros_params;
 pub mod watchdog;
 
-pub use controller::{ChassisController, Command, ControllerConfig, FeedbackOutcome, Safety};
+pub use controller::{ChassisController, Command, ControllerConfig, FeedbackOutcome, GatedCommand, Safety};
 pub use error::{ChassisError, OdometryError};
+pub use joints::{FeedbackDecoder, FeedbackSample};
 pub use kinematics::{forward, inverse, pre_steer, BodyTwist, Joint, JointKind, WheelState};
 pub use limits::{clamp_command, ClampReason, ClampReasons, Clamped};
 pub use model::{ChassisConfig, ChassisModel, ChassisParams};

@@ -73,7 +73,11 @@ pub struct ChassisConfig {
     pub wheel_radius: f64,
     /// Distance R (m) from the centre to each omni wheel (omni).
     pub omni_wheel_distance: f64,
-    /// Mechanical steering limit δ_max (rad), in (0, π/2] (tricycle, car-like).
+    /// Steering limit δ_max (rad), in (0, π/2] (tricycle, car-like), of the model's one steering
+    /// angle δ: the tricycle's wheel, the car-like chassis' virtual centre (bicycle) wheel, as in
+    /// SPEC §1 (δ = 70° on a 0.60 m wheelbase gives the 0.22 m radius L / tan δ). The inner
+    /// Ackermann wheel steers further, atan(L / (L / tan δ − B/2)); a limit δ_w of the inner
+    /// wheel is δ_max = atan(L / (L / tan δ_w + B/2)).
     pub max_steering: f64,
     /// Minimum turning radius R_min (m) at the kinematic origin (tricycle, car-like).
     pub min_turning_radius: f64,
@@ -281,7 +285,7 @@ impl ChassisParams {
         self.config.omni_wheel_distance
     }
 
-    /// Mechanical steering limit δ_max (rad).
+    /// Steering limit δ_max (rad) of the model's steering angle (car-like: the virtual centre wheel).
     pub fn max_steering(&self) -> f64 {
         self.config.max_steering
     }

@@ -15,6 +15,13 @@
 //! grow linearly with the distance travelled and the angle turned (a random walk per metre and per
 //! radian). The coefficients are [`OdometryNoise`]. The twist covariance is a constant diagonal
 //! ([`OdometryNoise::twist_variance`]).
+//!
+//! # Finite state, whatever arrives
+//!
+//! Every update is worked out on a copy first: one that would make the pose, the covariance or
+//! their values at the reference point non-finite (a finite but absurd twist, e.g. 1e306 m/s,
+//! overflows the covariance) is refused with [`OdometryError::NonFiniteResult`] and the state is
+//! left as it was. Plausibility (what a chassis can physically do) is the caller's check.
 
 use nalgebra::{Isometry2, Matrix3, Vector2, Vector3};
 use serde::{Deserialize, Serialize};
@@ -161,8 +168,7 @@ impl Odometry {
         if !twist.is_finite() {
             return Err(OdometryError::NonFiniteTwist(twist));
         }
-        self.integrate(twist, dt);
-        Ok(())
+        self.integrate(twist, dt)
     }
 
     /// Integrates `twist`, measured at time `t` (s), over the interval since the previous stamp.
@@ -185,7 +191,30 @@ impl Odometry {
         Ok(())
     }
 
-    fn integrate(&mut self, twist: BodyTwist, dt: f64) {
+    /// Integrates `twist`, held over (`from`, `to`] (s), whatever the previous stamp: the clock
+    /// restarts at `from`. For a displacement known to cover that interval however long it is,
+    /// e.g. the change of encoder angles between two samples.
+    ///
+    /// Refuses non-finite stamps, `to` not after `from` and a non-finite twist; the state is then
+    /// unchanged. Afterwards the stamp is `to`.
+    pub fn update_over(&mut self, twist: BodyTwist, from: f64, to: f64) -> Result<(), OdometryError> {
+        for t in [from, to] {
+            if !t.is_finite() {
+                return Err(OdometryError::NonFiniteTime(t));
+            }
+        }
+        if to <= from {
+            return Err(OdometryError::TimeNotIncreasing {
+                previous: from,
+                now: to,
+            });
+        }
+        self.update(twist, to - from)?;
+        self.last_stamp = Some(to);
+        Ok(())
+    }
+
+    fn integrate(&mut self, twist: BodyTwist, dt: f64) -> Result<(), OdometryError> {
         let step = arc_displacement(twist, dt);
         let (sin, cos) = self.pose.z.sin_cos();
         let dx = cos * step.x - sin * step.y;
@@ -207,10 +236,15 @@ impl Odometry {
             n.heading_var_per_rad * step.z.abs() + n.heading_var_per_m * distance,
         ));
         let p = f * self.covariance * f.transpose() + g * q_step * g.transpose();
-        self.covariance = 0.5 * (p + p.transpose());
-
-        self.pose = Vector3::new(self.pose.x + dx, self.pose.y + dy, wrap(self.pose.z + step.z));
+        let covariance = 0.5 * (p + p.transpose());
+        let pose = Vector3::new(self.pose.x + dx, self.pose.y + dy, wrap(self.pose.z + step.z));
+        if !state_is_finite(&pose, &covariance, self.reference_offset) {
+            return Err(OdometryError::NonFiniteResult { twist, dt });
+        }
+        self.covariance = covariance;
+        self.pose = pose;
         self.twist = twist;
+        Ok(())
     }
 
     /// Forgets the previous stamp, keeping pose and covariance: the next [`Odometry::update_at`]
@@ -221,15 +255,27 @@ impl Odometry {
 
     /// Back to the start: reference point at the odom origin, zero covariance, zero twist, no stamp.
     pub fn reset(&mut self) {
-        self.reset_to(Vector3::new(-self.reference_offset, 0.0, 0.0));
+        self.pose = Vector3::new(-self.reference_offset, 0.0, 0.0);
+        self.covariance = Matrix3::zeros();
+        self.twist = BodyTwist::ZERO;
+        self.last_stamp = None;
     }
 
-    /// Restarts at `pose_of_origin` [x, y, ϑ] (ϑ wrapped) with zero covariance, zero twist, no stamp.
-    pub fn reset_to(&mut self, pose_of_origin: Vector3<f64>) {
+    /// Restarts at `pose_of_origin` [x, y, ϑ] (ϑ wrapped) with zero covariance, zero twist, no
+    /// stamp; refuses a non-finite pose, leaving the state unchanged.
+    pub fn reset_to(&mut self, pose_of_origin: Vector3<f64>) -> Result<(), OdometryError> {
+        if !state_is_finite(&pose_of_origin, &Matrix3::zeros(), self.reference_offset) {
+            return Err(OdometryError::NonFinitePose([
+                pose_of_origin.x,
+                pose_of_origin.y,
+                pose_of_origin.z,
+            ]));
+        }
         self.pose = Vector3::new(pose_of_origin.x, pose_of_origin.y, wrap(pose_of_origin.z));
         self.covariance = Matrix3::zeros();
         self.twist = BodyTwist::ZERO;
         self.last_stamp = None;
+        Ok(())
     }
 
     /// Changes d (m) (finite); the state, kept at the origin, is unaffected.
@@ -315,6 +361,22 @@ impl Odometry {
     pub fn odom_from_origin(&self) -> Isometry2<f64> {
         Isometry2::new(Vector2::new(self.pose.x, self.pose.y), self.pose.z)
     }
+}
+
+/// True if the pose, its covariance and both at the reference point `d` ahead are all finite.
+fn state_is_finite(pose: &Vector3<f64>, covariance: &Matrix3<f64>, d: f64) -> bool {
+    if !(pose.iter().all(|v| v.is_finite()) && covariance.iter().all(|v| v.is_finite())) {
+        return false;
+    }
+    // As reference_pose and reference_covariance work them out.
+    let (sin, cos) = pose.z.sin_cos();
+    let reference = [pose.x + d * cos, pose.y + d * sin];
+    let j = Matrix3::new(1.0, 0.0, -d * sin, 0.0, 1.0, d * cos, 0.0, 0.0, 1.0);
+    let reference_covariance = j * covariance * j.transpose();
+    reference
+        .iter()
+        .chain(reference_covariance.iter())
+        .all(|v| v.is_finite())
 }
 
 fn check_offset(reference_offset: f64) -> Result<(), ChassisError> {

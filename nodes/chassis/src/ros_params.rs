@@ -28,8 +28,13 @@ pub fn chassis_param_specs() -> Vec<ParamSpec> {
             "R, centre to wheel [m] (omni)",
         )
         .min(0.0),
-        ParamSpec::double("max_steering", m.max_steering, "mechanical steering limit [rad]")
-            .within(0.0, std::f64::consts::FRAC_PI_2),
+        ParamSpec::double(
+            "max_steering",
+            m.max_steering,
+            "steering limit δ_max of the virtual centre (bicycle) wheel [rad]; on a car_like chassis the inner \
+             Ackermann wheel steers further: for an inner-wheel limit δ_w set atan(L / (L / tan δ_w + B/2))",
+        )
+        .within(0.0, std::f64::consts::FRAC_PI_2),
         ParamSpec::double(
             "min_turning_radius",
             m.min_turning_radius,

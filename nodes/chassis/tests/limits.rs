@@ -1,7 +1,10 @@
 //! Command limits: golden cases and feasibility/idempotence properties.
 
 use approx::{assert_relative_eq, relative_eq};
-use mobil_chassis::{clamp_command, inverse, BodyTwist, ChassisConfig, ChassisParams, ClampReason, ClampReasons};
+use mobil_chassis::kinematics::ackermann_centre_tan;
+use mobil_chassis::{
+    clamp_command, inverse, BodyTwist, ChassisConfig, ChassisParams, ClampReason, ClampReasons, WheelState,
+};
 use nalgebra::Vector3;
 use proptest::prelude::*;
 
@@ -88,6 +91,53 @@ fn curvature_is_clamped_at_fixed_speed() {
     );
     assert_eq!(c.reasons, reasons(&[ClampReason::MinRadius]));
     assert_eq!(c.pre_steer, None);
+}
+
+#[test]
+fn a_binding_steering_limit_bounds_the_virtual_centre_wheel_not_the_inner_one() {
+    // MOBIL-II geometry (L 0.60, B 0.62) with δ_max = 30°: atan(0.60/0.73) = 39.4° > 30°, so
+    // δ_max binds. SPEC §1 reads δ as the model's one (bicycle) angle: δ = 70° on L = 0.60 gives
+    // R = L / tan δ = 0.22 m. v = 0.3 with ω = 1.0 (R = 0.3 m) is clamped to the curvature
+    // tan 30° / 0.6 = 0.962250: ω = 0.3·0.962250 = 0.288675; R = 0.6·√3 = 1.039230.
+    let p = ChassisParams::new(ChassisConfig {
+        max_steering: 30f64.to_radians(),
+        ..ChassisConfig::mobil2()
+    })
+    .unwrap();
+    assert_relative_eq!(p.effective_steering_limit(), 30f64.to_radians(), epsilon = 1e-15);
+    let c = clamp_command(&p, BodyTwist::new(0.3, 0.0, 1.0));
+    assert_relative_eq!(c.twist.wz, 0.288_675_134_594_812_9, epsilon = 1e-12);
+    assert_eq!(c.reasons, reasons(&[ClampReason::MinRadius]));
+    // Ackermann: inner (left) wheel atan(0.6 / (1.039230 − 0.31)) = 39.447°, outer
+    // atan(0.6 / (1.039230 + 0.31)) = 23.975°: the centre wheel sits at δ_max, the inner one
+    // 9.4° beyond it.
+    match inverse(&p, c.twist) {
+        WheelState::CarLike {
+            front_left_steering,
+            front_right_steering,
+            ..
+        } => {
+            assert_relative_eq!(front_left_steering.to_degrees(), 39.447_04, epsilon = 1e-4);
+            assert_relative_eq!(front_right_steering.to_degrees(), 23.974_62, epsilon = 1e-4);
+            let centre = ackermann_centre_tan(0.6, 0.62, front_left_steering, front_right_steering);
+            assert_relative_eq!(centre.atan().to_degrees(), 30.0, epsilon = 1e-9);
+        }
+        other => panic!("{other:?}"),
+    }
+    // The limit for a 30° inner wheel: atan(0.6 / (1.039230 + 0.31)) = 23.975°; with it the
+    // inner wheel lands exactly on 30°.
+    let inner_limited = ChassisParams::new(ChassisConfig {
+        max_steering: (0.6 / (0.6 / 30f64.to_radians().tan() + 0.31)).atan(),
+        ..ChassisConfig::mobil2()
+    })
+    .unwrap();
+    let c = clamp_command(&inner_limited, BodyTwist::new(0.3, 0.0, 1.0));
+    match inverse(&inner_limited, c.twist) {
+        WheelState::CarLike {
+            front_left_steering, ..
+        } => assert_relative_eq!(front_left_steering.to_degrees(), 30.0, epsilon = 1e-9),
+        other => panic!("{other:?}"),
+    }
 }
 
 #[test]

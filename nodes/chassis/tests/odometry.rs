@@ -6,6 +6,7 @@ use approx::assert_relative_eq;
 use mobil_chassis::odometry::integrate_pose;
 use mobil_chassis::{BodyTwist, ChassisError, Odometry, OdometryError, OdometryNoise};
 use nalgebra::{Matrix3, Vector3};
+use proptest::prelude::*;
 
 fn odom() -> Odometry {
     Odometry::new(0.0, OdometryNoise::default()).unwrap()
@@ -200,8 +201,12 @@ fn reset_returns_to_the_origin() {
     o.update_at(BodyTwist::new(0.5, 0.0, 0.3), 2.0).unwrap();
     o.reset();
     assert_eq!(o, odom());
-    o.reset_to(Vector3::new(1.0, 2.0, 4.0));
+    o.reset_to(Vector3::new(1.0, 2.0, 4.0)).unwrap();
     assert_relative_eq!(o.pose(), Vector3::new(1.0, 2.0, 4.0 - 2.0 * PI), epsilon = 1e-15);
+    let before = o.clone();
+    assert!(o.reset_to(Vector3::new(f64::NAN, 0.0, 0.0)).is_err());
+    assert!(o.reset_to(Vector3::new(0.0, f64::INFINITY, 0.0)).is_err());
+    assert_eq!(o, before);
 }
 
 #[test]
@@ -218,4 +223,89 @@ fn bad_noise_or_offset_is_refused() {
         })
     ));
     assert!(Odometry::new(f64::NAN, OdometryNoise::default()).is_err());
+}
+
+#[test]
+fn an_absurd_but_finite_twist_cannot_poison_the_state() {
+    // After 0.5 m straight the heading variance is k_ϑs·0.5 = 5e-5 rad². Then 1e306 m/s for 1 s:
+    // F·P·Fᵀ gets Δx²·5e-5 = 1e612·5e-5, which overflows: refused, nothing changes.
+    let mut o = odom();
+    o.update(BodyTwist::new(0.5, 0.0, 0.0), 1.0).unwrap();
+    assert_relative_eq!(o.covariance()[(2, 2)], 5e-5, epsilon = 1e-18);
+    let before = o.clone();
+    let absurd = BodyTwist::new(1e306, 0.0, 0.0);
+    assert!(matches!(
+        o.update(absurd, 1.0),
+        Err(OdometryError::NonFiniteResult { .. })
+    ));
+    assert_eq!(o, before);
+    // From a fresh start (zero covariance) the same step is representable (x = 1e306 m, variances
+    // k·1e306): the odometry promises finiteness, plausibility is the controller's check. The
+    // next one overflows and is refused.
+    let mut fresh = odom();
+    fresh.update(absurd, 1.0).unwrap();
+    assert_eq!(fresh.pose().x, 1e306);
+    let kept = fresh.clone();
+    assert!(fresh.update(absurd, 1.0).is_err());
+    assert_eq!(fresh, kept);
+    // 1e308 m/s over 10 s overflows the step itself.
+    assert!(matches!(
+        o.update(BodyTwist::new(1e308, 1e308, 0.0), 10.0),
+        Err(OdometryError::NonFiniteResult { .. })
+    ));
+    assert_eq!(o, before);
+}
+
+#[test]
+fn update_over_integrates_an_interval_whatever_the_previous_stamp() {
+    let mut o = odom();
+    o.update_at(BodyTwist::ZERO, 1.0).unwrap();
+    // 0.5 m/s over (1.0, 3.0]: 1 m, then the stamp is 3.0.
+    o.update_over(BodyTwist::new(0.5, 0.0, 0.0), 1.0, 3.0).unwrap();
+    assert_relative_eq!(o.pose(), Vector3::new(1.0, 0.0, 0.0), epsilon = 1e-12);
+    assert_eq!(o.last_stamp(), Some(3.0));
+    // A clock reset: an interval before the last stamp is still a real distance.
+    o.update_over(BodyTwist::new(0.5, 0.0, 0.0), 0.0, 0.2).unwrap();
+    assert_relative_eq!(o.pose(), Vector3::new(1.1, 0.0, 0.0), epsilon = 1e-12);
+    let before = o.clone();
+    assert!(o.update_over(BodyTwist::new(0.5, 0.0, 0.0), 0.2, 0.2).is_err());
+    assert!(o.update_over(BodyTwist::new(0.5, 0.0, 0.0), f64::NAN, 0.3).is_err());
+    assert!(o.update_over(BodyTwist::new(f64::NAN, 0.0, 0.0), 0.2, 0.3).is_err());
+    assert_eq!(o, before);
+}
+
+/// Any f64: mostly ordinary values, but also huge, tiny, infinite and NaN.
+fn any_number() -> impl Strategy<Value = f64> {
+    prop_oneof![
+        4 => -10.0..10.0f64,
+        2 => prop::num::f64::ANY,
+        1 => prop::sample::select(vec![
+            f64::NAN,
+            f64::INFINITY,
+            f64::NEG_INFINITY,
+            f64::MAX,
+            f64::MIN,
+            1e308,
+            -1e308,
+            1e-308,
+            0.0
+        ]),
+    ]
+}
+
+proptest! {
+    #[test]
+    fn no_update_ever_makes_the_odometry_non_finite(
+        d in -1.0..1.0f64,
+        steps in prop::collection::vec((any_number(), any_number(), any_number(), any_number()), 1..30),
+    ) {
+        let mut o = Odometry::new(d, OdometryNoise::default()).unwrap();
+        for (vx, vy, wz, dt) in steps {
+            let _ = o.update(BodyTwist::new(vx, vy, wz), dt);
+            let _ = o.update_at(BodyTwist::new(vx, vy, wz), dt);
+            let finite = |m: &[f64]| m.iter().all(|v| v.is_finite());
+            prop_assert!(finite(o.pose().as_slice()) && finite(o.reference_pose().as_slice()));
+            prop_assert!(finite(o.covariance().as_slice()) && finite(o.reference_covariance().as_slice()));
+        }
+    }
 }

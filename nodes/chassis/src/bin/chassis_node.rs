@@ -1,9 +1,16 @@
 //! `chassis_node`: the LOW-LEVEL of the suite (SPEC §1). `cmd_vel` → limits → inverse kinematics
 //! → `wheel_commands`; `joint_states` → forward kinematics → exact arc odometry → `odom` + `tf`;
 //! a cmd_vel watchdog and a feedback watchdog; `~/status` reports both and every clamp.
+//!
+//! Every `wheel_commands` message is a [`GatedCommand`]: it comes out of the controller's one
+//! safety gate (watchdogs, refused `cmd_vel`, non-finite values), on `cmd_vel`, on the control
+//! tick and at shutdown alike.
 
 use futures::StreamExt;
-use mobil_chassis::controller::{ChassisController, Command, ControllerConfig, FeedbackError, FeedbackOutcome, Safety};
+use mobil_chassis::controller::{
+    ChassisController, ControllerConfig, FeedbackError, FeedbackOutcome, GatedCommand, Safety,
+    DEFAULT_FEEDBACK_SPEED_FACTOR,
+};
 use mobil_chassis::joints::{joints_from_wheel_state, FeedbackDecoder, JointStateError};
 use mobil_chassis::kinematics::BodyTwist;
 use mobil_chassis::model::ChassisModel;
@@ -29,6 +36,7 @@ use tracing::{info, warn};
 #[derive(Debug, Clone, PartialEq)]
 struct NodeConfig {
     controller: ControllerConfig,
+    feedback_speed_factor: f64,
     control_rate_hz: f64,
     odom_frame: String,
     base_frame: String,
@@ -57,6 +65,14 @@ fn decl() -> NodeDecl {
             "zero command after this long without joint_states (0: off)",
         )
         .min(0.0),
+    )
+    .param(
+        ParamSpec::double(
+            "max_feedback_wheel_speed_factor",
+            DEFAULT_FEEDBACK_SPEED_FACTOR,
+            "joint_states wheel speeds above this × max_wheel_speed are refused as impossible (bad encoder data)",
+        )
+        .within(1.0, 100.0),
     )
     .param(ParamSpec::double("control_rate_hz", 50.0, "wheel_commands and status rate").within(1.0, 1000.0))
     .param(ParamSpec::string("odom_frame", "odom", "odometry frame"))
@@ -91,6 +107,7 @@ fn node_config(p: &ParamValues) -> Result<NodeConfig, String> {
             feedback_timeout_s: p.f64("feedback_timeout_s")?,
             noise,
         },
+        feedback_speed_factor: p.f64("max_feedback_wheel_speed_factor")?,
         control_rate_hz: p.f64("control_rate_hz")?,
         odom_frame: p.string("odom_frame")?,
         base_frame: p.string("base_frame")?,
@@ -129,6 +146,7 @@ fn model_code(m: ChassisModel) -> u8 {
 async fn run(node: &mut RosNode) -> anyhow::Result<()> {
     let mut config = node_config(&node.params()).map_err(anyhow::Error::msg)?;
     let mut controller = ChassisController::new(config.controller)?;
+    controller.set_feedback_speed_factor(config.feedback_speed_factor)?;
     info!(
         "model {}, effective steering limit {:.1}°, v_max {} m/s, watchdog {} s",
         config.controller.params.model().as_str(),
@@ -155,8 +173,10 @@ async fn run(node: &mut RosNode) -> anyhow::Result<()> {
     let mut throttle = LogThrottle::default();
     let mut decoder = FeedbackDecoder::default();
     let mut rejected: u64 = 0;
+    // Start-up counts as stopped, so neither stop line is logged before the first command.
     let mut last_safety = Safety {
         cmd_vel_expired: true,
+        cmd_vel_refused: false,
         feedback_stale: true,
     };
     // The watchdogs run on the steady clock: a stalled or reset /clock must not keep the wheels
@@ -170,7 +190,10 @@ async fn run(node: &mut RosNode) -> anyhow::Result<()> {
             Some(changed) = node.param_changed() => {
                 match node_config(&changed) {
                     Ok(new) => {
-                        if let Err(e) = controller.reconfigure(new.controller) {
+                        let applied = controller
+                            .reconfigure(new.controller)
+                            .and_then(|()| controller.set_feedback_speed_factor(new.feedback_speed_factor));
+                        if let Err(e) = applied {
                             warn!("parameter change not applied: {e}");
                         } else {
                             if new.control_rate_hz != config.control_rate_hz {
@@ -186,14 +209,15 @@ async fn run(node: &mut RosNode) -> anyhow::Result<()> {
             Some(msg) = cmds.next() => match msg {
                 Ok((twist, _)) => {
                     let request = BodyTwist::new(twist.linear.x, twist.linear.y, twist.angular.z);
-                    let cmd = controller.on_cmd_vel(request, now_s(node));
+                    let gated = controller.on_cmd_vel(request, now_s(node));
+                    let requested = controller.requested();
                     if !request.is_finite() {
                         rejected += 1;
                         warn_throttled!(throttle, "cmd_nan", "cmd_vel with NaN/inf ({:?}): wheels stopped", request);
-                    } else if !cmd.reasons.is_empty() {
-                        warn_throttled!(throttle, "clamp", "cmd_vel {:?} clamped to {:?}: {}", request, cmd.twist, cmd.reasons);
+                    } else if !requested.reasons.is_empty() {
+                        warn_throttled!(throttle, "clamp", "cmd_vel {:?} clamped to {:?}: {}", request, requested.twist, requested.reasons);
                     }
-                    publish_wheels(&wheel_pub, node, &cmd);
+                    publish_wheels(&wheel_pub, node, &gated);
                 }
                 Err(e) => {
                     rejected += 1;
@@ -211,14 +235,25 @@ async fn run(node: &mut RosNode) -> anyhow::Result<()> {
                     match (parsed, stamp) {
                         // A position-only sample that only set the baseline.
                         (Ok(None), Some(_)) => {}
-                        (Ok(Some(wheels)), Some(stamp)) => match controller.on_feedback(&wheels, stamp, now) {
+                        (Ok(Some(sample)), Some(_)) => match controller.on_feedback_sample(&sample, now) {
                             Ok(outcome) => {
-                                if let FeedbackOutcome::Restarted { gap_s: Some(gap) } = outcome {
-                                    warn_throttled!(
+                                match outcome {
+                                    FeedbackOutcome::Restarted { gap_s: Some(gap) } => warn_throttled!(
                                         throttle,
                                         "feedback_gap",
                                         "joint_states stamps jumped by {gap:.3} s (dropout or clock reset): odometry not integrated across the gap"
-                                    );
+                                    ),
+                                    FeedbackOutcome::Ambiguous { gap_s } => warn_throttled!(
+                                        throttle,
+                                        "feedback_ambiguous",
+                                        "wrapped encoder angles {gap_s:.3} s apart are ambiguous (a wheel may have turned more than π): odometry not integrated across the gap"
+                                    ),
+                                    FeedbackOutcome::Bridged { gap_s } => warn_throttled!(
+                                        throttle,
+                                        "feedback_bridged",
+                                        "joint_states resumed after {gap_s:.3} s: the encoder angles cover the gap, odometry integrated across it"
+                                    ),
+                                    FeedbackOutcome::Integrated | FeedbackOutcome::Restarted { gap_s: None } => {}
                                 }
                                 publish_odometry(&odom_pub, &tf_pub, &config, &controller, stamp_msg);
                             }
@@ -227,6 +262,7 @@ async fn run(node: &mut RosNode) -> anyhow::Result<()> {
                                 let key = match e {
                                     FeedbackError::Kinematics(_) => "feedback_kinematics",
                                     FeedbackError::Odometry(_) => "feedback_time",
+                                    FeedbackError::Implausible { .. } => "feedback_implausible",
                                 };
                                 warn_throttled!(throttle, key, "joint_states dropped: {e}");
                             }
@@ -255,21 +291,21 @@ async fn run(node: &mut RosNode) -> anyhow::Result<()> {
             },
             _ = tick.tick() => {
                 let now = now_s(node);
-                let (cmd, safety) = controller.on_tick(now);
-                if safety != last_safety {
-                    if safety.cmd_vel_expired && !last_safety.cmd_vel_expired {
-                        warn!("no cmd_vel for {} s: wheels stopped", config.controller.cmd_vel_timeout_s);
-                    }
-                    if safety.feedback_stale && !last_safety.feedback_stale {
-                        warn!("no valid joint_states for {} s: odometry stale, wheels stopped", config.controller.feedback_timeout_s);
-                    }
-                    last_safety = safety;
+                let cmd = controller.gate(now);
+                let safety = cmd.safety();
+                // A refused (NaN) cmd_vel stops the wheels too, but was logged as what it is.
+                if safety.cmd_vel_timed_out() && !last_safety.cmd_vel_timed_out() {
+                    warn!("no cmd_vel for {} s: wheels stopped", config.controller.cmd_vel_timeout_s);
                 }
+                if safety.feedback_stale && !last_safety.feedback_stale {
+                    warn!("no valid joint_states for {} s: odometry stale, wheels stopped", config.controller.feedback_timeout_s);
+                }
+                last_safety = safety;
                 publish_wheels(&wheel_pub, node, &cmd);
                 let status = ChassisStatus {
                     header: Header { stamp: node.stamp(), frame_id: config.base_frame.clone() },
                     model: model_code(config.controller.params.model()),
-                    watchdog_expired: safety.cmd_vel_expired,
+                    watchdog_expired: safety.cmd_vel_expired || safety.cmd_vel_refused,
                     feedback_stale: safety.feedback_stale,
                     clamped: cmd.reasons.bits(),
                     commanded: Twist {
@@ -283,12 +319,13 @@ async fn run(node: &mut RosNode) -> anyhow::Result<()> {
         }
     }
     // Leave the wheels stopped.
-    let stop = controller.on_cmd_vel(BodyTwist::ZERO, now_s(node));
+    let stop = controller.stop(now_s(node));
     publish_wheels(&wheel_pub, node, &stop);
     Ok(())
 }
 
-fn publish_wheels(publisher: &ros2_client::Publisher<JointState>, node: &RosNode, cmd: &Command) {
+/// The only way to `wheel_commands`: it takes nothing but the safety gate's output.
+fn publish_wheels(publisher: &ros2_client::Publisher<JointState>, node: &RosNode, cmd: &GatedCommand) {
     let (name, position, velocity) = joints_from_wheel_state(&cmd.wheels);
     let msg = JointState {
         header: Header {
