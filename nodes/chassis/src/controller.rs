@@ -282,6 +282,13 @@ impl ChassisController {
         self.gate(now)
     }
 
+    /// A `cmd_vel` that arrived at `now` (s) but could not be decoded: the sender meant to command
+    /// something the chassis cannot know, so it is refused like a non-finite one — the chassis
+    /// stops at once and the watchdog is not fed.
+    pub fn on_unreadable_cmd_vel(&mut self, now: f64) -> GatedCommand {
+        self.on_cmd_vel(BodyTwist::new(f64::NAN, f64::NAN, f64::NAN), now)
+    }
+
     /// The last `cmd_vel` after the limits, as requested (for logs); what reaches the wheels is
     /// [`ChassisController::gate`]'s.
     pub fn requested(&self) -> &Command {
@@ -736,6 +743,31 @@ mod tests {
         assert_eq!(
             c.on_cmd_vel(BodyTwist::ZERO, 0.62).wheels,
             WheelState::zero(ChassisModel::CarLike)
+        );
+    }
+
+    #[test]
+    fn an_unreadable_cmd_vel_stops_the_wheels_at_once_and_does_not_feed_the_watchdog() {
+        let mut c = controller(ChassisConfig::omr3());
+        feed_feedback(&mut c, 0.0);
+        // 0.2 m/s along x with r = 0.05: Ω = 4·[1, −½, −½].
+        let moving = c.on_cmd_vel(BodyTwist::new(0.2, 0.0, 0.0), 0.0);
+        assert_eq!(
+            moving.wheels,
+            WheelState::Omni {
+                wheels: [4.0, -2.0, -2.0]
+            }
+        );
+        let refused = c.on_unreadable_cmd_vel(0.1);
+        assert!(is_zero_omni(&refused));
+        assert!(refused.safety().cmd_vel_refused);
+        feed_feedback(&mut c, 0.2);
+        assert!(is_zero_omni(&c.gate(0.2)), "the stop lasts until the next good cmd_vel");
+        assert_eq!(
+            c.on_cmd_vel(BodyTwist::new(0.2, 0.0, 0.0), 0.3).wheels,
+            WheelState::Omni {
+                wheels: [4.0, -2.0, -2.0]
+            }
         );
     }
 

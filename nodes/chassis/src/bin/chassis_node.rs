@@ -221,7 +221,9 @@ async fn run(node: &mut RosNode) -> anyhow::Result<()> {
                 }
                 Err(e) => {
                     rejected += 1;
-                    warn_throttled!(throttle, "cmd_decode", "undecodable cmd_vel dropped: {e:?}");
+                    warn_throttled!(throttle, "cmd_decode", "undecodable cmd_vel: wheels stopped ({e:?})");
+                    let gated = controller.on_unreadable_cmd_vel(now_s(node));
+                    publish_wheels(&wheel_pub, node, &gated);
                 }
             },
             Some(msg) = joints.next() => match msg {
