@@ -1664,13 +1664,16 @@ impl Writer {
   ) {
     let first_keeper = if !self.like_stateless {
       // Regular stateful writer behavior
-      // All readers have acked up to this point (SequenceNumber)
+      // All reliable readers have acked up to this point (SequenceNumber).
+      // Best-effort readers never acknowledge, and with no reliable reader
+      // nothing awaits acknowledgement, so only History depth keeps samples.
       let acked_by_all_readers = self
         .readers
         .values()
+        .filter(|rp| rp.qos().is_reliable())
         .map(RtpsReaderProxy::acked_up_to_before)
         .min()
-        .unwrap_or_else(SequenceNumber::zero);
+        .unwrap_or_else(|| self.send_buffer.last_change_sequence_number().plus_1());
       // If all readers have acked all up to before 5, and depth is 5, we need
       // to keep samples 0..4, i.e. from acked_up_to_before - depth .
       let depth_keeper = if let Some(depth) = depth {
@@ -3102,6 +3105,68 @@ mod tests {
         .map(|&sn| i64::from(sn))
         .collect();
       assert_eq!(gap, (9..=18).collect::<Vec<_>>());
+    }
+
+    // Cache cleaning of a TransientLocal KeepLast { depth: 2 } writer holding
+    // 20 samples: once no reliable reader awaits them, it keeps the last 2
+    // (19 and 20), whether the reader left or only a best-effort one matched.
+    #[test]
+    fn cache_cleaning_keeps_depth_without_reliable_readers() {
+      let writer_qos = QosPolicyBuilder::new()
+        .reliability(Reliability::Reliable {
+          max_blocking_time: Duration::from_millis(100),
+        })
+        .history(History::KeepLast { depth: 2 })
+        .durability(Durability::TransientLocal)
+        .build();
+      let best_effort_reader_qos = QosPolicyBuilder::new()
+        .reliability(Reliability::BestEffort)
+        .durability(Durability::TransientLocal)
+        .build();
+      let writer_id = EntityId::new([0, 0, 1], EntityKind::WRITER_NO_KEY_USER_DEFINED);
+      let reader_id = EntityId::new([0, 0, 2], EntityKind::READER_NO_KEY_USER_DEFINED);
+
+      let mut reader_left = Fixture::new(
+        writer_id,
+        writer_qos.clone(),
+        reader_id,
+        &writer_qos,
+        20,
+        8,
+        None,
+      );
+      let reader_guid = reader_left.reader_guid;
+      reader_left.writer.reader_lost(reader_guid);
+      let mut best_effort = Fixture::new(
+        writer_id,
+        writer_qos.clone(),
+        reader_id,
+        &best_effort_reader_qos,
+        20,
+        8,
+        None,
+      );
+      for f in [&mut reader_left, &mut best_effort] {
+        f.writer.handle_cache_cleaning();
+        assert_eq!(f.writer.send_buffer.retained_len(), 2);
+        assert_eq!(
+          f.writer.send_buffer.first_change_sequence_number(),
+          SequenceNumber::new(19)
+        );
+      }
+
+      // A reliable reader that has acknowledged nothing keeps everything.
+      let mut unacked = Fixture::new(
+        writer_id,
+        writer_qos.clone(),
+        reader_id,
+        &writer_qos,
+        20,
+        8,
+        None,
+      );
+      unacked.writer.handle_cache_cleaning();
+      assert_eq!(unacked.writer.send_buffer.retained_len(), 20);
     }
 
     // Built-in and user Writers alike answer an ACKNACK only after
