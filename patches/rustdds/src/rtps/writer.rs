@@ -44,9 +44,9 @@ use crate::{
     cache_change::CacheChange,
     duration::Duration,
     entity::RTPSEntity,
-    guid::{EntityId, GuidPrefix, GUID},
+    guid::{EntityId, EntityKind, GuidPrefix, GUID},
     locator::Locator,
-    sequence_number::{FragmentNumber, SequenceNumber},
+    sequence_number::{FragmentNumber, SequenceNumber, SequenceNumberRange},
     time::Timestamp,
   },
 };
@@ -1664,13 +1664,16 @@ impl Writer {
   ) {
     let first_keeper = if !self.like_stateless {
       // Regular stateful writer behavior
-      // All readers have acked up to this point (SequenceNumber)
+      // All reliable readers have acked up to this point (SequenceNumber).
+      // Best-effort readers never acknowledge, and with no reliable reader
+      // nothing awaits acknowledgement, so only History depth keeps samples.
       let acked_by_all_readers = self
         .readers
         .values()
+        .filter(|rp| rp.qos().is_reliable())
         .map(RtpsReaderProxy::acked_up_to_before)
         .min()
-        .unwrap_or_else(SequenceNumber::zero);
+        .unwrap_or_else(|| self.send_buffer.last_change_sequence_number().plus_1());
       // If all readers have acked all up to before 5, and depth is 5, we need
       // to keep samples 0..4, i.e. from acked_up_to_before - depth .
       let depth_keeper = if let Some(depth) = depth {
@@ -2073,6 +2076,7 @@ impl Writer {
   // return value: true = reader was new, false = reader was previously known
   fn matched_reader_update(&mut self, updated_reader_proxy: &RtpsReaderProxy) -> bool {
     let mut is_new = false;
+    let late_joiner_gap = self.late_joiner_gap();
     let is_volatile = self.qos().is_volatile(); // Get this in advance to work with the borrow checker
                                                 // Capture the interface set once; resolution consults current observations.
     let multicast_ifaces = self.udp_sender.multicast_interfaces();
@@ -2102,6 +2106,12 @@ impl Writer {
           // before matching with this reader. Therefore we set the reader as pending GAP
           // for all existing sequence numbers
           new_proxy.set_pending_gap_up_to(self.send_buffer.last_change_sequence_number());
+        } else if let Some(irrelevant_sns) = late_joiner_gap {
+          // A durable KeepLast writer owes a late joiner only its last `depth`
+          // samples: the older ones it still holds are irrelevant to this reader.
+          for sn in irrelevant_sns {
+            new_proxy.insert_pending_gap(sn);
+          }
         }
         new_proxy.resolve_send_route(
           &self.interface_observations.borrow(),
@@ -2115,6 +2125,33 @@ impl Writer {
     // minimum datagram budget used for packing.
     self.recompute_min_datagram_payload();
     is_new
+  }
+
+  /// For a durable (non-VOLATILE) writer with History `KeepLast { depth }`:
+  /// the retained samples a newly matched reader is not to receive, so that it
+  /// gets only the `depth` latest ones (DDS v1.4, DURABILITY and HISTORY QoS).
+  /// The send buffer may hold more than `depth` samples: it retains samples not
+  /// yet acknowledged by every reliable reader, and evicts acknowledged ones
+  /// only on the periodic cache cleaning. Older, evicted samples are below the
+  /// first_sn of our HEARTBEATs already.
+  ///
+  /// `depth` counts samples per instance, and the send buffer does not know
+  /// instances, so this applies only to user writers of topics without a key,
+  /// where the whole history is one instance.
+  fn late_joiner_gap(&self) -> Option<SequenceNumberRange> {
+    if self.qos().is_volatile()
+      || self.my_guid.entity_id.kind() != EntityKind::WRITER_NO_KEY_USER_DEFINED
+    {
+      return None;
+    }
+    match self.qos_policies.history {
+      Some(History::KeepLast { depth }) => Some(SequenceNumberRange::new(
+        self.send_buffer.first_change_sequence_number(),
+        self.send_buffer.last_change_sequence_number()
+          - SequenceNumber::from(i64::from(depth.max(1))),
+      )),
+      _ => None,
+    }
   }
 
   /// Recompute [`min_datagram_payload`](Self::min_datagram_payload) as the
@@ -2946,6 +2983,190 @@ mod tests {
         self.writer.handle_timed_event(event);
         before - self.unsent()
       }
+    }
+
+    // A reader that matches a writer holding 20 samples: which of them it is
+    // told are irrelevant (GAP), by the writer's durability, history and kind.
+    fn pending_gap_of_late_joiner(
+      writer_kind: EntityKind,
+      durability: Durability,
+      history: History,
+    ) -> Vec<i64> {
+      let qos = QosPolicyBuilder::new()
+        .reliability(Reliability::Reliable {
+          max_blocking_time: Duration::from_millis(100),
+        })
+        .history(history)
+        .durability(durability)
+        .build();
+      let reader_kind = if writer_kind == EntityKind::WRITER_NO_KEY_USER_DEFINED {
+        EntityKind::READER_NO_KEY_USER_DEFINED
+      } else {
+        EntityKind::READER_WITH_KEY_USER_DEFINED
+      };
+      let f = Fixture::new(
+        EntityId::new([0, 0, 1], writer_kind),
+        qos.clone(),
+        EntityId::new([0, 0, 2], reader_kind),
+        &qos,
+        20,
+        8,
+        None,
+      );
+      f.reader_proxy()
+        .get_pending_gap()
+        .iter()
+        .map(|&sn| i64::from(sn))
+        .collect()
+    }
+
+    // A late joiner of a TransientLocal KeepLast { depth } writer of a topic
+    // without a key gets the last `depth` samples (20 - depth + 1 ..= 20) and a
+    // GAP for the older ones, which the writer may still hold.
+    #[test]
+    fn late_joiner_of_durable_keep_last_writer_gets_last_depth_samples() {
+      let no_key = EntityKind::WRITER_NO_KEY_USER_DEFINED;
+      let transient_local = Durability::TransientLocal;
+      assert_eq!(
+        pending_gap_of_late_joiner(no_key, transient_local, History::KeepLast { depth: 1 }),
+        (1..=19).collect::<Vec<_>>()
+      );
+      assert_eq!(
+        pending_gap_of_late_joiner(no_key, transient_local, History::KeepLast { depth: 3 }),
+        (1..=17).collect::<Vec<_>>()
+      );
+      // Depth at or above what was written: everything is owed.
+      assert!(
+        pending_gap_of_late_joiner(no_key, transient_local, History::KeepLast { depth: 20 })
+          .is_empty()
+      );
+      assert!(pending_gap_of_late_joiner(no_key, transient_local, History::KeepAll).is_empty());
+      // Volatile: nothing from before the match.
+      assert_eq!(
+        pending_gap_of_late_joiner(no_key, Durability::Volatile, History::KeepLast { depth: 1 }),
+        (1..=20).collect::<Vec<_>>()
+      );
+      // With a key, depth counts per instance, which the send buffer does not
+      // track: every retained sample is owed, as before.
+      assert!(pending_gap_of_late_joiner(
+        EntityKind::WRITER_WITH_KEY_USER_DEFINED,
+        transient_local,
+        History::KeepLast { depth: 1 }
+      )
+      .is_empty());
+    }
+
+    // Samples the writer no longer holds are below the first_sn of its
+    // HEARTBEATs and need no GAP of their own: with depth 2 and 20 samples, of
+    // which cache cleaning evicted 1..=8 (the reader acked up to 10, and 9 and
+    // 10 stay as the depth behind it), a new reader gets GAP 9..=18.
+    #[test]
+    fn late_joiner_gap_covers_only_retained_samples() {
+      let qos = QosPolicyBuilder::new()
+        .reliability(Reliability::Reliable {
+          max_blocking_time: Duration::from_millis(100),
+        })
+        .history(History::KeepLast { depth: 2 })
+        .durability(Durability::TransientLocal)
+        .build();
+      let reader_id = EntityId::new([0, 0, 2], EntityKind::READER_NO_KEY_USER_DEFINED);
+      let mut f = Fixture::new(
+        EntityId::new([0, 0, 1], EntityKind::WRITER_NO_KEY_USER_DEFINED),
+        qos.clone(),
+        reader_id,
+        &qos,
+        20,
+        8,
+        None,
+      );
+      let ack_nack = AckNack {
+        reader_id,
+        writer_id: f.writer.my_guid.entity_id,
+        reader_sn_state: SequenceNumberSet::from_base_and_set(
+          SequenceNumber::new(11),
+          &BTreeSet::new(),
+        ),
+        count: 1,
+      };
+      f.writer
+        .handle_ack_nack(f.reader_guid.prefix, &AckSubmessage::AckNack(ack_nack));
+      f.writer.handle_cache_cleaning();
+      assert_eq!(
+        f.writer.send_buffer.first_change_sequence_number(),
+        SequenceNumber::new(9)
+      );
+
+      let late_guid = GUID::new(GuidPrefix::new(&[3; 12]), reader_id);
+      f.writer
+        .update_reader_proxy(&RtpsReaderProxy::new(late_guid, qos.clone(), false), &qos);
+      let gap: Vec<i64> = f.writer.readers[&late_guid]
+        .get_pending_gap()
+        .iter()
+        .map(|&sn| i64::from(sn))
+        .collect();
+      assert_eq!(gap, (9..=18).collect::<Vec<_>>());
+    }
+
+    // Cache cleaning of a TransientLocal KeepLast { depth: 2 } writer holding
+    // 20 samples: once no reliable reader awaits them, it keeps the last 2
+    // (19 and 20), whether the reader left or only a best-effort one matched.
+    #[test]
+    fn cache_cleaning_keeps_depth_without_reliable_readers() {
+      let writer_qos = QosPolicyBuilder::new()
+        .reliability(Reliability::Reliable {
+          max_blocking_time: Duration::from_millis(100),
+        })
+        .history(History::KeepLast { depth: 2 })
+        .durability(Durability::TransientLocal)
+        .build();
+      let best_effort_reader_qos = QosPolicyBuilder::new()
+        .reliability(Reliability::BestEffort)
+        .durability(Durability::TransientLocal)
+        .build();
+      let writer_id = EntityId::new([0, 0, 1], EntityKind::WRITER_NO_KEY_USER_DEFINED);
+      let reader_id = EntityId::new([0, 0, 2], EntityKind::READER_NO_KEY_USER_DEFINED);
+
+      let mut reader_left = Fixture::new(
+        writer_id,
+        writer_qos.clone(),
+        reader_id,
+        &writer_qos,
+        20,
+        8,
+        None,
+      );
+      let reader_guid = reader_left.reader_guid;
+      reader_left.writer.reader_lost(reader_guid);
+      let mut best_effort = Fixture::new(
+        writer_id,
+        writer_qos.clone(),
+        reader_id,
+        &best_effort_reader_qos,
+        20,
+        8,
+        None,
+      );
+      for f in [&mut reader_left, &mut best_effort] {
+        f.writer.handle_cache_cleaning();
+        assert_eq!(f.writer.send_buffer.retained_len(), 2);
+        assert_eq!(
+          f.writer.send_buffer.first_change_sequence_number(),
+          SequenceNumber::new(19)
+        );
+      }
+
+      // A reliable reader that has acknowledged nothing keeps everything.
+      let mut unacked = Fixture::new(
+        writer_id,
+        writer_qos.clone(),
+        reader_id,
+        &writer_qos,
+        20,
+        8,
+        None,
+      );
+      unacked.writer.handle_cache_cleaning();
+      assert_eq!(unacked.writer.send_buffer.retained_len(), 20);
     }
 
     // Built-in and user Writers alike answer an ACKNACK only after
