@@ -690,19 +690,20 @@ mod tests {
         // Toe-out: δ_l = +10°, δ_r = −10°, both rear wheels at 0.4 m/s. By symmetry vy = ω = 0;
         // least squares over 2·(vx − 0.4)² + 2·(sin 10°·vx)² gives vx = 0.4 / (1 + s²), and the
         // residual is 0.4·s·sqrt(2 / (1 + s²)), s = sin 10° = 0.173648:
-        // s² = 0.0301537, vx = 0.4 / 1.0301537 = 0.3882916 m/s,
-        // residual = 0.4 · 0.1736482 · sqrt(2 / 1.0301537) = 0.0967820 m/s.
+        // s² = 0.030153690, vx = 0.4 / 1.030153690 = 0.388291576 m/s,
+        // residual = 0.4 · 0.173648178 · sqrt(2 / 1.030153690) = 0.069459271 · 1.393362
+        // = 0.096781914 m/s.
         let toe_out = [10f64.to_radians(), -10f64.to_radians(), 4.0, 4.0];
         let s = twist_of(&params, &toe_out);
-        assert_relative_eq!(s.twist.vx, 0.388_291_6, epsilon = 1e-7);
+        assert_relative_eq!(s.twist.vx, 0.388_291_576, epsilon = 1e-9);
         assert!(s.twist.vy.abs() < 1e-12 && s.twist.wz.abs() < 1e-12, "{:?}", s.twist);
-        assert_relative_eq!(s.slip_residual, 0.096_782_0, epsilon = 1e-7);
+        assert_relative_eq!(s.slip_residual, 0.096_781_914, epsilon = 1e-9);
         // The plant reports the same slip while it drives on them.
         let mut p = plant_with(params, 0.0, 0.0, 0.3);
         p.command(&WheelState::from_values(ChassisModel::CarLike, &toe_out).unwrap())
             .unwrap();
         p.step(0.01, &empty());
-        assert_relative_eq!(p.slip_residual(), 0.096_782_0, epsilon = 1e-7);
+        assert_relative_eq!(p.slip_residual(), 0.096_781_914, epsilon = 1e-9);
         assert_relative_eq!(p.reference_pose().x, 0.003_882_916, epsilon = 1e-9);
     }
 
