@@ -447,7 +447,7 @@ impl Plant {
         let d = self.config.params.reference_offset();
         let (mut mid_buffer, mut end_buffer) = ([0.0; MAX_JOINTS], [0.0; MAX_JOINTS]);
         let (mid, end) = (&mut mid_buffer[..n], &mut end_buffer[..n]);
-        for _ in 0..substeps {
+        for done in 0..substeps {
             self.joints_after(&self.actual, 0.5 * h, mid);
             self.joints_after(&self.actual, h, end);
             let t0 = if self.twist_joints == self.actual {
@@ -471,6 +471,15 @@ impl Plant {
             if !finite || world.collides(Point2::new(reference.x, reference.y), self.config.robot_radius) {
                 self.collided |= finite;
                 self.slip_residual = 0.0;
+                // The pose stays where it is for the rest of the step, but the motors keep
+                // moving toward their commands over the sub-steps left (the lag is exact, so one
+                // jump covers them all): a steering motor still settles against a wall.
+                let remaining = (substeps - done - 1) as f64 * h;
+                if remaining > 0.0 {
+                    end.copy_from_slice(&self.actual[..n]);
+                    self.joints_after(end, remaining, mid);
+                    self.actual[..n].copy_from_slice(mid);
+                }
                 // Stalled against the obstacle: the wheels stop too.
                 for (actual, joint) in self.actual.iter_mut().zip(joints) {
                     if joint.kind == JointKind::Wheel {
@@ -861,6 +870,35 @@ mod tests {
             p.step(dt, &world);
             assert_eq!(p.reference_pose().x, x);
         }
+    }
+
+    #[test]
+    fn steering_keeps_settling_while_the_robot_stands_at_a_wall() {
+        // The tricycle (radius 0.3) starts 10 µm short of a wall at x = 0.30001 and is told to
+        // steer to 30° and drive at 5 rad/s, with τ = 0.1 s. Its first 5 ms sub-step already
+        // moves it about 6·10⁻⁵ m ahead, into the wall, so it stays at the origin; the steering
+        // motor keeps turning for the whole step all the same: after one 0.1 s step it is at
+        // 30°·(1 − e⁻¹) = 18.9636° (0.3309776 rad), not at the 30°·(1 − e^(−0.05)) = 1.46° of
+        // the first sub-step; after a second step, 30°·(1 − e⁻²) = 25.9399° (0.4527374 rad).
+        let world = World {
+            obstacles: vec![Obstacle::Polygon {
+                points: vec![[0.30001, -5.0], [0.4, -5.0], [0.4, 5.0], [0.30001, 5.0]],
+            }],
+        };
+        let mut p = plant_with(ChassisParams::tricycle(), 0.1, 0.0, 0.3);
+        let command = WheelState::from_values(ChassisModel::Tricycle, &[30f64.to_radians(), 5.0]).unwrap();
+        p.command(&command).unwrap();
+        p.step(0.1, &world);
+        assert!(p.collided());
+        assert_eq!(p.reference_pose(), Vector3::zeros());
+        assert_relative_eq!(p.feedback().positions[0], 0.330_977_551, epsilon = 1e-9);
+        // Stalled: the wheel stands, and the body with it.
+        assert_eq!(p.feedback().velocities[1], 0.0);
+        assert_eq!(p.reference_twist(), BodyTwist::ZERO);
+        p.command(&command).unwrap();
+        p.step(0.1, &world);
+        assert_eq!(p.reference_pose(), Vector3::zeros());
+        assert_relative_eq!(p.feedback().positions[0], 0.452_737_387, epsilon = 1e-9);
     }
 
     proptest::proptest! {
