@@ -76,13 +76,15 @@ fn drive(config: ChassisConfig, slip: f64, tau: f64, route: &[(f64, f64, f64)], 
         for _ in 0..steps {
             let t = step as f64 * dt;
             if step.is_multiple_of(4) {
-                // 50 Hz: cmd_vel, wheel_commands, joint_states.
-                let cmd = controller.on_cmd_vel(BodyTwist::new(v, 0.0, w), t);
-                plant.command(&cmd.wheels).unwrap();
+                // 50 Hz: joint_states, cmd_vel, wheel_commands. The feedback comes first, as
+                // from a robot whose encoders report before anyone drives it: the controller
+                // turns no wheel before its first feedback.
                 let fb = plant.feedback();
                 let wheels = wheel_state_from_joints(params.model(), &fb.names, &fb.positions, &fb.velocities).unwrap();
                 controller.on_feedback(&wheels, t, t).unwrap();
                 odometry.update_at(model(&params, &wheels), t).unwrap();
+                let cmd = controller.on_cmd_vel(BodyTwist::new(v, 0.0, w), t);
+                plant.command(&cmd.wheels).unwrap();
                 let truth = plant.reference_pose();
                 controller_error = controller_error.max(error(truth, controller.odometry().reference_pose()));
                 model_error = model_error.max(error(truth, odometry.reference_pose()));
