@@ -118,9 +118,10 @@ fn omni_without_two_thirds(params: &ChassisParams, wheels: &WheelState) -> BodyT
     BodyTwist::new(1.5 * t.vx, 1.5 * t.vy, t.wz)
 }
 
-/// Any model reading 1 % fast.
+/// Any model whose translation reads 1 % fast while its heading stays right.
 fn one_percent_fast(params: &ChassisParams, wheels: &WheelState) -> BodyTwist {
-    forward(params, wheels).unwrap().scaled(1.01)
+    let t = forward(params, wheels).unwrap();
+    BodyTwist::new(1.01 * t.vx, 1.01 * t.vy, t.wz)
 }
 
 fn loop_route() -> Vec<(f64, f64, f64)> {
@@ -231,9 +232,14 @@ fn with_motor_lag_odometry_stays_close_and_steering_transients_slip() {
 
 #[test]
 fn the_comparison_catches_a_wrong_forward_model() {
+    // The loop at the kinematic origin: 2 m ahead, a quarter turn of radius 1 about (2, 1),
+    // 1 m up, a quarter turn about (2, 2), 2 m back, one about (0, 2), 1 m down, one about
+    // (0, 1) home; a 4 m × 3 m loop whose farthest point from the start is on the turn about
+    // (2, 2), |(2, 2)| + 1 = 2.8284 + 1 = 3.8284 m away.
+    //
     // Without the 2/3 every translation reads 1.5× too long while the heading stays right: the
-    // odometry's loop is the true one scaled by 1.5 about the start. At the far corner of the
-    // 4 m × 3 m loop, about 4.3 m from the start, that is 0.5·4.3 ≈ 2 m off, not 0.1 %.
+    // odometry's loop is the true one scaled by 1.5 about the start, so it is off by 0.5·3.8284
+    // = 1.914 m at that point, not 0.1 %.
     for tau in [0.0, 0.05] {
         let wrong = drive(ChassisConfig::omr3(), 0.0, tau, &loop_route(), omni_without_two_thirds);
         assert!(
@@ -241,10 +247,16 @@ fn the_comparison_catches_a_wrong_forward_model() {
             "{}",
             wrong.model_error
         );
-        assert!(wrong.model_error > 1.5, "{}", wrong.model_error);
+        assert!(
+            wrong.model_error > 1.90 && wrong.model_error < 1.92,
+            "{}",
+            wrong.model_error
+        );
     }
-    // A 1 % scale error is caught too, on every chassis (about 1 % of 4.3 m, 4 cm, against a
-    // tolerance of 1.2 cm); the right model in the same loop passes.
+    // A translation 1 % fast is caught too, on every chassis: 1 % of 3.8284 m is 3.83 cm,
+    // against a tolerance of 0.1 % of the 12.3 m (12.6 m) driven, 1.2 cm (1.3 cm); the right
+    // model in the same loop passes. (The loop is driven at the kinematic origin on every
+    // chassis, and with the heading right the reference point is off by as much as the origin.)
     for config in configs() {
         let run = drive(config, 0.0, 0.0, &loop_route(), one_percent_fast);
         assert!(
@@ -253,7 +265,12 @@ fn the_comparison_catches_a_wrong_forward_model() {
             config.model,
             run.model_error
         );
-        assert!(run.model_error > 0.03, "{:?}: {}", config.model, run.model_error);
+        assert!(
+            run.model_error > 0.0375 && run.model_error < 0.0390,
+            "{:?}: {}",
+            config.model,
+            run.model_error
+        );
         assert!(
             within_tolerance(run.controller_error, run.distance),
             "{:?}",
