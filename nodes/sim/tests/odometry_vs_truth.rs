@@ -3,7 +3,9 @@
 //! the wheel constraints), not by the chassis' `forward`, so this comparison can catch a wrong
 //! forward model: without noise the chassis odometry must stay within 0.1 % of the distance
 //! driven from the truth at every feedback sample along the route, and a deliberately wrong
-//! model fed the same feedback must not; with encoder slip the odometry must drift by the slip.
+//! model fed the same feedback must not, even when the wheels are commanded by that model's own
+//! inverse (so that its odometry agrees with the command); with encoder slip the odometry must
+//! drift by the slip.
 //!
 //! The error is watched along the route, not only at its end: the test loop is closed, so a
 //! model that scales every length by the same factor would end exactly where the truth does.
@@ -11,13 +13,16 @@
 use mobil_chassis::controller::{ChassisController, ControllerConfig};
 use mobil_chassis::joints::wheel_state_from_joints;
 use mobil_chassis::{
-    forward, BodyTwist, ChassisConfig, ChassisModel, ChassisParams, Odometry, OdometryNoise, WheelState,
+    forward, inverse, BodyTwist, ChassisConfig, ChassisModel, ChassisParams, Odometry, OdometryNoise, WheelState,
 };
 use mobil_sim::plant::{Plant, PlantConfig};
 use mobil_sim::world::World;
 
 /// A forward model: the twist at the kinematic origin from measured wheels.
 type ForwardModel = fn(&ChassisParams, &WheelState) -> BodyTwist;
+
+/// An inverse model: the wheel commands for a twist at the kinematic origin.
+type InverseModel = fn(&ChassisParams, BodyTwist) -> WheelState;
 
 /// The result of one drive.
 struct Run {
@@ -34,6 +39,10 @@ struct Run {
     max_slip: f64,
     /// Slip residual of the plant's wheels at the end, at rest (m/s).
     final_slip: f64,
+    /// Largest distance (m) of the true reference point from its start, at the feedback samples.
+    truth_farthest: f64,
+    /// The same for the odometry of the model under test.
+    model_farthest: f64,
 }
 
 /// The comparison every noise-free odometry is held to: never farther from the truth than
@@ -46,6 +55,20 @@ fn within_tolerance(error: f64, distance: f64) -> bool {
 /// `tau` (s), and integrates a second odometry with `model` from the same feedback samples at
 /// the same stamps.
 fn drive(config: ChassisConfig, slip: f64, tau: f64, route: &[(f64, f64, f64)], model: ForwardModel) -> Run {
+    drive_commanded(config, slip, tau, route, model, None)
+}
+
+/// As [`drive`], but with the wheels commanded by `command` instead of the chassis controller
+/// (which still receives every `cmd_vel` and the feedback, and keeps its own odometry), when
+/// given.
+fn drive_commanded(
+    config: ChassisConfig,
+    slip: f64,
+    tau: f64,
+    route: &[(f64, f64, f64)],
+    model: ForwardModel,
+    command: Option<InverseModel>,
+) -> Run {
     let params = ChassisParams::new(config).unwrap();
     let mut controller = ChassisController::new(ControllerConfig {
         params,
@@ -70,6 +93,8 @@ fn drive(config: ChassisConfig, slip: f64, tau: f64, route: &[(f64, f64, f64)], 
     let mut last = plant.reference_pose();
     let mut step = 0u64;
     let (mut controller_error, mut model_error, mut max_slip) = (0.0f64, 0.0f64, 0.0f64);
+    let (mut truth_farthest, mut model_farthest) = (0.0f64, 0.0f64);
+    let start = plant.reference_pose();
     let error = |truth: nalgebra::Vector3<f64>, q: nalgebra::Vector3<f64>| (truth.x - q.x).hypot(truth.y - q.y);
     for &(v, w, duration) in route.iter().chain([(0.0, 0.0, 1.0)].iter()) {
         let steps = (duration / dt).round() as u64;
@@ -83,11 +108,17 @@ fn drive(config: ChassisConfig, slip: f64, tau: f64, route: &[(f64, f64, f64)], 
                 let wheels = wheel_state_from_joints(params.model(), &fb.names, &fb.positions, &fb.velocities).unwrap();
                 controller.on_feedback(&wheels, t, t).unwrap();
                 odometry.update_at(model(&params, &wheels), t).unwrap();
-                let cmd = controller.on_cmd_vel(BodyTwist::new(v, 0.0, w), t);
-                plant.command(&cmd.wheels).unwrap();
+                let twist = BodyTwist::new(v, 0.0, w);
+                let cmd = controller.on_cmd_vel(twist, t);
+                match command {
+                    Some(inverse) => plant.command(&inverse(&params, twist)).unwrap(),
+                    None => plant.command(&cmd.wheels).unwrap(),
+                };
                 let truth = plant.reference_pose();
                 controller_error = controller_error.max(error(truth, controller.odometry().reference_pose()));
                 model_error = model_error.max(error(truth, odometry.reference_pose()));
+                truth_farthest = truth_farthest.max(error(truth, start));
+                model_farthest = model_farthest.max(error(odometry.reference_pose(), start));
             }
             plant.step(dt, &world);
             max_slip = max_slip.max(plant.slip_residual());
@@ -104,6 +135,8 @@ fn drive(config: ChassisConfig, slip: f64, tau: f64, route: &[(f64, f64, f64)], 
         controller_final_error: error(plant.reference_pose(), controller.odometry().reference_pose()),
         max_slip,
         final_slip: plant.slip_residual(),
+        truth_farthest,
+        model_farthest,
     }
 }
 
@@ -116,6 +149,12 @@ fn chassis_forward(params: &ChassisParams, wheels: &WheelState) -> BodyTwist {
 fn omni_without_two_thirds(params: &ChassisParams, wheels: &WheelState) -> BodyTwist {
     let t = forward(params, wheels).unwrap();
     BodyTwist::new(1.5 * t.vx, 1.5 * t.vy, t.wz)
+}
+
+/// The inverse that matches [`omni_without_two_thirds`] exactly: the wheels turn for a translation
+/// only ⅔ as fast as they should, so that model reads back exactly the commanded twist.
+fn omni_inverse_without_two_thirds(params: &ChassisParams, twist: BodyTwist) -> WheelState {
+    inverse(params, BodyTwist::new(twist.vx / 1.5, twist.vy / 1.5, twist.wz))
 }
 
 /// Any model whose translation reads 1 % fast while its heading stays right.
@@ -275,6 +314,54 @@ fn the_comparison_catches_a_wrong_forward_model() {
             within_tolerance(run.controller_error, run.distance),
             "{:?}",
             config.model
+        );
+    }
+}
+
+#[test]
+fn the_truth_does_not_follow_a_wrong_but_self_consistent_chassis() {
+    // A chassis whose forward model lacks the 2/3 and whose inverse is its exact inverse: the
+    // wheels turn for a translation ⅔ as fast as they must, and the odometry, reading them with
+    // the matching wrong forward model, sees exactly the commanded loop. A plant that moved the
+    // body by the chassis' own kinematics would agree with it; the plant's wheel model does not.
+    //
+    // By hand: the body translates at ⅔·0.4 = 0.2667 m/s and turns at the commanded 0.4 rad/s
+    // (the omni wheels' rotation term R·ω is right), so it drives the commanded loop scaled by
+    // ⅔ about the start: straights of 4/3 and 2/3 m, turns of radius 2/3 m, a length of
+    // ⅔·(6 + 2π) = 4 + 4.1888 = 8.1888 m, its farthest point ⅔·3.8284 = 2.5523 m from the
+    // start. The odometry's loop is the commanded one, its farthest point 3.8284 m out, and the
+    // two are off by ⅓·3.8284 = 1.2761 m there.
+    for tau in [0.0, 0.05] {
+        let run = drive_commanded(
+            ChassisConfig::omr3(),
+            0.0,
+            tau,
+            &loop_route(),
+            omni_without_two_thirds,
+            Some(omni_inverse_without_two_thirds),
+        );
+        assert!(
+            (run.model_farthest - 3.8284).abs() < 0.01,
+            "{tau}: {}",
+            run.model_farthest
+        );
+        assert!(
+            (run.truth_farthest - 2.5523).abs() < 0.01,
+            "{tau}: {}",
+            run.truth_farthest
+        );
+        assert!((run.distance - 8.1888).abs() < 0.01, "{tau}: {}", run.distance);
+        assert!(
+            run.model_error > 1.26 && run.model_error < 1.29,
+            "{tau}: {}",
+            run.model_error
+        );
+        assert!(!within_tolerance(run.model_error, run.distance));
+        // The right model, fed the same wheels, follows the truth.
+        assert!(
+            within_tolerance(run.controller_error, run.distance),
+            "{tau}: {}",
+            run.controller_error
         );
     }
 }
