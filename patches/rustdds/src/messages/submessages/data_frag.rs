@@ -303,10 +303,10 @@ impl<C: Context> Writable<C> for DataFrag {
     writer.write_value(&self.data_size)?;
     // Write the ParameterList itself, not the Option: speedy would prefix an
     // Option with a one-byte tag, which is not part of the RTPS wire format.
+    // An empty list is still written (as its sentinel alone), as Data does:
+    // len_serialized() counts it, and the InlineQos flag says it is there.
     if let Some(inline_qos) = self.inline_qos.as_ref() {
-      if !inline_qos.parameters.is_empty() {
-        writer.write_value(inline_qos)?;
-      }
+      writer.write_value(inline_qos)?;
     }
     writer.write_bytes(&self.serialized_payload)?;
     Ok(())
@@ -424,6 +424,35 @@ mod tests {
     assert_eq!(&bytes[36..60], identity.as_slice());
     assert_eq!(&bytes[60..64], &[0x01, 0x00, 0x00, 0x00]); // PID_SENTINEL
     assert_eq!(&bytes[64..], payload.as_ref());
+
+    let flags = DATAFRAG_Flags::Endianness | DATAFRAG_Flags::InlineQos;
+    let read_back = DataFrag::deserialize(&bytes, flags).expect("deserialize DataFrag");
+    assert_eq!(read_back, df);
+  }
+
+  // Inline QoS present but empty is the sentinel alone (RTPS 2.5 §9.4.2.11):
+  // 32 bytes of fixed fields, 4 bytes of PID_SENTINEL, then the payload. The
+  // body must be exactly that long, since len_serialized() becomes
+  // octetsToNextHeader.
+  #[test]
+  fn empty_inline_qos_is_written_as_sentinel_and_counted() {
+    let payload = Bytes::from(vec![0xCD; 8]);
+    let df = DataFrag {
+      writer_sn: SequenceNumber::new(5),
+      fragment_starting_num: FragmentNumber::new(1),
+      fragments_in_submessage: 1,
+      fragment_size: 8,
+      data_size: 16,
+      inline_qos: Some(ParameterList::new()),
+      serialized_payload: payload.clone(),
+      ..Default::default()
+    };
+    let bytes = serialize_body(&df);
+
+    assert_eq!(bytes.len(), 32 + 4 + 8);
+    assert_eq!(bytes.len(), df.len_serialized());
+    assert_eq!(&bytes[32..36], &[0x01, 0x00, 0x00, 0x00]); // PID_SENTINEL
+    assert_eq!(&bytes[36..], payload.as_ref());
 
     let flags = DATAFRAG_Flags::Endianness | DATAFRAG_Flags::InlineQos;
     let read_back = DataFrag::deserialize(&bytes, flags).expect("deserialize DataFrag");
