@@ -4,16 +4,20 @@
 its control rate, 50 Hz with ``params/omr3.yaml``. The node runs for a few seconds with nobody
 subscribed, so about ``HISTORY_S * RATE_HZ`` statuses have been written; then a new DDS
 participant (its own rclpy Context, so it discovers the node late) subscribes with transient
-local durability. Whatever its depth, the publisher keeps only one sample, so the first status it
-receives is the one current at the match, and every later one is live: the first ``SAMPLES``
-statuses are stamped within ``(SAMPLES - 1) / RATE_HZ`` s of each other, plus scheduling slack,
-and the first one is a fraction of a second old when it arrives. Old history would make both
-spans about ``HISTORY_S``.
+local durability. The publisher keeps only one sample, so the first status received is the one
+current at the match, and every later one is live: the first ``SAMPLES`` statuses are stamped
+within ``(SAMPLES - 1) / RATE_HZ`` s of each other, plus scheduling slack, and the first one is
+at most that slack old when it arrives. Old history would make both spans about ``HISTORY_S``.
 
-Against a writer that resends old history (rustdds 0.15.1 unpatched, see patches/README.md) the
-depth-10 case fails every time; at depth 1 the reader's own keep-last usually hides it (the old
-samples arrive in a burst and only the newest is kept), so that case checks that the latest status
-still arrives, and fails only sometimes on the old writer.
+What each reader depth can show:
+
+- depth 10: the reader keeps what the writer sends, so old history would be in the first
+  ``SAMPLES``. Against a writer that resends old history (rustdds 0.15.1 unpatched, see
+  patches/README.md) this case fails every time.
+- depth 1 (``ros2 topic echo --once``): the reader's own keep-last 1 drops old samples that
+  arrive in one burst before they are taken, so this case cannot tell whether the writer sent
+  them. It checks what such a subscriber relies on: the first status it takes is the latest one,
+  not an older retained one, and live statuses follow in order.
 """
 
 from __future__ import annotations
@@ -30,7 +34,8 @@ from mobil_msgs.msg import ChassisStatus
 RATE_HZ = 50.0          # control_rate_hz in params/omr3.yaml
 HISTORY_S = 4.0         # how long the node publishes before anyone subscribes
 SAMPLES = 25            # statuses looked at: 0.48 s of live data at 50 Hz
-SLACK_S = 0.5           # delivery and scheduling on a loaded machine; far below HISTORY_S
+SLACK_S = 1.5           # delivery and scheduling on a loaded 2-core machine; far below
+                        # HISTORY_S and the 2.9 s spans of the old writer (patches/README.md)
 TOPIC = "/chassis/status"
 
 

@@ -1664,16 +1664,29 @@ impl Writer {
   ) {
     let first_keeper = if !self.like_stateless {
       // Regular stateful writer behavior
-      // All reliable readers have acked up to this point (SequenceNumber).
-      // Best-effort readers never acknowledge, and with no reliable reader
+      // All readers have acked up to this point (SequenceNumber).
+      //
+      // When the whole history is one instance, only reliable readers count:
+      // best-effort readers never acknowledge, and with no reliable reader
       // nothing awaits acknowledgement, so only History depth keeps samples.
+      // Otherwise `depth` counts per instance, which the send buffer does not
+      // know, so trimming to it would drop other instances' last samples:
+      // such writers keep everything no reliable reader has acknowledged,
+      // and with no reader (or a best-effort one) that is everything.
+      let single_instance = self.history_is_one_instance();
       let acked_by_all_readers = self
         .readers
         .values()
-        .filter(|rp| rp.qos().is_reliable())
+        .filter(|rp| !single_instance || rp.qos().is_reliable())
         .map(RtpsReaderProxy::acked_up_to_before)
         .min()
-        .unwrap_or_else(|| self.send_buffer.last_change_sequence_number().plus_1());
+        .unwrap_or_else(|| {
+          if single_instance {
+            self.send_buffer.last_change_sequence_number().plus_1()
+          } else {
+            SequenceNumber::zero()
+          }
+        });
       // If all readers have acked all up to before 5, and depth is 5, we need
       // to keep samples 0..4, i.e. from acked_up_to_before - depth .
       let depth_keeper = if let Some(depth) = depth {
@@ -2127,6 +2140,14 @@ impl Writer {
     is_new
   }
 
+  /// Whether all samples of this writer belong to one instance, so that
+  /// History `depth` counts samples of the send buffer. True for user writers
+  /// of topics without a key; keyed and built-in writers have instances, which
+  /// the send buffer does not track.
+  fn history_is_one_instance(&self) -> bool {
+    self.my_guid.entity_id.kind() == EntityKind::WRITER_NO_KEY_USER_DEFINED
+  }
+
   /// For a durable (non-VOLATILE) writer with History `KeepLast { depth }`:
   /// the retained samples a newly matched reader is not to receive, so that it
   /// gets only the `depth` latest ones (DDS v1.4, DURABILITY and HISTORY QoS).
@@ -2139,9 +2160,7 @@ impl Writer {
   /// instances, so this applies only to user writers of topics without a key,
   /// where the whole history is one instance.
   fn late_joiner_gap(&self) -> Option<SequenceNumberRange> {
-    if self.qos().is_volatile()
-      || self.my_guid.entity_id.kind() != EntityKind::WRITER_NO_KEY_USER_DEFINED
-    {
+    if self.qos().is_volatile() || !self.history_is_one_instance() {
       return None;
     }
     match self.qos_policies.history {
@@ -3167,6 +3186,102 @@ mod tests {
       );
       unacked.writer.handle_cache_cleaning();
       assert_eq!(unacked.writer.send_buffer.retained_len(), 20);
+    }
+
+    // A writer with instances, matched with one reader, that writes the
+    // samples of instance (key) A and B alternately: A=1 (sn 1), B=1 (sn 2),
+    // A=2 (sn 3), B=2 (sn 4). Returns the sequence numbers it still holds
+    // after cache cleaning, the reader having left if `reader_leaves`.
+    fn retained_after_cleaning_of_keyed_writer(
+      writer_id: EntityId,
+      writer_qos: QosPolicies,
+      reader_id: EntityId,
+      reader_qos: &QosPolicies,
+      reader_leaves: bool,
+    ) -> Vec<i64> {
+      let mut f = Fixture::new(writer_id, writer_qos, reader_id, reader_qos, 0, 0, None);
+      for (key, value) in [(b'A', 1u8), (b'B', 1), (b'A', 2), (b'B', 2)] {
+        let data = DDSData::new(SerializedPayload::new(
+          RepresentationIdentifier::CDR_LE,
+          vec![key, value],
+        ));
+        assert!(matches!(
+          f.writer.send_buffer.admit_blocking(
+            WriteOptions::default(),
+            data,
+            Some(StdDuration::ZERO)
+          ),
+          Admission::Admitted(_)
+        ));
+      }
+      if reader_leaves {
+        let reader_guid = f.reader_guid;
+        f.writer.reader_lost(reader_guid);
+      }
+      f.writer.handle_cache_cleaning();
+      (1..=4)
+        .filter(|&sn| {
+          f.writer
+            .send_buffer
+            .get_by_sn(SequenceNumber::new(sn))
+            .is_some()
+        })
+        .collect()
+    }
+
+    // History depth counts per instance, which the send buffer does not know:
+    // a keyed TransientLocal KeepLast { depth: 1 } writer with no reliable
+    // reader keeps all it wrote, so a late joiner still gets the last value of
+    // both instances (A=2 at sn 3 and B=2 at sn 4), not only of the last one
+    // written. The same holds for the built-in participant-message writer
+    // (KeepLast 1, one instance per liveliness kind).
+    #[test]
+    fn cache_cleaning_keeps_every_instance_of_keyed_writers() {
+      let writer_qos = QosPolicyBuilder::new()
+        .reliability(Reliability::Reliable {
+          max_blocking_time: Duration::from_millis(100),
+        })
+        .history(History::KeepLast { depth: 1 })
+        .durability(Durability::TransientLocal)
+        .build();
+      let best_effort_reader_qos = QosPolicyBuilder::new()
+        .reliability(Reliability::BestEffort)
+        .durability(Durability::TransientLocal)
+        .build();
+      let writer_id = EntityId::new([0, 0, 1], EntityKind::WRITER_WITH_KEY_USER_DEFINED);
+      let reader_id = EntityId::new([0, 0, 2], EntityKind::READER_WITH_KEY_USER_DEFINED);
+      let all = vec![1, 2, 3, 4];
+
+      assert_eq!(
+        retained_after_cleaning_of_keyed_writer(
+          writer_id,
+          writer_qos.clone(),
+          reader_id,
+          &writer_qos,
+          true
+        ),
+        all
+      );
+      assert_eq!(
+        retained_after_cleaning_of_keyed_writer(
+          writer_id,
+          writer_qos.clone(),
+          reader_id,
+          &best_effort_reader_qos,
+          false
+        ),
+        all
+      );
+      assert_eq!(
+        retained_after_cleaning_of_keyed_writer(
+          EntityId::P2P_BUILTIN_PARTICIPANT_MESSAGE_WRITER,
+          Discovery::PARTICIPANT_MESSAGE_QOS,
+          EntityId::P2P_BUILTIN_PARTICIPANT_MESSAGE_READER,
+          &Discovery::PARTICIPANT_MESSAGE_QOS,
+          true
+        ),
+        all
+      );
     }
 
     // Built-in and user Writers alike answer an ACKNACK only after
