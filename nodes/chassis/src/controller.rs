@@ -926,6 +926,11 @@ mod tests {
         assert!(car.on_feedback(&fast, 1.1, 1.1).is_err());
         assert!(car.set_feedback_speed_factor(0.5).is_err());
         assert!(car.set_feedback_speed_factor(f64::NAN).is_err());
+        // The same verdicts before anything is applied (a parameter change vets it first).
+        assert!(ChassisController::check_feedback_speed_factor(0.5).is_err());
+        assert!(ChassisController::check_feedback_speed_factor(f64::INFINITY).is_err());
+        assert!(ChassisController::check_feedback_speed_factor(1.0).is_ok());
+        assert_relative_eq!(car.feedback_speed_factor(), 2.0);
     }
 
     /// Position-only samples of OMR-III (wheel angles) fed at their stamps.
