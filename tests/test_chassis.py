@@ -614,8 +614,11 @@ def test_wheels_stop_within_the_feedback_timeout_when_joint_states_stop(start_no
             time.sleep(0.1)
         after = wheels.snapshot()[start:]
     stopped_at = next(i for i, m in enumerate(after) if m.velocity[2] == 0.0 and m.velocity[3] == 0.0)
+    # The node's watchdog counts from its receipt of the last sample, which the sample's stamp
+    # precedes: at least the 0.5 s timeout (the behaviour); at most that, one 20 ms tick and slack
+    # for DDS latency and scheduling on a loaded machine.
     delay = stamp_s(after[stopped_at]) - stamp_s(last)
-    assert 0.49 < delay < 0.5 + 0.02 + 0.1, f"wheels stopped {delay:.3f} s after the last joint_states"
+    assert 0.49 < delay < 0.5 + 0.02 + 0.4, f"wheels stopped {delay:.3f} s after the last joint_states"
     # From then on every command is a stop, with the steering held where it was.
     for m in after[stopped_at:]:
         assert list(m.velocity[2:]) == [0.0, 0.0]

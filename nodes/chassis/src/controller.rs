@@ -28,17 +28,21 @@
 //! (an out-of-order sample) is refused. So one bad stamp costs one sample, never the odometry.
 //! Encoder angles are different: their change over a gap is a distance really travelled, so it
 //! is integrated however long the gap — unless the encoder wraps and the gap is long enough for
-//! a wheel to turn π (see [`crate::joints::FeedbackDecoder`]), when the change is ambiguous.
+//! a wheel at the fastest believed speed to turn π (see [`crate::joints::FeedbackDecoder`]), when
+//! the change is ambiguous. They are differenced from the last sample the controller accepted
+//! ([`ChassisController::on_joint_state`]), so a refused or late sample neither loses distance nor
+//! counts it twice.
 
 use std::f64::consts::{FRAC_PI_2, PI};
 use std::ops::Deref;
 
 use crate::error::{ChassisError, OdometryError};
-use crate::joints::FeedbackSample;
+use crate::joints::{FeedbackDecoder, FeedbackSample, JointStateError};
 use crate::kinematics::{
     forward, inverse, pre_steer, twist_at_origin, twist_at_reference, BodyTwist, JointKind, WheelState,
 };
 use crate::limits::{clamp_command, ClampReason, ClampReasons};
+use crate::model::ChassisModel;
 use crate::model::ChassisParams;
 use crate::odometry::{Odometry, OdometryNoise};
 use crate::watchdog::CmdVelWatchdog;
@@ -137,6 +141,9 @@ pub enum FeedbackError {
     /// The stamp or twist was refused by the odometry.
     #[error(transparent)]
     Odometry(#[from] OdometryError),
+    /// The `joint_states` message could not be read, or its stamp was refused.
+    #[error(transparent)]
+    Joints(#[from] JointStateError),
     /// A joint value the chassis cannot physically reach.
     #[error("joint `{joint}` at {value} is beyond what the chassis can do (limit ±{limit})")]
     Implausible {
@@ -165,6 +172,8 @@ pub struct ChassisController {
     refused: bool,
     /// The wheels last let through the gate (their steering angles are held by a stop).
     sent: WheelState,
+    /// Turns `joint_states` into samples; its baseline moves only with an accepted sample.
+    decoder: FeedbackDecoder,
 }
 
 /// What happened to a feedback sample that was used.
@@ -203,6 +212,7 @@ impl ChassisController {
             request: None,
             refused: false,
             sent: WheelState::zero(config.params.model()),
+            decoder: FeedbackDecoder::default(),
             feedback_speed_factor: DEFAULT_FEEDBACK_SPEED_FACTOR,
             config,
         })
@@ -244,6 +254,14 @@ impl ChassisController {
     /// Sets k: wheel feedback faster than k × `max_wheel_speed` is refused as impossible
     /// (default [`DEFAULT_FEEDBACK_SPEED_FACTOR`]); k must be finite and at least 1.
     pub fn set_feedback_speed_factor(&mut self, factor: f64) -> Result<(), ChassisError> {
+        Self::check_feedback_speed_factor(factor)?;
+        self.feedback_speed_factor = factor;
+        Ok(())
+    }
+
+    /// The error [`ChassisController::set_feedback_speed_factor`] would give for `factor`, if any:
+    /// to vet it before applying anything else.
+    pub fn check_feedback_speed_factor(factor: f64) -> Result<(), ChassisError> {
         if !(factor.is_finite() && factor >= 1.0) {
             return Err(ChassisError::InvalidParameter {
                 name: "max_feedback_wheel_speed_factor",
@@ -251,8 +269,20 @@ impl ChassisController {
                 reason: "must be finite and at least 1",
             });
         }
-        self.feedback_speed_factor = factor;
         Ok(())
+    }
+
+    /// Takes position-only wheel feedback as wrapped angles (`true`) or a continuous count
+    /// (`false`, the default). A change forgets the previous position sample.
+    pub fn set_encoder_positions_wrap(&mut self, wraps: bool) {
+        if wraps != self.decoder.wraps() {
+            self.decoder = FeedbackDecoder::new(wraps);
+        }
+    }
+
+    /// True if position-only wheel feedback is taken as wrapped angles.
+    pub fn encoder_positions_wrap(&self) -> bool {
+        self.decoder.wraps()
     }
 
     /// k of [`ChassisController::set_feedback_speed_factor`].
@@ -416,13 +446,41 @@ impl ChassisController {
         })
     }
 
+    /// The arrays of a `joint_states` message stamped `stamp` (s), received at `now` (s) (node
+    /// clock, for the feedback watchdog), decoded (see [`FeedbackDecoder`]) and fed to
+    /// [`ChassisController::on_feedback_sample`]. `Ok(None)`: a position-only sample that only set
+    /// the baseline. A refused sample leaves the odometry and the encoder baseline as they were,
+    /// so the distance to the next good sample is not lost.
+    pub fn on_joint_state(
+        &mut self,
+        names: &[String],
+        positions: &[f64],
+        velocities: &[f64],
+        stamp: f64,
+        now: f64,
+    ) -> Result<Option<FeedbackOutcome>, FeedbackError> {
+        let model: ChassisModel = self.config.params.model();
+        let decoded = self
+            .decoder
+            .decode(model, names, positions, velocities, stamp, self.max_gap())?;
+        let outcome = match decoded.sample() {
+            Some(sample) => Some(self.on_feedback_sample(sample, now)?),
+            None => None,
+        };
+        self.decoder.commit(decoded);
+        Ok(outcome)
+    }
+
     /// A decoded feedback sample (see [`FeedbackSample`]), received at `now` (s) (node clock,
     /// for the feedback watchdog). Refused samples leave the odometry unchanged.
     ///
     /// Measured speeds go through [`ChassisController::on_feedback`]. Travelled samples (encoder
     /// angles) are integrated over their own interval however long: the clock restarts at its
-    /// start if needed (first sample, clock reset). A wrapped one whose interval is long enough
-    /// for a wheel at `max_wheel_speed` to turn π is ambiguous and only restarts the clock.
+    /// start if needed (first sample, clock reset). One that starts before the odometry's last
+    /// stamp, but less than the feedback timeout before it, overlaps what was integrated and is
+    /// refused. A wrapped one whose interval is long enough for a wheel at the fastest believed
+    /// speed ([`ChassisController::max_feedback_wheel_speed`]) to turn π is ambiguous and only
+    /// restarts the clock, with a zero twist.
     pub fn on_feedback_sample(&mut self, sample: &FeedbackSample, now: f64) -> Result<FeedbackOutcome, FeedbackError> {
         let (wheels, since, stamp, wrapped) = match *sample {
             FeedbackSample::Measured { ref wheels, stamp } => return self.on_feedback(wheels, stamp, now),
@@ -435,11 +493,21 @@ impl ChassisController {
         };
         let twist = forward(&self.config.params, &wheels)?;
         self.check_plausible(&wheels)?;
+        if let Some(last) = self.odometry.last_stamp() {
+            if since < last && since >= last - self.max_gap() {
+                return Err(OdometryError::TimeNotIncreasing {
+                    previous: last,
+                    now: since,
+                }
+                .into());
+            }
+        }
         let gap = stamp - since;
-        let outcome = if wrapped && gap * self.config.params.max_wheel_speed() >= PI {
+        let outcome = if wrapped && gap * self.max_feedback_wheel_speed() >= PI {
+            // The mean speed over the gap is aliased: no twist is known.
             let mut odometry = self.odometry.clone();
             odometry.restart_stamp();
-            odometry.update_at(twist, stamp)?;
+            odometry.update_at(BodyTwist::ZERO, stamp)?;
             self.odometry = odometry;
             FeedbackOutcome::Ambiguous { gap_s: gap }
         } else {
@@ -858,41 +926,140 @@ mod tests {
         assert!(car.on_feedback(&fast, 1.1, 1.1).is_err());
         assert!(car.set_feedback_speed_factor(0.5).is_err());
         assert!(car.set_feedback_speed_factor(f64::NAN).is_err());
+        // The same verdicts before anything is applied (a parameter change vets it first).
+        assert!(ChassisController::check_feedback_speed_factor(0.5).is_err());
+        assert!(ChassisController::check_feedback_speed_factor(f64::INFINITY).is_err());
+        assert!(ChassisController::check_feedback_speed_factor(1.0).is_ok());
+        assert_relative_eq!(car.feedback_speed_factor(), 2.0);
     }
 
-    /// Position-only samples of OMR-III (wheel angles) decoded and fed at their stamps.
+    /// Position-only samples of OMR-III (wheel angles) fed at their stamps.
     fn feed_angles(
         c: &mut ChassisController,
-        d: &mut crate::joints::FeedbackDecoder,
         t: f64,
         angles: [f64; 3],
-    ) -> Option<Result<FeedbackOutcome, FeedbackError>> {
+    ) -> Result<Option<FeedbackOutcome>, FeedbackError> {
         let names: Vec<String> = ["wheel_1", "wheel_2", "wheel_3"]
             .iter()
             .map(|s| (*s).to_owned())
             .collect();
-        let sample = d.decode(ChassisModel::Omni, &names, &angles, &[], t).unwrap()?;
-        Some(c.on_feedback_sample(&sample, t))
+        c.on_joint_state(&names, &angles, &[], t, t)
+    }
+
+    /// OMR-III driving along x at 0.3 m/s: wheel angles 6t, −3t, −3t (rad).
+    fn driving(t: f64) -> [f64; 3] {
+        [6.0 * t, -3.0 * t, -3.0 * t]
+    }
+
+    #[test]
+    fn a_late_or_unstamped_encoder_sample_is_not_integrated_twice() {
+        let mut c = controller(ChassisConfig::omr3());
+        // Samples at 1.00 and 1.02, a late 1.01, a NaN stamp, then 1.04: wheel 1 turns 0.24 rad
+        // in all, 0.04 s at 0.3 m/s = 12 mm (not 0.30 rad, 15 mm).
+        assert_eq!(feed_angles(&mut c, 1.0, driving(1.0)).unwrap(), None);
+        feed_angles(&mut c, 1.02, driving(1.02)).unwrap();
+        assert!(feed_angles(&mut c, 1.01, driving(1.01)).is_err());
+        assert!(feed_angles(&mut c, f64::NAN, driving(1.03)).is_err());
+        assert_eq!(
+            feed_angles(&mut c, 1.04, driving(1.04)).unwrap(),
+            Some(FeedbackOutcome::Integrated)
+        );
+        assert_relative_eq!(c.odometry().reference_pose().x, 0.012, epsilon = 1e-12);
+    }
+
+    #[test]
+    fn a_replayed_old_encoder_sample_does_not_repeat_the_distance() {
+        let mut c = controller(ChassisConfig::omr3());
+        // 50 Hz from 0 to 9.98 s: 0.3 m/s × 9.98 s = 2.994 m.
+        for k in 0..500 {
+            feed_angles(&mut c, 0.02 * f64::from(k), driving(0.02 * f64::from(k))).unwrap();
+        }
+        assert_relative_eq!(c.odometry().reference_pose().x, 2.994, epsilon = 1e-9);
+        // A sample from t = 0 replayed, then the next real one at 10 s (angle 60): it continues
+        // from 9.98 s, 6 mm, not the 60 rad (3 m) since t = 0 again.
+        assert_eq!(feed_angles(&mut c, 0.0, driving(0.0)).unwrap(), None);
+        assert_eq!(
+            feed_angles(&mut c, 10.0, driving(10.0)).unwrap(),
+            Some(FeedbackOutcome::Integrated)
+        );
+        assert_relative_eq!(c.odometry().reference_pose().x, 3.0, epsilon = 1e-9);
+        // A real clock reset (a restarted simulation, its encoders back at 0) is followed: 20 ms
+        // after it, 6 mm more.
+        assert_eq!(feed_angles(&mut c, 0.0, driving(0.0)).unwrap(), None);
+        feed_angles(&mut c, 0.02, driving(0.02)).unwrap();
+        assert_relative_eq!(c.odometry().reference_pose().x, 3.006, epsilon = 1e-9);
+    }
+
+    #[test]
+    fn a_refused_encoder_sample_loses_no_distance() {
+        let mut c = controller(ChassisConfig::omr3());
+        for k in 0..=50 {
+            feed_angles(&mut c, 0.02 * f64::from(k), driving(0.02 * f64::from(k))).unwrap();
+        }
+        assert_relative_eq!(c.odometry().reference_pose().x, 0.3, epsilon = 1e-9);
+        // A glitch of +100 rad on wheel 1 at 1.02 s (5006 rad/s): refused.
+        let mut glitch = driving(1.02);
+        glitch[0] += 100.0;
+        assert!(matches!(
+            feed_angles(&mut c, 1.02, glitch),
+            Err(FeedbackError::Implausible { joint: "wheel_1", .. })
+        ));
+        // 1.04 spans (1.00, 1.04]: 12 mm more.
+        assert_eq!(
+            feed_angles(&mut c, 1.04, driving(1.04)).unwrap(),
+            Some(FeedbackOutcome::Integrated)
+        );
+        assert_relative_eq!(c.odometry().reference_pose().x, 0.312, epsilon = 1e-9);
+    }
+
+    #[test]
+    fn travelled_distance_overlapping_the_odometry_is_refused() {
+        let mut c = controller(ChassisConfig::omr3());
+        let forward = WheelState::Omni {
+            wheels: [6.0, -3.0, -3.0],
+        };
+        c.on_feedback(&forward, 10.0, 10.0).unwrap();
+        c.on_feedback(&forward, 10.5, 10.5).unwrap();
+        let overlapping = FeedbackSample::Travelled {
+            wheels: forward,
+            since: 10.4,
+            stamp: 10.6,
+            wrapped: false,
+        };
+        assert!(matches!(
+            c.on_feedback_sample(&overlapping, 10.6),
+            Err(FeedbackError::Odometry(OdometryError::TimeNotIncreasing { .. }))
+        ));
+        assert_relative_eq!(c.odometry().reference_pose().x, 0.15, epsilon = 1e-12);
+        // Starting 5 s before it: a clock reset, integrated over its own 0.2 s (6 cm).
+        let after_reset = FeedbackSample::Travelled {
+            wheels: forward,
+            since: 5.5,
+            stamp: 5.7,
+            wrapped: false,
+        };
+        assert_eq!(
+            c.on_feedback_sample(&after_reset, 10.7).unwrap(),
+            FeedbackOutcome::Integrated
+        );
+        assert_relative_eq!(c.odometry().reference_pose().x, 0.21, epsilon = 1e-12);
     }
 
     #[test]
     fn encoder_angles_across_a_dropout_are_a_real_distance() {
         let mut c = controller(ChassisConfig::omr3());
-        let mut d = crate::joints::FeedbackDecoder::default();
         // At rest, 50 Hz, until t = 1 s.
         for k in 0..=50 {
-            feed_angles(&mut c, &mut d, 0.02 * f64::from(k), [0.0; 3]);
+            feed_angles(&mut c, 0.02 * f64::from(k), [0.0; 3]).unwrap();
         }
         // 2 s without feedback, in which the robot drives 1 m along x: wheel 1 (rolling along x)
         // turns 1/0.05 = 20 rad, wheels 2 and 3 −½ of that.
-        let outcome = feed_angles(&mut c, &mut d, 3.0, [20.0, -10.0, -10.0]).unwrap().unwrap();
+        let outcome = feed_angles(&mut c, 3.0, [20.0, -10.0, -10.0]).unwrap().unwrap();
         assert!(matches!(outcome, FeedbackOutcome::Bridged { gap_s } if (gap_s - 2.0).abs() < 1e-9));
         assert_relative_eq!(c.odometry().reference_pose().x, 1.0, epsilon = 1e-9);
         assert_relative_eq!(c.odometry().reference_pose().y, 0.0, epsilon = 1e-9);
         // And on from there at 50 Hz: 0.02 s at 0.3 m/s (6 rad/s on wheel 1) adds 6 mm.
-        let next = feed_angles(&mut c, &mut d, 3.02, [20.12, -10.06, -10.06])
-            .unwrap()
-            .unwrap();
+        let next = feed_angles(&mut c, 3.02, [20.12, -10.06, -10.06]).unwrap().unwrap();
         assert_eq!(next, FeedbackOutcome::Integrated);
         assert_relative_eq!(c.odometry().reference_pose().x, 1.006, epsilon = 1e-9);
     }
@@ -900,26 +1067,30 @@ mod tests {
     #[test]
     fn wrapped_encoder_angles_integrate_without_a_spike_and_refuse_an_ambiguous_gap() {
         let mut c = controller(ChassisConfig::omr3());
-        let mut d = crate::joints::FeedbackDecoder::default();
-        // 0.3 m/s along x for 1 s at 50 Hz: wheel angles 6t, −3t, −3t (rad), reported wrapped to
-        // (−π, π]: wheel 1 wraps at t = π/6 = 0.52 s. Odometry: x = 0.3 m, no spike.
+        c.set_encoder_positions_wrap(true);
+        let wrapped = |t: f64| driving(t).map(wrap);
+        // 0.3 m/s along x for 1 s at 50 Hz, wheel angles reported wrapped to (−π, π]: wheel 1
+        // wraps at t = π/6 = 0.52 s. Odometry: x = 0.3 m, no spike.
         for k in 0..=50 {
-            let t = 0.02 * f64::from(k);
-            feed_angles(&mut c, &mut d, t, [wrap(6.0 * t), wrap(-3.0 * t), wrap(-3.0 * t)]);
+            feed_angles(&mut c, 0.02 * f64::from(k), wrapped(0.02 * f64::from(k))).unwrap();
         }
         assert_relative_eq!(c.odometry().reference_pose().x, 0.3, epsilon = 1e-9);
         assert_relative_eq!(c.odometry().twist().vx, 0.3, epsilon = 1e-9);
-        // A 0.5 s gap: at max_wheel_speed 12 rad/s a wheel could turn 6 rad > π in it, so the
-        // wrapped difference says nothing: not integrated, the clock restarts.
-        let outcome = feed_angles(&mut c, &mut d, 1.5, [wrap(9.0), wrap(-4.5), wrap(-4.5)])
-            .unwrap()
-            .unwrap();
-        assert!(matches!(outcome, FeedbackOutcome::Ambiguous { gap_s } if (gap_s - 0.5).abs() < 1e-9));
+        // A 0.1 s gap: feedback is believed up to 3 × 12 = 36 rad/s, at which a wheel turns
+        // 3.6 rad > π in it, so the wrapped difference says nothing: not integrated, the clock
+        // restarts, and no twist is claimed.
+        let outcome = feed_angles(&mut c, 1.1, wrapped(1.1)).unwrap().unwrap();
+        assert!(matches!(outcome, FeedbackOutcome::Ambiguous { gap_s } if (gap_s - 0.1).abs() < 1e-9));
         assert_relative_eq!(c.odometry().reference_pose().x, 0.3, epsilon = 1e-9);
-        // The next 20 ms integrate normally (6 mm).
-        feed_angles(&mut c, &mut d, 1.52, [wrap(9.12), wrap(-4.56), wrap(-4.56)])
-            .unwrap()
-            .unwrap();
+        assert_eq!(c.odometry().twist(), BodyTwist::ZERO);
+        // The next 20 ms integrate normally (6 mm); so does a gap of 0.08 s (2.88 rad < π at
+        // 36 rad/s): 24 mm.
+        feed_angles(&mut c, 1.12, wrapped(1.12)).unwrap().unwrap();
         assert_relative_eq!(c.odometry().reference_pose().x, 0.306, epsilon = 1e-9);
+        assert_eq!(
+            feed_angles(&mut c, 1.2, wrapped(1.2)).unwrap(),
+            Some(FeedbackOutcome::Integrated)
+        );
+        assert_relative_eq!(c.odometry().reference_pose().x, 0.33, epsilon = 1e-9);
     }
 }

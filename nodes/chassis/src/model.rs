@@ -290,6 +290,27 @@ impl ChassisParams {
         self.config.max_steering
     }
 
+    /// The largest angle (rad) of any physical steering joint that the virtual limit δ_max
+    /// implies: the tricycle's one wheel is the virtual wheel (δ_max); the car-like chassis' inner
+    /// Ackermann wheel steers to atan(L / (L / tan δ_max − B/2)), π/2 when the turning centre of
+    /// δ_max lies within the track (MOBIL-II: L / tan 70° = 0.218 m < B/2 = 0.31 m). The limit to
+    /// hold each steering joint to; 0 for the omni chassis, which has none.
+    pub fn max_wheel_steering(&self) -> f64 {
+        let c = &self.config;
+        match c.model {
+            ChassisModel::Omni => 0.0,
+            ChassisModel::Tricycle => c.max_steering,
+            ChassisModel::CarLike => {
+                let inner_radius = c.wheelbase / c.max_steering.tan() - c.track / 2.0;
+                if inner_radius > 0.0 {
+                    (c.wheelbase / inner_radius).atan()
+                } else {
+                    FRAC_PI_2
+                }
+            }
+        }
+    }
+
     /// Minimum turning radius R_min (m) at the kinematic origin.
     pub fn min_turning_radius(&self) -> f64 {
         self.config.min_turning_radius

@@ -2,7 +2,6 @@
 //! feedback is refused before it reaches the odometry.
 
 use mobil_chassis::controller::{ChassisController, ControllerConfig};
-use mobil_chassis::joints::{FeedbackDecoder, FeedbackSample};
 use mobil_chassis::{ChassisModel, ChassisParams, OdometryNoise, WheelState};
 use proptest::prelude::*;
 
@@ -44,23 +43,19 @@ fn the_reported_huge_samples_are_refused_and_change_nothing() {
         let n = names(model);
         let zeros = vec![0.0; n.len()];
         let mut c = controller(params);
-        let mut d = FeedbackDecoder::default();
         for k in 0..10 {
             let t = 0.02 * f64::from(k);
-            let sample = d.decode(model, &n, &zeros, &zeros, t).unwrap().unwrap();
-            c.on_feedback_sample(&sample, t).unwrap();
+            c.on_joint_state(&n, &zeros, &zeros, t, t).unwrap().unwrap();
         }
         let before = c.odometry().clone();
-        let sample = d.decode(model, &n, &zeros, &huge, 0.2).unwrap().unwrap();
         assert!(
-            c.on_feedback_sample(&sample, 0.2).is_err(),
+            c.on_joint_state(&n, &zeros, &huge, 0.2, 0.2).is_err(),
             "{model}: {huge:?} accepted"
         );
         assert_eq!(c.odometry(), &before, "{model}");
         assert!(finite(&c));
         // The next ordinary sample is integrated as usual.
-        let sample = d.decode(model, &n, &zeros, &zeros, 0.22).unwrap().unwrap();
-        c.on_feedback_sample(&sample, 0.22).unwrap();
+        c.on_joint_state(&n, &zeros, &zeros, 0.22, 0.22).unwrap().unwrap();
         assert_eq!(c.odometry().last_stamp(), Some(0.22));
     }
 }
@@ -96,28 +91,23 @@ proptest! {
     fn no_feedback_ever_makes_the_odometry_non_finite(
         params in any_params(),
         positions_only in any::<bool>(),
+        wraps in any::<bool>(),
         samples in prop::collection::vec((prop::collection::vec(any_number(), 4), any_number()), 1..40),
     ) {
         let model = params.model();
         let n = names(model);
         let mut c = controller(params);
-        let mut d = FeedbackDecoder::default();
+        c.set_encoder_positions_wrap(wraps);
         let mut t = 0.0;
         for (values, dt) in samples {
             // Stamps mostly moving on by ordinary steps, sometimes anything at all.
             t = if dt.is_finite() && dt.abs() < 1e3 { t + dt.abs() * 0.01 } else { dt };
             let values = &values[..n.len()];
-            let decoded = if positions_only {
-                d.decode(model, &n, values, &[], t)
+            let _ = if positions_only {
+                c.on_joint_state(&n, values, &[], t, 0.0)
             } else {
-                d.decode(model, &n, values, values, t)
+                c.on_joint_state(&n, values, values, t, 0.0)
             };
-            if let Ok(Some(sample)) = decoded {
-                let _ = c.on_feedback_sample(&sample, 0.0);
-                if let FeedbackSample::Measured { wheels, .. } = sample {
-                    let _ = c.on_feedback(&wheels, t, 0.0);
-                }
-            }
             let direct = WheelState::from_values(model, values);
             if let Ok(wheels) = direct {
                 let _ = c.on_feedback(&wheels, t, 0.0);

@@ -1,7 +1,7 @@
 //! Parameter validation, presets and model names.
 
 use approx::assert_relative_eq;
-use mobil_chassis::{ChassisConfig, ChassisError, ChassisModel, ChassisParams};
+use mobil_chassis::{inverse, BodyTwist, ChassisConfig, ChassisError, ChassisModel, ChassisParams, WheelState};
 
 #[test]
 fn model_names_round_trip() {
@@ -129,4 +129,34 @@ fn refusal_message_names_the_reason() {
         err.to_string(),
         "parameter `wheel_radius` = 0 refused: must be positive"
     );
+}
+
+#[test]
+fn the_physical_steering_limit_follows_from_the_virtual_one() {
+    // MOBIL-II with δ_max = 30°: L / tan 30° = 0.6 / 0.577350 = 1.039230 m, inner wheel at
+    // 1.039230 − 0.31 = 0.729230 m: atan(0.6 / 0.729230) = atan(0.822786) = 0.688481 rad (39.45°).
+    let thirty = ChassisParams::new(ChassisConfig {
+        max_steering: 30f64.to_radians(),
+        ..ChassisConfig::mobil2()
+    })
+    .unwrap();
+    assert_relative_eq!(thirty.max_wheel_steering(), 0.688_481, epsilon = 1e-6);
+    // Second method: the inverse kinematics on the tightest left turn δ_max allows (ω/v =
+    // tan 30° / L) steer the inner (left) wheel exactly there.
+    let v = 0.2;
+    let turn = BodyTwist::new(v, 0.0, v * 30f64.to_radians().tan() / 0.6);
+    match inverse(&thirty, turn) {
+        WheelState::CarLike {
+            front_left_steering, ..
+        } => assert_relative_eq!(front_left_steering, thirty.max_wheel_steering(), epsilon = 1e-12),
+        other => panic!("{other:?}"),
+    }
+    // 70°: L / tan 70° = 0.218 m < B/2 = 0.31 m, the inner wheel would pass 90°.
+    assert_relative_eq!(
+        ChassisParams::mobil2().max_wheel_steering(),
+        std::f64::consts::FRAC_PI_2
+    );
+    // The tricycle's single wheel is the virtual wheel; the omni chassis has no steering.
+    assert_relative_eq!(ChassisParams::tricycle().max_wheel_steering(), 60f64.to_radians());
+    assert_eq!(ChassisParams::omr3().max_wheel_steering(), 0.0);
 }

@@ -11,7 +11,8 @@
 //! exact first-order lag (time constant τ; 0 = ideal) inside each sub-step.
 //!
 //! Commands are held to the chassis' limits: wheel speeds to ±`max_wheel_speed`, steering angles
-//! to ±`max_steering` (the mechanical limit); a command with a NaN or infinite value stops the
+//! to the largest angle the virtual limit `max_steering` implies for a physical wheel
+//! ([`ChassisParams::max_wheel_steering`]: the inner Ackermann wheel); a command with a NaN or infinite value stops the
 //! wheels. So whatever arrives, the true pose stays finite and the robot moves no faster than
 //! its wheels can drive it.
 //!
@@ -393,7 +394,7 @@ impl Plant {
         let mut limited = false;
         for (target, joint) in self.target.iter_mut().zip(params.model().joints()) {
             let limit = match joint.kind {
-                JointKind::Steering => params.max_steering(),
+                JointKind::Steering => params.max_wheel_steering(),
                 JointKind::Wheel => params.max_wheel_speed(),
             };
             let held = target.clamp(-limit, limit);
@@ -832,11 +833,12 @@ mod tests {
             assert_eq!(p.reference_pose(), before);
             assert_eq!(p.feedback().velocities, vec![0.0; 3]);
         }
-        // A car-like chassis at 1e308 everywhere: steering held to ±70°, wheels to 7.5 rad/s.
+        // A car-like chassis at 1e308 everywhere: steering held to ±90° (the inner wheel at
+        // δ_max = 70°: L / tan 70° = 0.218 m < B/2 = 0.31 m), wheels to 7.5 rad/s.
         let mut p = plant(ChassisConfig::mobil2(), 0.05, 0.0);
         let huge = WheelState::from_values(ChassisModel::CarLike, &[1e308, -1e308, 1e308, 1e308]).unwrap();
         assert_eq!(p.command(&huge), Ok(CommandOutcome::Limited));
-        let max = 70f64.to_radians();
+        let max = std::f64::consts::FRAC_PI_2;
         assert_eq!(p.commanded(), &[max, -max, 7.5, 7.5]);
         for _ in 0..1000 {
             p.step(0.005, &empty());

@@ -11,7 +11,7 @@ use mobil_chassis::controller::{
     ChassisController, ControllerConfig, FeedbackError, FeedbackOutcome, GatedCommand, Safety,
     DEFAULT_FEEDBACK_SPEED_FACTOR,
 };
-use mobil_chassis::joints::{joints_from_wheel_state, FeedbackDecoder, JointStateError};
+use mobil_chassis::joints::{joints_from_wheel_state, JointStateError};
 use mobil_chassis::kinematics::BodyTwist;
 use mobil_chassis::model::ChassisModel;
 use mobil_chassis::odometry::OdometryNoise;
@@ -37,6 +37,7 @@ use tracing::{info, warn};
 struct NodeConfig {
     controller: ControllerConfig,
     feedback_speed_factor: f64,
+    encoder_positions_wrap: bool,
     control_rate_hz: f64,
     odom_frame: String,
     base_frame: String,
@@ -74,6 +75,11 @@ fn decl() -> NodeDecl {
         )
         .within(1.0, 100.0),
     )
+    .param(ParamSpec::boolean(
+        "encoder_positions_wrap",
+        false,
+        "position-only joint_states report wheel angles wrapped to one turn (false: a continuous count)",
+    ))
     .param(ParamSpec::double("control_rate_hz", 50.0, "wheel_commands and status rate").within(1.0, 1000.0))
     .param(ParamSpec::string("odom_frame", "odom", "odometry frame"))
     .param(ParamSpec::string(
@@ -108,6 +114,7 @@ fn node_config(p: &ParamValues) -> Result<NodeConfig, String> {
             noise,
         },
         feedback_speed_factor: p.f64("max_feedback_wheel_speed_factor")?,
+        encoder_positions_wrap: p.bool("encoder_positions_wrap")?,
         control_rate_hz: p.f64("control_rate_hz")?,
         odom_frame: p.string("odom_frame")?,
         base_frame: p.string("base_frame")?,
@@ -147,6 +154,7 @@ async fn run(node: &mut RosNode) -> anyhow::Result<()> {
     let mut config = node_config(&node.params()).map_err(anyhow::Error::msg)?;
     let mut controller = ChassisController::new(config.controller)?;
     controller.set_feedback_speed_factor(config.feedback_speed_factor)?;
+    controller.set_encoder_positions_wrap(config.encoder_positions_wrap);
     info!(
         "model {}, effective steering limit {:.1}°, v_max {} m/s, watchdog {} s",
         config.controller.params.model().as_str(),
@@ -171,7 +179,6 @@ async fn run(node: &mut RosNode) -> anyhow::Result<()> {
     tokio::pin!(cmds, joints, shutdown);
 
     let mut throttle = LogThrottle::default();
-    let mut decoder = FeedbackDecoder::default();
     let mut rejected: u64 = 0;
     // Start-up counts as stopped, so neither stop line is logged before the first command.
     let mut last_safety = Safety {
@@ -190,12 +197,14 @@ async fn run(node: &mut RosNode) -> anyhow::Result<()> {
             Some(changed) = node.param_changed() => {
                 match node_config(&changed) {
                     Ok(new) => {
-                        let applied = controller
-                            .reconfigure(new.controller)
+                        // Everything that can fail is vetted before anything is applied.
+                        let applied = ChassisController::check_feedback_speed_factor(new.feedback_speed_factor)
+                            .and_then(|()| controller.reconfigure(new.controller))
                             .and_then(|()| controller.set_feedback_speed_factor(new.feedback_speed_factor));
                         if let Err(e) = applied {
                             warn!("parameter change not applied: {e}");
                         } else {
+                            controller.set_encoder_positions_wrap(new.encoder_positions_wrap);
                             if new.control_rate_hz != config.control_rate_hz {
                                 tick = tokio::time::interval(Duration::from_secs_f64(1.0 / new.control_rate_hz));
                             }
@@ -229,60 +238,51 @@ async fn run(node: &mut RosNode) -> anyhow::Result<()> {
             Some(msg) = joints.next() => match msg {
                 Ok((js, _)) => {
                     let now = now_s(node);
-                    let model = config.controller.params.model();
                     // An unstamped sample is stamped on arrival (node clock).
                     let stamp_msg = if is_zero(&js.header.stamp) { node.stamp() } else { js.header.stamp.clone() };
-                    let stamp = secs_from_stamp(&stamp_msg);
-                    let parsed = decoder.decode(model, &js.name, &js.position, &js.velocity, stamp.unwrap_or(f64::NAN));
-                    match (parsed, stamp) {
+                    let Some(stamp) = secs_from_stamp(&stamp_msg) else {
+                        rejected += 1;
+                        warn_throttled!(throttle, "stamp", "joint_states dropped: invalid stamp {:?}", js.header.stamp);
+                        continue;
+                    };
+                    match controller.on_joint_state(&js.name, &js.position, &js.velocity, stamp, now) {
                         // A position-only sample that only set the baseline.
-                        (Ok(None), Some(_)) => {}
-                        (Ok(Some(sample)), Some(_)) => match controller.on_feedback_sample(&sample, now) {
-                            Ok(outcome) => {
-                                match outcome {
-                                    FeedbackOutcome::Restarted { gap_s: Some(gap) } => warn_throttled!(
-                                        throttle,
-                                        "feedback_gap",
-                                        "joint_states stamps jumped by {gap:.3} s (dropout or clock reset): odometry not integrated across the gap"
-                                    ),
-                                    FeedbackOutcome::Ambiguous { gap_s } => warn_throttled!(
-                                        throttle,
-                                        "feedback_ambiguous",
-                                        "wrapped encoder angles {gap_s:.3} s apart are ambiguous (a wheel may have turned more than π): odometry not integrated across the gap"
-                                    ),
-                                    FeedbackOutcome::Bridged { gap_s } => warn_throttled!(
-                                        throttle,
-                                        "feedback_bridged",
-                                        "joint_states resumed after {gap_s:.3} s: the encoder angles cover the gap, odometry integrated across it"
-                                    ),
-                                    FeedbackOutcome::Integrated | FeedbackOutcome::Restarted { gap_s: None } => {}
-                                }
-                                publish_odometry(&odom_pub, &tf_pub, &config, &controller, stamp_msg);
+                        Ok(None) => {}
+                        Ok(Some(outcome)) => {
+                            match outcome {
+                                FeedbackOutcome::Restarted { gap_s: Some(gap) } => warn_throttled!(
+                                    throttle,
+                                    "feedback_gap",
+                                    "joint_states stamps jumped by {gap:.3} s (dropout or clock reset): odometry not integrated across the gap"
+                                ),
+                                FeedbackOutcome::Ambiguous { gap_s } => warn_throttled!(
+                                    throttle,
+                                    "feedback_ambiguous",
+                                    "wrapped encoder angles {gap_s:.3} s apart are ambiguous (a wheel may have turned more than π): odometry not integrated across the gap"
+                                ),
+                                FeedbackOutcome::Bridged { gap_s } => warn_throttled!(
+                                    throttle,
+                                    "feedback_bridged",
+                                    "joint_states resumed after {gap_s:.3} s: the encoder angles cover the gap, odometry integrated across it"
+                                ),
+                                FeedbackOutcome::Integrated | FeedbackOutcome::Restarted { gap_s: None } => {}
                             }
-                            Err(e) => {
-                                rejected += 1;
-                                let key = match e {
-                                    FeedbackError::Kinematics(_) => "feedback_kinematics",
-                                    FeedbackError::Odometry(_) => "feedback_time",
-                                    FeedbackError::Implausible { .. } => "feedback_implausible",
-                                };
-                                warn_throttled!(throttle, key, "joint_states dropped: {e}");
-                            }
-                        },
-                        (Err(e), _) => {
+                            publish_odometry(&odom_pub, &tf_pub, &config, &controller, stamp_msg);
+                        }
+                        Err(e) => {
                             rejected += 1;
                             // One throttle per kind of fault, so each kind is reported.
                             let key = match e {
-                                JointStateError::MismatchedLengths { .. } => "joints_lengths",
-                                JointStateError::MissingJoint(_) => "joints_missing",
-                                JointStateError::MissingField { .. } => "joints_field",
-                                JointStateError::NonFinite { .. } => "joints_nan",
+                                FeedbackError::Kinematics(_) => "feedback_kinematics",
+                                FeedbackError::Odometry(_) | FeedbackError::Joints(JointStateError::StampNotIncreasing { .. }) => "feedback_time",
+                                FeedbackError::Implausible { .. } => "feedback_implausible",
+                                FeedbackError::Joints(JointStateError::NonFiniteStamp(_)) => "stamp",
+                                FeedbackError::Joints(JointStateError::MismatchedLengths { .. }) => "joints_lengths",
+                                FeedbackError::Joints(JointStateError::MissingJoint(_)) => "joints_missing",
+                                FeedbackError::Joints(JointStateError::MissingField { .. }) => "joints_field",
+                                FeedbackError::Joints(JointStateError::NonFinite { .. }) => "joints_nan",
                             };
                             warn_throttled!(throttle, key, "joint_states dropped: {e}");
-                        }
-                        (_, None) => {
-                            rejected += 1;
-                            warn_throttled!(throttle, "stamp", "joint_states dropped: invalid stamp {:?}", js.header.stamp);
                         }
                     }
                 }
