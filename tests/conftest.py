@@ -11,7 +11,9 @@ Fixtures:
   launches a node executable and stops it at teardown (SIGINT, 5 s, else kill and fail).
 * ``ros2cli``: ``ros2cli(*args, timeout=30)`` runs tests/ros2cli.py in the test's domain.
 
-Environment: MOBIL_BIN_DIR (default target/release), MOBIL_TEST_DOMAIN_ID; the Fast DDS profile,
+Environment: MOBIL_BIN_DIR (default target/release), MOBIL_TEST_DOMAIN_ID,
+MOBIL_FASTDDS_VERBOSITY (Fast DDS's own log level in the test process: 1 = warnings;
+its warnings about discovery and QoS are otherwise hidden); the Fast DDS profile,
 RMW implementation and mobil_msgs paths are set here (rosutil.setup_process_environment).
 """
 
@@ -74,6 +76,11 @@ def rclpy_context(ros_domain_id: int) -> Iterator[Any]:
     from rclpy.signals import SignalHandlerOptions
     # No rclpy signal handlers: Ctrl-C stays pytest's KeyboardInterrupt.
     rclpy.init(signal_handler_options=SignalHandlerOptions.NO)
+    if os.environ.get("MOBIL_FASTDDS_VERBOSITY"):
+        import ctypes
+        lib = ctypes.CDLL("libfastrtps.so.2.14")
+        getattr(lib, "_ZN8eprosima7fastdds3dds3Log12SetVerbosityENS2_4KindE")(
+            int(os.environ["MOBIL_FASTDDS_VERBOSITY"]))
     from rclpy.utilities import get_default_context
     yield get_default_context()
     rclpy.try_shutdown()

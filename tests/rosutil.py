@@ -611,7 +611,13 @@ class TopicRecorder:
             return "graph unavailable"
         desc = ", ".join(f"{p.node_namespace.rstrip('/')}/{p.node_name} "
                          f"[{describe_qos(p.qos_profile)}]" for p in pubs) or "none"
-        return f"subscription QoS {describe_qos(self.qos)}; publishers: {desc}"
+        try:
+            nodes = ", ".join(sorted(f"{ns.rstrip('/')}/{n}"
+                                     for n, ns in self.node.get_node_names_and_namespaces()))
+        except Exception:  # pragma: no cover
+            nodes = "unavailable"
+        return (f"subscription QoS {describe_qos(self.qos)}; publishers: {desc}; "
+                f"nodes in the graph: {nodes or 'none'}")
 
     def close(self) -> None:
         self.node.destroy_subscription(self._sub)

@@ -195,6 +195,10 @@ enum DiscoveryTimerEvent {
   ParticipantCleanup,
   TopicCleanup,
   PublishParticipantMessage,
+  // One-shot: write the SEDP data of every local endpoint again, some time
+  // after a new remote participant was discovered (see
+  // `ENDPOINT_REANNOUNCE_DELAY`).
+  ReannounceLocalEndpoints,
   #[cfg(feature = "security")]
   CachedSecureMessageResend,
 }
@@ -256,6 +260,9 @@ pub(crate) struct Discovery {
   // resend timers), so discovery uses a single timer background thread.
   discovery_timer: SharedTimer<DiscoveryTimerEvent>,
 
+  // A `ReannounceLocalEndpoints` event is scheduled and has not fired yet.
+  endpoint_reannounce_pending: bool,
+
   // If security is enabled, this field contains a SecureDiscovery struct, an appendix
   // which is used for Secure functionality
   security_opt: Option<SecureDiscovery>,
@@ -302,6 +309,8 @@ impl Discovery {
   const PARTICIPANT_CLEANUP_PERIOD: StdDuration = StdDuration::from_secs(2);
   const TOPIC_CLEANUP_PERIOD: StdDuration = StdDuration::from_secs(60); // timer for cleaning up inactive topics
   const SPDP_PUBLISH_PERIOD: StdDuration = StdDuration::from_secs(10);
+  // Delay from discovering a new participant to re-announcing our endpoints.
+  const ENDPOINT_REANNOUNCE_DELAY: StdDuration = StdDuration::from_millis(1000);
   const CHECK_PARTICIPANT_MESSAGES: StdDuration = StdDuration::from_secs(1);
   #[cfg(feature = "security")]
   const CACHED_SECURE_DISCOVERY_MESSAGE_RESEND_PERIOD: StdDuration = StdDuration::from_secs(1);
@@ -677,6 +686,7 @@ impl Discovery {
       dcps_participant_message, // liveliness messages
 
       discovery_timer,
+      endpoint_reannounce_pending: false,
 
       security_opt,
       #[cfg(feature = "security")]
@@ -881,6 +891,10 @@ impl Discovery {
                     DiscoveryTimerEvent::TopicCleanup,
                   );
                 }
+                DiscoveryTimerEvent::ReannounceLocalEndpoints => {
+                  self.endpoint_reannounce_pending = false;
+                  self.reannounce_local_endpoints();
+                }
                 DiscoveryTimerEvent::PublishParticipantMessage => {
                   self.publish_participant_message();
                   self.discovery_timer.borrow_mut().set_timeout(
@@ -1082,6 +1096,18 @@ impl Discovery {
         self.discovery_timer.borrow_mut().set_timeout(
           StdDuration::from_millis(10),
           DiscoveryTimerEvent::SendParticipantInfo { reschedule: false },
+        );
+      }
+
+      // Write our endpoints' SEDP data once more a little later: see
+      // `reannounce_local_endpoints`. Participants discovered in the meantime
+      // share the one re-announcement.
+      if guid_prefix != self.domain_participant.guid().prefix && !self.endpoint_reannounce_pending
+      {
+        self.endpoint_reannounce_pending = true;
+        self.discovery_timer.borrow_mut().set_timeout(
+          Self::ENDPOINT_REANNOUNCE_DELAY,
+          DiscoveryTimerEvent::ReannounceLocalEndpoints,
         );
       }
 
@@ -1827,6 +1853,30 @@ impl Discovery {
         }
       }
     }
+  }
+
+  /// Writes the SEDP data (DCPSPublication / DCPSSubscription) of every local
+  /// user endpoint again, as new samples of the same instances.
+  ///
+  /// The samples written when the endpoints were created reach a participant
+  /// discovered later through the transient-local SEDP writers, but a peer may
+  /// acknowledge such a sample and still not act on it: Fast DDS 2.14 (ROS 2
+  /// Jazzy) at times loses the endpoints whose SEDP samples it receives while
+  /// it is still completing discovery of the sending participant, and never
+  /// matches them. A new sample of an unchanged instance is an update to a
+  /// peer that knows the endpoint and a discovery to one that lost it.
+  fn reannounce_local_endpoints(&self) {
+    let db = discovery_db_read(&self.discovery_db);
+    let mut count = 0;
+    for writer_data in db.get_all_local_topic_writers() {
+      self.sedp_publish_single_user_writer(writer_data);
+      count += 1;
+    }
+    for reader_data in db.get_all_local_topic_readers() {
+      self.sedp_publish_single_user_reader(reader_data);
+      count += 1;
+    }
+    debug!("Re-announced {count} local endpoints");
   }
 
   fn add_local_writer(&self, guid: GUID) {
