@@ -1,11 +1,12 @@
-//! The chassis geometry and limits as ROS parameters, shared by every node that models the
-//! chassis (`chassis_node`, `sim_node`, and the planners), so one `/**` section of a robot's
-//! params file configures them all.
+//! The ROS side of [`mobil_chassis`]: the `chassis_node` executable (src/main.rs), and the
+//! chassis geometry and limits as ROS parameters, shared by every node that models the chassis
+//! (`chassis_node`, `sim_node`, and the planners), so one `/**` section of a robot's params file
+//! configures them all.
 
 use mobil_ros::params::ParamValues;
 use mobil_ros::ParamSpec;
 
-use crate::model::{ChassisConfig, ChassisModel, ChassisParams};
+use mobil_chassis::model::{ChassisConfig, ChassisModel, ChassisParams};
 
 /// Parameter declarations of [`ChassisConfig`]; defaults are MOBIL-II's.
 pub fn chassis_param_specs() -> Vec<ParamSpec> {

@@ -7,7 +7,7 @@
 
 use futures::StreamExt;
 use mobil_chassis::joints::wheel_state_from_joints;
-use mobil_chassis::ros_params::{chassis_from_params, chassis_param_specs};
+use mobil_chassis_node::{chassis_from_params, chassis_param_specs};
 use mobil_msgs::geometry_msgs::msg::{Point, Transform, TransformStamped, Vector3};
 use mobil_msgs::nav_msgs::msg::Odometry;
 use mobil_msgs::rosgraph_msgs::msg::Clock;

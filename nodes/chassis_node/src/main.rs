@@ -15,7 +15,7 @@ use mobil_chassis::joints::{joints_from_wheel_state, JointStateError};
 use mobil_chassis::kinematics::BodyTwist;
 use mobil_chassis::model::ChassisModel;
 use mobil_chassis::odometry::OdometryNoise;
-use mobil_chassis::ros_params::{chassis_from_params, chassis_param_specs};
+use mobil_chassis_node::{chassis_from_params, chassis_param_specs};
 use mobil_msgs::builtin_interfaces::msg::Time;
 use mobil_msgs::geometry_msgs::msg::{Transform, TransformStamped, Twist, Vector3};
 use mobil_msgs::mobil_msgs::msg::ChassisStatus;
