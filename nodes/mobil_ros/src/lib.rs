@@ -1,17 +1,23 @@
-//! Shared ROS 2 plumbing of the mobil node suite.
+//! The node kit of the mobil suite: everything a node shell needs around its ROS-free
+//! algorithm crate, so that every node is written the same way.
 //!
-//! Every executable (`chassis_node`, `sim_node`, …) is a thin shell around a ROS-free library;
-//! this crate is the shell's common part:
-//! - [`args`]: `--ros-args` with `--params-file`, `-p`, `-r` (incl. `__ns`, `__node`), `--log-level`;
-//! - [`params`]: typed parameter declarations, ROS 2 YAML parameter files, validation;
-//! - [`node`]: the node itself — DDS domain from `ROS_DOMAIN_ID`, the standard parameter
-//!   services (list/get/set/describe) with validation, name resolution and remapping, clean
-//!   shutdown on SIGINT/SIGTERM;
-//! - [`qos`]: the QoS presets of the interface contract;
-//! - [`log`]: `tracing` set-up and rate-limited warnings;
-//! - [`time`]: message stamps; [`geometry`]: planar poses in messages.
+//! A node is a thin shell (see `nodes/chassis_node` for the pattern):
+//! - [`config`]: the configuration declared once — each parameter's name, type, default, range,
+//!   description and read-only flag, bound to the typed field it fills; from it come the ROS
+//!   declarations, `--help`, validation of files, `-p` and `set_parameters` (refused with a
+//!   reason), and the typed configuration ([`NodeDecl::for_config`], [`RosNode::config`],
+//!   [`RosNode::config_changed`]);
+//! - [`node`]: the node itself — command line, DDS domain from `ROS_DOMAIN_ID`, the standard
+//!   parameter services, name resolution and remapping, clean shutdown on SIGINT/SIGTERM
+//!   ([`run_node`]);
+//! - [`time`]: **the time rule** — stamps and algorithm `dt` from ROS time ([`time::DtClock`]),
+//!   watchdogs, freshness and tick periods on the steady clock;
+//! - [`qos`]: the QoS presets of the interface contract; [`log`]: `tracing` set-up and
+//!   rate-limited warnings ([`warn_throttled!`]); [`geometry`]: planar poses in messages;
+//!   [`args`], [`params`], [`names`]: the ROS command line, parameter files, names.
 
 pub mod args;
+pub mod config;
 pub mod geometry;
 pub mod log;
 pub mod names;
@@ -21,6 +27,7 @@ pub mod qos;
 pub mod time;
 
 pub use args::RosArgs;
+pub use config::{Config, ConfigError, Decl};
 pub use log::LogThrottle;
 pub use node::{run_node, shutdown_signal, NodeBody, NodeDecl, RosNode};
 pub use params::{ParamSpec, ParamValues};
