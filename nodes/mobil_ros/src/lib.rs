@@ -10,6 +10,9 @@
 //! - [`node`]: the node itself — command line, DDS domain from `ROS_DOMAIN_ID`, the standard
 //!   parameter services, name resolution and remapping, clean shutdown on SIGINT/SIGTERM
 //!   ([`run_node`]);
+//! - [`latest`]: [`Latest`], an input's last value with its stamp and steady receive time — the
+//!   one way to decide that an input is stale;
+//! - [`ticker`]: [`Ticker`], a periodic tick following a rate parameter;
 //! - [`time`]: **the time rule** — stamps and algorithm `dt` from ROS time ([`time::DtClock`]),
 //!   watchdogs, freshness and tick periods on the steady clock;
 //! - [`qos`]: the QoS presets of the interface contract; [`log`]: `tracing` set-up and
@@ -19,15 +22,19 @@
 pub mod args;
 pub mod config;
 pub mod geometry;
+pub mod latest;
 pub mod log;
 pub mod names;
 pub mod node;
 pub mod params;
 pub mod qos;
+pub mod ticker;
 pub mod time;
 
 pub use args::RosArgs;
 pub use config::{Config, ConfigError, Decl};
+pub use latest::{Freshness, Latest};
 pub use log::LogThrottle;
 pub use node::{run_node, shutdown_signal, NodeBody, NodeDecl, RosNode};
 pub use params::{ParamSpec, ParamValues};
+pub use ticker::Ticker;
