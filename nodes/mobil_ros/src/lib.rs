@@ -10,6 +10,7 @@
 //! - [`node`]: the node itself — command line, DDS domain from `ROS_DOMAIN_ID`, the standard
 //!   parameter services, name resolution and remapping, clean shutdown on SIGINT/SIGTERM
 //!   ([`run_node`]);
+//! - [`input`]: typed subscription streams that log (rate-limited) and drop undecodable samples;
 //! - [`latest`]: [`Latest`], an input's last value with its stamp and steady receive time — the
 //!   one way to decide that an input is stale;
 //! - [`ticker`]: [`Ticker`], a periodic tick following a rate parameter;
@@ -22,6 +23,7 @@
 pub mod args;
 pub mod config;
 pub mod geometry;
+pub mod input;
 pub mod latest;
 pub mod log;
 pub mod names;
