@@ -1,5 +1,5 @@
 //! Planar geometry shared by the mobil suite, ROS-free (nalgebra only): angle wrapping, 2D poses
-//! and frame composition.
+//! and frame composition, and the checked laser scan every navigation node reads.
 //!
 //! Frames follow REP-103 (x forward, y left, yaw counter-clockwise about z) and are named rerun
 //! style: `odom_from_base` is the pose of `base` in `odom`, and maps points from `base` to `odom`.
@@ -23,6 +23,8 @@
 
 pub mod angle;
 pub mod pose;
+pub mod scan;
 
 pub use angle::wrap;
 pub use pose::Pose2;
+pub use scan::{Beam, Scan, ScanError};

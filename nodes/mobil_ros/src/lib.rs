@@ -16,6 +16,8 @@
 //! - [`ticker`]: [`Ticker`], a periodic tick following a rate parameter;
 //! - [`time`]: **the time rule** — stamps and algorithm `dt` from ROS time ([`time::DtClock`]),
 //!   watchdogs, freshness and tick periods on the steady clock;
+//! - [`scan`]: LaserScan → checked [`mobil_geom::Scan`] at the edge, laser pose from `/tf_static`
+//!   ([`scan::StaticFrames`]) or a parameter;
 //! - [`qos`]: the QoS presets of the interface contract; [`log`]: `tracing` set-up and
 //!   rate-limited warnings ([`warn_throttled!`]); [`geometry`]: planar poses in messages;
 //!   [`args`], [`params`], [`names`]: the ROS command line, parameter files, names.
@@ -30,6 +32,7 @@ pub mod names;
 pub mod node;
 pub mod params;
 pub mod qos;
+pub mod scan;
 pub mod ticker;
 pub mod time;
 
