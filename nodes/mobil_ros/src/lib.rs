@@ -16,6 +16,8 @@
 //! - [`ticker`]: [`Ticker`], a periodic tick following a rate parameter;
 //! - [`time`]: **the time rule** — stamps and algorithm `dt` from ROS time ([`time::DtClock`]),
 //!   watchdogs, freshness and tick periods on the steady clock;
+//! - [`offloop`]: [`OffLoop`], searches of 10–500 ms off the event loop, pre-empted by newer
+//!   requests;
 //! - [`scan`]: LaserScan → checked [`mobil_geom::Scan`] at the edge, laser pose from `/tf_static`
 //!   ([`scan::StaticFrames`]) or a parameter;
 //! - [`qos`]: the QoS presets of the interface contract; [`log`]: `tracing` set-up and
@@ -30,6 +32,7 @@ pub mod latest;
 pub mod log;
 pub mod names;
 pub mod node;
+pub mod offloop;
 pub mod params;
 pub mod qos;
 pub mod scan;
@@ -41,5 +44,6 @@ pub use config::{Config, ConfigError, Decl};
 pub use latest::{Freshness, Latest};
 pub use log::LogThrottle;
 pub use node::{run_node, shutdown_signal, NodeBody, NodeDecl, RosNode};
+pub use offloop::{CancelToken, OffLoop};
 pub use params::{ParamSpec, ParamValues};
 pub use ticker::Ticker;
