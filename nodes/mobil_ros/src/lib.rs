@@ -18,6 +18,7 @@
 //!   watchdogs, freshness and tick periods on the steady clock;
 //! - [`offloop`]: [`OffLoop`], searches of 10–500 ms off the event loop, pre-empted by newer
 //!   requests;
+//! - [`stop`]: [`stop::final_stop`], the bounded last zero command of a motion node;
 //! - [`scan`]: LaserScan → checked [`mobil_geom::Scan`] at the edge, laser pose from `/tf_static`
 //!   ([`scan::StaticFrames`]) or a parameter;
 //! - [`qos`]: the QoS presets of the interface contract; [`log`]: `tracing` set-up and
@@ -36,6 +37,7 @@ pub mod offloop;
 pub mod params;
 pub mod qos;
 pub mod scan;
+pub mod stop;
 pub mod ticker;
 pub mod time;
 
