@@ -9,11 +9,11 @@ use std::ops::Mul;
 /// to the parent: name it `parent_from_child`.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct Pose2 {
-    /// x of the child's origin in the parent [m].
+    /// x of the child's origin in the parent (m).
     pub x: f64,
-    /// y of the child's origin in the parent [m].
+    /// y of the child's origin in the parent (m).
     pub y: f64,
-    /// Heading of the child's x axis in the parent [rad].
+    /// Heading of the child's x axis in the parent (rad).
     pub yaw: f64,
 }
 

@@ -65,7 +65,7 @@ pub enum ScanError {
 /// What one beam says.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Beam {
-    /// An echo at this range [m], within [range_min, range_max].
+    /// An echo at this range (m), within [range_min, range_max].
     Hit(f64),
     /// `+inf`: nothing within range_max along the beam (free space up to range_max).
     NoEcho,
@@ -161,7 +161,7 @@ impl Scan {
         self.ranges.is_empty()
     }
 
-    /// The angle of beam `i` in the laser frame [rad].
+    /// The angle of beam `i` in the laser frame (rad).
     pub fn angle(&self, i: usize) -> f64 {
         self.angle_min + i as f64 * self.angle_increment
     }
@@ -192,7 +192,7 @@ impl Scan {
         &self.intensities
     }
 
-    /// The valid range limits [m].
+    /// The valid range limits (m).
     pub fn range_limits(&self) -> (f64, f64) {
         (self.range_min, self.range_max)
     }

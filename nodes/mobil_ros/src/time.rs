@@ -34,7 +34,7 @@ pub enum DtError {
     /// the new time, so the next tick gives a `dt` again.
     #[error("ROS time went backwards by {by_nanos} ns (clock reset?); restarted at the new time")]
     Backwards {
-        /// How far back [ns].
+        /// How far back, in nanoseconds.
         by_nanos: i64,
     },
 }
