@@ -110,6 +110,7 @@ async fn dt_follows_the_simulated_clock_and_freshness_the_steady_clock() {
     // The input set before the loop is about `wall` old on the steady clock — not 4× that: a
     // 1.5 s watchdog still calls it fresh, although ROS time moved by about 4 s.
     let age = input.received().map(|r| r.elapsed().as_secs_f64()).unwrap_or(f64::NAN);
+    println!("ROS time {ros_sum:.3} s over {wall:.3} s of wall time (×{ratio:.2}); steady age {age:.3} s");
     assert!((age - wall).abs() < 0.1, "age {age:.3} s, wall {wall:.3} s");
     assert_eq!(input.status(Duration::from_millis(1500)), Freshness::Fresh);
     assert!(
@@ -149,6 +150,7 @@ async fn the_final_stop_is_acknowledged_by_a_matched_reader() {
     let started = Instant::now();
     let outcome = final_stop(&cmd, Twist::default(), Duration::from_millis(500)).await;
     let waited = started.elapsed();
+    println!("final stop {outcome:?} after {waited:?}");
     assert_eq!(outcome, FinalStop::Acknowledged);
     assert!(waited < Duration::from_millis(500), "{waited:?}");
     // Acknowledged means received: the zero command is in the reader's cache now.
