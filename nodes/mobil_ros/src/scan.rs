@@ -51,9 +51,11 @@ pub fn scan_from_msg(msg: &LaserScan, base_from_laser: Pose2) -> Result<Scan, Sc
 
 /// The static transforms seen on `/tf_static` (planar part: x, y, yaw), by child frame.
 ///
-/// Feed it every `tf2_msgs/TFMessage` of `/tf_static` (reliable, transient local) and ask
+/// Feed it every `tf2_msgs/TFMessage` of `tf_static` (subscribed with [`crate::qos::tf_static`],
+/// so that a node started after the publishers still gets them) and ask
 /// [`StaticFrames::lookup`] for `base_frame → laser_frame`, which composes the chain between
-/// them (e.g. base_link → mount → laser), in either direction.
+/// them (e.g. base_link → mount → laser), in either direction. Until the chain is known, a node
+/// uses the laser pose parameter or waits; it never guesses.
 #[derive(Debug, Clone, Default)]
 pub struct StaticFrames {
     /// child → (parent, parent_from_child).
