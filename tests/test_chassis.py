@@ -534,7 +534,7 @@ def test_node_logs_reach_rosout(start_node, ros_node):
         line = next(m for m in rosout.snapshot() if "clamped" in m.msg)
         cmd.publish(twist())
     assert line.level == Log.WARN
-    assert line.file.endswith("chassis_node.rs") and line.line > 0
+    assert line.file.endswith("chassis_node/src/main.rs") and line.line > 0
 
 
 CAR_JOINTS = ["front_left_steering", "front_right_steering", "rear_left_wheel", "rear_right_wheel"]

@@ -531,9 +531,9 @@ impl ChassisController {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::angles::wrap;
     use crate::model::{ChassisConfig, ChassisModel};
     use approx::assert_relative_eq;
+    use mobil_geom::wrap;
 
     fn controller(config: ChassisConfig) -> ChassisController {
         ChassisController::new(ControllerConfig {

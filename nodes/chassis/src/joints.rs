@@ -15,9 +15,9 @@
 
 use thiserror::Error;
 
-use crate::angles::wrap;
 use crate::kinematics::{JointKind, WheelState};
 use crate::model::ChassisModel;
+use mobil_geom::wrap;
 
 /// Why a JointState could not be read.
 #[derive(Debug, Clone, PartialEq, Error)]

@@ -16,6 +16,7 @@
 //! Steering joints carry a position (the angle, positive = turning left); wheel joints carry a
 //! velocity (positive = driving the robot forward along the wheel's rolling direction).
 
+use mobil_geom::Pose2;
 use nalgebra::Vector3;
 use serde::{Deserialize, Serialize};
 
@@ -449,16 +450,16 @@ pub fn twist_at_origin(twist_at_reference: BodyTwist, d: f64) -> BodyTwist {
 
 /// Pose `[x, y, ϑ]` of the reference point: the origin pose moved by Rot(ϑ)·[d, 0] (SPEC §1).
 pub fn pose_at_reference(pose_of_origin: &Vector3<f64>, d: f64) -> Vector3<f64> {
-    let (s, c) = pose_of_origin.z.sin_cos();
-    Vector3::new(pose_of_origin.x + d * c, pose_of_origin.y + d * s, pose_of_origin.z)
+    Pose2 {
+        x: pose_of_origin.x,
+        y: pose_of_origin.y,
+        yaw: pose_of_origin.z,
+    }
+    .ahead(d)
+    .to_vector()
 }
 
 /// Pose `[x, y, ϑ]` of the origin from the pose of the reference point `d` ahead.
 pub fn pose_at_origin(pose_of_reference: &Vector3<f64>, d: f64) -> Vector3<f64> {
-    let (s, c) = pose_of_reference.z.sin_cos();
-    Vector3::new(
-        pose_of_reference.x - d * c,
-        pose_of_reference.y - d * s,
-        pose_of_reference.z,
-    )
+    pose_at_reference(pose_of_reference, -d)
 }

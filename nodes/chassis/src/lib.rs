@@ -1,8 +1,9 @@
 //! LOW-LEVEL chassis method of the mobil suite (SPEC §1; dissertation 004 §3.1–3.3, §4.1).
 //!
-//! Pure algorithm core: no ROS types, no clock, no I/O. Time is always an input (`dt` or a
-//! timestamp in seconds), so tests and replays are deterministic. The `chassis_node` binary wires
-//! this library to topics.
+//! Pure algorithm core: no ROS types, no clock, no I/O, and no ROS dependency at all
+//! (`tests/check_ros_free.sh` proves it). Time is always an input (`dt` or a timestamp in
+//! seconds), so tests and replays are deterministic. Angles wrap with [`mobil_geom::wrap`].
+//! `chassis_node` (crate `mobil_chassis_node`) wires this library to topics.
 //!
 //! - [`model`]: [`ChassisModel`] (tricycle, car-like MOBIL-II, omni OMR-III) and validated
 //!   [`ChassisParams`], with presets and the effective steering limit δ_eff.
@@ -11,11 +12,9 @@
 //! - [`limits`]: [`clamp_command`] makes any requested twist feasible and says why it changed it.
 //! - [`odometry`]: [`Odometry`], exact arc integration with pose and twist covariance.
 //! - [`watchdog`]: [`CmdVelWatchdog`], the cmd_vel timeout.
-//! - [`angles`]: [`angles::wrap`] to (−π, π].
 //! - [`joints`]: the `sensor_msgs/JointState` layout of wheel commands and feedback, parsed once.
 //! - [`controller`]: [`ChassisController`], the LOW-LEVEL loop (limits, watchdogs, odometry)
 //!   that `chassis_node` wraps, with the one safety gate every wheel command comes out of.
-//! - [`ros_params`]: the chassis geometry as ROS parameters, shared by every node that models it.
 //!
 //! Frames: the *kinematic origin* is the rear-axle midpoint for the tricycle and the car-like
 //! chassis, and the centre for the omni chassis. The *reference point* (published as `base_link`)
@@ -38,7 +37,6 @@
 
 #![warn(missing_docs)]
 
-pub mod angles;
 pub mod controller;
 pub mod error;
 pub mod joints;
@@ -46,7 +44,6 @@ pub mod kinematics;
 pub mod limits;
 pub mod model;
 pub mod odometry;
-pub mod ros_params;
 pub mod watchdog;
 
 pub use controller::{ChassisController, Command, ControllerConfig, FeedbackOutcome, GatedCommand, Safety};

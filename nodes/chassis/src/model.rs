@@ -92,6 +92,13 @@ pub struct ChassisConfig {
     pub reference_offset: f64,
 }
 
+impl Default for ChassisConfig {
+    /// MOBIL-II's.
+    fn default() -> Self {
+        ChassisConfig::mobil2()
+    }
+}
+
 impl ChassisConfig {
     /// MOBIL-II figures (004 §4.1.1): car-like, L 0.60, B 0.62, δ_max 70°, R_min 0.73, v_max 0.5.
     ///

@@ -26,9 +26,9 @@
 use nalgebra::{Isometry2, Matrix3, Vector2, Vector3};
 use serde::{Deserialize, Serialize};
 
-use crate::angles::wrap;
 use crate::error::{ChassisError, OdometryError};
 use crate::kinematics::{pose_at_reference, twist_at_reference, BodyTwist};
+use mobil_geom::wrap;
 
 /// Below this |ω·dt| the arc uses its Taylor series (truncation error below 1e-27 relative).
 const SERIES_THRESHOLD: f64 = 1e-4;

@@ -1,26 +1,51 @@
-//! Shared ROS 2 plumbing of the mobil node suite.
+//! The node kit of the mobil suite: everything a node shell needs around its ROS-free
+//! algorithm crate, so that every node is written the same way.
 //!
-//! Every executable (`chassis_node`, `sim_node`, …) is a thin shell around a ROS-free library;
-//! this crate is the shell's common part:
-//! - [`args`]: `--ros-args` with `--params-file`, `-p`, `-r` (incl. `__ns`, `__node`), `--log-level`;
-//! - [`params`]: typed parameter declarations, ROS 2 YAML parameter files, validation;
-//! - [`node`]: the node itself — DDS domain from `ROS_DOMAIN_ID`, the standard parameter
-//!   services (list/get/set/describe) with validation, name resolution and remapping, clean
-//!   shutdown on SIGINT/SIGTERM;
-//! - [`qos`]: the QoS presets of the interface contract;
-//! - [`log`]: `tracing` set-up and rate-limited warnings;
-//! - [`time`]: message stamps; [`geometry`]: planar poses in messages.
+//! A node is a thin shell (see `nodes/chassis_node` for the pattern):
+//! - [`config`]: the configuration declared once — each parameter's name, type, default, range,
+//!   description and read-only flag, bound to the typed field it fills; from it come the ROS
+//!   declarations, `--help`, validation of files, `-p` and `set_parameters` (refused with a
+//!   reason), and the typed configuration ([`NodeDecl::for_config`], [`RosNode::config`],
+//!   [`RosNode::config_changed`]);
+//! - [`node`]: the node itself — command line, DDS domain from `ROS_DOMAIN_ID`, the standard
+//!   parameter services, name resolution and remapping, clean shutdown on SIGINT/SIGTERM
+//!   ([`run_node`]);
+//! - [`input`]: typed subscription streams that log (rate-limited) and drop undecodable samples;
+//! - [`latest`]: [`Latest`], an input's last value with its stamp and steady receive time — the
+//!   one way to decide that an input is stale;
+//! - [`ticker`]: [`Ticker`], a periodic tick following a rate parameter;
+//! - [`time`]: **the time rule** — stamps and algorithm `dt` from ROS time ([`time::DtClock`]),
+//!   watchdogs, freshness and tick periods on the steady clock;
+//! - [`offloop`]: [`OffLoop`], searches of 10–500 ms off the event loop, pre-empted by newer
+//!   requests;
+//! - [`stop`]: [`stop::final_stop`], the bounded last zero command of a motion node;
+//! - [`scan`]: LaserScan → checked [`mobil_geom::Scan`] at the edge, laser pose from `/tf_static`
+//!   ([`scan::StaticFrames`]) or a parameter;
+//! - [`qos`]: the QoS presets of the interface contract; [`log`]: `tracing` set-up and
+//!   rate-limited warnings ([`warn_throttled!`]); [`geometry`]: planar poses in messages;
+//!   [`args`], [`params`], [`names`]: the ROS command line, parameter files, names.
 
 pub mod args;
+pub mod config;
 pub mod geometry;
+pub mod input;
+pub mod latest;
 pub mod log;
 pub mod names;
 pub mod node;
+pub mod offloop;
 pub mod params;
 pub mod qos;
+pub mod scan;
+pub mod stop;
+pub mod ticker;
 pub mod time;
 
 pub use args::RosArgs;
+pub use config::{Config, ConfigError, Decl};
+pub use latest::{Freshness, Latest};
 pub use log::LogThrottle;
 pub use node::{run_node, shutdown_signal, NodeBody, NodeDecl, RosNode};
+pub use offloop::{CancelToken, OffLoop};
 pub use params::{ParamSpec, ParamValues};
+pub use ticker::Ticker;

@@ -18,6 +18,7 @@
 //! ```
 
 use crate::args::{split_ros_args, RosArgs, ROS_ARGS_HELP};
+use crate::config::{Config, ConfigError, Decl};
 use crate::names::NameResolver;
 use crate::params::{initial_params, type_name, ParamSpec, ParamValues};
 use anyhow::{anyhow, bail, Context as _};
@@ -59,6 +60,15 @@ impl NodeDecl {
         }
     }
 
+    /// A node whose parameters are those of configuration `C`, checked by building it (see
+    /// [`crate::config`]).
+    pub fn for_config<C: Config>(default_name: &str, about: &str) -> Self {
+        let decl = Decl::<C>::of();
+        NodeDecl::new(default_name, about)
+            .params(decl.specs())
+            .check(move |values| decl.build(values).map(|_| ()).map_err(|e| e.to_string()))
+    }
+
     /// Declares a parameter.
     pub fn param(mut self, spec: ParamSpec) -> Self {
         self.params.push(spec);
@@ -90,9 +100,15 @@ impl NodeDecl {
                 other => format!("{other:?}"),
             };
             let ro = if p.read_only { " (read-only)" } else { "" };
+            let allowed = p.constraint.to_string();
+            let allowed = if allowed.is_empty() {
+                String::new()
+            } else {
+                format!(" {allowed}")
+            };
             let _ = writeln!(
                 s,
-                "  {:<28} {:<10} {}{ro} [default {default}]",
+                "  {:<28} {:<10} {}{ro} [default {default}]{allowed}",
                 p.name,
                 type_name(&p.default),
                 p.description
@@ -291,6 +307,19 @@ impl RosNode {
     /// The current parameter values.
     pub fn params(&self) -> ParamValues {
         lock(&self.params).clone()
+    }
+
+    /// The typed configuration from the current parameter values.
+    pub fn config<C: Config>(&self) -> Result<C, ConfigError> {
+        crate::config::load(&self.params())
+    }
+
+    /// Waits for the next accepted parameter change and yields the new typed configuration
+    /// (already validated by the parameter services, so an error means the node's
+    /// configuration and its declaration disagree). Cancel-safe, for `select!`.
+    pub async fn config_changed<C: Config>(&mut self) -> Option<Result<C, ConfigError>> {
+        let values = self.changes.recv().await?;
+        Some(crate::config::load(&values))
     }
 
     /// Waits for the next accepted parameter change; yields the full new set of values.

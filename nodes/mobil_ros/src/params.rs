@@ -58,6 +58,31 @@ pub enum Constraint {
     Length(usize),
 }
 
+impl std::fmt::Display for Constraint {
+    /// The constraint for `--help`: `[0, 1.5707963267948966]`, `(0, ∞)`, `one of a, b`,
+    /// `3 elements`, or nothing.
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Constraint::Any => Ok(()),
+            Constraint::Range { min, max } => {
+                let (open, lo) = match min {
+                    Some((m, true)) => ("[", m.to_string()),
+                    Some((m, false)) => ("(", m.to_string()),
+                    None => ("(", "−∞".to_owned()),
+                };
+                let (hi, close) = match max {
+                    Some((m, true)) => (m.to_string(), "]"),
+                    Some((m, false)) => (m.to_string(), ")"),
+                    None => ("∞".to_owned(), ")"),
+                };
+                write!(f, "{open}{lo}, {hi}{close}")
+            }
+            Constraint::Choices(c) => write!(f, "one of {}", c.join(", ")),
+            Constraint::Length(n) => write!(f, "{n} elements"),
+        }
+    }
+}
+
 /// One declared parameter.
 #[derive(Debug, Clone, PartialEq)]
 pub struct ParamSpec {
@@ -646,6 +671,20 @@ other:
         )
         .unwrap();
         assert_eq!(p.values.i64("beams").unwrap(), 42);
+    }
+
+    #[test]
+    fn constraints_read_as_intervals() {
+        let text = |s: ParamSpec| s.constraint.to_string();
+        assert_eq!(text(ParamSpec::double("a", 1.0, "").within(0.0, 2.0)), "[0, 2]");
+        assert_eq!(text(ParamSpec::double("a", 1.0, "").above(0.0)), "(0, ∞)");
+        assert_eq!(text(ParamSpec::double("a", 1.0, "").max(3.5)), "(−∞, 3.5]");
+        assert_eq!(
+            text(ParamSpec::string("m", "x", "").choices(&["x", "y"])),
+            "one of x, y"
+        );
+        assert_eq!(text(ParamSpec::doubles("p", &[0.0; 3], "").length(3)), "3 elements");
+        assert_eq!(text(ParamSpec::boolean("b", true, "")), "");
     }
 
     #[test]

@@ -33,3 +33,9 @@ pub fn sensor_data() -> QosProfile {
 pub fn latched() -> QosProfile {
     reliable(1).durability(Durability::TransientLocal)
 }
+
+/// Reading `/tf_static` (tf2's static listener QoS): reliable, transient local, depth 100, so a
+/// late reader gets every static transform of every publisher, not only the last message.
+pub fn tf_static() -> QosProfile {
+    reliable(100).durability(Durability::TransientLocal)
+}

@@ -1,6 +1,83 @@
-//! Conversions between ROS message stamps and seconds.
+//! Time: which clock for what, and conversions between ROS message stamps and seconds.
+//!
+//! **The rule.** A node has two clocks, and each question has one of them:
+//! - **ROS time** ([`crate::RosNode::now_nanos`]: `/clock` under `use_sim_time`, else the system
+//!   clock) stamps messages and gives an algorithm its `dt`. Under a simulator running at 4×
+//!   real time, a 50 Hz control tick spans 80 ms of ROS time, and a planner integrating over
+//!   20 ms of wall time would be 4× wrong. Take `dt` from [`DtClock`] fed with ROS time (or from
+//!   the stamps of the messages integrated, as odometry does).
+//! - **The steady clock** ([`std::time::Instant`]) runs watchdogs, freshness
+//!   ([`crate::latest::Latest`]) and tick periods ([`crate::ticker::Ticker`]): a stalled, reset
+//!   or paused `/clock` must never keep a wheel turning or a stale input alive.
+//!
+//! ```
+//! use mobil_ros::time::{DtClock, DtError};
+//! let mut dt = DtClock::new();
+//! assert_eq!(dt.step(1_000_000_000), Ok(None)); // the first tick only starts the clock
+//! assert_eq!(dt.step(1_080_000_000), Ok(Some(0.08)));
+//! assert_eq!(dt.step(1_080_000_000), Err(DtError::Zero));
+//! assert!(matches!(dt.step(500_000_000), Err(DtError::Backwards { .. })));
+//! assert_eq!(dt.step(520_000_000), Ok(Some(0.02))); // restarted at the reset
+//! ```
 
 use mobil_msgs::builtin_interfaces::msg::Time;
+use thiserror::Error;
+
+/// Why [`DtClock::step`] yields no `dt`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Error)]
+pub enum DtError {
+    /// ROS time did not advance since the last tick (a paused or stalled `/clock`): skip the
+    /// step.
+    #[error("ROS time did not advance since the last tick (clock paused or stalled)")]
+    Zero,
+    /// ROS time went backwards (a restarted simulation, a clock reset): the clock restarts at
+    /// the new time, so the next tick gives a `dt` again.
+    #[error("ROS time went backwards by {by_nanos} ns (clock reset?); restarted at the new time")]
+    Backwards {
+        /// How far back, in nanoseconds.
+        by_nanos: i64,
+    },
+}
+
+/// The `dt` of an algorithm between ticks, measured in ROS time (see the module's rule).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct DtClock {
+    last_nanos: Option<i64>,
+}
+
+impl DtClock {
+    /// A clock that has not ticked.
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    /// Ticks at ROS time `now_nanos`: `Ok(None)` on the first tick, `Ok(Some(dt))` in seconds
+    /// after that; zero or negative steps are refused with the reason.
+    pub fn step(&mut self, now_nanos: i64) -> Result<Option<f64>, DtError> {
+        let Some(last) = self.last_nanos else {
+            self.last_nanos = Some(now_nanos);
+            return Ok(None);
+        };
+        match now_nanos.checked_sub(last) {
+            Some(0) => Err(DtError::Zero),
+            Some(d) if d > 0 => {
+                self.last_nanos = Some(now_nanos);
+                Ok(Some(d as f64 / 1e9))
+            }
+            d => {
+                self.last_nanos = Some(now_nanos);
+                Err(DtError::Backwards {
+                    by_nanos: d.map_or(i64::MAX, |d| -d),
+                })
+            }
+        }
+    }
+
+    /// Forgets the last tick (the next one starts the clock again).
+    pub fn reset(&mut self) {
+        self.last_nanos = None;
+    }
+}
 
 /// A stamp from nanoseconds since the epoch (negative values clamp to 0, as ROS time cannot be).
 pub fn stamp_from_nanos(nanos: i64) -> Time {
@@ -37,6 +114,26 @@ pub fn is_zero(t: &Time) -> bool {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn dt_clock_steps_refuses_and_recovers() {
+        let mut c = DtClock::new();
+        assert_eq!(c.step(2_000_000_000), Ok(None));
+        // 2.0 s → 2.25 s: 0.25 s.
+        assert_eq!(c.step(2_250_000_000), Ok(Some(0.25)));
+        assert_eq!(c.step(2_250_000_000), Err(DtError::Zero));
+        // Still 0.25 s past 2.25 s after the refused zero step: 2.5 s − 2.25 s.
+        assert_eq!(c.step(2_500_000_000), Ok(Some(0.25)));
+        assert_eq!(
+            c.step(1_000_000_000),
+            Err(DtError::Backwards {
+                by_nanos: 1_500_000_000
+            })
+        );
+        assert_eq!(c.step(1_001_000_000), Ok(Some(0.001)));
+        c.reset();
+        assert_eq!(c.step(5), Ok(None));
+    }
 
     #[test]
     fn round_trips() {

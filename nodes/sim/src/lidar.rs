@@ -6,6 +6,7 @@
 //! to [range_min, range_max], comes from a seeded ChaCha generator, so a run is reproducible.
 #![warn(missing_docs)]
 
+use mobil_geom::Pose2;
 use nalgebra::Point2;
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
@@ -142,11 +143,8 @@ impl Lidar {
     pub fn scan(&mut self, world: &World, base_pose: (f64, f64, f64)) -> ScanData {
         let c = self.config;
         let (x, y, yaw) = base_pose;
-        let (s, co) = yaw.sin_cos();
-        let origin = Point2::new(
-            x + co * c.mount[0] - s * c.mount[1],
-            y + s * c.mount[0] + co * c.mount[1],
-        );
+        let world_from_base = Pose2 { x, y, yaw };
+        let origin = world_from_base.transform_point(Point2::new(c.mount[0], c.mount[1]));
         let heading = yaw + c.mount[2];
         // A full circle must not measure ±π twice: N beams then split 2π into N gaps.
         let full_circle = (c.fov - std::f64::consts::TAU).abs() < 1e-9;

@@ -27,6 +27,7 @@ use std::f64::consts::TAU;
 
 use mobil_chassis::kinematics::{BodyTwist, JointKind, WheelState};
 use mobil_chassis::model::{ChassisModel, ChassisParams};
+use mobil_geom::{wrap, Pose2};
 use nalgebra::{Matrix3, Point2, Vector2, Vector3};
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
@@ -273,12 +274,13 @@ pub enum CommandOutcome {
 
 /// Pose `[x, y, ϑ]` of a point `d` ahead of `pose` along its body x.
 fn ahead(pose: &Vector3<f64>, d: f64) -> Vector3<f64> {
-    Vector3::new(pose.x + d * pose.z.cos(), pose.y + d * pose.z.sin(), pose.z)
-}
-
-/// Angle in (−π, π].
-fn wrap(a: f64) -> f64 {
-    a.sin().atan2(a.cos())
+    Pose2 {
+        x: pose.x,
+        y: pose.y,
+        yaw: pose.z,
+    }
+    .ahead(d)
+    .to_vector()
 }
 
 /// World-frame pose rate of a body moving with `twist` at heading `yaw`.

@@ -37,6 +37,18 @@ impl<M: Serialize> Publisher<M> {
       .map_err(Into::into)
   }
 
+  /// Waits until every matched reliable reader has acknowledged every sample
+  /// published so far, or `max_wait` has passed (DDS
+  /// `wait_for_acknowledgments`). `Ok(true)`: acknowledged, or no reliable
+  /// reader is matched; `Ok(false)`: timed out. Blocks the calling thread for at
+  /// most `max_wait` (a zero `max_wait` only checks).
+  pub fn wait_for_acknowledgments(&self, max_wait: std::time::Duration) -> WriteResult<bool, ()> {
+    self
+      .datawriter
+      .wait_for_acknowledgments(max_wait)
+      .map_err(Into::into)
+  }
+
   pub fn assert_liveliness(&self) -> WriteResult<(), ()> {
     self.datawriter.assert_liveliness().map_err(Into::into)
   }

@@ -3,7 +3,7 @@
 //! world's obstacles and prints a one-line summary: distance driven and final odometry error.
 
 use futures::StreamExt;
-use mobil_chassis::angles::wrap;
+use mobil_geom::wrap;
 use mobil_msgs::geometry_msgs::msg::Twist;
 use mobil_msgs::nav_msgs::msg::Odometry;
 use mobil_ros::geometry::yaw_of;

@@ -13,9 +13,10 @@ use mobil_chassis::controller::{
 };
 use mobil_chassis::joints::{joints_from_wheel_state, JointStateError};
 use mobil_chassis::kinematics::BodyTwist;
+use mobil_chassis::model::ChassisConfig;
 use mobil_chassis::model::ChassisModel;
 use mobil_chassis::odometry::OdometryNoise;
-use mobil_chassis::ros_params::{chassis_from_params, chassis_param_specs};
+use mobil_chassis_node::{chassis_params, declare_chassis};
 use mobil_msgs::builtin_interfaces::msg::Time;
 use mobil_msgs::geometry_msgs::msg::{Transform, TransformStamped, Twist, Vector3};
 use mobil_msgs::mobil_msgs::msg::ChassisStatus;
@@ -23,19 +24,23 @@ use mobil_msgs::nav_msgs::msg::Odometry;
 use mobil_msgs::sensor_msgs::msg::JointState;
 use mobil_msgs::std_msgs::msg::Header;
 use mobil_msgs::tf2_msgs::msg::TFMessage;
+use mobil_ros::config::{Config, ConfigError, Decl};
 use mobil_ros::geometry::{planar_odometry, yaw_quaternion};
-use mobil_ros::params::ParamValues;
+use mobil_ros::input::{decoded, Input};
+use mobil_ros::stop::{final_stop, FINAL_STOP_WAIT};
+use mobil_ros::ticker::{self, Ticker};
 use mobil_ros::time::{is_zero, secs_from_stamp};
-use mobil_ros::{qos, run_node, shutdown_signal, warn_throttled, LogThrottle, NodeDecl, ParamSpec, RosNode};
+use mobil_ros::{qos, run_node, shutdown_signal, warn_throttled, LogThrottle, NodeDecl, RosNode};
 use std::process::ExitCode;
-use std::time::Duration;
 use tracing::{info, warn};
 
-/// Everything the node is configured with, parsed from its parameters in one place (used both at
-/// start-up and to vet every parameter change).
-#[derive(Debug, Clone, PartialEq)]
+/// Everything the node is configured with, each field filled by one declared parameter.
+#[derive(Debug, Clone, Default, PartialEq)]
 struct NodeConfig {
-    controller: ControllerConfig,
+    chassis: ChassisConfig,
+    cmd_vel_timeout_s: f64,
+    feedback_timeout_s: f64,
+    noise: OdometryNoise,
     feedback_speed_factor: f64,
     encoder_positions_wrap: bool,
     control_rate_hz: f64,
@@ -44,82 +49,110 @@ struct NodeConfig {
     publish_tf: bool,
 }
 
-fn decl() -> NodeDecl {
-    let noise = OdometryNoise::default();
-    NodeDecl::new(
-        "chassis",
-        "LOW-LEVEL chassis control: kinematics, command limits, odometry, cmd_vel watchdog",
-    )
-    .params(chassis_param_specs())
-    .param(
-        ParamSpec::double(
+impl Config for NodeConfig {
+    fn declare(d: &mut Decl<Self>) {
+        let noise = OdometryNoise::default();
+        d.nest(|c: &mut NodeConfig| &mut c.chassis, declare_chassis);
+        d.double(
             "cmd_vel_timeout_s",
             0.5,
             "zero command after this long without cmd_vel (0: off)",
+            |c, v| c.cmd_vel_timeout_s = v,
         )
-        .min(0.0),
-    )
-    .param(
-        ParamSpec::double(
+        .min(0.0);
+        d.double(
             "feedback_timeout_s",
             0.5,
             "zero command after this long without joint_states (0: off)",
+            |c, v| c.feedback_timeout_s = v,
         )
-        .min(0.0),
-    )
-    .param(
-        ParamSpec::double(
+        .min(0.0);
+        d.double(
             "max_feedback_wheel_speed_factor",
             DEFAULT_FEEDBACK_SPEED_FACTOR,
             "joint_states wheel speeds above this × max_wheel_speed are refused as impossible (bad encoder data)",
+            |c, v| c.feedback_speed_factor = v,
         )
-        .within(1.0, 100.0),
-    )
-    .param(ParamSpec::boolean(
-        "encoder_positions_wrap",
-        false,
-        "position-only joint_states report wheel angles wrapped to one turn (false: a continuous count)",
-    ))
-    .param(ParamSpec::double("control_rate_hz", 50.0, "wheel_commands and status rate").within(1.0, 1000.0))
-    .param(ParamSpec::string("odom_frame", "odom", "odometry frame"))
-    .param(ParamSpec::string(
-        "base_frame",
-        "base_link",
-        "robot frame (at the reference point)",
-    ))
-    .param(ParamSpec::boolean("publish_tf", true, "publish odom → base_link on tf"))
-    .param(ParamSpec::double("odom.along_track_var_per_m", noise.along_track_var_per_m, "[m²/m]").min(0.0))
-    .param(ParamSpec::double("odom.cross_track_var_per_m", noise.cross_track_var_per_m, "[m²/m]").min(0.0))
-    .param(ParamSpec::double("odom.heading_var_per_rad", noise.heading_var_per_rad, "[rad²/rad]").min(0.0))
-    .param(ParamSpec::double("odom.heading_var_per_m", noise.heading_var_per_m, "[rad²/m]").min(0.0))
-    .param(ParamSpec::doubles("odom.twist_variance", &noise.twist_variance, "vx, vy, ω variances").length(3))
-    .check(|p| node_config(p).map(|_| ()))
+        .within(1.0, 100.0);
+        d.boolean(
+            "encoder_positions_wrap",
+            false,
+            "position-only joint_states report wheel angles wrapped to one turn (false: a continuous count)",
+            |c, v| c.encoder_positions_wrap = v,
+        );
+        d.double("control_rate_hz", 50.0, "wheel_commands and status rate", |c, v| {
+            c.control_rate_hz = v
+        })
+        .within(1.0, 1000.0);
+        d.string("odom_frame", "odom", "odometry frame", |c, v| c.odom_frame = v);
+        d.string(
+            "base_frame",
+            "base_link",
+            "robot frame (at the reference point)",
+            |c, v| c.base_frame = v,
+        );
+        d.boolean("publish_tf", true, "publish odom → base_link on tf", |c, v| {
+            c.publish_tf = v
+        });
+        d.double(
+            "odom.along_track_var_per_m",
+            noise.along_track_var_per_m,
+            "[m²/m]",
+            |c, v| c.noise.along_track_var_per_m = v,
+        )
+        .min(0.0);
+        d.double(
+            "odom.cross_track_var_per_m",
+            noise.cross_track_var_per_m,
+            "[m²/m]",
+            |c, v| c.noise.cross_track_var_per_m = v,
+        )
+        .min(0.0);
+        d.double(
+            "odom.heading_var_per_rad",
+            noise.heading_var_per_rad,
+            "[rad²/rad]",
+            |c, v| c.noise.heading_var_per_rad = v,
+        )
+        .min(0.0);
+        d.double(
+            "odom.heading_var_per_m",
+            noise.heading_var_per_m,
+            "[rad²/m]",
+            |c, v| c.noise.heading_var_per_m = v,
+        )
+        .min(0.0);
+        d.doubles(
+            "odom.twist_variance",
+            noise.twist_variance,
+            "vx, vy, ω variances",
+            |c, v| c.noise.twist_variance = v,
+        );
+    }
+
+    fn validate(&self) -> Result<(), ConfigError> {
+        self.controller().map(|_| ())
+    }
 }
 
-fn node_config(p: &ParamValues) -> Result<NodeConfig, String> {
-    let tv = p.f64s("odom.twist_variance")?;
-    let noise = OdometryNoise {
-        along_track_var_per_m: p.f64("odom.along_track_var_per_m")?,
-        cross_track_var_per_m: p.f64("odom.cross_track_var_per_m")?,
-        heading_var_per_rad: p.f64("odom.heading_var_per_rad")?,
-        heading_var_per_m: p.f64("odom.heading_var_per_m")?,
-        twist_variance: [tv[0], tv[1], tv[2]],
-    };
-    noise.validate().map_err(|e| e.to_string())?;
-    Ok(NodeConfig {
-        controller: ControllerConfig {
-            params: chassis_from_params(p)?,
-            cmd_vel_timeout_s: p.f64("cmd_vel_timeout_s")?,
-            feedback_timeout_s: p.f64("feedback_timeout_s")?,
-            noise,
-        },
-        feedback_speed_factor: p.f64("max_feedback_wheel_speed_factor")?,
-        encoder_positions_wrap: p.bool("encoder_positions_wrap")?,
-        control_rate_hz: p.f64("control_rate_hz")?,
-        odom_frame: p.string("odom_frame")?,
-        base_frame: p.string("base_frame")?,
-        publish_tf: p.bool("publish_tf")?,
-    })
+impl NodeConfig {
+    /// The controller's settings: validated geometry, watchdogs, odometry noise.
+    fn controller(&self) -> Result<ControllerConfig, ConfigError> {
+        self.noise.validate().map_err(ConfigError::inconsistent)?;
+        Ok(ControllerConfig {
+            params: chassis_params(&self.chassis)?,
+            cmd_vel_timeout_s: self.cmd_vel_timeout_s,
+            feedback_timeout_s: self.feedback_timeout_s,
+            noise: self.noise,
+        })
+    }
+}
+
+fn decl() -> NodeDecl {
+    NodeDecl::for_config::<NodeConfig>(
+        "chassis",
+        "LOW-LEVEL chassis control: kinematics, command limits, odometry, cmd_vel watchdog",
+    )
 }
 
 fn main() -> ExitCode {
@@ -151,16 +184,17 @@ fn model_code(m: ChassisModel) -> u8 {
 }
 
 async fn run(node: &mut RosNode) -> anyhow::Result<()> {
-    let mut config = node_config(&node.params()).map_err(anyhow::Error::msg)?;
-    let mut controller = ChassisController::new(config.controller)?;
+    let mut config: NodeConfig = node.config()?;
+    let mut controller = ChassisController::new(config.controller()?)?;
     controller.set_feedback_speed_factor(config.feedback_speed_factor)?;
     controller.set_encoder_positions_wrap(config.encoder_positions_wrap);
+    let params = controller.config().params;
     info!(
         "model {}, effective steering limit {:.1}°, v_max {} m/s, watchdog {} s",
-        config.controller.params.model().as_str(),
-        config.controller.params.effective_steering_limit().to_degrees(),
-        config.controller.params.v_max(),
-        config.controller.cmd_vel_timeout_s
+        params.model().as_str(),
+        params.effective_steering_limit().to_degrees(),
+        params.v_max(),
+        config.cmd_vel_timeout_s
     );
 
     let q = qos::default_qos();
@@ -171,11 +205,15 @@ async fn run(node: &mut RosNode) -> anyhow::Result<()> {
     let tf_pub = node.publisher::<TFMessage>("tf", &qos::reliable(100))?;
     let status_pub = node.publisher::<ChassisStatus>("~/status", &qos::latched())?;
 
-    let cmds = cmd_sub.async_stream();
-    let joints = joints_sub.async_stream();
+    let cmds = decoded(cmd_sub.async_stream(), "cmd_vel", "cmd_decode", "wheels stopped");
+    let joints = decoded(
+        joints_sub.async_stream(),
+        "joint_states",
+        "joints_decode",
+        "sample ignored",
+    );
     let shutdown = shutdown_signal();
-    let mut tick = tokio::time::interval(Duration::from_secs_f64(1.0 / config.control_rate_hz));
-    tick.set_missed_tick_behavior(tokio::time::MissedTickBehavior::Delay);
+    let mut tick = Ticker::new(config.control_rate_hz)?;
     tokio::pin!(cmds, joints, shutdown);
 
     let mut throttle = LogThrottle::default();
@@ -194,20 +232,21 @@ async fn run(node: &mut RosNode) -> anyhow::Result<()> {
     loop {
         tokio::select! {
             _ = &mut shutdown => break,
-            Some(changed) = node.param_changed() => {
-                match node_config(&changed) {
-                    Ok(new) => {
+            Some(changed) = node.config_changed::<NodeConfig>() => {
+                match changed.and_then(|new| Ok((new.controller()?, new))) {
+                    Ok((new_controller, new)) => {
                         // Everything that can fail is vetted before anything is applied.
                         let applied = ChassisController::check_feedback_speed_factor(new.feedback_speed_factor)
-                            .and_then(|()| controller.reconfigure(new.controller))
-                            .and_then(|()| controller.set_feedback_speed_factor(new.feedback_speed_factor));
+                            .map_err(anyhow::Error::from)
+                            .and_then(|()| Ok(ticker::period(new.control_rate_hz).map(|_| ())?))
+                            .and_then(|()| Ok(controller.reconfigure(new_controller)?))
+                            .and_then(|()| Ok(controller.set_feedback_speed_factor(new.feedback_speed_factor)?));
                         if let Err(e) = applied {
                             warn!("parameter change not applied: {e}");
                         } else {
                             controller.set_encoder_positions_wrap(new.encoder_positions_wrap);
-                            if new.control_rate_hz != config.control_rate_hz {
-                                tick = tokio::time::interval(Duration::from_secs_f64(1.0 / new.control_rate_hz));
-                            }
+                            // Vetted just above, so this cannot fail.
+                            let _ = tick.set_rate(new.control_rate_hz);
                             config = new;
                         }
                     }
@@ -216,7 +255,7 @@ async fn run(node: &mut RosNode) -> anyhow::Result<()> {
                 }
             }
             Some(msg) = cmds.next() => match msg {
-                Ok((twist, _)) => {
+                Input::Message(twist) => {
                     let request = BodyTwist::new(twist.linear.x, twist.linear.y, twist.angular.z);
                     let gated = controller.on_cmd_vel(request, now_s(node));
                     let requested = controller.requested();
@@ -228,15 +267,15 @@ async fn run(node: &mut RosNode) -> anyhow::Result<()> {
                     }
                     publish_wheels(&wheel_pub, node, &gated);
                 }
-                Err(e) => {
+                // Logged (rate-limited) by the input stream.
+                Input::Undecodable => {
                     rejected += 1;
-                    warn_throttled!(throttle, "cmd_decode", "undecodable cmd_vel: wheels stopped ({e:?})");
                     let gated = controller.on_unreadable_cmd_vel(now_s(node));
                     publish_wheels(&wheel_pub, node, &gated);
                 }
             },
             Some(msg) = joints.next() => match msg {
-                Ok((js, _)) => {
+                Input::Message(js) => {
                     let now = now_s(node);
                     // An unstamped sample is stamped on arrival (node clock).
                     let stamp_msg = if is_zero(&js.header.stamp) { node.stamp() } else { js.header.stamp.clone() };
@@ -286,10 +325,8 @@ async fn run(node: &mut RosNode) -> anyhow::Result<()> {
                         }
                     }
                 }
-                Err(e) => {
-                    rejected += 1;
-                    warn_throttled!(throttle, "joints_decode", "undecodable joint_states dropped: {e:?}");
-                }
+                // Logged (rate-limited) by the input stream.
+                Input::Undecodable => rejected += 1,
             },
             _ = tick.tick() => {
                 let now = now_s(node);
@@ -297,16 +334,16 @@ async fn run(node: &mut RosNode) -> anyhow::Result<()> {
                 let safety = cmd.safety();
                 // A refused (NaN) cmd_vel stops the wheels too, but was logged as what it is.
                 if safety.cmd_vel_timed_out() && !last_safety.cmd_vel_timed_out() {
-                    warn!("no cmd_vel for {} s: wheels stopped", config.controller.cmd_vel_timeout_s);
+                    warn!("no cmd_vel for {} s: wheels stopped", config.cmd_vel_timeout_s);
                 }
                 if safety.feedback_stale && !last_safety.feedback_stale {
-                    warn!("no valid joint_states for {} s: odometry stale, wheels stopped", config.controller.feedback_timeout_s);
+                    warn!("no valid joint_states for {} s: odometry stale, wheels stopped", config.feedback_timeout_s);
                 }
                 last_safety = safety;
                 publish_wheels(&wheel_pub, node, &cmd);
                 let status = ChassisStatus {
                     header: Header { stamp: node.stamp(), frame_id: config.base_frame.clone() },
-                    model: model_code(config.controller.params.model()),
+                    model: model_code(controller.config().params.model()),
                     watchdog_expired: safety.cmd_vel_expired || safety.cmd_vel_refused,
                     feedback_stale: safety.feedback_stale,
                     clamped: cmd.reasons.bits(),
@@ -320,16 +357,16 @@ async fn run(node: &mut RosNode) -> anyhow::Result<()> {
             }
         }
     }
-    // Leave the wheels stopped.
+    // Leave the wheels stopped, and wait (bounded) until the drivers have the command.
     let stop = controller.stop(now_s(node));
-    publish_wheels(&wheel_pub, node, &stop);
+    final_stop(&wheel_pub, wheels_message(node, &stop), FINAL_STOP_WAIT).await;
     Ok(())
 }
 
-/// The only way to `wheel_commands`: it takes nothing but the safety gate's output.
-fn publish_wheels(publisher: &ros2_client::Publisher<JointState>, node: &RosNode, cmd: &GatedCommand) {
+/// The `wheel_commands` message of the safety gate's output (it takes nothing else).
+fn wheels_message(node: &RosNode, cmd: &GatedCommand) -> JointState {
     let (name, position, velocity) = joints_from_wheel_state(&cmd.wheels);
-    let msg = JointState {
+    JointState {
         header: Header {
             stamp: node.stamp(),
             frame_id: String::new(),
@@ -338,8 +375,12 @@ fn publish_wheels(publisher: &ros2_client::Publisher<JointState>, node: &RosNode
         position,
         velocity,
         effort: Vec::new(),
-    };
-    if let Err(e) = publisher.publish(msg) {
+    }
+}
+
+/// The only way to `wheel_commands`: it takes nothing but the safety gate's output.
+fn publish_wheels(publisher: &ros2_client::Publisher<JointState>, node: &RosNode, cmd: &GatedCommand) {
+    if let Err(e) = publisher.publish(wheels_message(node, cmd)) {
         warn!("cannot publish wheel_commands: {e:?}");
     }
 }
@@ -401,11 +442,14 @@ mod tests {
             mobil_ros::params::initial_params(&d.params, &[("mobil2.yaml".into(), text)], &[], "/chassis", "chassis")
                 .unwrap();
         assert!(p.warnings.is_empty(), "{:?}", p.warnings);
-        let c = node_config(&p.values).unwrap();
-        assert_eq!(c.controller.params.model(), ChassisModel::CarLike);
+        let c = mobil_ros::config::load::<NodeConfig>(&p.values)
+            .unwrap()
+            .controller()
+            .unwrap();
+        assert_eq!(c.params.model(), ChassisModel::CarLike);
         // SPEC §1 Decision: δ_eff = atan(0.60 / 0.73) = 39.42°.
-        assert!((c.controller.params.effective_steering_limit().to_degrees() - 39.42).abs() < 0.01);
-        assert_eq!(c.controller.params.reference_offset(), 0.30);
+        assert!((c.params.effective_steering_limit().to_degrees() - 39.42).abs() < 0.01);
+        assert_eq!(c.params.reference_offset(), 0.30);
     }
 
     #[test]

@@ -7,7 +7,8 @@
 
 use futures::StreamExt;
 use mobil_chassis::joints::wheel_state_from_joints;
-use mobil_chassis::ros_params::{chassis_from_params, chassis_param_specs};
+use mobil_chassis::model::ChassisConfig;
+use mobil_chassis_node::{chassis_params, declare_chassis};
 use mobil_msgs::geometry_msgs::msg::{Point, Transform, TransformStamped, Vector3};
 use mobil_msgs::nav_msgs::msg::Odometry;
 use mobil_msgs::rosgraph_msgs::msg::Clock;
@@ -16,137 +17,195 @@ use mobil_msgs::std_msgs::msg::ColorRGBA;
 use mobil_msgs::std_msgs::msg::Header;
 use mobil_msgs::tf2_msgs::msg::TFMessage;
 use mobil_msgs::visualization_msgs::msg::{Marker, MarkerArray};
+use mobil_ros::config::{Config, ConfigError, Decl};
 use mobil_ros::geometry::{planar_odometry, yaw_quaternion};
-use mobil_ros::params::ParamValues;
+use mobil_ros::input::{decoded, Input};
 use mobil_ros::time::{stamp_from_nanos, stamp_from_secs};
-use mobil_ros::{qos, run_node, shutdown_signal, warn_throttled, LogThrottle, NodeDecl, ParamSpec, RosNode};
+use mobil_ros::{qos, run_node, shutdown_signal, warn_throttled, LogThrottle, NodeDecl, RosNode, Ticker};
 use mobil_sim::lidar::{Lidar, LidarConfig};
 use mobil_sim::plant::{CommandOutcome, Plant, PlantConfig};
 use mobil_sim::world::{Obstacle, World};
 use nalgebra::Vector3 as V3;
 use std::process::ExitCode;
-use std::time::Duration;
+use tokio::time::MissedTickBehavior;
 use tracing::{info, warn};
 
-#[derive(Debug, Clone)]
+/// Everything the simulator is configured with, each field filled by one declared parameter.
+#[derive(Debug, Clone, Default)]
 struct SimConfig {
-    plant: PlantConfig,
+    chassis: ChassisConfig,
+    robot_radius: f64,
+    world_file: String,
     seed: u64,
-    initial_pose: V3<f64>,
+    initial_pose: [f64; 3],
     physics_rate_hz: f64,
     joint_states_rate_hz: f64,
+    wheel_speed_noise: f64,
+    wheel_slip: f64,
+    motor_time_constant: f64,
+    command_timeout_s: f64,
     publish_clock: bool,
     real_time_factor: f64,
-    lidar: Option<LidarConfig>,
+    lidar_enabled: bool,
+    lidar: LidarConfig,
     world_frame: String,
     base_frame: String,
     laser_frame: String,
 }
 
+impl Config for SimConfig {
+    fn declare(d: &mut Decl<Self>) {
+        let lidar = LidarConfig::default();
+        d.nest(|c: &mut SimConfig| &mut c.chassis, declare_chassis);
+        d.double(
+            "robot_radius",
+            0.3,
+            "footprint radius around the reference point [m]",
+            |c, v| c.robot_radius = v,
+        )
+        .above(0.0);
+        d.string("world_file", "", "world YAML (empty: the built-in world)", |c, v| {
+            c.world_file = v
+        })
+        .read_only();
+        // The declared range keeps the value ≥ 0, so the conversion cannot fail.
+        d.integer("seed", 1, "random seed (noise)", |c, v| {
+            c.seed = u64::try_from(v).unwrap_or_default()
+        })
+        .min(0.0)
+        .read_only();
+        d.doubles(
+            "initial_pose",
+            [0.0, 0.0, 0.0],
+            "x, y, yaw of the reference point",
+            |c, v| c.initial_pose = v,
+        )
+        .read_only();
+        d.double(
+            "physics_rate_hz",
+            200.0,
+            "simulation steps per simulated second",
+            |c, v| c.physics_rate_hz = v,
+        )
+        .within(10.0, 10_000.0)
+        .read_only();
+        d.double(
+            "joint_states_rate_hz",
+            50.0,
+            "wheel feedback and ground_truth rate",
+            |c, v| c.joint_states_rate_hz = v,
+        )
+        .within(1.0, 1000.0);
+        d.double(
+            "wheel_speed_noise",
+            0.0,
+            "relative std of measured wheel speeds",
+            |c, v| c.wheel_speed_noise = v,
+        )
+        .min(0.0);
+        d.double("wheel_slip", 0.0, "relative bias of measured wheel speeds", |c, v| {
+            c.wheel_slip = v
+        })
+        .within(-0.5, 0.5);
+        d.double(
+            "motor_time_constant",
+            0.05,
+            "first-order lag of the wheels [s]",
+            |c, v| c.motor_time_constant = v,
+        )
+        .min(0.0);
+        d.double(
+            "command_timeout_s",
+            1.0,
+            "drivers stop without wheel_commands [s] (0: never)",
+            |c, v| c.command_timeout_s = v,
+        )
+        .min(0.0);
+        d.boolean(
+            "publish_clock",
+            false,
+            "publish /clock (simulated time from 0)",
+            |c, v| c.publish_clock = v,
+        )
+        .read_only();
+        d.double("real_time_factor", 1.0, "simulated seconds per wall second", |c, v| {
+            c.real_time_factor = v
+        })
+        .within(0.01, 100.0);
+        d.boolean("lidar.enabled", true, "publish scan", |c, v| c.lidar_enabled = v);
+        d.double("lidar.fov", lidar.fov, "field of view [rad]", |c, v| c.lidar.fov = v)
+            .within(0.01, std::f64::consts::TAU);
+        // The declared range keeps the value in [2, 100000], so the conversion cannot fail.
+        d.integer("lidar.beams", lidar.beams as i64, "beams per scan", |c, v| {
+            c.lidar.beams = usize::try_from(v).unwrap_or_default()
+        })
+        .within(2.0, 100_000.0);
+        d.double("lidar.range_min", lidar.range_min, "[m]", |c, v| c.lidar.range_min = v)
+            .min(0.0);
+        d.double("lidar.range_max", lidar.range_max, "[m]", |c, v| c.lidar.range_max = v)
+            .above(0.0);
+        d.double("lidar.noise_std", lidar.noise_std, "range noise std [m]", |c, v| {
+            c.lidar.noise_std = v
+        })
+        .min(0.0);
+        d.double("lidar.rate_hz", lidar.rate_hz, "scans per simulated second", |c, v| {
+            c.lidar.rate_hz = v
+        })
+        .within(0.1, 1000.0);
+        d.doubles(
+            "lidar.mount",
+            lidar.mount,
+            "x, y, yaw of the laser in base_link",
+            |c, v| c.lidar.mount = v,
+        );
+        d.string("world_frame", "odom", "frame of ground_truth", |c, v| c.world_frame = v);
+        d.string("base_frame", "base_link", "robot frame (reference point)", |c, v| {
+            c.base_frame = v
+        });
+        d.string("laser_frame", "laser", "frame of scan", |c, v| c.laser_frame = v);
+    }
+
+    fn validate(&self) -> Result<(), ConfigError> {
+        self.lidar.validate().map_err(ConfigError::inconsistent)?;
+        self.plant().map(|_| ())
+    }
+}
+
+impl SimConfig {
+    /// The plant's settings, with the validated chassis.
+    fn plant(&self) -> Result<PlantConfig, ConfigError> {
+        Ok(PlantConfig {
+            params: chassis_params(&self.chassis)?,
+            motor_time_constant: self.motor_time_constant,
+            wheel_speed_noise: self.wheel_speed_noise,
+            wheel_slip: self.wheel_slip,
+            command_timeout: self.command_timeout_s,
+            robot_radius: self.robot_radius,
+        })
+    }
+
+    /// The LIDAR's settings, if it is enabled.
+    fn lidar(&self) -> Option<LidarConfig> {
+        self.lidar_enabled.then_some(self.lidar)
+    }
+
+    /// Physics steps per wall second.
+    fn tick_rate_hz(&self) -> f64 {
+        self.physics_rate_hz * self.real_time_factor
+    }
+}
+
 fn decl() -> NodeDecl {
-    let lidar = LidarConfig::default();
-    NodeDecl::new("sim", "Simulated chassis, 2D world and LIDAR")
-        .params(chassis_param_specs())
-        .param(ParamSpec::double("robot_radius", 0.3, "footprint radius around the reference point [m]").above(0.0))
-        .param(ParamSpec::string("world_file", "", "world YAML (empty: the built-in world)").read_only())
-        .param(
-            ParamSpec::integer("seed", 1, "random seed (noise)")
-                .min(0.0)
-                .read_only(),
-        )
-        .param(
-            ParamSpec::doubles("initial_pose", &[0.0, 0.0, 0.0], "x, y, yaw of the reference point")
-                .length(3)
-                .read_only(),
-        )
-        .param(
-            ParamSpec::double("physics_rate_hz", 200.0, "simulation steps per simulated second")
-                .within(10.0, 10_000.0)
-                .read_only(),
-        )
-        .param(
-            ParamSpec::double("joint_states_rate_hz", 50.0, "wheel feedback and ground_truth rate").within(1.0, 1000.0),
-        )
-        .param(ParamSpec::double("wheel_speed_noise", 0.0, "relative std of measured wheel speeds").min(0.0))
-        .param(ParamSpec::double("wheel_slip", 0.0, "relative bias of measured wheel speeds").within(-0.5, 0.5))
-        .param(ParamSpec::double("motor_time_constant", 0.05, "first-order lag of the wheels [s]").min(0.0))
-        .param(
-            ParamSpec::double(
-                "command_timeout_s",
-                1.0,
-                "drivers stop without wheel_commands [s] (0: never)",
-            )
-            .min(0.0),
-        )
-        .param(ParamSpec::boolean("publish_clock", false, "publish /clock (simulated time from 0)").read_only())
-        .param(ParamSpec::double("real_time_factor", 1.0, "simulated seconds per wall second").within(0.01, 100.0))
-        .param(ParamSpec::boolean("lidar.enabled", true, "publish scan"))
-        .param(ParamSpec::double("lidar.fov", lidar.fov, "field of view [rad]").within(0.01, std::f64::consts::TAU))
-        .param(ParamSpec::integer("lidar.beams", lidar.beams as i64, "beams per scan").within(2.0, 100_000.0))
-        .param(ParamSpec::double("lidar.range_min", lidar.range_min, "[m]").min(0.0))
-        .param(ParamSpec::double("lidar.range_max", lidar.range_max, "[m]").above(0.0))
-        .param(ParamSpec::double("lidar.noise_std", lidar.noise_std, "range noise std [m]").min(0.0))
-        .param(ParamSpec::double("lidar.rate_hz", lidar.rate_hz, "scans per simulated second").within(0.1, 1000.0))
-        .param(ParamSpec::doubles("lidar.mount", &lidar.mount, "x, y, yaw of the laser in base_link").length(3))
-        .param(ParamSpec::string("world_frame", "odom", "frame of ground_truth"))
-        .param(ParamSpec::string(
-            "base_frame",
-            "base_link",
-            "robot frame (reference point)",
-        ))
-        .param(ParamSpec::string("laser_frame", "laser", "frame of scan"))
-        .check(|p| sim_config(p).map(|_| ()))
+    NodeDecl::for_config::<SimConfig>("sim", "Simulated chassis, 2D world and LIDAR")
 }
 
 /// The world named by `world_file` (read-only, so read once at start-up).
-fn load_world(p: &ParamValues) -> Result<World, String> {
-    let world_file = p.string("world_file")?;
-    if world_file.is_empty() {
+fn load_world(config: &SimConfig) -> anyhow::Result<World> {
+    if config.world_file.is_empty() {
         Ok(World::builtin())
     } else {
-        World::load(&world_file).map_err(|e| e.to_string())
+        Ok(World::load(&config.world_file)?)
     }
-}
-
-/// Everything but the world, so that vetting a parameter change does no file I/O.
-fn sim_config(p: &ParamValues) -> Result<SimConfig, String> {
-    let pose = p.f64s("initial_pose")?;
-    let mount = p.f64s("lidar.mount")?;
-    let lidar = LidarConfig {
-        fov: p.f64("lidar.fov")?,
-        beams: usize::try_from(p.i64("lidar.beams")?).map_err(|e| e.to_string())?,
-        range_min: p.f64("lidar.range_min")?,
-        range_max: p.f64("lidar.range_max")?,
-        noise_std: p.f64("lidar.noise_std")?,
-        rate_hz: p.f64("lidar.rate_hz")?,
-        mount: [mount[0], mount[1], mount[2]],
-    };
-    lidar.validate().map_err(|e| e.to_string())?;
-    let plant = PlantConfig {
-        params: chassis_from_params(p)?,
-        motor_time_constant: p.f64("motor_time_constant")?,
-        wheel_speed_noise: p.f64("wheel_speed_noise")?,
-        wheel_slip: p.f64("wheel_slip")?,
-        command_timeout: p.f64("command_timeout_s")?,
-        robot_radius: p.f64("robot_radius")?,
-    };
-    let initial_pose = V3::new(pose[0], pose[1], pose[2]);
-    if !initial_pose.iter().all(|v| v.is_finite()) {
-        return Err(format!("initial_pose must be finite, got {pose:?}"));
-    }
-    Ok(SimConfig {
-        plant,
-        seed: u64::try_from(p.i64("seed")?).map_err(|e| e.to_string())?,
-        initial_pose,
-        physics_rate_hz: p.f64("physics_rate_hz")?,
-        joint_states_rate_hz: p.f64("joint_states_rate_hz")?,
-        publish_clock: p.bool("publish_clock")?,
-        real_time_factor: p.f64("real_time_factor")?,
-        lidar: p.bool("lidar.enabled")?.then_some(lidar),
-        world_frame: p.string("world_frame")?,
-        base_frame: p.string("base_frame")?,
-        laser_frame: p.string("laser_frame")?,
-    })
 }
 
 /// The stamp of simulated t = 0.
@@ -221,19 +280,20 @@ fn main() -> ExitCode {
 }
 
 async fn run(node: &mut RosNode) -> anyhow::Result<()> {
-    let mut config = sim_config(&node.params()).map_err(anyhow::Error::msg)?;
-    let world = load_world(&node.params()).map_err(anyhow::Error::msg)?;
+    let mut config: SimConfig = node.config()?;
+    let mut plant_config = config.plant()?;
+    let world = load_world(&config)?;
     let start = config.initial_pose;
-    if world.collides(nalgebra::Point2::new(start.x, start.y), config.plant.robot_radius) {
+    if world.collides(nalgebra::Point2::new(start[0], start[1]), config.robot_radius) {
         anyhow::bail!("initial_pose {start:?} collides with the world");
     }
-    let mut plant = Plant::new(config.plant, config.initial_pose, config.seed);
-    let mut lidar = config.lidar.map(|c| Lidar::new(c, config.seed.wrapping_add(1)));
+    let mut plant = Plant::new(plant_config, V3::from(config.initial_pose), config.seed);
+    let mut lidar = config.lidar().map(|c| Lidar::new(c, config.seed.wrapping_add(1)));
     info!(
         "simulating a {} chassis in a world of {} obstacles; lidar {}",
-        config.plant.params.model().as_str(),
+        plant_config.params.model().as_str(),
         world.obstacles.len(),
-        match &config.lidar {
+        match &config.lidar() {
             Some(l) => format!("{} beams over {:.0}° at {} Hz", l.beams, l.fov.to_degrees(), l.rate_hz),
             None => "off".into(),
         }
@@ -266,7 +326,7 @@ async fn run(node: &mut RosNode) -> anyhow::Result<()> {
             stamp_from_nanos(epoch_nanos + (t * 1e9) as i64)
         }
     };
-    if let Some(l) = &config.lidar {
+    if let Some(l) = &config.lidar() {
         let mount = TransformStamped {
             header: Header {
                 stamp: stamp_at(0.0, config.publish_clock),
@@ -287,11 +347,15 @@ async fn run(node: &mut RosNode) -> anyhow::Result<()> {
         });
     }
 
-    let commands = commands_sub.async_stream();
+    let commands = decoded(
+        commands_sub.async_stream(),
+        "wheel_commands",
+        "decode",
+        "wheels stopped",
+    );
     let shutdown = shutdown_signal();
-    let period = |c: &SimConfig| Duration::from_secs_f64(1.0 / (c.physics_rate_hz * c.real_time_factor));
-    let mut tick = tokio::time::interval(period(&config));
-    tick.set_missed_tick_behavior(tokio::time::MissedTickBehavior::Burst);
+    // Burst: a late physics step is caught up, so simulated time keeps its rate.
+    let mut tick = Ticker::with_missed_tick_behavior(config.tick_rate_hz(), MissedTickBehavior::Burst)?;
     tokio::pin!(commands, shutdown);
     let mut throttle = LogThrottle::default();
     let dt = 1.0 / config.physics_rate_hz;
@@ -301,17 +365,19 @@ async fn run(node: &mut RosNode) -> anyhow::Result<()> {
     loop {
         tokio::select! {
             _ = &mut shutdown => break,
-            Some(changed) = node.param_changed() => match sim_config(&changed) {
-                Ok(new) => {
-                    if new.real_time_factor != config.real_time_factor {
-                        tick = tokio::time::interval(period(&new));
+            Some(changed) = node.config_changed::<SimConfig>() => match changed.and_then(|new| Ok((new.plant()?, new))) {
+                Ok((new_plant, new)) => {
+                    // The declared ranges keep the rate valid; a refusal would keep the old one.
+                    if let Err(e) = tick.set_rate(new.tick_rate_hz()) {
+                        warn!("real_time_factor not applied: {e}");
                     }
-                    lidar = match (new.lidar, lidar.take()) {
-                        (Some(c), Some(l)) if Some(c) == config.lidar => Some(l),
+                    lidar = match (new.lidar(), lidar.take()) {
+                        (Some(c), Some(l)) if Some(c) == config.lidar() => Some(l),
                         (Some(c), _) => Some(Lidar::new(c, config.seed.wrapping_add(1))),
                         (None, _) => None,
                     };
-                    plant.reconfigure(new.plant);
+                    plant.reconfigure(new_plant);
+                    plant_config = new_plant;
                     config = new;
                 }
                 Err(e) => warn!("parameter change not applied: {e}"),
@@ -319,7 +385,7 @@ async fn run(node: &mut RosNode) -> anyhow::Result<()> {
             Some(msg) = commands.next() => match msg {
                 // A bad command stops the wheels, as real motor drivers do: the previous
                 // command must not keep them turning until the driver timeout.
-                Ok((js, _)) => match wheel_state_from_joints(config.plant.params.model(), &js.name, &js.position, &js.velocity) {
+                Input::Message(js) => match wheel_state_from_joints(plant_config.params.model(), &js.name, &js.position, &js.velocity) {
                     Ok(wheels) => match plant.command(&wheels) {
                         Ok(CommandOutcome::Accepted) => {}
                         Ok(CommandOutcome::Limited) => warn_throttled!(
@@ -335,10 +401,8 @@ async fn run(node: &mut RosNode) -> anyhow::Result<()> {
                         warn_throttled!(throttle, "cmd", "wheel_commands dropped, wheels stopped: {e}");
                     }
                 },
-                Err(e) => {
-                    plant.stop();
-                    warn_throttled!(throttle, "decode", "undecodable wheel_commands dropped, wheels stopped: {e:?}");
-                }
+                // Logged (rate-limited) by the input stream.
+                Input::Undecodable => plant.stop(),
             },
             _ = tick.tick() => {
                 plant.step(dt, &world);
@@ -371,7 +435,7 @@ async fn run(node: &mut RosNode) -> anyhow::Result<()> {
                     );
                     let _ = truth_pub.publish(truth);
                 }
-                if let (Some(l), Some(cfg)) = (lidar.as_mut(), config.lidar.as_ref()) {
+                if let (Some(l), Some(cfg)) = (lidar.as_mut(), config.lidar()) {
                     if t + 1e-9 >= next_scan {
                         next_scan += 1.0 / cfg.rate_hz;
                         let pose = plant.reference_pose();

@@ -1,10 +1,6 @@
-//! cmd_vel watchdog and angle wrapping.
+//! cmd_vel watchdog (angle wrapping is tested in mobil_geom).
 
-use std::f64::consts::{PI, TAU};
-
-use mobil_chassis::angles::wrap;
 use mobil_chassis::CmdVelWatchdog;
-use proptest::prelude::*;
 
 #[test]
 fn watchdog_expires_after_the_timeout() {
@@ -39,28 +35,4 @@ fn watchdog_time_backwards_counts_as_expired() {
 fn watchdog_refuses_bad_timeouts() {
     assert!(CmdVelWatchdog::new(-0.1).is_err());
     assert!(CmdVelWatchdog::new(f64::NAN).is_err());
-}
-
-#[test]
-fn wrap_golden() {
-    assert_eq!(wrap(-PI), PI);
-    assert_eq!(wrap(PI), PI);
-    assert_eq!(wrap(0.0), 0.0);
-    assert!((wrap(3.0 * PI) - PI).abs() < 1e-15);
-    assert!((wrap(-3.0 * PI) - PI).abs() < 1e-15);
-    assert!((wrap(1.5 * PI) + 0.5 * PI).abs() < 1e-15);
-    assert!((wrap(-7.0) - (-7.0 + TAU)).abs() < 1e-15);
-    assert!(wrap(f64::NAN).is_nan());
-    assert!(wrap(f64::INFINITY).is_nan());
-}
-
-proptest! {
-    #[test]
-    fn wrap_lands_in_range_and_differs_by_whole_turns(a in -1e4..1e4f64) {
-        let w = wrap(a);
-        prop_assert!(w > -PI && w <= PI, "{a} → {w}");
-        let turns = (a - w) / TAU;
-        prop_assert!((turns - turns.round()).abs() < 1e-9, "{a} → {w}");
-        prop_assert_eq!(wrap(w), w);
-    }
 }

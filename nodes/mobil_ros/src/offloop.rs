@@ -1,0 +1,199 @@
+//! Computations of 10–500 ms (a search, a plan) off the event loop, pre-empted by newer requests.
+//!
+//! [`OffLoop::start`] runs a job on tokio's blocking pool with a [`CancelToken`] the algorithm
+//! checks now and then; starting a newer job cancels the running one, and a cancelled (stale)
+//! job's result is discarded, never delivered. [`OffLoop::result`] is cancel-safe, so it sits in
+//! the node's `select!` beside the ticker and the subscriptions, which keep being served while
+//! the search runs.
+//!
+//! ```
+//! # #[tokio::main(flavor = "current_thread")]
+//! # async fn main() {
+//! use mobil_ros::offloop::OffLoop;
+//! let mut search = OffLoop::new();
+//! search.start(|cancel| (0..1000u64).take_while(|_| !cancel.is_cancelled()).sum::<u64>());
+//! search.start(|_| 7); // pre-empts the first: its sum, if it finishes, is thrown away
+//! assert_eq!(search.result().await, 7);
+//! # }
+//! ```
+
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Arc;
+use tokio::sync::mpsc;
+
+/// Tells a running job it has been pre-empted; the algorithm checks it between steps and
+/// returns early (any value: it is discarded).
+#[derive(Debug, Clone, Default)]
+pub struct CancelToken(Arc<AtomicBool>);
+
+impl CancelToken {
+    /// A token not cancelled.
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    /// Whether the job should stop.
+    pub fn is_cancelled(&self) -> bool {
+        self.0.load(Ordering::Relaxed)
+    }
+
+    /// Asks the job to stop.
+    pub fn cancel(&self) {
+        self.0.store(true, Ordering::Relaxed);
+    }
+}
+
+/// One computation at a time off the event loop; the newest request wins.
+#[derive(Debug)]
+pub struct OffLoop<R> {
+    generation: u64,
+    running: Option<(u64, CancelToken)>,
+    tx: mpsc::UnboundedSender<(u64, R)>,
+    rx: mpsc::UnboundedReceiver<(u64, R)>,
+}
+
+impl<R: Send + 'static> Default for OffLoop<R> {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl<R: Send + 'static> OffLoop<R> {
+    /// Nothing running.
+    pub fn new() -> Self {
+        let (tx, rx) = mpsc::unbounded_channel();
+        OffLoop {
+            generation: 0,
+            running: None,
+            tx,
+            rx,
+        }
+    }
+
+    /// Starts `job` on the blocking pool, cancelling the job still running (whose result will
+    /// be discarded). Must be called inside a tokio runtime.
+    pub fn start(&mut self, job: impl FnOnce(&CancelToken) -> R + Send + 'static) {
+        self.cancel();
+        self.generation += 1;
+        let generation = self.generation;
+        let token = CancelToken::new();
+        self.running = Some((generation, token.clone()));
+        let tx = self.tx.clone();
+        tokio::task::spawn_blocking(move || {
+            let result = job(&token);
+            if !token.is_cancelled() {
+                // The receiver lives as long as the OffLoop; if it is gone nobody waits.
+                let _ = tx.send((generation, result));
+            }
+        });
+    }
+
+    /// Cancels the running job, if any; its result will be discarded.
+    pub fn cancel(&mut self) {
+        if let Some((_, token)) = self.running.take() {
+            token.cancel();
+        }
+    }
+
+    /// Whether a job is running (started, not cancelled, result not yet taken).
+    pub fn is_running(&self) -> bool {
+        self.running.is_some()
+    }
+
+    /// The result of the newest job, when it is done; pending for ever while nothing runs.
+    /// Cancel-safe (for `select!`).
+    pub async fn result(&mut self) -> R {
+        loop {
+            let Some((generation, result)) = self.rx.recv().await else {
+                // Unreachable: `self.tx` keeps the channel open.
+                std::future::pending::<()>().await;
+                continue;
+            };
+            if self.running.as_ref().is_some_and(|(g, _)| *g == generation) {
+                self.running = None;
+                return result;
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::time::{Duration, Instant};
+
+    /// A search that takes `ms` of real work, checking the token every millisecond; returns its
+    /// label, or "cancelled" (which must never be delivered).
+    fn search(label: &'static str, ms: u64, saw_cancel: Arc<AtomicBool>) -> impl FnOnce(&CancelToken) -> &'static str {
+        move |cancel| {
+            let until = Instant::now() + Duration::from_millis(ms);
+            while Instant::now() < until {
+                if cancel.is_cancelled() {
+                    saw_cancel.store(true, Ordering::Relaxed);
+                    return "cancelled";
+                }
+                std::thread::sleep(Duration::from_millis(1));
+            }
+            label
+        }
+    }
+
+    // A single-threaded runtime: if a search ran on the event loop, no tick could happen.
+    #[tokio::test(flavor = "current_thread")]
+    async fn a_newer_request_preempts_and_the_loop_keeps_ticking() {
+        let first_cancelled = Arc::new(AtomicBool::new(false));
+        let second_cancelled = Arc::new(AtomicBool::new(false));
+        let mut off = OffLoop::new();
+        let mut tick = tokio::time::interval(Duration::from_millis(10));
+        let start = Instant::now();
+        off.start(search("first", 2000, first_cancelled.clone()));
+        assert!(off.is_running());
+        let mut ticks = 0u32;
+        let mut restarted = false;
+        let result = loop {
+            tokio::select! {
+                r = off.result() => break r,
+                _ = tick.tick() => {
+                    ticks += 1;
+                    // After 50 ms a newer request comes in.
+                    if !restarted && start.elapsed() >= Duration::from_millis(50) {
+                        off.start(search("second", 200, second_cancelled.clone()));
+                        restarted = true;
+                    }
+                }
+            }
+        };
+        let elapsed = start.elapsed();
+        assert_eq!(result, "second", "the stale result is never delivered");
+        assert!(
+            first_cancelled.load(Ordering::Relaxed),
+            "the first search saw its cancellation"
+        );
+        assert!(!second_cancelled.load(Ordering::Relaxed));
+        assert!(!off.is_running());
+        // 50 ms + 200 ms of search; far below the first search's 2 s.
+        assert!(
+            elapsed >= Duration::from_millis(250) && elapsed < Duration::from_millis(1500),
+            "{elapsed:?}"
+        );
+        // The loop ticked every 10 ms meanwhile: about 25 ticks; at least half of them, allowing
+        // for a loaded machine.
+        assert!(ticks >= 12, "only {ticks} ticks in {elapsed:?}: the loop was blocked");
+    }
+
+    #[tokio::test(flavor = "current_thread")]
+    async fn cancel_discards_and_result_then_waits_for_the_next_job() {
+        let mut off = OffLoop::new();
+        off.start(|_| 1);
+        off.cancel();
+        assert!(!off.is_running());
+        // The cancelled job's 1 may already be in the channel; it must be skipped.
+        tokio::time::sleep(Duration::from_millis(20)).await;
+        off.start(|_| 2);
+        assert_eq!(off.result().await, 2);
+        // Nothing running: result() stays pending.
+        assert!(tokio::time::timeout(Duration::from_millis(50), off.result())
+            .await
+            .is_err());
+    }
+}

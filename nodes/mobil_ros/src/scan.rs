@@ -1,0 +1,184 @@
+//! Laser scans at the edge: a `sensor_msgs/LaserScan` becomes a checked
+//! [`mobil_geom::Scan`] once, on arrival, with the laser's pose in the base frame, taken from a
+//! parameter or from `/tf_static` ([`StaticFrames`]).
+//!
+//! ```
+//! use mobil_msgs::geometry_msgs::msg::TransformStamped;
+//! use mobil_msgs::sensor_msgs::msg::LaserScan;
+//! use mobil_msgs::tf2_msgs::msg::TFMessage;
+//! use mobil_ros::geometry::yaw_quaternion;
+//! use mobil_ros::scan::{scan_from_msg, StaticFrames};
+//!
+//! // sim_node's tf_static: the laser 0.3 m ahead of base_link.
+//! let mut mount = TransformStamped::default();
+//! mount.header.frame_id = "base_link".into();
+//! mount.child_frame_id = "laser".into();
+//! mount.transform.translation.x = 0.3;
+//! mount.transform.rotation = yaw_quaternion(0.0);
+//! let mut frames = StaticFrames::default();
+//! frames.add(&TFMessage { transforms: vec![mount] });
+//! let base_from_laser = frames.lookup("base_link", "laser").unwrap();
+//!
+//! let msg = LaserScan {
+//!     angle_min: -0.5, angle_max: 0.5, angle_increment: 0.5,
+//!     range_min: 0.1, range_max: 10.0, ranges: vec![1.0, 2.0, f32::INFINITY],
+//!     ..Default::default()
+//! };
+//! let scan = scan_from_msg(&msg, base_from_laser).unwrap();
+//! // The straight-ahead echo at 2 m is 2.3 m ahead of base_link.
+//! assert!((scan.points_in_base().nth(1).unwrap().x - 2.3).abs() < 1e-6);
+//! ```
+
+use crate::geometry::yaw_of;
+use mobil_geom::{Pose2, Scan, ScanError};
+use mobil_msgs::sensor_msgs::msg::LaserScan;
+use mobil_msgs::tf2_msgs::msg::TFMessage;
+use std::collections::HashMap;
+
+/// The checked scan of a LaserScan message, the laser at `base_from_laser` in the base frame.
+pub fn scan_from_msg(msg: &LaserScan, base_from_laser: Pose2) -> Result<Scan, ScanError> {
+    Scan::new(
+        f64::from(msg.angle_min),
+        f64::from(msg.angle_max),
+        f64::from(msg.angle_increment),
+        f64::from(msg.range_min),
+        f64::from(msg.range_max),
+        msg.ranges.clone(),
+        msg.intensities.clone(),
+        base_from_laser,
+    )
+}
+
+/// The static transforms seen on `/tf_static` (planar part: x, y, yaw), by child frame.
+///
+/// Feed it every `tf2_msgs/TFMessage` of `tf_static` (subscribed with [`crate::qos::tf_static`],
+/// so that a node started after the publishers still gets them) and ask
+/// [`StaticFrames::lookup`] for `base_frame → laser_frame`, which composes the chain between
+/// them (e.g. base_link → mount → laser), in either direction. Until the chain is known, a node
+/// uses the laser pose parameter or waits; it never guesses.
+#[derive(Debug, Clone, Default)]
+pub struct StaticFrames {
+    /// child → (parent, parent_from_child).
+    parents: HashMap<String, (String, Pose2)>,
+}
+
+impl StaticFrames {
+    /// Adds (or replaces) the transforms of one message; transforms with non-finite values or
+    /// empty frame names are skipped, and their count returned.
+    pub fn add(&mut self, msg: &TFMessage) -> usize {
+        let mut skipped = 0;
+        for t in &msg.transforms {
+            let pose = Pose2::new(
+                t.transform.translation.x,
+                t.transform.translation.y,
+                yaw_of(&t.transform.rotation),
+            );
+            let parent = t.header.frame_id.trim_start_matches('/');
+            let child = t.child_frame_id.trim_start_matches('/');
+            if !pose.is_finite() || parent.is_empty() || child.is_empty() || parent == child {
+                skipped += 1;
+                continue;
+            }
+            self.parents.insert(child.to_owned(), (parent.to_owned(), pose));
+        }
+        skipped
+    }
+
+    /// The chain from `frame` up to its root: (root, root_from_frame).
+    fn to_root(&self, frame: &str) -> (String, Pose2) {
+        let mut pose = Pose2::identity();
+        let mut at = frame.to_owned();
+        // A loop in the data (a → b → a) ends after as many steps as there are frames.
+        for _ in 0..=self.parents.len() {
+            match self.parents.get(&at) {
+                Some((parent, parent_from_at)) => {
+                    pose = *parent_from_at * pose;
+                    at = parent.clone();
+                }
+                None => break,
+            }
+        }
+        (at, pose)
+    }
+
+    /// `parent_from_child` between two frames of the same tree, composing the chain between
+    /// them; `None` while they are not connected.
+    pub fn lookup(&self, parent: &str, child: &str) -> Option<Pose2> {
+        let (parent, child) = (parent.trim_start_matches('/'), child.trim_start_matches('/'));
+        let (root_p, root_from_parent) = self.to_root(parent);
+        let (root_c, root_from_child) = self.to_root(child);
+        (root_p == root_c).then(|| root_from_parent.inverse() * root_from_child)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::geometry::yaw_quaternion;
+    use mobil_msgs::geometry_msgs::msg::TransformStamped;
+    use std::f64::consts::FRAC_PI_2;
+
+    fn tf(parent: &str, child: &str, x: f64, y: f64, yaw: f64) -> TransformStamped {
+        let mut t = TransformStamped::default();
+        t.header.frame_id = parent.into();
+        t.child_frame_id = child.into();
+        t.transform.translation.x = x;
+        t.transform.translation.y = y;
+        t.transform.rotation = yaw_quaternion(yaw);
+        t
+    }
+
+    #[test]
+    fn a_chain_is_composed_in_either_direction() {
+        let mut f = StaticFrames::default();
+        // base_link → mount: 0.2 ahead, turned +90°; mount → laser: 0.1 along the mount's x.
+        let skipped = f.add(&TFMessage {
+            transforms: vec![
+                tf("base_link", "mount", 0.2, 0.0, FRAC_PI_2),
+                tf("/mount", "laser", 0.1, 0.0, 0.0),
+                tf("base_link", "bad", f64::NAN, 0.0, 0.0),
+            ],
+        });
+        assert_eq!(skipped, 1);
+        f.add(&TFMessage {
+            transforms: vec![tf("odom_other_tree", "x", 1.0, 0.0, 0.0)],
+        });
+        // The mount's x is base_link's +y: the laser is at (0.2, 0.1), facing +90°.
+        let p = f.lookup("base_link", "laser").unwrap();
+        assert!((p.x - 0.2).abs() < 1e-12 && (p.y - 0.1).abs() < 1e-12 && (p.yaw - FRAC_PI_2).abs() < 1e-12);
+        // Inverse: base_link seen from the laser: the laser's x is base +y, so base_link's
+        // origin, 0.2 behind and 0.1 to the right in base terms, is at (−0.1, 0.2) in it.
+        let q = f.lookup("laser", "base_link").unwrap();
+        assert!((q.x + 0.1).abs() < 1e-12 && (q.y - 0.2).abs() < 1e-12 && (q.yaw + FRAC_PI_2).abs() < 1e-12);
+        assert_eq!(f.lookup("base_link", "x"), None, "different trees");
+        assert_eq!(f.lookup("base_link", "bad"), None, "skipped");
+        assert_eq!(f.lookup("laser", "laser"), Some(Pose2::identity()));
+    }
+
+    #[test]
+    fn a_laser_scan_message_is_checked_at_the_edge() {
+        let msg = LaserScan {
+            angle_min: -1.0,
+            angle_max: 1.0,
+            angle_increment: 1.0,
+            range_min: 0.1,
+            range_max: 5.0,
+            ranges: vec![1.0, 2.0],
+            ..Default::default()
+        };
+        // Two beams of 1 rad from −1 end at 0, one increment short of angle_max 1: accepted.
+        assert!(scan_from_msg(&msg, Pose2::identity()).is_ok());
+        let mut bad = msg.clone();
+        bad.angle_increment = -1.0;
+        assert_eq!(
+            scan_from_msg(&bad, Pose2::identity()),
+            Err(ScanError::BadIncrement(-1.0))
+        );
+        let mut bad = msg;
+        bad.ranges = vec![1.0; 7];
+        assert!(matches!(
+            scan_from_msg(&bad, Pose2::identity()),
+            Err(ScanError::SpanMismatch { beams: 7, .. })
+        ));
+    }
+}

@@ -1,0 +1,74 @@
+//! The last command of a motion node: published, then waited for (bounded) before the node
+//! leaves the DDS domain.
+//!
+//! On shutdown or failure a node that commands motion publishes its zero command with
+//! [`final_stop`], which returns once every matched reliable reader has acknowledged it, or
+//! after [`FINAL_STOP_WAIT`]; the node then shuts down. Dropping the writer right after
+//! `publish` could lose the sample, and the drivers would keep the previous command until their
+//! own timeout.
+//!
+//! ```no_run
+//! # async fn demo(node: &mut mobil_ros::RosNode) -> anyhow::Result<()> {
+//! use mobil_msgs::geometry_msgs::msg::Twist;
+//! use mobil_ros::stop::{final_stop, FINAL_STOP_WAIT};
+//! let cmd = node.publisher::<Twist>("cmd_vel", &mobil_ros::qos::default_qos())?;
+//! let result: anyhow::Result<()> = async { /* the node's loop */ Ok(()) }.await;
+//! final_stop(&cmd, Twist::default(), FINAL_STOP_WAIT).await; // on success and failure alike
+//! result
+//! # }
+//! ```
+
+use ros2_client::Publisher;
+use serde::Serialize;
+use std::time::{Duration, Instant};
+use tracing::warn;
+
+/// How long [`final_stop`] waits by default for the readers' acknowledgements.
+pub const FINAL_STOP_WAIT: Duration = Duration::from_millis(500);
+
+/// How the final command went out.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum FinalStop {
+    /// Every matched reliable reader acknowledged it (or none was matched).
+    Acknowledged,
+    /// Some reader had not acknowledged it when the wait ended.
+    TimedOut,
+    /// It could not be published.
+    Failed(String),
+}
+
+/// Publishes `stop` and waits until every matched reliable reader has acknowledged it, at most
+/// `max_wait`; logs a warning unless it was acknowledged. Never blocks the event loop.
+pub async fn final_stop<M: Serialize + std::fmt::Debug>(
+    publisher: &Publisher<M>,
+    stop: M,
+    max_wait: Duration,
+) -> FinalStop {
+    let outcome = publish_and_wait(publisher, stop, max_wait).await;
+    match &outcome {
+        FinalStop::Acknowledged => {}
+        FinalStop::TimedOut => warn!("final stop command not acknowledged within {max_wait:?}"),
+        FinalStop::Failed(e) => warn!("cannot publish the final stop command: {e}"),
+    }
+    outcome
+}
+
+async fn publish_and_wait<M: Serialize + std::fmt::Debug>(
+    publisher: &Publisher<M>,
+    stop: M,
+    max_wait: Duration,
+) -> FinalStop {
+    if let Err(e) = publisher.publish(stop) {
+        return FinalStop::Failed(format!("{e:?}"));
+    }
+    let deadline = Instant::now() + max_wait;
+    loop {
+        // A zero wait only checks, so the event loop is never blocked.
+        match publisher.wait_for_acknowledgments(Duration::ZERO) {
+            Ok(true) => return FinalStop::Acknowledged,
+            Ok(false) if Instant::now() >= deadline => return FinalStop::TimedOut,
+            Ok(false) => tokio::time::sleep(Duration::from_millis(2)).await,
+            Err(e) => return FinalStop::Failed(format!("{e:?}")),
+        }
+    }
+}
