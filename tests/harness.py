@@ -16,9 +16,10 @@ called ``rosutil.setup_process_environment()``, ``rclpy.init()`` and spins its n
   ``real_time_factor:=R`` and the other nodes with ``use_sim_time:=true`` (one params file for
   all), returning the processes; ``SimClock`` follows ``/clock`` (``wait_started``, ``now``,
   ``wait_until(T)`` in simulated seconds, ``factor()``: simulated seconds per wall second since
-  it started, for a test to assert); ``publish_on_sim_time`` sends a command every P simulated
-  seconds (and at least every few wall milliseconds, so the nodes' steady-clock watchdogs never
-  see a gap) until simulated time T.
+  it started or since a ``mark()``, for a test to assert; ``max_gap``: the longest wall-clock
+  pause of the clock); ``publish_on_sim_time`` sends a command every P simulated seconds (and at
+  least every 0.1 wall seconds, so the nodes' steady-clock watchdogs never see a gap) until
+  simulated time T.
 """
 
 from __future__ import annotations
