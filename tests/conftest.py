@@ -10,6 +10,11 @@ Fixtures:
 * ``start_node``: factory ``start_node(exe, *ros_args, params_file=None, name=None, ...)`` that
   launches a node executable and stops it at teardown (SIGINT, 5 s, else kill and fail).
 * ``ros2cli``: ``ros2cli(*args, timeout=30)`` runs tests/ros2cli.py in the test's domain.
+* ``start_scenario``: factory ``start_scenario(params_file, real_time_factor=R, nodes=(...),
+  sim_args=(), node_args=(), lidar=False)`` (harness.launch_scenario on ``start_node``):
+  ``sim_node`` publishing ``/clock`` at R× real time and the nodes on ``use_sim_time``.
+* ``sim_clock``: a ``harness.SimClock`` on the test's node (``wait_started``, ``now``,
+  ``wait_until``, ``factor``).
 
 Environment: MOBIL_BIN_DIR (default target/release), MOBIL_TEST_DOMAIN_ID,
 MOBIL_FASTDDS_VERBOSITY (Fast DDS's own log level in the test process: 1 = warnings;
@@ -133,3 +138,19 @@ def start_node(request: pytest.FixtureRequest, tmp_path: Path) -> Iterator[Calla
 def ros2cli() -> Callable[..., Any]:
     """``ros2cli('topic', 'echo', '/odom', '--once', timeout=30) -> CompletedProcess``."""
     return harness.run_ros2cli
+
+
+@pytest.fixture
+def start_scenario(start_node: Callable[..., harness.NodeProcess]) -> Callable[..., list[harness.NodeProcess]]:
+    """``start_scenario(params_file, real_time_factor=R, ...) -> [sim, *nodes]``; see
+    harness.launch_scenario. Stopped at teardown with the other started nodes."""
+    def start(params_file: Any, **kwargs: Any) -> list[harness.NodeProcess]:
+        return harness.launch_scenario(params_file, launch=start_node, **kwargs)
+    return start
+
+
+@pytest.fixture
+def sim_clock(ros_node: Any) -> Iterator[harness.SimClock]:
+    """The test node's view of ``/clock`` (see harness.SimClock)."""
+    with harness.SimClock(ros_node) as clock:
+        yield clock

@@ -11,17 +11,28 @@ called ``rosutil.setup_process_environment()``, ``rclpy.init()`` and spins its n
 * ``param_get``, ``param_set``, ``param_list``: the rcl_interfaces parameter services, with
   retries (shared with tests/ros2cli.py through rosutil).
 * ``run_ros2cli``: run tests/ros2cli.py as a subprocess in the test's ROS domain.
+* ``launch_scenario``, ``SimClock``, ``publish_on_sim_time``: closed-loop scenarios faster than
+  real time. ``launch_scenario`` starts ``sim_node`` with ``publish_clock:=true`` and
+  ``real_time_factor:=R`` and the other nodes with ``use_sim_time:=true`` (one params file for
+  all), returning the processes; ``SimClock`` follows ``/clock`` (``wait_started``, ``now``,
+  ``wait_until(T)`` in simulated seconds, ``factor()``: simulated seconds per wall second since
+  it started or since a ``mark()``, for a test to assert; ``max_gap``: the longest wall-clock
+  pause of the clock); ``publish_on_sim_time`` sends a command every P simulated seconds (and at
+  least every 0.1 wall seconds, so the nodes' steady-clock watchdogs never see a gap) until
+  simulated time T.
 """
 
 from __future__ import annotations
 
 import atexit
+import math
 import os
 import re
 import shutil
 import signal
 import subprocess
 import sys
+import threading
 import time
 from collections.abc import Callable, Sequence
 from pathlib import Path
@@ -34,10 +45,11 @@ from rosutil import (  # noqa: F401  (re-exported for tests)
 
 __all__ = [
     "BIN_DIR", "CLEAN_EXIT_CODES", "NodeProcess", "NodeProcessError", "ROOT", "ROS2CLI",
-    "ServiceUnavailable", "TESTS_DIR", "TopicRecorder", "collect", "import_type", "launch_node",
-    "make_qos", "message_to_yaml", "param_get", "param_list", "param_set", "publish_until",
-    "qos_default", "qos_latched", "qos_sensor", "resolve_executable", "run_ros2cli",
-    "set_message_fields", "subscribe", "wait_for_message", "wait_for_node", "wait_until",
+    "ServiceUnavailable", "SimClock", "TESTS_DIR", "TopicRecorder", "collect", "import_type",
+    "launch_node", "launch_scenario", "make_qos", "message_to_yaml", "param_get", "param_list",
+    "param_set", "publish_on_sim_time", "publish_until", "qos_default", "qos_latched",
+    "qos_sensor", "resolve_executable", "run_ros2cli", "set_message_fields", "subscribe",
+    "wait_for_message", "wait_for_node", "wait_until",
 ]
 
 BIN_DIR = Path(os.environ.get("MOBIL_BIN_DIR", str(ROOT / "target" / "release")))
@@ -335,3 +347,172 @@ def run_ros2cli(*args: str, timeout: float = 30.0,
     child_env.update(env or {})
     return subprocess.run([sys.executable, str(ROS2CLI), *args], env=child_env,
                           capture_output=True, text=True, timeout=timeout, cwd=str(ROOT))
+
+
+# --------------------------------------------------------------------------------------------
+# Scenarios under the simulated clock
+# --------------------------------------------------------------------------------------------
+
+def launch_scenario(params_file: Union[str, Path], *, real_time_factor: float,
+                    nodes: Sequence[str] = ("chassis_node",), sim_args: Sequence[str] = (),
+                    node_args: Sequence[str] = (), lidar: bool = False,
+                    driver_timeout_wall_s: Optional[float] = 1.0,
+                    log_dir: Optional[Path] = None,
+                    launch: Optional[Callable[..., NodeProcess]] = None) -> list[NodeProcess]:
+    """Start ``sim_node`` publishing ``/clock`` at ``real_time_factor`` simulated seconds per
+    wall second, then each executable of ``nodes`` with ``use_sim_time:=true``, all configured by
+    ``params_file``; return the processes, ``sim_node`` first.
+
+    ``sim_args`` go to ``sim_node`` only, ``node_args`` to every other node. The LIDAR is off
+    unless ``lidar`` (a 1081-beam scan costs the most of anything in the simulation).
+
+    The simulated motor drivers stop the wheels after ``command_timeout_s`` *simulated* seconds
+    without ``wheel_commands``, but chassis_node sends them on its steady-clock tick, so at R×
+    a stall of chassis_node for 1/R of that in wall time (0.2 s at 5×, e.g. while the 2-core
+    machine is busy) would stop the robot mid-scenario. ``driver_timeout_wall_s`` (default 1.0,
+    the drivers' default at 1×) sets ``command_timeout_s`` to R times it, so the drivers
+    tolerate the same wall-clock gap as at real time; ``None`` keeps the params file's value
+    (a test of the drivers' own timeout), and ``sim_args`` may override it. ``launch``
+    is the function that starts one process (the ``start_node`` fixture, which stops them at
+    teardown); without it ``launch_node`` is used with ``log_dir`` and the caller stops them.
+    Use ``SimClock`` to wait for the clock and to measure the factor actually reached.
+    """
+    if launch is None:
+        if log_dir is None:
+            raise ValueError("launch_scenario needs launch= or log_dir=")
+
+        def launch(exe: str, *ros_args: str, params_file: Any = None) -> NodeProcess:
+            return launch_node(exe, *ros_args, log_dir=log_dir, params_file=params_file)
+
+    clock_args = ["-p", "publish_clock:=true", "-p", f"real_time_factor:={float(real_time_factor)!r}"]
+    if driver_timeout_wall_s is not None:
+        clock_args += ["-p", f"command_timeout_s:={float(driver_timeout_wall_s * real_time_factor)!r}"]
+    lidar_args = [] if lidar else ["-p", "lidar.enabled:=false"]
+    procs = [launch("sim_node", *clock_args, *lidar_args, *sim_args, params_file=params_file)]
+    for exe in nodes:
+        procs.append(launch(exe, "-p", "use_sim_time:=true", *node_args, params_file=params_file))
+    return procs
+
+
+class SimClock:
+    """Follows ``/clock`` (rosgraph_msgs/Clock) in the test: simulated time and the factor
+    reached. Close it (or use it as a context manager) when done.
+
+    Best effort, as the nodes' own clock subscription. Each message is kept only as the latest
+    (simulated seconds, monotonic arrival time), so a clock at 800 Hz costs no memory. A clock
+    that goes backwards (a restarted simulation) restarts the measurement of ``factor``.
+    ``max_gap`` is the longest wall time between two ``/clock`` arrivals: a stalled simulation
+    (or test process) shows there, which the average ``factor`` hides (sim_node catches up).
+    """
+
+    def __init__(self, node: Any, topic: str = "/clock") -> None:
+        from rosgraph_msgs.msg import Clock
+        self.node = node
+        self.count = 0
+        self.max_gap = 0.0  # the longest wall time between two /clock arrivals [s]
+        self._first: Optional[tuple[float, float]] = None
+        self._latest: Optional[tuple[float, float]] = None
+        self._cond = threading.Condition()
+        self._sub = node.create_subscription(Clock, topic, self._callback, qos_sensor())
+
+    def _callback(self, msg: Any) -> None:
+        sample = (msg.clock.sec + msg.clock.nanosec * 1e-9, time.monotonic())
+        with self._cond:
+            if self._latest is None or sample[0] < self._latest[0]:
+                self._first = sample
+            else:
+                self.max_gap = max(self.max_gap, sample[1] - self._latest[1])
+            self._latest = sample
+            self.count += 1
+            self._cond.notify_all()
+
+    def close(self) -> None:
+        self.node.destroy_subscription(self._sub)
+
+    def __enter__(self) -> "SimClock":
+        return self
+
+    def __exit__(self, *exc: Any) -> None:
+        self.close()
+
+    def wait_started(self, timeout: float = 10.0) -> float:
+        """Wait for the first ``/clock``; return the simulated time it carried."""
+        with self._cond:
+            if not self._cond.wait_for(lambda: self._latest is not None, timeout):
+                raise TimeoutError(f"no /clock within {timeout:g} s (is sim_node running with "
+                                   "publish_clock:=true?)")
+            assert self._first is not None
+            return self._first[0]
+
+    def now(self) -> float:
+        """The latest simulated time received [s]; raises if no ``/clock`` came yet."""
+        with self._cond:
+            if self._latest is None:
+                raise RuntimeError("no /clock received yet (call wait_started first)")
+            return self._latest[0]
+
+    def wait_until(self, t: float, timeout: float = 30.0) -> float:
+        """Wait until simulated time reaches ``t`` (not wall time); return the time reached.
+        Raises TimeoutError after ``timeout`` wall seconds."""
+        with self._cond:
+            if not self._cond.wait_for(lambda: self._latest is not None and self._latest[0] >= t,
+                                       timeout):
+                at = "no /clock" if self._latest is None else f"at {self._latest[0]:.3f} s"
+                raise TimeoutError(f"simulated time did not reach {t:.3f} s within {timeout:g} "
+                                   f"wall seconds ({at})")
+            assert self._latest is not None
+            return self._latest[0]
+
+    def mark(self) -> tuple[float, float]:
+        """(simulated time, monotonic wall time) of the latest ``/clock``: a start for
+        ``factor(since=...)``."""
+        with self._cond:
+            if self._latest is None:
+                raise RuntimeError("no /clock received yet (call wait_started first)")
+            return self._latest
+
+    def factor(self, since: Optional[tuple[float, float]] = None) -> float:
+        """Simulated seconds per wall second, from ``since`` (a ``mark()``; default: the first
+        ``/clock`` received) to the latest ``/clock``. Both ends are arrival times in this
+        process, so DDS latency cancels out; measure over a few wall seconds."""
+        with self._cond:
+            start, end = since or self._first, self._latest
+            if start is None or end is None or end[1] <= start[1]:
+                raise RuntimeError("too few /clock messages to measure the real-time factor")
+            return (end[0] - start[0]) / (end[1] - start[1])
+
+
+def publish_on_sim_time(pub: Any, msg: Union[Any, Callable[[float], Any]], clock: SimClock,
+                        until: float, period: float = 0.05, max_wall_gap: float = 0.1,
+                        timeout: float = 30.0, done: Optional[Callable[[], Any]] = None) -> int:
+    """Publish ``msg`` (or ``msg(t)``, ``t`` the simulated time) every ``period`` simulated
+    seconds until simulated time ``until`` (``math.inf``: no end) or until ``done()`` is truthy;
+    return how many were published.
+
+    The schedule is in simulated time, as a node under the simulation would publish. Also at
+    least every ``max_wall_gap`` wall seconds: the nodes' watchdogs (``cmd_vel_timeout_s``,
+    0.5 s) run on the steady clock by design, so a stream that is on time only in simulated
+    time would stop the wheels whenever the simulation itself waits for the CPU; the extra
+    messages repeat the current command, which changes nothing. Raises TimeoutError if
+    ``until`` is not reached within ``timeout`` wall seconds.
+    """
+    deadline = time.monotonic() + timeout
+    next_sim = clock.now()
+    last_wall = -math.inf
+    count = 0
+    while True:
+        t = clock.now()
+        if t >= until or (done is not None and done()):
+            return count
+        wall = time.monotonic()
+        if wall >= deadline:
+            goal = f"not {until:.3f} s" if done is None else "condition not met"
+            raise TimeoutError(f"simulated time at {t:.3f} s, {goal}, after {timeout:g} wall "
+                               f"seconds ({count} message(s) published on {pub.topic_name})")
+        if t >= next_sim or wall - last_wall >= max_wall_gap:
+            pub.publish(msg(t) if callable(msg) else msg)
+            count += 1
+            last_wall = wall
+            if t >= next_sim:
+                next_sim = (math.floor(t / period + 1e-9) + 1) * period
+        time.sleep(0.002)

@@ -493,3 +493,68 @@ def test_call_service_retries_and_ignores_late_answers(ros_node, rclpy_context):
         assert response.message != "call 1"
         assert len(calls) >= 2 and time.monotonic() - start < 5
     server_node.destroy_node()
+
+
+def test_sim_clock_and_publishing_on_simulated_time(ros_node):
+    """SimClock and publish_on_sim_time against a /clock published here at exactly 3× real time
+    (simulated seconds = 3 × wall seconds since the start), then paused."""
+    import threading
+    from rosgraph_msgs.msg import Clock
+    clock_pub = ros_node.create_publisher(Clock, "/clock", rosutil.make_qos("reliable", "volatile", 1))
+    cmd_pub = ros_node.create_publisher(String, "scenario_cmd", rosutil.qos_default())
+    stop, paused = threading.Event(), threading.Event()
+    t0 = time.monotonic()
+
+    def run_clock() -> None:
+        while not stop.is_set():
+            if not paused.is_set():
+                sim = 3.0 * (time.monotonic() - t0)
+                msg = Clock()
+                msg.clock.sec, msg.clock.nanosec = int(sim), int((sim % 1.0) * 1e9)
+                clock_pub.publish(msg)
+            time.sleep(0.005)
+
+    thread = threading.Thread(target=run_clock, daemon=True)
+    thread.start()
+    try:
+        with harness.SimClock(ros_node) as clock, \
+                harness.subscribe(ros_node, String, "scenario_cmd", qos=rosutil.qos_default()) as cmds:
+            clock.wait_started(timeout=10)
+            # Discovery of the command topic first: its first message may be lost otherwise.
+            harness.publish_until(ros_node, cmd_pub, String(data="hello"), lambda: len(cmds) > 0)
+            mark = clock.mark()
+            # 3 simulated seconds take 1 wall second at 3×.
+            reached = clock.wait_until(mark[0] + 3.0, timeout=10)
+            assert reached >= mark[0] + 3.0
+            assert time.monotonic() - mark[1] == pytest.approx(1.0, abs=0.15)
+            assert clock.factor(since=mark) == pytest.approx(3.0, rel=0.05)
+
+            # Every 0.3 simulated seconds over 3 of them: one at once, then one at each multiple
+            # of 0.3 crossed, 10 (9 if the start falls on one, fewer if this loop stalls across
+            # two of them on a loaded machine); no wall-clock repeats, which would make dozens.
+            cmds.clear()
+            t_start = clock.now()
+            count = harness.publish_on_sim_time(cmd_pub, lambda t: String(data=repr(t)), clock,
+                                                until=t_start + 3.0, period=0.3, max_wall_gap=10.0)
+            assert 8 <= count <= 11
+            rosutil.wait_until(lambda: len(cmds) >= count, timeout=5)
+            sent = [float(m.data) for m in cmds.snapshot()]
+            assert all(t_start <= t < t_start + 3.0 for t in sent)  # msg(t) gets simulated time
+
+            # Paused clock: nothing more on simulated time; at least every 0.1 wall s with the
+            # wall-clock rule: 1 at once + 4 or 5 over 0.5 s (3 if the loop runs late under load).
+            paused.set()
+            time.sleep(0.05)
+            end = time.monotonic() + 0.5
+            assert harness.publish_on_sim_time(cmd_pub, String(), clock, until=math.inf, period=0.3,
+                                               max_wall_gap=10.0, done=lambda: time.monotonic() >= end) == 1
+            end = time.monotonic() + 0.5
+            assert harness.publish_on_sim_time(cmd_pub, String(), clock, until=math.inf, period=0.3,
+                                               max_wall_gap=0.1, done=lambda: time.monotonic() >= end) in (4, 5, 6)
+            assert clock.max_gap < 0.2  # not yet resumed
+            paused.clear()
+            clock.wait_until(clock.now() + 0.3, timeout=5)
+            assert clock.max_gap > 1.0  # the pause, about 1.05 s
+    finally:
+        stop.set()
+        thread.join(5)
