@@ -9,8 +9,10 @@
 //!   shutdown on SIGINT/SIGTERM;
 //! - [`qos`]: the QoS presets of the interface contract;
 //! - [`log`]: `tracing` set-up and rate-limited warnings;
-//! - [`time`]: message stamps; [`geometry`]: planar poses in messages.
+//! - [`time`]: message stamps; [`geometry`]: planar poses in messages;
+//! - [`action`]: an action server with one active goal, for a node's main loop.
 
+pub mod action;
 pub mod args;
 pub mod geometry;
 pub mod log;
