@@ -27,6 +27,7 @@ NO_LIDAR = ("-p", "lidar.enabled:=false")
 # A goal response or result can take one Fast DDS repair period (3 s) when the first request is
 # lost during discovery (ROS2-NOTES), so waits are well above that.
 REPLY_TIMEOUT = 10.0
+DISCOVERY_TIMEOUT = 20.0
 
 # Stopping, by hand, for drive_node's defaults (decel 0.5 m/s², min_speed 0.03 m/s, tolerance
 # 5 mm, 20 Hz) on OMR-III (motor time constant τ = 0.05 s, chassis at 50 Hz): near the end the
@@ -86,7 +87,9 @@ def drive_client(ros_node) -> ActionClient:
     """A DriveDistance client whose goal responses are known to arrive: a goal drive_node must
     refuse (speed not above zero; nothing moves) is sent until its rejection is received."""
     client = ActionClient(ros_node, DriveDistance, "drive_distance")
-    assert client.wait_for_server(timeout_sec=REPLY_TIMEOUT), "drive_distance server not found"
+    # Usually immediate; on a loaded 2-core machine discovery of a fresh node has been seen to
+    # take over 10 s, hence the bound of DISCOVERY_TIMEOUT.
+    assert client.wait_for_server(timeout_sec=DISCOVERY_TIMEOUT), "drive_distance server not found"
     assert not send_until_answered(client, drive_goal(0.5, 0.0)).accepted
     return client
 
@@ -204,7 +207,7 @@ def test_nav2_action_types_round_trip_through_a_rust_server(start_node, ros_node
 
     def round_trip(action_type, name: str, goal):
         client = ActionClient(ros_node, action_type, name)
-        assert client.wait_for_server(timeout_sec=REPLY_TIMEOUT), f"{name} server not found"
+        assert client.wait_for_server(timeout_sec=DISCOVERY_TIMEOUT), f"{name} server not found"
         handle = send_until_answered(client, goal)
         assert handle.accepted
         response = wait_future(handle.get_result_async(), f"{name} result")
@@ -234,3 +237,26 @@ def test_nav2_action_types_round_trip_through_a_rust_server(start_node, ros_node
     assert (w.header.frame_id, w.pose.position.x, w.pose.position.y) == ("odom", -1.0, 2.0)
     assert result.missed_waypoints[1].goal.pose.position.x == -0.5
     assert (result.error_code, result.error_msg) == (600, "2 of 4 missed, 2 loops from 1")
+
+
+def test_stale_odometry_aborts_the_goal_and_stops(start_node, ros_node):
+    params = "params/omr3.yaml"
+    start_node("sim_node", *NO_LIDAR, params_file=params)
+    chassis = start_node("chassis_node", params_file=params)
+    start_node("drive_node", "-p", "odom_timeout_s:=0.3")
+    with subscribe(ros_node, Odometry, "odom") as odom, \
+            subscribe(ros_node, Twist, "cmd_vel") as cmd:
+        odom.wait_for(None, REPLY_TIMEOUT)
+        client = drive_client(ros_node)
+        feedback = []
+        handle = send_accepted(client, drive_goal(2.0, 0.3),
+                               feedback=lambda f: feedback.append(f.feedback))
+        result = handle.get_result_async()
+        assert wait_until(lambda: feedback and feedback[-1].travelled > 0.1, REPLY_TIMEOUT)
+        chassis.stop()  # odom ends
+        response = wait_future(result, "result after odom stopped")
+        assert response.status == GoalStatus.STATUS_ABORTED
+        assert response.result.reason == "odometry stale"
+        assert 0.1 < response.result.travelled < 2.0
+        last = cmd.latest
+        assert (last.linear.x, last.linear.y, last.angular.z) == (0.0, 0.0, 0.0)

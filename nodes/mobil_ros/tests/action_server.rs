@@ -66,8 +66,10 @@ async fn within<T, E: std::fmt::Debug>(f: impl std::future::Future<Output = Resu
         .expect("the call failed")
 }
 
-/// Sends a goal until a response arrives: a response written before the server has matched the
-/// client's reply reader is lost, so only a reply proves the path works.
+/// Sends a goal until a response arrives. ros2-client's client writes its first request at once,
+/// before discovery may have matched the server's request reader, and that request is lost
+/// (measured here: the first goal usually needs a second attempt); only a reply proves the path
+/// works.
 async fn send(client: &Client, g: DriveDistanceGoal) -> (ros2_client::action::GoalId, bool) {
     for _ in 0..5 {
         if let Ok(Ok((id, response))) =
