@@ -97,6 +97,9 @@ pub enum ActionError {
     Goal(GoalId, String),
 }
 
+/// The longest [`GoalServer::close`] waits for queued results.
+pub const CLOSE_WAIT: Duration = Duration::from_secs(2);
+
 /// Settings of a [`GoalServer`].
 #[derive(Debug, Clone, PartialEq)]
 pub struct GoalServerConfig {
@@ -360,18 +363,21 @@ where
     }
 
     /// Ends the active goal (if any) ABORTED with `result`, then waits until the queued results
-    /// are delivered or given up (at most the result timeout, plus a second).
+    /// are delivered, at most [`CLOSE_WAIT`] (a node shutting down must not hang on a client
+    /// that never asks for its result); what is left then is dropped with a warning.
     pub async fn close(mut self, result: A::Result) {
         if self.active.is_some() {
             self.finish(GoalEnd::Aborted, result);
         }
         self.results = None;
-        if let Some(task) = self.delivery.take() {
-            if tokio::time::timeout(self.result_timeout + Duration::from_secs(1), task)
-                .await
-                .is_err()
-            {
-                warn!("{}: results still undelivered at close", self.name);
+        if let Some(mut task) = self.delivery.take() {
+            let wait = CLOSE_WAIT.min(self.result_timeout + Duration::from_millis(100));
+            if tokio::time::timeout(wait, &mut task).await.is_err() {
+                warn!(
+                    "{}: results still undelivered after {wait:?} at close: dropped",
+                    self.name
+                );
+                task.abort();
             }
         }
     }
