@@ -59,7 +59,7 @@ def ros_environ(base: Optional[dict[str, str]] = None, domain_id: Optional[int] 
 
     Starts from ``base`` (default: ``os.environ``) and adds, without overriding what is already
     set: the RMW implementation, the Fast DDS profile, ROS_DISTRO, and PYTHONPATH /
-    LD_LIBRARY_PATH for the mobil_msgs install. ``domain_id`` overrides ROS_DOMAIN_ID.
+    LD_LIBRARY_PATH for the mobil_msgs (and nav2_msgs) install. ``domain_id`` overrides ROS_DOMAIN_ID.
     """
     env = dict(os.environ if base is None else base)
     env.setdefault("RMW_IMPLEMENTATION", RMW_IMPLEMENTATION)
@@ -87,7 +87,9 @@ def setup_process_environment() -> None:
     if str(MSGS_PYTHONPATH) not in sys.path and MSGS_PYTHONPATH.is_dir():
         sys.path.append(str(MSGS_PYTHONPATH))
     if MSGS_LIB.is_dir():
-        _msgs_preload_error = _preload_libraries(sorted(MSGS_LIB.glob("libmobil_msgs__*.so")))
+        # mobil_msgs, and nav2_msgs (Nav2's action types), which setup_env.sh installs beside it.
+        _msgs_preload_error = _preload_libraries(
+            sorted(MSGS_LIB.glob("libmobil_msgs__*.so")) + sorted(MSGS_LIB.glob("libnav2_msgs__*.so")))
 
 
 def _preload_libraries(libs: Sequence[Path]) -> Optional[str]:

@@ -1,7 +1,8 @@
-//! Generates the Rust message types from `.msg` / `.srv` files at build time.
+//! Generates the Rust message types from `.msg` / `.srv` / `.action` files at build time.
 //!
-//! Inputs: the suite's own interface package (`msgs/msg`, `msgs/srv`, package `mobil_msgs`) and
-//! the standard ROS 2 Jazzy definitions the suite uses, vendored unchanged under `msgs/rust/ros`.
+//! Inputs: the suite's own interface package (`msgs/msg`, `msgs/srv`, `msgs/action`, package
+//! `mobil_msgs`), Nav2's Jazzy action types (`msgs/nav2_msgs`, package `nav2_msgs`) and the
+//! standard ROS 2 Jazzy definitions the suite uses, vendored unchanged under `msgs/rust/ros`.
 //! Output: `$OUT_DIR/generated.rs`, one module per package (`geometry_msgs::msg::Twist`, …),
 //! with serde layouts that match the CDR encoding rmw implementations use (field order, fixed
 //! arrays without a length prefix, sequences with one).
@@ -21,6 +22,7 @@ fn main() {
 
     let mut sources: Vec<(String, PathBuf)> = Vec::new();
     collect(&own_package, "mobil_msgs", &mut sources);
+    collect(&own_package.join("nav2_msgs"), "nav2_msgs", &mut sources);
     let mut std_packages: Vec<_> = std::fs::read_dir(&vendored)
         .expect("msgs/rust/ros exists")
         .filter_map(|e| e.ok())
@@ -44,6 +46,7 @@ fn main() {
         let result = match path.extension().and_then(|e| e.to_str()) {
             Some("msg") => packages.add_message(pkg, &name, &text),
             Some("srv") => packages.add_service(pkg, &name, &text),
+            Some("action") => packages.add_action(pkg, &name, &text),
             _ => continue,
         };
         if let Err(e) = result {
@@ -59,10 +62,12 @@ fn main() {
     println!("cargo:rerun-if-changed=ros");
     println!("cargo:rerun-if-changed=../msg");
     println!("cargo:rerun-if-changed=../srv");
+    println!("cargo:rerun-if-changed=../action");
+    println!("cargo:rerun-if-changed=../nav2_msgs");
 }
 
 fn collect(package_dir: &Path, pkg: &str, out: &mut Vec<(String, PathBuf)>) {
-    for sub in ["msg", "srv"] {
+    for sub in ["msg", "srv", "action"] {
         let Ok(entries) = std::fs::read_dir(package_dir.join(sub)) else {
             continue;
         };

@@ -1,6 +1,8 @@
 //! A parser for ROS 2 `.msg` / `.srv` files and the Rust code generator behind this crate.
 //!
 //! Used by `build.rs` (the same file is included there with `#[path]`) and unit-tested here.
+//! An `.action` file becomes its three parts (`Name_Goal`, `Name_Result`, `Name_Feedback`) plus
+//! a marker type implementing `crate::RosAction`, which names the action for ros2-client.
 //! Supported: every primitive type, bounded and unbounded strings, fixed (`T[N]`), bounded
 //! (`T[<=N]`) and unbounded (`T[]`) arrays, nested messages (same package or `pkg/Type`),
 //! constants (`TYPE NAME=VALUE`) and default values (`TYPE name VALUE`). `wstring` is refused.
@@ -319,16 +321,35 @@ fn unquote(s: &str) -> String {
     }
 }
 
-/// Splits a `.srv` into its request and response halves.
-pub fn split_srv(text: &str) -> Result<(&str, &str), IdlError> {
-    let mut offset = 0;
+/// Splits a definition at its `---` lines.
+fn split_parts(text: &str) -> Vec<&str> {
+    let mut parts = Vec::new();
+    let (mut start, mut offset) = (0, 0);
     for line in text.split_inclusive('\n') {
         if line.trim() == "---" {
-            return Ok((&text[..offset], &text[offset + line.len()..]));
+            parts.push(&text[start..offset]);
+            start = offset + line.len();
         }
         offset += line.len();
     }
-    Err(err(0, "a service needs a `---` line between request and response"))
+    parts.push(&text[start..]);
+    parts
+}
+
+/// Splits a `.srv` into its request and response halves.
+pub fn split_srv(text: &str) -> Result<(&str, &str), IdlError> {
+    match split_parts(text).as_slice() {
+        [request, response] => Ok((request, response)),
+        _ => Err(err(0, "a service needs one `---` line between request and response")),
+    }
+}
+
+/// Splits an `.action` into its goal, result and feedback parts.
+pub fn split_action(text: &str) -> Result<(&str, &str, &str), IdlError> {
+    match split_parts(text).as_slice() {
+        [goal, result, feedback] => Ok((goal, result, feedback)),
+        _ => Err(err(0, "an action needs two `---` lines: goal, result, feedback")),
+    }
 }
 
 #[derive(Debug, Default)]
@@ -336,6 +357,8 @@ struct Package {
     msgs: Vec<MsgSpec>,
     /// Service name → (request, response), both also in `msgs` of the `srv` module.
     srvs: Vec<(String, MsgSpec, MsgSpec)>,
+    /// Action name → (goal, result, feedback), in the `action` module.
+    actions: Vec<(String, MsgSpec, MsgSpec, MsgSpec)>,
 }
 
 /// All definitions to generate, grouped by package.
@@ -377,6 +400,21 @@ impl Packages {
             .or_default()
             .srvs
             .push((name.to_owned(), request, response));
+        Ok(())
+    }
+
+    /// Adds an action definition (`Name.action` → `NameGoal`, `NameResult`, `NameFeedback`, and
+    /// the marker type `Name`).
+    pub fn add_action(&mut self, package: &str, name: &str, text: &str) -> Result<(), IdlError> {
+        let (goal, result, feedback) = split_action(text)?;
+        let goal = parse_msg(package, &format!("{name}_Goal"), goal)?;
+        let result = parse_msg(package, &format!("{name}_Result"), result)?;
+        let feedback = parse_msg(package, &format!("{name}_Feedback"), feedback)?;
+        self.packages
+            .entry(package.to_owned())
+            .or_default()
+            .actions
+            .push((name.to_owned(), goal, result, feedback));
         Ok(())
     }
 
@@ -543,6 +581,26 @@ impl Packages {
                 }
                 let _ = writeln!(out, "}}");
             }
+            if !contents.actions.is_empty() {
+                let _ = writeln!(out, "/// Actions of `{package}`.");
+                let _ = writeln!(out, "pub mod action {{");
+                for (name, goal, result, feedback) in &contents.actions {
+                    self.generate_struct(&mut out, goal, "action")?;
+                    self.generate_struct(&mut out, result, "action")?;
+                    self.generate_struct(&mut out, feedback, "action")?;
+                    let _ = writeln!(out, "    /// The `{package}/action/{name}` action.");
+                    let _ = writeln!(out, "    #[derive(Debug, Clone, Copy, Default)]");
+                    let _ = writeln!(out, "    pub struct {name};\n");
+                    let _ = writeln!(out, "    impl crate::RosAction for {name} {{");
+                    let _ = writeln!(out, "        type Goal = {name}Goal;");
+                    let _ = writeln!(out, "        type Result = {name}Result;");
+                    let _ = writeln!(out, "        type Feedback = {name}Feedback;");
+                    let _ = writeln!(out, "        const PACKAGE: &'static str = {package:?};");
+                    let _ = writeln!(out, "        const NAME: &'static str = {name:?};");
+                    let _ = writeln!(out, "    }}\n");
+                }
+                let _ = writeln!(out, "}}");
+            }
             let _ = writeln!(out, "}}\n");
         }
         Ok(out)
@@ -640,6 +698,46 @@ Point[] points
             .unwrap_err()
             .message
             .contains("unknown message type pkg/Missing"));
+    }
+
+    #[test]
+    fn actions_split_into_goal_result_feedback() {
+        let text = "float64 distance\nfloat64 speed 0.2\n---\nuint8 OK=0\nstring reason\n---\n";
+        let (g, r, f) = split_action(text).unwrap();
+        assert_eq!(
+            (g, r, f),
+            (
+                "float64 distance\nfloat64 speed 0.2\n",
+                "uint8 OK=0\nstring reason\n",
+                ""
+            )
+        );
+        assert!(split_action("int32 a\n---\nint32 b\n").is_err());
+        assert!(split_action("a\n---\n---\n---\n").is_err());
+        assert!(split_srv("int32 a\n---\nint32 b\n---\nint32 c\n").is_err());
+        let mut p = Packages::default();
+        p.add_message("pkg", "Inner", "float64 w\n").unwrap();
+        p.add_action(
+            "pkg",
+            "Drive",
+            text.replace("float64 speed", "Inner[] inner\nfloat64 speed").as_str(),
+        )
+        .unwrap();
+        let code = p.generate().unwrap();
+        assert!(code.contains("pub mod action {"));
+        assert!(
+            code.contains("pub struct DriveGoal {")
+                && code.contains("pub inner: ::std::vec::Vec<crate::pkg::msg::Inner>,")
+        );
+        assert!(code.contains("speed: 0.2,"));
+        assert!(code.contains("pub struct DriveResult {") && code.contains("pub const OK: u8 = 0;"));
+        // The empty feedback gets the IDL's dummy octet.
+        let feedback = &code[code.find("pub struct DriveFeedback {").unwrap()..];
+        assert!(
+            feedback.starts_with("pub struct DriveFeedback {\n        pub structure_needs_at_least_one_member: u8,")
+        );
+        assert!(code.contains("impl crate::RosAction for Drive {") && code.contains("type Feedback = DriveFeedback;"));
+        assert!(code.contains("`pkg/action/Drive_Goal`"));
     }
 
     #[test]

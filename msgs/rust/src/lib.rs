@@ -2,8 +2,12 @@
 //! suite uses, generated at build time from their `.msg` / `.srv` files (see `build.rs`).
 //!
 //! Module paths follow the ROS names: `geometry_msgs::msg::Twist`, `mobil_msgs::msg::NavStatus`,
-//! `mobil_msgs::srv::CheckRoute`. Every message implements [`RosMessage`], which knows its ROS type
-//! name, and `ros2_client::Message`, so it can be published and subscribed with ros2-client.
+//! `mobil_msgs::srv::CheckRoute`, `nav2_msgs::action::NavigateToPose`. Every message implements
+//! [`RosMessage`], which knows its ROS type name, and `ros2_client::Message`, so it can be published
+//! and subscribed with ros2-client. An action `pkg/action/Name` is the marker type
+//! `pkg::action::Name` implementing [`RosAction`], with its parts `NameGoal`, `NameResult` and
+//! `NameFeedback` beside it; the goal-id wrappers of the action's services and feedback topic
+//! (`SendGoal`, `GetResult`, `FeedbackMessage`) are ros2-client's (`ros2_client::action`).
 
 #[allow(clippy::all)]
 mod generated {
@@ -13,7 +17,7 @@ pub use generated::*;
 
 pub mod idl;
 
-use ros2_client::{MessageTypeName, ServiceTypeName};
+use ros2_client::{ActionTypeName, MessageTypeName, ServiceTypeName};
 
 /// A message type generated from a `.msg` file.
 pub trait RosMessage:
@@ -44,5 +48,25 @@ pub trait RosService {
     /// The name ros2-client uses to create a server or client of this service.
     fn type_name() -> ServiceTypeName {
         ServiceTypeName::new(Self::PACKAGE, Self::NAME)
+    }
+}
+
+/// An action type generated from an `.action` file.
+pub trait RosAction {
+    /// What a client asks for.
+    type Goal: RosMessage;
+    /// What the server answers when the goal ends (whatever its status).
+    type Result: RosMessage;
+    /// What the server reports while the goal executes.
+    type Feedback: RosMessage;
+    /// ROS package.
+    const PACKAGE: &'static str;
+    /// Action name inside the package.
+    const NAME: &'static str;
+
+    /// The name ros2-client uses to create a server or client of this action (`pkg/action/Name`;
+    /// ros2-client derives the DDS names of the parts, e.g. `pkg::action::dds_::Name_SendGoal_Request_`).
+    fn type_name() -> ActionTypeName {
+        ActionTypeName::new(Self::PACKAGE, Self::NAME)
     }
 }

@@ -18,6 +18,8 @@
 //!   watchdogs, freshness and tick periods on the steady clock;
 //! - [`offloop`]: [`OffLoop`], searches of 10–500 ms off the event loop, pre-empted by newer
 //!   requests;
+//! - [`action`]: [`action::GoalServer`], an action server with one active goal for a node's
+//!   select loop (accept/reject, feedback, result, cancel, pre-emption);
 //! - [`stop`]: [`stop::final_stop`], the bounded last zero command of a motion node;
 //! - [`scan`]: LaserScan → checked [`mobil_geom::Scan`] at the edge, laser pose from `/tf_static`
 //!   ([`scan::StaticFrames`]) or a parameter;
@@ -25,6 +27,7 @@
 //!   rate-limited warnings ([`warn_throttled!`]); [`geometry`]: planar poses in messages;
 //!   [`args`], [`params`], [`names`]: the ROS command line, parameter files, names.
 
+pub mod action;
 pub mod args;
 pub mod config;
 pub mod geometry;

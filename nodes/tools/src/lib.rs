@@ -1,4 +1,6 @@
-//! Tools around the mobil nodes. [`route`] holds the scripted routes the demo drives and the
+//! Tools around the mobil nodes. [`drive`] is the ROS-free logic of `drive_node` (drive a
+//! distance, the `DriveDistance` action). [`route`] holds the scripted routes the demo drives and the
 //! bookkeeping that turns two pose streams (odometry, ground truth) into the demo's summary.
 
+pub mod drive;
 pub mod route;

@@ -1,0 +1,442 @@
+//! An action server for a node's main loop: at most one active goal, accepted or rejected with a
+//! reason, feedback while it runs, a result however it ends, cancel, and pre-emption by a newer
+//! goal.
+//!
+//! [`GoalServer`] wraps ros2-client's `AsyncActionServer` for the way the suite's nodes run: one
+//! `tokio::select!` over topics, a ticker and [`GoalServer::next_event`]. The node owns the
+//! decisions (is this goal valid? is it done?), the server owns the protocol:
+//!
+//! - **QoS as rcl_action has it**, which Fast DDS clients need to match: the three services and
+//!   the feedback topic reliable and volatile (depth 10), the status topic reliable and transient
+//!   local (depth 1). A transient-local request reader does not match rclpy's volatile request
+//!   writers, and goals would never arrive.
+//! - **Accept or reject with a reason**: ROS 2's goal response carries only accepted/rejected, so
+//!   the reason is logged (info) with the goal id.
+//! - **Pre-emption**: accepting a new goal while one is active ends the old one **ABORTED**, with a
+//!   result the node builds (its reason says "preempted"), as Nav2's `SimpleActionServer` does —
+//!   so a Nav2-style client sees the same status from this suite as from Nav2. (CANCELED is kept
+//!   for what a client asked for; an old goal that was already being canceled ends CANCELED.)
+//! - **Cancel**: a cancel request that names the active goal is agreed to at once (the goal goes
+//!   CANCELING) and reported as [`ActionEvent::CancelRequested`]; the node stops and calls
+//!   [`GoalServer::finish`] with [`GoalEnd::Canceled`]. Requests for other goals are refused.
+//! - **Results with a bounded wait**: ros2-client sends a result only once the client has asked
+//!   for it (`get_result`). [`GoalServer::finish`] hands the result to a background task that
+//!   delivers results one after another, each waiting at most
+//!   [`GoalServerConfig::result_timeout`] for the client's request, so the node's loop never
+//!   blocks on a client. A result nobody asked for in time is dropped with a warning (an accepted
+//!   goal that was not canceling is then marked aborted). The timeout must exceed Fast DDS's
+//!   3 s repair of a request lost during discovery (ROS2-NOTES), hence the 10 s default.
+//!
+//! ```no_run
+//! # async fn demo(node: &mut mobil_ros::RosNode) -> anyhow::Result<()> {
+//! use mobil_msgs::mobil_msgs::action::{DriveDistance, DriveDistanceFeedback, DriveDistanceResult};
+//! use mobil_ros::action::{ActionEvent, GoalEnd, GoalServer, GoalServerConfig};
+//! use std::time::Duration;
+//! let mut server = GoalServer::<DriveDistance>::create(node, "drive_distance", GoalServerConfig::default())?;
+//! let mut ticker = tokio::time::interval(Duration::from_millis(50));
+//! let mut travelled = 0.0;
+//! let result = |travelled: f64, reason: &str| DriveDistanceResult { travelled, reason: reason.into() };
+//! loop {
+//!     tokio::select! {
+//!         event = server.next_event() => match event {
+//!             ActionEvent::Goal(request) if request.goal().speed <= 0.0 => {
+//!                 server.reject(request, "speed must be above zero").await;
+//!             }
+//!             ActionEvent::Goal(request) => {
+//!                 server.accept(request, |_old| result(travelled, "preempted by a newer goal")).await?;
+//!                 travelled = 0.0;
+//!             }
+//!             ActionEvent::CancelRequested => {
+//!                 server.finish(GoalEnd::Canceled, result(travelled, "canceled"));
+//!             }
+//!         },
+//!         _ = ticker.tick() => {
+//!             let Some(goal) = server.active_goal() else { continue };
+//!             let distance = goal.distance;
+//!             travelled += 0.01;
+//!             if travelled >= distance {
+//!                 server.finish(GoalEnd::Succeeded, result(travelled, "reached"));
+//!             } else {
+//!                 server.feedback(DriveDistanceFeedback { travelled, remaining: distance - travelled }).await?;
+//!             }
+//!         }
+//!     }
+//! }
+//! # }
+//! ```
+
+use crate::RosNode;
+use mobil_msgs::RosAction;
+use ros2_client::action::{
+    ActionServerQosPolicies, AsyncActionServer, CancelHandle, ExecutingGoalHandle, NewGoalHandle,
+};
+pub use ros2_client::action::{GoalEndStatus as GoalEnd, GoalId};
+use ros2_client::{Name, Node, ServiceMapping};
+use std::sync::{Arc, Mutex};
+use std::time::{Duration, Instant};
+use thiserror::Error;
+use tokio::sync::mpsc;
+use tracing::{info, warn};
+
+type Server<A> = AsyncActionServer<<A as RosAction>::Goal, <A as RosAction>::Result, <A as RosAction>::Feedback>;
+
+/// What can go wrong serving an action.
+#[derive(Debug, Error)]
+pub enum ActionError {
+    /// The action name does not resolve or is not a valid ROS name.
+    #[error("bad action name `{0}`: {1}")]
+    Name(String, String),
+    /// ros2-client could not create the action's services and topics.
+    #[error("cannot create action server {0}: {1}")]
+    Create(String, String),
+    /// A call that needs an active goal came without one.
+    #[error("no active goal")]
+    NoActiveGoal,
+    /// ros2-client refused a goal transition, or DDS failed to send.
+    #[error("goal {0:?}: {1}")]
+    Goal(GoalId, String),
+}
+
+/// The longest [`GoalServer::close`] waits for queued results.
+pub const CLOSE_WAIT: Duration = Duration::from_secs(2);
+
+/// Settings of a [`GoalServer`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct GoalServerConfig {
+    /// How long a finished goal's result waits for the client's `get_result` request.
+    pub result_timeout: Duration,
+}
+
+impl Default for GoalServerConfig {
+    fn default() -> Self {
+        GoalServerConfig {
+            result_timeout: Duration::from_secs(10),
+        }
+    }
+}
+
+/// The QoS of an action server as rcl_action sets it (see the module docs).
+pub fn server_qos() -> ActionServerQosPolicies {
+    let service = crate::qos::reliable(10);
+    ActionServerQosPolicies {
+        goal_service: service.clone(),
+        result_service: service.clone(),
+        cancel_service: service.clone(),
+        feedback_publisher: service,
+        status_publisher: crate::qos::latched(),
+    }
+}
+
+/// A goal a client sent, waiting for [`GoalServer::accept`] or [`GoalServer::reject`].
+pub struct GoalRequest<G> {
+    handle: NewGoalHandle<G>,
+    goal: G,
+}
+
+impl<G> GoalRequest<G> {
+    /// What the client asks for.
+    pub fn goal(&self) -> &G {
+        &self.goal
+    }
+
+    /// The client's id for the goal.
+    pub fn id(&self) -> GoalId {
+        self.handle.goal_id()
+    }
+}
+
+/// Something the node has to react to.
+pub enum ActionEvent<G> {
+    /// A client sent a goal: accept it (pre-empting the active one, if any) or reject it.
+    Goal(GoalRequest<G>),
+    /// A client asked to cancel the active goal and the server agreed (it is CANCELING): stop,
+    /// then [`GoalServer::finish`] it, normally with [`GoalEnd::Canceled`].
+    CancelRequested,
+}
+
+struct Active<G> {
+    handle: ExecutingGoalHandle<G>,
+    goal: G,
+    canceling: bool,
+}
+
+struct Finished<A: RosAction> {
+    handle: ExecutingGoalHandle<A::Goal>,
+    status: GoalEnd,
+    result: A::Result,
+}
+
+/// An action server owning at most one active goal (see the module docs).
+pub struct GoalServer<A: RosAction> {
+    server: Arc<Server<A>>,
+    name: String,
+    active: Option<Active<A::Goal>>,
+    /// A cancel request agreed to but not yet answered (kept so that a dropped
+    /// [`GoalServer::next_event`] future answers it on the next call).
+    pending_cancel: Option<(CancelHandle, Option<GoalId>)>,
+    results: Option<mpsc::UnboundedSender<Finished<A>>>,
+    delivery: Option<tokio::task::JoinHandle<()>>,
+    result_timeout: Duration,
+    throttle: Mutex<crate::LogThrottle>,
+}
+
+impl<A> GoalServer<A>
+where
+    A: RosAction + 'static,
+{
+    /// Serves `action` (resolved and remapped like a topic name) on a running node. Needs a tokio
+    /// runtime (the result delivery task is spawned on it).
+    pub fn create(node: &mut RosNode, action: &str, config: GoalServerConfig) -> Result<Self, ActionError> {
+        let full = node
+            .names()
+            .resolve(action)
+            .map_err(|e| ActionError::Name(action.to_owned(), e.to_string()))?;
+        let name = Name::parse(&full).map_err(|e| ActionError::Name(full.clone(), format!("{e:?}")))?;
+        Self::on_node(node.inner(), &name, config)
+    }
+
+    /// Serves the action `name` on a bare ros2-client node. Needs a tokio runtime.
+    pub fn on_node(node: &mut Node, name: &Name, config: GoalServerConfig) -> Result<Self, ActionError> {
+        let server = node
+            .create_action_server::<A::Goal, A::Result, A::Feedback>(
+                ServiceMapping::Enhanced,
+                name,
+                &A::type_name(),
+                server_qos(),
+            )
+            .map_err(|e| ActionError::Create(name.to_string(), format!("{e:?}")))?;
+        let server = Arc::new(AsyncActionServer::new(server));
+        let (tx, rx) = mpsc::unbounded_channel();
+        let delivery = tokio::spawn(deliver_results::<A>(
+            server.clone(),
+            rx,
+            config.result_timeout,
+            name.to_string(),
+        ));
+        Ok(GoalServer {
+            server,
+            name: name.to_string(),
+            active: None,
+            pending_cancel: None,
+            results: Some(tx),
+            delivery: Some(delivery),
+            result_timeout: config.result_timeout,
+            throttle: Mutex::new(crate::LogThrottle::new(Duration::from_secs(2))),
+        })
+    }
+
+    /// The active goal, if any (also while it is being canceled).
+    pub fn active_goal(&self) -> Option<&A::Goal> {
+        self.active.as_ref().map(|a| &a.goal)
+    }
+
+    /// The active goal's id.
+    pub fn active_id(&self) -> Option<GoalId> {
+        self.active.as_ref().map(|a| a.handle.goal_id())
+    }
+
+    /// Whether the active goal is being canceled.
+    pub fn is_canceling(&self) -> bool {
+        self.active.as_ref().is_some_and(|a| a.canceling)
+    }
+
+    /// Waits for the next goal or cancel request. Cancel-safe: a request is never half taken, so
+    /// this can be one branch of a `tokio::select!` that other branches win.
+    pub async fn next_event(&mut self) -> ActionEvent<A::Goal> {
+        loop {
+            if let Some((handle, goal)) = self.pending_cancel.as_ref() {
+                let agreed = goal.iter().copied().collect::<Vec<_>>();
+                if let Err(e) = self.server.respond_to_cancel_requests(handle, agreed.into_iter()).await {
+                    self.warn(
+                        "cancel-response",
+                        format_args!("{}: cannot answer a cancel request: {e:?}", self.name),
+                    );
+                }
+                let agreed = goal.is_some();
+                self.pending_cancel = None;
+                if agreed {
+                    return ActionEvent::CancelRequested;
+                }
+                continue;
+            }
+            tokio::select! {
+                goal = self.server.receive_new_goal() => match goal {
+                    Ok(handle) => match self.server.get_new_goal(handle.clone()) {
+                        Some(goal) => return ActionEvent::Goal(GoalRequest { handle, goal }),
+                        None => self.warn("goal-lost", format_args!("{}: goal {:?} vanished before it was read", self.name, handle.goal_id())),
+                    },
+                    Err(e) => self.warn("goal-read", format_args!("{}: undecodable goal request dropped: {e:?}", self.name)),
+                },
+                cancel = self.server.receive_cancel_request() => match cancel {
+                    Ok(handle) => {
+                        let agreed = self
+                            .active
+                            .as_mut()
+                            .filter(|a| !a.canceling && handle.contains_goal(&a.handle.goal_id()))
+                            .map(|a| {
+                                a.canceling = true;
+                                a.handle.goal_id()
+                            });
+                        match agreed {
+                            Some(id) => info!("{}: goal {id:?} is canceling", self.name),
+                            None => info!("{}: cancel request refused: it names no active goal", self.name),
+                        }
+                        self.pending_cancel = Some((handle, agreed));
+                    }
+                    Err(e) => self.warn("cancel-read", format_args!("{}: undecodable cancel request dropped: {e:?}", self.name)),
+                },
+            }
+        }
+    }
+
+    /// Accepts a goal and makes it the active one. If a goal was active, it ends first:
+    /// ABORTED with the result `preempted` builds from it (CANCELED if it was being canceled).
+    pub async fn accept(
+        &mut self,
+        request: GoalRequest<A::Goal>,
+        preempted: impl FnOnce(&A::Goal) -> A::Result,
+    ) -> Result<(), ActionError> {
+        let id = request.id();
+        if let Some(old) = self.active.take() {
+            let status = if old.canceling {
+                GoalEnd::Canceled
+            } else {
+                GoalEnd::Aborted
+            };
+            info!(
+                "{}: goal {:?} preempted by goal {id:?}: it ends {status:?}",
+                self.name,
+                old.handle.goal_id()
+            );
+            let result = preempted(&old.goal);
+            self.queue(old.handle, status, result);
+        }
+        let accepted = self
+            .server
+            .accept_goal(request.handle)
+            .await
+            .map_err(|e| ActionError::Goal(id, format!("cannot accept: {e:?}")))?;
+        let executing = self
+            .server
+            .start_executing_goal(accepted)
+            .await
+            .map_err(|e| ActionError::Goal(id, format!("cannot start: {e:?}")))?;
+        info!("{}: goal {id:?} accepted", self.name);
+        self.active = Some(Active {
+            handle: executing,
+            goal: request.goal,
+            canceling: false,
+        });
+        Ok(())
+    }
+
+    /// Rejects a goal; the reason is logged (a ROS 2 goal response cannot carry it).
+    pub async fn reject(&mut self, request: GoalRequest<A::Goal>, reason: &str) {
+        let id = request.id();
+        info!("{}: goal {id:?} rejected: {reason}", self.name);
+        if let Err(e) = self.server.reject_goal(request.handle).await {
+            self.warn(
+                "reject",
+                format_args!("{}: cannot send the rejection of {id:?}: {e:?}", self.name),
+            );
+        }
+    }
+
+    /// Publishes feedback on the active goal.
+    pub async fn feedback(&self, feedback: A::Feedback) -> Result<(), ActionError> {
+        let active = self.active.as_ref().ok_or(ActionError::NoActiveGoal)?;
+        let id = active.handle.goal_id();
+        self.server
+            .publish_feedback(active.handle.clone(), feedback)
+            .await
+            .map_err(|e| ActionError::Goal(id, format!("cannot publish feedback: {e:?}")))
+    }
+
+    /// Ends the active goal with `status` and `result` (delivered in the background, see the
+    /// module docs). Returns the goal's id, or `None` when no goal was active.
+    pub fn finish(&mut self, status: GoalEnd, result: A::Result) -> Option<GoalId> {
+        let active = self.active.take()?;
+        let id = active.handle.goal_id();
+        info!("{}: goal {id:?} ends {status:?}", self.name);
+        self.queue(active.handle, status, result);
+        Some(id)
+    }
+
+    /// Ends the active goal (if any) ABORTED with `result`, then waits until the queued results
+    /// are delivered, at most [`CLOSE_WAIT`] (a node shutting down must not hang on a client
+    /// that never asks for its result); what is left then is dropped with a warning.
+    pub async fn close(mut self, result: A::Result) {
+        if self.active.is_some() {
+            self.finish(GoalEnd::Aborted, result);
+        }
+        self.results = None;
+        if let Some(mut task) = self.delivery.take() {
+            let wait = CLOSE_WAIT.min(self.result_timeout + Duration::from_millis(100));
+            if tokio::time::timeout(wait, &mut task).await.is_err() {
+                warn!(
+                    "{}: results still undelivered after {wait:?} at close: dropped",
+                    self.name
+                );
+                task.abort();
+            }
+        }
+    }
+
+    fn queue(&self, handle: ExecutingGoalHandle<A::Goal>, status: GoalEnd, result: A::Result) {
+        let id = handle.goal_id();
+        let sent = self
+            .results
+            .as_ref()
+            .is_some_and(|tx| tx.send(Finished { handle, status, result }).is_ok());
+        if !sent {
+            warn!(
+                "{}: result of goal {id:?} not delivered: the server is closing",
+                self.name
+            );
+        }
+    }
+
+    fn warn(&self, key: &'static str, message: std::fmt::Arguments<'_>) {
+        if let Ok(mut throttle) = self.throttle.lock() {
+            crate::warn_throttled!(throttle, key, "{message}");
+        }
+    }
+}
+
+impl<A: RosAction> Drop for GoalServer<A> {
+    fn drop(&mut self) {
+        if let Some(active) = &self.active {
+            warn!(
+                "{}: dropped with goal {:?} active; its client gets no result",
+                self.name,
+                active.handle.goal_id()
+            );
+        }
+    }
+}
+
+/// Sends queued results one after another, each waiting at most `timeout` for the client's
+/// `get_result` request. One at a time, because each `send_result_response` reads the result
+/// service's requests and keeps those of other goals for them.
+async fn deliver_results<A: RosAction>(
+    server: Arc<Server<A>>,
+    mut queue: mpsc::UnboundedReceiver<Finished<A>>,
+    timeout: Duration,
+    name: String,
+) {
+    while let Some(Finished { handle, status, result }) = queue.recv().await {
+        let id = handle.goal_id();
+        let started = Instant::now();
+        match tokio::time::timeout(timeout, server.send_result_response(handle.clone(), status, result)).await {
+            Ok(Ok(())) => tracing::debug!("{name}: result of {id:?} sent after {:?}", started.elapsed()),
+            Ok(Err(e)) => warn!("{name}: cannot send the result of goal {id:?}: {e:?}"),
+            Err(_) => {
+                warn!("{name}: no client asked for the result of goal {id:?} within {timeout:?}; dropped");
+                if status != GoalEnd::Canceled {
+                    // Leaves the goal's status ABORTED rather than EXECUTING for ever.
+                    let _ = server.abort_executing_goal(handle).await;
+                }
+            }
+        }
+    }
+}

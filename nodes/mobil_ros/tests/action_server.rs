@@ -1,0 +1,154 @@
+//! `GoalServer` against ros2-client's own action client, two DDS participants in one process:
+//! reject, accept, feedback, pre-emption (the old goal ends ABORTED with the result built from
+//! it), cancel (CANCELED) and results delivered after the client asks for them.
+
+use futures::StreamExt;
+use mobil_msgs::mobil_msgs::action::{DriveDistance, DriveDistanceFeedback, DriveDistanceGoal, DriveDistanceResult};
+use mobil_msgs::RosAction;
+use mobil_ros::action::{ActionEvent, GoalEnd, GoalServer, GoalServerConfig};
+use ros2_client::action::{ActionClient, ActionClientQosPolicies, GoalStatusEnum};
+use ros2_client::builtin_interfaces::Time;
+use ros2_client::{Context, ContextOptions, Name, NodeName, NodeOptions, ServiceMapping};
+use std::time::Duration;
+
+type Client = ActionClient<DriveDistanceGoal, DriveDistanceResult, DriveDistanceFeedback>;
+
+fn goal(distance: f64) -> DriveDistanceGoal {
+    DriveDistanceGoal { distance, speed: 0.2 }
+}
+
+/// The server side: rejects goals with a distance ≤ 0; a pre-empted goal's result is its own
+/// distance (so the test sees which goal the closure got); a canceled goal's result is half of
+/// its distance; every accepted goal gets one feedback of (0.25, distance − 0.25).
+async fn serve(mut server: GoalServer<DriveDistance>) {
+    loop {
+        match server.next_event().await {
+            ActionEvent::Goal(request) if request.goal().distance <= 0.0 => {
+                server.reject(request, "distance must be above zero").await;
+            }
+            ActionEvent::Goal(request) => {
+                let distance = request.goal().distance;
+                server
+                    .accept(request, |old| DriveDistanceResult {
+                        travelled: old.distance,
+                        reason: "preempted by a newer goal".into(),
+                    })
+                    .await
+                    .unwrap();
+                server
+                    .feedback(DriveDistanceFeedback {
+                        travelled: 0.25,
+                        remaining: distance - 0.25,
+                    })
+                    .await
+                    .unwrap();
+            }
+            ActionEvent::CancelRequested => {
+                let half = server.active_goal().map(|g| g.distance / 2.0).unwrap();
+                assert!(server.is_canceling());
+                server.finish(
+                    GoalEnd::Canceled,
+                    DriveDistanceResult {
+                        travelled: half,
+                        reason: "canceled".into(),
+                    },
+                );
+            }
+        }
+    }
+}
+
+/// Awaits `f` for at most 10 s; the reply must be a success.
+async fn within<T, E: std::fmt::Debug>(f: impl std::future::Future<Output = Result<T, E>>) -> T {
+    tokio::time::timeout(Duration::from_secs(10), f)
+        .await
+        .expect("no reply within 10 s")
+        .expect("the call failed")
+}
+
+/// Sends a goal until a response arrives. ros2-client's client writes its first request at once,
+/// before discovery may have matched the server's request reader, and that request is lost
+/// (measured here: the first goal usually needs a second attempt); only a reply proves the path
+/// works.
+async fn send(client: &Client, g: DriveDistanceGoal) -> (ros2_client::action::GoalId, bool) {
+    for _ in 0..5 {
+        if let Ok(Ok((id, response))) =
+            tokio::time::timeout(Duration::from_secs(3), client.async_send_goal(g.clone())).await
+        {
+            return (id, response.accepted);
+        }
+    }
+    panic!("no goal response in 5 attempts");
+}
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn reject_accept_feedback_preempt_cancel_and_results() {
+    // A domain of its own (the Python tests use 100..199).
+    let domain = 200 + (std::process::id() % 30) as u16;
+    let name = Name::new("/", "drive_test").unwrap();
+
+    let server_context = Context::with_options(ContextOptions::new().domain_id(domain)).unwrap();
+    let mut server_node = server_context
+        .new_node(NodeName::new("/", "server").unwrap(), NodeOptions::new())
+        .unwrap();
+    let server = GoalServer::<DriveDistance>::on_node(&mut server_node, &name, GoalServerConfig::default()).unwrap();
+    let serving = tokio::spawn(serve(server));
+
+    let client_context = Context::with_options(ContextOptions::new().domain_id(domain)).unwrap();
+    let mut client_node = client_context
+        .new_node(NodeName::new("/", "client").unwrap(), NodeOptions::new())
+        .unwrap();
+    let service = mobil_ros::qos::reliable(10);
+    let client: Client = client_node
+        .create_action_client(
+            ServiceMapping::Enhanced,
+            &name,
+            &DriveDistance::type_name(),
+            ActionClientQosPolicies {
+                goal_service: service.clone(),
+                result_service: service.clone(),
+                cancel_service: service.clone(),
+                feedback_subscription: service,
+                status_subscription: mobil_ros::qos::latched(),
+            },
+        )
+        .unwrap();
+
+    // Rejected: the server refuses a negative distance.
+    let (_, accepted) = send(&client, goal(-1.0)).await;
+    assert!(!accepted);
+
+    // Accepted, with feedback.
+    let (first, accepted) = send(&client, goal(1.5)).await;
+    assert!(accepted);
+    // The one feedback message may be published before the client's feedback reader is
+    // matched; when it arrives, it carries the server's numbers.
+    let stream = client.feedback_stream(first);
+    futures::pin_mut!(stream);
+    if let Ok(Some(Ok(f))) = tokio::time::timeout(Duration::from_secs(2), stream.next()).await {
+        assert_eq!((f.travelled, f.remaining), (0.25, 1.25));
+    }
+
+    // A second goal pre-empts the first: ABORTED, with the result the closure built from the
+    // FIRST goal (its distance, 1.5).
+    let (second, accepted) = send(&client, goal(3.0)).await;
+    assert!(accepted);
+    let (status, result) = within(client.async_request_result(first)).await;
+    assert_eq!(status, GoalStatusEnum::Aborted);
+    assert_eq!(result.travelled, 1.5);
+    assert_eq!(result.reason, "preempted by a newer goal");
+
+    // Canceling the second: CANCELED, half of its 3.0.
+    let cancel = within(client.async_cancel_goal(second, Time::ZERO)).await;
+    assert_eq!(cancel.goals_canceling.len(), 1);
+    assert_eq!(cancel.goals_canceling[0].goal_id, second);
+    let (status, result) = within(client.async_request_result(second)).await;
+    assert_eq!(status, GoalStatusEnum::Canceled);
+    assert_eq!((result.travelled, result.reason.as_str()), (1.5, "canceled"));
+
+    // Nothing is active now: a cancel of the finished goal is refused.
+    let cancel = within(client.async_cancel_goal(second, Time::ZERO)).await;
+    assert!(cancel.goals_canceling.is_empty());
+
+    serving.abort();
+}

@@ -1,0 +1,218 @@
+//! `drive_node`: serves the `mobil_msgs/action/DriveDistance` action `drive_distance` — drive
+//! straight ahead or back by a distance, following `odom` and commanding `cmd_vel`, like Nav2's
+//! DriveOnHeading / BackUp behaviours. The logic is `mobil_tools::drive`; this is its shell.
+//!
+//! It publishes `cmd_vel` only while it has a goal, and one zero `cmd_vel` when the goal ends:
+//! reached, canceled, pre-empted by a newer goal (the old one ends ABORTED), odometry stale for
+//! `odom_timeout_s` (steady clock; ABORTED) or shutdown (ABORTED).
+
+use futures::StreamExt;
+use mobil_msgs::geometry_msgs::msg::Twist;
+use mobil_msgs::mobil_msgs::action::{DriveDistance, DriveDistanceFeedback, DriveDistanceResult};
+use mobil_msgs::nav_msgs::msg::Odometry;
+use mobil_ros::action::{ActionEvent, GoalEnd, GoalServer, GoalServerConfig};
+use mobil_ros::geometry::yaw_of;
+use mobil_ros::params::ParamValues;
+use mobil_ros::{qos, run_node, shutdown_signal, warn_throttled, LogThrottle, NodeDecl, ParamSpec, RosNode};
+use mobil_tools::drive::{DistanceDrive, DriveSettings, Pose2};
+use std::process::ExitCode;
+use std::time::{Duration, Instant};
+use tracing::{info, warn};
+
+/// The node's configuration, from its parameters.
+#[derive(Debug, Clone, Copy)]
+struct Config {
+    settings: DriveSettings,
+    rate_hz: f64,
+    odom_timeout: Duration,
+    result_timeout: Duration,
+}
+
+fn decl() -> NodeDecl {
+    NodeDecl::new(
+        "drive",
+        "Serves the DriveDistance action: drives straight by a distance, following odom, commanding cmd_vel",
+    )
+    .param(ParamSpec::double("max_speed", 0.5, "highest speed a goal may ask for [m/s]").above(0.0))
+    .param(ParamSpec::double("min_speed", 0.03, "slowest speed before arrival [m/s]").above(0.0))
+    .param(ParamSpec::double("decel", 0.5, "deceleration of the ramp-down before arrival [m/s²]").above(0.0))
+    .param(ParamSpec::double("tolerance", 0.005, "arrived when this close to the distance [m]").above(0.0))
+    .param(ParamSpec::double("rate_hz", 20.0, "cmd_vel and feedback rate while driving [Hz]").within(1.0, 200.0))
+    .param(
+        ParamSpec::double(
+            "odom_timeout_s",
+            0.5,
+            "a goal is aborted when no odom arrived for this long (steady clock) [s]",
+        )
+        .above(0.0),
+    )
+    .param(
+        ParamSpec::double(
+            "result_timeout_s",
+            10.0,
+            "how long a finished goal's result waits for the client to ask for it [s]",
+        )
+        .above(0.0),
+    )
+    .check(|p| parse_config(p).map(|_| ()))
+}
+
+fn parse_config(p: &ParamValues) -> Result<Config, String> {
+    let settings = DriveSettings {
+        max_speed: p.f64("max_speed")?,
+        min_speed: p.f64("min_speed")?,
+        decel: p.f64("decel")?,
+        tolerance: p.f64("tolerance")?,
+    };
+    if settings.min_speed > settings.max_speed {
+        return Err(format!(
+            "min_speed {} is above max_speed {}",
+            settings.min_speed, settings.max_speed
+        ));
+    }
+    Ok(Config {
+        settings,
+        rate_hz: p.f64("rate_hz")?,
+        odom_timeout: Duration::from_secs_f64(p.f64("odom_timeout_s")?),
+        result_timeout: Duration::from_secs_f64(p.f64("result_timeout_s")?),
+    })
+}
+
+fn main() -> ExitCode {
+    run_node(&decl(), |node| Box::pin(serve(node)))
+}
+
+fn result(travelled: f64, reason: &str) -> DriveDistanceResult {
+    DriveDistanceResult {
+        travelled,
+        reason: reason.to_owned(),
+    }
+}
+
+fn twist(v: f64) -> Twist {
+    let mut t = Twist::default();
+    t.linear.x = v;
+    t
+}
+
+async fn serve(node: &mut RosNode) -> anyhow::Result<()> {
+    let mut config = parse_config(&node.params()).map_err(anyhow::Error::msg)?;
+    let cmd = node.publisher::<Twist>("cmd_vel", &qos::default_qos())?;
+    let odom_sub = node.subscription::<Odometry>("odom", &qos::default_qos())?;
+    let mut server = GoalServer::<DriveDistance>::create(
+        node,
+        "drive_distance",
+        GoalServerConfig {
+            result_timeout: config.result_timeout,
+        },
+    )?;
+    let odom = odom_sub.async_stream();
+    let shutdown = shutdown_signal();
+    tokio::pin!(odom, shutdown);
+    let mut ticker = tokio::time::interval(Duration::from_secs_f64(1.0 / config.rate_hz));
+    ticker.set_missed_tick_behavior(tokio::time::MissedTickBehavior::Delay);
+    let mut throttle = LogThrottle::new(Duration::from_secs(2));
+
+    // The latest valid odometry pose and when it arrived (steady clock).
+    let mut latest: Option<(Pose2, Instant)> = None;
+    let mut drive: Option<DistanceDrive> = None;
+    let stop = |why: &str| {
+        if let Err(e) = cmd.publish(Twist::default()) {
+            warn!("cannot publish the zero cmd_vel ({why}): {e:?}");
+        }
+    };
+    info!("serving drive_distance");
+    loop {
+        tokio::select! {
+            _ = &mut shutdown => break,
+            changed = node.param_changed() => {
+                if let Some(values) = changed {
+                    match parse_config(&values) {
+                        Ok(c) => {
+                            if c.rate_hz != config.rate_hz {
+                                ticker = tokio::time::interval(Duration::from_secs_f64(1.0 / c.rate_hz));
+                                ticker.set_missed_tick_behavior(tokio::time::MissedTickBehavior::Delay);
+                            }
+                            config = c;
+                        }
+                        Err(e) => warn!("parameters not applied: {e}"),
+                    }
+                }
+            }
+            message = odom.next() => match message {
+                Some(Ok((m, _))) => {
+                    let p = &m.pose.pose;
+                    let pose = Pose2 { x: p.position.x, y: p.position.y, yaw: yaw_of(&p.orientation) };
+                    if pose.x.is_finite() && pose.y.is_finite() && pose.yaw.is_finite() {
+                        latest = Some((pose, Instant::now()));
+                    } else {
+                        warn_throttled!(throttle, "odom-nan", "odom with a non-finite pose dropped");
+                    }
+                }
+                Some(Err(e)) => warn_throttled!(throttle, "odom-read", "undecodable odom dropped: {e:?}"),
+                None => anyhow::bail!("the odom subscription ended"),
+            },
+            event = server.next_event() => match event {
+                ActionEvent::Goal(request) => {
+                    let goal = request.goal().clone();
+                    let start = latest.filter(|(_, at)| at.elapsed() <= config.odom_timeout).map(|(p, _)| p);
+                    let Some(start) = start else {
+                        server.reject(request, "no recent odom: is the chassis running?").await;
+                        continue;
+                    };
+                    match DistanceDrive::new(start, goal.distance, goal.speed, config.settings) {
+                        Err(e) => server.reject(request, &e.to_string()).await,
+                        Ok(new) => {
+                            let old = drive.take();
+                            if old.is_some() {
+                                stop("preempted");
+                            }
+                            let travelled = old.map_or(0.0, |d| d.progress().travelled);
+                            server.accept(request, |_| result(travelled, "preempted by a newer goal")).await?;
+                            info!("driving {} m at {} m/s", goal.distance, goal.speed);
+                            drive = Some(new);
+                        }
+                    }
+                }
+                ActionEvent::CancelRequested => {
+                    stop("canceled");
+                    let travelled = drive.take().map_or(0.0, |d| d.progress().travelled);
+                    server.finish(GoalEnd::Canceled, result(travelled, "canceled"));
+                }
+            },
+            _ = ticker.tick() => {
+                let Some(d) = drive.as_mut() else { continue };
+                let fresh = latest.filter(|(_, at)| at.elapsed() <= config.odom_timeout);
+                let Some((pose, _)) = fresh else {
+                    stop("odom stale");
+                    warn!("no odom for {:?}: goal aborted", config.odom_timeout);
+                    let travelled = d.progress().travelled;
+                    drive = None;
+                    server.finish(GoalEnd::Aborted, result(travelled, "odometry stale"));
+                    continue;
+                };
+                let progress = d.update(pose);
+                if progress.arrived {
+                    stop("reached");
+                    info!("reached: travelled {:.3} m of {} m", progress.travelled, d.distance());
+                    drive = None;
+                    server.finish(GoalEnd::Succeeded, result(progress.travelled, "reached"));
+                } else {
+                    if let Err(e) = cmd.publish(twist(d.command())) {
+                        warn_throttled!(throttle, "cmd", "cannot publish cmd_vel: {e:?}");
+                    }
+                    let feedback = DriveDistanceFeedback { travelled: progress.travelled, remaining: progress.remaining };
+                    if let Err(e) = server.feedback(feedback).await {
+                        warn_throttled!(throttle, "feedback", "{e}");
+                    }
+                }
+            }
+        }
+    }
+    let travelled = drive.take().map(|d| {
+        stop("shutdown");
+        d.progress().travelled
+    });
+    server.close(result(travelled.unwrap_or(0.0), "shutting down")).await;
+    Ok(())
+}
