@@ -7,18 +7,8 @@
 //! ramps down near the end, v = min(speed, max(min_speed, √(2·decel·remaining))), so the robot
 //! arrives slowly enough to stop within `tolerance`.
 
+pub use mobil_geom::Pose2;
 use thiserror::Error;
-
-/// A planar pose in the odometry frame: x, y (m), yaw (rad).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Pose2 {
-    /// x (m).
-    pub x: f64,
-    /// y (m).
-    pub y: f64,
-    /// Heading (rad).
-    pub yaw: f64,
-}
 
 /// How a drive is carried out.
 #[derive(Debug, Clone, Copy, PartialEq)]
