@@ -6,7 +6,7 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
-CRATES=(mobil_geom mobil_chassis mobil_sim)
+CRATES=(mobil_geom mobil_chassis mobil_sim mobil_local_nav)
 FORBIDDEN='^(ros2-client|rustdds|tokio) '
 
 status=0
