@@ -192,6 +192,7 @@ impl Sectors {
         let increment = scan.angle(1.min(scan.len() - 1)) - scan.angle(0);
         let (rs, rc) = increment.sin_cos();
         let mut dir = Vector2::new(first.cos(), first.sin());
+        let per_radian = n as f64 / TAU;
         for i in 0..scan.len() {
             // The beam's direction in the base frame, rotated incrementally (exact every 64 beams).
             if i % 64 == 0 {
@@ -200,10 +201,10 @@ impl Sectors {
             } else if i > 0 {
                 dir = Vector2::new(dir.x * rc - dir.y * rs, dir.x * rs + dir.y * rc);
             }
-            let range = match scan.beam(i) {
-                Some(Beam::Hit(r)) => r,
-                Some(Beam::NoEcho) => range_max,
-                Some(Beam::TooClose) => range_min,
+            let (range, obstacle, distance_override) = match scan.beam(i) {
+                Some(Beam::Hit(r)) => (r, true, None),
+                Some(Beam::NoEcho) => (range_max, false, None),
+                Some(Beam::TooClose) => (range_min, true, Some(0.0)),
                 _ => continue,
             };
             let p = origin + dir * range;
@@ -212,20 +213,26 @@ impl Sectors {
             } else {
                 (p.norm(), p.y.atan2(p.x))
             };
-            let distance = match scan.beam(i) {
-                Some(Beam::TooClose) => 0.0,
-                _ => distance,
-            };
-            if !matches!(scan.beam(i), Some(Beam::NoEcho)) {
+            let distance = distance_override.unwrap_or(distance);
+            if obstacle {
                 self.obstacles.push(Point2::from(p));
             }
-            let k = (wrap(self.reference_bearing - bearing) / (TAU / n as f64)).round() as i64;
+            // Whole turns of the difference shift k by multiples of N: no wrapping needed.
+            // Nearest integer by a cast (round() is a libm call, a sixth of the time here).
+            let t = (self.reference_bearing - bearing) * per_radian + 0.5;
+            let mut k = t as i64;
+            if (k as f64) > t {
+                k -= 1;
+            }
             let s = &mut self.sectors[k.rem_euclid(n as i64) as usize];
             if !s.known || distance < s.distance {
                 s.distance = distance;
-                s.nearest_bearing = wrap(bearing);
+                s.nearest_bearing = bearing;
                 s.known = true;
             }
+        }
+        for s in &mut self.sectors {
+            s.nearest_bearing = wrap(s.nearest_bearing);
         }
     }
 }
