@@ -11,6 +11,31 @@
 //!   free distance ahead and near the goal, hard stop.
 //! - [`config`]: [`NavConfig`], every default justified.
 //!
+//! Where the SPEC leaves a choice open, or where a Decision needed a guard to work in closed
+//! loop, the library chooses as follows (each tested in `tests/modes.rs` or
+//! `tests/closed_loop.rs`):
+//! - **R-mode weights**: no side has been chosen yet, so R-mode uses the symmetric mean of the
+//!   two sets; with every known sector clear it heads straight for G (SPEC all-clear rule).
+//!   Unknown sectors (outside the field of view) do not veto the all-clear rule, but sector 0
+//!   must be known.
+//! - **Sliding instead of settling**: |f_i| is never negative, so F keeps pointing into a wall
+//!   it faces. Inside d_sa the component of the motion toward the nearest reading is scaled
+//!   down with the clearance (to zero at the stop distance), the component along the boundary
+//!   kept, and the speed scaled with it.
+//! - **Stall makes H**: an L-mode command slower than `stall_speed` cannot make progress
+//!   (steps are path increments, so eq. 3.58 alone would never fire): H is set there at once.
+//! - **Leave on a clear goal sector only nearer G than H** (and beyond d_sa + hysteresis):
+//!   without it the mouth of a U-trap, where the goal sector sees the far bottom wall beyond
+//!   d_sa, would send the robot back in for ever. The crossing of HG must be strictly between
+//!   H and G (∠HLG = 180°, eq. 3.59).
+//! - **NO_PATH on return to H** only after the robot has been twice `hit_radius` away.
+//! - **Omni and the field of view**: an omni chassis holds its heading, but turns in place
+//!   toward a direction of motion outside the field of view rather than drive there blind.
+//! - **Car-like**: pure-pursuit curvature toward a point d_sa along the direction, clipped to
+//!   tan δ_eff / L; the hard stop looks straight ahead. The method has no reversing, so a
+//!   car-like robot that reaches the hard stop facing a wall it cannot turn away from within
+//!   its turning circle stays stopped (d_sa must leave room for the turning circle).
+//!
 //! ```
 //! use mobil_chassis::ChassisParams;
 //! use mobil_geom::{Pose2, Scan};

@@ -263,3 +263,18 @@ fn car_like_goes_round_a_convex_obstacle() {
     assert!(run.modes.contains(&Mode::Lock(Side::Left)), "{:?}", run.modes);
     assert!(run.min_clearance > 0.53, "clearance {}", run.min_clearance);
 }
+
+#[test]
+fn wide_wall_is_followed_in_track_mode_to_its_end() {
+    // A 6 m wall square to the goal line at x = 3 (y from −2.5 to 3.5, longer on the left, where
+    // the tie sends the robot), G (6, 0) behind it: the lock slides along it without progress,
+    // so T-mode takes the robot round the end.
+    let p = Point2::new;
+    let world = World(vec![Shape::Segment(p(3.0, -2.5), p(3.0, 3.5))]);
+    let run = drive(&world, ChassisParams::omr3(), Pose2::identity(), p(6.0, 0.0), 6000);
+    assert_eq!(run.final_mode, Mode::Reached, "{:?}", run.modes);
+    assert!(run.modes.contains(&Mode::Track(Side::Left)), "{:?}", run.modes);
+    let h = run.hit.expect("a hit point");
+    assert!(h.x < 3.0, "H {h}");
+    assert!(run.min_clearance > 0.25, "clearance {}", run.min_clearance);
+}
