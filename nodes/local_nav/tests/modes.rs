@@ -302,3 +302,41 @@ fn lock_that_cannot_move_makes_the_hit_point_at_once() {
     assert_eq!(out.changed_from, Some(Mode::Lock(Side::Left)));
     assert_eq!(out.hit_point, Some(p.position()));
 }
+
+#[test]
+fn omni_turns_toward_a_goal_behind_its_field_of_view() {
+    // A 270° scanner (±135°), nothing in range; G straight behind at (−5, 0).
+    let fov = 0.75 * PI;
+    let empty = Scan::new(
+        -fov,
+        fov,
+        fov / 270.0,
+        0.05,
+        10.0,
+        vec![f32::INFINITY; 541],
+        vec![],
+        Pose2::identity(),
+    )
+    .unwrap();
+    let mut nav = Navigator::new(NavConfig::default(), MotionLimits::from_chassis(&ChassisParams::omr3())).unwrap();
+    nav.set_goal(Point2::new(-5.0, 0.0)).unwrap();
+    // Sector 0 (180° ± 22.5°) is unseen and blocked. F = the clear ring minus sector 0's pull,
+    // symmetric weights: along the goal 0.8·(0.9 + 0.477297 − 1) = 0.301838 — toward G, which
+    // is blind: no translation, turn at 1.5·π → ω_max = 1.5 rad/s.
+    let out = nav.step(Pose2::identity(), &empty);
+    assert_eq!(out.mode, Mode::Rotate);
+    assert_relative_eq!(out.direction.x, -0.301_838, epsilon = 1e-6);
+    assert_eq!(
+        out.command,
+        VelocityCommand {
+            vx: 0.0,
+            vy: 0.0,
+            omega: 1.5
+        }
+    );
+    // Turned to face +y: G is at +90°, seen and clear: straight for it along base +y.
+    let out = nav.step(Pose2::new(0.0, 0.0, PI / 2.0), &empty);
+    assert_relative_eq!(out.command.vx, 0.0, epsilon = 1e-12);
+    assert_relative_eq!(out.command.vy, 0.5, epsilon = 1e-12);
+    assert_eq!(out.command.omega, 0.0);
+}
