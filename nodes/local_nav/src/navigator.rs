@@ -209,9 +209,10 @@ impl Navigator {
         };
     }
 
-    /// Advances the path counter to `q`; true when a progress window of `window` steps closed
-    /// with less than `min_progress` toward G (then the window restarts).
-    fn progress_failed(&mut self, q: Point2<f64>, goal_distance: f64, window: u32) -> Option<f64> {
+    /// Advances the path counter (whole steps of ds) to `q`. When this closes a window of
+    /// `window` steps, returns the progress toward G over it, |Q_j G| − |Q_{j+window} G|
+    /// (eq. 3.58 / 3.60), and starts the next window here.
+    fn close_progress_window(&mut self, q: Point2<f64>, goal_distance: f64, window: u32) -> Option<f64> {
         let travelled = self.last_position.map_or(0.0, |p| (q - p).norm());
         let travelled = if travelled.is_finite() { travelled } else { 0.0 };
         self.counters.partial += travelled;
@@ -292,7 +293,7 @@ impl Navigator {
                     self.enter(Mode::Rotate, goal_distance);
                     self.sectors.update(scan, goal_bearing);
                 } else if self
-                    .progress_failed(q, goal_distance, self.config.lock_steps)
+                    .close_progress_window(q, goal_distance, self.config.lock_steps)
                     .is_some_and(|p| p < self.config.lock_min_progress)
                 {
                     self.hit = Some(q);
@@ -325,7 +326,7 @@ impl Navigator {
                     } else if self.left_hit && from_hit < self.config.hit_radius {
                         self.mode = Mode::NoPath(NoPathReason::ReturnedToHitPoint);
                     } else if self
-                        .progress_failed(q, goal_distance, self.config.track_steps)
+                        .close_progress_window(q, goal_distance, self.config.track_steps)
                         .is_some_and(|p| p < self.config.track_min_progress)
                     {
                         self.mode = Mode::NoPath(NoPathReason::NoProgress);
