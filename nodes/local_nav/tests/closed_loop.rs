@@ -1,0 +1,280 @@
+//! Closed loop in pure Rust: the navigator's command integrated by an omni (or unicycle) model
+//! over a synthetic world of circles and segments, scanned by a tiny raycaster.
+
+use mobil_chassis::ChassisParams;
+use mobil_geom::{Pose2, Scan};
+use mobil_local_nav::{Mode, MotionLimits, NavConfig, Navigator, NoPathReason, Side};
+use nalgebra::{Point2, Vector2};
+
+enum Shape {
+    Circle(Point2<f64>, f64),
+    Segment(Point2<f64>, Point2<f64>),
+}
+
+struct World(Vec<Shape>);
+
+impl World {
+    /// Distance along the ray o + t·u to the first shape, if within `max`.
+    fn ray(&self, o: Point2<f64>, u: Vector2<f64>, max: f64) -> Option<f64> {
+        let mut best = f64::INFINITY;
+        for s in &self.0 {
+            let t = match *s {
+                Shape::Circle(c, r) => {
+                    // |o + t u − c|² = r²: t² + 2 b t + k = 0.
+                    let oc = o - c;
+                    let b = oc.dot(&u);
+                    let k = oc.norm_squared() - r * r;
+                    let disc = b * b - k;
+                    if disc < 0.0 {
+                        continue;
+                    }
+                    let t = -b - disc.sqrt();
+                    if t >= 0.0 {
+                        t
+                    } else {
+                        continue;
+                    }
+                }
+                Shape::Segment(a, b) => {
+                    let e = b - a;
+                    let den = u.x * e.y - u.y * e.x;
+                    if den.abs() < 1e-12 {
+                        continue;
+                    }
+                    let ao = a - o;
+                    let t = (ao.x * e.y - ao.y * e.x) / den;
+                    let s = (ao.x * u.y - ao.y * u.x) / den;
+                    if t >= 0.0 && (0.0..=1.0).contains(&s) {
+                        t
+                    } else {
+                        continue;
+                    }
+                }
+            };
+            best = best.min(t);
+        }
+        (best <= max).then_some(best)
+    }
+
+    /// Smallest distance from a point to any shape.
+    fn clearance(&self, p: Point2<f64>) -> f64 {
+        self.0
+            .iter()
+            .map(|s| match *s {
+                Shape::Circle(c, r) => (p - c).norm() - r,
+                Shape::Segment(a, b) => {
+                    let e = b - a;
+                    let t = ((p - a).dot(&e) / e.norm_squared()).clamp(0.0, 1.0);
+                    (p - (a + e * t)).norm()
+                }
+            })
+            .fold(f64::INFINITY, f64::min)
+    }
+
+    /// A 270° scan of 541 beams (0.5°), range [0.05, 10], laser at the centre.
+    fn scan(&self, pose: Pose2) -> Scan {
+        let fov = 0.75 * std::f64::consts::PI;
+        let inc = 2.0 * fov / 540.0;
+        let ranges = (0..541)
+            .map(|i| {
+                let a = pose.yaw - fov + i as f64 * inc;
+                match self.ray(pose.position(), Vector2::new(a.cos(), a.sin()), 10.0) {
+                    Some(t) => t as f32,
+                    None => f32::INFINITY,
+                }
+            })
+            .collect();
+        Scan::new(-fov, fov, inc, 0.05, 10.0, ranges, vec![], Pose2::identity()).expect("valid scan")
+    }
+}
+
+/// MOBIL-II: body radius 0.53 m; d_sa must leave room for the 0.73 m turning radius, so
+/// d_sa = 0.53 + 0.73 + 0.24 = 1.5 m; hard stop 0.12 m beyond the body.
+fn mobil2_config() -> NavConfig {
+    NavConfig {
+        robot_radius: 0.53,
+        stop_distance: 0.65,
+        safe_distance: 1.5,
+        ..NavConfig::default()
+    }
+}
+
+struct Run {
+    modes: Vec<Mode>,
+    final_mode: Mode,
+    min_clearance: f64,
+    final_pose: Pose2,
+    last_speed: f64,
+    hit: Option<Point2<f64>>,
+    leave: Option<Point2<f64>>,
+}
+
+/// Drives from `start` to `goal` for at most `max_steps` of 0.05 s.
+fn drive(world: &World, chassis: ChassisParams, start: Pose2, goal: Point2<f64>, max_steps: usize) -> Run {
+    let config = if chassis.model().is_nonholonomic() {
+        mobil2_config()
+    } else {
+        NavConfig::default()
+    };
+    let limits = MotionLimits::from_chassis(&chassis);
+    let mut nav = Navigator::new(config, limits).expect("valid config");
+    nav.set_goal(goal).expect("finite goal");
+    let dt = 0.05;
+    let mut pose = start;
+    let mut modes = vec![nav.mode()];
+    let mut min_clearance = world.clearance(pose.position());
+    let mut last_speed = f64::NAN;
+    let mut hit = None;
+    let mut leave = None;
+    for _ in 0..max_steps {
+        let out = nav.step(pose, &world.scan(pose));
+        if modes.last() != Some(&out.mode) {
+            modes.push(out.mode);
+        }
+        hit = hit.or(out.hit_point);
+        leave = out.leave_point.or(leave);
+        let c = out.command;
+        last_speed = c.speed() + c.omega.abs();
+        if out.mode.is_final() {
+            break;
+        }
+        // Exact enough at 0.05 s: body velocity rotated into odom.
+        let v = pose.rotate(Vector2::new(c.vx, c.vy));
+        pose = Pose2::new(pose.x + v.x * dt, pose.y + v.y * dt, pose.yaw + c.omega * dt);
+        min_clearance = min_clearance.min(world.clearance(pose.position()));
+    }
+    Run {
+        modes,
+        final_mode: nav.mode(),
+        min_clearance,
+        final_pose: pose,
+        last_speed,
+        hit,
+        leave,
+    }
+}
+
+#[test]
+fn open_space_goes_straight_to_the_goal() {
+    let world = World(vec![]);
+    let run = drive(
+        &world,
+        ChassisParams::omr3(),
+        Pose2::identity(),
+        Point2::new(4.0, 1.0),
+        400,
+    );
+    assert_eq!(run.modes, vec![Mode::Rotate, Mode::Reached]);
+    // Straight line from (0, 0) to (4, 1): |y − x/4| stays tiny, final within 0.10 m.
+    let p = run.final_pose;
+    assert!((p.y - p.x / 4.0).abs() < 1e-6, "{p:?}");
+    assert!(((p.x - 4.0).powi(2) + (p.y - 1.0).powi(2)).sqrt() <= 0.10);
+}
+
+#[test]
+fn convex_obstacle_locks_then_reaches_the_goal() {
+    // A disc of radius 0.5 at (3, 0) on the line from (0, 0) to G (6, 0).
+    let world = World(vec![Shape::Circle(Point2::new(3.0, 0.0), 0.5)]);
+    let run = drive(
+        &world,
+        ChassisParams::omr3(),
+        Pose2::identity(),
+        Point2::new(6.0, 0.0),
+        1200,
+    );
+    assert_eq!(run.final_mode, Mode::Reached, "{:?}", run.modes);
+    // Symmetric world: the tie goes left.
+    assert!(run.modes.contains(&Mode::Lock(Side::Left)), "{:?}", run.modes);
+    assert!(
+        !run.modes.iter().any(|m| matches!(m, Mode::Track(_))),
+        "{:?}",
+        run.modes
+    );
+    // Never closer to the disc than the robot radius (0.25 m).
+    assert!(run.min_clearance > 0.25, "clearance {}", run.min_clearance);
+}
+
+fn u_trap() -> World {
+    // A U open toward the robot: bottom x = 3 from y = −1.5 to 1.5, arms back to x = 1.5.
+    let p = Point2::new;
+    World(vec![
+        Shape::Segment(p(3.0, -1.5), p(3.0, 1.5)),
+        Shape::Segment(p(1.5, 1.5), p(3.0, 1.5)),
+        Shape::Segment(p(1.5, -1.5), p(3.0, -1.5)),
+    ])
+}
+
+#[test]
+fn u_trap_needs_track_mode_and_escapes() {
+    let world = u_trap();
+    let run = drive(
+        &world,
+        ChassisParams::omr3(),
+        Pose2::identity(),
+        Point2::new(6.0, 0.0),
+        4000,
+    );
+    assert_eq!(run.final_mode, Mode::Reached, "{:?}", run.modes);
+    assert!(run.modes.iter().any(|m| matches!(m, Mode::Track(_))), "{:?}", run.modes);
+    let h = run.hit.expect("a hit point");
+    // H inside the U (x between the mouth and the bottom), the leave point beyond it, on HG.
+    assert!(h.x > 1.5 && h.x < 3.0, "H {h}");
+    let l = run.leave.expect("a leave point");
+    assert!(
+        (Point2::new(6.0, 0.0) - l).norm() < (Point2::new(6.0, 0.0) - h).norm(),
+        "L {l} H {h}"
+    );
+    assert!(run.min_clearance > 0.25, "clearance {}", run.min_clearance);
+}
+
+#[test]
+fn enclosed_goal_is_no_path_and_the_robot_stops() {
+    // G (5, 0) inside a closed 2 × 2 m box.
+    let p = Point2::new;
+    let world = World(vec![
+        Shape::Segment(p(4.0, -1.0), p(6.0, -1.0)),
+        Shape::Segment(p(6.0, -1.0), p(6.0, 1.0)),
+        Shape::Segment(p(6.0, 1.0), p(4.0, 1.0)),
+        Shape::Segment(p(4.0, 1.0), p(4.0, -1.0)),
+    ]);
+    let run = drive(&world, ChassisParams::omr3(), Pose2::identity(), p(5.0, 0.0), 6000);
+    assert_eq!(
+        run.final_mode,
+        Mode::NoPath(NoPathReason::ReturnedToHitPoint),
+        "{:?}",
+        run.modes
+    );
+    assert_eq!(run.last_speed, 0.0);
+    assert!(run.min_clearance > 0.25, "clearance {}", run.min_clearance);
+}
+
+#[test]
+fn car_like_goes_round_a_convex_obstacle() {
+    // MOBIL-II (0.73 m turning radius, robot radius 0.53): a 0.4 m disc at (4, 0), G (8, 0).
+    let world = World(vec![Shape::Circle(Point2::new(4.0, 0.0), 0.4)]);
+    let run = drive(
+        &world,
+        ChassisParams::mobil2(),
+        Pose2::identity(),
+        Point2::new(8.0, 0.0),
+        1500,
+    );
+    assert_eq!(run.final_mode, Mode::Reached, "{:?}", run.modes);
+    assert!(run.modes.contains(&Mode::Lock(Side::Left)), "{:?}", run.modes);
+    assert!(run.min_clearance > 0.53, "clearance {}", run.min_clearance);
+}
+
+#[test]
+fn wide_wall_is_followed_in_track_mode_to_its_end() {
+    // A 6 m wall square to the goal line at x = 3 (y from −2.5 to 3.5, longer on the left, where
+    // the tie sends the robot), G (6, 0) behind it: the lock slides along it without progress,
+    // so T-mode takes the robot round the end.
+    let p = Point2::new;
+    let world = World(vec![Shape::Segment(p(3.0, -2.5), p(3.0, 3.5))]);
+    let run = drive(&world, ChassisParams::omr3(), Pose2::identity(), p(6.0, 0.0), 6000);
+    assert_eq!(run.final_mode, Mode::Reached, "{:?}", run.modes);
+    assert!(run.modes.contains(&Mode::Track(Side::Left)), "{:?}", run.modes);
+    let h = run.hit.expect("a hit point");
+    assert!(h.x < 3.0, "H {h}");
+    assert!(run.min_clearance > 0.25, "clearance {}", run.min_clearance);
+}
