@@ -27,7 +27,7 @@ import rosutil
 
 ROUNDS = 8
 TIMEOUT_S = 5.0   # the re-announcement comes about 1 s after discovery; slack for a loaded machine
-NO_LIDAR = ("-p", "lidar_enabled:=false")
+NO_LIDAR = ("-p", "lidar.enabled:=false")
 
 
 def _publisher_nodes(node, topic: str) -> set[str]:

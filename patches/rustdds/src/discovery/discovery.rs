@@ -260,8 +260,10 @@ pub(crate) struct Discovery {
   // resend timers), so discovery uses a single timer background thread.
   discovery_timer: SharedTimer<DiscoveryTimerEvent>,
 
-  // A `ReannounceLocalEndpoints` event is scheduled and has not fired yet.
-  endpoint_reannounce_pending: bool,
+  // A re-announcement is pending: when it was first asked for, and when it is due (1 s after the
+  // latest newly discovered participant, postponed at most `ENDPOINT_REANNOUNCE_MAX_POSTPONE`
+  // after the first request).
+  endpoint_reannounce: Option<(std::time::Instant, std::time::Instant)>,
 
   // If security is enabled, this field contains a SecureDiscovery struct, an appendix
   // which is used for Secure functionality
@@ -311,6 +313,8 @@ impl Discovery {
   const SPDP_PUBLISH_PERIOD: StdDuration = StdDuration::from_secs(10);
   // Delay from discovering a new participant to re-announcing our endpoints.
   const ENDPOINT_REANNOUNCE_DELAY: StdDuration = StdDuration::from_millis(1000);
+  // How long new participants may keep postponing a pending re-announcement.
+  const ENDPOINT_REANNOUNCE_MAX_POSTPONE: StdDuration = StdDuration::from_secs(3);
   const CHECK_PARTICIPANT_MESSAGES: StdDuration = StdDuration::from_secs(1);
   #[cfg(feature = "security")]
   const CACHED_SECURE_DISCOVERY_MESSAGE_RESEND_PERIOD: StdDuration = StdDuration::from_secs(1);
@@ -686,7 +690,7 @@ impl Discovery {
       dcps_participant_message, // liveliness messages
 
       discovery_timer,
-      endpoint_reannounce_pending: false,
+      endpoint_reannounce: None,
 
       security_opt,
       #[cfg(feature = "security")]
@@ -892,8 +896,15 @@ impl Discovery {
                   );
                 }
                 DiscoveryTimerEvent::ReannounceLocalEndpoints => {
-                  self.endpoint_reannounce_pending = false;
-                  self.reannounce_local_endpoints();
+                  // Every request scheduled an event; only the one at (or after)
+                  // the current due time acts.
+                  let now = std::time::Instant::now();
+                  if let Some((_, due)) = self.endpoint_reannounce {
+                    if now + StdDuration::from_millis(5) >= due {
+                      self.endpoint_reannounce = None;
+                      self.reannounce_local_endpoints();
+                    }
+                  }
                 }
                 DiscoveryTimerEvent::PublishParticipantMessage => {
                   self.publish_participant_message();
@@ -1101,10 +1112,20 @@ impl Discovery {
 
       // Write our endpoints' SEDP data once more a little later: see
       // `reannounce_local_endpoints`. Participants discovered in the meantime
-      // share the one re-announcement.
-      if guid_prefix != self.domain_participant.guid().prefix && !self.endpoint_reannounce_pending
-      {
-        self.endpoint_reannounce_pending = true;
+      // share the one re-announcement, which waits until 1 s after the latest
+      // of them, so that none gets it while still completing discovery; a
+      // steady stream of new participants postpones it by at most
+      // `ENDPOINT_REANNOUNCE_MAX_POSTPONE`.
+      if guid_prefix != self.domain_participant.guid().prefix {
+        let now = std::time::Instant::now();
+        let due = now + Self::ENDPOINT_REANNOUNCE_DELAY;
+        self.endpoint_reannounce = match self.endpoint_reannounce {
+          Some((first, _)) if now.duration_since(first) < Self::ENDPOINT_REANNOUNCE_MAX_POSTPONE => {
+            Some((first, due))
+          }
+          Some(pending) => Some(pending),
+          None => Some((now, due)),
+        };
         self.discovery_timer.borrow_mut().set_timeout(
           Self::ENDPOINT_REANNOUNCE_DELAY,
           DiscoveryTimerEvent::ReannounceLocalEndpoints,
