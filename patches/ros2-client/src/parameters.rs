@@ -905,7 +905,7 @@ mod tests {
       (0, 8)
     );
     // Not described: built from the value; not declared: unknown.
-    assert_eq!(d[1].r#type, ParameterType::Boolean as u8);
+    assert_eq!(d[1].r#type, ParameterType::Bool as u8);
     assert!(!d[1].read_only);
     assert_eq!(d[2].r#type, ParameterType::NotSet as u8);
   }
