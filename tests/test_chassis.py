@@ -10,11 +10,13 @@ import math
 import os
 import signal
 import subprocess
+import sys
 import time
 
 import pytest
 
 import harness
+import rosutil
 from harness import collect, param_get, param_list, param_set, publish_until, subscribe, wait_for_message
 
 from geometry_msgs.msg import Twist
@@ -346,6 +348,24 @@ def test_parameters_list_get_set_and_invalid_set_refused(start_node, ros_node, r
     assert out.returncode == 0 and "0.3" in out.stdout, out.stdout + out.stderr
     out = ros2cli("param", "set", "/chassis", "cmd_vel_timeout_s", "-2")
     assert out.returncode == 1 and "failed" in out.stdout.lower() + out.stderr.lower()
+    # describe_parameters answers from the same declarations (nodes/chassis_node/src/lib.rs):
+    # v_max > 0, unbounded above; model read-only, one of three; an unknown name is NOT_SET.
+    from rcl_interfaces.msg import ParameterType
+    from rcl_interfaces.srv import DescribeParameters
+    response = rosutil.call_service(ros_node, DescribeParameters, "/chassis/describe_parameters",
+                                    DescribeParameters.Request(names=["v_max", "model", "no_such"]))
+    v_max, model, unknown = response.descriptors
+    assert (v_max.name, v_max.type, v_max.description) == ("v_max", ParameterType.PARAMETER_DOUBLE,
+                                                           "speed limit [m/s]")
+    assert not v_max.read_only
+    assert len(v_max.floating_point_range) == 1 and not v_max.integer_range
+    fp = v_max.floating_point_range[0]
+    assert (fp.from_value, fp.to_value, fp.step) == (0.0, sys.float_info.max, 0.0)
+    assert v_max.additional_constraints == "(0, ∞)", "the open lower bound, in words"
+    assert model.read_only and model.type == ParameterType.PARAMETER_STRING
+    assert model.additional_constraints == "one of tricycle, car_like, omni"
+    assert not model.floating_point_range and not model.integer_range
+    assert unknown.type == ParameterType.PARAMETER_NOT_SET
 
 
 def test_sim_scan_sees_the_built_in_world(start_node, ros_node):

@@ -71,3 +71,44 @@ def test_wheel_commands_are_held_to_the_limits_and_nan_stops_the_wheels_at_once(
         p = m.pose.pose.position
         assert math.isfinite(p.x) and math.isfinite(p.y)
         assert math.hypot(p.x, p.y) <= 0.8 + 1e-6
+
+
+def test_the_drivers_stop_the_wheels_when_wheel_commands_stop(start_node, ros_node):
+    # params/omr3.yaml: command_timeout_s 1.0, motor_time_constant 0.05.
+    start_node("sim_node", "-p", "lidar.enabled:=false", params_file="params/omr3.yaml")
+    pub = ros_node.create_publisher(JointState, "wheel_commands", 10)
+    with subscribe(ros_node, Odometry, "ground_truth") as truth:
+        # Equal wheels at 4 rad/s: a turn on the spot at r·Σω / (3R) = 0.05·12 / 0.6 = 1 rad/s.
+        publish_until(ros_node, pub, omni_command(4.0, 4.0, 4.0),
+                      lambda: truth.latest is not None and abs(truth.latest.twist.twist.angular.z - 1.0) < 1e-6,
+                      rate_hz=20, timeout=15)
+        # A few more commands at 20 Hz, then silence.
+        for _ in range(6):
+            pub.publish(omni_command(4.0, 4.0, 4.0))
+            last_sent = time.time()
+            time.sleep(0.05)
+        deadline = time.monotonic() + 5.0
+        while abs(truth.latest.twist.twist.angular.z) >= 1e-3:
+            assert time.monotonic() < deadline, "still turning 5 s after the last wheel_commands"
+            time.sleep(0.02)
+        messages = truth.snapshot()
+
+    # As in the NaN test: the coast-down ω0·e^(−(t − t0)/τ) from ω0 = 1 rad/s, τ = 0.05 s, dates
+    # the stop: t0 = t + τ·ln(ω/ω0) for every decaying sample. The drivers stop when the last
+    # command is more than 1 s old: not before last_sent + 1 s (its arrival is later still), and
+    # within a physics step plus scheduling after it (stamps are wall-clock time in real-time mode,
+    # through the simulated clock, which may trail the wall by a late step on a loaded machine:
+    # 0.1 s of slack below; a stop for any other reason, e.g. the first or a lost command, would
+    # be far outside).
+    turning = [m for m in messages if m.twist.twist.angular.z > 0.99]
+    decaying = [m for m in messages
+                if stamp_s(m) > stamp_s(turning[-1]) and 0.01 < m.twist.twist.angular.z < 0.99]
+    assert len(decaying) >= 2, [m.twist.twist.angular.z for m in messages]
+    starts = [stamp_s(m) + 0.05 * math.log(m.twist.twist.angular.z / 1.0) for m in decaying]
+    assert max(starts) - min(starts) < 1e-3, starts
+    waited = min(starts) - last_sent
+    assert 1.0 - 0.1 <= waited <= 1.0 + 0.3, waited
+    # Stopped (|ω| < 1e-3 after τ·ln(1000) = 0.35 s of coasting) within timeout + lag.
+    stopped = next(m for m in messages
+                   if stamp_s(m) > min(starts) and abs(m.twist.twist.angular.z) < 1e-3)
+    assert stamp_s(stopped) - last_sent <= 1.0 + 0.35 + 0.3, stamp_s(stopped) - last_sent

@@ -11,7 +11,7 @@
 //!   layout, and the reference-point shift (pose and twist at the point `d` ahead).
 //! - [`limits`]: [`clamp_command`] makes any requested twist feasible and says why it changed it.
 //! - [`odometry`]: [`Odometry`], exact arc integration with pose and twist covariance.
-//! - [`watchdog`]: [`CmdVelWatchdog`], the cmd_vel timeout.
+//! - [`watchdog`]: [`InputTimeout`], the timeout the safety gate applies to an input's age.
 //! - [`joints`]: the `sensor_msgs/JointState` layout of wheel commands and feedback, parsed once.
 //! - [`controller`]: [`ChassisController`], the LOW-LEVEL loop (limits, watchdogs, odometry)
 //!   that `chassis_node` wraps, with the one safety gate every wheel command comes out of.
@@ -53,4 +53,4 @@ pub use kinematics::{forward, inverse, pre_steer, BodyTwist, Joint, JointKind, W
 pub use limits::{clamp_command, ClampReason, ClampReasons, Clamped};
 pub use model::{ChassisConfig, ChassisModel, ChassisParams};
 pub use odometry::{Odometry, OdometryNoise};
-pub use watchdog::CmdVelWatchdog;
+pub use watchdog::InputTimeout;

@@ -1,31 +1,32 @@
-//! cmd_vel watchdog: stop the chassis when commands stop arriving (SPEC §1, LOW-LEVEL safety).
+//! Input timeouts: stop the chassis when an input stops arriving (SPEC §1, LOW-LEVEL safety).
+//!
+//! The timeout only decides; the age of an input is measured where it arrives (the node holds
+//! each input with its steady-clock receive instant and passes the age in), so an input's
+//! freshness is measured in one place and decided in one place.
 
 use crate::error::ChassisError;
 
-/// Expires when no command was fed for longer than `timeout_s`; a timeout of 0 disables it.
+/// Expired when an input is older than `timeout_s`; a timeout of 0 disables it.
 ///
-/// Safe by default: before the first feed, and when time goes backwards (now earlier than the
-/// last feed), an enabled watchdog reports expired.
+/// Safe by default: an input never received (age `None`) or of a non-finite or negative age
+/// counts as expired while the timeout is enabled.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct CmdVelWatchdog {
+pub struct InputTimeout {
     timeout_s: f64,
-    last_feed: Option<f64>,
 }
 
-impl CmdVelWatchdog {
-    /// A watchdog with `timeout_s` ≥ 0 (0 = disabled); refuses negative or non-finite values.
-    pub fn new(timeout_s: f64) -> Result<Self, ChassisError> {
+impl InputTimeout {
+    /// A timeout of `timeout_s` ≥ 0 (0 = disabled); refuses negative or non-finite values.
+    /// `name` is the parameter it comes from, for the error.
+    pub fn new(name: &'static str, timeout_s: f64) -> Result<Self, ChassisError> {
         if !(timeout_s.is_finite() && timeout_s >= 0.0) {
             return Err(ChassisError::InvalidParameter {
-                name: "cmd_vel_timeout_s",
+                name,
                 value: timeout_s,
                 reason: "must be finite and non-negative (0 disables the watchdog)",
             });
         }
-        Ok(Self {
-            timeout_s,
-            last_feed: None,
-        })
+        Ok(Self { timeout_s })
     }
 
     /// The timeout (s); 0 means disabled.
@@ -33,42 +34,21 @@ impl CmdVelWatchdog {
         self.timeout_s
     }
 
-    /// True if the watchdog is disabled (timeout 0).
+    /// True if the timeout is disabled (0).
     pub fn is_disabled(&self) -> bool {
         self.timeout_s == 0.0
     }
 
-    /// Records a valid command at time `t` (s); a non-finite `t` is ignored and returns false.
-    ///
-    /// A feed earlier than the previous one is accepted (e.g. a restarted simulation clock).
-    pub fn feed(&mut self, t: f64) -> bool {
-        if t.is_finite() {
-            self.last_feed = Some(t);
-            true
-        } else {
-            false
-        }
-    }
-
-    /// Time (s) of the last accepted feed.
-    pub fn last_feed(&self) -> Option<f64> {
-        self.last_feed
-    }
-
-    /// Forgets the last feed (the watchdog is then expired until fed, unless disabled).
-    pub fn reset(&mut self) {
-        self.last_feed = None;
-    }
-
-    /// True if the chassis must stop at time `now` (s): never when disabled; otherwise when never
-    /// fed, `now` is non-finite, `now` is before the last feed, or `now − last feed > timeout_s`.
-    pub fn expired(&self, now: f64) -> bool {
+    /// True if the chassis must stop for an input last received `age_s` seconds ago (`None`:
+    /// never): never when disabled; otherwise when never received, the age is not a finite
+    /// non-negative number, or it exceeds the timeout (exactly the timeout is still alive).
+    pub fn expired(&self, age_s: Option<f64>) -> bool {
         if self.is_disabled() {
             return false;
         }
-        match self.last_feed {
+        match age_s {
             None => true,
-            Some(last) => !now.is_finite() || now < last || now - last > self.timeout_s,
+            Some(age) => !(age.is_finite() && age >= 0.0) || age > self.timeout_s,
         }
     }
 }

@@ -45,17 +45,17 @@ fn the_reported_huge_samples_are_refused_and_change_nothing() {
         let mut c = controller(params);
         for k in 0..10 {
             let t = 0.02 * f64::from(k);
-            c.on_joint_state(&n, &zeros, &zeros, t, t).unwrap().unwrap();
+            c.on_joint_state(&n, &zeros, &zeros, t).unwrap().unwrap();
         }
         let before = c.odometry().clone();
         assert!(
-            c.on_joint_state(&n, &zeros, &huge, 0.2, 0.2).is_err(),
+            c.on_joint_state(&n, &zeros, &huge, 0.2).is_err(),
             "{model}: {huge:?} accepted"
         );
         assert_eq!(c.odometry(), &before, "{model}");
         assert!(finite(&c));
         // The next ordinary sample is integrated as usual.
-        c.on_joint_state(&n, &zeros, &zeros, 0.22, 0.22).unwrap().unwrap();
+        c.on_joint_state(&n, &zeros, &zeros, 0.22).unwrap().unwrap();
         assert_eq!(c.odometry().last_stamp(), Some(0.22));
     }
 }
@@ -104,13 +104,13 @@ proptest! {
             t = if dt.is_finite() && dt.abs() < 1e3 { t + dt.abs() * 0.01 } else { dt };
             let values = &values[..n.len()];
             let _ = if positions_only {
-                c.on_joint_state(&n, values, &[], t, 0.0)
+                c.on_joint_state(&n, values, &[], t)
             } else {
-                c.on_joint_state(&n, values, values, t, 0.0)
+                c.on_joint_state(&n, values, values, t)
             };
             let direct = WheelState::from_values(model, values);
             if let Ok(wheels) = direct {
-                let _ = c.on_feedback(&wheels, t, 0.0);
+                let _ = c.on_feedback(&wheels, t);
             }
             prop_assert!(finite(&c), "{:?}", c.odometry());
         }

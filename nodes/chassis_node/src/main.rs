@@ -5,10 +5,14 @@
 //! Every `wheel_commands` message is a [`GatedCommand`]: it comes out of the controller's one
 //! safety gate (watchdogs, refused `cmd_vel`, non-finite values), on `cmd_vel`, on the control
 //! tick and at shutdown alike.
+//!
+//! Freshness is measured once, by the kit's [`Latest`] holders (steady receive instants of the
+//! last valid `cmd_vel` and the last feedback sample used); the gate decides on those ages with
+//! its timeouts. The node keeps no clock of its own for the watchdogs.
 
 use futures::StreamExt;
 use mobil_chassis::controller::{
-    ChassisController, ControllerConfig, FeedbackError, FeedbackOutcome, GatedCommand, Safety,
+    ChassisController, ControllerConfig, FeedbackError, FeedbackOutcome, GatedCommand, InputAges, Safety,
     DEFAULT_FEEDBACK_SPEED_FACTOR,
 };
 use mobil_chassis::joints::{joints_from_wheel_state, JointStateError};
@@ -27,6 +31,7 @@ use mobil_msgs::tf2_msgs::msg::TFMessage;
 use mobil_ros::config::{Config, ConfigError, Decl};
 use mobil_ros::geometry::{planar_odometry, yaw_quaternion};
 use mobil_ros::input::{decoded, Input};
+use mobil_ros::latest::Latest;
 use mobil_ros::stop::{final_stop, FINAL_STOP_WAIT};
 use mobil_ros::ticker::{self, Ticker};
 use mobil_ros::time::{is_zero, secs_from_stamp};
@@ -224,10 +229,9 @@ async fn run(node: &mut RosNode) -> anyhow::Result<()> {
         cmd_vel_refused: false,
         feedback_stale: true,
     };
-    // The watchdogs run on the steady clock: a stalled or reset /clock must not keep the wheels
-    // turning. Odometry runs on the feedback's own stamps.
-    let steady = std::time::Instant::now();
-    let now_s = |_: &RosNode| steady.elapsed().as_secs_f64();
+    // The inputs' freshness, on the steady clock: a stalled or reset /clock must not keep the
+    // wheels turning. Odometry runs on the feedback's own stamps.
+    let mut inputs = Inputs::default();
 
     loop {
         tokio::select! {
@@ -257,7 +261,9 @@ async fn run(node: &mut RosNode) -> anyhow::Result<()> {
             Some(msg) = cmds.next() => match msg {
                 Input::Message(twist) => {
                     let request = BodyTwist::new(twist.linear.x, twist.linear.y, twist.angular.z);
-                    let gated = controller.on_cmd_vel(request, now_s(node));
+                    let accepted = controller.on_cmd_vel(request);
+                    inputs.cmd_vel(accepted, node);
+                    let gated = controller.gate(inputs.ages());
                     let requested = controller.requested();
                     if !request.is_finite() {
                         rejected += 1;
@@ -270,13 +276,14 @@ async fn run(node: &mut RosNode) -> anyhow::Result<()> {
                 // Logged (rate-limited) by the input stream.
                 Input::Undecodable => {
                     rejected += 1;
-                    let gated = controller.on_unreadable_cmd_vel(now_s(node));
+                    let accepted = controller.on_unreadable_cmd_vel();
+                    inputs.cmd_vel(accepted, node);
+                    let gated = controller.gate(inputs.ages());
                     publish_wheels(&wheel_pub, node, &gated);
                 }
             },
             Some(msg) = joints.next() => match msg {
                 Input::Message(js) => {
-                    let now = now_s(node);
                     // An unstamped sample is stamped on arrival (node clock).
                     let stamp_msg = if is_zero(&js.header.stamp) { node.stamp() } else { js.header.stamp.clone() };
                     let Some(stamp) = secs_from_stamp(&stamp_msg) else {
@@ -284,10 +291,11 @@ async fn run(node: &mut RosNode) -> anyhow::Result<()> {
                         warn_throttled!(throttle, "stamp", "joint_states dropped: invalid stamp {:?}", js.header.stamp);
                         continue;
                     };
-                    match controller.on_joint_state(&js.name, &js.position, &js.velocity, stamp, now) {
+                    match controller.on_joint_state(&js.name, &js.position, &js.velocity, stamp) {
                         // A position-only sample that only set the baseline.
                         Ok(None) => {}
                         Ok(Some(outcome)) => {
+                            inputs.feedback.set((), stamp_msg.clone());
                             match outcome {
                                 FeedbackOutcome::Restarted { gap_s: Some(gap) } => warn_throttled!(
                                     throttle,
@@ -329,8 +337,7 @@ async fn run(node: &mut RosNode) -> anyhow::Result<()> {
                 Input::Undecodable => rejected += 1,
             },
             _ = tick.tick() => {
-                let now = now_s(node);
-                let cmd = controller.gate(now);
+                let cmd = controller.gate(inputs.ages());
                 let safety = cmd.safety();
                 // A refused (NaN) cmd_vel stops the wheels too, but was logged as what it is.
                 if safety.cmd_vel_timed_out() && !last_safety.cmd_vel_timed_out() {
@@ -358,9 +365,38 @@ async fn run(node: &mut RosNode) -> anyhow::Result<()> {
         }
     }
     // Leave the wheels stopped, and wait (bounded) until the drivers have the command.
-    let stop = controller.stop(now_s(node));
+    let stop = controller.stop(inputs.ages());
     final_stop(&wheel_pub, wheels_message(node, &stop), FINAL_STOP_WAIT).await;
     Ok(())
+}
+
+/// The node's inputs as the safety gate sees them: when each last arrived valid (steady clock).
+#[derive(Default)]
+struct Inputs {
+    /// The last valid `cmd_vel` (forgotten on a refused one).
+    cmd_vel: Latest<()>,
+    /// The last feedback sample the controller used.
+    feedback: Latest<()>,
+}
+
+impl Inputs {
+    /// Records a `cmd_vel` the controller accepted, or forgets the last one if it refused it.
+    fn cmd_vel(&mut self, accepted: bool, node: &RosNode) {
+        if accepted {
+            self.cmd_vel.set((), node.stamp());
+        } else {
+            self.cmd_vel.clear();
+        }
+    }
+
+    /// The ages the gate decides on, now.
+    fn ages(&self) -> InputAges {
+        let now = std::time::Instant::now();
+        InputAges {
+            cmd_vel_s: self.cmd_vel.age_at(now).map(|a| a.as_secs_f64()),
+            feedback_s: self.feedback.age_at(now).map(|a| a.as_secs_f64()),
+        }
+    }
 }
 
 /// The `wheel_commands` message of the safety gate's output (it takes nothing else).

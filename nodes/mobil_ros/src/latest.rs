@@ -78,10 +78,9 @@ impl<T> Latest<T> {
 
     /// How fresh the input is at `now` (steady clock). An arrival "after" `now` counts as age 0.
     pub fn status_at(&self, max_age: Duration, now: Instant) -> Freshness {
-        match &self.last {
+        match self.age_at(now) {
             None => Freshness::Never,
-            Some((_, _, received)) => {
-                let age = now.saturating_duration_since(*received);
+            Some(age) => {
                 if age <= max_age {
                     Freshness::Fresh
                 } else {
@@ -89,6 +88,19 @@ impl<T> Latest<T> {
                 }
             }
         }
+    }
+
+    /// Time since the value arrived (steady clock), `None` if never received: for a safety gate
+    /// that applies its own timeout (see `ChassisController::gate`).
+    pub fn age(&self) -> Option<Duration> {
+        self.age_at(Instant::now())
+    }
+
+    /// Time since the value arrived, at `now` (steady clock); an arrival "after" `now` is age 0.
+    pub fn age_at(&self, now: Instant) -> Option<Duration> {
+        self.last
+            .as_ref()
+            .map(|(_, _, received)| now.saturating_duration_since(*received))
     }
 
     /// The value if it is fresh now.
@@ -140,6 +152,12 @@ mod tests {
         );
         // ...its arrival 501 ms ago does.
         assert_eq!(l.status_at(ms(500), t0 + ms(501)), Freshness::Stale { age: ms(501) });
+        assert_eq!(l.age_at(t0 + ms(501)), Some(ms(501)));
+        assert_eq!(
+            l.age_at(t0 - ms(1)),
+            Some(ms(0)),
+            "an instant before the arrival: age 0"
+        );
         assert_eq!(l.get_at(ms(500), t0 + ms(501)), None);
         assert_eq!(l.value(), Some(&"a"), "the value stays readable for reports");
         assert_eq!(l.stamp().map(|s| s.sec), Some(3));
@@ -149,5 +167,6 @@ mod tests {
         assert_eq!(l.get_at(ms(100), t0 + ms(1000)), Some(&"b"));
         l.clear();
         assert_eq!(l.status_at(ms(100), t0 + ms(1000)), Freshness::Never);
+        assert_eq!(l.age_at(t0 + ms(1000)), None);
     }
 }

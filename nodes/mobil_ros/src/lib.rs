@@ -12,7 +12,8 @@
 //!   ([`run_node`]);
 //! - [`input`]: typed subscription streams that log (rate-limited) and drop undecodable samples;
 //! - [`latest`]: [`Latest`], an input's last value with its stamp and steady receive time — the
-//!   one way to decide that an input is stale;
+//!   one way to decide that an input is stale (`get(max_age)`; a safety gate with its own
+//!   timeouts takes `age()` instead);
 //! - [`ticker`]: [`Ticker`], a periodic tick following a rate parameter;
 //! - [`time`]: **the time rule** — stamps and algorithm `dt` from ROS time ([`time::DtClock`]),
 //!   watchdogs, freshness and tick periods on the steady clock;
@@ -21,8 +22,9 @@
 //! - [`action`]: [`action::GoalServer`], an action server with one active goal for a node's
 //!   select loop (accept/reject, feedback, result, cancel, pre-emption);
 //! - [`stop`]: [`stop::final_stop`], the bounded last zero command of a motion node;
-//! - [`scan`]: LaserScan → checked [`mobil_geom::Scan`] at the edge, laser pose from `/tf_static`
-//!   ([`scan::StaticFrames`]) or a parameter;
+//! - [`scan`]: LaserScan → checked [`mobil_geom::Scan`] at the edge, laser pose from `tf_static`
+//!   ([`scan::tf_static_subscription`] feeding [`scan::LaserPose`]; `tf_static` wins) or a
+//!   parameter;
 //! - [`qos`]: the QoS presets of the interface contract; [`log`]: `tracing` set-up and
 //!   rate-limited warnings ([`warn_throttled!`]); [`geometry`]: planar poses in messages;
 //!   [`args`], [`params`], [`names`]: the ROS command line, parameter files, names.

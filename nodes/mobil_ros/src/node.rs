@@ -241,6 +241,11 @@ impl RosNode {
             candidate.set(name, value);
             check(&candidate)
         }));
+        // describe_parameters answers from the same declarations: description, range, read-only.
+        let described = decl.params.clone();
+        options = options.parameter_describer(Box::new(move |name| {
+            described.iter().find(|s| s.name == name).map(ParamSpec::descriptor)
+        }));
         let action_values = params.clone();
         // The whole configuration is checked again as each value is applied: ros2-client validates
         // the parameters of a `set_parameters_atomically` call one by one against the current

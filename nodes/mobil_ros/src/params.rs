@@ -18,6 +18,7 @@
 //! a robot whether or not it runs under `-r __ns:=/robot1`.
 
 use crate::args::ParamArg;
+use ros2_client::parameters::{NumericRange, ParameterDescriptor, ParameterType};
 use ros2_client::ParameterValue;
 use serde_norway::Value;
 use std::collections::BTreeMap;
@@ -138,6 +139,49 @@ impl ParamSpec {
     /// Accept only values > `min`.
     pub fn above(self, min: f64) -> Self {
         self.range(Some((min, false)), None)
+    }
+
+    /// The `describe_parameters` answer for this declaration: description, read-only, the range
+    /// (`floating_point_range` for doubles, `integer_range` for integers, step 0 = any value in
+    /// it; an unbounded side is the type's extreme) and, for any constraint, its full text in
+    /// `additional_constraints` (which also says whether a bound is open, e.g. `(0, ∞)`, and
+    /// lists choices or array lengths, which a range cannot express).
+    pub fn descriptor(&self) -> ParameterDescriptor {
+        let range = match (&self.constraint, &self.default) {
+            (Constraint::Range { min, max }, ParameterValue::Double(_) | ParameterValue::DoubleArray(_)) => {
+                NumericRange::FloatingPointRange {
+                    from_value: min.map_or(f64::MIN, |(m, _)| m),
+                    to_value: max.map_or(f64::MAX, |(m, _)| m),
+                    step: 0.0,
+                }
+            }
+            (Constraint::Range { min, max }, ParameterValue::Integer(_) | ParameterValue::IntegerArray(_)) => {
+                // The integers the range holds: an open bound excludes its own value.
+                let from = min.map_or(i64::MIN, |(m, inclusive)| {
+                    let c = m.ceil();
+                    (if !inclusive && c == m { c + 1.0 } else { c }) as i64
+                });
+                let to = max.map_or(i64::MAX, |(m, inclusive)| {
+                    let f = m.floor();
+                    (if !inclusive && f == m { f - 1.0 } else { f }) as i64
+                });
+                NumericRange::IntegerRange {
+                    from_value: from,
+                    to_value: to,
+                    step: 0,
+                }
+            }
+            _ => NumericRange::NotSpecified,
+        };
+        ParameterDescriptor {
+            name: self.name.clone(),
+            param_type: ParameterType::NotSet,
+            description: self.description.clone(),
+            additional_constraints: self.constraint.to_string(),
+            read_only: self.read_only,
+            dynamic_typing: false,
+            range,
+        }
     }
 
     /// Accept only values in [min, max].
@@ -570,6 +614,49 @@ pub fn initial_params(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn descriptors_carry_description_range_and_read_only() {
+        let v = ParamSpec::double("v_max", 0.5, "max speed")
+            .above(0.0)
+            .max(2.0)
+            .descriptor();
+        assert_eq!((v.name.as_str(), v.description.as_str()), ("v_max", "max speed"));
+        assert!(!v.read_only);
+        assert!(matches!(
+            v.range,
+            NumericRange::FloatingPointRange { from_value, to_value, step }
+                if from_value == 0.0 && to_value == 2.0 && step == 0.0
+        ));
+        assert_eq!(v.additional_constraints, "(0, 2]", "the open bound is said in words");
+        // Integers: (0, 10) holds 1..=9; an unbounded side is the type's extreme.
+        let n = ParamSpec::integer("n", 3, "count").above(0.0).max(10.0).descriptor();
+        let n_range = match n.range {
+            NumericRange::IntegerRange {
+                from_value,
+                to_value,
+                step,
+            } => (from_value, to_value, step),
+            _ => panic!("an integer range"),
+        };
+        assert_eq!(n_range, (1, 10, 0));
+        let m = ParamSpec::integer("m", 3, "count").min(-2.5).descriptor();
+        assert!(matches!(
+            m.range,
+            NumericRange::IntegerRange {
+                from_value: -2,
+                to_value: i64::MAX,
+                ..
+            }
+        ));
+        let model = ParamSpec::string("model", "omni", "chassis model")
+            .choices(&["car_like", "omni"])
+            .read_only()
+            .descriptor();
+        assert!(model.read_only);
+        assert!(matches!(model.range, NumericRange::NotSpecified));
+        assert_eq!(model.additional_constraints, "one of car_like, omni");
+    }
 
     fn specs() -> Vec<ParamSpec> {
         vec![

@@ -30,9 +30,11 @@
 //! ```
 
 use crate::geometry::yaw_of;
+use crate::RosNode;
 use mobil_geom::{Pose2, Scan, ScanError};
 use mobil_msgs::sensor_msgs::msg::LaserScan;
 use mobil_msgs::tf2_msgs::msg::TFMessage;
+use ros2_client::Subscription;
 use std::collections::HashMap;
 
 /// The checked scan of a LaserScan message, the laser at `base_from_laser` in the base frame.
@@ -109,6 +111,81 @@ impl StaticFrames {
         let (root_c, root_from_child) = self.to_root(child);
         (root_p == root_c).then(|| root_from_parent.inverse() * root_from_child)
     }
+}
+
+/// The laser's pose in the base frame for a node that reads scans: from `tf_static` when the
+/// chain `base_frame → … → laser_frame` is known there, else from the node's laser pose
+/// parameter (`fallback`), else unknown (the node waits for it; it never guesses).
+///
+/// **Precedence: `tf_static` wins over the parameter.** `tf_static` describes the robot as it is
+/// mounted (and is what every other ROS tool uses), so the parameter is only for a robot that
+/// publishes no static transforms. Once known, the `tf_static` pose stays, and a later message
+/// that changes a link of the chain replaces it.
+///
+/// Feed it from [`tf_static_subscription`] with [`LaserPose::poll`] (or [`LaserPose::add`] for
+/// each message of a stream).
+#[derive(Debug, Clone)]
+pub struct LaserPose {
+    frames: StaticFrames,
+    base_frame: String,
+    laser_frame: String,
+    fallback: Option<Pose2>,
+}
+
+/// Where [`LaserPose::get`]'s pose comes from.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum LaserPoseSource {
+    /// The `tf_static` chain between the two frames.
+    TfStatic,
+    /// The node's parameter (no `tf_static` chain seen yet).
+    Parameter,
+}
+
+impl LaserPose {
+    /// Looks for `base_frame → laser_frame`; `fallback` is the parameter's pose, if the node has
+    /// one.
+    pub fn new(base_frame: &str, laser_frame: &str, fallback: Option<Pose2>) -> Self {
+        LaserPose {
+            frames: StaticFrames::default(),
+            base_frame: base_frame.to_owned(),
+            laser_frame: laser_frame.to_owned(),
+            fallback,
+        }
+    }
+
+    /// Takes one `tf_static` message; returns how many transforms it skipped as invalid.
+    pub fn add(&mut self, msg: &TFMessage) -> usize {
+        self.frames.add(msg)
+    }
+
+    /// Takes every message waiting on `sub` (non-blocking); returns how many transforms were
+    /// skipped as invalid. A sample that cannot be decoded is skipped too (counted as one).
+    pub fn poll(&mut self, sub: &Subscription<TFMessage>) -> usize {
+        let mut skipped = 0;
+        loop {
+            match sub.take() {
+                Ok(Some((msg, _))) => skipped += self.add(&msg),
+                Ok(None) => break,
+                Err(_) => skipped += 1,
+            }
+        }
+        skipped
+    }
+
+    /// The laser pose in the base frame and where it comes from; `None` while neither
+    /// `tf_static` nor the parameter gives one.
+    pub fn get(&self) -> Option<(Pose2, LaserPoseSource)> {
+        match self.frames.lookup(&self.base_frame, &self.laser_frame) {
+            Some(pose) => Some((pose, LaserPoseSource::TfStatic)),
+            None => self.fallback.map(|p| (p, LaserPoseSource::Parameter)),
+        }
+    }
+}
+
+/// Subscribes `tf_static` (relative, so `-r __ns:=/robot1` moves it with the publishers) with
+/// [`crate::qos::tf_static`]: a node started after the publishers still gets their transforms.
+pub fn tf_static_subscription(node: &mut RosNode) -> anyhow::Result<Subscription<TFMessage>> {
+    node.subscription::<TFMessage>("tf_static", &crate::qos::tf_static())
 }
 
 #[cfg(test)]

@@ -17,7 +17,6 @@ fn bench(c: &mut Criterion) {
             motor_time_constant: 0.05,
             wheel_speed_noise: 0.01,
             wheel_slip: 0.0,
-            command_timeout: 0.0,
             robot_radius: 0.53,
         },
         nalgebra::Vector3::zeros(),

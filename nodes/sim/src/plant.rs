@@ -20,8 +20,9 @@
 //! (relative), so odometry built on it drifts the way real odometry does, deterministically for a
 //! seed. A pose that would collide with the world is not entered (the robot stops at the
 //! obstacle, as on a bumper); the collision is checked after every sub-step, so the robot cannot
-//! jump through a wall. Without a command for `command_timeout` seconds the simulated motor
-//! drivers stop the wheels.
+//! jump through a wall. The drivers' command timeout is the node's: it holds the commands with
+//! their arrival time and calls [`Plant::stop`] when they go stale (the plant keeps no clock of
+//! commands, so freshness is measured in one place).
 
 use std::f64::consts::TAU;
 
@@ -246,8 +247,6 @@ pub struct PlantConfig {
     pub wheel_speed_noise: f64,
     /// Relative bias of the measured wheel speeds (measured = true · (1 + slip)).
     pub wheel_slip: f64,
-    /// The drivers stop the wheels after this long without a command (s); 0 = never.
-    pub command_timeout: f64,
     /// Radius of the robot's footprint around the reference point, for collisions (m).
     pub robot_radius: f64,
 }
@@ -306,7 +305,6 @@ pub struct Plant {
     twist_joints: Vec<f64>,
     slip_residual: f64,
     time: f64,
-    last_command: Option<f64>,
     collided: bool,
     rng: ChaCha8Rng,
 }
@@ -332,7 +330,6 @@ impl Plant {
             twist_joints: zero,
             slip_residual: 0.0,
             time: 0.0,
-            last_command: None,
             collided: false,
             rng: ChaCha8Rng::seed_from_u64(seed),
             config,
@@ -372,7 +369,6 @@ impl Plant {
             });
         }
         self.target = values;
-        self.last_command = Some(self.time);
         Ok(if self.limit_targets() {
             CommandOutcome::Limited
         } else {
@@ -430,13 +426,6 @@ impl Plant {
             return;
         }
         let joints = self.config.params.model().joints();
-        let timed_out = self.config.command_timeout > 0.0
-            && self
-                .last_command
-                .is_none_or(|t| self.time - t > self.config.command_timeout);
-        if timed_out {
-            self.stop();
-        }
         // At most four joints (car-like): scratch space on the stack, no allocation per step.
         let n = self.actual.len().min(MAX_JOINTS);
         let mut before = [0.0; MAX_JOINTS];
@@ -599,7 +588,6 @@ mod tests {
                 motor_time_constant: tau,
                 wheel_speed_noise: 0.0,
                 wheel_slip: slip,
-                command_timeout: 1.0,
                 robot_radius: radius,
             },
             Vector3::zeros(),
@@ -720,7 +708,7 @@ mod tests {
     }
 
     #[test]
-    fn lag_slip_timeout_and_collision() {
+    fn lag_slip_stop_and_collision() {
         let mut p = plant(ChassisConfig::omr3(), 0.1, 0.02);
         let world = World::builtin();
         p.command(&WheelState::Omni {
@@ -734,7 +722,8 @@ mod tests {
         assert!((fb.velocities[0] - expected).abs() < 1e-12, "{fb:?}");
         // ... and the body has moved ∫ 0.3·(1 − e^(−t/τ)) dt over 0.1 s = 0.3·τ·e⁻¹ = 0.011036 m.
         assert_relative_eq!(p.reference_pose().x, 0.3 * 0.1 * (-1.0f64).exp(), epsilon = 1e-9);
-        // No command for more than 1 s: the drivers stop the wheels.
+        // The drivers stop (the node's command timeout): the wheels coast down, e^(−3 s / 0.1 s).
+        p.stop();
         for _ in 0..300 {
             p.step(0.01, &world);
         }

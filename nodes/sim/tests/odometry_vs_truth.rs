@@ -10,7 +10,7 @@
 //! The error is watched along the route, not only at its end: the test loop is closed, so a
 //! model that scales every length by the same factor would end exactly where the truth does.
 
-use mobil_chassis::controller::{ChassisController, ControllerConfig};
+use mobil_chassis::controller::{ChassisController, ControllerConfig, InputAges};
 use mobil_chassis::joints::wheel_state_from_joints;
 use mobil_chassis::{
     forward, inverse, BodyTwist, ChassisConfig, ChassisModel, ChassisParams, Odometry, OdometryNoise, WheelState,
@@ -83,7 +83,6 @@ fn drive_commanded(
         motor_time_constant: tau,
         wheel_speed_noise: 0.0,
         wheel_slip: slip,
-        command_timeout: 1.0,
         robot_radius: 0.3,
     };
     let mut plant = Plant::new(plant_config, nalgebra::Vector3::zeros(), 1);
@@ -106,10 +105,15 @@ fn drive_commanded(
                 // turns no wheel before its first feedback.
                 let fb = plant.feedback();
                 let wheels = wheel_state_from_joints(params.model(), &fb.names, &fb.positions, &fb.velocities).unwrap();
-                controller.on_feedback(&wheels, t, t).unwrap();
+                controller.on_feedback(&wheels, t).unwrap();
                 odometry.update_at(model(&params, &wheels), t).unwrap();
                 let twist = BodyTwist::new(v, 0.0, w);
-                let cmd = controller.on_cmd_vel(twist, t);
+                // Both inputs arrived just now (age 0), as the node's holders would say.
+                assert!(controller.on_cmd_vel(twist), "a finite cmd_vel is accepted");
+                let cmd = controller.gate(InputAges {
+                    cmd_vel_s: Some(0.0),
+                    feedback_s: Some(0.0),
+                });
                 match command {
                     Some(inverse) => plant.command(&inverse(&params, twist)).unwrap(),
                     None => plant.command(&cmd.wheels).unwrap(),

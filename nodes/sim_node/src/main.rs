@@ -2,7 +2,8 @@
 //! feedback on `joint_states` (optional noise and slip), the true pose on `ground_truth`, and a
 //! simulated LIDAR on `scan`, in a 2D world from a YAML file (or the built-in one).
 //! Wheel commands are held to the chassis' limits; a malformed one, or one with NaN or infinity,
-//! stops the wheels. Deterministic for a given seed. Real time by default; with `publish_clock` it publishes
+//! stops the wheels, and so does a pause in them longer than `command_timeout_s` (steady clock,
+//! judged by the kit's [`Latest`] holder), as a real motor driver does. Deterministic for a given seed. Real time by default; with `publish_clock` it publishes
 //! `/clock` and may run faster (`real_time_factor`) for nodes started with `use_sim_time:=true`.
 
 use futures::StreamExt;
@@ -20,6 +21,7 @@ use mobil_msgs::visualization_msgs::msg::{Marker, MarkerArray};
 use mobil_ros::config::{Config, ConfigError, Decl};
 use mobil_ros::geometry::{planar_odometry, yaw_quaternion};
 use mobil_ros::input::{decoded, Input};
+use mobil_ros::latest::{Freshness, Latest};
 use mobil_ros::time::{stamp_from_nanos, stamp_from_secs};
 use mobil_ros::{qos, run_node, shutdown_signal, warn_throttled, LogThrottle, NodeDecl, RosNode, Ticker};
 use mobil_sim::lidar::{Lidar, LidarConfig};
@@ -27,6 +29,7 @@ use mobil_sim::plant::{CommandOutcome, Plant, PlantConfig};
 use mobil_sim::world::{Obstacle, World};
 use nalgebra::Vector3 as V3;
 use std::process::ExitCode;
+use std::time::{Duration, Instant};
 use tokio::time::MissedTickBehavior;
 use tracing::{info, warn};
 
@@ -114,6 +117,9 @@ impl Config for SimConfig {
             |c, v| c.motor_time_constant = v,
         )
         .min(0.0);
+        // 1 s: chassis_node sends wheel_commands every control period (20 ms at its default
+        // 50 Hz, 1 s at its slowest 1 Hz) and stops the wheels itself 0.5 s after the last
+        // cmd_vel, logging why; this is the drivers' backstop for a chassis_node that died.
         d.double(
             "command_timeout_s",
             1.0,
@@ -179,7 +185,6 @@ impl SimConfig {
             motor_time_constant: self.motor_time_constant,
             wheel_speed_noise: self.wheel_speed_noise,
             wheel_slip: self.wheel_slip,
-            command_timeout: self.command_timeout_s,
             robot_radius: self.robot_radius,
         })
     }
@@ -361,6 +366,7 @@ async fn run(node: &mut RosNode) -> anyhow::Result<()> {
     let dt = 1.0 / config.physics_rate_hz;
     let (mut next_joints, mut next_scan) = (0.0f64, 0.0f64);
     let mut reported_collision = false;
+    let mut watch = CommandWatch::default();
 
     loop {
         tokio::select! {
@@ -387,13 +393,16 @@ async fn run(node: &mut RosNode) -> anyhow::Result<()> {
                 // command must not keep them turning until the driver timeout.
                 Input::Message(js) => match wheel_state_from_joints(plant_config.params.model(), &js.name, &js.position, &js.velocity) {
                     Ok(wheels) => match plant.command(&wheels) {
-                        Ok(CommandOutcome::Accepted) => {}
-                        Ok(CommandOutcome::Limited) => warn_throttled!(
+                        Ok(CommandOutcome::Accepted) => watch.commanded(js.header.stamp.clone(), Instant::now()),
+                        Ok(CommandOutcome::Limited) => {
+                            watch.commanded(js.header.stamp.clone(), Instant::now());
+                            warn_throttled!(
                             throttle,
                             "limit",
                             "wheel_commands beyond the chassis limits (max_wheel_speed, max_steering) held to them: {:?}",
                             plant.commanded()
-                        ),
+                            )
+                        }
                         Err(e) => warn_throttled!(throttle, "cmd", "wheel_commands refused: {e}"),
                     },
                     Err(e) => {
@@ -405,6 +414,12 @@ async fn run(node: &mut RosNode) -> anyhow::Result<()> {
                 Input::Undecodable => plant.stop(),
             },
             _ = tick.tick() => {
+                if watch.check(config.command_timeout_s, Instant::now()) {
+                    if watch.newly_stale() {
+                        warn_throttled!(throttle, "cmd_timeout", "no wheel_commands for {} s: wheels stopped", config.command_timeout_s);
+                    }
+                    plant.stop();
+                }
                 plant.step(dt, &world);
                 let t = plant.time();
                 if plant.collided() && !reported_collision {
@@ -460,9 +475,75 @@ async fn run(node: &mut RosNode) -> anyhow::Result<()> {
     Ok(())
 }
 
+/// The simulated drivers' command timeout: the last valid `wheel_commands` in a [`Latest`]
+/// (steady receive instant), judged on every physics step.
+#[derive(Default)]
+struct CommandWatch {
+    last: Latest<()>,
+    /// The last check found the commands stale (after having had fresh ones).
+    stale: bool,
+    /// `stale` turned true at the last check.
+    newly: bool,
+}
+
+impl CommandWatch {
+    /// A valid command arrived at `now`.
+    fn commanded(&mut self, stamp: mobil_msgs::builtin_interfaces::msg::Time, now: Instant) {
+        self.last.set_at((), stamp, now);
+    }
+
+    /// True if the drivers must hold the wheels stopped at `now`: the last command is older
+    /// than `timeout_s` (0: never), or there never was one (the wheels are at rest then; the
+    /// stop changes nothing and is not reported).
+    fn check(&mut self, timeout_s: f64, now: Instant) -> bool {
+        if timeout_s <= 0.0 {
+            self.stale = false;
+            self.newly = false;
+            return false;
+        }
+        let max_age = Duration::try_from_secs_f64(timeout_s).unwrap_or(Duration::MAX);
+        let (stop, stale) = match self.last.status_at(max_age, now) {
+            Freshness::Fresh => (false, false),
+            Freshness::Stale { .. } => (true, true),
+            Freshness::Never => (true, false),
+        };
+        self.newly = stale && !self.stale;
+        self.stale = stale;
+        stop
+    }
+
+    /// The commands went stale at the last check (to log once, not on every step).
+    fn newly_stale(&self) -> bool {
+        self.newly
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_drivers_stop_once_the_last_command_is_older_than_the_timeout() {
+        let ms = Duration::from_millis;
+        let t0 = Instant::now();
+        let mut w = CommandWatch::default();
+        assert!(w.check(1.0, t0), "no command yet: at rest");
+        assert!(!w.newly_stale(), "nothing to report before the first command");
+        w.commanded(Default::default(), t0);
+        assert!(!w.check(1.0, t0 + ms(1000)), "exactly the timeout: still driving");
+        assert!(w.check(1.0, t0 + ms(1001)));
+        assert!(w.newly_stale(), "reported once...");
+        assert!(w.check(1.0, t0 + ms(1020)));
+        assert!(!w.newly_stale(), "...not on every step");
+        // A new command drives again; 0 turns the timeout off.
+        w.commanded(Default::default(), t0 + ms(1100));
+        assert!(!w.check(1.0, t0 + ms(1200)));
+        assert!(!w.check(0.0, t0 + ms(60_000)));
+        assert!(
+            w.check(0.5, t0 + ms(1601)) && w.newly_stale(),
+            "a shorter timeout applies at once"
+        );
+    }
 
     #[test]
     fn every_obstacle_becomes_one_marker() {

@@ -573,7 +573,8 @@ impl Node {
       options.parameter_validator.take(),
       options.parameter_set_action.take(),
     )
-    .map_err(NodeCreateError::BadParameter)?;
+    .map_err(NodeCreateError::BadParameter)?
+    .with_describer(options.parameter_describer.take());
 
     let mut node = Node {
       node_name,

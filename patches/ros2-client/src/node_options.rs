@@ -12,7 +12,7 @@
 //! `src/zenoh_backend/node.rs`). Fields not honored by a backend are
 //! documented as no-ops there (logged once at `debug` level).
 
-use crate::parameters::{Parameter, ParameterValue, SetParametersResult};
+use crate::parameters::{Parameter, ParameterDescriptor, ParameterValue, SetParametersResult};
 
 /// Signature of a user-supplied parameter validator / set-action callback
 /// (see [`NodeOptions::parameter_validator`] /
@@ -22,6 +22,11 @@ use crate::parameters::{Parameter, ParameterValue, SetParametersResult};
 /// stores it (for API parity) but does not yet call it (logged once at
 /// `debug` level if set).
 pub(crate) type ParameterFunc = dyn Fn(&str, &ParameterValue) -> SetParametersResult + Send + Sync;
+
+/// Signature of a user-supplied parameter describer (see
+/// [`NodeOptions::parameter_describer`]): the descriptor of a declared
+/// parameter, or `None` for the default one built from its value.
+pub(crate) type ParameterDescriberFunc = dyn Fn(&str) -> Option<ParameterDescriptor> + Send + Sync;
 
 /// Configuration of a [`Node`](crate::Node). This is a builder-like struct.
 ///
@@ -37,6 +42,7 @@ pub struct NodeOptions {
   pub(crate) allow_undeclared_parameters: bool,
   pub(crate) parameter_validator: Option<Box<ParameterFunc>>,
   pub(crate) parameter_set_action: Option<Box<ParameterFunc>>,
+  pub(crate) parameter_describer: Option<Box<ParameterDescriberFunc>>,
 }
 
 impl NodeOptions {
@@ -52,6 +58,7 @@ impl NodeOptions {
       allow_undeclared_parameters: false,
       parameter_validator: None,
       parameter_set_action: None,
+      parameter_describer: None,
     }
   }
   pub fn enable_rosout(self, enable_rosout: bool) -> NodeOptions {
@@ -113,6 +120,15 @@ impl NodeOptions {
 
   pub fn parameter_set_action(mut self, action: Box<ParameterFunc>) -> NodeOptions {
     self.parameter_set_action = Some(action);
+    self
+  }
+
+  /// Describes declared parameters in `describe_parameters` replies
+  /// (description, ranges, read-only, ...). Without it, or where it returns
+  /// `None`, a descriptor is built from the value alone. The parameter type
+  /// is always that of the current value. DDS backend only.
+  pub fn parameter_describer(mut self, describer: Box<ParameterDescriberFunc>) -> NodeOptions {
+    self.parameter_describer = Some(describer);
     self
   }
 }

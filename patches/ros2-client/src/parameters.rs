@@ -350,6 +350,7 @@ pub(crate) struct ParameterStore {
   // Not held at the same time as `values`, as the callbacks may be slow.
   validator: Option<Mutex<Box<ParameterFunc>>>,
   set_action: Option<Mutex<Box<ParameterFunc>>>,
+  describer: Option<Box<crate::node_options::ParameterDescriberFunc>>,
   use_sim_time: AtomicBool,
 }
 
@@ -383,6 +384,7 @@ impl ParameterStore {
       allow_undeclared,
       validator: validator.map(Mutex::new),
       set_action: set_action.map(Mutex::new),
+      describer: None,
       use_sim_time: AtomicBool::new(false),
     };
     for (name, value) in &initial {
@@ -390,6 +392,16 @@ impl ParameterStore {
       store.run_set_action(name, value)?;
     }
     Ok(store)
+  }
+
+  /// Sets the describer `describe` asks first (see
+  /// `NodeOptions::parameter_describer`).
+  pub fn with_describer(
+    mut self,
+    describer: Option<Box<crate::node_options::ParameterDescriberFunc>>,
+  ) -> Self {
+    self.describer = describer;
+    self
   }
 
   pub fn allow_undeclared(&self) -> bool {
@@ -429,7 +441,14 @@ impl ParameterStore {
     names
       .iter()
       .map(|name| match values.get(name) {
-        Some(value) => ParameterDescriptor::from_value(name, value),
+        Some(value) => match self.describer.as_ref().and_then(|d| d(name)) {
+          Some(mut descriptor) => {
+            descriptor.name = name.clone();
+            descriptor.param_type = value.to_parameter_type();
+            descriptor
+          }
+          None => ParameterDescriptor::from_value(name, value),
+        },
         None => ParameterDescriptor::unknown(name),
       })
       .collect()
@@ -850,5 +869,44 @@ mod tests {
     // The separator after the prefix counts towards depth.
     assert_eq!(names(&["a"], 1).names, ["a"]);
     assert_eq!(names(&["a"], 2).names, ["a", "a.b"]);
+  }
+
+  #[test]
+  fn a_describer_gives_the_declared_descriptor_with_the_value_type() {
+    use super::{raw, NumericRange, ParameterDescriptor, ParameterType};
+    let s = store(false).with_describer(Some(Box::new(|name: &str| {
+      (name == "p").then(|| ParameterDescriptor {
+        name: String::new(),
+        param_type: ParameterType::NotSet,
+        description: "a count".to_string(),
+        additional_constraints: "even".to_string(),
+        read_only: true,
+        dynamic_typing: false,
+        range: NumericRange::IntegerRange {
+          from_value: 0,
+          to_value: 8,
+          step: 0,
+        },
+      })
+    })));
+    let d: Vec<raw::ParameterDescriptor> = s
+      .describe(&["p".to_string(), "use_sim_time".to_string(), "q".to_string()])
+      .into_iter()
+      .map(raw::ParameterDescriptor::from)
+      .collect();
+    assert_eq!(d[0].name, "p");
+    assert_eq!(d[0].r#type, ParameterType::Integer as u8);
+    assert_eq!(d[0].description, "a count");
+    assert_eq!(d[0].additional_constraints, "even");
+    assert!(d[0].read_only);
+    assert_eq!(d[0].integer_range.len(), 1);
+    assert_eq!(
+      (d[0].integer_range[0].from_value, d[0].integer_range[0].to_value),
+      (0, 8)
+    );
+    // Not described: built from the value; not declared: unknown.
+    assert_eq!(d[1].r#type, ParameterType::Bool as u8);
+    assert!(!d[1].read_only);
+    assert_eq!(d[2].r#type, ParameterType::NotSet as u8);
   }
 }
