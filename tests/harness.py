@@ -356,7 +356,6 @@ def run_ros2cli(*args: str, timeout: float = 30.0,
 def launch_scenario(params_file: Union[str, Path], *, real_time_factor: float,
                     nodes: Sequence[str] = ("chassis_node",), sim_args: Sequence[str] = (),
                     node_args: Sequence[str] = (), lidar: bool = False,
-                    driver_timeout_wall_s: Optional[float] = 1.0,
                     log_dir: Optional[Path] = None,
                     launch: Optional[Callable[..., NodeProcess]] = None) -> list[NodeProcess]:
     """Start ``sim_node`` publishing ``/clock`` at ``real_time_factor`` simulated seconds per
@@ -366,13 +365,10 @@ def launch_scenario(params_file: Union[str, Path], *, real_time_factor: float,
     ``sim_args`` go to ``sim_node`` only, ``node_args`` to every other node. The LIDAR is off
     unless ``lidar`` (a 1081-beam scan costs the most of anything in the simulation).
 
-    The simulated motor drivers stop the wheels after ``command_timeout_s`` *simulated* seconds
-    without ``wheel_commands``, but chassis_node sends them on its steady-clock tick, so at R×
-    a stall of chassis_node for 1/R of that in wall time (0.2 s at 5×, e.g. while the 2-core
-    machine is busy) would stop the robot mid-scenario. ``driver_timeout_wall_s`` (default 1.0,
-    the drivers' default at 1×) sets ``command_timeout_s`` to R times it, so the drivers
-    tolerate the same wall-clock gap as at real time; ``None`` keeps the params file's value
-    (a test of the drivers' own timeout), and ``sim_args`` may override it. ``launch``
+    Watchdogs run on the steady clock at any factor (the time rule, ``mobil_ros::time``): the
+    simulated motor drivers' ``command_timeout_s`` and chassis_node's ``cmd_vel`` and feedback
+    timeouts are wall-clock seconds, so a test that commands on simulated time must also keep
+    ``cmd_vel`` coming in wall time (``publish_on_sim_time`` does). ``launch``
     is the function that starts one process (the ``start_node`` fixture, which stops them at
     teardown); without it ``launch_node`` is used with ``log_dir`` and the caller stops them.
     Use ``SimClock`` to wait for the clock and to measure the factor actually reached.
@@ -385,8 +381,6 @@ def launch_scenario(params_file: Union[str, Path], *, real_time_factor: float,
             return launch_node(exe, *ros_args, log_dir=log_dir, params_file=params_file)
 
     clock_args = ["-p", "publish_clock:=true", "-p", f"real_time_factor:={float(real_time_factor)!r}"]
-    if driver_timeout_wall_s is not None:
-        clock_args += ["-p", f"command_timeout_s:={float(driver_timeout_wall_s * real_time_factor)!r}"]
     lidar_args = [] if lidar else ["-p", "lidar.enabled:=false"]
     procs = [launch("sim_node", *clock_args, *lidar_args, *sim_args, params_file=params_file)]
     for exe in nodes:

@@ -13,10 +13,9 @@ simulated time leaves wall-clock gaps whenever the simulation or this process wa
 With a message at least every 0.1 wall seconds the watchdog, five times longer, never fires
 while the test drives; the repeats carry the same command, so they change nothing in the
 kinematics checked. Feedback (joint_states) comes at 50 simulated Hz, i.e. every 4 wall ms.
-The other way round, sim_node's simulated motor drivers time out in simulated time while
-chassis_node sends wheel_commands on its steady-clock tick; harness.launch_scenario scales their
-timeout by the factor (1 wall second, as at 1×), since a 0.2 s stall of chassis_node on a busy
-machine stopped the robot mid-turn at 5× (and reliably at 10×) before it did.
+sim_node's simulated motor drivers time out on the steady clock too (1 wall second without
+wheel_commands, which chassis_node sends every 20 ms), so a stall of chassis_node on a busy
+machine does not stop the robot mid-turn at any factor.
 The feedback watchdog (no joint_states for 0.5 wall s) is the one this test cannot feed: with
 builds running beside it (load average 9), /clock arrived here with gaps of up to 0.23 s and
 once chassis_node went 0.5 s without feedback mid-turn and stopped the wheels, as designed. The
