@@ -64,12 +64,33 @@ pub struct StaticFrames {
     parents: HashMap<String, (String, Pose2)>,
 }
 
+/// The largest roll or pitch (rad) of a static transform taken as planar: 1°.
+pub const MAX_TILT_RAD: f64 = 0.017_453_292_519_943_295;
+
+/// Whether a rotation keeps the z axis within [`MAX_TILT_RAD`] of vertical (a non-finite or
+/// zero quaternion is not). For a unit quaternion the rotated z axis has z component
+/// 1 − 2(x² + y²); the norm divides out so that an unnormalised one is judged alike.
+fn is_planar(q: &mobil_msgs::geometry_msgs::msg::Quaternion) -> bool {
+    let n = q.x * q.x + q.y * q.y + q.z * q.z + q.w * q.w;
+    if !n.is_finite() || n <= 0.0 {
+        return false;
+    }
+    let cos_tilt = 1.0 - 2.0 * (q.x * q.x + q.y * q.y) / n;
+    cos_tilt >= MAX_TILT_RAD.cos()
+}
+
 impl StaticFrames {
-    /// Adds (or replaces) the transforms of one message; transforms with non-finite values or
-    /// empty frame names are skipped, and their count returned.
+    /// Adds (or replaces) the transforms of one message; transforms with non-finite values,
+    /// empty frame names, or a tilt out of the plane (roll or pitch beyond
+    /// [`MAX_TILT_RAD`], e.g. a scanner mounted upside down, whose beams a planar pose would
+    /// mirror) are skipped, and their count returned.
     pub fn add(&mut self, msg: &TFMessage) -> usize {
         let mut skipped = 0;
         for t in &msg.transforms {
+            if !is_planar(&t.transform.rotation) {
+                skipped += 1;
+                continue;
+            }
             let pose = Pose2::new(
                 t.transform.translation.x,
                 t.transform.translation.y,
@@ -86,29 +107,30 @@ impl StaticFrames {
         skipped
     }
 
-    /// The chain from `frame` up to its root: (root, root_from_frame).
-    fn to_root(&self, frame: &str) -> (String, Pose2) {
+    /// The chain from `frame` up to its root: (root, root_from_frame); `None` when the chain
+    /// loops (a → b → a), which no tree has.
+    fn to_root(&self, frame: &str) -> Option<(String, Pose2)> {
         let mut pose = Pose2::identity();
         let mut at = frame.to_owned();
-        // A loop in the data (a → b → a) ends after as many steps as there are frames.
+        // A chain without a loop has at most as many links as there are frames.
         for _ in 0..=self.parents.len() {
             match self.parents.get(&at) {
                 Some((parent, parent_from_at)) => {
                     pose = *parent_from_at * pose;
                     at = parent.clone();
                 }
-                None => break,
+                None => return Some((at, pose)),
             }
         }
-        (at, pose)
+        None
     }
 
     /// `parent_from_child` between two frames of the same tree, composing the chain between
     /// them; `None` while they are not connected.
     pub fn lookup(&self, parent: &str, child: &str) -> Option<Pose2> {
         let (parent, child) = (parent.trim_start_matches('/'), child.trim_start_matches('/'));
-        let (root_p, root_from_parent) = self.to_root(parent);
-        let (root_c, root_from_child) = self.to_root(child);
+        let (root_p, root_from_parent) = self.to_root(parent)?;
+        let (root_c, root_from_child) = self.to_root(child)?;
         (root_p == root_c).then(|| root_from_parent.inverse() * root_from_child)
     }
 }
@@ -203,6 +225,35 @@ mod tests {
         t.transform.translation.y = y;
         t.transform.rotation = yaw_quaternion(yaw);
         t
+    }
+
+    #[test]
+    fn tilted_transforms_are_refused_and_a_loop_has_no_root() {
+        let mut f = StaticFrames::default();
+        let mut upside_down = tf("base_link", "laser", 0.2, 0.0, 0.0);
+        // Roll π: the quaternion (x, y, z, w) = (1, 0, 0, 0); its beams would be mirrored.
+        upside_down.transform.rotation.x = 1.0;
+        upside_down.transform.rotation.w = 0.0;
+        let mut tilted_2deg = tf("base_link", "tilted", 0.2, 0.0, 0.0);
+        // Pitch 2°: (0, sin 1°, 0, cos 1°).
+        tilted_2deg.transform.rotation.y = 1f64.to_radians().sin();
+        tilted_2deg.transform.rotation.w = 1f64.to_radians().cos();
+        let mut tilted_half_deg = tf("base_link", "level", 0.2, 0.0, 0.0);
+        tilted_half_deg.transform.rotation.y = 0.25f64.to_radians().sin();
+        tilted_half_deg.transform.rotation.w = 0.25f64.to_radians().cos();
+        let skipped = f.add(&TFMessage {
+            transforms: vec![upside_down, tilted_2deg, tilted_half_deg],
+        });
+        assert_eq!(skipped, 2);
+        assert_eq!(f.lookup("base_link", "laser"), None);
+        assert_eq!(f.lookup("base_link", "tilted"), None);
+        assert!(f.lookup("base_link", "level").is_some());
+        // a → b → a: no root, so nothing is found through it.
+        f.add(&TFMessage {
+            transforms: vec![tf("a", "b", 1.0, 0.0, 0.0), tf("b", "a", 1.0, 0.0, 0.0)],
+        });
+        assert_eq!(f.lookup("a", "b"), None);
+        assert_eq!(f.lookup("base_link", "a"), None);
     }
 
     #[test]
