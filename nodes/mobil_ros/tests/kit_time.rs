@@ -159,5 +159,12 @@ async fn the_final_stop_is_acknowledged_by_a_matched_reader() {
         last = Some(t);
     }
     assert_eq!(last.map(|t| t.linear.x), Some(0.0));
+    // The wait is bounded: with no time allowed, a command just written cannot have been
+    // acknowledged (the acknowledgement needs a round trip through the reader's event loop),
+    // so the helper reports TimedOut at once instead of waiting.
+    let started = Instant::now();
+    let outcome = final_stop(&cmd, Twist::default(), Duration::ZERO).await;
+    assert_eq!(outcome, FinalStop::TimedOut);
+    assert!(started.elapsed() < Duration::from_millis(100), "{:?}", started.elapsed());
     node.shutdown().await;
 }
