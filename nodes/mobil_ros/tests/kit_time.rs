@@ -165,6 +165,10 @@ async fn the_final_stop_is_acknowledged_by_a_matched_reader() {
     let started = Instant::now();
     let outcome = final_stop(&cmd, Twist::default(), Duration::ZERO).await;
     assert_eq!(outcome, FinalStop::TimedOut);
-    assert!(started.elapsed() < Duration::from_millis(100), "{:?}", started.elapsed());
+    assert!(
+        started.elapsed() < Duration::from_millis(100),
+        "{:?}",
+        started.elapsed()
+    );
     node.shutdown().await;
 }
