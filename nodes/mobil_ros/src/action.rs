@@ -21,11 +21,14 @@
 //!   [`GoalServer::finish`] with [`GoalEnd::Canceled`]. Requests for other goals are refused.
 //! - **Results with a bounded wait**: ros2-client sends a result only once the client has asked
 //!   for it (`get_result`). [`GoalServer::finish`] hands the result to a background task that
-//!   delivers results one after another, each waiting at most
-//!   [`GoalServerConfig::result_timeout`] for the client's request, so the node's loop never
-//!   blocks on a client. A result nobody asked for in time is dropped with a warning (an accepted
-//!   goal that was not canceling is then marked aborted). The timeout must exceed Fast DDS's
-//!   3 s repair of a request lost during discovery (ROS2-NOTES), hence the 10 s default.
+//!   delivers each finished goal's result concurrently with the others, each waiting at most
+//!   [`GoalServerConfig::result_timeout`] for its client's request: the node's loop never blocks
+//!   on a client, and a client that never asks holds up no other goal's result. A result nobody
+//!   asked for in time is dropped with a warning. ros2-client sets a goal's end status only when
+//!   it sends the result, so such a goal that ended ABORTED is then marked ABORTED, while one
+//!   that ended SUCCEEDED or CANCELED keeps the status last published for it (EXECUTING or
+//!   CANCELING) rather than being reported ABORTED. The timeout must exceed Fast DDS's 3 s repair
+//!   of a request lost during discovery (ROS2-NOTES), hence the 10 s default.
 //!
 //! ```no_run
 //! # async fn demo(node: &mut mobil_ros::RosNode) -> anyhow::Result<()> {
@@ -73,7 +76,7 @@ use ros2_client::action::{
 pub use ros2_client::action::{GoalEndStatus as GoalEnd, GoalId};
 use ros2_client::{Name, Node, ServiceMapping};
 use std::sync::{Arc, Mutex};
-use std::time::{Duration, Instant};
+use std::time::Duration;
 use thiserror::Error;
 use tokio::sync::mpsc;
 use tracing::{info, warn};
@@ -415,28 +418,66 @@ impl<A: RosAction> Drop for GoalServer<A> {
     }
 }
 
-/// Sends queued results one after another, each waiting at most `timeout` for the client's
-/// `get_result` request. One at a time, because each `send_result_response` reads the result
-/// service's requests and keeps those of other goals for them.
-async fn deliver_results<A: RosAction>(
+/// How long one attempt to send a result waits for its `get_result` request before it looks again.
+/// Each attempt reads the result service's requests and keeps those of other goals in
+/// ros2-client's table, where their own attempts find them on their next look: this bounds how
+/// long a request taken by another goal's attempt waits.
+const RESULT_LOOK: Duration = Duration::from_millis(50);
+
+/// Delivers each queued result in a task of its own, so a client that never asks for its result
+/// holds up no other goal's; each waits at most `timeout`. Ends once the queue is closed and every
+/// delivery has ended.
+async fn deliver_results<A: RosAction + 'static>(
     server: Arc<Server<A>>,
     mut queue: mpsc::UnboundedReceiver<Finished<A>>,
     timeout: Duration,
     name: String,
 ) {
-    while let Some(Finished { handle, status, result }) = queue.recv().await {
-        let id = handle.goal_id();
-        let started = Instant::now();
-        match tokio::time::timeout(timeout, server.send_result_response(handle.clone(), status, result)).await {
-            Ok(Ok(())) => tracing::debug!("{name}: result of {id:?} sent after {:?}", started.elapsed()),
-            Ok(Err(e)) => warn!("{name}: cannot send the result of goal {id:?}: {e:?}"),
-            Err(_) => {
-                warn!("{name}: no client asked for the result of goal {id:?} within {timeout:?}; dropped");
-                if status != GoalEnd::Canceled {
-                    // Leaves the goal's status ABORTED rather than EXECUTING for ever.
-                    let _ = server.abort_executing_goal(handle).await;
+    let mut deliveries = tokio::task::JoinSet::new();
+    loop {
+        tokio::select! {
+            finished = queue.recv() => match finished {
+                Some(finished) => {
+                    deliveries.spawn(deliver_one::<A>(server.clone(), finished, timeout, name.clone()));
                 }
-            }
+                None => break,
+            },
+            Some(_) = deliveries.join_next(), if !deliveries.is_empty() => {}
         }
+    }
+    while deliveries.join_next().await.is_some() {}
+}
+
+/// Sends one result once its client asks for it, waiting at most `timeout`.
+async fn deliver_one<A: RosAction>(server: Arc<Server<A>>, finished: Finished<A>, timeout: Duration, name: String) {
+    let Finished { handle, status, result } = finished;
+    let id = handle.goal_id();
+    let started = tokio::time::Instant::now();
+    let deadline = started + timeout;
+    loop {
+        let left = deadline.saturating_duration_since(tokio::time::Instant::now());
+        if left.is_zero() {
+            break;
+        }
+        // Cancel-safe: ros2-client takes a request and files or answers it in the same poll.
+        let attempt = server.send_result_response(handle.clone(), status, result.clone());
+        match tokio::time::timeout(RESULT_LOOK.min(left), attempt).await {
+            Ok(Ok(())) => {
+                tracing::debug!("{name}: result of {id:?} sent after {:?}", started.elapsed());
+                return;
+            }
+            Ok(Err(e)) => {
+                warn!("{name}: cannot send the result of goal {id:?}: {e:?}");
+                return;
+            }
+            Err(_) => {}
+        }
+    }
+    warn!("{name}: no client asked for the result of goal {id:?} within {timeout:?}; dropped");
+    if status == GoalEnd::Aborted {
+        // ros2-client sets a goal's end status only when it sends the result: without this the
+        // goal would be reported EXECUTING for ever. A SUCCEEDED or CANCELED goal is left as it
+        // was last reported rather than labelled ABORTED, which it is not.
+        let _ = server.abort_executing_goal(handle).await;
     }
 }

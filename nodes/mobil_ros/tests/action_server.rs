@@ -81,22 +81,29 @@ async fn send(client: &Client, g: DriveDistanceGoal) -> (ros2_client::action::Go
     panic!("no goal response in 5 attempts");
 }
 
-#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
-async fn reject_accept_feedback_preempt_cancel_and_results() {
-    // A domain of its own (the Python tests use 100..199).
+/// A server on `action` (spawned, running [`serve`]) and a client of it, in two DDS participants
+/// of a domain of this test process's own (the Python tests use 100..199); the contexts are
+/// returned to be kept alive.
+fn start(action: &str, config: GoalServerConfig) -> (Client, tokio::task::JoinHandle<()>, (Context, Context)) {
     let domain = 200 + (std::process::id() % 30) as u16;
-    let name = Name::new("/", "drive_test").unwrap();
+    let name = Name::new("/", action).unwrap();
 
     let server_context = Context::with_options(ContextOptions::new().domain_id(domain)).unwrap();
     let mut server_node = server_context
-        .new_node(NodeName::new("/", "server").unwrap(), NodeOptions::new())
+        .new_node(
+            NodeName::new("/", &format!("{action}_server")).unwrap(),
+            NodeOptions::new(),
+        )
         .unwrap();
-    let server = GoalServer::<DriveDistance>::on_node(&mut server_node, &name, GoalServerConfig::default()).unwrap();
+    let server = GoalServer::<DriveDistance>::on_node(&mut server_node, &name, config).unwrap();
     let serving = tokio::spawn(serve(server));
 
     let client_context = Context::with_options(ContextOptions::new().domain_id(domain)).unwrap();
     let mut client_node = client_context
-        .new_node(NodeName::new("/", "client").unwrap(), NodeOptions::new())
+        .new_node(
+            NodeName::new("/", &format!("{action}_client")).unwrap(),
+            NodeOptions::new(),
+        )
         .unwrap();
     let service = mobil_ros::qos::reliable(10);
     let client: Client = client_node
@@ -113,6 +120,12 @@ async fn reject_accept_feedback_preempt_cancel_and_results() {
             },
         )
         .unwrap();
+    (client, serving, (server_context, client_context))
+}
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn reject_accept_feedback_preempt_cancel_and_results() {
+    let (client, serving, _contexts) = start("drive_test", GoalServerConfig::default());
 
     // Rejected: the server refuses a negative distance.
     let (_, accepted) = send(&client, goal(-1.0)).await;
@@ -150,5 +163,40 @@ async fn reject_accept_feedback_preempt_cancel_and_results() {
     let cancel = within(client.async_cancel_goal(second, Time::ZERO)).await;
     assert!(cancel.goals_canceling.is_empty());
 
+    serving.abort();
+}
+
+/// Goal 1 is pre-empted by goal 2 and its client never asks for goal 1's result; goal 2 is then
+/// canceled and its result asked for. With results delivered one after another, goal 2's would
+/// wait behind goal 1's for the 10 s `result_timeout`; delivered concurrently, it comes as soon as
+/// it is asked for (a reply round trip in one process: well under 2 s).
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn an_unasked_result_does_not_hold_up_the_next() {
+    let timeout = Duration::from_secs(10);
+    let (client, serving, _contexts) = start(
+        "drive_test_unasked",
+        GoalServerConfig {
+            result_timeout: timeout,
+        },
+    );
+
+    let (first, accepted) = send(&client, goal(1.0)).await;
+    assert!(accepted);
+    let (second, accepted) = send(&client, goal(2.0)).await;
+    assert!(accepted);
+    assert_ne!(first, second);
+    // Goal 1 is now ABORTED, its result queued; nobody asks for it.
+    let cancel = within(client.async_cancel_goal(second, Time::ZERO)).await;
+    assert_eq!(cancel.goals_canceling.len(), 1);
+
+    let asked = std::time::Instant::now();
+    let (status, result) = within(client.async_request_result(second)).await;
+    let waited = asked.elapsed();
+    assert_eq!(status, GoalStatusEnum::Canceled);
+    assert_eq!((result.travelled, result.reason.as_str()), (1.0, "canceled"));
+    assert!(
+        waited < Duration::from_secs(2),
+        "goal 2's result took {waited:?}: held up behind goal 1's"
+    );
     serving.abort();
 }
