@@ -17,8 +17,11 @@
 //!   so a Nav2-style client sees the same status from this suite as from Nav2. (CANCELED is kept
 //!   for what a client asked for; an old goal that was already being canceled ends CANCELED.)
 //! - **Cancel**: a cancel request that names the active goal is agreed to at once (the goal goes
-//!   CANCELING) and reported as [`ActionEvent::CancelRequested`]; the node stops and calls
-//!   [`GoalServer::finish`] with [`GoalEnd::Canceled`]. Requests for other goals are refused.
+//!   CANCELING) and reported, once, as [`ActionEvent::CancelRequested`] with the goal's id, if it
+//!   is still the active goal then; the node stops and calls [`GoalServer::finish`] with
+//!   [`GoalEnd::Canceled`]. A further cancel of a goal already canceling is agreed to again
+//!   (ERROR_NONE, the goal listed), as rcl_action does, and not reported again. Requests for other
+//!   goals are refused.
 //! - **Results with a bounded wait**: ros2-client sends a result only once the client has asked
 //!   for it (`get_result`). [`GoalServer::finish`] hands the result to a background task that
 //!   delivers each finished goal's result concurrently with the others, each waiting at most
@@ -49,7 +52,7 @@
 //!                 server.accept(request, |_old| result(travelled, "preempted by a newer goal")).await?;
 //!                 travelled = 0.0;
 //!             }
-//!             ActionEvent::CancelRequested => {
+//!             ActionEvent::CancelRequested(_) => {
 //!                 server.finish(GoalEnd::Canceled, result(travelled, "canceled"));
 //!             }
 //!         },
@@ -152,9 +155,9 @@ impl<G> GoalRequest<G> {
 pub enum ActionEvent<G> {
     /// A client sent a goal: accept it (pre-empting the active one, if any) or reject it.
     Goal(GoalRequest<G>),
-    /// A client asked to cancel the active goal and the server agreed (it is CANCELING): stop,
-    /// then [`GoalServer::finish`] it, normally with [`GoalEnd::Canceled`].
-    CancelRequested,
+    /// A client asked to cancel the active goal, whose id this is, and the server agreed (it is
+    /// CANCELING): stop, then [`GoalServer::finish`] it, normally with [`GoalEnd::Canceled`].
+    CancelRequested(GoalId),
 }
 
 struct Active<G> {
@@ -174,9 +177,12 @@ pub struct GoalServer<A: RosAction> {
     server: Arc<Server<A>>,
     name: String,
     active: Option<Active<A::Goal>>,
-    /// A cancel request agreed to but not yet answered (kept so that a dropped
-    /// [`GoalServer::next_event`] future answers it on the next call).
+    /// A cancel request read but not yet answered, with the goal agreed to (taken before the
+    /// answer is awaited, so a dropped [`GoalServer::next_event`] future never answers twice).
     pending_cancel: Option<(CancelHandle, Option<GoalId>)>,
+    /// A goal that went CANCELING and that the node has not yet been told of (kept so that a
+    /// dropped [`GoalServer::next_event`] future reports it on the next call).
+    unreported_cancel: Option<GoalId>,
     results: Option<mpsc::UnboundedSender<Finished<A>>>,
     delivery: Option<tokio::task::JoinHandle<()>>,
     result_timeout: Duration,
@@ -221,6 +227,7 @@ where
             name: name.to_string(),
             active: None,
             pending_cancel: None,
+            unreported_cancel: None,
             results: Some(tx),
             delivery: Some(delivery),
             result_timeout: config.result_timeout,
@@ -247,20 +254,19 @@ where
     /// this can be one branch of a `tokio::select!` that other branches win.
     pub async fn next_event(&mut self) -> ActionEvent<A::Goal> {
         loop {
-            if let Some((handle, goal)) = self.pending_cancel.as_ref() {
-                let agreed = goal.iter().copied().collect::<Vec<_>>();
-                if let Err(e) = self.server.respond_to_cancel_requests(handle, agreed.into_iter()).await {
+            if let Some((handle, goal)) = self.pending_cancel.take() {
+                if let Err(e) = self.server.respond_to_cancel_requests(&handle, goal.into_iter()).await {
                     self.warn(
                         "cancel-response",
                         format_args!("{}: cannot answer a cancel request: {e:?}", self.name),
                     );
                 }
-                let agreed = goal.is_some();
-                self.pending_cancel = None;
-                if agreed {
-                    return ActionEvent::CancelRequested;
+            }
+            if let Some(id) = self.unreported_cancel.take() {
+                // The goal may have ended since (pre-empted while this future was dropped).
+                if self.active_id() == Some(id) {
+                    return ActionEvent::CancelRequested(id);
                 }
-                continue;
             }
             tokio::select! {
                 goal = self.server.receive_new_goal() => match goal {
@@ -272,18 +278,24 @@ where
                 },
                 cancel = self.server.receive_cancel_request() => match cancel {
                     Ok(handle) => {
-                        let agreed = self
-                            .active
-                            .as_mut()
-                            .filter(|a| !a.canceling && handle.contains_goal(&a.handle.goal_id()))
-                            .map(|a| {
+                        let named = self.active.as_mut().filter(|a| handle.contains_goal(&a.handle.goal_id()));
+                        let agreed = match named {
+                            Some(a) if a.canceling => {
+                                info!("{}: goal {:?} is already canceling", self.name, a.handle.goal_id());
+                                Some(a.handle.goal_id())
+                            }
+                            Some(a) => {
                                 a.canceling = true;
-                                a.handle.goal_id()
-                            });
-                        match agreed {
-                            Some(id) => info!("{}: goal {id:?} is canceling", self.name),
-                            None => info!("{}: cancel request refused: it names no active goal", self.name),
-                        }
+                                let id = a.handle.goal_id();
+                                info!("{}: goal {id:?} is canceling", self.name);
+                                self.unreported_cancel = Some(id);
+                                Some(id)
+                            }
+                            None => {
+                                info!("{}: cancel request refused: it names no active goal", self.name);
+                                None
+                            }
+                        };
                         self.pending_cancel = Some((handle, agreed));
                     }
                     Err(e) => self.warn("cancel-read", format_args!("{}: undecodable cancel request dropped: {e:?}", self.name)),

@@ -7,6 +7,7 @@ use mobil_msgs::mobil_msgs::action::{DriveDistance, DriveDistanceFeedback, Drive
 use mobil_msgs::RosAction;
 use mobil_ros::action::{ActionEvent, GoalEnd, GoalServer, GoalServerConfig};
 use ros2_client::action::{ActionClient, ActionClientQosPolicies, GoalStatusEnum};
+use ros2_client::action_msgs::CancelGoalResponseEnum;
 use ros2_client::builtin_interfaces::Time;
 use ros2_client::{Context, ContextOptions, Name, NodeName, NodeOptions, ServiceMapping};
 use std::time::Duration;
@@ -19,8 +20,11 @@ fn goal(distance: f64) -> DriveDistanceGoal {
 
 /// The server side: rejects goals with a distance ≤ 0; a pre-empted goal's result is its own
 /// distance (so the test sees which goal the closure got); a canceled goal's result is half of
-/// its distance; every accepted goal gets one feedback of (0.25, distance − 0.25).
+/// its distance, except a goal of distance 5, whose cancel it never acts on (it stays CANCELING);
+/// every accepted goal gets one feedback of (0.25, distance − 0.25). It panics (ending its task)
+/// if a cancel is reported for anything but the active goal, or twice for one goal.
 async fn serve(mut server: GoalServer<DriveDistance>) {
+    let mut reported = Vec::new();
     loop {
         match server.next_event().await {
             ActionEvent::Goal(request) if request.goal().distance <= 0.0 => {
@@ -43,9 +47,16 @@ async fn serve(mut server: GoalServer<DriveDistance>) {
                     .await
                     .unwrap();
             }
-            ActionEvent::CancelRequested => {
-                let half = server.active_goal().map(|g| g.distance / 2.0).unwrap();
+            ActionEvent::CancelRequested(id) => {
+                assert_eq!(server.active_id(), Some(id));
+                assert!(!reported.contains(&id), "cancel of {id:?} reported twice");
+                reported.push(id);
                 assert!(server.is_canceling());
+                let distance = server.active_goal().map(|g| g.distance).unwrap();
+                if distance == 5.0 {
+                    continue;
+                }
+                let half = distance / 2.0;
                 server.finish(
                     GoalEnd::Canceled,
                     DriveDistanceResult {
@@ -162,7 +173,30 @@ async fn reject_accept_feedback_preempt_cancel_and_results() {
     // Nothing is active now: a cancel of the finished goal is refused.
     let cancel = within(client.async_cancel_goal(second, Time::ZERO)).await;
     assert!(cancel.goals_canceling.is_empty());
+    assert_eq!(cancel.return_code, CancelGoalResponseEnum::Rejected);
 
+    // A goal the server is slow to cancel (distance 5): canceled once, then again while it is
+    // CANCELING, which is agreed to again as rcl_action does (no error, the goal listed) and not
+    // reported to the node a second time (`serve` would panic).
+    let (third, accepted) = send(&client, goal(5.0)).await;
+    assert!(accepted);
+    for _ in 0..2 {
+        let cancel = within(client.async_cancel_goal(third, Time::ZERO)).await;
+        assert_eq!(cancel.return_code, CancelGoalResponseEnum::None);
+        assert_eq!(cancel.goals_canceling.len(), 1);
+        assert_eq!(cancel.goals_canceling[0].goal_id, third);
+    }
+    // Pre-empted while CANCELING, it ends CANCELED with the result built from it (5.0).
+    let (_, accepted) = send(&client, goal(1.0)).await;
+    assert!(accepted);
+    let (status, result) = within(client.async_request_result(third)).await;
+    assert_eq!(status, GoalStatusEnum::Canceled);
+    assert_eq!(
+        (result.travelled, result.reason.as_str()),
+        (5.0, "preempted by a newer goal")
+    );
+
+    assert!(!serving.is_finished(), "the server task panicked");
     serving.abort();
 }
 

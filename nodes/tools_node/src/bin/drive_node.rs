@@ -212,7 +212,7 @@ async fn event_loop(
                         }
                     }
                 }
-                ActionEvent::CancelRequested => {
+                ActionEvent::CancelRequested(_) => {
                     stop("canceled");
                     let travelled = drive.take().map_or(0.0, |d| d.progress().travelled);
                     server.finish(GoalEnd::Canceled, result(travelled, "canceled"));
