@@ -21,28 +21,33 @@ fn goal(distance: f64) -> DriveDistanceGoal {
 /// The server side: rejects goals with a distance ≤ 0; a pre-empted goal's result is its own
 /// distance (so the test sees which goal the closure got); a canceled goal's result is half of
 /// its distance, except a goal of distance 5, whose cancel it never acts on (it stays CANCELING);
-/// every accepted goal gets one feedback of (0.25, distance − 0.25). It panics (ending its task)
+/// the active goal gets a feedback of (0.25, distance − 0.25) every 50 ms. It panics (ending its task)
 /// if a cancel is reported for anything but the active goal, or twice for one goal.
 async fn serve(mut server: GoalServer<DriveDistance>) {
     let mut reported = Vec::new();
+    let mut ticker = tokio::time::interval(Duration::from_millis(50));
     loop {
-        match server.next_event().await {
+        let event = tokio::select! {
+            event = server.next_event() => event,
+            _ = ticker.tick() => {
+                if let Some(distance) = server.active_goal().map(|g| g.distance) {
+                    server
+                        .feedback(DriveDistanceFeedback { travelled: 0.25, remaining: distance - 0.25 })
+                        .await
+                        .unwrap();
+                }
+                continue;
+            }
+        };
+        match event {
             ActionEvent::Goal(request) if request.goal().distance <= 0.0 => {
                 server.reject(request, "distance must be above zero").await;
             }
             ActionEvent::Goal(request) => {
-                let distance = request.goal().distance;
                 server
                     .accept(request, |old| DriveDistanceResult {
                         travelled: old.distance,
                         reason: "preempted by a newer goal".into(),
-                    })
-                    .await
-                    .unwrap();
-                server
-                    .feedback(DriveDistanceFeedback {
-                        travelled: 0.25,
-                        remaining: distance - 0.25,
                     })
                     .await
                     .unwrap();
@@ -145,13 +150,16 @@ async fn reject_accept_feedback_preempt_cancel_and_results() {
     // Accepted, with feedback.
     let (first, accepted) = send(&client, goal(1.5)).await;
     assert!(accepted);
-    // The one feedback message may be published before the client's feedback reader is
-    // matched; when it arrives, it carries the server's numbers.
+    // Feedback published before the client's feedback reader is matched is lost; the server
+    // publishes it every 50 ms, so one arrives once the reader is matched.
     let stream = client.feedback_stream(first);
     futures::pin_mut!(stream);
-    if let Ok(Some(Ok(f))) = tokio::time::timeout(Duration::from_secs(2), stream.next()).await {
-        assert_eq!((f.travelled, f.remaining), (0.25, 1.25));
-    }
+    let f = tokio::time::timeout(Duration::from_secs(5), stream.next())
+        .await
+        .expect("no feedback within 5 s")
+        .expect("the feedback stream ended")
+        .expect("undecodable feedback");
+    assert_eq!((f.travelled, f.remaining), (0.25, 1.25));
 
     // A second goal pre-empts the first: ABORTED, with the result the closure built from the
     // FIRST goal (its distance, 1.5).
