@@ -17,15 +17,21 @@
 //!   so a Nav2-style client sees the same status from this suite as from Nav2. (CANCELED is kept
 //!   for what a client asked for; an old goal that was already being canceled ends CANCELED.)
 //! - **Cancel**: a cancel request that names the active goal is agreed to at once (the goal goes
-//!   CANCELING) and reported as [`ActionEvent::CancelRequested`]; the node stops and calls
-//!   [`GoalServer::finish`] with [`GoalEnd::Canceled`]. Requests for other goals are refused.
+//!   CANCELING) and reported, once, as [`ActionEvent::CancelRequested`] with the goal's id, if it
+//!   is still the active goal then; the node stops and calls [`GoalServer::finish`] with
+//!   [`GoalEnd::Canceled`]. A further cancel of a goal already canceling is agreed to again
+//!   (ERROR_NONE, the goal listed), as rcl_action does, and not reported again. Requests for other
+//!   goals are refused.
 //! - **Results with a bounded wait**: ros2-client sends a result only once the client has asked
 //!   for it (`get_result`). [`GoalServer::finish`] hands the result to a background task that
-//!   delivers results one after another, each waiting at most
-//!   [`GoalServerConfig::result_timeout`] for the client's request, so the node's loop never
-//!   blocks on a client. A result nobody asked for in time is dropped with a warning (an accepted
-//!   goal that was not canceling is then marked aborted). The timeout must exceed Fast DDS's
-//!   3 s repair of a request lost during discovery (ROS2-NOTES), hence the 10 s default.
+//!   delivers each finished goal's result concurrently with the others, each waiting at most
+//!   [`GoalServerConfig::result_timeout`] for its client's request: the node's loop never blocks
+//!   on a client, and a client that never asks holds up no other goal's result. A result nobody
+//!   asked for in time is dropped with a warning. ros2-client sets a goal's end status only when
+//!   it sends the result, so such a goal that ended ABORTED is then marked ABORTED, while one
+//!   that ended SUCCEEDED or CANCELED keeps the status last published for it (EXECUTING or
+//!   CANCELING) rather than being reported ABORTED. The timeout must exceed Fast DDS's 3 s repair
+//!   of a request lost during discovery (ROS2-NOTES), hence the 10 s default.
 //!
 //! ```no_run
 //! # async fn demo(node: &mut mobil_ros::RosNode) -> anyhow::Result<()> {
@@ -46,7 +52,7 @@
 //!                 server.accept(request, |_old| result(travelled, "preempted by a newer goal")).await?;
 //!                 travelled = 0.0;
 //!             }
-//!             ActionEvent::CancelRequested => {
+//!             ActionEvent::CancelRequested(_) => {
 //!                 server.finish(GoalEnd::Canceled, result(travelled, "canceled"));
 //!             }
 //!         },
@@ -73,7 +79,7 @@ use ros2_client::action::{
 pub use ros2_client::action::{GoalEndStatus as GoalEnd, GoalId};
 use ros2_client::{Name, Node, ServiceMapping};
 use std::sync::{Arc, Mutex};
-use std::time::{Duration, Instant};
+use std::time::Duration;
 use thiserror::Error;
 use tokio::sync::mpsc;
 use tracing::{info, warn};
@@ -149,9 +155,9 @@ impl<G> GoalRequest<G> {
 pub enum ActionEvent<G> {
     /// A client sent a goal: accept it (pre-empting the active one, if any) or reject it.
     Goal(GoalRequest<G>),
-    /// A client asked to cancel the active goal and the server agreed (it is CANCELING): stop,
-    /// then [`GoalServer::finish`] it, normally with [`GoalEnd::Canceled`].
-    CancelRequested,
+    /// A client asked to cancel the active goal, whose id this is, and the server agreed (it is
+    /// CANCELING): stop, then [`GoalServer::finish`] it, normally with [`GoalEnd::Canceled`].
+    CancelRequested(GoalId),
 }
 
 struct Active<G> {
@@ -171,9 +177,12 @@ pub struct GoalServer<A: RosAction> {
     server: Arc<Server<A>>,
     name: String,
     active: Option<Active<A::Goal>>,
-    /// A cancel request agreed to but not yet answered (kept so that a dropped
-    /// [`GoalServer::next_event`] future answers it on the next call).
+    /// A cancel request read but not yet answered, with the goal agreed to (taken before the
+    /// answer is awaited, so a dropped [`GoalServer::next_event`] future never answers twice).
     pending_cancel: Option<(CancelHandle, Option<GoalId>)>,
+    /// A goal that went CANCELING and that the node has not yet been told of (kept so that a
+    /// dropped [`GoalServer::next_event`] future reports it on the next call).
+    unreported_cancel: Option<GoalId>,
     results: Option<mpsc::UnboundedSender<Finished<A>>>,
     delivery: Option<tokio::task::JoinHandle<()>>,
     result_timeout: Duration,
@@ -218,6 +227,7 @@ where
             name: name.to_string(),
             active: None,
             pending_cancel: None,
+            unreported_cancel: None,
             results: Some(tx),
             delivery: Some(delivery),
             result_timeout: config.result_timeout,
@@ -244,20 +254,19 @@ where
     /// this can be one branch of a `tokio::select!` that other branches win.
     pub async fn next_event(&mut self) -> ActionEvent<A::Goal> {
         loop {
-            if let Some((handle, goal)) = self.pending_cancel.as_ref() {
-                let agreed = goal.iter().copied().collect::<Vec<_>>();
-                if let Err(e) = self.server.respond_to_cancel_requests(handle, agreed.into_iter()).await {
+            if let Some((handle, goal)) = self.pending_cancel.take() {
+                if let Err(e) = self.server.respond_to_cancel_requests(&handle, goal.into_iter()).await {
                     self.warn(
                         "cancel-response",
                         format_args!("{}: cannot answer a cancel request: {e:?}", self.name),
                     );
                 }
-                let agreed = goal.is_some();
-                self.pending_cancel = None;
-                if agreed {
-                    return ActionEvent::CancelRequested;
+            }
+            if let Some(id) = self.unreported_cancel.take() {
+                // The goal may have ended since (pre-empted while this future was dropped).
+                if self.active_id() == Some(id) {
+                    return ActionEvent::CancelRequested(id);
                 }
-                continue;
             }
             tokio::select! {
                 goal = self.server.receive_new_goal() => match goal {
@@ -269,18 +278,24 @@ where
                 },
                 cancel = self.server.receive_cancel_request() => match cancel {
                     Ok(handle) => {
-                        let agreed = self
-                            .active
-                            .as_mut()
-                            .filter(|a| !a.canceling && handle.contains_goal(&a.handle.goal_id()))
-                            .map(|a| {
+                        let named = self.active.as_mut().filter(|a| handle.contains_goal(&a.handle.goal_id()));
+                        let agreed = match named {
+                            Some(a) if a.canceling => {
+                                info!("{}: goal {:?} is already canceling", self.name, a.handle.goal_id());
+                                Some(a.handle.goal_id())
+                            }
+                            Some(a) => {
                                 a.canceling = true;
-                                a.handle.goal_id()
-                            });
-                        match agreed {
-                            Some(id) => info!("{}: goal {id:?} is canceling", self.name),
-                            None => info!("{}: cancel request refused: it names no active goal", self.name),
-                        }
+                                let id = a.handle.goal_id();
+                                info!("{}: goal {id:?} is canceling", self.name);
+                                self.unreported_cancel = Some(id);
+                                Some(id)
+                            }
+                            None => {
+                                info!("{}: cancel request refused: it names no active goal", self.name);
+                                None
+                            }
+                        };
                         self.pending_cancel = Some((handle, agreed));
                     }
                     Err(e) => self.warn("cancel-read", format_args!("{}: undecodable cancel request dropped: {e:?}", self.name)),
@@ -415,28 +430,66 @@ impl<A: RosAction> Drop for GoalServer<A> {
     }
 }
 
-/// Sends queued results one after another, each waiting at most `timeout` for the client's
-/// `get_result` request. One at a time, because each `send_result_response` reads the result
-/// service's requests and keeps those of other goals for them.
-async fn deliver_results<A: RosAction>(
+/// How long one attempt to send a result waits for its `get_result` request before it looks again.
+/// Each attempt reads the result service's requests and keeps those of other goals in
+/// ros2-client's table, where their own attempts find them on their next look: this bounds how
+/// long a request taken by another goal's attempt waits.
+const RESULT_LOOK: Duration = Duration::from_millis(50);
+
+/// Delivers each queued result in a task of its own, so a client that never asks for its result
+/// holds up no other goal's; each waits at most `timeout`. Ends once the queue is closed and every
+/// delivery has ended.
+async fn deliver_results<A: RosAction + 'static>(
     server: Arc<Server<A>>,
     mut queue: mpsc::UnboundedReceiver<Finished<A>>,
     timeout: Duration,
     name: String,
 ) {
-    while let Some(Finished { handle, status, result }) = queue.recv().await {
-        let id = handle.goal_id();
-        let started = Instant::now();
-        match tokio::time::timeout(timeout, server.send_result_response(handle.clone(), status, result)).await {
-            Ok(Ok(())) => tracing::debug!("{name}: result of {id:?} sent after {:?}", started.elapsed()),
-            Ok(Err(e)) => warn!("{name}: cannot send the result of goal {id:?}: {e:?}"),
-            Err(_) => {
-                warn!("{name}: no client asked for the result of goal {id:?} within {timeout:?}; dropped");
-                if status != GoalEnd::Canceled {
-                    // Leaves the goal's status ABORTED rather than EXECUTING for ever.
-                    let _ = server.abort_executing_goal(handle).await;
+    let mut deliveries = tokio::task::JoinSet::new();
+    loop {
+        tokio::select! {
+            finished = queue.recv() => match finished {
+                Some(finished) => {
+                    deliveries.spawn(deliver_one::<A>(server.clone(), finished, timeout, name.clone()));
                 }
-            }
+                None => break,
+            },
+            Some(_) = deliveries.join_next(), if !deliveries.is_empty() => {}
         }
+    }
+    while deliveries.join_next().await.is_some() {}
+}
+
+/// Sends one result once its client asks for it, waiting at most `timeout`.
+async fn deliver_one<A: RosAction>(server: Arc<Server<A>>, finished: Finished<A>, timeout: Duration, name: String) {
+    let Finished { handle, status, result } = finished;
+    let id = handle.goal_id();
+    let started = tokio::time::Instant::now();
+    let deadline = started + timeout;
+    loop {
+        let left = deadline.saturating_duration_since(tokio::time::Instant::now());
+        if left.is_zero() {
+            break;
+        }
+        // Cancel-safe: ros2-client takes a request and files or answers it in the same poll.
+        let attempt = server.send_result_response(handle.clone(), status, result.clone());
+        match tokio::time::timeout(RESULT_LOOK.min(left), attempt).await {
+            Ok(Ok(())) => {
+                tracing::debug!("{name}: result of {id:?} sent after {:?}", started.elapsed());
+                return;
+            }
+            Ok(Err(e)) => {
+                warn!("{name}: cannot send the result of goal {id:?}: {e:?}");
+                return;
+            }
+            Err(_) => {}
+        }
+    }
+    warn!("{name}: no client asked for the result of goal {id:?} within {timeout:?}; dropped");
+    if status == GoalEnd::Aborted {
+        // ros2-client sets a goal's end status only when it sends the result: without this the
+        // goal would be reported EXECUTING for ever. A SUCCEEDED or CANCELED goal is left as it
+        // was last reported rather than labelled ABORTED, which it is not.
+        let _ = server.abort_executing_goal(handle).await;
     }
 }

@@ -4,7 +4,10 @@
 //!
 //! It publishes `cmd_vel` only while it has a goal, and one zero `cmd_vel` when the goal ends:
 //! reached, canceled, pre-empted by a newer goal (the old one ends ABORTED), odometry stale for
-//! `odom_timeout_s` (steady clock; ABORTED) or shutdown (ABORTED).
+//! `odom_timeout_s` (steady clock; ABORTED) or shutdown (ABORTED). However the node leaves
+//! (shutdown or a failure), its last `cmd_vel` is a zero one, waited for until the readers
+//! acknowledge it (at most `mobil_ros::stop::FINAL_STOP_WAIT`). A goal that cannot be started (a
+//! DDS send to that client failed) is logged and the node goes on serving.
 
 use futures::StreamExt;
 use mobil_msgs::geometry_msgs::msg::Twist;
@@ -13,8 +16,10 @@ use mobil_msgs::nav_msgs::msg::Odometry;
 use mobil_ros::action::{ActionEvent, GoalEnd, GoalServer, GoalServerConfig};
 use mobil_ros::geometry::yaw_of;
 use mobil_ros::params::ParamValues;
+use mobil_ros::stop::{final_stop, FINAL_STOP_WAIT};
 use mobil_ros::{qos, run_node, shutdown_signal, warn_throttled, LogThrottle, NodeDecl, ParamSpec, RosNode};
 use mobil_tools::drive::{DistanceDrive, DriveSettings, Pose2};
+use ros2_client::{Publisher, Subscription};
 use std::process::ExitCode;
 use std::time::{Duration, Instant};
 use tracing::{info, warn};
@@ -96,8 +101,16 @@ fn twist(v: f64) -> Twist {
 }
 
 async fn serve(node: &mut RosNode) -> anyhow::Result<()> {
-    let mut config = parse_config(&node.params()).map_err(anyhow::Error::msg)?;
+    let config = parse_config(&node.params()).map_err(anyhow::Error::msg)?;
     let cmd = node.publisher::<Twist>("cmd_vel", &qos::default_qos())?;
+    // Whatever ends the loop (shutdown or a failure), the last command is a zero one, waited
+    // for, so the chassis does not keep the last speed until its own watchdog fires.
+    let outcome = drive_loop(node, &cmd, config).await;
+    final_stop(&cmd, Twist::default(), FINAL_STOP_WAIT).await;
+    outcome
+}
+
+async fn drive_loop(node: &mut RosNode, cmd: &Publisher<Twist>, mut config: Config) -> anyhow::Result<()> {
     let odom_sub = node.subscription::<Odometry>("odom", &qos::default_qos())?;
     let mut server = GoalServer::<DriveDistance>::create(
         node,
@@ -106,6 +119,26 @@ async fn serve(node: &mut RosNode) -> anyhow::Result<()> {
             result_timeout: config.result_timeout,
         },
     )?;
+    let mut drive: Option<DistanceDrive> = None;
+    let outcome = event_loop(node, cmd, &odom_sub, &mut server, &mut drive, &mut config).await;
+    let travelled = drive.take().map_or(0.0, |d| d.progress().travelled);
+    let reason = if outcome.is_ok() {
+        "shutting down"
+    } else {
+        "node failed"
+    };
+    server.close(result(travelled, reason)).await;
+    outcome
+}
+
+async fn event_loop(
+    node: &mut RosNode,
+    cmd: &Publisher<Twist>,
+    odom_sub: &Subscription<Odometry>,
+    server: &mut GoalServer<DriveDistance>,
+    drive: &mut Option<DistanceDrive>,
+    config: &mut Config,
+) -> anyhow::Result<()> {
     let odom = odom_sub.async_stream();
     let shutdown = shutdown_signal();
     tokio::pin!(odom, shutdown);
@@ -115,7 +148,6 @@ async fn serve(node: &mut RosNode) -> anyhow::Result<()> {
 
     // The latest valid odometry pose and when it arrived (steady clock).
     let mut latest: Option<(Pose2, Instant)> = None;
-    let mut drive: Option<DistanceDrive> = None;
     let stop = |why: &str| {
         if let Err(e) = cmd.publish(Twist::default()) {
             warn!("cannot publish the zero cmd_vel ({why}): {e:?}");
@@ -124,7 +156,7 @@ async fn serve(node: &mut RosNode) -> anyhow::Result<()> {
     info!("serving drive_distance");
     loop {
         tokio::select! {
-            _ = &mut shutdown => break,
+            _ = &mut shutdown => return Ok(()),
             changed = node.param_changed() => {
                 if let Some(values) = changed {
                     match parse_config(&values) {
@@ -133,7 +165,7 @@ async fn serve(node: &mut RosNode) -> anyhow::Result<()> {
                                 ticker = tokio::time::interval(Duration::from_secs_f64(1.0 / c.rate_hz));
                                 ticker.set_missed_tick_behavior(tokio::time::MissedTickBehavior::Delay);
                             }
-                            config = c;
+                            *config = c;
                         }
                         Err(e) => warn!("parameters not applied: {e}"),
                     }
@@ -168,13 +200,19 @@ async fn serve(node: &mut RosNode) -> anyhow::Result<()> {
                                 stop("preempted");
                             }
                             let travelled = old.map_or(0.0, |d| d.progress().travelled);
-                            server.accept(request, |_| result(travelled, "preempted by a newer goal")).await?;
-                            info!("driving {} m at {} m/s", goal.distance, goal.speed);
-                            drive = Some(new);
+                            // A failure here is one client's goal (a DDS send failed): logged,
+                            // and the node goes on serving the others.
+                            match server.accept(request, |_| result(travelled, "preempted by a newer goal")).await {
+                                Ok(()) => {
+                                    info!("driving {} m at {} m/s", goal.distance, goal.speed);
+                                    *drive = Some(new);
+                                }
+                                Err(e) => warn_throttled!(throttle, "accept", "goal not started: {e}"),
+                            }
                         }
                     }
                 }
-                ActionEvent::CancelRequested => {
+                ActionEvent::CancelRequested(_) => {
                     stop("canceled");
                     let travelled = drive.take().map_or(0.0, |d| d.progress().travelled);
                     server.finish(GoalEnd::Canceled, result(travelled, "canceled"));
@@ -187,7 +225,7 @@ async fn serve(node: &mut RosNode) -> anyhow::Result<()> {
                     stop("odom stale");
                     warn!("no odom for {:?}: goal aborted", config.odom_timeout);
                     let travelled = d.progress().travelled;
-                    drive = None;
+                    *drive = None;
                     server.finish(GoalEnd::Aborted, result(travelled, "odometry stale"));
                     continue;
                 };
@@ -195,7 +233,7 @@ async fn serve(node: &mut RosNode) -> anyhow::Result<()> {
                 if progress.arrived {
                     stop("reached");
                     info!("reached: travelled {:.3} m of {} m", progress.travelled, d.distance());
-                    drive = None;
+                    *drive = None;
                     server.finish(GoalEnd::Succeeded, result(progress.travelled, "reached"));
                 } else {
                     if let Err(e) = cmd.publish(twist(d.command())) {
@@ -209,10 +247,4 @@ async fn serve(node: &mut RosNode) -> anyhow::Result<()> {
             }
         }
     }
-    let travelled = drive.take().map(|d| {
-        stop("shutdown");
-        d.progress().travelled
-    });
-    server.close(result(travelled.unwrap_or(0.0), "shutting down")).await;
-    Ok(())
 }
