@@ -19,9 +19,9 @@
 //! - **Cancel**: a cancel request that names the active goal is agreed to at once (the goal goes
 //!   CANCELING) and reported, once, as [`ActionEvent::CancelRequested`] with the goal's id, if it
 //!   is still the active goal then; the node stops and calls [`GoalServer::finish`] with
-//!   [`GoalEnd::Canceled`]. A further cancel of a goal already canceling is agreed to again
-//!   (ERROR_NONE, the goal listed), as rcl_action does, and not reported again. Requests for other
-//!   goals are refused.
+//!   [`GoalEnd::Canceled`]. A further cancel of a goal already canceling is refused
+//!   (ERROR_REJECTED), as rcl_action refuses a goal that cannot move to CANCELING, and not
+//!   reported again. Requests for other goals are refused.
 //! - **Results with a bounded wait**: ros2-client sends a result only once the client has asked
 //!   for it (`get_result`). [`GoalServer::finish`] hands the result to a background task that
 //!   delivers each finished goal's result concurrently with the others, each waiting at most
@@ -281,8 +281,10 @@ where
                         let named = self.active.as_mut().filter(|a| handle.contains_goal(&a.handle.goal_id()));
                         let agreed = match named {
                             Some(a) if a.canceling => {
-                                info!("{}: goal {:?} is already canceling", self.name, a.handle.goal_id());
-                                Some(a.handle.goal_id())
+                                // rcl_action refuses it too: a CANCELING goal cannot move to
+                                // CANCELING again (`rcl_action_goal_handle_is_cancelable`).
+                                info!("{}: goal {:?} is already canceling: repeated cancel refused", self.name, a.handle.goal_id());
+                                None
                             }
                             Some(a) => {
                                 a.canceling = true;

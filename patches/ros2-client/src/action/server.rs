@@ -729,13 +729,10 @@ where
         .lock()
         .unwrap()
         .iter()
-        // only consider goals with status Executing, Accepted or Canceling for
-        // Cancel: a second cancel of a goal already canceling is agreed to again,
-        // as rcl_action does.
+        // only consider goals with status Executing or Accepted for Cancel
         .filter(|(_, async_goal)| {
           async_goal.status == GoalStatusEnum::Executing
             || async_goal.status == GoalStatusEnum::Accepted
-            || async_goal.status == GoalStatusEnum::Canceling
         })
         // and then filter those that were specified by the cancel request
         .filter(goal_filter)
