@@ -14,73 +14,109 @@ use mobil_msgs::geometry_msgs::msg::Twist;
 use mobil_msgs::mobil_msgs::action::{DriveDistance, DriveDistanceFeedback, DriveDistanceResult};
 use mobil_msgs::nav_msgs::msg::Odometry;
 use mobil_ros::action::{ActionEvent, GoalEnd, GoalServer, GoalServerConfig};
+use mobil_ros::config::{Config, ConfigError, Decl};
 use mobil_ros::geometry::yaw_of;
-use mobil_ros::params::ParamValues;
+use mobil_ros::input::{decoded, Input};
+use mobil_ros::latest::Latest;
 use mobil_ros::stop::{final_stop, FINAL_STOP_WAIT};
-use mobil_ros::{qos, run_node, shutdown_signal, warn_throttled, LogThrottle, NodeDecl, ParamSpec, RosNode};
+use mobil_ros::ticker::Ticker;
+use mobil_ros::{qos, run_node, shutdown_signal, warn_throttled, LogThrottle, NodeDecl, RosNode};
 use mobil_tools::drive::{DistanceDrive, DriveSettings, Pose2};
 use ros2_client::{Publisher, Subscription};
 use std::process::ExitCode;
-use std::time::{Duration, Instant};
+use std::time::Duration;
 use tracing::{info, warn};
 
-/// The node's configuration, from its parameters.
-#[derive(Debug, Clone, Copy)]
-struct Config {
-    settings: DriveSettings,
+/// The node's configuration: each parameter declared once, bound to its field.
+#[derive(Debug, Clone, Default, PartialEq)]
+struct DriveConfig {
+    max_speed: f64,
+    min_speed: f64,
+    decel: f64,
+    tolerance: f64,
     rate_hz: f64,
-    odom_timeout: Duration,
-    result_timeout: Duration,
+    odom_timeout_s: f64,
+    result_timeout_s: f64,
 }
 
-fn decl() -> NodeDecl {
-    NodeDecl::new(
-        "drive",
-        "Serves the DriveDistance action: drives straight by a distance, following odom, commanding cmd_vel",
-    )
-    .param(ParamSpec::double("max_speed", 0.5, "highest speed a goal may ask for [m/s]").above(0.0))
-    .param(ParamSpec::double("min_speed", 0.03, "slowest speed before arrival [m/s]").above(0.0))
-    .param(ParamSpec::double("decel", 0.5, "deceleration of the ramp-down before arrival [m/s²]").above(0.0))
-    .param(ParamSpec::double("tolerance", 0.005, "arrived when this close to the distance [m]").above(0.0))
-    .param(ParamSpec::double("rate_hz", 20.0, "cmd_vel and feedback rate while driving [Hz]").within(1.0, 200.0))
-    .param(
-        ParamSpec::double(
+impl Config for DriveConfig {
+    fn declare(d: &mut Decl<Self>) {
+        d.double("max_speed", 0.5, "highest speed a goal may ask for [m/s]", |c, v| {
+            c.max_speed = v
+        })
+        .above(0.0);
+        d.double("min_speed", 0.03, "slowest speed before arrival [m/s]", |c, v| {
+            c.min_speed = v
+        })
+        .above(0.0);
+        d.double(
+            "decel",
+            0.5,
+            "deceleration of the ramp-down before arrival [m/s²]",
+            |c, v| c.decel = v,
+        )
+        .above(0.0);
+        d.double(
+            "tolerance",
+            0.005,
+            "arrived when this close to the distance [m]",
+            |c, v| c.tolerance = v,
+        )
+        .above(0.0);
+        d.double(
+            "rate_hz",
+            20.0,
+            "cmd_vel and feedback rate while driving [Hz]",
+            |c, v| c.rate_hz = v,
+        )
+        .within(1.0, 200.0);
+        d.double(
             "odom_timeout_s",
             0.5,
             "a goal is aborted when no odom arrived for this long (steady clock) [s]",
+            |c, v| c.odom_timeout_s = v,
         )
-        .above(0.0),
-    )
-    .param(
-        ParamSpec::double(
+        .above(0.0);
+        d.double(
             "result_timeout_s",
             10.0,
             "how long a finished goal's result waits for the client to ask for it [s]",
+            |c, v| c.result_timeout_s = v,
         )
-        .above(0.0),
-    )
-    .check(|p| parse_config(p).map(|_| ()))
+        .above(0.0);
+    }
+
+    fn validate(&self) -> Result<(), ConfigError> {
+        if self.min_speed > self.max_speed {
+            return Err(ConfigError::inconsistent(format!(
+                "min_speed {} is above max_speed {}",
+                self.min_speed, self.max_speed
+            )));
+        }
+        Ok(())
+    }
 }
 
-fn parse_config(p: &ParamValues) -> Result<Config, String> {
-    let settings = DriveSettings {
-        max_speed: p.f64("max_speed")?,
-        min_speed: p.f64("min_speed")?,
-        decel: p.f64("decel")?,
-        tolerance: p.f64("tolerance")?,
-    };
-    if settings.min_speed > settings.max_speed {
-        return Err(format!(
-            "min_speed {} is above max_speed {}",
-            settings.min_speed, settings.max_speed
-        ));
+impl DriveConfig {
+    fn settings(&self) -> DriveSettings {
+        DriveSettings {
+            max_speed: self.max_speed,
+            min_speed: self.min_speed,
+            decel: self.decel,
+            tolerance: self.tolerance,
+        }
     }
-    Ok(Config {
-        settings,
-        rate_hz: p.f64("rate_hz")?,
-        odom_timeout: Duration::from_secs_f64(p.f64("odom_timeout_s")?),
-        result_timeout: Duration::from_secs_f64(p.f64("result_timeout_s")?),
-    })
+
+    fn odom_timeout(&self) -> Duration {
+        Duration::from_secs_f64(self.odom_timeout_s)
+    }
+}
+
+fn decl() -> NodeDecl {
+    NodeDecl::for_config::<DriveConfig>(
+        "drive",
+        "Serves the DriveDistance action: drives straight by a distance, following odom, commanding cmd_vel",
+    )
 }
 
 fn main() -> ExitCode {
@@ -101,7 +137,7 @@ fn twist(v: f64) -> Twist {
 }
 
 async fn serve(node: &mut RosNode) -> anyhow::Result<()> {
-    let config = parse_config(&node.params()).map_err(anyhow::Error::msg)?;
+    let config: DriveConfig = node.config()?;
     let cmd = node.publisher::<Twist>("cmd_vel", &qos::default_qos())?;
     // Whatever ends the loop (shutdown or a failure), the last command is a zero one, waited
     // for, so the chassis does not keep the last speed until its own watchdog fires.
@@ -110,13 +146,13 @@ async fn serve(node: &mut RosNode) -> anyhow::Result<()> {
     outcome
 }
 
-async fn drive_loop(node: &mut RosNode, cmd: &Publisher<Twist>, mut config: Config) -> anyhow::Result<()> {
+async fn drive_loop(node: &mut RosNode, cmd: &Publisher<Twist>, mut config: DriveConfig) -> anyhow::Result<()> {
     let odom_sub = node.subscription::<Odometry>("odom", &qos::default_qos())?;
     let mut server = GoalServer::<DriveDistance>::create(
         node,
         "drive_distance",
         GoalServerConfig {
-            result_timeout: config.result_timeout,
+            result_timeout: Duration::from_secs_f64(config.result_timeout_s),
         },
     )?;
     let mut drive: Option<DistanceDrive> = None;
@@ -137,17 +173,17 @@ async fn event_loop(
     odom_sub: &Subscription<Odometry>,
     server: &mut GoalServer<DriveDistance>,
     drive: &mut Option<DistanceDrive>,
-    config: &mut Config,
+    config: &mut DriveConfig,
 ) -> anyhow::Result<()> {
-    let odom = odom_sub.async_stream();
+    let odom = decoded(odom_sub.async_stream(), "odom", "odom-read", "sample ignored");
     let shutdown = shutdown_signal();
     tokio::pin!(odom, shutdown);
-    let mut ticker = tokio::time::interval(Duration::from_secs_f64(1.0 / config.rate_hz));
-    ticker.set_missed_tick_behavior(tokio::time::MissedTickBehavior::Delay);
+    let mut ticker = Ticker::new(config.rate_hz)?;
     let mut throttle = LogThrottle::new(Duration::from_secs(2));
 
-    // The latest valid odometry pose and when it arrived (steady clock).
-    let mut latest: Option<(Pose2, Instant)> = None;
+    // The latest valid odometry pose, with its stamp and steady receive instant: the one
+    // place odom freshness is judged.
+    let mut latest: Latest<Pose2> = Latest::new();
     let stop = |why: &str| {
         if let Err(e) = cmd.publish(Twist::default()) {
             warn!("cannot publish the zero cmd_vel ({why}): {e:?}");
@@ -157,42 +193,34 @@ async fn event_loop(
     loop {
         tokio::select! {
             _ = &mut shutdown => return Ok(()),
-            changed = node.param_changed() => {
-                if let Some(values) = changed {
-                    match parse_config(&values) {
-                        Ok(c) => {
-                            if c.rate_hz != config.rate_hz {
-                                ticker = tokio::time::interval(Duration::from_secs_f64(1.0 / c.rate_hz));
-                                ticker.set_missed_tick_behavior(tokio::time::MissedTickBehavior::Delay);
-                            }
-                            *config = c;
-                        }
-                        Err(e) => warn!("parameters not applied: {e}"),
-                    }
-                }
-            }
+            Some(changed) = node.config_changed::<DriveConfig>() => match changed {
+                Ok(c) => match ticker.set_rate(c.rate_hz) {
+                    Ok(()) => *config = c,
+                    Err(e) => warn!("parameters not applied: {e}"),
+                },
+                Err(e) => warn!("parameters not applied: {e}"),
+            },
             message = odom.next() => match message {
-                Some(Ok((m, _))) => {
+                Some(Input::Message(m)) => {
                     let p = &m.pose.pose;
-                    let pose = Pose2 { x: p.position.x, y: p.position.y, yaw: yaw_of(&p.orientation) };
-                    if pose.x.is_finite() && pose.y.is_finite() && pose.yaw.is_finite() {
-                        latest = Some((pose, Instant::now()));
+                    let pose = Pose2::new(p.position.x, p.position.y, yaw_of(&p.orientation));
+                    if pose.is_finite() {
+                        latest.set(pose, m.header.stamp);
                     } else {
                         warn_throttled!(throttle, "odom-nan", "odom with a non-finite pose dropped");
                     }
                 }
-                Some(Err(e)) => warn_throttled!(throttle, "odom-read", "undecodable odom dropped: {e:?}"),
+                Some(Input::Undecodable) => {}
                 None => anyhow::bail!("the odom subscription ended"),
             },
             event = server.next_event() => match event {
                 ActionEvent::Goal(request) => {
                     let goal = request.goal().clone();
-                    let start = latest.filter(|(_, at)| at.elapsed() <= config.odom_timeout).map(|(p, _)| p);
-                    let Some(start) = start else {
+                    let Some(&start) = latest.get(config.odom_timeout()) else {
                         server.reject(request, "no recent odom: is the chassis running?").await;
                         continue;
                     };
-                    match DistanceDrive::new(start, goal.distance, goal.speed, config.settings) {
+                    match DistanceDrive::new(start, goal.distance, goal.speed, config.settings()) {
                         Err(e) => server.reject(request, &e.to_string()).await,
                         Ok(new) => {
                             let old = drive.take();
@@ -220,10 +248,9 @@ async fn event_loop(
             },
             _ = ticker.tick() => {
                 let Some(d) = drive.as_mut() else { continue };
-                let fresh = latest.filter(|(_, at)| at.elapsed() <= config.odom_timeout);
-                let Some((pose, _)) = fresh else {
+                let Some(&pose) = latest.get(config.odom_timeout()) else {
                     stop("odom stale");
-                    warn!("no odom for {:?}: goal aborted", config.odom_timeout);
+                    warn!("no odom for {:?}: goal aborted", config.odom_timeout());
                     let travelled = d.progress().travelled;
                     *drive = None;
                     server.finish(GoalEnd::Aborted, result(travelled, "odometry stale"));
