@@ -83,9 +83,14 @@ class Session:
 
 
 def settle_graph(node: Any, snapshot, spin_time: float, min_time: float = 1.0,
-                 stable_time: float = 0.5) -> Any:
+                 stable_time: float = 1.2) -> Any:
     """Discovery has no end signal: return ``snapshot()`` once it is unchanged for
-    ``stable_time`` after at least ``min_time`` (or at ``spin_time`` at the latest)."""
+    ``stable_time`` after at least ``min_time`` (or at ``spin_time`` at the latest).
+
+    ``stable_time`` exceeds Fast DDS's 1 s heartbeat period of its discovery (SEDP) writers: a
+    discovery sample lost on the way is repaired after the next heartbeat, so a graph that stood
+    still for only 0.5 s could still lack an endpoint (seen: a topic list without the other
+    process's topics while a node list of the same moment had its node)."""
     start = time.monotonic()
     last = snapshot()
     last_change = start
