@@ -486,12 +486,25 @@ class Spinner:
         return self
 
     def _run(self) -> None:
+        from rclpy.exceptions import InvalidHandle
         from rclpy.executors import ExternalShutdownException, ShutdownException
+        invalid_in_a_row = 0
         while not self._stop.is_set():
             try:
                 self.executor.spin_once(timeout_sec=0.05)
+                invalid_in_a_row = 0
             except (ExternalShutdownException, ShutdownException):
                 break
+            except InvalidHandle as exc:
+                # A subscription (or its QoS event handler) destroyed by the test's thread while
+                # this one was building the wait set: rclpy's executor guards callbacks against
+                # that, not event handlers (Jazzy, event_handler.add_to_wait_set). Not a callback
+                # failure; the next spin_once no longer sees the entity. One that stays is.
+                invalid_in_a_row += 1
+                if invalid_in_a_row == 20:
+                    self.errors.append(exc)
+                    traceback.print_exc()
+                time.sleep(0.001)
             except Exception as exc:  # a callback failed: record, keep spinning
                 if not self.executor.context.ok():
                     break
@@ -663,7 +676,8 @@ def call_service(node: Any, srv_type: type, service: str, request: Any, *, timeo
     deadline = time.monotonic() + timeout
     client = _cached_client(node, srv_type, service)  # kept: later calls need no matching
     if not wait_until(client.service_is_ready, timeout, 0.02):
-        raise ServiceUnavailable(f"service {service} not available within {timeout:g} s")
+        raise ServiceUnavailable(f"service {service} not available within {timeout:g} s "
+                                 f"({_service_graph_info(node, service)})")
     attempt_wait = attempt_timeout
     attempts = 0
     while True:
@@ -681,6 +695,20 @@ def call_service(node: Any, srv_type: type, service: str, request: Any, *, timeo
             raise TimeoutError(f"service {service}: no response within {timeout:g} s "
                                f"({attempts} attempts)")
         attempt_wait = min(attempt_wait * 2, 2.0)
+
+
+def _service_graph_info(node: Any, service: str) -> str:
+    """What this participant's graph knows of a service's two DDS topics, and the nodes."""
+    def endpoints(infos: Any) -> str:
+        return ", ".join(f"{i.node_namespace.rstrip('/')}/{i.node_name}" for i in infos) or "none"
+    try:
+        request_readers = node.get_subscriptions_info_by_topic(f"rq{service}Request", no_mangle=True)
+        reply_writers = node.get_publishers_info_by_topic(f"rr{service}Reply", no_mangle=True)
+        nodes = ", ".join(node_names(node)) or "none"
+    except Exception as exc:  # pragma: no cover
+        return f"graph unavailable: {exc}"
+    return (f"request readers: {endpoints(request_readers)}; reply writers: {endpoints(reply_writers)}; "
+            f"nodes in the graph: {nodes}")
 
 
 _client_cache_lock = threading.Lock()

@@ -125,7 +125,9 @@ def test_cmd_vel_moves_odom_as_the_kinematics_predict(robot, start_node, ros_nod
     # agree to about 1e-5; 0.1 % catches a 1 % error in the model (or MOBIL-II's rear-axle
     # radius, 2 % short).
     dt = seconds(end_odom) - seconds(start_odom)
-    assert dt > 2.5
+    # 3 s of commands; the ends move inward when rclpy, on a loaded machine, delivers odom late
+    # or loses a truth sample (seen: 2.5 s with two builds running beside the test).
+    assert dt > 2.0
     dyaw = math.remainder(yaw(end_odom) - yaw(start_odom), math.tau)
     assert dyaw == pytest.approx(wz * dt, rel=0.001)
     (ox0, oy0), (ox1, oy1) = xy(start_odom), xy(end_odom)
