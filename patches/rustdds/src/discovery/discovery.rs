@@ -264,6 +264,9 @@ pub(crate) struct Discovery {
   // latest newly discovered participant, postponed at most `ENDPOINT_REANNOUNCE_MAX_POSTPONE`
   // after the first request).
   endpoint_reannounce: Option<(std::time::Instant, std::time::Instant)>,
+  // Re-announcements still to make for the latest burst of new participants: the first when
+  // `endpoint_reannounce` falls due, then one more `ENDPOINT_REANNOUNCE_AGAIN_AFTER` later.
+  endpoint_reannounce_rounds_left: u8,
 
   // If security is enabled, this field contains a SecureDiscovery struct, an appendix
   // which is used for Secure functionality
@@ -315,6 +318,10 @@ impl Discovery {
   const ENDPOINT_REANNOUNCE_DELAY: StdDuration = StdDuration::from_millis(1000);
   // How long new participants may keep postponing a pending re-announcement.
   const ENDPOINT_REANNOUNCE_MAX_POSTPONE: StdDuration = StdDuration::from_secs(3);
+  // The second re-announcement, for a peer still completing discovery at the first one (a
+  // heavily loaded machine).
+  const ENDPOINT_REANNOUNCE_AGAIN_AFTER: StdDuration = StdDuration::from_secs(3);
+  const ENDPOINT_REANNOUNCE_ROUNDS: u8 = 2;
   const CHECK_PARTICIPANT_MESSAGES: StdDuration = StdDuration::from_secs(1);
   #[cfg(feature = "security")]
   const CACHED_SECURE_DISCOVERY_MESSAGE_RESEND_PERIOD: StdDuration = StdDuration::from_secs(1);
@@ -691,6 +698,7 @@ impl Discovery {
 
       discovery_timer,
       endpoint_reannounce: None,
+      endpoint_reannounce_rounds_left: 0,
 
       security_opt,
       #[cfg(feature = "security")]
@@ -903,6 +911,16 @@ impl Discovery {
                     if now + StdDuration::from_millis(5) >= due {
                       self.endpoint_reannounce = None;
                       self.reannounce_local_endpoints();
+                      self.endpoint_reannounce_rounds_left =
+                        self.endpoint_reannounce_rounds_left.saturating_sub(1);
+                      if self.endpoint_reannounce_rounds_left > 0 {
+                        let again = now + Self::ENDPOINT_REANNOUNCE_AGAIN_AFTER;
+                        self.endpoint_reannounce = Some((again, again));
+                        self.discovery_timer.borrow_mut().set_timeout(
+                          Self::ENDPOINT_REANNOUNCE_AGAIN_AFTER,
+                          DiscoveryTimerEvent::ReannounceLocalEndpoints,
+                        );
+                      }
                     }
                   }
                 }
@@ -1126,6 +1144,7 @@ impl Discovery {
           Some(pending) => Some(pending),
           None => Some((now, due)),
         };
+        self.endpoint_reannounce_rounds_left = Self::ENDPOINT_REANNOUNCE_ROUNDS;
         self.discovery_timer.borrow_mut().set_timeout(
           Self::ENDPOINT_REANNOUNCE_DELAY,
           DiscoveryTimerEvent::ReannounceLocalEndpoints,
