@@ -8,6 +8,7 @@ import signal
 import subprocess
 import time
 from pathlib import Path
+from typing import Optional
 
 import pytest
 
@@ -17,8 +18,11 @@ from harness import ROOT
 from rcl_interfaces.srv import DescribeParameters
 
 
-def _pids_of(name: str) -> set[int]:
-    out = subprocess.run(["pgrep", "-x", name], capture_output=True, text=True)
+def _pids_of(name: str, session: Optional[int] = None) -> set[int]:
+    """PIDs of processes called ``name`` (in the session ``session`` only, if given: other
+    programs on the machine may run the same executables)."""
+    cmd = ["pgrep", "-x", name] + (["-s", str(session)] if session is not None else [])
+    out = subprocess.run(cmd, capture_output=True, text=True)
     return {int(p) for p in out.stdout.split()}
 
 
@@ -31,7 +35,6 @@ def _script_env() -> dict[str, str]:
 
 @pytest.mark.parametrize("robot,model,how", [("omr3", "omni", "ctrl-c"), ("tricycle", "tricycle", "sigterm")])
 def test_robot_script_starts_its_nodes_and_stopping_it_stops_them_all(robot, model, how, tmp_path):
-    before = _pids_of("sim_node") | _pids_of("chassis_node")
     log = open(tmp_path / "launch.log", "wb")
     script = subprocess.Popen([str(ROOT / "launch_scripts" / robot), "-r", "__ns:=/launch_test"],
                               env=_script_env(), stdout=log, stderr=subprocess.STDOUT, start_new_session=True)
@@ -45,10 +48,13 @@ def test_robot_script_starts_its_nodes_and_stopping_it_stops_them_all(robot, mod
         assert echo.returncode == 0, echo.stdout + echo.stderr
         assert "frame_id: odom" in echo.stdout, echo.stdout
         for node_name in ("chassis", "sim"):
-            result = harness.run_ros2cli("param", "get", f"/launch_test/{node_name}", "model", timeout=40)
+            # (--timeout: ros2cli's 5 s default is short for a machine running builds beside.)
+            result = harness.run_ros2cli("param", "get", f"/launch_test/{node_name}", "model",
+                                         "--timeout", "20", timeout=40)
             assert result.returncode == 0, result.stdout + result.stderr
             assert result.stdout.strip().splitlines()[-1] == f"String value is: {model}", result.stdout
-        started = (_pids_of("sim_node") | _pids_of("chassis_node")) - before
+        # The script runs in a session of its own (start_new_session), and so do its nodes.
+        started = _pids_of("sim_node", script.pid) | _pids_of("chassis_node", script.pid)
         assert len(started) == 2, started
         if how == "ctrl-c":
             # Ctrl-C in a terminal signals the whole foreground process group.
