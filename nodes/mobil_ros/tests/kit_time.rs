@@ -16,26 +16,11 @@ use mobil_ros::latest::{Freshness, Latest};
 use mobil_ros::stop::{final_stop, FinalStop};
 use mobil_ros::time::{stamp_from_nanos, DtClock};
 use mobil_ros::{NodeDecl, RosNode, Ticker};
-use ros2_client::{Context, ContextOptions, Name, NodeName, NodeOptions};
+use ros2_client::Name;
 use std::time::{Duration, Instant};
 
-fn domain_id() -> u16 {
-    std::env::var("MOBIL_TEST_DOMAIN_ID")
-        .ok()
-        .and_then(|v| v.parse().ok())
-        .unwrap_or(100 + (std::process::id() % 100) as u16)
-}
-
-fn participant(name: &str) -> (Context, ros2_client::Node) {
-    let context = Context::with_options(ContextOptions::new().domain_id(domain_id())).expect("DDS context");
-    let node = context
-        .new_node(
-            NodeName::new("/", name).expect("node name"),
-            NodeOptions::new().enable_rosout(false),
-        )
-        .expect("node");
-    (context, node)
-}
+mod common;
+use common::{domain_id, participant};
 
 /// A RosNode on the test's domain with these ROS arguments.
 fn ros_node(name: &str, ros_args: &[&str]) -> RosNode {

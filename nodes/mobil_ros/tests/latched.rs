@@ -14,7 +14,9 @@ use std::time::{Duration, Instant};
 
 use mobil_msgs::std_msgs::msg::String as StringMsg;
 use mobil_msgs::RosMessage;
-use ros2_client::{Context, ContextOptions, Name, Node, NodeName, NodeOptions, Publisher, QosProfile, Subscription};
+mod common;
+
+use ros2_client::{Context, Name, Node, Publisher, QosProfile, Subscription};
 
 /// Samples published before the late joiner subscribes.
 const HISTORY: u32 = 200;
@@ -25,22 +27,8 @@ struct Participant {
     node: Node,
 }
 
-fn domain_id() -> u16 {
-    // 100..=199 like the rclpy tests, but per process, and topics carry the pid as well.
-    std::env::var("MOBIL_TEST_DOMAIN_ID")
-        .ok()
-        .and_then(|v| v.parse().ok())
-        .unwrap_or(100 + (std::process::id() % 100) as u16)
-}
-
 fn participant(name: &str) -> Participant {
-    let context = Context::with_options(ContextOptions::new().domain_id(domain_id())).expect("DDS context");
-    let node = context
-        .new_node(
-            NodeName::new("/", name).expect("node name"),
-            NodeOptions::new().enable_rosout(false),
-        )
-        .expect("node");
+    let (context, node) = common::participant(name);
     Participant {
         _context: context,
         node,

@@ -14,27 +14,12 @@ use mobil_msgs::RosMessage;
 use mobil_ros::geometry::yaw_quaternion;
 use mobil_ros::qos;
 use mobil_ros::scan::{LaserPose, LaserPoseSource};
-use ros2_client::{Context, ContextOptions, Name, Node, NodeName, NodeOptions};
+use ros2_client::Name;
 
 const TIMEOUT: Duration = Duration::from_secs(15);
 
-fn domain_id() -> u16 {
-    std::env::var("MOBIL_TEST_DOMAIN_ID")
-        .ok()
-        .and_then(|v| v.parse().ok())
-        .unwrap_or(100 + (std::process::id() % 100) as u16)
-}
-
-fn node(name: &str) -> (Context, Node) {
-    let context = Context::with_options(ContextOptions::new().domain_id(domain_id())).expect("DDS context");
-    let node = context
-        .new_node(
-            NodeName::new("/", name).expect("node name"),
-            NodeOptions::new().enable_rosout(false),
-        )
-        .expect("node");
-    (context, node)
-}
+mod common;
+use common::participant as node;
 
 fn tf(parent: &str, child: &str, x: f64, y: f64, yaw_deg: f64) -> TransformStamped {
     let mut t = TransformStamped::default();
