@@ -58,7 +58,7 @@ pub struct LocalNavConfig {
     pub scan_timeout_s: f64,
     /// A goal fails STALE_INPUT when no odometry arrived for this long (steady clock) [s].
     pub odom_timeout_s: f64,
-    /// Status, markers and action feedback rate while a goal is active [Hz].
+    /// Status and markers rate while a goal is active [Hz].
     pub status_rate_hz: f64,
     /// How long a finished action goal's result waits for the client to ask for it [s].
     pub result_timeout_s: f64,
@@ -237,7 +237,7 @@ impl Config for LocalNavConfig {
         d.double(
             "status_rate_hz",
             2.0,
-            "local_nav/status, markers and action feedback rate while a goal is active [Hz]",
+            "local_nav/status and markers rate while a goal is active (action feedback: 20 Hz) [Hz]",
             |c, v| c.status_rate_hz = v,
         )
         .within(0.1, 50.0);

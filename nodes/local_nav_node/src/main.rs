@@ -6,8 +6,9 @@
 //! **One step per scan**: each valid scan, with fresh odometry, is one navigator step and one
 //! `cmd_vel`. The method works on the scan, so a step between scans would repeat the last one,
 //! and stepping on arrival adds no queueing delay to the scan-to-command latency. A 20 Hz
-//! watchdog tick on the steady clock ends a goal whose scan or odometry went stale, and
-//! publishes status, markers and action feedback at `status_rate_hz`.
+//! watchdog tick on the steady clock ends a goal whose scan or odometry went stale and sends the
+//! action feedback; status and markers follow at `status_rate_hz` (and the status on every
+//! change of state or mode).
 //!
 //! `cmd_vel` goes out only while a goal is active, and exactly one zero `cmd_vel` when a goal
 //! ends (reached, no path, no progress, stale input, canceled, pre-empted, refused, shutdown);
@@ -21,7 +22,7 @@ use mobil_local_nav_node::{
     goal_in_odom, markers, stale_input, status_message, twist_from_command, GoalOutcome, LocalNavConfig, MarkerView,
     StatusView,
 };
-use mobil_msgs::builtin_interfaces::msg::Duration as RosDuration;
+use mobil_msgs::builtin_interfaces::msg::{Duration as RosDuration, Time};
 use mobil_msgs::geometry_msgs::msg::{Pose, PoseStamped, Twist};
 use mobil_msgs::mobil_msgs::msg::NavStatus;
 use mobil_msgs::nav2_msgs::action::{NavigateToPose, NavigateToPoseFeedback, NavigateToPoseGoal, NavigateToPoseResult};
@@ -549,6 +550,16 @@ impl Shell {
                 return;
             }
         };
+        if self.scan_seen.value().is_none() {
+            info!(
+                "first scan: {} beams, laser at ({:.3}, {:.3}, {:.3} rad) in {}",
+                scan.len(),
+                base_from_laser.x,
+                base_from_laser.y,
+                base_from_laser.yaw,
+                self.config.base_frame
+            );
+        }
         self.scan_seen.set((), m.header.stamp.clone());
         if self.active.is_none() {
             return;
@@ -604,14 +615,18 @@ impl Shell {
             return self.end_goal(node, out, server, GoalOutcome::Stale(which));
         }
         let period = Duration::from_secs_f64(1.0 / self.config.status_rate_hz);
+        let stamp = node.stamp();
         if self
             .last_status
-            .is_some_and(|t| now.saturating_duration_since(t) < period)
+            .is_none_or(|t| now.saturating_duration_since(t) >= period)
         {
-            return;
+            self.publish_status(node, out, NavStatus::ACTIVE, String::new());
+            self.publish_markers(out, &active, stamp.clone());
         }
-        self.publish_status(node, out, NavStatus::ACTIVE, String::new());
-        let stamp = node.stamp();
+        self.feedback(node, server, &active, stamp).await;
+    }
+
+    fn publish_markers(&mut self, out: &Outputs, active: &ActiveGoal, stamp: Time) {
         if let Some(step) = &self.last_step {
             let view = MarkerView {
                 sectors: self.nav.sectors(),
@@ -620,11 +635,21 @@ impl Shell {
                 hit_point: step.hit_point,
                 leave_point: step.leave_point,
             };
-            let array = markers(&view, stamp.clone(), &self.config.odom_frame, &self.config.base_frame);
+            let array = markers(&view, stamp, &self.config.odom_frame, &self.config.base_frame);
             if let Err(e) = out.markers.publish(array) {
                 warn_throttled!(self.throttle, "markers", "cannot publish local_nav/markers: {e:?}");
             }
         }
+    }
+
+    /// Action feedback, on every watchdog tick (20 Hz) while an action goal is active.
+    async fn feedback(
+        &mut self,
+        node: &RosNode,
+        server: &mut GoalServer<NavigateToPose>,
+        active: &ActiveGoal,
+        stamp: Time,
+    ) {
         if active.source == Source::Action {
             let Some(odom) = self.odom.value() else { return };
             let distance = (active.goal - odom.pose.position()).norm();
