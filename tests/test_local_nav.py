@@ -96,8 +96,8 @@ def test_goal_pose_in_open_space(start_scenario, start_node, sim_clock, ros_node
     goal tolerance at rest, no cmd_vel before the goal, one zero cmd_vel after."""
     world = tmp_path / "empty.yaml"
     world.write_text("obstacles: []\n")
-    start_scenario(PARAMS, real_time_factor=REAL_TIME_FACTOR, lidar=True,
-                   sim_args=("-p", f"world_file:={world}"), node_args=CHASSIS_ARGS)
+    sim = start_scenario(PARAMS, real_time_factor=REAL_TIME_FACTOR, lidar=True,
+                         sim_args=("-p", f"world_file:={world}"), node_args=CHASSIS_ARGS)[0]
     start_local_nav(start_node)
     goal = (2.0, 1.5)
     pub = ros_node.create_publisher(PoseStamped, "goal_pose", 10)
@@ -126,6 +126,8 @@ def test_goal_pose_in_open_space(start_scenario, start_node, sim_clock, ros_node
         factor = sim_clock.factor(since=mark)
         rest = truth.wait_for(lambda m: speed(m) < 1e-3, REPLY_TIMEOUT, start=len(truth))
         statuses, cmds = status.snapshot(), cmd.snapshot()
+        # sim_node first, so that no ground truth or clock is in flight when the readers close.
+        sim.stop()
 
     assert factor >= MIN_FACTOR, f"{factor:.2f}× real time"
     x, y = position(rest)
@@ -164,14 +166,43 @@ class OpenSpaceScan:
         self.msg.range_min, self.msg.range_max = 0.06, 10.0
         self.msg.ranges = [math.inf] * 541
         self.last_sent = math.nan
+        self.defects: list = []
+        self.defects_sent = 0
+        self._broken = threading.Event()
         self._stop = threading.Event()
         self._thread = threading.Thread(target=self._run, daemon=True)
         self._thread.start()
 
     def _run(self) -> None:
+        n = 0
         while not self._stop.wait(0.05):
+            if self._broken.is_set():
+                self.pub.publish(self.defects[n % len(self.defects)])
+                n += 1
+                self.defects_sent = n
+                continue
             self.pub.publish(self.msg)
             self.last_sent = time.monotonic()
+
+    def break_scans(self) -> float:
+        """From now on, only defective scans, each a defect the checked Scan refuses (no beams;
+        a negative, a NaN increment; NaN angles; more beams than the angles span; range_min
+        above range_max; three intensities for 541 ranges); returns the monotonic time of the
+        last valid scan."""
+        def bad(**fields) -> LaserScan:
+            m = LaserScan()
+            for name in ("header", "angle_min", "angle_max", "angle_increment", "range_min",
+                         "range_max", "ranges"):
+                setattr(m, name, getattr(self.msg, name))
+            for name, value in fields.items():
+                setattr(m, name, value)
+            return m
+        self.defects = [bad(ranges=[]), bad(angle_increment=-0.01), bad(angle_increment=math.nan),
+                        bad(angle_min=math.nan), bad(ranges=[1.0] * 900),
+                        bad(range_min=20.0), bad(intensities=[1.0, 2.0, 3.0])]
+        self._broken.set()
+        assert wait_until(lambda: self.defects_sent > 0, 5.0), "no defective scan sent"
+        return self.last_sent
 
     def stop(self) -> float:
         """Stops; returns the monotonic time of the last scan sent."""
@@ -261,8 +292,8 @@ def test_foreign_lidar_with_navigate_to_pose_and_cancel(start_scenario, start_no
     world.write_text("obstacles:\n"
                      f"  - circle: {{ center: [{PILLAR[0]}, {PILLAR[1]}], radius: {PILLAR[2]} }}\n"
                      "  - polygon: { points: [[-2, -3], [6, -3], [6, -2.9], [-2, -2.9]] }\n")
-    start_scenario(PARAMS, real_time_factor=REAL_TIME_FACTOR,
-                   sim_args=("-p", f"world_file:={world}"), node_args=CHASSIS_ARGS)
+    sim = start_scenario(PARAMS, real_time_factor=REAL_TIME_FACTOR,
+                         sim_args=("-p", f"world_file:={world}"), node_args=CHASSIS_ARGS)[0]
     nav = start_local_nav(start_node)
     lidar = start_foreign_lidar(start_node, tmp_path, world)
     feedback = []
@@ -314,6 +345,8 @@ def test_foreign_lidar_with_navigate_to_pose_and_cancel(start_scenario, start_no
         sim_clock.wait_until(sim_clock.now() + 0.5)
         assert "first scan published" in lidar.log_text()
         statuses, cmds = status.snapshot(), cmd.snapshot()
+        # sim_node first, so that no ground truth or clock is in flight when the readers close.
+        sim.stop()
 
     assert factor >= MIN_FACTOR, f"{factor:.2f}× real time"
     # Feedback: in odom, the distance remaining falling toward the goal.
@@ -338,14 +371,15 @@ def test_foreign_lidar_with_navigate_to_pose_and_cancel(start_scenario, start_no
 
 def test_refusals_preemption_and_stale_scan(start_scenario, start_node, sim_clock, ros_node, tmp_path):
     """An empty scan from this test (open space). goal_pose in `map` and with NaN: status
-    FAILED INVALID_GOAL, nothing moves. An action
-    goal pre-empted by a goal_pose goal ends ABORTED with the reason PREEMPTED. The scan stops:
-    within the scan timeout (0.5 s, steady clock) plus a tick the goal fails STALE_INPUT naming
-    the scan, the last cmd_vel is zero and the robot comes to rest."""
+    FAILED INVALID_GOAL, nothing moves. An action goal pre-empted by a goal_pose goal ends
+    ABORTED with the reason PREEMPTED. Then only defective scans (each a defect the checked Scan
+    refuses), then none: within the scan timeout (0.5 s, steady clock) plus a tick of the last
+    valid scan the goal fails STALE_INPUT naming the scan, the last cmd_vel is zero, the robot
+    comes to rest, and local_nav_node exits cleanly at the end (checked at teardown)."""
     world = tmp_path / "empty.yaml"
     world.write_text("obstacles: []\n")
-    start_scenario(PARAMS, real_time_factor=REAL_TIME_FACTOR,
-                   sim_args=("-p", f"world_file:={world}"), node_args=CHASSIS_ARGS)
+    sim = start_scenario(PARAMS, real_time_factor=REAL_TIME_FACTOR,
+                         sim_args=("-p", f"world_file:={world}"), node_args=CHASSIS_ARGS)[0]
     nav = start_local_nav(start_node)
     lidar = OpenSpaceScan(ros_node)
     pub = ros_node.create_publisher(PoseStamped, "goal_pose", 10)
@@ -388,15 +422,21 @@ def test_refusals_preemption_and_stale_scan(start_scenario, start_node, sim_cloc
         assert res.result.error_msg == "PREEMPTED: preempted by a newer goal (goal_pose)"
         assert res.result.error_code == 0
 
-        stopped = lidar.stop()
+        stopped = lidar.break_scans()
         stale = status.wait_for(lambda s: s.state == NavStatus.FAILED and s.reason.startswith("STALE"),
                                 REPLY_TIMEOUT)
+        # Every defect again after the goal ended: refused without a panic (the node's exit code
+        # at teardown is checked), then no scan at all.
+        assert wait_until(lambda: lidar.defects_sent >= 2 * len(lidar.defects), REPLY_TIMEOUT)
+        lidar.stop()
         after = status.times[statuses_index(status, stale)] - stopped
         rest = truth.wait_for(lambda m: speed(m) < 1e-3, REPLY_TIMEOUT, start=len(truth))
         # The zero command, then a simulated second for a stray command to show.
         wait_until(lambda: cmd.latest is not None and is_zero(cmd.latest), REPLY_TIMEOUT)
         sim_clock.wait_until(sim_clock.now() + 1.0)
         statuses, cmds = status.snapshot(), cmd.snapshot()
+        # sim_node first, so that no ground truth or clock is in flight when the readers close.
+        sim.stop()
 
     assert stale.reason == "STALE_INPUT: scan stale: robot stopped"
     # 0.5 s of scan timeout from the last scan, a 50 ms tick, and DDS and scheduling on a loaded

@@ -66,7 +66,7 @@ pub struct LocalNavConfig {
     pub odom_frame: String,
     /// The robot frame [base_link].
     pub base_frame: String,
-    /// The laser frame looked up in `tf_static` when a scan names none.
+    /// The scan's frame, looked up in `tf_static`.
     pub laser_frame: String,
     /// Laser pose (x, y, yaw) in the base frame, used until (unless) `tf_static` gives one.
     pub laser_pose: [f64; 3],
@@ -253,22 +253,26 @@ impl Config for LocalNavConfig {
             "odom",
             "frame of odom; goals in any other frame are refused",
             |c, v| c.odom_frame = v,
-        );
+        )
+        .read_only();
         d.string("base_frame", "base_link", "robot frame (reference point)", |c, v| {
             c.base_frame = v
-        });
+        })
+        .read_only();
         d.string(
             "laser_frame",
             "laser",
-            "laser frame looked up in tf_static when a scan's header names none",
+            "the scan's frame: its pose in base_frame comes from tf_static",
             |c, v| c.laser_frame = v,
-        );
+        )
+        .read_only();
         d.doubles(
             "laser_pose",
             [0.0, 0.0, 0.0],
             "x, y, yaw of the laser in the base frame, used until (unless) tf_static gives it",
             |c, v| c.laser_pose = v,
-        );
+        )
+        .read_only();
     }
 
     fn validate(&self) -> Result<(), ConfigError> {

@@ -543,6 +543,16 @@ impl Shell {
             );
             return;
         };
+        let frame = m.header.frame_id.trim_start_matches('/');
+        if !frame.is_empty() && frame != self.config.laser_frame.trim_start_matches('/') {
+            warn_throttled!(
+                self.throttle,
+                "scan-frame",
+                "scan in frame `{frame}` but laser_frame is `{}`: the pose of `{}` is used",
+                self.config.laser_frame,
+                self.config.laser_frame
+            );
+        }
         let scan = match scan_from_msg(m, base_from_laser) {
             Ok(s) => s,
             Err(e) => {
