@@ -54,17 +54,17 @@ pub struct LocalNavConfig {
     pub weights: Vec<f64>,
     /// Nav2's progress checker.
     pub progress: ProgressSettings,
-    /// A goal fails STALE_INPUT when no scan arrived for this long (steady clock) [s].
+    /// A goal fails STALE_INPUT when no scan arrived for this long (steady clock), in seconds.
     pub scan_timeout_s: f64,
-    /// A goal fails STALE_INPUT when no odometry arrived for this long (steady clock) [s].
+    /// A goal fails STALE_INPUT when no odometry arrived for this long (steady clock), in seconds.
     pub odom_timeout_s: f64,
-    /// Status and markers rate while a goal is active [Hz].
+    /// Status and markers rate while a goal is active, in Hz.
     pub status_rate_hz: f64,
-    /// How long a finished action goal's result waits for the client to ask for it [s].
+    /// How long a finished action goal's result waits for the client to ask for it, in seconds.
     pub result_timeout_s: f64,
-    /// Frame goals must be in, and the frame of `odom` [odom].
+    /// Frame goals must be in, and the frame of `odom` (default `odom`).
     pub odom_frame: String,
-    /// The robot frame [base_link].
+    /// The robot frame (default `base_link`).
     pub base_frame: String,
     /// The scan's frame, looked up in `tf_static`.
     pub laser_frame: String,
