@@ -249,10 +249,11 @@ def cancel_until_answered(handle, attempts: int = 4):
     """Cancels until a cancel response arrives, each attempt 3 s: rclpy's ActionClient drops a
     response that comes back before it has filed the request ("Ignoring unexpected cancel
     response"), which a fast server on a loaded machine makes happen now and then."""
+    futures = []
     for _ in range(attempts):
-        future = handle.cancel_goal_async()
-        if wait_until(future.done, 3.0):
-            return future.result()
+        futures.append(handle.cancel_goal_async())
+        if wait_until(lambda: any(f.done() for f in futures), 3.0):
+            return next(f for f in futures if f.done()).result()
     raise AssertionError(f"no cancel response to {attempts} requests")
 
 
@@ -260,10 +261,12 @@ def result_of(handle, timeout: float = 30.0):
     """The goal's result; the request is repeated every 5 s while none came, for the same
     rclpy race as ``cancel_until_answered`` ("Ignoring unexpected result response")."""
     deadline = time.monotonic() + timeout
+    futures = []  # every request stays watched: the server may answer any of them
     while time.monotonic() < deadline:
-        future = handle.get_result_async()
-        if wait_until(future.done, min(5.0, max(0.1, deadline - time.monotonic()))):
-            return future.result()
+        futures.append(handle.get_result_async())
+        if wait_until(lambda: any(f.done() for f in futures),
+                      min(5.0, max(0.1, deadline - time.monotonic()))):
+            return next(f for f in futures if f.done()).result()
     raise AssertionError(f"no result within {timeout} s")
 
 
