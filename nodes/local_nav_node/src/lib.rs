@@ -15,7 +15,7 @@ use mobil_local_nav::{
     Drive, Mode, MotionLimits, NavConfig, NoPathReason, ProgressSettings, Sectors, Side, UnseenSectors,
     VelocityCommand, WeightProfile,
 };
-use mobil_msgs::builtin_interfaces::msg::Time;
+use mobil_msgs::builtin_interfaces::msg::{Duration as RosDuration, Time};
 use mobil_msgs::geometry_msgs::msg::{Point, Pose, PoseStamped, Twist, Vector3};
 use mobil_msgs::mobil_msgs::msg::NavStatus;
 use mobil_msgs::std_msgs::msg::{ColorRGBA, Header};
@@ -373,6 +373,21 @@ pub fn twist_from_command(command: VelocityCommand, limits: &MotionLimits) -> Tw
     t.linear.y = c.vy;
     t.angular.z = c.omega;
     t
+}
+
+/// A duration message of `seconds` (navigation time, time remaining): negative (the clock went
+/// backwards), NaN or infinite give zero, and it saturates at 10⁹ s.
+pub fn duration_msg(seconds: f64) -> RosDuration {
+    let s = if seconds.is_finite() {
+        seconds.clamp(0.0, 1e9)
+    } else {
+        0.0
+    };
+    let sec = s.floor();
+    RosDuration {
+        sec: sec as i32,
+        nanosec: ((s - sec) * 1e9).min(999_999_999.0) as u32,
+    }
 }
 
 /// Which input went stale.
@@ -788,6 +803,17 @@ mod tests {
         assert_eq!(stale_input(None, None, ms(600), st, ot), Some(StaleInput::ScanAndOdom));
         // A scan 10 s old when the goal came 400 ms ago: within the grace still.
         assert_eq!(stale_input(Some(ms(10_000)), Some(ms(10)), ms(400), st, ot), None);
+    }
+
+    #[test]
+    fn durations_never_go_negative() {
+        let d = duration_msg(12.25);
+        assert_eq!((d.sec, d.nanosec), (12, 250_000_000));
+        for bad in [-3.0, f64::NAN, f64::INFINITY] {
+            let d = duration_msg(bad);
+            assert_eq!((d.sec, d.nanosec), (0, 0), "{bad}");
+        }
+        assert_eq!(duration_msg(5e9).sec, 1_000_000_000);
     }
 
     #[test]

@@ -19,10 +19,10 @@ use futures::StreamExt;
 use mobil_geom::Pose2;
 use mobil_local_nav::{Mode, MotionLimits, Navigator, Progress, ProgressChecker, StepOutput};
 use mobil_local_nav_node::{
-    goal_in_odom, markers, stale_input, status_message, twist_from_command, GoalOutcome, LocalNavConfig, MarkerView,
-    StatusView,
+    duration_msg, goal_in_odom, markers, stale_input, status_message, twist_from_command, GoalOutcome, LocalNavConfig,
+    MarkerView, StatusView,
 };
-use mobil_msgs::builtin_interfaces::msg::{Duration as RosDuration, Time};
+use mobil_msgs::builtin_interfaces::msg::Time;
 use mobil_msgs::geometry_msgs::msg::{Pose, PoseStamped, Twist};
 use mobil_msgs::mobil_msgs::msg::NavStatus;
 use mobil_msgs::nav2_msgs::action::{NavigateToPose, NavigateToPoseFeedback, NavigateToPoseGoal, NavigateToPoseResult};
@@ -150,19 +150,6 @@ fn goal_end(outcome: &GoalOutcome) -> GoalEnd {
         GoalOutcome::Succeeded => GoalEnd::Succeeded,
         GoalOutcome::Canceled => GoalEnd::Canceled,
         _ => GoalEnd::Aborted,
-    }
-}
-
-fn duration(seconds: f64) -> RosDuration {
-    let s = if seconds.is_finite() {
-        seconds.clamp(0.0, 1e9)
-    } else {
-        0.0
-    };
-    let sec = s.floor();
-    RosDuration {
-        sec: sec as i32,
-        nanosec: ((s - sec) * 1e9).min(999_999_999.0) as u32,
     }
 }
 
@@ -673,8 +660,8 @@ impl Shell {
                     },
                     pose: odom.msg_pose.clone(),
                 },
-                navigation_time: duration(elapsed),
-                estimated_time_remaining: duration(remaining),
+                navigation_time: duration_msg(elapsed),
+                estimated_time_remaining: duration_msg(remaining),
                 number_of_recoveries: 0,
                 distance_remaining: distance as f32,
             };
