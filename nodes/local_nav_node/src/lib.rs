@@ -681,6 +681,18 @@ pub fn markers(view: &MarkerView<'_>, stamp: Time, odom_frame: &str, base_frame:
     MarkerArray { markers: out }
 }
 
+/// The marker array that removes every local_nav marker (sent when a goal ends, so RViz does not
+/// keep showing the sectors and points of a goal that is over).
+pub fn clear_markers(stamp: Time, frame: &str) -> MarkerArray {
+    let header = Header {
+        stamp,
+        frame_id: frame.to_owned(),
+    };
+    let mut m = marker(&header, 0, Marker::SPHERE, 0.0, color(0.0, 0.0, 0.0));
+    m.action = Marker::DELETEALL;
+    MarkerArray { markers: vec![m] }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -897,5 +909,11 @@ mod tests {
         assert_eq!(a.markers[3].action, Marker::DELETE);
         assert_eq!(a.markers[4].pose.position.x, 1.0);
         assert_eq!(a.markers[2].header.frame_id, "odom");
+        let cleared = clear_markers(Time::default(), "odom");
+        assert_eq!(cleared.markers.len(), 1);
+        assert_eq!(
+            (cleared.markers[0].action, cleared.markers[0].ns.as_str()),
+            (Marker::DELETEALL, "local_nav")
+        );
     }
 }

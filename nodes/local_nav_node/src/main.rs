@@ -19,8 +19,8 @@ use futures::StreamExt;
 use mobil_geom::Pose2;
 use mobil_local_nav::{Mode, MotionLimits, Navigator, Progress, ProgressChecker, StepOutput};
 use mobil_local_nav_node::{
-    duration_msg, goal_in_odom, markers, stale_input, status_message, twist_from_command, GoalOutcome, LocalNavConfig,
-    MarkerView, StatusView,
+    clear_markers, duration_msg, goal_in_odom, markers, stale_input, status_message, twist_from_command, GoalOutcome,
+    LocalNavConfig, MarkerView, StatusView,
 };
 use mobil_msgs::builtin_interfaces::msg::Time;
 use mobil_msgs::geometry_msgs::msg::{Pose, PoseStamped, Twist};
@@ -380,6 +380,12 @@ impl Shell {
         self.nav.cancel();
         self.progress.reset();
         self.last_step = None;
+        if let Err(e) = out
+            .markers
+            .publish(clear_markers(node.stamp(), &self.config.odom_frame))
+        {
+            warn_throttled!(self.throttle, "markers", "cannot publish local_nav/markers: {e:?}");
+        }
     }
 
     fn publish_status_with_mode(
