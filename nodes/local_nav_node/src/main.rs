@@ -318,34 +318,39 @@ impl Shell {
         }
     }
 
-    fn publish_status(&mut self, node: &RosNode, out: &Outputs, state: u8, reason: String) {
+    /// What the status says: the last step's distance, H and L (else the distance from the
+    /// latest odometry, else NaN).
+    fn status_view(&self, state: u8, reason: String, mode: Mode, goal: Option<Point2<f64>>) -> StatusView {
         let last = self.last_step.as_ref();
-        let (goal, distance) = match (&self.active, last) {
-            (Some(a), Some(s)) => (Some(a.goal), s.goal_distance),
-            (Some(a), None) => (
-                Some(a.goal),
-                self.odom
-                    .value()
-                    .map_or(f64::NAN, |o| (a.goal - o.pose.position()).norm()),
-            ),
-            (None, _) => (self.nav.goal(), f64::NAN),
+        let distance = match (last, goal, self.odom.value()) {
+            (Some(s), _, _) => s.goal_distance,
+            (None, Some(g), Some(o)) => (g - o.pose.position()).norm(),
+            _ => f64::NAN,
         };
-        let view = StatusView {
+        StatusView {
             state,
-            mode: self.nav.mode(),
+            mode,
             goal,
             distance_to_goal: distance,
             reason,
             hit_point: last.and_then(|s| s.hit_point),
             leave_point: last.and_then(|s| s.leave_point),
-        };
-        if let Err(e) = out
-            .status
-            .publish(status_message(&view, node.stamp(), &self.config.odom_frame))
-        {
+        }
+    }
+
+    fn send_status(&mut self, node: &RosNode, out: &Outputs, view: &StatusView) {
+        let msg = status_message(view, node.stamp(), &self.config.odom_frame);
+        if let Err(e) = out.status.publish(msg) {
             warn_throttled!(self.throttle, "status", "cannot publish local_nav/status: {e:?}");
         }
         self.last_status = Some(Instant::now());
+    }
+
+    /// The status of the current goal (or of none).
+    fn publish_status(&mut self, node: &RosNode, out: &Outputs, state: u8, reason: String) {
+        let goal = self.active.as_ref().map(|a| a.goal).or(self.nav.goal());
+        let view = self.status_view(state, reason, self.nav.mode(), goal);
+        self.send_status(node, out, &view);
     }
 
     fn zero(&mut self, out: &Outputs) {
@@ -397,23 +402,8 @@ impl Shell {
         mode: Mode,
         goal: Option<Point2<f64>>,
     ) {
-        let last = self.last_step.as_ref();
-        let view = StatusView {
-            state,
-            mode,
-            goal,
-            distance_to_goal: last.map_or(f64::NAN, |s| s.goal_distance),
-            reason,
-            hit_point: last.and_then(|s| s.hit_point),
-            leave_point: last.and_then(|s| s.leave_point),
-        };
-        if let Err(e) = out
-            .status
-            .publish(status_message(&view, node.stamp(), &self.config.odom_frame))
-        {
-            warn_throttled!(self.throttle, "status", "cannot publish local_nav/status: {e:?}");
-        }
-        self.last_status = Some(Instant::now());
+        let view = self.status_view(state, reason, mode, goal);
+        self.send_status(node, out, &view);
     }
 
     /// Starts a validated goal (the old one, if any, has been ended).
