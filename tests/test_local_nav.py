@@ -25,7 +25,8 @@ import pytest
 
 from foreign_lidar import WorldRaycaster
 
-from harness import TESTS_DIR as TESTS, make_qos, qos_latched, qos_sensor, subscribe, wait_until
+from harness import (TESTS_DIR as TESTS, make_qos, param_set, qos_latched, qos_sensor, subscribe,
+                     wait_until)
 
 from action_msgs.msg import GoalStatus
 from geometry_msgs.msg import PoseStamped, Twist
@@ -375,7 +376,8 @@ def test_foreign_lidar_with_navigate_to_pose_and_cancel(start_scenario, start_no
 def test_refusals_preemption_and_stale_scan(start_scenario, start_node, sim_clock, ros_node, tmp_path):
     """An empty scan from this test (open space). goal_pose in `map` and with NaN: status
     FAILED INVALID_GOAL, nothing moves. An action goal pre-empted by a goal_pose goal ends
-    ABORTED with the reason PREEMPTED. Then only defective scans (each a defect the checked Scan
+    ABORTED with the reason PREEMPTED. The progress checker, made impossible to satisfy by
+    parameters set at run time, ends a goal ABORTED. Then only defective scans (each a defect the checked Scan
     refuses), then none: within the scan timeout (0.5 s, steady clock) plus a tick of the last
     valid scan the goal fails STALE_INPUT naming the scan, the last cmd_vel is zero, the robot
     comes to rest, and local_nav_node exits cleanly at the end (checked at teardown)."""
@@ -425,6 +427,18 @@ def test_refusals_preemption_and_stale_scan(start_scenario, start_node, sim_cloc
         assert res.result.error_msg == "PREEMPTED: preempted by a newer goal (goal_pose)"
         assert res.result.error_code == 0
 
+        # The progress checker, with Nav2's parameters set at run time: 5 m within 1 simulated
+        # second is more than OMR-III's 0.5 m/s can do, so the running goal (restarted with the
+        # new parameters) ends ABORTED once more than 1 s of ROS time passed without it.
+        assert param_set(ros_node, "/local_nav", "required_movement_radius", 5.0).successful
+        assert param_set(ros_node, "/local_nav", "movement_time_allowance", 1.0).successful
+        aborted = status.wait_for(lambda s: s.state == NavStatus.FAILED
+                                  and s.reason.startswith("ABORTED"), REPLY_TIMEOUT)
+        assert param_set(ros_node, "/local_nav", "movement_time_allowance", 10.0).successful
+        assert param_set(ros_node, "/local_nav", "required_movement_radius", 0.5).successful
+        publish_until_status(goal_pose(0.0, -2.0), lambda s: s.state == NavStatus.ACTIVE
+                             and s.goal.position.y == -2.0)
+
         stopped = lidar.break_scans()
         stale = status.wait_for(lambda s: s.state == NavStatus.FAILED and s.reason.startswith("STALE"),
                                 REPLY_TIMEOUT)
@@ -441,13 +455,18 @@ def test_refusals_preemption_and_stale_scan(start_scenario, start_node, sim_cloc
         # sim_node first, so that no ground truth or clock is in flight when the readers close.
         sim.stop()
 
+    # Checked on the scan after 1 s: 20 wall Hz is 0.25 simulated s at 5×, and a loaded machine
+    # may delay a scan further.
+    prefix = "ABORTED: no progress: moved less than 5 m in "
+    assert aborted.reason.startswith(prefix) and aborted.reason.endswith(" s"), aborted.reason
+    assert 1.0 < float(aborted.reason[len(prefix):-2]) <= 2.0, aborted.reason
     assert stale.reason == "STALE_INPUT: scan stale: robot stopped"
     # 0.5 s of scan timeout from the last scan, a 50 ms tick, and DDS and scheduling on a loaded
     # machine.
     assert 0.45 <= after <= 1.5, f"STALE_INPUT {after:.2f} s after the last scan"
     assert speed(rest) < 1e-3
-    # Two goals ended: the action goal (PREEMPTED, in its result: the status is latched with
+    # Three goals ended: the action goal (PREEMPTED, in its result: the status is latched with
     # depth 1, so the new goal's ACTIVE may supersede it before it reaches this reader) and the
-    # goal_pose goal (STALE_INPUT); the refused goals started nothing and stopped nothing.
-    assert [s.reason.split(":")[0] for s in ends_of(statuses)][-1] == "STALE_INPUT"
-    check_commands(cmds, 2)
+    # goal_pose goals (ABORTED, STALE_INPUT); the refused goals started and stopped nothing.
+    assert [s.reason.split(":")[0] for s in ends_of(statuses)][-2:] == ["ABORTED", "STALE_INPUT"]
+    check_commands(cmds, 3)
