@@ -10,6 +10,8 @@
 //! - [`motion`]: motion along F for an omni or a car-like chassis (δ_eff), speed scaled by the
 //!   free distance ahead and near the goal, hard stop.
 //! - [`config`]: [`NavConfig`], every default justified.
+//! - [`progress`]: Nav2's progress checker (`required_movement_radius` within
+//!   `movement_time_allowance`), time as an input.
 //!
 //! Where the SPEC leaves a choice open, or where a Decision needed a guard to work in closed
 //! loop, the library chooses as follows (each tested in `tests/modes.rs` or
@@ -60,10 +62,12 @@ pub mod config;
 pub mod field;
 pub mod motion;
 pub mod navigator;
+pub mod progress;
 pub mod sectors;
 
 pub use config::{ConfigError, NavConfig};
 pub use field::{vector_distance, Side, WeightProfile};
 pub use motion::{command_along, Drive, MotionInput, MotionLimits, SpeedProfile, VelocityCommand};
 pub use navigator::{InputError, Mode, Navigator, NoPathReason, StepOutput};
+pub use progress::{Progress, ProgressChecker, ProgressSettings};
 pub use sectors::{Sector, Sectors, UnseenSectors};

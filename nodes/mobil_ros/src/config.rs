@@ -299,6 +299,27 @@ impl<C: 'static> Decl<C> {
         )
     }
 
+    /// An array of doubles of any length filling a field (a weight profile whose length follows
+    /// another parameter; [`Config::validate`] checks the length).
+    pub fn double_list(
+        &mut self,
+        name: &str,
+        default: &[f64],
+        description: &str,
+        set: impl Fn(&mut C, Vec<f64>) + Send + Sync + 'static,
+    ) -> Declared<'_> {
+        self.push(
+            ParamSpec::doubles(name, default, description),
+            Arc::new(move |c, v| match v {
+                ParameterValue::DoubleArray(a) => {
+                    set(c, a.clone());
+                    Ok(())
+                }
+                other => Err(wrong_type("double array", other)),
+            }),
+        )
+    }
+
     /// Declares a group of parameters (its own [`Decl`]) that fills one part of `C`, e.g. the
     /// chassis geometry shared by every node that models the chassis.
     pub fn nest<S: 'static>(

@@ -1,0 +1,871 @@
+//! The ROS side of [`mobil_local_nav`]: the `local_nav_node` executable (src/main.rs) and what
+//! its shell does that can be checked without DDS — the configuration (every parameter declared
+//! once), goal validation, the command clamp, the stale-input decision, how a goal ends (status
+//! reason and Nav2 error code), and the status and marker messages.
+//!
+//! The method itself (sectors, the vector-distance function, the R/L/T modes, the progress
+//! checker) is in [`mobil_local_nav`]; nothing here decides where the robot goes.
+
+#![warn(missing_docs)]
+
+use mobil_chassis::model::ChassisConfig;
+use mobil_chassis_node::{chassis_params, declare_chassis};
+use mobil_geom::Pose2;
+use mobil_local_nav::{
+    Drive, Mode, MotionLimits, NavConfig, NoPathReason, ProgressSettings, Sectors, Side, UnseenSectors,
+    VelocityCommand, WeightProfile,
+};
+use mobil_msgs::builtin_interfaces::msg::Time;
+use mobil_msgs::geometry_msgs::msg::{Point, Pose, PoseStamped, Twist, Vector3};
+use mobil_msgs::mobil_msgs::msg::NavStatus;
+use mobil_msgs::std_msgs::msg::{ColorRGBA, Header};
+use mobil_msgs::visualization_msgs::msg::{Marker, MarkerArray};
+use mobil_ros::config::{Config, ConfigError, Decl};
+use mobil_ros::geometry::yaw_quaternion;
+use nalgebra::{Point2, Vector2};
+use std::time::Duration;
+use thiserror::Error;
+
+/// Nav2's Jazzy error codes used in `NavigateToPose` results. Jazzy's NavigateToPose defines
+/// only `NONE`; its navigator passes on the code of the failing server, so a failure here gets
+/// the code Nav2's controller (`FollowPath`, 100…) or planner (`ComputePathToPose`, 200…) server
+/// gives the same failure.
+pub mod nav2_error {
+    /// No error (succeeded, canceled, pre-empted).
+    pub const NONE: u16 = 0;
+    /// FollowPath UNKNOWN: the node shut down under the goal.
+    pub const UNKNOWN: u16 = 100;
+    /// FollowPath FAILED_TO_MAKE_PROGRESS: the progress checker fired.
+    pub const FAILED_TO_MAKE_PROGRESS: u16 = 105;
+    /// FollowPath NO_VALID_CONTROL: no command can be computed (scan or odometry stale).
+    pub const NO_VALID_CONTROL: u16 = 106;
+    /// ComputePathToPose NO_VALID_PATH: the method found no path (NO_PATH).
+    pub const NO_VALID_PATH: u16 = 208;
+}
+
+/// Everything the node is configured with, each field filled by one declared parameter.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct LocalNavConfig {
+    /// The chassis geometry and limits (the params file's `/**` section).
+    pub chassis: ChassisConfig,
+    /// The navigator's configuration (weights filled from `weights` or the default profile).
+    pub nav: NavConfig,
+    /// The weight profile as given (empty: the default profile for `sector_count`).
+    pub weights: Vec<f64>,
+    /// Nav2's progress checker.
+    pub progress: ProgressSettings,
+    /// A goal fails STALE_INPUT when no scan arrived for this long (steady clock) [s].
+    pub scan_timeout_s: f64,
+    /// A goal fails STALE_INPUT when no odometry arrived for this long (steady clock) [s].
+    pub odom_timeout_s: f64,
+    /// Status, markers and action feedback rate while a goal is active [Hz].
+    pub status_rate_hz: f64,
+    /// How long a finished action goal's result waits for the client to ask for it [s].
+    pub result_timeout_s: f64,
+    /// Frame goals must be in, and the frame of `odom` [odom].
+    pub odom_frame: String,
+    /// The robot frame [base_link].
+    pub base_frame: String,
+    /// The laser frame looked up in `tf_static` when a scan names none.
+    pub laser_frame: String,
+    /// Laser pose (x, y, yaw) in the base frame, used until (unless) `tf_static` gives one.
+    pub laser_pose: [f64; 3],
+}
+
+impl Config for LocalNavConfig {
+    fn declare(d: &mut Decl<Self>) {
+        let n = NavConfig::default();
+        let p = ProgressSettings::default();
+        d.nest(|c: &mut LocalNavConfig| &mut c.chassis, declare_chassis);
+        d.double(
+            "robot_radius",
+            n.robot_radius,
+            "radius of the circle around the body, centred on the reference point [m]",
+            |c, v| c.nav.robot_radius = v,
+        )
+        .min(0.0);
+        d.integer(
+            "sector_count",
+            n.sector_count as i64,
+            "N, the number of sectors the scan is reduced to (eq. 3.50)",
+            |c, v| c.nav.sector_count = usize::try_from(v).unwrap_or(0),
+        )
+        .within(4.0, 360.0);
+        d.double_list(
+            "weights",
+            &[],
+            "w'0 … w'(N−1) of the right-turning set (eq. 3.53–3.55); empty: the default linear profile",
+            |c, v| c.weights = v,
+        );
+        d.string(
+            "unseen_sectors",
+            "blocked",
+            "sectors outside the scan's field of view: blocked (|f| = 0) or free (|f| = d_sa)",
+            |c, v| {
+                c.nav.unseen = if v == "free" {
+                    UnseenSectors::Free
+                } else {
+                    UnseenSectors::Blocked
+                }
+            },
+        )
+        .choices(&["blocked", "free"]);
+        d.double(
+            "stop_distance",
+            n.stop_distance,
+            "hard stop: no forward motion with an obstacle nearer than this ahead [m]",
+            |c, v| c.nav.stop_distance = v,
+        )
+        .above(0.0);
+        d.double(
+            "safe_distance",
+            n.safe_distance,
+            "d_sa, the safe distance (eq. 3.52) and the boundary-following distance [m]",
+            |c, v| c.nav.safe_distance = v,
+        )
+        .above(0.0);
+        d.double(
+            "release_hysteresis",
+            n.release_hysteresis,
+            "added to d_sa before a blocked goal sector counts as clear again [m]",
+            |c, v| c.nav.release_hysteresis = v,
+        )
+        .min(0.0);
+        d.double(
+            "step_length",
+            n.step_length,
+            "ds, the path increment that makes one step [m]",
+            |c, v| c.nav.step_length = v,
+        )
+        .above(0.0);
+        d.integer(
+            "lock_steps",
+            i64::from(n.lock_steps),
+            "n: L-mode steps over which the progress must reach c1 (eq. 3.58)",
+            |c, v| c.nav.lock_steps = u32::try_from(v).unwrap_or(0),
+        )
+        .within(1.0, 1e6);
+        d.double(
+            "lock_min_progress",
+            n.lock_min_progress,
+            "c1: least progress toward G over n steps in L-mode, else hit point H [m]",
+            |c, v| c.nav.lock_min_progress = v,
+        );
+        d.integer(
+            "track_steps",
+            i64::from(n.track_steps),
+            "m: T-mode steps over which the progress must reach c2 (eq. 3.60)",
+            |c, v| c.nav.track_steps = u32::try_from(v).unwrap_or(0),
+        )
+        .within(1.0, 1e6);
+        d.double(
+            "track_min_progress",
+            n.track_min_progress,
+            "c2: least progress toward G over m steps in T-mode, else NO_PATH [m]",
+            |c, v| c.nav.track_min_progress = v,
+        );
+        d.double(
+            "stall_speed",
+            n.stall_speed,
+            "an L-mode command slower than this is a stall: hit point H at once [m/s]",
+            |c, v| c.nav.stall_speed = v,
+        )
+        .min(0.0);
+        d.double(
+            "hit_radius",
+            n.hit_radius,
+            "a return within this of H (after leaving twice as far) is NO_PATH [m]",
+            |c, v| c.nav.hit_radius = v,
+        )
+        .above(0.0);
+        d.double(
+            "xy_goal_tolerance",
+            n.goal_tolerance,
+            "the goal is reached within this distance (Nav2's name) [m]",
+            |c, v| c.nav.goal_tolerance = v,
+        )
+        .above(0.0);
+        d.double(
+            "slow_down_radius",
+            n.slow_down_radius,
+            "the speed falls linearly toward zero inside this distance to the goal [m]",
+            |c, v| c.nav.slow_down_radius = v,
+        )
+        .above(0.0);
+        d.double(
+            "track_gain",
+            n.track_gain,
+            "T-mode: bend of the tracking direction per metre of distance error [rad/m]",
+            |c, v| c.nav.track_gain = v,
+        )
+        .min(0.0);
+        d.double(
+            "heading_gain",
+            n.heading_gain,
+            "omni: gain of the turn toward a direction outside the field of view [1/s]",
+            |c, v| c.nav.heading_gain = v,
+        )
+        .above(0.0);
+        d.double(
+            "required_movement_radius",
+            p.required_movement_radius,
+            "progress checker: the robot must move this far … [m]",
+            |c, v| c.progress.required_movement_radius = v,
+        )
+        .above(0.0);
+        d.double(
+            "movement_time_allowance",
+            p.movement_time_allowance,
+            "… within this time (ROS time), else the goal fails ABORTED [s]",
+            |c, v| c.progress.movement_time_allowance = v,
+        )
+        .above(0.0);
+        d.double(
+            "scan_timeout_s",
+            0.5,
+            "a goal fails STALE_INPUT when no valid scan arrived for this long (steady clock) [s]",
+            |c, v| c.scan_timeout_s = v,
+        )
+        .above(0.0);
+        d.double(
+            "odom_timeout_s",
+            0.5,
+            "a goal fails STALE_INPUT when no valid odom arrived for this long (steady clock) [s]",
+            |c, v| c.odom_timeout_s = v,
+        )
+        .above(0.0);
+        d.double(
+            "status_rate_hz",
+            2.0,
+            "local_nav/status, markers and action feedback rate while a goal is active [Hz]",
+            |c, v| c.status_rate_hz = v,
+        )
+        .within(0.1, 50.0);
+        d.double(
+            "result_timeout_s",
+            10.0,
+            "how long a finished action goal's result waits for the client to ask for it [s]",
+            |c, v| c.result_timeout_s = v,
+        )
+        .above(0.0);
+        d.string(
+            "odom_frame",
+            "odom",
+            "frame of odom; goals in any other frame are refused",
+            |c, v| c.odom_frame = v,
+        );
+        d.string("base_frame", "base_link", "robot frame (reference point)", |c, v| {
+            c.base_frame = v
+        });
+        d.string(
+            "laser_frame",
+            "laser",
+            "laser frame looked up in tf_static when a scan's header names none",
+            |c, v| c.laser_frame = v,
+        );
+        d.doubles(
+            "laser_pose",
+            [0.0, 0.0, 0.0],
+            "x, y, yaw of the laser in the base frame, used until (unless) tf_static gives it",
+            |c, v| c.laser_pose = v,
+        );
+    }
+
+    fn validate(&self) -> Result<(), ConfigError> {
+        self.motion_limits()?;
+        self.nav_config()?;
+        Ok(())
+    }
+}
+
+impl LocalNavConfig {
+    /// The navigator's configuration: the declared fields and the weight profile (the given
+    /// one, checked against eq. 3.53–3.55, or the default linear one for N sectors).
+    pub fn nav_config(&self) -> Result<NavConfig, ConfigError> {
+        let mut nav = self.nav.clone();
+        nav.weights = if self.weights.is_empty() {
+            WeightProfile::linear(nav.sector_count)
+        } else {
+            WeightProfile::new(self.weights.clone()).map_err(ConfigError::inconsistent)?
+        };
+        nav.validate().map_err(ConfigError::inconsistent)?;
+        Ok(nav)
+    }
+
+    /// The chassis limits the commands respect (δ_eff for a car-like chassis).
+    pub fn motion_limits(&self) -> Result<MotionLimits, ConfigError> {
+        Ok(MotionLimits::from_chassis(&chassis_params(&self.chassis)?))
+    }
+
+    /// The laser pose parameter as a pose; `None` when not finite.
+    pub fn laser_pose(&self) -> Option<Pose2> {
+        let [x, y, yaw] = self.laser_pose;
+        let p = Pose2::new(x, y, yaw);
+        p.is_finite().then_some(p)
+    }
+
+    /// The scan timeout.
+    pub fn scan_timeout(&self) -> Duration {
+        Duration::from_secs_f64(self.scan_timeout_s)
+    }
+
+    /// The odometry timeout.
+    pub fn odom_timeout(&self) -> Duration {
+        Duration::from_secs_f64(self.odom_timeout_s)
+    }
+}
+
+/// Why a goal pose is refused.
+#[derive(Debug, Clone, PartialEq, Eq, Error)]
+pub enum GoalError {
+    /// Not in the odometry frame (the node has no map, and no other transform).
+    #[error("goal in frame `{got}`, but goals must be in `{want}`")]
+    Frame {
+        /// The goal's frame.
+        got: String,
+        /// The odometry frame.
+        want: String,
+    },
+    /// NaN or infinity in the position or orientation.
+    #[error("goal pose is not finite")]
+    NotFinite,
+}
+
+/// The goal point in the odometry frame, or why it is refused: a frame other than `odom_frame`
+/// (a leading `/` ignored, as tf2 ignores it), or any non-finite number in the pose.
+pub fn goal_in_odom(goal: &PoseStamped, odom_frame: &str) -> Result<Point2<f64>, GoalError> {
+    let frame = goal.header.frame_id.trim_start_matches('/');
+    if frame != odom_frame.trim_start_matches('/') {
+        return Err(GoalError::Frame {
+            got: goal.header.frame_id.clone(),
+            want: odom_frame.to_owned(),
+        });
+    }
+    let (p, q) = (&goal.pose.position, &goal.pose.orientation);
+    if ![p.x, p.y, p.z, q.x, q.y, q.z, q.w].iter().all(|v| v.is_finite()) {
+        return Err(GoalError::NotFinite);
+    }
+    Ok(Point2::new(p.x, p.y))
+}
+
+/// The command as a Twist, held to the chassis limits whatever the navigator asked: speed at
+/// most `v_max`, |ω| at most `omega_max`, and on a car-like chassis no sideways speed and
+/// |ω| ≤ κ_max·|vx| (a turn no tighter than δ_eff allows). Anything non-finite gives zero.
+pub fn twist_from_command(command: VelocityCommand, limits: &MotionLimits) -> Twist {
+    let mut c = command.limited(limits);
+    if let Drive::CarLike { max_curvature } = limits.drive {
+        let bound = max_curvature * c.vx.abs();
+        c.omega = if bound.is_finite() {
+            c.omega.clamp(-bound, bound)
+        } else {
+            0.0
+        };
+    }
+    if !c.is_finite() {
+        c = VelocityCommand::ZERO;
+    }
+    let mut t = Twist::default();
+    t.linear.x = c.vx;
+    t.linear.y = c.vy;
+    t.angular.z = c.omega;
+    t
+}
+
+/// Which input went stale.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum StaleInput {
+    /// The scan.
+    Scan,
+    /// The odometry.
+    Odom,
+    /// Both.
+    ScanAndOdom,
+}
+
+impl StaleInput {
+    /// For the status reason: "scan", "odom", "scan and odom".
+    pub fn as_str(&self) -> &'static str {
+        match self {
+            StaleInput::Scan => "scan",
+            StaleInput::Odom => "odom",
+            StaleInput::ScanAndOdom => "scan and odom",
+        }
+    }
+}
+
+/// Whether an input is stale for a running goal (steady clock). An input counts as old as its
+/// last valid message (`None`: never), but never older than the goal: a goal gets one timeout
+/// from its start for the inputs to arrive, so a goal sent just before the first scan does not
+/// fail at once.
+pub fn stale_input(
+    scan_age: Option<Duration>,
+    odom_age: Option<Duration>,
+    goal_age: Duration,
+    scan_timeout: Duration,
+    odom_timeout: Duration,
+) -> Option<StaleInput> {
+    let old = |age: Option<Duration>, timeout: Duration| age.map_or(goal_age, |a| a.min(goal_age)) > timeout;
+    match (old(scan_age, scan_timeout), old(odom_age, odom_timeout)) {
+        (true, true) => Some(StaleInput::ScanAndOdom),
+        (true, false) => Some(StaleInput::Scan),
+        (false, true) => Some(StaleInput::Odom),
+        (false, false) => None,
+    }
+}
+
+/// How a goal ended.
+#[derive(Debug, Clone, PartialEq)]
+pub enum GoalOutcome {
+    /// Within `xy_goal_tolerance`.
+    Succeeded,
+    /// The method found no path (eq. 3.60).
+    NoPath(NoPathReason),
+    /// The progress checker fired after this many seconds without progress.
+    NoProgress {
+        /// Seconds since the last progress.
+        since: f64,
+        /// The required movement radius (m).
+        radius: f64,
+    },
+    /// An input went stale.
+    Stale(StaleInput),
+    /// The action client canceled it.
+    Canceled,
+    /// A newer goal took over (from `goal_pose` or the action).
+    Preempted(&'static str),
+    /// The goal was refused (frame, NaN).
+    Invalid(GoalError),
+    /// The node shut down.
+    ShuttingDown,
+}
+
+impl GoalOutcome {
+    /// The reason code of the status: SUCCEEDED, NO_PATH, ABORTED, STALE_INPUT, CANCELED,
+    /// PREEMPTED, INVALID_GOAL, SHUTDOWN.
+    pub fn code(&self) -> &'static str {
+        match self {
+            GoalOutcome::Succeeded => "SUCCEEDED",
+            GoalOutcome::NoPath(_) => "NO_PATH",
+            GoalOutcome::NoProgress { .. } => "ABORTED",
+            GoalOutcome::Stale(_) => "STALE_INPUT",
+            GoalOutcome::Canceled => "CANCELED",
+            GoalOutcome::Preempted(_) => "PREEMPTED",
+            GoalOutcome::Invalid(_) => "INVALID_GOAL",
+            GoalOutcome::ShuttingDown => "SHUTDOWN",
+        }
+    }
+
+    /// The status reason: the code, a colon and the detail ("NO_PATH: returned to the hit
+    /// point").
+    pub fn reason(&self) -> String {
+        let detail = match self {
+            GoalOutcome::Succeeded => "goal reached".to_owned(),
+            GoalOutcome::NoPath(NoPathReason::ReturnedToHitPoint) => {
+                "boundary following returned to the hit point".to_owned()
+            }
+            GoalOutcome::NoPath(NoPathReason::NoProgress) => {
+                "boundary following made too little progress toward the goal".to_owned()
+            }
+            GoalOutcome::NoProgress { since, radius } => {
+                format!("no progress: moved less than {radius} m in {since:.1} s")
+            }
+            GoalOutcome::Stale(which) => format!("{} stale: robot stopped", which.as_str()),
+            GoalOutcome::Canceled => "canceled by the client".to_owned(),
+            GoalOutcome::Preempted(by) => format!("preempted by a newer goal ({by})"),
+            GoalOutcome::Invalid(e) => e.to_string(),
+            GoalOutcome::ShuttingDown => "the node is shutting down".to_owned(),
+        };
+        format!("{}: {detail}", self.code())
+    }
+
+    /// The NavStatus state it leaves: SUCCEEDED or FAILED.
+    pub fn state(&self) -> u8 {
+        match self {
+            GoalOutcome::Succeeded => NavStatus::SUCCEEDED,
+            _ => NavStatus::FAILED,
+        }
+    }
+
+    /// The Nav2 error code of the action result (see [`nav2_error`]).
+    pub fn nav2_error_code(&self) -> u16 {
+        match self {
+            GoalOutcome::Succeeded | GoalOutcome::Canceled | GoalOutcome::Preempted(_) => nav2_error::NONE,
+            GoalOutcome::NoPath(_) => nav2_error::NO_VALID_PATH,
+            GoalOutcome::NoProgress { .. } => nav2_error::FAILED_TO_MAKE_PROGRESS,
+            GoalOutcome::Stale(_) => nav2_error::NO_VALID_CONTROL,
+            GoalOutcome::Invalid(_) | GoalOutcome::ShuttingDown => nav2_error::UNKNOWN,
+        }
+    }
+}
+
+/// The mode's name in the status: idle, rotate, lock_left, lock_right, track_left, track_right,
+/// reached, no_path.
+pub fn mode_name(mode: Mode) -> &'static str {
+    match mode {
+        Mode::Idle => "idle",
+        Mode::Rotate => "rotate",
+        Mode::Lock(Side::Left) => "lock_left",
+        Mode::Lock(Side::Right) => "lock_right",
+        Mode::Track(Side::Left) => "track_left",
+        Mode::Track(Side::Right) => "track_right",
+        Mode::Reached => "reached",
+        Mode::NoPath(_) => "no_path",
+    }
+}
+
+/// What a status message says.
+#[derive(Debug, Clone, PartialEq)]
+pub struct StatusView {
+    /// NavStatus state (IDLE, ACTIVE, SUCCEEDED, FAILED).
+    pub state: u8,
+    /// The mode.
+    pub mode: Mode,
+    /// The goal (odom), if any.
+    pub goal: Option<Point2<f64>>,
+    /// Distance to the goal (m), NaN when unknown.
+    pub distance_to_goal: f64,
+    /// Reason (empty while active).
+    pub reason: String,
+    /// Hit point H.
+    pub hit_point: Option<Point2<f64>>,
+    /// Leave point L.
+    pub leave_point: Option<Point2<f64>>,
+}
+
+fn point(p: Point2<f64>) -> Point {
+    Point { x: p.x, y: p.y, z: 0.0 }
+}
+
+/// The NavStatus message of a view, stamped `stamp`, in `frame` (odom).
+pub fn status_message(view: &StatusView, stamp: Time, frame: &str) -> NavStatus {
+    let mut goal = Pose::default();
+    goal.orientation.w = 1.0;
+    if let Some(g) = view.goal {
+        goal.position = point(g);
+    }
+    NavStatus {
+        header: Header {
+            stamp,
+            frame_id: frame.to_owned(),
+        },
+        state: view.state,
+        mode: mode_name(view.mode).to_owned(),
+        goal,
+        distance_to_goal: view.distance_to_goal,
+        reason: view.reason.clone(),
+        has_hit_point: view.hit_point.is_some(),
+        hit_point: view.hit_point.map(point).unwrap_or_default(),
+        has_leave_point: view.leave_point.is_some(),
+        leave_point: view.leave_point.map(point).unwrap_or_default(),
+    }
+}
+
+/// What the markers show: the sectors and F (base frame), the goal, H and L (odom).
+#[derive(Debug, Clone, Copy)]
+pub struct MarkerView<'a> {
+    /// The sectors of the last step.
+    pub sectors: &'a Sectors,
+    /// The direction the robot was sent (base frame), scaled as the navigator gave it.
+    pub direction: Vector2<f64>,
+    /// The goal.
+    pub goal: Option<Point2<f64>>,
+    /// Hit point H.
+    pub hit_point: Option<Point2<f64>>,
+    /// Leave point L.
+    pub leave_point: Option<Point2<f64>>,
+}
+
+fn color(r: f32, g: f32, b: f32) -> ColorRGBA {
+    ColorRGBA { r, g, b, a: 1.0 }
+}
+
+fn marker(header: &Header, id: i32, kind: i32, scale: f64, c: ColorRGBA) -> Marker {
+    let mut m = Marker {
+        header: header.clone(),
+        ns: "local_nav".into(),
+        id,
+        r#type: kind,
+        action: Marker::ADD,
+        color: c,
+        scale: Vector3 {
+            x: scale,
+            y: scale,
+            z: scale,
+        },
+        ..Default::default()
+    };
+    m.pose.orientation = yaw_quaternion(0.0);
+    m
+}
+
+/// Longest sector vector drawn (m): an open sector is drawn at this length.
+const MAX_DRAWN: f64 = 5.0;
+
+/// The marker array: one LINE_LIST of the N sector vectors (each along its centre, as long as
+/// its effective distance, at most 5 m), one ARROW for F, and a SPHERE each for the goal, H and
+/// L when known (a DELETE for those not, so RViz drops stale ones). At most 5 markers and
+/// 2·N + 2 points: a few kilobytes.
+pub fn markers(view: &MarkerView<'_>, stamp: Time, odom_frame: &str, base_frame: &str) -> MarkerArray {
+    let base = Header {
+        stamp: stamp.clone(),
+        frame_id: base_frame.to_owned(),
+    };
+    let odom = Header {
+        stamp,
+        frame_id: odom_frame.to_owned(),
+    };
+    let mut sectors = marker(&base, 0, Marker::LINE_LIST, 0.02, color(0.2, 0.6, 1.0));
+    for i in 0..view.sectors.len() {
+        let d = view.sectors.effective_distance(i).min(MAX_DRAWN);
+        let d = if d.is_finite() { d } else { 0.0 };
+        let (s, c) = view.sectors.bearing(i).sin_cos();
+        sectors.points.push(Point::default());
+        sectors.points.push(Point {
+            x: d * c,
+            y: d * s,
+            z: 0.0,
+        });
+    }
+    let mut f = marker(&base, 1, Marker::ARROW, 0.0, color(1.0, 0.5, 0.0));
+    f.scale = Vector3 {
+        x: 0.05,
+        y: 0.1,
+        z: 0.1,
+    };
+    let tip = if view.direction.iter().all(|v| v.is_finite()) {
+        view.direction
+    } else {
+        Vector2::zeros()
+    };
+    f.points = vec![
+        Point::default(),
+        Point {
+            x: tip.x,
+            y: tip.y,
+            z: 0.0,
+        },
+    ];
+    let mut out = vec![sectors, f];
+    let spots = [
+        (2, view.goal, color(0.0, 0.8, 0.0)),
+        (3, view.hit_point, color(0.9, 0.0, 0.0)),
+        (4, view.leave_point, color(0.8, 0.0, 0.8)),
+    ];
+    for (id, at, c) in spots {
+        let mut m = marker(&odom, id, Marker::SPHERE, 0.15, c);
+        match at {
+            Some(p) if p.x.is_finite() && p.y.is_finite() => m.pose.position = point(p),
+            _ => m.action = Marker::DELETE,
+        }
+        out.push(m);
+    }
+    MarkerArray { markers: out }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use mobil_chassis::ChassisParams;
+    use mobil_geom::Scan;
+    use mobil_ros::params::ParamValues;
+
+    fn pose_stamped(frame: &str, x: f64, y: f64) -> PoseStamped {
+        let mut g = PoseStamped::default();
+        g.header.frame_id = frame.into();
+        g.pose.position.x = x;
+        g.pose.position.y = y;
+        g.pose.orientation.w = 1.0;
+        g
+    }
+
+    #[test]
+    fn goals_outside_odom_or_with_nan_are_refused() {
+        assert_eq!(
+            goal_in_odom(&pose_stamped("odom", 2.5, -1.0), "odom"),
+            Ok(Point2::new(2.5, -1.0))
+        );
+        assert_eq!(
+            goal_in_odom(&pose_stamped("/odom", 1.0, 0.0), "odom"),
+            Ok(Point2::new(1.0, 0.0))
+        );
+        assert_eq!(
+            goal_in_odom(&pose_stamped("map", 1.0, 0.0), "odom"),
+            Err(GoalError::Frame {
+                got: "map".into(),
+                want: "odom".into()
+            })
+        );
+        assert!(matches!(
+            goal_in_odom(&pose_stamped("", 1.0, 0.0), "odom"),
+            Err(GoalError::Frame { .. })
+        ));
+        assert_eq!(
+            goal_in_odom(&pose_stamped("odom", f64::NAN, 0.0), "odom"),
+            Err(GoalError::NotFinite)
+        );
+        let mut g = pose_stamped("odom", 1.0, 0.0);
+        g.pose.orientation.z = f64::INFINITY;
+        assert_eq!(goal_in_odom(&g, "odom"), Err(GoalError::NotFinite));
+        assert_eq!(
+            GoalError::Frame {
+                got: "map".into(),
+                want: "odom".into()
+            }
+            .to_string(),
+            "goal in frame `map`, but goals must be in `odom`"
+        );
+    }
+
+    #[test]
+    fn commands_are_held_to_the_chassis_limits() {
+        // OMR-III: v_max 0.5, ω_max 1.5. (0.6, 0.8) is 1.0 m/s: scaled by 0.5 to (0.3, 0.4).
+        let omni = MotionLimits::from_chassis(&ChassisParams::omr3());
+        let t = twist_from_command(
+            VelocityCommand {
+                vx: 0.6,
+                vy: 0.8,
+                omega: -3.0,
+            },
+            &omni,
+        );
+        assert!((t.linear.x - 0.3).abs() < 1e-12 && (t.linear.y - 0.4).abs() < 1e-12);
+        assert_eq!(t.angular.z, -1.5);
+        // MOBIL-II: δ_eff = atan(0.60 / 0.73), κ_max = tan δ_eff / L = 1 / 0.73 = 1.36986 1/m.
+        // At vx 0.2 the turn rate is held to 0.2 / 0.73 = 0.273973 rad/s; vy dropped.
+        let car = MotionLimits::from_chassis(&ChassisParams::mobil2());
+        let t = twist_from_command(
+            VelocityCommand {
+                vx: 0.2,
+                vy: 0.3,
+                omega: 0.9,
+            },
+            &car,
+        );
+        assert_eq!((t.linear.x, t.linear.y), (0.2, 0.0));
+        assert!((t.angular.z - 0.2 / 0.73).abs() < 1e-9, "{}", t.angular.z);
+        // A standing car cannot turn; NaN anywhere gives the zero command.
+        let t = twist_from_command(
+            VelocityCommand {
+                vx: 0.0,
+                vy: 0.0,
+                omega: 0.5,
+            },
+            &car,
+        );
+        assert_eq!(t.angular.z, 0.0);
+        let t = twist_from_command(
+            VelocityCommand {
+                vx: f64::NAN,
+                vy: 0.0,
+                omega: 0.1,
+            },
+            &omni,
+        );
+        assert_eq!((t.linear.x, t.linear.y, t.angular.z), (0.0, 0.0, 0.0));
+    }
+
+    #[test]
+    fn stale_inputs_are_named_after_a_grace_of_one_timeout() {
+        let ms = Duration::from_millis;
+        let (st, ot) = (ms(500), ms(300));
+        // Fresh both.
+        assert_eq!(stale_input(Some(ms(100)), Some(ms(100)), ms(5000), st, ot), None);
+        // Scan 600 ms old (> 500), odom 200 ms (< 300): the scan.
+        assert_eq!(
+            stale_input(Some(ms(600)), Some(ms(200)), ms(5000), st, ot),
+            Some(StaleInput::Scan)
+        );
+        assert_eq!(
+            stale_input(Some(ms(100)), Some(ms(400)), ms(5000), st, ot),
+            Some(StaleInput::Odom)
+        );
+        // Never any input, goal 200 ms old: within the grace. At 600 ms: both.
+        assert_eq!(stale_input(None, None, ms(200), st, ot), None);
+        assert_eq!(stale_input(None, None, ms(600), st, ot), Some(StaleInput::ScanAndOdom));
+        // A scan 10 s old when the goal came 400 ms ago: within the grace still.
+        assert_eq!(stale_input(Some(ms(10_000)), Some(ms(10)), ms(400), st, ot), None);
+    }
+
+    #[test]
+    fn outcomes_give_status_reasons_and_nav2_codes() {
+        let stale = GoalOutcome::Stale(StaleInput::Scan);
+        assert_eq!(stale.reason(), "STALE_INPUT: scan stale: robot stopped");
+        assert_eq!((stale.state(), stale.nav2_error_code()), (NavStatus::FAILED, 106));
+        assert_eq!(
+            GoalOutcome::NoPath(NoPathReason::ReturnedToHitPoint).nav2_error_code(),
+            208
+        );
+        let stuck = GoalOutcome::NoProgress {
+            since: 10.25,
+            radius: 0.5,
+        };
+        assert_eq!(stuck.reason(), "ABORTED: no progress: moved less than 0.5 m in 10.2 s");
+        assert_eq!(stuck.nav2_error_code(), 105);
+        assert_eq!(GoalOutcome::Succeeded.state(), NavStatus::SUCCEEDED);
+        assert_eq!(GoalOutcome::Invalid(GoalError::NotFinite).code(), "INVALID_GOAL");
+    }
+
+    #[test]
+    fn defaults_build_the_library_defaults_and_bad_weights_are_refused() {
+        let mut values = ParamValues::defaults(&Decl::<LocalNavConfig>::of().specs());
+        let c: LocalNavConfig = mobil_ros::config::load(&values).unwrap();
+        assert_eq!(c.nav_config().unwrap(), NavConfig::default());
+        assert_eq!(c.progress, ProgressSettings::default());
+        // MOBIL-II chassis defaults: car-like, κ_max = 1 / 0.73.
+        match c.motion_limits().unwrap().drive {
+            Drive::CarLike { max_curvature } => assert!((max_curvature - 1.0 / 0.73).abs() < 1e-9),
+            Drive::Omni => panic!("default chassis is MOBIL-II"),
+        }
+        // w'1 = 0.4 < w'7 = 0.5 breaks eq. 3.54: refused with the equation named.
+        values.set(
+            "weights",
+            ros2_client::ParameterValue::DoubleArray(vec![1.0, 0.4, 0.3, 0.2, 0.1, 0.1, 0.1, 0.5]),
+        );
+        let e = mobil_ros::config::load::<LocalNavConfig>(&values).unwrap_err();
+        assert!(e.to_string().contains("3.54"), "{e}");
+        // Twelve sectors with eight weights: refused.
+        values.set("weights", ros2_client::ParameterValue::DoubleArray(vec![]));
+        values.set("sector_count", ros2_client::ParameterValue::Integer(12));
+        let c: LocalNavConfig = mobil_ros::config::load(&values).unwrap();
+        assert_eq!(c.nav_config().unwrap().weights.len(), 12);
+        values.set("stop_distance", ros2_client::ParameterValue::Double(0.9));
+        assert!(mobil_ros::config::load::<LocalNavConfig>(&values).is_err());
+    }
+
+    #[test]
+    fn markers_stay_small_and_draw_the_sectors() {
+        // Eight beams on the sector centres (−180° + 45°·k), all at 2 m except straight ahead
+        // (the goal's sector 0) at 1 m.
+        let ranges: Vec<f32> = (0..8).map(|k| if k == 4 { 1.0 } else { 2.0 }).collect();
+        let step = std::f64::consts::FRAC_PI_4;
+        let scan = Scan::new(
+            -std::f64::consts::PI,
+            0.75 * std::f64::consts::PI,
+            step,
+            0.05,
+            10.0,
+            ranges,
+            vec![],
+            Pose2::identity(),
+        )
+        .unwrap();
+        let sectors = Sectors::compute(&scan, 0.0, 8, UnseenSectors::Blocked);
+        let view = MarkerView {
+            sectors: &sectors,
+            direction: Vector2::new(0.5, 0.0),
+            goal: Some(Point2::new(3.0, 0.0)),
+            hit_point: None,
+            leave_point: Some(Point2::new(1.0, 1.0)),
+        };
+        let a = markers(&view, Time::default(), "odom", "base_link");
+        assert_eq!(a.markers.len(), 5);
+        let lines = &a.markers[0];
+        assert_eq!(lines.points.len(), 16);
+        // Sector 0 straight ahead at 1 m; sector 2 at −90° at 2 m.
+        assert!((lines.points[1].x - 1.0).abs() < 1e-9 && lines.points[1].y.abs() < 1e-9);
+        assert!(lines.points[5].x.abs() < 1e-9 && (lines.points[5].y + 2.0).abs() < 1e-9);
+        assert_eq!(a.markers[3].action, Marker::DELETE);
+        assert_eq!(a.markers[4].pose.position.x, 1.0);
+        assert_eq!(a.markers[2].header.frame_id, "odom");
+    }
+}

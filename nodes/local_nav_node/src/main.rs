@@ -1,0 +1,651 @@
+//! `local_nav_node`: reactive navigation to a goal by the vector-distance function (SPEC §2),
+//! the shell of [`mobil_local_nav`]. Goals come from `goal_pose` (PoseStamped in `odom`, as
+//! RViz's "2D Goal Pose" sends it) and from Nav2's `navigate_to_pose` action; both drive one
+//! navigator, and a new goal from either pre-empts the old one.
+//!
+//! **One step per scan**: each valid scan, with fresh odometry, is one navigator step and one
+//! `cmd_vel`. The method works on the scan, so a step between scans would repeat the last one,
+//! and stepping on arrival adds no queueing delay to the scan-to-command latency. A 20 Hz
+//! watchdog tick on the steady clock ends a goal whose scan or odometry went stale, and
+//! publishes status, markers and action feedback at `status_rate_hz`.
+//!
+//! `cmd_vel` goes out only while a goal is active, and exactly one zero `cmd_vel` when a goal
+//! ends (reached, no path, no progress, stale input, canceled, pre-empted, refused, shutdown);
+//! every command is held to the chassis limits ([`twist_from_command`]). The last command of the
+//! process is a zero one, waited for ([`final_stop`]).
+
+use futures::StreamExt;
+use mobil_geom::Pose2;
+use mobil_local_nav::{Mode, MotionLimits, Navigator, Progress, ProgressChecker, StepOutput};
+use mobil_local_nav_node::{
+    goal_in_odom, markers, stale_input, status_message, twist_from_command, GoalOutcome, LocalNavConfig, MarkerView,
+    StatusView,
+};
+use mobil_msgs::builtin_interfaces::msg::Duration as RosDuration;
+use mobil_msgs::geometry_msgs::msg::{Pose, PoseStamped, Twist};
+use mobil_msgs::mobil_msgs::msg::NavStatus;
+use mobil_msgs::nav2_msgs::action::{NavigateToPose, NavigateToPoseFeedback, NavigateToPoseGoal, NavigateToPoseResult};
+use mobil_msgs::nav_msgs::msg::Odometry;
+use mobil_msgs::sensor_msgs::msg::LaserScan;
+use mobil_msgs::std_msgs::msg::Header;
+use mobil_msgs::visualization_msgs::msg::MarkerArray;
+use mobil_ros::action::{ActionEvent, GoalEnd, GoalRequest, GoalServer, GoalServerConfig};
+use mobil_ros::geometry::yaw_of;
+use mobil_ros::input::{decoded, Input};
+use mobil_ros::latest::Latest;
+use mobil_ros::scan::{scan_from_msg, tf_static_subscription, LaserPose};
+use mobil_ros::stop::{final_stop, FINAL_STOP_WAIT};
+use mobil_ros::ticker::Ticker;
+use mobil_ros::{qos, run_node, shutdown_signal, warn_throttled, ConfigError, LogThrottle, NodeDecl, RosNode};
+use nalgebra::Point2;
+use ros2_client::{Publisher, Subscription};
+use std::process::ExitCode;
+use std::time::{Duration, Instant};
+use tracing::{info, warn};
+
+/// The watchdog tick (steady clock): stale inputs are noticed within 50 ms of their timeout.
+const WATCHDOG_RATE_HZ: f64 = 20.0;
+
+fn decl() -> NodeDecl {
+    NodeDecl::for_config::<LocalNavConfig>(
+        "local_nav",
+        "Reactive navigation to a goal by the vector-distance function (R/L/T modes): goal_pose and \
+         navigate_to_pose in, cmd_vel out",
+    )
+}
+
+fn main() -> ExitCode {
+    run_node(&decl(), |node| Box::pin(serve(node)))
+}
+
+/// Where the active goal came from.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Source {
+    Topic,
+    Action,
+}
+
+impl Source {
+    fn name(self) -> &'static str {
+        match self {
+            Source::Topic => "goal_pose",
+            Source::Action => "navigate_to_pose",
+        }
+    }
+}
+
+#[derive(Debug, Clone)]
+struct ActiveGoal {
+    goal: Point2<f64>,
+    source: Source,
+    started: Instant,
+    started_ros_nanos: i64,
+}
+
+/// The latest valid odometry: the pose for the navigator, the message pose and speed for the
+/// action feedback.
+#[derive(Debug, Clone)]
+struct OdomSample {
+    pose: Pose2,
+    msg_pose: Pose,
+    speed: f64,
+}
+
+struct Outputs {
+    cmd: Publisher<Twist>,
+    status: Publisher<NavStatus>,
+    markers: Publisher<MarkerArray>,
+}
+
+/// Everything the loop holds between events.
+struct Shell {
+    config: LocalNavConfig,
+    limits: MotionLimits,
+    nav: Navigator,
+    progress: ProgressChecker,
+    active: Option<ActiveGoal>,
+    scan_seen: Latest<()>,
+    odom: Latest<OdomSample>,
+    last_step: Option<StepOutput>,
+    last_status: Option<Instant>,
+    throttle: LogThrottle,
+}
+
+/// What woke the loop. One lives at a time, on the stack, so its size does not matter.
+#[allow(clippy::large_enum_variant)]
+enum Event {
+    Shutdown,
+    Config(Result<LocalNavConfig, ConfigError>),
+    Scan(LaserScan),
+    Odom(Odometry),
+    GoalPose(PoseStamped),
+    Action(ActionEvent<NavigateToPoseGoal>),
+    Tick,
+    Nothing,
+}
+
+async fn serve(node: &mut RosNode) -> anyhow::Result<()> {
+    let config: LocalNavConfig = node.config()?;
+    let outputs = Outputs {
+        cmd: node.publisher::<Twist>("cmd_vel", &qos::default_qos())?,
+        status: node.publisher::<NavStatus>("local_nav/status", &qos::latched())?,
+        markers: node.publisher::<MarkerArray>("local_nav/markers", &qos::default_qos())?,
+    };
+    let outcome = run(node, &outputs, config).await;
+    // Whatever ends the loop, the last command is a zero one, waited for.
+    final_stop(&outputs.cmd, Twist::default(), FINAL_STOP_WAIT).await;
+    outcome
+}
+
+fn result(outcome: &GoalOutcome) -> NavigateToPoseResult {
+    NavigateToPoseResult {
+        error_code: outcome.nav2_error_code(),
+        error_msg: outcome.reason(),
+    }
+}
+
+fn goal_end(outcome: &GoalOutcome) -> GoalEnd {
+    match outcome {
+        GoalOutcome::Succeeded => GoalEnd::Succeeded,
+        GoalOutcome::Canceled => GoalEnd::Canceled,
+        _ => GoalEnd::Aborted,
+    }
+}
+
+fn duration(seconds: f64) -> RosDuration {
+    let s = if seconds.is_finite() {
+        seconds.clamp(0.0, 1e9)
+    } else {
+        0.0
+    };
+    let sec = s.floor();
+    RosDuration {
+        sec: sec as i32,
+        nanosec: ((s - sec) * 1e9).min(999_999_999.0) as u32,
+    }
+}
+
+async fn run(node: &mut RosNode, out: &Outputs, config: LocalNavConfig) -> anyhow::Result<()> {
+    let limits = config.motion_limits()?;
+    let nav = Navigator::new(config.nav_config()?, limits)?;
+    let scan_sub = node.subscription::<LaserScan>("scan", &qos::sensor_data())?;
+    let odom_sub = node.subscription::<Odometry>("odom", &qos::default_qos())?;
+    let goal_sub = node.subscription::<PoseStamped>("goal_pose", &qos::default_qos())?;
+    let tf_sub = tf_static_subscription(node)?;
+    let mut server = GoalServer::<NavigateToPose>::create(
+        node,
+        "navigate_to_pose",
+        GoalServerConfig {
+            result_timeout: Duration::from_secs_f64(config.result_timeout_s),
+        },
+    )?;
+    let mut laser = LaserPose::new(&config.base_frame, &config.laser_frame, config.laser_pose());
+    let mut shell = Shell {
+        progress: ProgressChecker::new(config.progress),
+        config,
+        limits,
+        nav,
+        active: None,
+        scan_seen: Latest::new(),
+        odom: Latest::new(),
+        last_step: None,
+        last_status: None,
+        throttle: LogThrottle::new(Duration::from_secs(2)),
+    };
+    shell.publish_status(node, out, NavStatus::IDLE, String::new());
+    info!(
+        "waiting for goals on goal_pose and navigate_to_pose (frame `{}`)",
+        shell.config.odom_frame
+    );
+    let outcome = event_loop(
+        node,
+        out,
+        &mut shell,
+        &mut server,
+        &mut laser,
+        &scan_sub,
+        &odom_sub,
+        &goal_sub,
+        &tf_sub,
+    )
+    .await;
+    if shell.active.is_some() {
+        shell.end_goal(node, out, &mut server, GoalOutcome::ShuttingDown);
+    }
+    server.close(result(&GoalOutcome::ShuttingDown)).await;
+    outcome
+}
+
+#[allow(clippy::too_many_arguments)]
+async fn event_loop(
+    node: &mut RosNode,
+    out: &Outputs,
+    shell: &mut Shell,
+    server: &mut GoalServer<NavigateToPose>,
+    laser: &mut LaserPose,
+    scan_sub: &Subscription<LaserScan>,
+    odom_sub: &Subscription<Odometry>,
+    goal_sub: &Subscription<PoseStamped>,
+    tf_sub: &Subscription<TFMessageAlias>,
+) -> anyhow::Result<()> {
+    let scans = decoded(scan_sub.async_stream(), "scan", "scan-read", "scan ignored");
+    let odoms = decoded(odom_sub.async_stream(), "odom", "odom-read", "sample ignored");
+    let goals = decoded(goal_sub.async_stream(), "goal_pose", "goal-read", "goal ignored");
+    let shutdown = shutdown_signal();
+    tokio::pin!(scans, odoms, goals, shutdown);
+    let mut ticker = Ticker::new(WATCHDOG_RATE_HZ)?;
+    loop {
+        let event = tokio::select! {
+            _ = &mut shutdown => Event::Shutdown,
+            Some(changed) = node.config_changed::<LocalNavConfig>() => Event::Config(changed),
+            m = scans.next() => match m {
+                Some(Input::Message(m)) => Event::Scan(m),
+                Some(Input::Undecodable) => Event::Nothing,
+                None => anyhow::bail!("the scan subscription ended"),
+            },
+            m = odoms.next() => match m {
+                Some(Input::Message(m)) => Event::Odom(m),
+                Some(Input::Undecodable) => Event::Nothing,
+                None => anyhow::bail!("the odom subscription ended"),
+            },
+            m = goals.next() => match m {
+                Some(Input::Message(m)) => Event::GoalPose(m),
+                Some(Input::Undecodable) => Event::Nothing,
+                None => anyhow::bail!("the goal_pose subscription ended"),
+            },
+            e = server.next_event() => Event::Action(e),
+            _ = ticker.tick() => Event::Tick,
+        };
+        match event {
+            Event::Shutdown => return Ok(()),
+            Event::Nothing => {}
+            Event::Config(Ok(c)) => shell.reconfigure(c),
+            Event::Config(Err(e)) => warn!("parameters not applied: {e}"),
+            Event::Odom(m) => shell.odom_in(&m),
+            Event::Scan(m) => {
+                let skipped = laser.poll(tf_sub);
+                if skipped > 0 {
+                    warn_throttled!(
+                        shell.throttle,
+                        "tf-static",
+                        "{skipped} invalid tf_static transform(s) skipped"
+                    );
+                }
+                shell.scan_in(node, out, server, laser, &m);
+            }
+            Event::GoalPose(m) => shell.goal_pose_in(node, out, server, &m),
+            Event::Action(ActionEvent::Goal(request)) => shell.action_goal_in(node, out, server, request).await,
+            Event::Action(ActionEvent::CancelRequested(id)) => {
+                if shell.active.as_ref().is_some_and(|a| a.source == Source::Action) && server.active_id() == Some(id) {
+                    shell.end_goal(node, out, server, GoalOutcome::Canceled);
+                }
+            }
+            Event::Tick => shell.tick(node, out, server).await,
+        }
+    }
+}
+
+type TFMessageAlias = mobil_msgs::tf2_msgs::msg::TFMessage;
+
+impl Shell {
+    fn reconfigure(&mut self, c: LocalNavConfig) {
+        let built = c
+            .motion_limits()
+            .and_then(|l| Ok((l, c.nav_config()?)))
+            .map_err(|e| e.to_string())
+            .and_then(|(l, n)| Navigator::new(n, l).map(|nav| (l, nav)).map_err(|e| e.to_string()));
+        match built {
+            Ok((limits, mut nav)) => {
+                if let Some(a) = &self.active {
+                    // A valid goal stays valid; the new navigator starts it again in R-mode.
+                    if nav.set_goal(a.goal).is_err() {
+                        warn!("goal could not be carried over the parameter change");
+                    }
+                    info!("parameters changed: the goal restarts in R-mode with them");
+                }
+                self.limits = limits;
+                self.nav = nav;
+                self.progress = ProgressChecker::new(c.progress);
+                self.config = c;
+            }
+            Err(e) => warn!("parameters not applied: {e}"),
+        }
+    }
+
+    fn odom_in(&mut self, m: &Odometry) {
+        let p = &m.pose.pose;
+        let pose = Pose2::new(p.position.x, p.position.y, yaw_of(&p.orientation));
+        let speed = m.twist.twist.linear.x.hypot(m.twist.twist.linear.y);
+        if pose.is_finite() {
+            self.odom.set(
+                OdomSample {
+                    pose,
+                    msg_pose: p.clone(),
+                    speed: if speed.is_finite() { speed } else { 0.0 },
+                },
+                m.header.stamp.clone(),
+            );
+        } else {
+            warn_throttled!(self.throttle, "odom-nan", "odom with a non-finite pose dropped");
+        }
+    }
+
+    fn publish_status(&mut self, node: &RosNode, out: &Outputs, state: u8, reason: String) {
+        let last = self.last_step.as_ref();
+        let (goal, distance) = match (&self.active, last) {
+            (Some(a), Some(s)) => (Some(a.goal), s.goal_distance),
+            (Some(a), None) => (
+                Some(a.goal),
+                self.odom
+                    .value()
+                    .map_or(f64::NAN, |o| (a.goal - o.pose.position()).norm()),
+            ),
+            (None, _) => (self.nav.goal(), f64::NAN),
+        };
+        let view = StatusView {
+            state,
+            mode: self.nav.mode(),
+            goal,
+            distance_to_goal: distance,
+            reason,
+            hit_point: last.and_then(|s| s.hit_point),
+            leave_point: last.and_then(|s| s.leave_point),
+        };
+        if let Err(e) = out
+            .status
+            .publish(status_message(&view, node.stamp(), &self.config.odom_frame))
+        {
+            warn_throttled!(self.throttle, "status", "cannot publish local_nav/status: {e:?}");
+        }
+        self.last_status = Some(Instant::now());
+    }
+
+    fn zero(&mut self, out: &Outputs) {
+        if let Err(e) = out.cmd.publish(Twist::default()) {
+            warn_throttled!(self.throttle, "cmd", "cannot publish the zero cmd_vel: {e:?}");
+        }
+    }
+
+    /// Ends the active goal: one zero command, the status with the reason, the action's result.
+    fn end_goal(
+        &mut self,
+        node: &RosNode,
+        out: &Outputs,
+        server: &mut GoalServer<NavigateToPose>,
+        outcome: GoalOutcome,
+    ) {
+        let Some(active) = self.active.take() else { return };
+        self.zero(out);
+        if active.source == Source::Action {
+            server.finish(goal_end(&outcome), result(&outcome));
+        }
+        match outcome {
+            GoalOutcome::Succeeded | GoalOutcome::Canceled | GoalOutcome::Preempted(_) => {
+                info!("goal ({}) ends: {}", active.source.name(), outcome.reason())
+            }
+            _ => warn!("goal ({}) ends: {}", active.source.name(), outcome.reason()),
+        }
+        // The status keeps the last step's mode, distance, H and L; the goal stays in it.
+        let state = outcome.state();
+        let mode_before = self.nav.mode();
+        self.publish_status_with_mode(node, out, state, outcome.reason(), mode_before, Some(active.goal));
+        self.nav.cancel();
+        self.progress.reset();
+        self.last_step = None;
+    }
+
+    fn publish_status_with_mode(
+        &mut self,
+        node: &RosNode,
+        out: &Outputs,
+        state: u8,
+        reason: String,
+        mode: Mode,
+        goal: Option<Point2<f64>>,
+    ) {
+        let last = self.last_step.as_ref();
+        let view = StatusView {
+            state,
+            mode,
+            goal,
+            distance_to_goal: last.map_or(f64::NAN, |s| s.goal_distance),
+            reason,
+            hit_point: last.and_then(|s| s.hit_point),
+            leave_point: last.and_then(|s| s.leave_point),
+        };
+        if let Err(e) = out
+            .status
+            .publish(status_message(&view, node.stamp(), &self.config.odom_frame))
+        {
+            warn_throttled!(self.throttle, "status", "cannot publish local_nav/status: {e:?}");
+        }
+        self.last_status = Some(Instant::now());
+    }
+
+    /// Starts a validated goal (the old one, if any, has been ended).
+    fn start_goal(&mut self, node: &RosNode, out: &Outputs, goal: Point2<f64>, source: Source) {
+        if let Err(e) = self.nav.set_goal(goal) {
+            // goal_in_odom checked it: unreachable in practice, and safe if reached.
+            warn!("goal refused by the navigator: {e}");
+            return;
+        }
+        self.progress.reset();
+        self.last_step = None;
+        self.active = Some(ActiveGoal {
+            goal,
+            source,
+            started: Instant::now(),
+            started_ros_nanos: node.now_nanos(),
+        });
+        info!(
+            "goal ({}): ({:.3}, {:.3}) in {}",
+            source.name(),
+            goal.x,
+            goal.y,
+            self.config.odom_frame
+        );
+        self.publish_status(node, out, NavStatus::ACTIVE, String::new());
+    }
+
+    fn goal_pose_in(
+        &mut self,
+        node: &RosNode,
+        out: &Outputs,
+        server: &mut GoalServer<NavigateToPose>,
+        m: &PoseStamped,
+    ) {
+        match goal_in_odom(m, &self.config.odom_frame) {
+            Ok(goal) => {
+                if self.active.is_some() {
+                    self.end_goal(node, out, server, GoalOutcome::Preempted("goal_pose"));
+                }
+                self.start_goal(node, out, goal, Source::Topic);
+            }
+            Err(e) => {
+                // A goal the user meant to replace the old one with: the old one stops too.
+                if self.active.is_some() {
+                    self.end_goal(node, out, server, GoalOutcome::Preempted("goal_pose, refused"));
+                }
+                let outcome = GoalOutcome::Invalid(e);
+                warn!("goal_pose refused: {}", outcome.reason());
+                self.publish_status_with_mode(node, out, NavStatus::FAILED, outcome.reason(), Mode::Idle, None);
+            }
+        }
+    }
+
+    async fn action_goal_in(
+        &mut self,
+        node: &RosNode,
+        out: &Outputs,
+        server: &mut GoalServer<NavigateToPose>,
+        request: GoalRequest<NavigateToPoseGoal>,
+    ) {
+        let goal = match goal_in_odom(&request.goal().pose, &self.config.odom_frame) {
+            Ok(g) => g,
+            Err(e) => {
+                let reason = GoalOutcome::Invalid(e).reason();
+                warn!("navigate_to_pose goal rejected: {reason}");
+                server.reject(request, &reason).await;
+                return;
+            }
+        };
+        if !request.goal().behavior_tree.is_empty() {
+            warn_throttled!(
+                self.throttle,
+                "behavior-tree",
+                "navigate_to_pose: behavior_tree `{}` ignored (this navigator has no behaviour trees)",
+                request.goal().behavior_tree
+            );
+        }
+        if let Some(old) = self.active.clone() {
+            let outcome = GoalOutcome::Preempted("navigate_to_pose");
+            if old.source == Source::Action {
+                // The server ends the old action goal itself on accept, with this result.
+                self.active = None;
+                self.zero(out);
+                info!("goal ({}) ends: {}", old.source.name(), outcome.reason());
+                self.publish_status_with_mode(
+                    node,
+                    out,
+                    NavStatus::FAILED,
+                    outcome.reason(),
+                    self.nav.mode(),
+                    Some(old.goal),
+                );
+                self.nav.cancel();
+            } else {
+                self.end_goal(node, out, server, outcome);
+            }
+        }
+        let preempted = result(&GoalOutcome::Preempted("navigate_to_pose"));
+        match server.accept(request, |_| preempted).await {
+            Ok(()) => self.start_goal(node, out, goal, Source::Action),
+            Err(e) => warn_throttled!(self.throttle, "accept", "navigate_to_pose goal not started: {e}"),
+        }
+    }
+
+    fn scan_in(
+        &mut self,
+        node: &RosNode,
+        out: &Outputs,
+        server: &mut GoalServer<NavigateToPose>,
+        laser: &LaserPose,
+        m: &LaserScan,
+    ) {
+        let Some((base_from_laser, _)) = laser.get() else {
+            warn_throttled!(
+                self.throttle,
+                "laser-pose",
+                "scan ignored: no laser pose (tf_static {} → {} unknown and laser_pose invalid)",
+                self.config.base_frame,
+                self.config.laser_frame
+            );
+            return;
+        };
+        let scan = match scan_from_msg(m, base_from_laser) {
+            Ok(s) => s,
+            Err(e) => {
+                warn_throttled!(self.throttle, "scan-bad", "scan refused: {e}");
+                return;
+            }
+        };
+        self.scan_seen.set((), m.header.stamp.clone());
+        if self.active.is_none() {
+            return;
+        }
+        let Some(odom) = self.odom.get(self.config.odom_timeout()).cloned() else {
+            // The watchdog ends the goal if this lasts; no command from stale odometry.
+            return;
+        };
+        let step = self.nav.step(odom.pose, &scan);
+        if let Some(e) = step.input_error {
+            warn_throttled!(
+                self.throttle,
+                "nav-input",
+                "navigator refused its input: {e}; zero command"
+            );
+            self.zero(out);
+            return;
+        }
+        let changed = step.changed_from.is_some();
+        let mode = step.mode;
+        let command = step.command;
+        self.last_step = Some(step);
+        match mode {
+            Mode::Reached => return self.end_goal(node, out, server, GoalOutcome::Succeeded),
+            Mode::NoPath(r) => return self.end_goal(node, out, server, GoalOutcome::NoPath(r)),
+            _ => {}
+        }
+        let now = node.now_nanos() as f64 * 1e-9;
+        if let Progress::Stuck { since } = self.progress.check(odom.pose.position(), now) {
+            let radius = self.progress.settings().required_movement_radius;
+            return self.end_goal(node, out, server, GoalOutcome::NoProgress { since, radius });
+        }
+        let twist = twist_from_command(command, &self.limits);
+        if let Err(e) = out.cmd.publish(twist) {
+            warn_throttled!(self.throttle, "cmd", "cannot publish cmd_vel: {e:?}");
+        }
+        if changed {
+            info!("mode {}", mobil_local_nav_node::mode_name(mode));
+            self.publish_status(node, out, NavStatus::ACTIVE, String::new());
+        }
+    }
+
+    async fn tick(&mut self, node: &RosNode, out: &Outputs, server: &mut GoalServer<NavigateToPose>) {
+        let Some(active) = self.active.clone() else { return };
+        let now = Instant::now();
+        if let Some(which) = stale_input(
+            self.scan_seen.age_at(now),
+            self.odom.age_at(now),
+            now.saturating_duration_since(active.started),
+            self.config.scan_timeout(),
+            self.config.odom_timeout(),
+        ) {
+            return self.end_goal(node, out, server, GoalOutcome::Stale(which));
+        }
+        let period = Duration::from_secs_f64(1.0 / self.config.status_rate_hz);
+        if self
+            .last_status
+            .is_some_and(|t| now.saturating_duration_since(t) < period)
+        {
+            return;
+        }
+        self.publish_status(node, out, NavStatus::ACTIVE, String::new());
+        let stamp = node.stamp();
+        if let Some(step) = &self.last_step {
+            let view = MarkerView {
+                sectors: self.nav.sectors(),
+                direction: step.direction,
+                goal: Some(active.goal),
+                hit_point: step.hit_point,
+                leave_point: step.leave_point,
+            };
+            let array = markers(&view, stamp.clone(), &self.config.odom_frame, &self.config.base_frame);
+            if let Err(e) = out.markers.publish(array) {
+                warn_throttled!(self.throttle, "markers", "cannot publish local_nav/markers: {e:?}");
+            }
+        }
+        if active.source == Source::Action {
+            let Some(odom) = self.odom.value() else { return };
+            let distance = (active.goal - odom.pose.position()).norm();
+            let elapsed = (node.now_nanos().saturating_sub(active.started_ros_nanos)) as f64 * 1e-9;
+            let remaining = if odom.speed > 0.01 { distance / odom.speed } else { 0.0 };
+            let feedback = NavigateToPoseFeedback {
+                current_pose: PoseStamped {
+                    header: Header {
+                        stamp: stamp.clone(),
+                        frame_id: self.config.odom_frame.clone(),
+                    },
+                    pose: odom.msg_pose.clone(),
+                },
+                navigation_time: duration(elapsed),
+                estimated_time_remaining: duration(remaining),
+                number_of_recoveries: 0,
+                distance_remaining: distance as f32,
+            };
+            if let Err(e) = server.feedback(feedback).await {
+                warn_throttled!(self.throttle, "feedback", "{e}");
+            }
+        }
+    }
+}
