@@ -13,16 +13,20 @@ Each scenario sends one goal on ``goal_pose`` (PoseStamped in ``odom``) and chec
   would hide a navigator that drives too close;
 * the final state (SUCCEEDED, or FAILED with NO_PATH in the enclosed case), reached within a
   bounded simulated time, with the robot at rest afterwards;
-* for SUCCEEDED, the true final position within ``xy_goal_tolerance`` of G, plus the odometry's
-  own drift (the node stops on odometry; noise-free simulated encoders drift at most 0.15 % of the
-  distance driven on MOBIL-II, README "Simulator behaviour"): 0.2 % of the path is allowed;
+* for SUCCEEDED, the final odometry (what the node navigates on) within ``xy_goal_tolerance`` of
+  G, and the true final position within it plus the odometry's own drift, 1 % of the path (the
+  simulated encoders are noise-free, but a car-like robot slips while its two steering motors
+  move, most when it creeps along a wall: see ``ODOM_DRIFT_PER_M``);
 * the modes seen in the status (R, L, T), as each scenario needs them.
 
 Speed: sim_node publishes ``/clock`` at ``REAL_TIME_FACTOR``, the factor reached is measured here
 and must be at least ``MIN_FACTOR`` (see test_scenario.py for the watchdogs on the steady clock).
 The long scenarios (MOBIL-II's wall, trap and enclosure, OMR-III's trap and enclosure: 30-140
 simulated seconds) carry the ``slow_scenario`` marker (tests/pytest.ini) so that a quick run can
-leave them out with ``-m "not slow_scenario"``.
+leave them out with ``-m "not slow_scenario"``. Measured on the 2-core build machine at a load
+average of 7-12 (other builds running): the whole file 107 s of wall time, 5.0x reached in every
+case; the five slow cases 85 s of it (MOBIL-II's enclosure 30 s, its U-trap 26 s), the other six
+about 20 s.
 """
 
 from __future__ import annotations
@@ -49,8 +53,24 @@ CHASSIS_ARGS = ("-p", "feedback_timeout_s:=2.0")
 # sim_node's collision radius: small, so that the clearance check, not the simulated bumper,
 # judges how close the robot came.
 SIM_COLLISION_RADIUS = 0.05
-# Odometry drift allowed on top of xy_goal_tolerance, per metre of path (see the docstring).
-ODOM_DRIFT_PER_M = 0.002
+# Odometry drift allowed on top of xy_goal_tolerance for the true end, per metre of path (see the
+# docstring): 1 %. Measured: 0.2 % in open space; 0.6 % for MOBIL-II after creeping along a wall
+# with its steering moving (wall-mobil2: odometry 0.09 m from the truth after 12.8 m).
+ODOM_DRIFT_PER_M = 0.01
+# local_nav_node publishes its status at status_rate_hz (2 Hz of wall time by default) and not at
+# each mode change, so a mode held for less than half a wall second could go unseen; 20 Hz shows
+# every mode the scenarios rely on (each lasts simulated seconds).
+# Its scan and odom watchdogs (steady clock, 0.5 s) get 2 s, as chassis_node's feedback watchdog
+# does: with other builds holding the 2-core machine at a load average of 20, odom once stopped
+# for over half a wall second mid-run (a stalled machine is not what these scenarios check).
+NAV_ARGS = ("-p", "status_rate_hz:=20.0", "-p", "odom_timeout_s:=2.0", "-p", "scan_timeout_s:=2.0")
+# MOBIL-II cannot reverse or slide: where it meets a wall inside d_sa, the navigator slows its
+# motion toward the wall down to zero at the hard stop, and the car, whose turn needs forward
+# speed, then turns away at 1-2 cm/s for 15-25 simulated seconds before its turning circle clears
+# the wall (measured with the library on sim_node's plant). Nav2's default progress checker
+# (0.5 m within 10 s, params/mobil2.yaml) aborts the goal there; the scenarios that make the car
+# follow a wall (c, d, e) judge the method, so they give the checker 60 s.
+CREEP_ARGS = ("-p", "movement_time_allowance:=120.0")
 # NavStatus states.
 IDLE, ACTIVE, SUCCEEDED, FAILED = 0, 1, 2, 3
 
@@ -64,6 +84,7 @@ class Scenario:
     must_see: str = ""  # mode letters that must appear (R, L, T)
     must_not_see: str = ""  # mode letters that must not appear
     slow: bool = False
+    creeps: bool = False  # MOBIL-II at a wall: the progress checker needs more time (see below)
 
 
 # Worked out with the library (nodes/local_nav) on sim_node's plant and LIDAR in pure Rust: the
@@ -78,17 +99,17 @@ SCENARIOS: dict[str, dict[str, Scenario]] = {
     # (c) a 5 m wall: 23 s (OMR-III), 54 s (MOBIL-II).
     "wall": {"omr3": Scenario("local_nav_wall.yaml", (7.0, 1.0), 40.0, SUCCEEDED, "RL"),
              "mobil2": Scenario("local_nav_wall.yaml", (7.0, 1.0), 85.0, SUCCEEDED, "RL",
-                                slow=True)},
+                                slow=True, creeps=True)},
     # (d) the U-trap: 34 s (OMR-III), 123 s in the wide one (MOBIL-II).
     "u_trap": {"omr3": Scenario("local_nav_u_trap.yaml", (6.0, 0.0), 55.0, SUCCEEDED, "RLT",
                                 slow=True),
                "mobil2": Scenario("local_nav_u_trap_wide.yaml", (9.0, 0.0), 180.0, SUCCEEDED,
-                                  "RLT", slow=True)},
+                                  "RLT", slow=True, creeps=True)},
     # (e) the enclosed goal: NO_PATH after 46 s (OMR-III), 137 s (MOBIL-II).
     "enclosed": {"omr3": Scenario("local_nav_enclosed.yaml", (5.0, 0.0), 75.0, FAILED, "RLT",
                                   slow=True),
                  "mobil2": Scenario("local_nav_enclosed.yaml", (5.0, 0.0), 200.0, FAILED,
-                                    "RLT", slow=True)},
+                                    "RLT", slow=True, creeps=True)},
 }
 CASES = [pytest.param(name, robot, id=f"{name}-{robot}",
                       marks=[pytest.mark.slow_scenario] if s.slow else [])
@@ -214,13 +235,15 @@ def test_local_nav_scenario(name, robot, start_scenario, start_node, sim_clock, 
                    sim_args=("-p", f"world_file:={world_file}",
                              "-p", f"robot_radius:={SIM_COLLISION_RADIUS}"),
                    node_args=CHASSIS_ARGS)
-    start_node("local_nav_node", "-p", "use_sim_time:=true", params_file=params)
+    start_node("local_nav_node", "-p", "use_sim_time:=true", *NAV_ARGS,
+               *(CREEP_ARGS if sc.creeps else ()), params_file=params)
     if tolerance is None:
         tolerance = float(param_get(ros_node, "local_nav", "xy_goal_tolerance"))
 
     deep = make_qos("reliable", "volatile", 1000)
     goal_pub = ros_node.create_publisher(PoseStamped, "goal_pose", 10)
     with subscribe(ros_node, Odometry, "ground_truth", qos=deep) as truth, \
+            subscribe(ros_node, Odometry, "odom", qos=deep) as odom, \
             subscribe(ros_node, NavStatus, "local_nav/status",
                       qos=make_qos("reliable", "transient_local", 1000)) as status:
         sim_clock.wait_started(timeout=10)
@@ -242,14 +265,21 @@ def test_local_nav_scenario(name, robot, start_scenario, start_node, sim_clock, 
                       rate_hz=2.0, timeout=20.0)
         t_goal = sim_clock.now()
         mark = sim_clock.mark()
-        final = status.wait_for(lambda s: s.state in (SUCCEEDED, FAILED),
-                                timeout=sc.budget / MIN_FACTOR + 10.0)
+        # The end of this goal: after its first ACTIVE status (a FAILED before it, e.g. a goal
+        # refused while the inputs were not in yet, is not this goal's end).
+        # A goal still on its way when the first ACTIVE came pre-empts it (FAILED, PREEMPTED)
+        # and starts the same goal again: that is not this goal's end.
+        active = next(i for i, s in enumerate(status.snapshot()) if s.state == ACTIVE)
+        final = status.wait_for(lambda s: s.state == SUCCEEDED or s.state == FAILED
+                                and not s.reason.startswith("PREEMPTED"),
+                                timeout=sc.budget / MIN_FACTOR + 10.0, start=active)
         t_final = sim_clock.now()
         factor = sim_clock.factor(since=mark)
         # At rest: the ground truth one simulated second later has stopped.
         t_rest = t_final + 1.0
         sim_clock.wait_until(t_rest, timeout=10)
         rest = truth.wait_for(lambda m: seconds(m.header.stamp) >= t_rest, timeout=5)
+        odom_end = odom.wait_for(lambda m: seconds(m.header.stamp) >= t_rest, timeout=5)
         truths = truth.snapshot()
         statuses = status.snapshot()
 
@@ -277,6 +307,9 @@ def test_local_nav_scenario(name, robot, start_scenario, start_node, sim_clock, 
     tw = rest.twist.twist
     assert math.hypot(tw.linear.x, tw.linear.y) < 0.01 and abs(tw.angular.z) < 0.02, tw
     if sc.final == SUCCEEDED:
+        o = odom_end.pose.pose.position
+        assert math.dist((o.x, o.y), sc.goal) <= tolerance, (
+            f"odometry ends {math.dist((o.x, o.y), sc.goal):.3f} m from G, tolerance {tolerance}")
         miss = math.dist(end, sc.goal)
         assert miss <= tolerance + ODOM_DRIFT_PER_M * path, (
             f"true end {miss:.3f} m from G, tolerance {tolerance} + drift allowance "
