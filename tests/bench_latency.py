@@ -196,20 +196,24 @@ def main() -> int:
     spinner = rosutil.Spinner(node).start()
     try:
         x = 0.0
-        for t in targets:
-            # Warm up: until replies come (discovery), the goal repeated for local_nav.
+
+        def warm_up(t: Target, x: float) -> float:
+            """Feed until replies come (discovery; for local_nav a goal, sent again each round:
+            its scan and odom watchdogs end the goal while the other node is measured)."""
             deadline = time.monotonic() + 20.0
             while True:
                 t.goal_pub.publish(make_goal(time.time_ns()))
                 x = feed(t, 20, x, measure=False)
                 with t.lock:
                     if len(t.replies) >= 15:
-                        break
+                        return x
                 if time.monotonic() > deadline:
                     raise SystemExit(f"{t.ns}: no cmd_vel after 20 s; logs in {logs}")
+
         per_round = math.ceil(args.scans / args.rounds)
         for _ in range(args.rounds):
             for t in targets:
+                x = warm_up(t, x)
                 x = feed(t, per_round, x, measure=True)
     finally:
         spinner.stop()
