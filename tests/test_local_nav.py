@@ -9,20 +9,24 @@ gets 2 s, as in test_scenario.py.
 
 Invariants checked on cmd_vel: nothing before the first goal; every command within OMR-III's
 limits (speed ≤ v_max 0.5 m/s, |ω| ≤ omega_max 1.5 rad/s); exactly one zero command per goal
-that ends (each end is a status with a reason), and none after the last.
+that ends, and none after the last.
 """
 
 from __future__ import annotations
 
 import math
+import sys
+import threading
 import time
 from pathlib import Path
 
 import numpy as np
 import pytest
-import yaml
 
-from harness import make_qos, qos_latched, qos_sensor, subscribe, wait_until
+from foreign_lidar import WorldRaycaster
+
+from harness import (TESTS_DIR as TESTS, make_qos, param_set, qos_latched, qos_sensor, subscribe,
+                     wait_until)
 
 from action_msgs.msg import GoalStatus
 from geometry_msgs.msg import PoseStamped, Twist
@@ -57,11 +61,11 @@ def is_zero(t: Twist) -> bool:
     return (t.linear.x, t.linear.y, t.linear.z, t.angular.x, t.angular.y, t.angular.z) == (0.0,) * 6
 
 
-def check_commands(cmds: list[Twist], ends: int) -> None:
+def check_commands(cmds: list[Twist], ends: int, v_max: float = V_MAX) -> None:
     """Limits; one zero command per goal end, and the last command is zero."""
     for t in cmds:
         assert math.isfinite(t.linear.x) and math.isfinite(t.linear.y) and math.isfinite(t.angular.z)
-        assert math.hypot(t.linear.x, t.linear.y) <= V_MAX + 1e-9
+        assert math.hypot(t.linear.x, t.linear.y) <= v_max + 1e-9
         assert abs(t.angular.z) <= OMEGA_MAX + 1e-9
     zeros = [i for i, t in enumerate(cmds) if is_zero(t)]
     assert len(zeros) == ends, f"{len(zeros)} zero commands for {ends} goal end(s)"
@@ -70,6 +74,10 @@ def check_commands(cmds: list[Twist], ends: int) -> None:
 
 def ends_of(statuses: list[NavStatus]) -> list[NavStatus]:
     return [s for s in statuses if s.state in (NavStatus.SUCCEEDED, NavStatus.FAILED)]
+
+
+def statuses_index(rec, msg) -> int:
+    return next(i for i, m in enumerate(rec.snapshot()) if m is msg)
 
 
 def speed(m: Odometry) -> float:
@@ -89,8 +97,8 @@ def test_goal_pose_in_open_space(start_scenario, start_node, sim_clock, ros_node
     goal tolerance at rest, no cmd_vel before the goal, one zero cmd_vel after."""
     world = tmp_path / "empty.yaml"
     world.write_text("obstacles: []\n")
-    start_scenario(PARAMS, real_time_factor=REAL_TIME_FACTOR, lidar=True,
-                   sim_args=("-p", f"world_file:={world}"), node_args=CHASSIS_ARGS)
+    sim = start_scenario(PARAMS, real_time_factor=REAL_TIME_FACTOR, lidar=True,
+                         sim_args=("-p", f"world_file:={world}"), node_args=CHASSIS_ARGS)[0]
     start_local_nav(start_node)
     goal = (2.0, 1.5)
     pub = ros_node.create_publisher(PoseStamped, "goal_pose", 10)
@@ -112,11 +120,15 @@ def test_goal_pose_in_open_space(start_scenario, start_node, sim_clock, ros_node
         done = status.wait_for(lambda s: s.state in (NavStatus.SUCCEEDED, NavStatus.FAILED), 20.0)
         assert done.state == NavStatus.SUCCEEDED, done.reason
         assert done.reason.startswith("SUCCEEDED")
-        # At rest: 1 simulated second after the end (motor lag τ = 0.05 s).
+        # The zero command (reliable: it may take a repair), then 1 simulated second more, for
+        # a stray command to show and the robot to come to rest (motor lag τ = 0.05 s).
+        cmd.wait_for(is_zero, REPLY_TIMEOUT)
         sim_clock.wait_until(sim_clock.now() + 1.0)
         factor = sim_clock.factor(since=mark)
         rest = truth.wait_for(lambda m: speed(m) < 1e-3, REPLY_TIMEOUT, start=len(truth))
         statuses, cmds = status.snapshot(), cmd.snapshot()
+        # sim_node first, so that no ground truth or clock is in flight when the readers close.
+        sim.stop()
 
     assert factor >= MIN_FACTOR, f"{factor:.2f}× real time"
     x, y = position(rest)
@@ -126,10 +138,335 @@ def test_goal_pose_in_open_space(start_scenario, start_node, sim_clock, ros_node
     active = [s for s in statuses if s.state == NavStatus.ACTIVE]
     assert active and active[0].mode == "rotate"
     assert active[0].goal.position.x == goal[0] and active[0].goal.position.y == goal[1]
-    # The first ACTIVE status came before the first step: distance from the start, 2.5 m.
-    assert active[0].distance_to_goal == pytest.approx(math.hypot(*goal), abs=0.02)
+    # Distances while active (NaN before the first odometry): within the 2.5 m from the start.
+    distances = [s.distance_to_goal for s in active if math.isfinite(s.distance_to_goal)]
+    assert distances and max(distances) <= math.hypot(*goal) + 0.02
     assert statuses.index(active[0]) < statuses.index(done)
     assert done.distance_to_goal <= GOAL_TOLERANCE
     check_commands(cmds, len(ends_of(statuses)))
     # Open space: the navigator went straight, nothing tracked.
     assert not done.has_hit_point
+
+
+# --------------------------------------------------------------------------------------------
+# A foreign LIDAR: tests/foreign_lidar.py, its own raycaster over the world file, fed by
+# sim_node's ground truth, in its own process; sim_node's LIDAR off
+# --------------------------------------------------------------------------------------------
+
+class OpenSpaceScan:
+    """Publishes an empty 270° scan (541 beams, all +inf: nothing in range) on ``scan`` at 20
+    wall Hz from a thread, until stopped: a scan whose end the test controls."""
+
+    def __init__(self, node) -> None:
+        self.pub = node.create_publisher(LaserScan, "scan", qos_sensor())
+        self.msg = LaserScan()
+        self.msg.header.frame_id = "laser"
+        fov = 1.5 * math.pi
+        self.msg.angle_min, self.msg.angle_max = -fov / 2, fov / 2
+        self.msg.angle_increment = fov / 540
+        self.msg.range_min, self.msg.range_max = 0.06, 10.0
+        self.msg.ranges = [math.inf] * 541
+        self.last_sent = math.nan
+        self.defects: list = []
+        self.defects_sent = 0
+        self._broken = threading.Event()
+        self._stop = threading.Event()
+        self._thread = threading.Thread(target=self._run, daemon=True)
+        self._thread.start()
+
+    def _run(self) -> None:
+        n = 0
+        while not self._stop.wait(0.05):
+            if self._broken.is_set():
+                self.pub.publish(self.defects[n % len(self.defects)])
+                n += 1
+                self.defects_sent = n
+                continue
+            self.pub.publish(self.msg)
+            self.last_sent = time.monotonic()
+
+    def break_scans(self) -> float:
+        """From now on, only defective scans, each a defect the checked Scan refuses (no beams;
+        a negative, a NaN increment; NaN angles; more beams than the angles span; range_min
+        above range_max; three intensities for 541 ranges); returns the monotonic time of the
+        last valid scan."""
+        def bad(**fields) -> LaserScan:
+            m = LaserScan()
+            for name in ("header", "angle_min", "angle_max", "angle_increment", "range_min",
+                         "range_max", "ranges"):
+                setattr(m, name, getattr(self.msg, name))
+            for name, value in fields.items():
+                setattr(m, name, value)
+            return m
+        self.defects = [bad(ranges=[]), bad(angle_increment=-0.01), bad(angle_increment=math.nan),
+                        bad(angle_min=math.nan), bad(ranges=[1.0] * 900),
+                        bad(range_min=20.0), bad(intensities=[1.0, 2.0, 3.0])]
+        self._broken.set()
+        assert wait_until(lambda: self.defects_sent > 0, 5.0), "no defective scan sent"
+        return self.last_sent
+
+    def stop(self) -> float:
+        """Stops; returns the monotonic time of the last scan sent."""
+        self._stop.set()
+        self._thread.join(timeout=5)
+        return self.last_sent
+
+
+def start_foreign_lidar(start_node, tmp_path: Path, world: Path):
+    """tests/foreign_lidar.py as a node process (stopped like the Rust nodes)."""
+    wrapper = tmp_path / "foreign_lidar"
+    wrapper.write_text(f'#!/bin/sh\nexec "{sys.executable}" "{TESTS / "foreign_lidar.py"}" "$@"\n')
+    wrapper.chmod(0o755)
+    proc = start_node(str(wrapper), args=(str(world),))
+    proc.wait_for_log("foreign_lidar up", timeout=REPLY_TIMEOUT)
+    return proc
+
+
+def test_world_raycaster_by_hand(tmp_path):
+    """The test's raycaster against distances worked out by hand."""
+    world = tmp_path / "w.yaml"
+    world.write_text("obstacles:\n"
+                     "  - circle: { center: [2.0, 0.0], radius: 0.5 }\n"
+                     "  - polygon: { points: [[-1, 3], [1, 3], [1, 4], [-1, 4]] }\n")
+    c = WorldRaycaster(world, range_max=10.0)
+    r = c.ranges(0.0, 0.0, np.array([0.0, math.pi / 2, math.pi, math.atan2(3.0, 1.0)]))
+    # East: the circle's near side at 2 − 0.5 = 1.5; north: the box's edge y = 3; west: nothing;
+    # toward the box's corner (1, 3): √10 = 3.1623.
+    assert r[0] == pytest.approx(1.5) and r[1] == pytest.approx(3.0)
+    assert math.isinf(r[2]) and r[3] == pytest.approx(math.sqrt(10.0))
+
+
+def send_until_answered(client: ActionClient, goal, attempts: int = 4):
+    """Sends ``goal`` until a goal response arrives (a response sent before discovery has
+    matched this client's reply reader is lost; see test_actions.py), each attempt 3 s."""
+    for _ in range(attempts):
+        future = client.send_goal_async(goal)
+        if wait_until(future.done, 3.0):
+            return future.result()
+    raise AssertionError(f"no goal response to {attempts} goals")
+
+
+def cancel_until_answered(handle, attempts: int = 4):
+    """Cancels until a cancel response arrives, each attempt 3 s: rclpy's ActionClient drops a
+    response that comes back before it has filed the request ("Ignoring unexpected cancel
+    response"), which a fast server on a loaded machine makes happen now and then."""
+    futures = []
+    for _ in range(attempts):
+        futures.append(handle.cancel_goal_async())
+        if wait_until(lambda: any(f.done() for f in futures), 3.0):
+            return next(f for f in futures if f.done()).result()
+    raise AssertionError(f"no cancel response to {attempts} requests")
+
+
+def result_of(handle, timeout: float = 30.0):
+    """The goal's result; the request is repeated every 5 s while none came, for the same
+    rclpy race as ``cancel_until_answered`` ("Ignoring unexpected result response")."""
+    deadline = time.monotonic() + timeout
+    futures = []  # every request stays watched: the server may answer any of them
+    while time.monotonic() < deadline:
+        futures.append(handle.get_result_async())
+        if wait_until(lambda: any(f.done() for f in futures),
+                      min(5.0, max(0.1, deadline - time.monotonic()))):
+            return next(f for f in futures if f.done()).result()
+    raise AssertionError(f"no result within {timeout} s")
+
+
+def nav_goal(x: float, y: float, frame: str = "odom", tree: str = "") -> NavigateToPose.Goal:
+    g = NavigateToPose.Goal()
+    g.pose = goal_pose(x, y, frame)
+    g.behavior_tree = tree
+    return g
+
+
+def wait_future(future, what: str, timeout: float = REPLY_TIMEOUT):
+    assert wait_until(future.done, timeout), f"no {what} within {timeout} s"
+    return future.result()
+
+
+PILLAR = (1.5, 0.0, 0.3)  # x, y, radius: on the line from the start to the first goal
+
+
+def test_foreign_lidar_with_navigate_to_pose_and_cancel(start_scenario, start_node, sim_clock,
+                                                         ros_node, tmp_path):
+    """sim_node's LIDAR off; this test's raycaster feeds ``scan``. NavigateToPose round a pillar
+    on the straight line: feedback arrives, SUCCEEDED, the ground truth never nearer the pillar
+    than the robot radius and within the tolerance of the goal. A second goal is canceled mid-way:
+    CANCELED, the robot at rest within 1 simulated second, the last cmd_vel zero."""
+    world = tmp_path / "pillar.yaml"
+    world.write_text("obstacles:\n"
+                     f"  - circle: {{ center: [{PILLAR[0]}, {PILLAR[1]}], radius: {PILLAR[2]} }}\n"
+                     "  - polygon: { points: [[-2, -3], [6, -3], [6, -2.9], [-2, -2.9]] }\n")
+    sim = start_scenario(PARAMS, real_time_factor=REAL_TIME_FACTOR,
+                         sim_args=("-p", f"world_file:={world}"), node_args=CHASSIS_ARGS)[0]
+    nav = start_local_nav(start_node)
+    lidar = start_foreign_lidar(start_node, tmp_path, world)
+    feedback = []
+    with subscribe(ros_node, NavStatus, "local_nav/status", qos=qos_latched()) as status, \
+            subscribe(ros_node, Twist, "cmd_vel", qos=DEEP) as cmd, \
+            subscribe(ros_node, Odometry, "ground_truth", qos=make_qos("reliable", "volatile", 500)) as truth:
+        sim_clock.wait_started()
+        truth.wait_for(None, REPLY_TIMEOUT)
+        client = ActionClient(ros_node, NavigateToPose, "navigate_to_pose")
+        assert client.wait_for_server(timeout_sec=20.0), "navigate_to_pose not found"
+        # A goal in `map` is rejected (it also proves goal responses arrive).
+        rejected = send_until_answered(client, nav_goal(3.0, 0.0, frame="map"))
+        assert not rejected.accepted
+        # The cancel service answers too (a cancel naming no active goal is refused): its
+        # first request may be lost during discovery, which must not delay the real cancel.
+        cancel_until_answered(rejected)
+        nan = wait_future(client.send_goal_async(nav_goal(float("nan"), 0.0)), "goal response")
+        assert not nan.accepted
+        assert len(cmd) == 0, "cmd_vel before any accepted goal"
+        # The foreign scans reach local_nav_node (a goal gets one scan_timeout for them).
+        nav.wait_for_log("first scan", timeout=REPLY_TIMEOUT)
+
+        goal = (3.0, 0.0)
+        mark = sim_clock.mark()
+        handle = wait_future(client.send_goal_async(
+            nav_goal(*goal, tree="ignored.xml"), feedback_callback=feedback.append), "goal response")
+        assert handle.accepted
+        t_start = len(truth)
+        res = result_of(handle)
+        factor = sim_clock.factor(since=mark)
+        assert res.status == GoalStatus.STATUS_SUCCEEDED, res.result.error_msg
+        assert res.result.error_code == 0
+        rest1 = truth.wait_for(lambda m: speed(m) < 1e-3, REPLY_TIMEOUT, start=len(truth))
+        run = truth.snapshot()[t_start:]
+
+        # The second goal, 6 m north, canceled once the robot is under way.
+        handle2 = wait_future(client.send_goal_async(nav_goal(3.0, 6.0)), "goal response")
+        assert handle2.accepted
+        # Mid-way: 0.5 m on, under way at more than 0.2 m/s.
+        truth.wait_for(lambda m: position(m)[1] > 0.5 and speed(m) > 0.2, REPLY_TIMEOUT,
+                       start=len(truth))
+        cancel_until_answered(handle2)
+        t_cancel = sim_clock.now()
+        res2 = result_of(handle2)
+        assert res2.status == GoalStatus.STATUS_CANCELED
+        rest = truth.wait_for(lambda m: speed(m) < 1e-3, REPLY_TIMEOUT, start=len(truth))
+        stopped_after = rest.header.stamp.sec + rest.header.stamp.nanosec * 1e-9 - t_cancel
+        wait_until(lambda: cmd.latest is not None and is_zero(cmd.latest), REPLY_TIMEOUT)
+        sim_clock.wait_until(sim_clock.now() + 0.5)
+        assert "first scan published" in lidar.log_text()
+        statuses, cmds = status.snapshot(), cmd.snapshot()
+        # sim_node first, so that no ground truth or clock is in flight when the readers close.
+        sim.stop()
+
+    assert factor >= MIN_FACTOR, f"{factor:.2f}× real time"
+    # Feedback: in odom, the distance remaining falling toward the goal.
+    assert len(feedback) >= 2
+    first, last = feedback[0].feedback, feedback[-1].feedback
+    assert first.current_pose.header.frame_id == "odom"
+    # Feedback comes at status_rate_hz (2 Hz of wall time, 2.5 simulated seconds at 5×).
+    assert 0.0 < last.distance_remaining < first.distance_remaining <= 3.0 + 0.01
+    assert last.navigation_time.sec + last.navigation_time.nanosec * 1e-9 > 0.0
+    # Round the pillar: never nearer its surface than the robot radius; the goal reached.
+    clearance = min(math.hypot(x - PILLAR[0], y - PILLAR[1]) for x, y in map(position, run)) - PILLAR[2]
+    assert clearance >= ROBOT_RADIUS, f"clearance {clearance:.3f} m"
+    assert max(abs(position(m)[1]) for m in run) > 0.3, "went through the pillar's place"
+    x, y = position(rest1)
+    assert math.hypot(x - goal[0], y - goal[1]) <= GOAL_TOLERANCE
+    # Canceled: at rest within 1 simulated second of the cancel response (motor lag τ = 0.05 s).
+    assert stopped_after <= 1.0, f"stopped {stopped_after:.2f} s after the cancel"
+    reasons = [s.reason.split(":")[0] for s in ends_of(statuses)]
+    assert reasons[-2:] == ["SUCCEEDED", "CANCELED"], reasons
+    check_commands(cmds, 2)
+
+
+def test_refusals_preemption_and_stale_scan(start_scenario, start_node, sim_clock, ros_node, tmp_path):
+    """An empty scan from this test (open space). goal_pose in `map` and with NaN: status
+    FAILED INVALID_GOAL, nothing moves. An action goal pre-empted by a goal_pose goal ends
+    ABORTED with the reason PREEMPTED. The progress checker, made impossible to satisfy by
+    parameters set at run time, ends a goal ABORTED. Then only defective scans (each a defect the checked Scan
+    refuses), then none: within the scan timeout (0.5 s, steady clock) plus a tick of the last
+    valid scan the goal fails STALE_INPUT naming the scan, the last cmd_vel is zero, the robot
+    comes to rest, and local_nav_node exits cleanly at the end (checked at teardown)."""
+    world = tmp_path / "empty.yaml"
+    world.write_text("obstacles: []\n")
+    sim = start_scenario(PARAMS, real_time_factor=REAL_TIME_FACTOR,
+                         sim_args=("-p", f"world_file:={world}"), node_args=CHASSIS_ARGS)[0]
+    nav = start_local_nav(start_node)
+    lidar = OpenSpaceScan(ros_node)
+    pub = ros_node.create_publisher(PoseStamped, "goal_pose", 10)
+
+    def publish_until_status(msg: PoseStamped, predicate) -> NavStatus:
+        deadline = time.monotonic() + REPLY_TIMEOUT
+        start = len(status)
+        while True:
+            pub.publish(msg)
+            try:
+                return status.wait_for(predicate, 1.0, start=start)
+            except TimeoutError:
+                assert time.monotonic() < deadline, "goal_pose never answered on local_nav/status"
+
+    with subscribe(ros_node, NavStatus, "local_nav/status", qos=qos_latched()) as status, \
+            subscribe(ros_node, Twist, "cmd_vel", qos=DEEP) as cmd, \
+            subscribe(ros_node, Odometry, "ground_truth") as truth:
+        sim_clock.wait_started()
+        status.wait_for(lambda s: s.state == NavStatus.IDLE, REPLY_TIMEOUT)
+        truth.wait_for(None, REPLY_TIMEOUT)
+        in_map = publish_until_status(goal_pose(1.0, 0.0, frame="map"),
+                                      lambda s: s.state == NavStatus.FAILED)
+        assert in_map.reason == "INVALID_GOAL: goal in frame `map`, but goals must be in `odom`"
+        nan = publish_until_status(goal_pose(float("nan"), 0.0),
+                                   lambda s: s.state == NavStatus.FAILED)
+        assert nan.reason == "INVALID_GOAL: goal pose is not finite"
+        assert len(cmd) == 0, "a refused goal moved the robot"
+
+        nav.wait_for_log("first scan", timeout=REPLY_TIMEOUT)
+        client = ActionClient(ros_node, NavigateToPose, "navigate_to_pose")
+        assert client.wait_for_server(timeout_sec=20.0), "navigate_to_pose not found"
+        handle = send_until_answered(client, nav_goal(5.0, 0.0))
+        assert handle.accepted
+        cmd.wait_for(lambda t: t.linear.x > 0.1, REPLY_TIMEOUT)
+        active = publish_until_status(goal_pose(0.0, 2.0), lambda s: s.state == NavStatus.ACTIVE
+                                      and s.goal.position.y == 2.0)
+        assert active.mode == "rotate"
+        res = result_of(handle)
+        assert res.status == GoalStatus.STATUS_ABORTED
+        assert res.result.error_msg == "PREEMPTED: preempted by a newer goal (goal_pose)"
+        assert res.result.error_code == 0
+
+        # The progress checker, with Nav2's parameters set at run time: 5 m within 1 simulated
+        # second is more than OMR-III's 0.5 m/s can do, so the running goal (restarted with the
+        # new parameters) ends ABORTED once more than 1 s of ROS time passed without it.
+        assert param_set(ros_node, "/local_nav", "required_movement_radius", 5.0).successful
+        assert param_set(ros_node, "/local_nav", "movement_time_allowance", 1.0).successful
+        aborted = status.wait_for(lambda s: s.state == NavStatus.FAILED
+                                  and s.reason.startswith("ABORTED"), REPLY_TIMEOUT)
+        assert param_set(ros_node, "/local_nav", "movement_time_allowance", 10.0).successful
+        assert param_set(ros_node, "/local_nav", "required_movement_radius", 0.5).successful
+        publish_until_status(goal_pose(0.0, -2.0), lambda s: s.state == NavStatus.ACTIVE
+                             and s.goal.position.y == -2.0)
+
+        stopped = lidar.break_scans()
+        stale = status.wait_for(lambda s: s.state == NavStatus.FAILED and s.reason.startswith("STALE"),
+                                REPLY_TIMEOUT)
+        # Every defect again after the goal ended: refused without a panic (the node's exit code
+        # at teardown is checked), then no scan at all.
+        assert wait_until(lambda: lidar.defects_sent >= 2 * len(lidar.defects), REPLY_TIMEOUT)
+        lidar.stop()
+        after = status.times[statuses_index(status, stale)] - stopped
+        rest = truth.wait_for(lambda m: speed(m) < 1e-3, REPLY_TIMEOUT, start=len(truth))
+        # The zero command, then a simulated second for a stray command to show.
+        wait_until(lambda: cmd.latest is not None and is_zero(cmd.latest), REPLY_TIMEOUT)
+        sim_clock.wait_until(sim_clock.now() + 1.0)
+        statuses, cmds = status.snapshot(), cmd.snapshot()
+        # sim_node first, so that no ground truth or clock is in flight when the readers close.
+        sim.stop()
+
+    # Checked on the scan after 1 s: 20 wall Hz is 0.25 simulated s at 5×, and a loaded machine
+    # may delay a scan further.
+    prefix = "ABORTED: no progress: moved less than 5 m in "
+    assert aborted.reason.startswith(prefix) and aborted.reason.endswith(" s"), aborted.reason
+    assert 1.0 < float(aborted.reason[len(prefix):-2]) <= 2.0, aborted.reason
+    assert stale.reason == "STALE_INPUT: scan stale: robot stopped"
+    # 0.5 s of scan timeout from the last scan, a 50 ms tick, and DDS and scheduling on a loaded
+    # machine.
+    assert 0.45 <= after <= 1.5, f"STALE_INPUT {after:.2f} s after the last scan"
+    assert speed(rest) < 1e-3
+    # Three goals ended: the action goal (PREEMPTED, in its result: the status is latched with
+    # depth 1, so the new goal's ACTIVE may supersede it before it reaches this reader) and the
+    # goal_pose goals (ABORTED, STALE_INPUT); the refused goals started and stopped nothing.
+    assert [s.reason.split(":")[0] for s in ends_of(statuses)][-2:] == ["ABORTED", "STALE_INPUT"]
+    check_commands(cmds, 3)

@@ -15,7 +15,7 @@ use mobil_local_nav::{
     Drive, Mode, MotionLimits, NavConfig, NoPathReason, ProgressSettings, Sectors, Side, UnseenSectors,
     VelocityCommand, WeightProfile,
 };
-use mobil_msgs::builtin_interfaces::msg::Time;
+use mobil_msgs::builtin_interfaces::msg::{Duration as RosDuration, Time};
 use mobil_msgs::geometry_msgs::msg::{Point, Pose, PoseStamped, Twist, Vector3};
 use mobil_msgs::mobil_msgs::msg::NavStatus;
 use mobil_msgs::std_msgs::msg::{ColorRGBA, Header};
@@ -54,19 +54,19 @@ pub struct LocalNavConfig {
     pub weights: Vec<f64>,
     /// Nav2's progress checker.
     pub progress: ProgressSettings,
-    /// A goal fails STALE_INPUT when no scan arrived for this long (steady clock) [s].
+    /// A goal fails STALE_INPUT when no scan arrived for this long (steady clock), in seconds.
     pub scan_timeout_s: f64,
-    /// A goal fails STALE_INPUT when no odometry arrived for this long (steady clock) [s].
+    /// A goal fails STALE_INPUT when no odometry arrived for this long (steady clock), in seconds.
     pub odom_timeout_s: f64,
-    /// Status, markers and action feedback rate while a goal is active [Hz].
+    /// Status and markers rate while a goal is active, in Hz.
     pub status_rate_hz: f64,
-    /// How long a finished action goal's result waits for the client to ask for it [s].
+    /// How long a finished action goal's result waits for the client to ask for it, in seconds.
     pub result_timeout_s: f64,
-    /// Frame goals must be in, and the frame of `odom` [odom].
+    /// Frame goals must be in, and the frame of `odom` (default `odom`).
     pub odom_frame: String,
-    /// The robot frame [base_link].
+    /// The robot frame (default `base_link`).
     pub base_frame: String,
-    /// The laser frame looked up in `tf_static` when a scan names none.
+    /// The scan's frame, looked up in `tf_static`.
     pub laser_frame: String,
     /// Laser pose (x, y, yaw) in the base frame, used until (unless) `tf_static` gives one.
     pub laser_pose: [f64; 3],
@@ -237,7 +237,7 @@ impl Config for LocalNavConfig {
         d.double(
             "status_rate_hz",
             2.0,
-            "local_nav/status, markers and action feedback rate while a goal is active [Hz]",
+            "local_nav/status and markers rate while a goal is active (action feedback: 20 Hz) [Hz]",
             |c, v| c.status_rate_hz = v,
         )
         .within(0.1, 50.0);
@@ -253,22 +253,26 @@ impl Config for LocalNavConfig {
             "odom",
             "frame of odom; goals in any other frame are refused",
             |c, v| c.odom_frame = v,
-        );
+        )
+        .read_only();
         d.string("base_frame", "base_link", "robot frame (reference point)", |c, v| {
             c.base_frame = v
-        });
+        })
+        .read_only();
         d.string(
             "laser_frame",
             "laser",
-            "laser frame looked up in tf_static when a scan's header names none",
+            "the scan's frame: its pose in base_frame comes from tf_static",
             |c, v| c.laser_frame = v,
-        );
+        )
+        .read_only();
         d.doubles(
             "laser_pose",
             [0.0, 0.0, 0.0],
             "x, y, yaw of the laser in the base frame, used until (unless) tf_static gives it",
             |c, v| c.laser_pose = v,
-        );
+        )
+        .read_only();
     }
 
     fn validate(&self) -> Result<(), ConfigError> {
@@ -369,6 +373,21 @@ pub fn twist_from_command(command: VelocityCommand, limits: &MotionLimits) -> Tw
     t.linear.y = c.vy;
     t.angular.z = c.omega;
     t
+}
+
+/// A duration message of `seconds` (navigation time, time remaining): negative (the clock went
+/// backwards), NaN or infinite give zero, and it saturates at 10⁹ s.
+pub fn duration_msg(seconds: f64) -> RosDuration {
+    let s = if seconds.is_finite() {
+        seconds.clamp(0.0, 1e9)
+    } else {
+        0.0
+    };
+    let sec = s.floor();
+    RosDuration {
+        sec: sec as i32,
+        nanosec: ((s - sec) * 1e9).min(999_999_999.0) as u32,
+    }
 }
 
 /// Which input went stale.
@@ -662,6 +681,18 @@ pub fn markers(view: &MarkerView<'_>, stamp: Time, odom_frame: &str, base_frame:
     MarkerArray { markers: out }
 }
 
+/// The marker array that removes every local_nav marker (sent when a goal ends, so RViz does not
+/// keep showing the sectors and points of a goal that is over).
+pub fn clear_markers(stamp: Time, frame: &str) -> MarkerArray {
+    let header = Header {
+        stamp,
+        frame_id: frame.to_owned(),
+    };
+    let mut m = marker(&header, 0, Marker::SPHERE, 0.0, color(0.0, 0.0, 0.0));
+    m.action = Marker::DELETEALL;
+    MarkerArray { markers: vec![m] }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -787,6 +818,17 @@ mod tests {
     }
 
     #[test]
+    fn durations_never_go_negative() {
+        let d = duration_msg(12.25);
+        assert_eq!((d.sec, d.nanosec), (12, 250_000_000));
+        for bad in [-3.0, f64::NAN, f64::INFINITY] {
+            let d = duration_msg(bad);
+            assert_eq!((d.sec, d.nanosec), (0, 0), "{bad}");
+        }
+        assert_eq!(duration_msg(5e9).sec, 1_000_000_000);
+    }
+
+    #[test]
     fn outcomes_give_status_reasons_and_nav2_codes() {
         let stale = GoalOutcome::Stale(StaleInput::Scan);
         assert_eq!(stale.reason(), "STALE_INPUT: scan stale: robot stopped");
@@ -867,5 +909,11 @@ mod tests {
         assert_eq!(a.markers[3].action, Marker::DELETE);
         assert_eq!(a.markers[4].pose.position.x, 1.0);
         assert_eq!(a.markers[2].header.frame_id, "odom");
+        let cleared = clear_markers(Time::default(), "odom");
+        assert_eq!(cleared.markers.len(), 1);
+        assert_eq!(
+            (cleared.markers[0].action, cleared.markers[0].ns.as_str()),
+            (Marker::DELETEALL, "local_nav")
+        );
     }
 }

@@ -6,8 +6,9 @@
 //! **One step per scan**: each valid scan, with fresh odometry, is one navigator step and one
 //! `cmd_vel`. The method works on the scan, so a step between scans would repeat the last one,
 //! and stepping on arrival adds no queueing delay to the scan-to-command latency. A 20 Hz
-//! watchdog tick on the steady clock ends a goal whose scan or odometry went stale, and
-//! publishes status, markers and action feedback at `status_rate_hz`.
+//! watchdog tick on the steady clock ends a goal whose scan or odometry went stale and sends the
+//! action feedback; status and markers follow at `status_rate_hz` (and the status on every
+//! change of state or mode).
 //!
 //! `cmd_vel` goes out only while a goal is active, and exactly one zero `cmd_vel` when a goal
 //! ends (reached, no path, no progress, stale input, canceled, pre-empted, refused, shutdown);
@@ -18,10 +19,10 @@ use futures::StreamExt;
 use mobil_geom::Pose2;
 use mobil_local_nav::{Mode, MotionLimits, Navigator, Progress, ProgressChecker, StepOutput};
 use mobil_local_nav_node::{
-    goal_in_odom, markers, stale_input, status_message, twist_from_command, GoalOutcome, LocalNavConfig, MarkerView,
-    StatusView,
+    clear_markers, duration_msg, goal_in_odom, markers, stale_input, status_message, twist_from_command, GoalOutcome,
+    LocalNavConfig, MarkerView, StatusView,
 };
-use mobil_msgs::builtin_interfaces::msg::Duration as RosDuration;
+use mobil_msgs::builtin_interfaces::msg::Time;
 use mobil_msgs::geometry_msgs::msg::{Pose, PoseStamped, Twist};
 use mobil_msgs::mobil_msgs::msg::NavStatus;
 use mobil_msgs::nav2_msgs::action::{NavigateToPose, NavigateToPoseFeedback, NavigateToPoseGoal, NavigateToPoseResult};
@@ -149,19 +150,6 @@ fn goal_end(outcome: &GoalOutcome) -> GoalEnd {
         GoalOutcome::Succeeded => GoalEnd::Succeeded,
         GoalOutcome::Canceled => GoalEnd::Canceled,
         _ => GoalEnd::Aborted,
-    }
-}
-
-fn duration(seconds: f64) -> RosDuration {
-    let s = if seconds.is_finite() {
-        seconds.clamp(0.0, 1e9)
-    } else {
-        0.0
-    };
-    let sec = s.floor();
-    RosDuration {
-        sec: sec as i32,
-        nanosec: ((s - sec) * 1e9).min(999_999_999.0) as u32,
     }
 }
 
@@ -330,34 +318,39 @@ impl Shell {
         }
     }
 
-    fn publish_status(&mut self, node: &RosNode, out: &Outputs, state: u8, reason: String) {
+    /// What the status says: the last step's distance, H and L (else the distance from the
+    /// latest odometry, else NaN).
+    fn status_view(&self, state: u8, reason: String, mode: Mode, goal: Option<Point2<f64>>) -> StatusView {
         let last = self.last_step.as_ref();
-        let (goal, distance) = match (&self.active, last) {
-            (Some(a), Some(s)) => (Some(a.goal), s.goal_distance),
-            (Some(a), None) => (
-                Some(a.goal),
-                self.odom
-                    .value()
-                    .map_or(f64::NAN, |o| (a.goal - o.pose.position()).norm()),
-            ),
-            (None, _) => (self.nav.goal(), f64::NAN),
+        let distance = match (last, goal, self.odom.value()) {
+            (Some(s), _, _) => s.goal_distance,
+            (None, Some(g), Some(o)) => (g - o.pose.position()).norm(),
+            _ => f64::NAN,
         };
-        let view = StatusView {
+        StatusView {
             state,
-            mode: self.nav.mode(),
+            mode,
             goal,
             distance_to_goal: distance,
             reason,
             hit_point: last.and_then(|s| s.hit_point),
             leave_point: last.and_then(|s| s.leave_point),
-        };
-        if let Err(e) = out
-            .status
-            .publish(status_message(&view, node.stamp(), &self.config.odom_frame))
-        {
+        }
+    }
+
+    fn send_status(&mut self, node: &RosNode, out: &Outputs, view: &StatusView) {
+        let msg = status_message(view, node.stamp(), &self.config.odom_frame);
+        if let Err(e) = out.status.publish(msg) {
             warn_throttled!(self.throttle, "status", "cannot publish local_nav/status: {e:?}");
         }
         self.last_status = Some(Instant::now());
+    }
+
+    /// The status of the current goal (or of none).
+    fn publish_status(&mut self, node: &RosNode, out: &Outputs, state: u8, reason: String) {
+        let goal = self.active.as_ref().map(|a| a.goal).or(self.nav.goal());
+        let view = self.status_view(state, reason, self.nav.mode(), goal);
+        self.send_status(node, out, &view);
     }
 
     fn zero(&mut self, out: &Outputs) {
@@ -392,6 +385,12 @@ impl Shell {
         self.nav.cancel();
         self.progress.reset();
         self.last_step = None;
+        if let Err(e) = out
+            .markers
+            .publish(clear_markers(node.stamp(), &self.config.odom_frame))
+        {
+            warn_throttled!(self.throttle, "markers", "cannot publish local_nav/markers: {e:?}");
+        }
     }
 
     fn publish_status_with_mode(
@@ -403,23 +402,8 @@ impl Shell {
         mode: Mode,
         goal: Option<Point2<f64>>,
     ) {
-        let last = self.last_step.as_ref();
-        let view = StatusView {
-            state,
-            mode,
-            goal,
-            distance_to_goal: last.map_or(f64::NAN, |s| s.goal_distance),
-            reason,
-            hit_point: last.and_then(|s| s.hit_point),
-            leave_point: last.and_then(|s| s.leave_point),
-        };
-        if let Err(e) = out
-            .status
-            .publish(status_message(&view, node.stamp(), &self.config.odom_frame))
-        {
-            warn_throttled!(self.throttle, "status", "cannot publish local_nav/status: {e:?}");
-        }
-        self.last_status = Some(Instant::now());
+        let view = self.status_view(state, reason, mode, goal);
+        self.send_status(node, out, &view);
     }
 
     /// Starts a validated goal (the old one, if any, has been ended).
@@ -542,6 +526,16 @@ impl Shell {
             );
             return;
         };
+        let frame = m.header.frame_id.trim_start_matches('/');
+        if !frame.is_empty() && frame != self.config.laser_frame.trim_start_matches('/') {
+            warn_throttled!(
+                self.throttle,
+                "scan-frame",
+                "scan in frame `{frame}` but laser_frame is `{}`: the pose of `{}` is used",
+                self.config.laser_frame,
+                self.config.laser_frame
+            );
+        }
         let scan = match scan_from_msg(m, base_from_laser) {
             Ok(s) => s,
             Err(e) => {
@@ -549,6 +543,16 @@ impl Shell {
                 return;
             }
         };
+        if self.scan_seen.value().is_none() {
+            info!(
+                "first scan: {} beams, laser at ({:.3}, {:.3}, {:.3} rad) in {}",
+                scan.len(),
+                base_from_laser.x,
+                base_from_laser.y,
+                base_from_laser.yaw,
+                self.config.base_frame
+            );
+        }
         self.scan_seen.set((), m.header.stamp.clone());
         if self.active.is_none() {
             return;
@@ -604,14 +608,18 @@ impl Shell {
             return self.end_goal(node, out, server, GoalOutcome::Stale(which));
         }
         let period = Duration::from_secs_f64(1.0 / self.config.status_rate_hz);
+        let stamp = node.stamp();
         if self
             .last_status
-            .is_some_and(|t| now.saturating_duration_since(t) < period)
+            .is_none_or(|t| now.saturating_duration_since(t) >= period)
         {
-            return;
+            self.publish_status(node, out, NavStatus::ACTIVE, String::new());
+            self.publish_markers(out, &active, stamp.clone());
         }
-        self.publish_status(node, out, NavStatus::ACTIVE, String::new());
-        let stamp = node.stamp();
+        self.feedback(node, server, &active, stamp).await;
+    }
+
+    fn publish_markers(&mut self, out: &Outputs, active: &ActiveGoal, stamp: Time) {
         if let Some(step) = &self.last_step {
             let view = MarkerView {
                 sectors: self.nav.sectors(),
@@ -620,11 +628,21 @@ impl Shell {
                 hit_point: step.hit_point,
                 leave_point: step.leave_point,
             };
-            let array = markers(&view, stamp.clone(), &self.config.odom_frame, &self.config.base_frame);
+            let array = markers(&view, stamp, &self.config.odom_frame, &self.config.base_frame);
             if let Err(e) = out.markers.publish(array) {
                 warn_throttled!(self.throttle, "markers", "cannot publish local_nav/markers: {e:?}");
             }
         }
+    }
+
+    /// Action feedback, on every watchdog tick (20 Hz) while an action goal is active.
+    async fn feedback(
+        &mut self,
+        node: &RosNode,
+        server: &mut GoalServer<NavigateToPose>,
+        active: &ActiveGoal,
+        stamp: Time,
+    ) {
         if active.source == Source::Action {
             let Some(odom) = self.odom.value() else { return };
             let distance = (active.goal - odom.pose.position()).norm();
@@ -638,8 +656,8 @@ impl Shell {
                     },
                     pose: odom.msg_pose.clone(),
                 },
-                navigation_time: duration(elapsed),
-                estimated_time_remaining: duration(remaining),
+                navigation_time: duration_msg(elapsed),
+                estimated_time_remaining: duration_msg(remaining),
                 number_of_recoveries: 0,
                 distance_remaining: distance as f32,
             };
