@@ -9,12 +9,16 @@
 //! - [`sim`]: continuous-time integration of a docking (RK4 sub-steps on the closed loop).
 //! - [`mod@approach`]: the goal approach without final heading for a steered chassis (δ within
 //!   δ_eff, atan2, progress stop only within steering reach, Z_crit) and the shortest step.
+//! - [`route`]: the route pre-check — a virtual robot drives the route on the chassis model
+//!   against a [`mobil_sim::world::World`] and reports every collision, turn below the minimum
+//!   radius and unreachable waypoint with its index.
 
 #![warn(missing_docs)]
 
 pub mod approach;
 pub mod docking;
 pub mod error;
+pub mod route;
 pub mod sim;
 
 pub use approach::{
@@ -27,4 +31,5 @@ pub use docking::{
     DockingPhase, Finish, GainWarning, PolarError, Velocity, VelocityLimits,
 };
 pub use error::PlannerError;
+pub use route::{arc_radius, check_route, ProblemKind, RouteCheckConfig, RouteProblem, RouteReport, UnreachableCause};
 pub use sim::{advance, rk4_step, simulate_docking, DockingRun, DockingSample, Kinematics};
