@@ -1,5 +1,8 @@
 //! Route pre-check by a virtual robot (SPEC §4): every problem with its waypoint index.
 
+#[path = "../benches/common/demo_loop.rs"]
+mod demo_loop;
+
 use std::f64::consts::PI;
 
 use approx::assert_relative_eq;
@@ -209,6 +212,26 @@ fn every_problem_of_one_route_is_reported() {
     };
     assert!((at.y - 4.97).abs() < 0.03, "{at:?}");
     assert_eq!(report.reached, [false, true, false, false]);
+}
+
+#[test]
+fn the_demo_loop_passes_on_both_chassis() {
+    let route = demo_loop::demo_loop(20);
+    // Waypoint 5 (index 4) lies 12.2832·5/20 = 3.0708 m along: 2 m of straight, then 1.0708 rad
+    // round the corner (2, 1) from −π/2: (2 + cos(−0.5), 1 + sin(−0.5)) = (2.877583, 0.520574).
+    assert_relative_eq!(route[4].x, 2.877_583, epsilon = 1e-6);
+    assert_relative_eq!(route[4].y, 0.520_574, epsilon = 1e-6);
+    assert_relative_eq!((route[19] - Point2::new(0.0, 0.0)).norm(), 0.0, epsilon = 1e-12);
+    let world = default_world();
+    for (params, radius) in [(ChassisParams::mobil2(), 0.53), (ChassisParams::omr3(), 0.25)] {
+        let config = RouteCheckConfig {
+            robot_radius: radius,
+            ..RouteCheckConfig::default()
+        };
+        let report = check_route(&Pose2::identity(), &route, &params, &world, &config).expect("valid");
+        assert!(report.is_ok(), "{}: {:?}", params.model(), report.problems);
+        assert_eq!(report.reached, [true; 20]);
+    }
 }
 
 #[test]
