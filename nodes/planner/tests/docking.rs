@@ -91,6 +91,30 @@ fn paper_run_reverses_then_docks_with_v_never_increasing() {
 }
 
 #[test]
+fn commands_held_for_a_control_period_still_never_raise_v() {
+    // A node holds each command for its period (exact arcs): at 10, 20 and 50 ms the paper's
+    // run still has V falling at every step until the in-place rotation takes over.
+    for period in [0.01, 0.02, 0.05] {
+        let mut c = controller(VelocityLimits::unlimited(), Finish::RotateInPlace);
+        let mut pose = paper_start();
+        let mut previous = f64::INFINITY;
+        let mut steps = 0;
+        loop {
+            let out = c.update(&pose, steps as f64 * period).expect("finite");
+            if out.phase != DockingPhase::Approach {
+                assert_eq!(out.phase, DockingPhase::Rotate, "period {period}");
+                break;
+            }
+            assert!(out.lyapunov < previous, "period {period}, step {steps}: V rose");
+            previous = out.lyapunov;
+            pose = mobil_planner::advance(&pose, &out.command.to_twist(), period);
+            steps += 1;
+            assert!(steps as f64 * period < 60.0, "period {period}: no convergence");
+        }
+    }
+}
+
+#[test]
 fn lyapunov_rate_matches_a_finite_difference_of_v() {
     // A second method for eq. (3.48): V̇ from a central difference of V along the closed loop.
     let gains = DockingGains::paper();
@@ -167,6 +191,38 @@ fn limits_scale_v_and_omega_by_one_factor() {
     // Within limits: unchanged.
     assert_eq!(limits.apply(Velocity::new(0.1, -0.2)), (Velocity::new(0.1, -0.2), 1.0));
     assert_eq!(limits.factor(Velocity::new(f64::NAN, 0.0)), 0.0);
+}
+
+#[test]
+fn clipping_omega_alone_would_raise_v() {
+    // V̇ for any (v, ω), from the kinematics (ė = −v cos α, α̇ = −ω + v sin α / e,
+    // Θ̇ = v sin α / e): V̇ = −λev cos α + α(−ω + v sin α/e) + hΘ·v sin α/e.
+    let (lambda, h) = (0.55, 0.5);
+    let p = mobil_planner::PolarError {
+        e: 0.1,
+        alpha: 0.1,
+        theta: 3.0,
+    };
+    let rate = |v: f64, w: f64| {
+        let s = v * p.alpha.sin() / p.e;
+        -lambda * p.e * v * p.alpha.cos() + p.alpha * (-w + s) + h * p.theta * s
+    };
+    // The law: v = 0.5·0.1·cos 0.1 = 0.0497502; ω = 0.03 + 0.5·cos 0.1·sinc 0.1·(0.1 + 1.5)
+    // = 0.824678.
+    let law = DockingGains::paper().law(&p);
+    assert_relative_eq!(law.v, 0.049_750_2, epsilon = 1e-7);
+    assert_relative_eq!(law.omega, 0.824_678, epsilon = 1e-6);
+    // ω clipped alone to 0.2: V̇ = −0.0027225 − 0.0150333 + 0.0745009 = +0.0567451 > 0.
+    assert_relative_eq!(rate(law.v, 0.2), 0.056_745_1, epsilon = 1e-6);
+    // One common factor s = 0.2/0.824678 = 0.242519: V̇ = s·(−0.0057226) = −0.0013878 < 0.
+    let (cmd, s) = VelocityLimits::new(1.0, 0.2).expect("valid").apply(law);
+    assert_relative_eq!(s, 0.242_519, epsilon = 1e-6);
+    assert_relative_eq!(rate(cmd.v, cmd.omega), -0.001_387_8, epsilon = 1e-6);
+    assert_relative_eq!(
+        rate(cmd.v, cmd.omega),
+        DockingGains::paper().lyapunov_rate(&p, s),
+        epsilon = 1e-12
+    );
 }
 
 #[test]
