@@ -216,15 +216,30 @@ pub struct ApproachRun {
     pub travelled: f64,
 }
 
-/// Drives the approach from `start` to `goal`, calling `visit` with every new pose; `visit`
-/// returns false to stop early (reported as [`ApproachEnd::StepLimit`]).
+/// How an approach ended, without its path.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ApproachOutcome {
+    /// Why it ended.
+    pub end: ApproachEnd,
+    /// The last pose.
+    pub pose: Pose2,
+    /// Smallest distance to the goal on the way (m).
+    pub closest: f64,
+    /// Path length driven (m).
+    pub travelled: f64,
+}
+
+/// Drives the approach from `start` to `goal`, calling `visit` with every new pose and the
+/// path length so far; `visit` returns false to stop early (reported as
+/// [`ApproachEnd::StepLimit`]). The configuration is taken as valid
+/// ([`ApproachConfig::validate`]).
 pub fn approach_with(
     start: &Pose2,
     goal: &Point2<f64>,
     motion: &Motion,
     config: &ApproachConfig,
     mut visit: impl FnMut(&Pose2, f64) -> bool,
-) -> (ApproachEnd, Pose2, f64, f64) {
+) -> ApproachOutcome {
     let mut pose = *start;
     let mut v = config.step_length;
     let mut z = distance(&pose, goal);
@@ -234,9 +249,15 @@ pub fn approach_with(
         Motion::Steered(s) => s.limit,
         Motion::Holonomic => std::f64::consts::PI + 1.0,
     };
+    let outcome = |end, pose, closest, travelled| ApproachOutcome {
+        end,
+        pose,
+        closest,
+        travelled,
+    };
     for _ in 0..config.max_steps {
         if z < config.critical_distance {
-            return (ApproachEnd::Reached, pose, closest, travelled);
+            return outcome(ApproachEnd::Reached, pose, closest, travelled);
         }
         let step = approach_step(&pose, goal, v, motion);
         travelled += v;
@@ -247,16 +268,16 @@ pub fn approach_with(
         let progress = z - z_next;
         z = z_next;
         if !visit(&pose, travelled) {
-            return (ApproachEnd::StepLimit, pose, closest, travelled);
+            return outcome(ApproachEnd::StepLimit, pose, closest, travelled);
         }
         if z < config.critical_distance {
-            return (ApproachEnd::Reached, pose, closest, travelled);
+            return outcome(ApproachEnd::Reached, pose, closest, travelled);
         }
         if bearing(&pose, goal).abs() < reach && progress <= config.progress_epsilon {
-            return (ApproachEnd::NoProgress, pose, closest, travelled);
+            return outcome(ApproachEnd::NoProgress, pose, closest, travelled);
         }
     }
-    (ApproachEnd::StepLimit, pose, closest, travelled)
+    outcome(ApproachEnd::StepLimit, pose, closest, travelled)
 }
 
 /// Drives the approach from `start` to `goal` and records the path.
@@ -270,16 +291,16 @@ pub fn approach(
     crate::docking::check_pose("start", start)?;
     check_point("goal", goal)?;
     let mut path = vec![*start];
-    let (end, pose, closest, travelled) = approach_with(start, goal, motion, config, |p, _| {
+    let out = approach_with(start, goal, motion, config, |p, _| {
         path.push(*p);
         true
     });
     Ok(ApproachRun {
         path,
-        end,
-        final_distance: distance(&pose, goal),
-        closest,
-        travelled,
+        end: out.end,
+        final_distance: distance(&out.pose, goal),
+        closest: out.closest,
+        travelled: out.travelled,
     })
 }
 

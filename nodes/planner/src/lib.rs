@@ -87,8 +87,8 @@ pub mod route;
 pub mod sim;
 
 pub use approach::{
-    approach, approach_step, approach_with, shortest_step, ApproachConfig, ApproachEnd, ApproachRun, ApproachStep,
-    Motion, ShortestStep, Steering,
+    approach, approach_step, approach_with, shortest_step, ApproachConfig, ApproachEnd, ApproachOutcome, ApproachRun,
+    ApproachStep, Motion, ShortestStep, Steering,
 };
 
 pub use docking::{

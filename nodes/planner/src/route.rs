@@ -239,7 +239,7 @@ pub fn check_route(
         let leg_start = pose;
         let straight = distance(&leg_start, goal);
         let budget = (config.detour_factor * straight + TAU * min_radius).min(config.max_leg_length);
-        let (end, end_pose, closest, travelled) = approach_with(&leg_start, goal, &motion, &config.approach, |p, s| {
+        let out = approach_with(&leg_start, goal, &motion, &config.approach, |p, s| {
             path.push(*p);
             let c = clearance(&p.position());
             if c < 0.0 && !in_collision {
@@ -255,10 +255,10 @@ pub fn check_route(
             s < budget
         });
         let blocked = clearance(goal);
-        let ok = end == ApproachEnd::Reached && blocked >= 0.0;
+        let ok = out.end == ApproachEnd::Reached && blocked >= 0.0;
         reached.push(ok);
         if ok {
-            pose = end_pose;
+            pose = out.pose;
             continue;
         }
         let required = arc_radius(&leg_start, goal);
@@ -269,12 +269,12 @@ pub fn check_route(
                 required,
                 minimum: min_radius,
             }
-        } else if end == ApproachEnd::NoProgress {
-            ProblemKind::Unreachable(UnreachableCause::PassedBy { closest })
+        } else if out.end == ApproachEnd::NoProgress {
+            ProblemKind::Unreachable(UnreachableCause::PassedBy { closest: out.closest })
         } else {
             ProblemKind::Unreachable(UnreachableCause::DistanceBound {
-                travelled,
-                remaining: distance(&end_pose, goal),
+                travelled: out.travelled,
+                remaining: distance(&out.pose, goal),
             })
         };
         problems.push(RouteProblem { index, kind });

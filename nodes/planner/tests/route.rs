@@ -54,6 +54,9 @@ fn half_metre_turn_rejected_for_mobil2_accepted_for_omr3() {
     let omni = check_route(&start, &route, &ChassisParams::omr3(), &world, &config).expect("valid");
     assert!(omni.is_ok(), "{:?}", omni.problems);
     assert!(omni.reached.iter().all(|r| *r));
+    // The tricycle preset turns down to 0.50 / tan 60° = 0.289 m: the 0.5 m turn is fine too.
+    let tricycle = check_route(&start, &route, &ChassisParams::tricycle(), &world, &config).expect("valid");
+    assert!(tricycle.is_ok(), "{:?}", tricycle.problems);
 
     let car = check_route(&start, &route, &ChassisParams::mobil2(), &world, &config).expect("valid");
     assert!(!car.is_ok());
