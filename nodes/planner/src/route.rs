@@ -1,0 +1,293 @@
+//! Route pre-check by a virtual robot (SPEC §4, MOBIL-II HIGH-LEVEL): before a route is sent to
+//! the robot, a virtual robot drives it in simulation — the goal approach of
+//! [`mod@crate::approach`] on the chosen chassis model, waypoint after waypoint — against a known
+//! map (a [`mobil_sim::world::World`], the sim's world format and geometry) and every problem is
+//! reported with the index of its waypoint:
+//!
+//! - [`ProblemKind::Collision`]: the robot's footprint (a disc of `robot_radius` around the
+//!   reference point) overlaps an obstacle on the leg into waypoint i. Each stretch of overlap
+//!   is one problem, at the point where it begins. The virtual robot drives on through it (a
+//!   ghost), so one collision does not hide the problems behind it.
+//! - [`ProblemKind::TurnRadius`]: waypoint i was not reached and the arc from where the leg
+//!   began (tangent to the heading there) through waypoint i has a radius below the chassis'
+//!   minimum L / tan δ_eff.
+//! - [`ProblemKind::Unreachable`]: waypoint i was not reached for another cause: its own
+//!   footprint overlaps an obstacle (blocked), the closest approach passed outside Z_crit, or
+//!   the leg's distance bound ran out.
+//!
+//! After a waypoint that was not reached the virtual robot is set down on it, heading along the
+//! leg's chord, so later legs are checked as if it had been reached. The check is deterministic:
+//! no clock, no randomness; the leg bound is a path length.
+
+use std::f64::consts::TAU;
+
+use mobil_chassis::ChassisParams;
+use mobil_geom::Pose2;
+use mobil_sim::world::World;
+use nalgebra::Point2;
+
+use crate::approach::{approach_with, check_point, distance, ApproachConfig, ApproachEnd, Motion};
+use crate::error::{positive_finite, PlannerError};
+
+/// Settings of the route pre-check; every default justified.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct RouteCheckConfig {
+    /// The virtual robot's goal approach (step length, Z_crit, ε, step limit).
+    pub approach: ApproachConfig,
+    /// Radius (m) of the footprint disc around the reference point. Default 0.25: OMR-III, as
+    /// `mobil_local_nav`; MOBIL-II sets 0.53.
+    pub robot_radius: f64,
+    /// A leg may be at most this many times its straight length, plus one full circle at the
+    /// minimum turning radius (a car-like chassis may need one loop to line up). Default 2.
+    pub detour_factor: f64,
+    /// No leg may be longer than this (m), whatever its straight length. Default 50: beyond the
+    /// size of the maps the suite drives; a waypoint further away is a typing error.
+    pub max_leg_length: f64,
+}
+
+impl Default for RouteCheckConfig {
+    fn default() -> Self {
+        RouteCheckConfig {
+            approach: ApproachConfig::default(),
+            robot_radius: 0.25,
+            detour_factor: 2.0,
+            max_leg_length: 50.0,
+        }
+    }
+}
+
+impl RouteCheckConfig {
+    /// Checks every field.
+    pub fn validate(&self) -> Result<(), PlannerError> {
+        self.approach.validate()?;
+        positive_finite("robot_radius", self.robot_radius)?;
+        positive_finite("max_leg_length", self.max_leg_length)?;
+        if !(self.detour_factor.is_finite() && self.detour_factor >= 1.0) {
+            return Err(PlannerError::InvalidConfig {
+                name: "detour_factor",
+                value: self.detour_factor,
+                reason: "must be finite and at least 1",
+            });
+        }
+        Ok(())
+    }
+}
+
+/// Why a waypoint cannot be reached (other than a turn too tight).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum UnreachableCause {
+    /// The robot cannot stand there: its footprint at the waypoint overlaps an obstacle.
+    Blocked {
+        /// Distance (m) from the waypoint to the nearest surface minus the robot radius (< 0).
+        clearance: f64,
+    },
+    /// The virtual robot passed its closest approach outside Z_crit.
+    PassedBy {
+        /// The closest approach (m).
+        closest: f64,
+    },
+    /// The leg's distance bound (or step limit) ran out.
+    DistanceBound {
+        /// Path driven on the leg (m).
+        travelled: f64,
+        /// Distance to the waypoint at the end (m).
+        remaining: f64,
+    },
+}
+
+/// What is wrong at a waypoint.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum ProblemKind {
+    /// The footprint overlaps an obstacle on the way into the waypoint.
+    Collision {
+        /// Where the overlap begins (the reference point).
+        at: Point2<f64>,
+        /// Distance (m) from there to the nearest surface minus the robot radius (< 0).
+        clearance: f64,
+    },
+    /// The waypoint needs a tighter turn than the chassis can make.
+    TurnRadius {
+        /// The radius (m) of the arc from the leg's start pose through the waypoint.
+        required: f64,
+        /// The chassis' minimum L / tan δ_eff (m).
+        minimum: f64,
+    },
+    /// The waypoint cannot be reached.
+    Unreachable(UnreachableCause),
+}
+
+impl ProblemKind {
+    /// A short machine-readable name: `collision`, `turn_radius`, `unreachable`.
+    pub fn as_str(&self) -> &'static str {
+        match self {
+            ProblemKind::Collision { .. } => "collision",
+            ProblemKind::TurnRadius { .. } => "turn_radius",
+            ProblemKind::Unreachable(_) => "unreachable",
+        }
+    }
+}
+
+impl std::fmt::Display for ProblemKind {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            ProblemKind::Collision { at, clearance } => write!(
+                f,
+                "collision at ({:.2}, {:.2}): footprint {:.2} m into an obstacle",
+                at.x, at.y, -clearance
+            ),
+            ProblemKind::TurnRadius { required, minimum } => {
+                write!(
+                    f,
+                    "turn radius {required:.2} m below the chassis minimum {minimum:.2} m"
+                )
+            }
+            ProblemKind::Unreachable(UnreachableCause::Blocked { clearance }) => {
+                write!(
+                    f,
+                    "unreachable: the waypoint lies {:.2} m inside an obstacle's clearance",
+                    -clearance
+                )
+            }
+            ProblemKind::Unreachable(UnreachableCause::PassedBy { closest }) => {
+                write!(f, "unreachable: closest approach {closest:.2} m")
+            }
+            ProblemKind::Unreachable(UnreachableCause::DistanceBound { travelled, remaining }) => write!(
+                f,
+                "unreachable: {remaining:.2} m short after {travelled:.2} m of driving"
+            ),
+        }
+    }
+}
+
+/// One problem, with the index (from 0) of the waypoint whose leg it lies on.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct RouteProblem {
+    /// Index of the waypoint.
+    pub index: usize,
+    /// What is wrong.
+    pub kind: ProblemKind,
+}
+
+/// The result of a pre-check.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RouteReport {
+    /// Every problem, in route order (by index, then as met).
+    pub problems: Vec<RouteProblem>,
+    /// The virtual robot's predicted path, the start first (a jump where it was set down on a
+    /// waypoint it did not reach).
+    pub path: Vec<Pose2>,
+    /// For each waypoint, whether the virtual robot reached it (within Z_crit).
+    pub reached: Vec<bool>,
+}
+
+impl RouteReport {
+    /// True when the route has no problem.
+    pub fn is_ok(&self) -> bool {
+        self.problems.is_empty()
+    }
+}
+
+/// Radius (m) of the arc that starts at `pose` tangent to its heading and passes through `p`:
+/// with p at (x_b, y_b) in the body frame, (x_b² + y_b²) / (2|y_b|); infinite on the centre line.
+pub fn arc_radius(pose: &Pose2, p: &Point2<f64>) -> f64 {
+    let body = pose.inverse().transform_point(*p);
+    let y = body.y.abs();
+    if y == 0.0 {
+        f64::INFINITY
+    } else {
+        (body.x * body.x + body.y * body.y) / (2.0 * y)
+    }
+}
+
+/// Pre-checks `waypoints` driven in order from `start` by the virtual robot of `chassis` in
+/// `world` (module documentation). Refuses an empty route and non-finite input.
+pub fn check_route(
+    start: &Pose2,
+    waypoints: &[Point2<f64>],
+    chassis: &ChassisParams,
+    world: &World,
+    config: &RouteCheckConfig,
+) -> Result<RouteReport, PlannerError> {
+    config.validate()?;
+    crate::docking::check_pose("start", start)?;
+    if waypoints.is_empty() {
+        return Err(PlannerError::EmptyRoute);
+    }
+    for (i, w) in waypoints.iter().enumerate() {
+        check_point(&format!("waypoint {i}"), w)?;
+    }
+    let motion = Motion::from_chassis(chassis);
+    let min_radius = motion.min_radius();
+    let radius = config.robot_radius;
+    let clearance = |p: &Point2<f64>| world.distance_to(*p) - radius;
+
+    let mut problems = Vec::new();
+    let mut path = vec![*start];
+    let mut reached = Vec::with_capacity(waypoints.len());
+    let mut pose = *start;
+    let mut in_collision = clearance(&start.position()) < 0.0;
+    if in_collision {
+        problems.push(RouteProblem {
+            index: 0,
+            kind: ProblemKind::Collision {
+                at: start.position(),
+                clearance: clearance(&start.position()),
+            },
+        });
+    }
+    for (index, goal) in waypoints.iter().enumerate() {
+        let leg_start = pose;
+        let straight = distance(&leg_start, goal);
+        let budget = (config.detour_factor * straight + TAU * min_radius).min(config.max_leg_length);
+        let out = approach_with(&leg_start, goal, &motion, &config.approach, |p, s| {
+            path.push(*p);
+            let c = clearance(&p.position());
+            if c < 0.0 && !in_collision {
+                problems.push(RouteProblem {
+                    index,
+                    kind: ProblemKind::Collision {
+                        at: p.position(),
+                        clearance: c,
+                    },
+                });
+            }
+            in_collision = c < 0.0;
+            s < budget
+        });
+        let blocked = clearance(goal);
+        let ok = out.end == ApproachEnd::Reached && blocked >= 0.0;
+        reached.push(ok);
+        if ok {
+            pose = out.pose;
+            continue;
+        }
+        let required = arc_radius(&leg_start, goal);
+        let kind = if blocked < 0.0 {
+            ProblemKind::Unreachable(UnreachableCause::Blocked { clearance: blocked })
+        } else if required < min_radius {
+            ProblemKind::TurnRadius {
+                required,
+                minimum: min_radius,
+            }
+        } else if out.end == ApproachEnd::NoProgress {
+            ProblemKind::Unreachable(UnreachableCause::PassedBy { closest: out.closest })
+        } else {
+            ProblemKind::Unreachable(UnreachableCause::DistanceBound {
+                travelled: out.travelled,
+                remaining: distance(&out.pose, goal),
+            })
+        };
+        problems.push(RouteProblem { index, kind });
+        // Set down on the waypoint, heading along the leg's chord, and go on from there.
+        let chord = (goal.y - leg_start.y).atan2(goal.x - leg_start.x);
+        let yaw = if straight > 0.0 { chord } else { leg_start.yaw };
+        pose = Pose2::new(goal.x, goal.y, yaw);
+        path.push(pose);
+        in_collision = clearance(goal) < 0.0;
+    }
+    Ok(RouteReport {
+        problems,
+        path,
+        reached,
+    })
+}

@@ -1,0 +1,259 @@
+//! Route pre-check by a virtual robot (SPEC §4): every problem with its waypoint index.
+
+#[path = "../benches/common/demo_loop.rs"]
+mod demo_loop;
+
+use std::f64::consts::PI;
+
+use approx::assert_relative_eq;
+use mobil_chassis::ChassisParams;
+use mobil_geom::Pose2;
+use mobil_planner::{
+    arc_radius, check_route, PlannerError, ProblemKind, RouteCheckConfig, RouteReport, UnreachableCause,
+};
+use mobil_sim::world::World;
+use nalgebra::Point2;
+
+fn default_world() -> World {
+    World::load(concat!(env!("CARGO_MANIFEST_DIR"), "/../../params/worlds/default.yaml")).expect("default world")
+}
+
+/// From (0, 0) facing +x: to (1, 0), then half a circle of radius 0.5 about (1, 0.5) in 30°
+/// steps — (1 + 0.5 sin φ, 0.5 − 0.5 cos φ), φ = 30°…180° — then back to (0, 1).
+fn tight_turn_route() -> Vec<Point2<f64>> {
+    let mut route = vec![Point2::new(1.0, 0.0)];
+    for k in 1..=6 {
+        let phi = (30.0 * k as f64).to_radians();
+        route.push(Point2::new(1.0 + 0.5 * phi.sin(), 0.5 - 0.5 * phi.cos()));
+    }
+    route.push(Point2::new(0.0, 1.0));
+    route
+}
+
+fn kinds(report: &RouteReport) -> Vec<(usize, &'static str)> {
+    report.problems.iter().map(|p| (p.index, p.kind.as_str())).collect()
+}
+
+#[test]
+fn arc_radius_by_hand() {
+    // From (1, 0) facing +x through (1 + 0.5 sin 30°, 0.5 − 0.5 cos 30°) = (1.25, 0.066987):
+    // body (0.25, 0.066987), r = (0.0625 + 0.0044873) / (2·0.066987) = 0.5, the circle itself.
+    let p = Point2::new(1.25, 0.5 - 0.5 * (PI / 6.0).cos());
+    assert_relative_eq!(arc_radius(&Pose2::new(1.0, 0.0, 0.0), &p), 0.5, epsilon = 1e-12);
+    // A point on the centre line needs no turn.
+    assert_eq!(arc_radius(&Pose2::identity(), &Point2::new(-2.0, 0.0)), f64::INFINITY);
+}
+
+#[test]
+fn half_metre_turn_rejected_for_mobil2_accepted_for_omr3() {
+    let world = World::default();
+    let route = tight_turn_route();
+    let start = Pose2::identity();
+    let config = RouteCheckConfig::default();
+
+    let omni = check_route(&start, &route, &ChassisParams::omr3(), &world, &config).expect("valid");
+    assert!(omni.is_ok(), "{:?}", omni.problems);
+    assert!(omni.reached.iter().all(|r| *r));
+    // The tricycle preset turns down to 0.50 / tan 60° = 0.289 m: the 0.5 m turn is fine too.
+    let tricycle = check_route(&start, &route, &ChassisParams::tricycle(), &world, &config).expect("valid");
+    assert!(tricycle.is_ok(), "{:?}", tricycle.problems);
+
+    let car = check_route(&start, &route, &ChassisParams::mobil2(), &world, &config).expect("valid");
+    assert!(!car.is_ok());
+    for p in &car.problems {
+        // Only the arc's waypoints (1…6) can be too tight; (1, 0) and (0, 1) are wide.
+        assert!((1..=6).contains(&p.index), "{p:?}");
+        match p.kind {
+            ProblemKind::TurnRadius { required, minimum } => {
+                assert_relative_eq!(minimum, 0.73, epsilon = 1e-12);
+                assert!(required < minimum, "{p:?}");
+            }
+            other => panic!("only turn-radius problems expected, got {other:?} at {}", p.index),
+        }
+    }
+    println!("MOBIL-II on the 0.5 m turn: {:?}", car.problems);
+}
+
+#[test]
+fn collision_reported_on_the_leg_that_hits_the_pillar() {
+    // Default world, OMR-III (radius 0.25). Leg 0 to (2, 0) is clear (the pillar at (1, 1.5),
+    // r 0.3, is 1.2 m off the line); leg 1 from there to (0, 3) runs through the pillar.
+    let world = default_world();
+    let route = [Point2::new(2.0, 0.0), Point2::new(0.0, 3.0), Point2::new(-1.0, 3.0)];
+    let report = check_route(
+        &Pose2::identity(),
+        &route,
+        &ChassisParams::omr3(),
+        &world,
+        &RouteCheckConfig::default(),
+    )
+    .expect("valid");
+    assert_eq!(kinds(&report), [(1, "collision")]);
+    let ProblemKind::Collision { at, clearance } = report.problems[0].kind else {
+        unreachable!()
+    };
+    // The footprint first overlaps where the centre comes within 0.3 + 0.25 = 0.55 m of the
+    // pillar's centre, at most one 0.02 m step inside.
+    let d = (at - Point2::new(1.0, 1.5)).norm();
+    assert!(d < 0.55 && d > 0.53, "{d}");
+    assert_relative_eq!(clearance, d - 0.55, epsilon = 1e-12);
+    assert!(report.reached.iter().all(|r| *r), "a ghost drives on through");
+}
+
+#[test]
+fn blocked_waypoint_is_unreachable_with_its_index() {
+    // Waypoint 1 is inside the box x ∈ [4.5, 5.5], y ∈ [−0.5, 1.0]: at (5.0, 0.25) the nearest
+    // faces are 0.5 m away, so the clearance is −0.5 − 0.25 = −0.75 m.
+    let world = default_world();
+    let route = [Point2::new(3.5, 0.0), Point2::new(5.0, 0.25), Point2::new(3.5, 0.5)];
+    let report = check_route(
+        &Pose2::identity(),
+        &route,
+        &ChassisParams::omr3(),
+        &world,
+        &RouteCheckConfig::default(),
+    )
+    .expect("valid");
+    // Driving into the box collides on leg 1; the waypoint itself is unreachable; leaving the
+    // box on leg 2 is not a new collision.
+    assert_eq!(kinds(&report), [(1, "collision"), (1, "unreachable")]);
+    match report.problems[1].kind {
+        ProblemKind::Unreachable(UnreachableCause::Blocked { clearance }) => {
+            assert_relative_eq!(clearance, -0.75, epsilon = 1e-12)
+        }
+        other => panic!("{other:?}"),
+    }
+    assert_eq!(report.reached, [true, false, true]);
+}
+
+#[test]
+fn waypoint_beyond_the_distance_bound_is_unreachable() {
+    // In an empty world, waypoint 1 is 60 m from waypoint 0: beyond the 50 m leg bound.
+    let route = [Point2::new(1.0, 0.0), Point2::new(61.0, 0.0), Point2::new(62.0, 0.0)];
+    let report = check_route(
+        &Pose2::identity(),
+        &route,
+        &ChassisParams::omr3(),
+        &World::default(),
+        &RouteCheckConfig::default(),
+    )
+    .expect("valid");
+    assert_eq!(kinds(&report), [(1, "unreachable")]);
+    match report.problems[0].kind {
+        ProblemKind::Unreachable(UnreachableCause::DistanceBound { travelled, remaining }) => {
+            // The robot stops at the first step past 50 m: 50.00…50.02 m driven, about 10 m short
+            // (it started up to 0.16 m short of waypoint 0).
+            assert!((50.0..50.02 + 1e-9).contains(&travelled), "{travelled}");
+            assert!((remaining - 10.0).abs() < 0.2, "{remaining}");
+        }
+        other => panic!("{other:?}"),
+    }
+    assert_eq!(report.reached, [true, false, true], "set down on 1, it reaches 2");
+}
+
+#[test]
+fn every_problem_of_one_route_is_reported() {
+    // MOBIL-II (footprint 0.53 m) in the default world, from (0, 0) facing +x:
+    // 0: (0, −0.3) lies inside the right turning circle (centre (0, −0.73)); the arc through it
+    //    has r = 0.3² / (2·0.3) = 0.15 m < 0.73 m. The robot circles clear of everything (the
+    //    left circle would clip the pillar), then is set down on it facing south.
+    // 1: (1, 3.2): after a U-turn, the leg runs by the pillar (1, 1.5): the chord from
+    //    (0, −0.3) passes 1.7 / √13.25 = 0.467 m from its centre, 0.167 m from its surface,
+    //    less than the 0.53 m footprint: a collision.
+    // 2: (5, 0.25) lies in the box: the leg collides, the waypoint is blocked.
+    // 3: (5, 60.25) is 60 m on: beyond the 50 m leg bound (on the way it crosses the north
+    //    wall, one more collision on that leg).
+    let world = default_world();
+    let config = RouteCheckConfig {
+        robot_radius: 0.53,
+        ..RouteCheckConfig::default()
+    };
+    let route = [
+        Point2::new(0.0, -0.3),
+        Point2::new(1.0, 3.2),
+        Point2::new(5.0, 0.25),
+        Point2::new(5.0, 60.25),
+    ];
+    let report = check_route(&Pose2::identity(), &route, &ChassisParams::mobil2(), &world, &config).expect("valid");
+    assert_eq!(
+        kinds(&report),
+        [
+            (0, "turn_radius"),
+            (1, "collision"),
+            (2, "collision"),
+            (2, "unreachable"),
+            (3, "collision"),
+            (3, "unreachable"),
+        ],
+        "{:#?}",
+        report.problems
+    );
+    match report.problems[0].kind {
+        ProblemKind::TurnRadius { required, .. } => assert_relative_eq!(required, 0.15, epsilon = 1e-12),
+        other => panic!("{other:?}"),
+    }
+    match report.problems[3].kind {
+        // The box's nearest face to (5, 0.25) is 0.5 m away: −0.5 − 0.53 = −1.03 m.
+        ProblemKind::Unreachable(UnreachableCause::Blocked { clearance }) => {
+            assert_relative_eq!(clearance, -1.03, epsilon = 1e-12)
+        }
+        other => panic!("{other:?}"),
+    }
+    assert!(matches!(
+        report.problems[5].kind,
+        ProblemKind::Unreachable(UnreachableCause::DistanceBound { .. })
+    ));
+    // Leg 1's collision is the pillar's: the centre within 0.3 + 0.53 m of (1, 1.5), one step in.
+    let ProblemKind::Collision { at, .. } = report.problems[1].kind else {
+        unreachable!()
+    };
+    let d = (at - Point2::new(1.0, 1.5)).norm();
+    assert!(d < 0.83 && d > 0.81, "{at:?}");
+    // The north wall's inner face is y = 5.5: the footprint touches it at y ≈ 5.5 − 0.53.
+    let ProblemKind::Collision { at, .. } = report.problems[4].kind else {
+        unreachable!()
+    };
+    assert!((at.y - 4.97).abs() < 0.03, "{at:?}");
+    assert_eq!(report.reached, [false, true, false, false]);
+}
+
+#[test]
+fn the_demo_loop_passes_on_both_chassis() {
+    let route = demo_loop::demo_loop(20);
+    // Waypoint 5 (index 4) lies 12.2832·5/20 = 3.0708 m along: 2 m of straight, then 1.0708 rad
+    // round the corner (2, 1) from −π/2: (2 + cos(−0.5), 1 + sin(−0.5)) = (2.877583, 0.520574).
+    assert_relative_eq!(route[4].x, 2.877_583, epsilon = 1e-6);
+    assert_relative_eq!(route[4].y, 0.520_574, epsilon = 1e-6);
+    assert_relative_eq!((route[19] - Point2::new(0.0, 0.0)).norm(), 0.0, epsilon = 1e-12);
+    let world = default_world();
+    for (params, radius) in [(ChassisParams::mobil2(), 0.53), (ChassisParams::omr3(), 0.25)] {
+        let config = RouteCheckConfig {
+            robot_radius: radius,
+            ..RouteCheckConfig::default()
+        };
+        let report = check_route(&Pose2::identity(), &route, &params, &world, &config).expect("valid");
+        assert!(report.is_ok(), "{}: {:?}", params.model(), report.problems);
+        assert_eq!(report.reached, [true; 20]);
+    }
+}
+
+#[test]
+fn bad_routes_are_refused() {
+    let world = World::default();
+    let c = RouteCheckConfig::default();
+    let p = ChassisParams::omr3();
+    assert_eq!(
+        check_route(&Pose2::identity(), &[], &p, &world, &c),
+        Err(PlannerError::EmptyRoute)
+    );
+    let err = check_route(&Pose2::identity(), &[Point2::new(f64::NAN, 0.0)], &p, &world, &c).unwrap_err();
+    assert!(
+        matches!(err, PlannerError::NonFinite { ref what, .. } if what == "waypoint 0"),
+        "{err}"
+    );
+    let bad = RouteCheckConfig {
+        robot_radius: -1.0,
+        ..c
+    };
+    assert!(check_route(&Pose2::identity(), &[Point2::new(1.0, 0.0)], &p, &world, &bad).is_err());
+}
