@@ -39,8 +39,9 @@
 //! - **Omni and the field of view**: an omni chassis holds its heading, but turns in place
 //!   toward a direction of motion outside the field of view rather than drive there blind.
 //! - **Car-like**: pure-pursuit curvature toward a point d_sa along the direction, clipped to
-//!   tan δ_eff / L. The speed and the hard stop look along the arc the car will drive (its
-//!   circle swept along the arc against the scan points, [`motion::arc_free_distance`]), not
+//!   tan δ_eff / L. The speed and the hard stop look along the arc the car will drive (a
+//!   circle swept along the arc against the scan points, [`motion::arc_free_distance`]; its
+//!   radius is the robot's plus half the margin to the stop distance, a margin to the side), not
 //!   straight ahead: a car turning away from a wall it meets inside d_sa has the wall close
 //!   ahead while its arc curves clear, and judged by the straight line it crawled away at
 //!   1–2 cm/s for up to a minute, long enough for Nav2's progress checker to abort. When the

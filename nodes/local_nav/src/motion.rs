@@ -146,7 +146,9 @@ pub struct SpeedProfile {
     pub slow_down_radius: f64,
     /// Gain (1/s) of an omni chassis' turn toward a direction outside the field of view.
     pub heading_gain: f64,
-    /// Radius (m) of the robot's circle, swept along a car-like chassis' arcs.
+    /// Radius (m) of the circle swept along a car-like chassis' arcs: the robot's, or more for
+    /// a margin to the side as well as ahead (the navigator sweeps the robot radius plus half
+    /// the margin to the stop distance).
     pub robot_radius: f64,
     /// Car-like: the least speed (m/s) of a turn whose arc is clear; the turn's own slow-downs
     /// (with the angle to the direction, and the sliding rule's) never go below it. Only the

@@ -455,7 +455,10 @@ impl Navigator {
             safe_distance: self.config.safe_distance,
             slow_down_radius: self.config.slow_down_radius,
             heading_gain: self.config.heading_gain,
-            robot_radius: self.config.robot_radius,
+            // The car's swept circle: the body plus half its margin to the hard stop, so that an
+            // arc passing an obstacle keeps a margin to the side too (with the body alone, a car
+            // could graze a wall's end at the robot radius plus millimetres).
+            robot_radius: 0.5 * (self.config.robot_radius + self.config.stop_distance),
             min_turn_speed: self.config.min_turn_speed,
         };
         let input = MotionInput {
