@@ -25,7 +25,7 @@ The long scenarios (the traps and enclosures of both robots: 30-80 simulated sec
 ``slow_scenario`` marker (tests/pytest.ini) so that a quick run can
 leave them out with ``-m "not slow_scenario"``. Measured on the 2-core build machine at a load
 average of about 5 (other builds running): the whole file 81 s of wall time, 5.0x reached in
-every case; MOBIL-II's enclosure and U-trap 80 and 52 simulated s (16 and 10 s of wall time).
+every case; MOBIL-II's enclosure and U-trap 79 and 48 simulated s (16 and 10 s of wall time).
 """
 
 from __future__ import annotations
@@ -92,15 +92,15 @@ SCENARIOS: dict[str, dict[str, Scenario]] = {
     # (b) round a 0.4 m disc: 14 s (OMR-III), 18 s (MOBIL-II).
     "convex": {r: Scenario("local_nav_convex.yaml", (6.0, 0.0), 30.0, SUCCEEDED, "RL", "T")
                for r in ("omr3", "mobil2")},
-    # (c) a 5 m wall: 23 s (OMR-III), 25 s (MOBIL-II).
+    # (c) a 5 m wall: 23 s (OMR-III), 24 s (MOBIL-II).
     "wall": {r: Scenario("local_nav_wall.yaml", (7.0, 1.0), 40.0, SUCCEEDED, "RL")
              for r in ("omr3", "mobil2")},
-    # (d) the U-trap: 34 s (OMR-III), 53 s in the wide one (MOBIL-II).
+    # (d) the U-trap: 34 s (OMR-III), 48 s in the wide one (MOBIL-II).
     "u_trap": {"omr3": Scenario("local_nav_u_trap.yaml", (6.0, 0.0), 55.0, SUCCEEDED, "RLT",
                                 slow=True),
                "mobil2": Scenario("local_nav_u_trap_wide.yaml", (9.0, 0.0), 80.0, SUCCEEDED,
                                   "RLT", slow=True)},
-    # (e) the enclosed goal: NO_PATH after 46 s (OMR-III), 80 s (MOBIL-II).
+    # (e) the enclosed goal: NO_PATH after 46 s (OMR-III), 79 s (MOBIL-II).
     "enclosed": {"omr3": Scenario("local_nav_enclosed.yaml", (5.0, 0.0), 75.0, FAILED, "RLT",
                                   slow=True),
                  "mobil2": Scenario("local_nav_enclosed.yaml", (5.0, 0.0), 120.0, FAILED,
