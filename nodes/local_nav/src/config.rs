@@ -92,6 +92,15 @@ pub struct NavConfig {
     /// so the n-step test of eq. 3.58 alone would never fire). Default 0.02: at that speed the n
     /// steps (2 m) would take 100 s.
     pub stall_speed: f64,
+    /// Car-like chassis: the least speed (m/s) of a turn whose arc (the robot's circle swept
+    /// along the commanded arc) is clear of the scan points; the slow-downs of the turn itself
+    /// (angle to the direction, sliding) never go below it, only the arc's clearance and the
+    /// goal can. Default 0.10: Nav2's progress checker wants 0.5 m in 10 s, i.e. 0.05 m/s on
+    /// average, and a turn away from a wall at 0.10 m/s covers the quarter circle of MOBIL-II's
+    /// 0.73 m turning radius (1.15 m) in 11.5 s; it stops within a centimetre (a 0.05 s motor
+    /// lag and a 40 Hz scan's age: 0.1 × 0.1 s), well inside the 0.10–0.12 m between the body
+    /// and the hard stop. 0 restores a turn as slow as its own slow-downs make it.
+    pub min_turn_speed: f64,
     /// c2 (m): least progress toward G over m steps of T-mode (eq. 3.60). Default 0.50.
     pub track_min_progress: f64,
     /// Radius (m) around H that counts as a return to it (NO_PATH) once the robot has been
@@ -126,6 +135,7 @@ impl Default for NavConfig {
             track_steps: 600,
             track_min_progress: 0.50,
             stall_speed: 0.02,
+            min_turn_speed: 0.10,
             hit_radius: 0.40,
             goal_tolerance: 0.10,
             slow_down_radius: 0.60,
@@ -196,6 +206,12 @@ impl NavConfig {
         check("lock_min_progress", self.lock_min_progress, true, "must be finite")?;
         check("track_min_progress", self.track_min_progress, true, "must be finite")?;
         check("stall_speed", self.stall_speed, self.stall_speed >= 0.0, "must be ≥ 0")?;
+        check(
+            "min_turn_speed",
+            self.min_turn_speed,
+            self.min_turn_speed >= 0.0,
+            "must be ≥ 0",
+        )?;
         check(
             "hit_radius",
             self.hit_radius,

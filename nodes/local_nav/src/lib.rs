@@ -8,7 +8,8 @@
 //!   against eq. 3.53–3.55.
 //! - [`navigator`]: the modes R (rotate), L (lock) and T (track), hit and leave points, NO_PATH.
 //! - [`motion`]: motion along F for an omni or a car-like chassis (δ_eff), speed scaled by the
-//!   free distance ahead and near the goal, hard stop.
+//!   free distance ahead (along the arc driven, for a car-like chassis) and near the goal, hard
+//!   stop.
 //! - [`config`]: [`NavConfig`], every default justified.
 //! - [`progress`]: Nav2's progress checker (`required_movement_radius` within
 //!   `movement_time_allowance`), time as an input.
@@ -26,6 +27,10 @@
 //!   kept, and the speed scaled with it.
 //! - **Stall makes H**: an L-mode command slower than `stall_speed` cannot make progress
 //!   (steps are path increments, so eq. 3.58 alone would never fire): H is set there at once.
+//!   So does a car-like L-mode command that turns at the steering limit away from F because
+//!   every arc toward F is blocked before d_sa ([`motion::CarArc::against`]): the lock cannot
+//!   be followed there, and without H the car, turned away, would release the lock, come back
+//!   in R-mode and circle in a U-trap for ever.
 //! - **Leave on a clear goal sector only nearer G than H** (and beyond d_sa + hysteresis):
 //!   without it the mouth of a U-trap, where the goal sector sees the far bottom wall beyond
 //!   d_sa, would send the robot back in for ever. The crossing of HG must be strictly between
@@ -34,9 +39,18 @@
 //! - **Omni and the field of view**: an omni chassis holds its heading, but turns in place
 //!   toward a direction of motion outside the field of view rather than drive there blind.
 //! - **Car-like**: pure-pursuit curvature toward a point d_sa along the direction, clipped to
-//!   tan δ_eff / L; the hard stop looks straight ahead. The method has no reversing, so a
-//!   car-like robot that reaches the hard stop facing a wall it cannot turn away from within
-//!   its turning circle stays stopped (d_sa must leave room for the turning circle).
+//!   tan δ_eff / L. The speed and the hard stop look along the arc the car will drive (a
+//!   circle swept along the arc against the scan points, [`motion::arc_free_distance`]; its
+//!   radius is the robot's plus half the margin to the stop distance, a margin to the side), not
+//!   straight ahead: a car turning away from a wall it meets inside d_sa has the wall close
+//!   ahead while its arc curves clear, and judged by the straight line it crawled away at
+//!   1–2 cm/s for up to a minute, long enough for Nav2's progress checker to abort. When the
+//!   pursuit arc is blocked before d_sa and the arc at the steering limit is freer, the car
+//!   turns at the limit; the turn's own slow-downs (angle to F, sliding) never take it below
+//!   `min_turn_speed` (0.1 m/s) on a clear arc. The method has no reversing, so a car-like
+//!   robot with no arc free beyond the hard stop (a wall square ahead nearer than the robot
+//!   radius plus the turning radius) stays stopped, and the progress checker or NO_PATH ends
+//!   the goal (d_sa must leave room for the turning circle).
 //!
 //! ```
 //! use mobil_chassis::ChassisParams;
@@ -67,7 +81,9 @@ pub mod sectors;
 
 pub use config::{ConfigError, NavConfig};
 pub use field::{vector_distance, Side, WeightProfile};
-pub use motion::{command_along, Drive, MotionInput, MotionLimits, SpeedProfile, VelocityCommand};
+pub use motion::{
+    arc_free_distance, car_arc, command_along, CarArc, Drive, MotionInput, MotionLimits, SpeedProfile, VelocityCommand,
+};
 pub use navigator::{InputError, Mode, Navigator, NoPathReason, StepOutput};
 pub use progress::{Progress, ProgressChecker, ProgressSettings};
 pub use sectors::{Sector, Sectors, UnseenSectors};

@@ -4,7 +4,7 @@
 
 use crate::config::{ConfigError, NavConfig};
 use crate::field::{vector_distance, Side};
-use crate::motion::{command_along, Drive, MotionInput, MotionLimits, SpeedProfile, VelocityCommand};
+use crate::motion::{car_arc, command_along, Drive, MotionInput, MotionLimits, SpeedProfile, VelocityCommand};
 use crate::sectors::Sectors;
 use mobil_geom::{wrap, Pose2, Scan};
 use nalgebra::{Point2, Vector2};
@@ -360,18 +360,19 @@ impl Navigator {
             Mode::Track(side) => self.track_direction(side, goal_bearing),
             _ => Vector2::zeros(),
         };
-        let command = self.move_along(direction, goal_distance);
+        let (command, against) = self.move_along(direction, goal_distance);
         if let Mode::Lock(side) = self.mode {
             // A lock that cannot move (F into a concave corner, the hard stop) makes no progress
-            // however long it waits, and steps are path increments: the hit point is here.
-            if command.speed() < self.config.stall_speed {
+            // however long it waits, and steps are path increments: the hit point is here. So
+            // for a car that must turn away from F because every arc toward it is blocked.
+            if command.speed() < self.config.stall_speed || against {
                 self.hit = Some(q);
                 self.left_hit = false;
                 self.leave = None;
                 self.enter(Mode::Track(side), goal_distance);
                 self.sectors.update(scan, goal_bearing);
                 let direction = self.track_direction(side, goal_bearing);
-                let command = self.move_along(direction, goal_distance);
+                let (command, _) = self.move_along(direction, goal_distance);
                 return self.output(command, before, direction, goal_distance);
             }
         }
@@ -420,10 +421,10 @@ impl Navigator {
     /// pulling toward a wall it faces (|f_i| never goes negative), so without this the robot
     /// would settle at the hard stop instead of sliding along the obstacle as the locked weights
     /// ask.
-    fn move_along(&self, direction: Vector2<f64>, goal_distance: f64) -> VelocityCommand {
+    fn move_along(&self, direction: Vector2<f64>, goal_distance: f64) -> (VelocityCommand, bool) {
         let norm = direction.norm();
         if !norm.is_finite() || norm <= 1e-9 {
-            return VelocityCommand::ZERO;
+            return (VelocityCommand::ZERO, false);
         }
         let mut direction = direction;
         if let Some((d, phi)) = self.sectors.nearest() {
@@ -437,31 +438,42 @@ impl Navigator {
         }
         let ratio = (direction.norm() / norm).clamp(0.0, 1.0);
         if ratio.is_nan() || ratio <= 1e-6 {
-            return VelocityCommand::ZERO;
+            return (VelocityCommand::ZERO, false);
         }
         let bearing = direction.y.atan2(direction.x);
-        let (free_bearing, seen) = match self.limits.drive {
-            Drive::Omni => (bearing, self.sectors.sector(self.sectors.index_of(bearing)).known),
-            Drive::CarLike { .. } => (0.0, true),
+        let seen = match self.limits.drive {
+            Drive::Omni => self.sectors.sector(self.sectors.index_of(bearing)).known,
+            Drive::CarLike { .. } => true,
+        };
+        let free_ahead = match self.limits.drive {
+            Drive::Omni => self.sectors.free_distance_along(bearing, self.config.robot_radius),
+            // The car's arcs are checked against the points in `command_along`.
+            Drive::CarLike { .. } => f64::INFINITY,
         };
         let profile = SpeedProfile {
             stop_distance: self.config.stop_distance,
             safe_distance: self.config.safe_distance,
             slow_down_radius: self.config.slow_down_radius,
             heading_gain: self.config.heading_gain,
+            // The car's swept circle: the body plus half its margin to the hard stop, so that an
+            // arc passing an obstacle keeps a margin to the side too (with the body alone, a car
+            // could graze a wall's end at the robot radius plus millimetres).
+            robot_radius: 0.5 * (self.config.robot_radius + self.config.stop_distance),
+            min_turn_speed: self.config.min_turn_speed,
         };
         let input = MotionInput {
             bearing,
             bearing_seen: seen,
-            free_ahead: self.sectors.free_distance_along(free_bearing, self.config.robot_radius),
+            free_ahead,
+            obstacles: self.sectors.obstacles(),
             goal_distance,
+            speed_scale: ratio,
         };
-        let c = command_along(&input, &profile, &self.limits);
-        VelocityCommand {
-            vx: c.vx * ratio,
-            vy: c.vy * ratio,
-            omega: c.omega * ratio,
-        }
+        let against = match self.limits.drive {
+            Drive::Omni => false,
+            Drive::CarLike { max_curvature } => car_arc(input.obstacles, bearing, max_curvature, &profile).against,
+        };
+        (command_along(&input, &profile, &self.limits), against)
     }
 }
 

@@ -3,7 +3,9 @@
 
 use mobil_chassis::ChassisParams;
 use mobil_geom::{Pose2, Scan};
-use mobil_local_nav::{Mode, MotionLimits, NavConfig, Navigator, NoPathReason, Side};
+use mobil_local_nav::{
+    Mode, MotionLimits, NavConfig, Navigator, NoPathReason, Progress, ProgressChecker, ProgressSettings, Side,
+};
 use nalgebra::{Point2, Vector2};
 
 enum Shape {
@@ -12,6 +14,17 @@ enum Shape {
 }
 
 struct World(Vec<Shape>);
+
+/// The four edges of the rectangle [x0, x1] × [y0, y1] (a wall of a world file).
+fn rect(x0: f64, y0: f64, x1: f64, y1: f64) -> [Shape; 4] {
+    let p = Point2::new;
+    [
+        Shape::Segment(p(x0, y0), p(x1, y0)),
+        Shape::Segment(p(x1, y0), p(x1, y1)),
+        Shape::Segment(p(x1, y1), p(x0, y1)),
+        Shape::Segment(p(x0, y1), p(x0, y0)),
+    ]
+}
 
 impl World {
     /// Distance along the ray o + t·u to the first shape, if within `max`.
@@ -107,6 +120,11 @@ struct Run {
     last_speed: f64,
     hit: Option<Point2<f64>>,
     leave: Option<Point2<f64>>,
+    /// Simulated seconds until the final mode (or the step limit).
+    time: f64,
+    /// The longest time (s) Nav2's default progress checker (0.5 m in 10 s) saw without
+    /// progress, had it been running; `None` if it never would have aborted.
+    stuck: Option<f64>,
 }
 
 /// Drives from `start` to `goal` for at most `max_steps` of 0.05 s.
@@ -126,7 +144,13 @@ fn drive(world: &World, chassis: ChassisParams, start: Pose2, goal: Point2<f64>,
     let mut last_speed = f64::NAN;
     let mut hit = None;
     let mut leave = None;
+    let mut checker = ProgressChecker::new(ProgressSettings::default());
+    let mut stuck = None;
+    let mut time = 0.0;
     for _ in 0..max_steps {
+        if let Progress::Stuck { since } = checker.check(pose.position(), time) {
+            stuck = Some(since);
+        }
         let out = nav.step(pose, &world.scan(pose));
         if modes.last() != Some(&out.mode) {
             modes.push(out.mode);
@@ -141,6 +165,7 @@ fn drive(world: &World, chassis: ChassisParams, start: Pose2, goal: Point2<f64>,
         // Exact enough at 0.05 s: body velocity rotated into odom.
         let v = pose.rotate(Vector2::new(c.vx, c.vy));
         pose = Pose2::new(pose.x + v.x * dt, pose.y + v.y * dt, pose.yaw + c.omega * dt);
+        time += dt;
         min_clearance = min_clearance.min(world.clearance(pose.position()));
     }
     Run {
@@ -151,6 +176,8 @@ fn drive(world: &World, chassis: ChassisParams, start: Pose2, goal: Point2<f64>,
         last_speed,
         hit,
         leave,
+        time,
+        stuck,
     }
 }
 
@@ -277,4 +304,57 @@ fn wide_wall_is_followed_in_track_mode_to_its_end() {
     let h = run.hit.expect("a hit point");
     assert!(h.x < 3.0, "H {h}");
     assert!(run.min_clearance > 0.25, "clearance {}", run.min_clearance);
+}
+
+#[test]
+fn car_like_turns_away_from_a_wall_without_creeping() {
+    // Scenario (c) of the rclpy tests (params/worlds/local_nav_wall.yaml): a 5 m wall, 0.1 m
+    // thick, at x = 4 (y from −2.5 to 2.5), G (7, 1) behind it. MOBIL-II meets the wall inside
+    // d_sa and must turn away along it. Bound: the path round the wall's end is about
+    // 4 + 2·2.5 + 3 = 12 m, at 0.5 m/s 24 s; with the slow turns and the slide along the
+    // wall at most twice that. Nav2's default progress checker (0.5 m in 10 s) must never fire.
+    let world = World(rect(4.0, -2.5, 4.1, 2.5).into());
+    let run = drive(
+        &world,
+        ChassisParams::mobil2(),
+        Pose2::identity(),
+        Point2::new(7.0, 1.0),
+        2000,
+    );
+    eprintln!(
+        "wall, MOBIL-II: {:.1} s, modes {:?}, clearance {:.3}",
+        run.time, run.modes, run.min_clearance
+    );
+    assert_eq!(run.final_mode, Mode::Reached, "{:?}", run.modes);
+    assert!(run.time < 50.0, "{} s", run.time);
+    assert_eq!(run.stuck, None, "{:?}", run.modes);
+    assert!(run.min_clearance > 0.53, "clearance {}", run.min_clearance);
+}
+
+#[test]
+fn car_like_leaves_the_wide_u_trap_without_creeping() {
+    // Scenario (d) for MOBIL-II (params/worlds/local_nav_u_trap_wide.yaml): the U 6 m wide
+    // inside, mouth at x = 2.5, bottom at x = 5, walls 0.1 m thick; G (9, 0). Bound: in, along
+    // the bottom and an arm at d_sa, out round the arm's end and back to the goal line is
+    // about 2.5 + 3 + 4 + 4 + 5 = 18.5 m, at 0.5 m/s 37 s; at most twice that.
+    let mut shapes: Vec<Shape> = rect(5.0, -3.0, 5.1, 3.0).into();
+    shapes.extend(rect(2.5, 2.9, 5.0, 3.0));
+    shapes.extend(rect(2.5, -3.0, 5.0, -2.9));
+    let world = World(shapes);
+    let run = drive(
+        &world,
+        ChassisParams::mobil2(),
+        Pose2::identity(),
+        Point2::new(9.0, 0.0),
+        3000,
+    );
+    eprintln!(
+        "wide U, MOBIL-II: {:.1} s, modes {:?}, clearance {:.3}",
+        run.time, run.modes, run.min_clearance
+    );
+    assert_eq!(run.final_mode, Mode::Reached, "{:?}", run.modes);
+    assert!(run.modes.iter().any(|m| matches!(m, Mode::Track(_))), "{:?}", run.modes);
+    assert!(run.time < 75.0, "{} s", run.time);
+    assert_eq!(run.stuck, None, "{:?}", run.modes);
+    assert!(run.min_clearance > 0.53, "clearance {}", run.min_clearance);
 }

@@ -172,6 +172,13 @@ impl Config for LocalNavConfig {
         )
         .min(0.0);
         d.double(
+            "min_turn_speed",
+            n.min_turn_speed,
+            "car-like: least speed of a turn whose arc is clear of the scan [m/s]",
+            |c, v| c.nav.min_turn_speed = v,
+        )
+        .min(0.0);
+        d.double(
             "hit_radius",
             n.hit_radius,
             "a return within this of H (after leaving twice as far) is NO_PATH [m]",
