@@ -565,3 +565,67 @@ def test_refusals_preemption_and_stale_scan(start_scenario, start_node, sim_cloc
     assert not is_zero(cmds[-3]) and is_zero(cmds[-2]) and is_zero(cmds[-1]), cmds[-3:]
     assert started >= 4
     check_commands(cmds, started + 1)
+
+
+class OdomFeed:
+    """Publishes ``msg`` on ``odom`` at 20 wall Hz from a thread until stopped; the test swaps
+    ``msg`` to feed bad odometry."""
+
+    def __init__(self, node, msg: Odometry) -> None:
+        self.pub = node.create_publisher(Odometry, "odom", 10)
+        self.msg = msg
+        self._stop = threading.Event()
+        self._thread = threading.Thread(target=self._run, daemon=True)
+        self._thread.start()
+
+    def _run(self) -> None:
+        while not self._stop.wait(0.05):
+            self.pub.publish(self.msg)
+
+    def stop(self) -> None:
+        self._stop.set()
+        self._thread.join(timeout=5)
+
+
+def odom_at_origin(frame: str = "odom", x: float = 0.0) -> Odometry:
+    m = Odometry()
+    m.header.frame_id, m.child_frame_id = frame, "base_link"
+    m.pose.pose.position.x = x
+    m.pose.pose.orientation.w = 1.0
+    return m
+
+
+def test_refused_odometry_stops_the_robot(start_node, ros_node):
+    """No simulator: this test feeds ``scan`` (open space) and ``odom`` (the robot standing at the
+    origin) and sends a goal 3 m ahead. Odometry with a NaN position, and later odometry in
+    frame ``map``, are refused: the moving robot gets one zero command at once, no moving
+    command after it, and the goal ends STALE_INPUT (odom) with its own zero."""
+    nav = start_node("local_nav_node", params_file=PARAMS)
+    lidar = OpenSpaceScan(ros_node)
+    feed = OdomFeed(ros_node, odom_at_origin())
+    pub = ros_node.create_publisher(PoseStamped, "goal_pose", 10)
+    bad_odoms = [odom_at_origin(x=math.nan), odom_at_origin(frame="map")]
+    logs = ["odom with a non-finite pose", "odom in frames `map` → `base_link`"]
+    with subscribe(ros_node, NavStatus, "local_nav/status", qos=qos_latched()) as status, \
+            subscribe(ros_node, Twist, "cmd_vel", qos=DEEP) as cmd:
+        status.wait_for(lambda s: s.state == NavStatus.IDLE, REPLY_TIMEOUT)
+        nav.wait_for_log("first scan", timeout=REPLY_TIMEOUT)
+        for bad, log in zip(bad_odoms, logs):
+            feed.msg = odom_at_origin()
+            publish_until_taken(pub, nav, goal_pose(3.0, 0.0))
+            cmd.wait_for(lambda t: not is_zero(t), REPLY_TIMEOUT, start=len(cmd))
+            mark, mark_status = len(cmd), len(status)
+            feed.msg = bad
+            stale = status.wait_for(lambda s: s.state == NavStatus.FAILED, REPLY_TIMEOUT,
+                                    start=mark_status)
+            assert stale.reason == "STALE_INPUT: odom stale: robot stopped"
+            assert wait_until(lambda: sum(map(is_zero, cmd.snapshot()[mark:])) >= 2, REPLY_TIMEOUT)
+            time.sleep(0.2)  # for a stray command to show
+            after = cmd.snapshot()[mark:]
+            first_zero = next(i for i, t in enumerate(after) if is_zero(t))
+            # Moving commands in flight before the switch, then: zero (refused odometry), zero
+            # (the goal's end), nothing else.
+            assert after[first_zero:] == [Twist(), Twist()], after[first_zero:]
+            nav.wait_for_log(log)
+        feed.stop()
+        lidar.stop()

@@ -109,6 +109,9 @@ struct Shell {
     active: Option<ActiveGoal>,
     scan_seen: Latest<()>,
     odom: Latest<OdomSample>,
+    /// The latest odometry message was refused: no step until a valid one comes (the last
+    /// valid one still times the watchdog).
+    odom_refused: bool,
     last_step: Option<StepOutput>,
     last_status: Option<Instant>,
     gate: CommandGate,
@@ -196,6 +199,7 @@ async fn start(
         active: None,
         scan_seen: Latest::new(),
         odom: Latest::new(),
+        odom_refused: false,
         last_step: None,
         last_status: None,
         gate: CommandGate::default(),
@@ -344,16 +348,20 @@ impl Shell {
     fn odom_in(&mut self, out: &Outputs, m: &Odometry) {
         let speed = m.twist.twist.linear.x.hypot(m.twist.twist.linear.y);
         match odom_pose(m, &self.config.odom_frame, &self.config.base_frame) {
-            Ok(pose) => self.odom.set(
-                OdomSample {
-                    pose,
-                    msg_pose: m.pose.pose.clone(),
-                    speed: if speed.is_finite() { speed } else { 0.0 },
-                },
-                m.header.stamp.clone(),
-            ),
+            Ok(pose) => {
+                self.odom_refused = false;
+                self.odom.set(
+                    OdomSample {
+                        pose,
+                        msg_pose: m.pose.pose.clone(),
+                        speed: if speed.is_finite() { speed } else { 0.0 },
+                    },
+                    m.header.stamp.clone(),
+                );
+            }
             Err(e) => {
-                warn_throttled!(self.throttle, "odom-bad", "odom sample dropped: {e}");
+                warn_throttled!(self.throttle, "odom-bad", "odom sample dropped: {e}; robot stopped");
+                self.odom_refused = true;
                 self.refused(out);
             }
         }
@@ -638,10 +646,15 @@ impl Shell {
         if self.active.is_none() {
             return;
         }
-        let Some(odom) = self.odom.get(self.config.odom_timeout()).cloned() else {
-            // No command from stale odometry: the robot stops; the watchdog ends the goal if
-            // this lasts.
-            warn_throttled!(self.throttle, "odom-stale", "scan ignored: odom stale; robot stopped");
+        let fresh = self.odom.get(self.config.odom_timeout()).filter(|_| !self.odom_refused);
+        let Some(odom) = fresh.cloned() else {
+            // No command from stale or refused odometry: the robot stops; the watchdog ends the
+            // goal if this lasts.
+            warn_throttled!(
+                self.throttle,
+                "odom-stale",
+                "scan ignored: odom stale or refused; robot stopped"
+            );
             return self.refused(out);
         };
         let step = self.nav.step(odom.pose, &scan);
