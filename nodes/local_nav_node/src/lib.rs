@@ -12,16 +12,18 @@ use mobil_chassis::model::ChassisConfig;
 use mobil_chassis_node::{chassis_params, declare_chassis};
 use mobil_geom::Pose2;
 use mobil_local_nav::{
-    Drive, Mode, MotionLimits, NavConfig, NoPathReason, ProgressSettings, Sectors, Side, UnseenSectors,
-    VelocityCommand, WeightProfile,
+    Drive, Mode, MotionLimits, NavConfig, NoPathReason, ProgressChecker, ProgressSettings, Sectors, Side,
+    UnseenSectors, VelocityCommand, WeightProfile,
 };
 use mobil_msgs::builtin_interfaces::msg::{Duration as RosDuration, Time};
 use mobil_msgs::geometry_msgs::msg::{Point, Pose, PoseStamped, Twist, Vector3};
 use mobil_msgs::mobil_msgs::msg::NavStatus;
+use mobil_msgs::nav_msgs::msg::Odometry;
 use mobil_msgs::std_msgs::msg::{ColorRGBA, Header};
 use mobil_msgs::visualization_msgs::msg::{Marker, MarkerArray};
 use mobil_ros::config::{Config, ConfigError, Decl};
-use mobil_ros::geometry::yaw_quaternion;
+use mobil_ros::geometry::{yaw_of, yaw_quaternion};
+use mobil_ros::scan::StaticFrames;
 use nalgebra::{Point2, Vector2};
 use std::time::Duration;
 use thiserror::Error;
@@ -68,8 +70,9 @@ pub struct LocalNavConfig {
     pub base_frame: String,
     /// The scan's frame, looked up in `tf_static`.
     pub laser_frame: String,
-    /// Laser pose (x, y, yaw) in the base frame, used until (unless) `tf_static` gives one.
-    pub laser_pose: [f64; 3],
+    /// Laser pose (x, y, yaw) in the base frame, for scans whose frame `tf_static` does not
+    /// give; empty when not set (such scans are then refused).
+    pub laser_pose: Vec<f64>,
 }
 
 impl Config for LocalNavConfig {
@@ -233,14 +236,16 @@ impl Config for LocalNavConfig {
             "a goal fails STALE_INPUT when no valid scan arrived for this long (steady clock) [s]",
             |c, v| c.scan_timeout_s = v,
         )
-        .above(0.0);
+        .above(0.0)
+        .max(MAX_INPUT_TIMEOUT_S);
         d.double(
             "odom_timeout_s",
             0.5,
             "a goal fails STALE_INPUT when no valid odom arrived for this long (steady clock) [s]",
             |c, v| c.odom_timeout_s = v,
         )
-        .above(0.0);
+        .above(0.0)
+        .max(MAX_INPUT_TIMEOUT_S);
         d.double(
             "status_rate_hz",
             2.0,
@@ -254,7 +259,9 @@ impl Config for LocalNavConfig {
             "how long a finished action goal's result waits for the client to ask for it [s]",
             |c, v| c.result_timeout_s = v,
         )
-        .above(0.0);
+        .above(0.0)
+        .max(MAX_RESULT_TIMEOUT_S)
+        .read_only();
         d.string(
             "odom_frame",
             "odom",
@@ -273,16 +280,23 @@ impl Config for LocalNavConfig {
             |c, v| c.laser_frame = v,
         )
         .read_only();
-        d.doubles(
+        d.double_list(
             "laser_pose",
-            [0.0, 0.0, 0.0],
-            "x, y, yaw of the laser in the base frame, used until (unless) tf_static gives it",
+            &[],
+            "x, y, yaw of the laser in the base frame for scans whose frame tf_static does not give; \
+             empty (default): such scans are refused",
             |c, v| c.laser_pose = v,
         )
         .read_only();
     }
 
     fn validate(&self) -> Result<(), ConfigError> {
+        if !matches!(self.laser_pose.len(), 0 | 3) {
+            return Err(ConfigError::inconsistent(format!(
+                "laser_pose has {} values: give x, y, yaw (3) or none",
+                self.laser_pose.len()
+            )));
+        }
         self.motion_limits()?;
         self.nav_config()?;
         Ok(())
@@ -308,26 +322,46 @@ impl LocalNavConfig {
         Ok(MotionLimits::from_chassis(&chassis_params(&self.chassis)?))
     }
 
-    /// The laser pose parameter as a pose; `None` when not finite.
+    /// The laser pose parameter as a pose; `None` when not set (or not finite).
     pub fn laser_pose(&self) -> Option<Pose2> {
-        let [x, y, yaw] = self.laser_pose;
-        let p = Pose2::new(x, y, yaw);
+        let [x, y, yaw] = self.laser_pose.as_slice() else {
+            return None;
+        };
+        let p = Pose2::new(*x, *y, *yaw);
         p.is_finite().then_some(p)
     }
 
     /// The scan timeout.
     pub fn scan_timeout(&self) -> Duration {
-        Duration::from_secs_f64(self.scan_timeout_s)
+        seconds(self.scan_timeout_s, MAX_INPUT_TIMEOUT_S)
     }
 
     /// The odometry timeout.
     pub fn odom_timeout(&self) -> Duration {
-        Duration::from_secs_f64(self.odom_timeout_s)
+        seconds(self.odom_timeout_s, MAX_INPUT_TIMEOUT_S)
+    }
+
+    /// How long a finished action goal's result waits for the client.
+    pub fn result_timeout(&self) -> Duration {
+        seconds(self.result_timeout_s, MAX_RESULT_TIMEOUT_S)
     }
 }
 
+/// The largest `scan_timeout_s` and `odom_timeout_s` (s): an input silent for a minute is gone.
+pub const MAX_INPUT_TIMEOUT_S: f64 = 60.0;
+
+/// The largest `result_timeout_s` (s): an hour.
+pub const MAX_RESULT_TIMEOUT_S: f64 = 3600.0;
+
+/// `s` seconds as a duration, held to [0, `max_s`] (NaN gives `max_s`): never a panic, whatever
+/// the number.
+pub fn seconds(s: f64, max_s: f64) -> Duration {
+    let s = if s.is_nan() { max_s } else { s.clamp(0.0, max_s) };
+    Duration::try_from_secs_f64(s).unwrap_or(Duration::ZERO)
+}
+
 /// Why a goal pose is refused.
-#[derive(Debug, Clone, PartialEq, Eq, Error)]
+#[derive(Debug, Clone, PartialEq, Error)]
 pub enum GoalError {
     /// Not in the odometry frame (the node has no map, and no other transform).
     #[error("goal in frame `{got}`, but goals must be in `{want}`")]
@@ -340,10 +374,22 @@ pub enum GoalError {
     /// NaN or infinity in the position or orientation.
     #[error("goal pose is not finite")]
     NotFinite,
+    /// A coordinate beyond [`MAX_GOAL_COORD`]: farther than any reactive drive can mean.
+    #[error("goal ({x}, {y}) is beyond ±{MAX_GOAL_COORD} m")]
+    TooFar {
+        /// The goal's x (m).
+        x: f64,
+        /// The goal's y (m).
+        y: f64,
+    },
 }
 
+/// The largest |x| and |y| of a goal (m, odom).
+pub const MAX_GOAL_COORD: f64 = 1e4;
+
 /// The goal point in the odometry frame, or why it is refused: a frame other than `odom_frame`
-/// (a leading `/` ignored, as tf2 ignores it), or any non-finite number in the pose.
+/// (a leading `/` ignored, as tf2 ignores it), any non-finite number in the pose, or a
+/// coordinate beyond ±[`MAX_GOAL_COORD`].
 pub fn goal_in_odom(goal: &PoseStamped, odom_frame: &str) -> Result<Point2<f64>, GoalError> {
     let frame = goal.header.frame_id.trim_start_matches('/');
     if frame != odom_frame.trim_start_matches('/') {
@@ -355,6 +401,9 @@ pub fn goal_in_odom(goal: &PoseStamped, odom_frame: &str) -> Result<Point2<f64>,
     let (p, q) = (&goal.pose.position, &goal.pose.orientation);
     if ![p.x, p.y, p.z, q.x, q.y, q.z, q.w].iter().all(|v| v.is_finite()) {
         return Err(GoalError::NotFinite);
+    }
+    if p.x.abs() > MAX_GOAL_COORD || p.y.abs() > MAX_GOAL_COORD {
+        return Err(GoalError::TooFar { x: p.x, y: p.y });
     }
     Ok(Point2::new(p.x, p.y))
 }
@@ -459,8 +508,15 @@ pub enum GoalOutcome {
     Canceled,
     /// A newer goal took over (from `goal_pose` or the action).
     Preempted(&'static str),
-    /// The goal was refused (frame, NaN).
+    /// The goal was refused (frame, NaN, too far).
     Invalid(GoalError),
+    /// The navigator refused its input on this many scans in a row (the last error given).
+    StepErrors {
+        /// Consecutive refused steps.
+        count: u32,
+        /// The navigator's last error.
+        error: String,
+    },
     /// The node shut down.
     ShuttingDown,
 }
@@ -472,7 +528,7 @@ impl GoalOutcome {
         match self {
             GoalOutcome::Succeeded => "SUCCEEDED",
             GoalOutcome::NoPath(_) => "NO_PATH",
-            GoalOutcome::NoProgress { .. } => "ABORTED",
+            GoalOutcome::NoProgress { .. } | GoalOutcome::StepErrors { .. } => "ABORTED",
             GoalOutcome::Stale(_) => "STALE_INPUT",
             GoalOutcome::Canceled => "CANCELED",
             GoalOutcome::Preempted(_) => "PREEMPTED",
@@ -493,7 +549,10 @@ impl GoalOutcome {
                 "boundary following made too little progress toward the goal".to_owned()
             }
             GoalOutcome::NoProgress { since, radius } => {
-                format!("no progress: moved less than {radius} m in {since:.1} s")
+                format!("no progress: moved less than {radius} m in {since:.2} s")
+            }
+            GoalOutcome::StepErrors { count, error } => {
+                format!("the navigator refused its input on {count} scans in a row: {error}")
             }
             GoalOutcome::Stale(which) => format!("{} stale: robot stopped", which.as_str()),
             GoalOutcome::Canceled => "canceled by the client".to_owned(),
@@ -518,9 +577,183 @@ impl GoalOutcome {
             GoalOutcome::Succeeded | GoalOutcome::Canceled | GoalOutcome::Preempted(_) => nav2_error::NONE,
             GoalOutcome::NoPath(_) => nav2_error::NO_VALID_PATH,
             GoalOutcome::NoProgress { .. } => nav2_error::FAILED_TO_MAKE_PROGRESS,
-            GoalOutcome::Stale(_) => nav2_error::NO_VALID_CONTROL,
+            GoalOutcome::Stale(_) | GoalOutcome::StepErrors { .. } => nav2_error::NO_VALID_CONTROL,
             GoalOutcome::Invalid(_) | GoalOutcome::ShuttingDown => nav2_error::UNKNOWN,
         }
+    }
+}
+
+/// After this many scans in a row that the navigator refuses, the goal ends ABORTED.
+pub const MAX_STEP_ERRORS: u32 = 20;
+
+/// Counts the navigator's consecutive refusals of one goal.
+#[derive(Debug, Clone, Default, PartialEq, Eq)]
+pub struct StepErrors {
+    count: u32,
+}
+
+impl StepErrors {
+    /// A step the navigator took: the count starts again.
+    pub fn ok(&mut self) {
+        self.count = 0;
+    }
+
+    /// A refused step; `Some(count)` once the count reaches [`MAX_STEP_ERRORS`] (the goal ends).
+    pub fn failed(&mut self) -> Option<u32> {
+        self.count = self.count.saturating_add(1);
+        (self.count >= MAX_STEP_ERRORS).then_some(self.count)
+    }
+}
+
+/// Whether the robot is (as far as this node commanded it) moving: a refused input stops it
+/// with one zero command, not one per refusal.
+#[derive(Debug, Clone, Default, PartialEq, Eq)]
+pub struct CommandGate {
+    moving: bool,
+}
+
+impl CommandGate {
+    /// A command went out (zero or not).
+    pub fn sent(&mut self, twist: &Twist) {
+        let t = twist;
+        self.moving = [
+            t.linear.x,
+            t.linear.y,
+            t.linear.z,
+            t.angular.x,
+            t.angular.y,
+            t.angular.z,
+        ]
+        .iter()
+        .any(|v| *v != 0.0);
+    }
+
+    /// An input was refused while a goal runs: `true` when a zero command must go out now (the
+    /// last command moved the robot); the gate then counts the robot as stopped.
+    pub fn refused(&mut self) -> bool {
+        std::mem::take(&mut self.moving)
+    }
+}
+
+/// Why a scan gives no navigator step.
+#[derive(Debug, Clone, PartialEq, Error)]
+pub enum ScanRefusal {
+    /// The scan's frame has no pose in the base frame: not in `tf_static`, and no `laser_pose`
+    /// parameter was given.
+    #[error("no laser pose: frame `{frame}` not in tf_static (from `{base}`) and no laser_pose parameter set")]
+    NoLaserPose {
+        /// The scan's frame.
+        frame: String,
+        /// The base frame.
+        base: String,
+    },
+    /// The scan itself is malformed.
+    #[error("scan refused: {0}")]
+    Invalid(String),
+}
+
+/// Where the laser pose of a scan came from.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum LaserPoseFrom {
+    /// `tf_static`, for the scan's own frame.
+    TfStatic,
+    /// The `laser_pose` parameter (the scan's frame is not in `tf_static`).
+    Parameter,
+}
+
+/// The pose in `base_frame` of the laser of a scan in `scan_frame` (empty: `laser_frame`): the
+/// `tf_static` chain to the scan's own frame, else the `laser_pose` parameter if one was given,
+/// else refused, naming the frame.
+pub fn scan_laser_pose(
+    frames: &StaticFrames,
+    base_frame: &str,
+    scan_frame: &str,
+    laser_frame: &str,
+    parameter: Option<Pose2>,
+) -> Result<(Pose2, LaserPoseFrom), ScanRefusal> {
+    let frame = match scan_frame.trim_start_matches('/') {
+        "" => laser_frame.trim_start_matches('/'),
+        f => f,
+    };
+    if let Some(p) = frames.lookup(base_frame, frame) {
+        return Ok((p, LaserPoseFrom::TfStatic));
+    }
+    parameter
+        .map(|p| (p, LaserPoseFrom::Parameter))
+        .ok_or_else(|| ScanRefusal::NoLaserPose {
+            frame: frame.to_owned(),
+            base: base_frame.to_owned(),
+        })
+}
+
+/// Why an odometry message is refused.
+#[derive(Debug, Clone, PartialEq, Eq, Error)]
+pub enum OdomError {
+    /// `header.frame_id` or `child_frame_id` is not the configured frame (a leading `/` and an
+    /// empty frame are accepted, as many drivers leave it empty).
+    #[error("odom in frames `{frame}` → `{child}`, expected `{want_frame}` → `{want_child}`")]
+    Frames {
+        /// The message's `header.frame_id`.
+        frame: String,
+        /// The message's `child_frame_id`.
+        child: String,
+        /// `odom_frame`.
+        want_frame: String,
+        /// `base_frame`.
+        want_child: String,
+    },
+    /// NaN or infinity in the pose.
+    #[error("odom with a non-finite pose")]
+    NotFinite,
+}
+
+/// The robot pose of an odometry message, or why it is refused: frames other than
+/// `odom_frame` → `base_frame` (an empty frame passes), or a non-finite pose.
+pub fn odom_pose(m: &Odometry, odom_frame: &str, base_frame: &str) -> Result<Pose2, OdomError> {
+    let same = |got: &str, want: &str| {
+        let got = got.trim_start_matches('/');
+        got.is_empty() || got == want.trim_start_matches('/')
+    };
+    if !same(&m.header.frame_id, odom_frame) || !same(&m.child_frame_id, base_frame) {
+        return Err(OdomError::Frames {
+            frame: m.header.frame_id.clone(),
+            child: m.child_frame_id.clone(),
+            want_frame: odom_frame.to_owned(),
+            want_child: base_frame.to_owned(),
+        });
+    }
+    let p = &m.pose.pose;
+    let q = &p.orientation;
+    let pose = Pose2::new(p.position.x, p.position.y, yaw_of(q));
+    // The yaw of a quaternion with an infinity in it can come out finite: each part is checked.
+    if pose.is_finite() && [q.x, q.y, q.z, q.w].iter().all(|v| v.is_finite()) {
+        Ok(pose)
+    } else {
+        Err(OdomError::NotFinite)
+    }
+}
+
+/// The heading a goal asks for, when it asks for one: the yaw of its orientation, `None` for
+/// the identity (or a quaternion within 1 mrad of it, or a zero one). The method reaches a
+/// position only, so the node says the heading is not kept.
+pub fn goal_heading(goal: &PoseStamped) -> Option<f64> {
+    let q = &goal.pose.orientation;
+    let n = q.x * q.x + q.y * q.y + q.z * q.z + q.w * q.w;
+    if !(n.is_finite() && n > 0.0) {
+        return None;
+    }
+    let yaw = yaw_of(q);
+    (yaw.abs() > 1e-3).then_some(yaw)
+}
+
+/// The progress checker after a parameter change: the same one (its window and anchor kept)
+/// unless its own settings changed, so that setting other parameters again and again cannot
+/// keep a stuck goal alive.
+pub fn reconfigured_progress(old: ProgressChecker, settings: ProgressSettings) -> ProgressChecker {
+    if old.settings() == settings {
+        old
+    } else {
+        ProgressChecker::new(settings)
     }
 }
 
@@ -848,7 +1081,25 @@ mod tests {
             since: 10.25,
             radius: 0.5,
         };
-        assert_eq!(stuck.reason(), "ABORTED: no progress: moved less than 0.5 m in 10.2 s");
+        // Two decimals: an elapsed 1.04 s against an allowance of 1 s must not print "1.0 s".
+        assert_eq!(stuck.reason(), "ABORTED: no progress: moved less than 0.5 m in 10.25 s");
+        let just_over = GoalOutcome::NoProgress {
+            since: 1.04,
+            radius: 5.0,
+        };
+        assert_eq!(
+            just_over.reason(),
+            "ABORTED: no progress: moved less than 5 m in 1.04 s"
+        );
+        let errors = GoalOutcome::StepErrors {
+            count: 20,
+            error: "bad".into(),
+        };
+        assert_eq!(
+            errors.reason(),
+            "ABORTED: the navigator refused its input on 20 scans in a row: bad"
+        );
+        assert_eq!((errors.state(), errors.nav2_error_code()), (NavStatus::FAILED, 106));
         assert_eq!(stuck.nav2_error_code(), 105);
         assert_eq!(GoalOutcome::Succeeded.state(), NavStatus::SUCCEEDED);
         assert_eq!(GoalOutcome::Invalid(GoalError::NotFinite).code(), "INVALID_GOAL");
@@ -921,6 +1172,218 @@ mod tests {
         assert_eq!(
             (cleared.markers[0].action, cleared.markers[0].ns.as_str()),
             (Marker::DELETEALL, "local_nav")
+        );
+    }
+
+    #[test]
+    fn far_goals_are_refused() {
+        // 1e4 m is the last accepted coordinate; 1e200 (finite) and -10000.5 are refused.
+        assert_eq!(
+            goal_in_odom(&pose_stamped("odom", 1e4, -1e4), "odom"),
+            Ok(Point2::new(1e4, -1e4))
+        );
+        assert_eq!(
+            goal_in_odom(&pose_stamped("odom", 1e200, 0.0), "odom"),
+            Err(GoalError::TooFar { x: 1e200, y: 0.0 })
+        );
+        assert!(matches!(
+            goal_in_odom(&pose_stamped("odom", 0.0, -10_000.5), "odom"),
+            Err(GoalError::TooFar { .. })
+        ));
+        assert_eq!(
+            GoalOutcome::Invalid(GoalError::TooFar { x: 2e4, y: 0.0 }).reason(),
+            "INVALID_GOAL: goal (20000, 0) is beyond ±10000 m"
+        );
+    }
+
+    #[test]
+    fn timeouts_are_bounded_and_never_panic() {
+        let specs = Decl::<LocalNavConfig>::of().specs();
+        let mut values = ParamValues::defaults(&specs);
+        // 1e300 s is finite and positive, and used to panic in Duration::from_secs_f64.
+        let spec = |name: &str| specs.iter().find(|s| s.name == name).unwrap();
+        for (name, max) in [
+            ("scan_timeout_s", 60.0),
+            ("odom_timeout_s", 60.0),
+            ("result_timeout_s", 3600.0),
+        ] {
+            let check = |v: f64| spec(name).check(&ros2_client::ParameterValue::Double(v));
+            assert!(check(1e300).is_err(), "{name}");
+            assert!(check(max).is_ok() && check(max * 1.001).is_err(), "{name}");
+            assert!(check(0.0).is_err(), "{name}");
+        }
+        values.set("odom_timeout_s", ros2_client::ParameterValue::Double(2.5));
+        values.set("scan_timeout_s", ros2_client::ParameterValue::Double(60.0));
+        values.set("result_timeout_s", ros2_client::ParameterValue::Double(3600.0));
+        let c: LocalNavConfig = mobil_ros::config::load(&values).unwrap();
+        assert_eq!(c.scan_timeout(), Duration::from_secs(60));
+        assert_eq!(c.odom_timeout(), Duration::from_millis(2500));
+        assert_eq!(c.result_timeout(), Duration::from_secs(3600));
+        // The result timeout is read once, at start-up.
+        assert!(specs.iter().any(|s| s.name == "result_timeout_s" && s.read_only));
+        // Whatever reaches the conversion, it is held: no panic.
+        assert_eq!(seconds(1e300, 60.0), Duration::from_secs(60));
+        assert_eq!(seconds(f64::INFINITY, 60.0), Duration::from_secs(60));
+        assert_eq!(seconds(f64::NAN, 60.0), Duration::from_secs(60));
+        assert_eq!(seconds(-1.0, 60.0), Duration::ZERO);
+        assert_eq!(seconds(0.25, 60.0), Duration::from_millis(250));
+    }
+
+    #[test]
+    fn consecutive_step_errors_end_the_goal_and_a_good_step_resets_them() {
+        let mut e = StepErrors::default();
+        for _ in 0..19 {
+            assert_eq!(e.failed(), None);
+        }
+        e.ok();
+        // After a good step, 19 more are allowed again; the 20th in a row ends the goal.
+        for _ in 0..19 {
+            assert_eq!(e.failed(), None);
+        }
+        assert_eq!(e.failed(), Some(20));
+        assert_eq!(MAX_STEP_ERRORS, 20);
+    }
+
+    #[test]
+    fn a_refusal_stops_a_moving_robot_once() {
+        let mut g = CommandGate::default();
+        // Nothing commanded yet: no zero needed.
+        assert!(!g.refused());
+        let mut moving = Twist::default();
+        moving.angular.z = 0.3;
+        g.sent(&moving);
+        assert!(g.refused());
+        // The zero went out: a second refusal in a row sends none.
+        assert!(!g.refused());
+        g.sent(&moving);
+        g.sent(&Twist::default());
+        assert!(!g.refused());
+    }
+
+    fn tf(parent: &str, child: &str, x: f64) -> mobil_msgs::geometry_msgs::msg::TransformStamped {
+        let mut t = mobil_msgs::geometry_msgs::msg::TransformStamped::default();
+        t.header.frame_id = parent.into();
+        t.child_frame_id = child.into();
+        t.transform.translation.x = x;
+        t.transform.rotation = yaw_quaternion(0.0);
+        t
+    }
+
+    #[test]
+    fn the_scan_s_own_frame_gives_the_laser_pose() {
+        let mut frames = StaticFrames::default();
+        frames.add(&mobil_msgs::tf2_msgs::msg::TFMessage {
+            transforms: vec![tf("base_link", "laser", 0.3), tf("base_link", "rear_laser", -0.4)],
+        });
+        let param = Some(Pose2::new(0.1, 0.0, 0.0));
+        // The scan says rear_laser: its transform (−0.4 m), not laser_frame's (0.3 m).
+        let (p, from) = scan_laser_pose(&frames, "base_link", "rear_laser", "laser", None).unwrap();
+        assert_eq!((p.x, from), (-0.4, LaserPoseFrom::TfStatic));
+        // tf_static wins over the parameter; an empty frame means laser_frame.
+        let (p, from) = scan_laser_pose(&frames, "base_link", "", "laser", param).unwrap();
+        assert_eq!((p.x, from), (0.3, LaserPoseFrom::TfStatic));
+        // An unknown frame: the parameter if one was set, else refused, naming the frame.
+        let (p, from) = scan_laser_pose(&frames, "base_link", "/other", "laser", param).unwrap();
+        assert_eq!((p.x, from), (0.1, LaserPoseFrom::Parameter));
+        let e = scan_laser_pose(&frames, "base_link", "other", "laser", None).unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "no laser pose: frame `other` not in tf_static (from `base_link`) and no laser_pose parameter set"
+        );
+    }
+
+    #[test]
+    fn laser_pose_is_unset_by_default_and_takes_three_values() {
+        let mut values = ParamValues::defaults(&Decl::<LocalNavConfig>::of().specs());
+        let c: LocalNavConfig = mobil_ros::config::load(&values).unwrap();
+        assert_eq!(c.laser_pose(), None);
+        values.set(
+            "laser_pose",
+            ros2_client::ParameterValue::DoubleArray(vec![0.2, -0.1, 0.5]),
+        );
+        let c: LocalNavConfig = mobil_ros::config::load(&values).unwrap();
+        assert_eq!(c.laser_pose(), Some(Pose2::new(0.2, -0.1, 0.5)));
+        values.set("laser_pose", ros2_client::ParameterValue::DoubleArray(vec![0.2, -0.1]));
+        assert!(mobil_ros::config::load::<LocalNavConfig>(&values).is_err());
+    }
+
+    fn odom(frame: &str, child: &str, x: f64) -> Odometry {
+        let mut m = Odometry::default();
+        m.header.frame_id = frame.into();
+        m.child_frame_id = child.into();
+        m.pose.pose.position.x = x;
+        m.pose.pose.orientation.w = 1.0;
+        m
+    }
+
+    #[test]
+    fn odometry_in_other_frames_or_with_nan_is_refused() {
+        assert_eq!(
+            odom_pose(&odom("odom", "base_link", 1.5), "odom", "base_link"),
+            Ok(Pose2::new(1.5, 0.0, 0.0))
+        );
+        // Empty frames (many drivers) and a leading slash pass.
+        assert!(odom_pose(&odom("", "", 1.0), "odom", "base_link").is_ok());
+        assert!(odom_pose(&odom("/odom", "base_link", 1.0), "odom", "base_link").is_ok());
+        let e = odom_pose(&odom("map", "base_link", 1.0), "odom", "base_link").unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "odom in frames `map` → `base_link`, expected `odom` → `base_link`"
+        );
+        assert!(matches!(
+            odom_pose(&odom("odom", "laser", 1.0), "odom", "base_link"),
+            Err(OdomError::Frames { .. })
+        ));
+        assert_eq!(
+            odom_pose(&odom("odom", "base_link", f64::NAN), "odom", "base_link"),
+            Err(OdomError::NotFinite)
+        );
+        let mut q_inf = odom("odom", "base_link", 0.0);
+        q_inf.pose.pose.orientation.z = f64::INFINITY;
+        assert_eq!(odom_pose(&q_inf, "odom", "base_link"), Err(OdomError::NotFinite));
+    }
+
+    #[test]
+    fn a_goal_heading_is_noticed_only_when_there_is_one() {
+        let mut g = pose_stamped("odom", 1.0, 0.0);
+        assert_eq!(goal_heading(&g), None);
+        // 90°: (0, 0, sin 45°, cos 45°).
+        g.pose.orientation = yaw_quaternion(std::f64::consts::FRAC_PI_2);
+        let yaw = goal_heading(&g).unwrap();
+        assert!((yaw - std::f64::consts::FRAC_PI_2).abs() < 1e-12);
+        // An all-zero quaternion (RViz-less tools often send it) asks for nothing.
+        g.pose.orientation = Default::default();
+        g.pose.orientation.w = 0.0;
+        assert_eq!(goal_heading(&g), None);
+    }
+
+    #[test]
+    fn a_parameter_change_keeps_the_progress_window_unless_its_settings_change() {
+        let settings = ProgressSettings {
+            required_movement_radius: 0.5,
+            movement_time_allowance: 10.0,
+        };
+        let mut p = ProgressChecker::new(settings);
+        assert_eq!(p.check(Point2::new(0.0, 0.0), 100.0), mobil_local_nav::Progress::Ok);
+        // Other parameters set at 105 s: the window opened at 100 s stays, so at 110.5 s the
+        // robot (0.1 m on) is stuck for 10.5 s.
+        let mut p = reconfigured_progress(p, settings);
+        assert_eq!(p.check(Point2::new(0.1, 0.0), 105.0), mobil_local_nav::Progress::Ok);
+        assert_eq!(
+            p.check(Point2::new(0.1, 0.0), 110.5),
+            mobil_local_nav::Progress::Stuck { since: 10.5 }
+        );
+        // The allowance itself changed: a fresh window from the next check.
+        let changed = ProgressSettings {
+            movement_time_allowance: 20.0,
+            ..settings
+        };
+        let mut p = reconfigured_progress(p, changed);
+        assert_eq!(p.check(Point2::new(0.1, 0.0), 111.0), mobil_local_nav::Progress::Ok);
+        assert_eq!(p.check(Point2::new(0.1, 0.0), 130.0), mobil_local_nav::Progress::Ok);
+        assert_eq!(
+            p.check(Point2::new(0.1, 0.0), 131.5),
+            mobil_local_nav::Progress::Stuck { since: 20.5 }
         );
     }
 }

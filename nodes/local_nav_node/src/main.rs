@@ -12,15 +12,18 @@
 //!
 //! `cmd_vel` goes out only while a goal is active, and exactly one zero `cmd_vel` when a goal
 //! ends (reached, no path, no progress, stale input, canceled, pre-empted, refused, shutdown);
-//! every command is held to the chassis limits ([`twist_from_command`]). The last command of the
-//! process is a zero one, waited for ([`final_stop`]).
+//! every command is held to the chassis limits ([`twist_from_command`]). A refused input while a
+//! goal runs (scan, laser pose, odometry, navigator step) stops the robot with one zero command.
+//! At shutdown with a goal under way, that goal's zero command is the last one, waited for
+//! ([`final_stop`]); an idle node sends none.
 
 use futures::StreamExt;
 use mobil_geom::Pose2;
 use mobil_local_nav::{Mode, MotionLimits, Navigator, Progress, ProgressChecker, StepOutput};
 use mobil_local_nav_node::{
-    clear_markers, duration_msg, goal_in_odom, markers, stale_input, status_message, twist_from_command, GoalOutcome,
-    LocalNavConfig, MarkerView, StatusView,
+    clear_markers, duration_msg, goal_heading, goal_in_odom, markers, odom_pose, reconfigured_progress,
+    scan_laser_pose, stale_input, status_message, twist_from_command, CommandGate, GoalOutcome, LaserPoseFrom,
+    LocalNavConfig, MarkerView, ScanRefusal, StatusView, StepErrors,
 };
 use mobil_msgs::builtin_interfaces::msg::Time;
 use mobil_msgs::geometry_msgs::msg::{Pose, PoseStamped, Twist};
@@ -31,10 +34,9 @@ use mobil_msgs::sensor_msgs::msg::LaserScan;
 use mobil_msgs::std_msgs::msg::Header;
 use mobil_msgs::visualization_msgs::msg::MarkerArray;
 use mobil_ros::action::{ActionEvent, GoalEnd, GoalRequest, GoalServer, GoalServerConfig};
-use mobil_ros::geometry::yaw_of;
 use mobil_ros::input::{decoded, Input};
 use mobil_ros::latest::Latest;
-use mobil_ros::scan::{scan_from_msg, tf_static_subscription, LaserPose};
+use mobil_ros::scan::{scan_from_msg, tf_static_subscription, StaticFrames};
 use mobil_ros::stop::{final_stop, FINAL_STOP_WAIT};
 use mobil_ros::ticker::Ticker;
 use mobil_ros::{qos, run_node, shutdown_signal, warn_throttled, ConfigError, LogThrottle, NodeDecl, RosNode};
@@ -107,8 +109,13 @@ struct Shell {
     active: Option<ActiveGoal>,
     scan_seen: Latest<()>,
     odom: Latest<OdomSample>,
+    /// The latest odometry message was refused: no step until a valid one comes (the last
+    /// valid one still times the watchdog).
+    odom_refused: bool,
     last_step: Option<StepOutput>,
     last_status: Option<Instant>,
+    gate: CommandGate,
+    step_errors: StepErrors,
     throttle: LogThrottle,
 }
 
@@ -132,9 +139,12 @@ async fn serve(node: &mut RosNode) -> anyhow::Result<()> {
         status: node.publisher::<NavStatus>("local_nav/status", &qos::latched())?,
         markers: node.publisher::<MarkerArray>("local_nav/markers", &qos::default_qos())?,
     };
-    let outcome = run(node, &outputs, config).await;
-    // Whatever ends the loop, the last command is a zero one, waited for.
-    final_stop(&outputs.cmd, Twist::default(), FINAL_STOP_WAIT).await;
+    let (outcome, was_active) = run(node, &outputs, config).await;
+    // A goal under way at the end gets its zero command, waited for; an idle node sends none
+    // (another node, teleop or a twist_mux input, may be commanding the robot).
+    if was_active {
+        final_stop(&outputs.cmd, Twist::default(), FINAL_STOP_WAIT).await;
+    }
     outcome
 }
 
@@ -153,7 +163,20 @@ fn goal_end(outcome: &GoalOutcome) -> GoalEnd {
     }
 }
 
-async fn run(node: &mut RosNode, out: &Outputs, config: LocalNavConfig) -> anyhow::Result<()> {
+/// The loop's outcome, and whether a goal was active when it ended (its zero command is then
+/// still to be sent).
+async fn run(node: &mut RosNode, out: &Outputs, config: LocalNavConfig) -> (anyhow::Result<()>, bool) {
+    match start(node, out, config).await {
+        Ok(r) => r,
+        Err(e) => (Err(e), false),
+    }
+}
+
+async fn start(
+    node: &mut RosNode,
+    out: &Outputs,
+    config: LocalNavConfig,
+) -> anyhow::Result<(anyhow::Result<()>, bool)> {
     let limits = config.motion_limits()?;
     let nav = Navigator::new(config.nav_config()?, limits)?;
     let scan_sub = node.subscription::<LaserScan>("scan", &qos::sensor_data())?;
@@ -164,10 +187,10 @@ async fn run(node: &mut RosNode, out: &Outputs, config: LocalNavConfig) -> anyho
         node,
         "navigate_to_pose",
         GoalServerConfig {
-            result_timeout: Duration::from_secs_f64(config.result_timeout_s),
+            result_timeout: config.result_timeout(),
         },
     )?;
-    let mut laser = LaserPose::new(&config.base_frame, &config.laser_frame, config.laser_pose());
+    let mut laser = StaticFrames::default();
     let mut shell = Shell {
         progress: ProgressChecker::new(config.progress),
         config,
@@ -176,8 +199,11 @@ async fn run(node: &mut RosNode, out: &Outputs, config: LocalNavConfig) -> anyho
         active: None,
         scan_seen: Latest::new(),
         odom: Latest::new(),
+        odom_refused: false,
         last_step: None,
         last_status: None,
+        gate: CommandGate::default(),
+        step_errors: StepErrors::default(),
         throttle: LogThrottle::new(Duration::from_secs(2)),
     };
     shell.publish_status(node, out, NavStatus::IDLE, String::new());
@@ -197,11 +223,13 @@ async fn run(node: &mut RosNode, out: &Outputs, config: LocalNavConfig) -> anyho
         &tf_sub,
     )
     .await;
-    if shell.active.is_some() {
-        shell.end_goal(node, out, &mut server, GoalOutcome::ShuttingDown);
+    let was_active = shell.active.is_some();
+    if was_active {
+        // The zero command is the final, acknowledged one (serve); none here.
+        shell.end_goal_without_zero(node, out, &mut server, GoalOutcome::ShuttingDown);
     }
     server.close(result(&GoalOutcome::ShuttingDown)).await;
-    outcome
+    Ok((outcome, was_active))
 }
 
 #[allow(clippy::too_many_arguments)]
@@ -210,7 +238,7 @@ async fn event_loop(
     out: &Outputs,
     shell: &mut Shell,
     server: &mut GoalServer<NavigateToPose>,
-    laser: &mut LaserPose,
+    laser: &mut StaticFrames,
     scan_sub: &Subscription<LaserScan>,
     odom_sub: &Subscription<Odometry>,
     goal_sub: &Subscription<PoseStamped>,
@@ -249,9 +277,9 @@ async fn event_loop(
             Event::Nothing => {}
             Event::Config(Ok(c)) => shell.reconfigure(c),
             Event::Config(Err(e)) => warn!("parameters not applied: {e}"),
-            Event::Odom(m) => shell.odom_in(&m),
+            Event::Odom(m) => shell.odom_in(out, &m),
             Event::Scan(m) => {
-                let skipped = laser.poll(tf_sub);
+                let skipped = poll_tf_static(laser, tf_sub);
                 if skipped > 0 {
                     warn_throttled!(
                         shell.throttle,
@@ -275,6 +303,20 @@ async fn event_loop(
 
 type TFMessageAlias = mobil_msgs::tf2_msgs::msg::TFMessage;
 
+/// Takes every `tf_static` message waiting (non-blocking); returns how many transforms were
+/// skipped as invalid (an undecodable sample counts as one).
+fn poll_tf_static(frames: &mut StaticFrames, sub: &Subscription<TFMessageAlias>) -> usize {
+    let mut skipped = 0;
+    loop {
+        match sub.take() {
+            Ok(Some((msg, _))) => skipped += frames.add(&msg),
+            Ok(None) => break,
+            Err(_) => skipped += 1,
+        }
+    }
+    skipped
+}
+
 impl Shell {
     fn reconfigure(&mut self, c: LocalNavConfig) {
         let built = c
@@ -293,28 +335,42 @@ impl Shell {
                 }
                 self.limits = limits;
                 self.nav = nav;
-                self.progress = ProgressChecker::new(c.progress);
+                let old = std::mem::replace(&mut self.progress, ProgressChecker::new(c.progress));
+                self.progress = reconfigured_progress(old, c.progress);
                 self.config = c;
             }
             Err(e) => warn!("parameters not applied: {e}"),
         }
     }
 
-    fn odom_in(&mut self, m: &Odometry) {
-        let p = &m.pose.pose;
-        let pose = Pose2::new(p.position.x, p.position.y, yaw_of(&p.orientation));
+    /// A valid odometry message is kept; a refused one is dropped, and while a goal runs the
+    /// robot stops (one zero command) until valid odometry comes again.
+    fn odom_in(&mut self, out: &Outputs, m: &Odometry) {
         let speed = m.twist.twist.linear.x.hypot(m.twist.twist.linear.y);
-        if pose.is_finite() {
-            self.odom.set(
-                OdomSample {
-                    pose,
-                    msg_pose: p.clone(),
-                    speed: if speed.is_finite() { speed } else { 0.0 },
-                },
-                m.header.stamp.clone(),
-            );
-        } else {
-            warn_throttled!(self.throttle, "odom-nan", "odom with a non-finite pose dropped");
+        match odom_pose(m, &self.config.odom_frame, &self.config.base_frame) {
+            Ok(pose) => {
+                self.odom_refused = false;
+                self.odom.set(
+                    OdomSample {
+                        pose,
+                        msg_pose: m.pose.pose.clone(),
+                        speed: if speed.is_finite() { speed } else { 0.0 },
+                    },
+                    m.header.stamp.clone(),
+                );
+            }
+            Err(e) => {
+                warn_throttled!(self.throttle, "odom-bad", "odom sample dropped: {e}; robot stopped");
+                self.odom_refused = true;
+                self.refused(out);
+            }
+        }
+    }
+
+    /// An input was refused while a goal may run: a zero command if the robot was moving.
+    fn refused(&mut self, out: &Outputs) {
+        if self.active.is_some() && self.gate.refused() {
+            self.zero(out);
         }
     }
 
@@ -354,6 +410,7 @@ impl Shell {
     }
 
     fn zero(&mut self, out: &Outputs) {
+        self.gate.sent(&Twist::default());
         if let Err(e) = out.cmd.publish(Twist::default()) {
             warn_throttled!(self.throttle, "cmd", "cannot publish the zero cmd_vel: {e:?}");
         }
@@ -367,8 +424,21 @@ impl Shell {
         server: &mut GoalServer<NavigateToPose>,
         outcome: GoalOutcome,
     ) {
+        if self.active.is_some() {
+            self.zero(out);
+        }
+        self.end_goal_without_zero(node, out, server, outcome);
+    }
+
+    /// [`Shell::end_goal`] but for the zero command, which the caller sends.
+    fn end_goal_without_zero(
+        &mut self,
+        node: &RosNode,
+        out: &Outputs,
+        server: &mut GoalServer<NavigateToPose>,
+        outcome: GoalOutcome,
+    ) {
         let Some(active) = self.active.take() else { return };
-        self.zero(out);
         if active.source == Source::Action {
             server.finish(goal_end(&outcome), result(&outcome));
         }
@@ -384,6 +454,7 @@ impl Shell {
         self.publish_status_with_mode(node, out, state, outcome.reason(), mode_before, Some(active.goal));
         self.nav.cancel();
         self.progress.reset();
+        self.step_errors.ok();
         self.last_step = None;
         if let Err(e) = out
             .markers
@@ -407,13 +478,14 @@ impl Shell {
     }
 
     /// Starts a validated goal (the old one, if any, has been ended).
-    fn start_goal(&mut self, node: &RosNode, out: &Outputs, goal: Point2<f64>, source: Source) {
+    fn start_goal(&mut self, node: &RosNode, out: &Outputs, goal: Point2<f64>, heading: Option<f64>, source: Source) {
         if let Err(e) = self.nav.set_goal(goal) {
             // goal_in_odom checked it: unreachable in practice, and safe if reached.
             warn!("goal refused by the navigator: {e}");
             return;
         }
         self.progress.reset();
+        self.step_errors.ok();
         self.last_step = None;
         self.active = Some(ActiveGoal {
             goal,
@@ -428,6 +500,14 @@ impl Shell {
             goal.y,
             self.config.odom_frame
         );
+        if let Some(yaw) = heading {
+            info!(
+                "goal ({}): its heading {yaw:.3} rad is not kept: the robot stops within xy_goal_tolerance \
+                 ({} m) of the position, facing where it arrives",
+                source.name(),
+                self.config.nav.goal_tolerance
+            );
+        }
         self.publish_status(node, out, NavStatus::ACTIVE, String::new());
     }
 
@@ -443,7 +523,7 @@ impl Shell {
                 if self.active.is_some() {
                     self.end_goal(node, out, server, GoalOutcome::Preempted("goal_pose"));
                 }
-                self.start_goal(node, out, goal, Source::Topic);
+                self.start_goal(node, out, goal, goal_heading(m), Source::Topic);
             }
             Err(e) => {
                 // A goal the user meant to replace the old one with: the old one stops too.
@@ -470,6 +550,13 @@ impl Shell {
                 let reason = GoalOutcome::Invalid(e).reason();
                 warn!("navigate_to_pose goal rejected: {reason}");
                 server.reject(request, &reason).await;
+                // The status says so too; a running goal keeps running (unlike a refused
+                // goal_pose, a rejected action goal never replaces the active one), and its
+                // ACTIVE status follows, so that the latched status is the running goal's.
+                self.publish_status_with_mode(node, out, NavStatus::FAILED, reason, Mode::Idle, None);
+                if self.active.is_some() {
+                    self.publish_status(node, out, NavStatus::ACTIVE, String::new());
+                }
                 return;
             }
         };
@@ -501,9 +588,10 @@ impl Shell {
                 self.end_goal(node, out, server, outcome);
             }
         }
+        let heading = goal_heading(&request.goal().pose);
         let preempted = result(&GoalOutcome::Preempted("navigate_to_pose"));
         match server.accept(request, |_| preempted).await {
-            Ok(()) => self.start_goal(node, out, goal, Source::Action),
+            Ok(()) => self.start_goal(node, out, goal, heading, Source::Action),
             Err(e) => warn_throttled!(self.throttle, "accept", "navigate_to_pose goal not started: {e}"),
         }
     }
@@ -513,64 +601,79 @@ impl Shell {
         node: &RosNode,
         out: &Outputs,
         server: &mut GoalServer<NavigateToPose>,
-        laser: &LaserPose,
+        laser: &StaticFrames,
         m: &LaserScan,
     ) {
-        let Some((base_from_laser, _)) = laser.get() else {
-            warn_throttled!(
-                self.throttle,
-                "laser-pose",
-                "scan ignored: no laser pose (tf_static {} → {} unknown and laser_pose invalid)",
-                self.config.base_frame,
-                self.config.laser_frame
-            );
-            return;
-        };
-        let frame = m.header.frame_id.trim_start_matches('/');
-        if !frame.is_empty() && frame != self.config.laser_frame.trim_start_matches('/') {
-            warn_throttled!(
-                self.throttle,
-                "scan-frame",
-                "scan in frame `{frame}` but laser_frame is `{}`: the pose of `{}` is used",
-                self.config.laser_frame,
-                self.config.laser_frame
-            );
-        }
-        let scan = match scan_from_msg(m, base_from_laser) {
-            Ok(s) => s,
+        let checked = scan_laser_pose(
+            laser,
+            &self.config.base_frame,
+            &m.header.frame_id,
+            &self.config.laser_frame,
+            self.config.laser_pose(),
+        )
+        .and_then(|(pose, from)| {
+            scan_from_msg(m, pose)
+                .map(|scan| (scan, pose, from))
+                .map_err(|e| ScanRefusal::Invalid(e.to_string()))
+        });
+        let (scan, base_from_laser, from) = match checked {
+            Ok(c) => c,
             Err(e) => {
-                warn_throttled!(self.throttle, "scan-bad", "scan refused: {e}");
-                return;
+                let key = match e {
+                    ScanRefusal::NoLaserPose { .. } => "laser-pose",
+                    ScanRefusal::Invalid(_) => "scan-bad",
+                };
+                warn_throttled!(self.throttle, key, "{e}; scan ignored");
+                return self.refused(out);
             }
         };
         if self.scan_seen.value().is_none() {
             info!(
-                "first scan: {} beams, laser at ({:.3}, {:.3}, {:.3} rad) in {}",
+                "first scan: {} beams, laser `{}` at ({:.3}, {:.3}, {:.3} rad) in {} (from {})",
                 scan.len(),
+                m.header.frame_id,
                 base_from_laser.x,
                 base_from_laser.y,
                 base_from_laser.yaw,
-                self.config.base_frame
+                self.config.base_frame,
+                match from {
+                    LaserPoseFrom::TfStatic => "tf_static",
+                    LaserPoseFrom::Parameter => "laser_pose",
+                }
             );
         }
         self.scan_seen.set((), m.header.stamp.clone());
         if self.active.is_none() {
             return;
         }
-        let Some(odom) = self.odom.get(self.config.odom_timeout()).cloned() else {
-            // The watchdog ends the goal if this lasts; no command from stale odometry.
-            return;
+        let fresh = self.odom.get(self.config.odom_timeout()).filter(|_| !self.odom_refused);
+        let Some(odom) = fresh.cloned() else {
+            // No command from stale or refused odometry: the robot stops; the watchdog ends the
+            // goal if this lasts.
+            warn_throttled!(
+                self.throttle,
+                "odom-stale",
+                "scan ignored: odom stale or refused; robot stopped"
+            );
+            return self.refused(out);
         };
         let step = self.nav.step(odom.pose, &scan);
         if let Some(e) = step.input_error {
             warn_throttled!(
                 self.throttle,
                 "nav-input",
-                "navigator refused its input: {e}; zero command"
+                "navigator refused its input: {e}; robot stopped"
             );
-            self.zero(out);
-            return;
+            if let Some(count) = self.step_errors.failed() {
+                let outcome = GoalOutcome::StepErrors {
+                    count,
+                    error: e.to_string(),
+                };
+                return self.end_goal(node, out, server, outcome);
+            }
+            return self.refused(out);
         }
+        self.step_errors.ok();
         let changed = step.changed_from.is_some();
         let mode = step.mode;
         let command = step.command;
@@ -586,6 +689,7 @@ impl Shell {
             return self.end_goal(node, out, server, GoalOutcome::NoProgress { since, radius });
         }
         let twist = twist_from_command(command, &self.limits);
+        self.gate.sent(&twist);
         if let Err(e) = out.cmd.publish(twist) {
             warn_throttled!(self.throttle, "cmd", "cannot publish cmd_vel: {e:?}");
         }
