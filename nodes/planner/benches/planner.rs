@@ -70,10 +70,7 @@ fn bench(c: &mut Criterion) {
     let world =
         World::load(concat!(env!("CARGO_MANIFEST_DIR"), "/../../params/worlds/default.yaml")).expect("default world");
     let route = demo_loop(20);
-    let config = RouteCheckConfig {
-        robot_radius: 0.53,
-        ..RouteCheckConfig::default()
-    };
+    let config = RouteCheckConfig::new(0.53);
     let params = ChassisParams::mobil2();
     let report = check_route(&Pose2::identity(), &route, &params, &world, &config).expect("valid");
     assert!(report.is_ok(), "{:?}", report.problems);

@@ -605,14 +605,5 @@ impl DockingController {
 }
 
 pub(crate) fn check_pose(what: &str, p: &Pose2) -> Result<(), PlannerError> {
-    if p.is_finite() {
-        Ok(())
-    } else {
-        Err(PlannerError::NonFinite {
-            what: what.to_owned(),
-            x: p.x,
-            y: p.y,
-            yaw: p.yaw,
-        })
-    }
+    crate::error::check_coordinates(what, p.x, p.y, p.yaw)
 }
