@@ -18,15 +18,16 @@
 //! - **e = 0**: the line of sight Ω is undefined at the goal position; it is taken as ϑ_G, so
 //!   Θ = 0 and α is the plain heading error.
 //! - **Gain ranges**: the printed ranges (0,1), (0,1), (0,6), (0,1) are read in the printed
-//!   order γ, λ, k, h — the one reading that holds the paper's own gains; outside them a
-//!   [`GainWarning`], never a refusal.
+//!   order γ, λ, k, h — a chosen reading (the source garbles the assignment, and the paper's
+//!   gains, all below 1, fit most readings); outside them a [`GainWarning`], never a refusal.
 //! - **Common factor**: v_max, ω_max and, from a chassis, its wheel-speed limit (wheel speeds
 //!   are homogeneous of degree one in (v, ω)) — all three by one factor s, V̇ = s·V̇_law. A
 //!   car-like chassis' curvature limit cannot be met by any factor (ω/v is kept): its
 //!   LOW-LEVEL clamps the curvature, the law is then not followed, and the docking ends in
 //!   FAILED with its residual.
 //! - **Docking ends**: in-place rotation ω = k_rot·wrap(ϑ_G − ϑ) once e < ε_e (handing back to
-//!   the law if e exceeds 2ε_e); FAILED on a time limit, on the progress measure (V, or the
+//!   the law if e exceeds 2ε_e, or if e ≥ ε_e with the heading already within ε_ϑ, where the
+//!   rotation would stand still); a failure carries e and the heading error at that step; FAILED on a time limit, on the progress measure (V, or the
 //!   heading error while rotating) not falling by 0.1 % within `stall_time_s`, or, on a
 //!   chassis that cannot turn in place, on reaching ε_e with the heading outside ε_ϑ.
 //! - **Integration**: RK4 on the closed loop in sub-steps of h (the tests use 10 and 5 ms); a
@@ -104,7 +105,7 @@ pub use approach::{
 
 pub use docking::{
     polar_error, sinc, wrap_alpha, DockingConfig, DockingController, DockingFailure, DockingGains, DockingOutput,
-    DockingPhase, Finish, GainWarning, PolarError, Velocity, VelocityLimits,
+    DockingPhase, Finish, GainWarning, PolarError, Residual, Velocity, VelocityLimits,
 };
 pub use error::{PlannerError, COORDINATE_LIMIT};
 pub use route::{arc_radius, check_route, ProblemKind, RouteCheckConfig, RouteProblem, RouteReport, UnreachableCause};

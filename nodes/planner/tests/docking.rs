@@ -7,7 +7,7 @@ use mobil_chassis::ChassisParams;
 use mobil_geom::Pose2;
 use mobil_planner::{
     polar_error, simulate_docking, sinc, DockingConfig, DockingController, DockingFailure, DockingGains, DockingPhase,
-    DockingRun, Finish, Kinematics, PlannerError, Velocity, VelocityLimits,
+    DockingRun, Finish, Kinematics, PlannerError, Residual, Velocity, VelocityLimits,
 };
 use proptest::prelude::*;
 
@@ -256,21 +256,84 @@ fn omni_chassis_docks_with_a_final_rotation() {
 
 #[test]
 fn car_like_chassis_reports_its_residual() {
-    // MOBIL-II cannot follow the law: the path needs radii below 0.73 m and a cusp where v = 0
-    // while ω ≠ 0 (the LOW-LEVEL turns that into a stop). The docking must end in FAILED with
-    // the residual that the final pose really has.
+    // MOBIL-II cannot follow the law: from the paper's start the law reverses and turns
+    // (v₀ = −0.707, ω₀ = −0.942: radius 0.75 m), then v = γe·cos α falls to 0 as |α| → π/2
+    // while ω stays ≠ 0 — a cusp, a turn in place. The car-like LOW-LEVEL keeps the curvature
+    // within 1/0.73 m⁻¹, so near the cusp it barely moves: V stops falling, and after
+    // stall_time_s (5 s) of V falling by less than 0.1 % the docking fails as not converging,
+    // far from the goal (e ≫ ε_e), with |α| near π/2. The residual reported is the final pose's.
     let params = ChassisParams::mobil2();
     let mut c = controller(VelocityLimits::from_chassis(&params), Finish::for_chassis(&params));
     let run = simulate_docking(&mut c, Kinematics::Chassis(params), paper_start(), 0.01, 120.0).expect("valid run");
     let last = run.samples.last().expect("samples").output;
-    assert!(matches!(run.end, DockingPhase::Failed(_)), "{:?}", run.end);
-    let dx = run.final_pose.x.hypot(run.final_pose.y);
-    assert_relative_eq!(last.polar.e, dx, epsilon = 1e-12);
-    assert_relative_eq!(last.heading_error, -run.final_pose.yaw, epsilon = 1e-12);
+    assert_eq!(run.end, DockingPhase::Failed(DockingFailure::NotConverging));
+    assert!(last.polar.e > 0.1, "{:?}", last.polar);
+    assert!(last.polar.alpha.cos().abs() < 0.05, "{:?}", last.polar);
+    // The stall window: over the last 5 s V fell by less than 0.1 %.
+    let v_end = last.lyapunov;
+    let before = run
+        .samples
+        .iter()
+        .rev()
+        .find(|s| s.t <= run.time - 5.0)
+        .expect("longer than 5 s")
+        .output
+        .lyapunov;
+    assert!(v_end >= 0.999 * before, "V {before} → {v_end}");
+    // The residual: e = |G − q| and wrap(0 − ϑ) of the final pose, computed here.
+    let residual = last.residual.expect("a failure carries its residual");
+    assert_relative_eq!(residual.e, run.final_pose.x.hypot(run.final_pose.y), epsilon = 1e-12);
+    assert_relative_eq!(residual.heading, mobil_geom::wrap(-run.final_pose.yaw), epsilon = 1e-12);
     println!(
         "MOBIL-II docking from the paper's start: {:?} after {:.2} s, residual e = {:.3} m, heading {:.3} rad",
-        run.end, run.time, last.polar.e, last.heading_error
+        run.end, run.time, residual.e, residual.heading
     );
+}
+
+#[test]
+fn heading_residual_failure_carries_e_and_heading() {
+    // A chassis that cannot turn in place, 0.01 m short of G (e < ε_e = 0.02) with the heading
+    // 0.5 rad off (> ε_ϑ = 0.03): FAILED with the residual (0.01, wrap(0 − 0.5) = −0.5), and the
+    // same residual on every later step, wherever the robot is.
+    let mut c = controller(VelocityLimits::unlimited(), Finish::ReportResidual);
+    let out = c.update(&Pose2::new(-0.01, 0.0, 0.5), 0.0).expect("finite");
+    assert_eq!(out.phase, DockingPhase::Failed(DockingFailure::HeadingResidual));
+    assert_eq!(out.command, Velocity::ZERO);
+    let expected = Residual { e: 0.01, heading: -0.5 };
+    assert_eq!(out.residual, Some(expected));
+    let later = c.update(&Pose2::new(1.0, 0.0, 0.0), 0.1).expect("finite");
+    assert_eq!(later.residual, Some(expected));
+}
+
+#[test]
+fn rotation_reports_its_real_scale() {
+    // In place 0.005 m from G (< ε_e) with the heading 2 rad off: ω = 1.5·2 = 3 rad/s, limit
+    // 0.5 rad/s → s = 0.5 / 3 = 1/6, ω = 0.5.
+    let mut c = controller(VelocityLimits::new(1.0, 0.5).expect("valid"), Finish::RotateInPlace);
+    let out = c.update(&Pose2::new(0.005, 0.0, -2.0), 0.0).expect("finite");
+    assert_eq!(out.phase, DockingPhase::Rotate);
+    assert_relative_eq!(out.scale, 1.0 / 6.0, epsilon = 1e-15);
+    assert_relative_eq!(out.command.omega, 0.5, epsilon = 1e-15);
+    assert_eq!(out.command.v, 0.0);
+}
+
+#[test]
+fn drifting_out_of_the_position_tolerance_with_the_heading_right_goes_back_to_the_law() {
+    // Rotating (e = 0.01 < ε_e, heading 0.5 rad off), the robot is then found 1.5·ε_e = 0.03 m
+    // behind G with the heading already right: the rotation would command ω = 1.5·0 = 0 and
+    // stall. Back to the law instead: α = Θ = 0, v = γe = 0.5·0.03 = 0.015 m/s, ω = 0; driving
+    // straight, e = 0.03·e^(−0.5t) falls below ε_e = 0.02 at t = 2 ln 1.5 = 0.8109 s: docked.
+    let mut c = controller(VelocityLimits::unlimited(), Finish::RotateInPlace);
+    let out = c.update(&Pose2::new(-0.01, 0.0, 0.5), 0.0).expect("finite");
+    assert_eq!(out.phase, DockingPhase::Rotate);
+    let run = simulate_docking(&mut c, Kinematics::Unicycle, Pose2::new(-0.03, 0.0, 0.0), 0.01, 10.0).expect("valid");
+    let first = run.samples[0].output;
+    assert_eq!(first.phase, DockingPhase::Approach);
+    assert_relative_eq!(first.command.v, 0.015, epsilon = 1e-15);
+    assert_eq!(first.command.omega, 0.0);
+    assert_eq!(run.end, DockingPhase::Docked);
+    // Docked at the first 10 ms sample after 0.8109 s.
+    assert_relative_eq!(run.time, 0.82, epsilon = 1e-9);
 }
 
 #[test]
