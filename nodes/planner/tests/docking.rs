@@ -234,8 +234,26 @@ fn v_never_increases_under_tight_limits() {
     assert!(rise <= 1e-12, "V rose by {rise}");
     for s in &run.samples {
         assert!(s.output.command.v.abs() <= 0.1 + 1e-12 && s.output.command.omega.abs() <= 0.2 + 1e-12);
-        assert!(s.output.lyapunov_rate <= 0.0);
     }
+    // The reported V̇ (the limited command's) against a second method: the change of V between
+    // consecutive approach samples over h, compared with the trapezoid mean of V̇ at both ends
+    // (exact to O(h²·V̈); the scale factor has kinks where the binding limit changes).
+    let mut checked = 0;
+    for w in run.samples.windows(2) {
+        if w[0].output.phase != DockingPhase::Approach || w[1].output.phase != DockingPhase::Approach {
+            continue;
+        }
+        let h = w[1].t - w[0].t;
+        let difference = (w[1].output.lyapunov - w[0].output.lyapunov) / h;
+        let trapezoid = 0.5 * (w[0].output.lyapunov_rate + w[1].output.lyapunov_rate);
+        assert!(
+            (difference - trapezoid).abs() <= 1e-3 * trapezoid.abs() + 1e-5,
+            "t = {}: ΔV/h = {difference}, mean V̇ = {trapezoid}",
+            w[0].t
+        );
+        checked += 1;
+    }
+    assert!(checked > 1000, "{checked}");
     // The limit binds at the start: s₀ = min(0.1/0.707107, 0.2/0.942478) = 0.141421.
     assert_relative_eq!(run.samples[0].output.scale, 0.141_421_356, epsilon = 1e-9);
     assert_eq!(run.end, DockingPhase::Docked);
@@ -394,17 +412,32 @@ proptest! {
     #![proptest_config(ProptestConfig::with_cases(48))]
     #[test]
     fn random_starts_converge_with_v_never_increasing(
-        x in -3.0..3.0f64, y in -3.0..3.0f64, yaw in -PI..PI, gx in -1.0..1.0f64, gyaw in -PI..PI,
+        x in -3.0..3.0f64, y in -3.0..3.0f64, yaw in -PI..PI, gx in -1.0..1.0f64, gy in -1.0..1.0f64,
+        gyaw in -PI..PI,
     ) {
-        let goal = Pose2::new(gx, 0.5, gyaw);
+        let goal = Pose2::new(gx, gy, gyaw);
         let start = Pose2::new(x, y, yaw);
         prop_assume!((start.x - goal.x).hypot(start.y - goal.y) > 0.05);
         let mut c = DockingController::new(
             DockingGains::paper(), DockingConfig::default(), VelocityLimits::unlimited(), Finish::RotateInPlace, goal,
         ).unwrap();
         let run = simulate_docking(&mut c, Kinematics::Unicycle, start, 0.01, 100.0).unwrap();
-        let rise = largest_rise(&run);
-        prop_assert!(rise <= 1e-12 * run.samples[0].output.lyapunov.max(1.0), "V rose by {}", rise);
+        // Θ = wrap(Ω − ϑ_G) jumps from ∓π to ±π when the line of sight swings past the goal's
+        // back; ω = … + γ·cos α·sinc α·hΘ jumps with it by up to 2πγh = 1.571 rad/s. V itself is
+        // continuous there and falls on both sides, but an RK4 step straddling the jump has an
+        // O(h) error: up to h·Δω = 0.0157 rad in α, so V may rise by up to
+        // |α|·0.0157 + 0.0157²/2 ≤ π·0.0157 + 0.000123 = 0.0495 on that one step. Everywhere else V
+        // never rises.
+        let v0 = run.samples[0].output.lyapunov.max(1.0);
+        for w in run.samples.windows(2) {
+            if w[1].output.phase != DockingPhase::Approach {
+                continue;
+            }
+            let rise = w[1].output.lyapunov - w[0].output.lyapunov;
+            let wrapped = (w[1].output.polar.theta - w[0].output.polar.theta).abs() > PI;
+            let bound = if wrapped { 0.0495 } else { 1e-12 * v0 };
+            prop_assert!(rise <= bound, "V rose by {} at t = {} (Θ wrapped: {})", rise, w[0].t, wrapped);
+        }
         prop_assert_eq!(run.end, DockingPhase::Docked);
         prop_assert!(run.time < 100.0);
     }
