@@ -109,4 +109,4 @@ pub use docking::{
 };
 pub use error::{PlannerError, COORDINATE_LIMIT};
 pub use route::{arc_radius, check_route, ProblemKind, RouteCheckConfig, RouteProblem, RouteReport, UnreachableCause};
-pub use sim::{advance, rk4_step, simulate_docking, DockingRun, DockingSample, Kinematics};
+pub use sim::{advance, rk4_step, simulate_docking, DockingRun, DockingSample, Kinematics, MAX_SIMULATION_STEPS};

@@ -355,6 +355,33 @@ fn drifting_out_of_the_position_tolerance_with_the_heading_right_goes_back_to_th
 }
 
 #[test]
+fn huge_but_finite_poses_and_simulation_lengths_are_refused() {
+    // e² overflows above about 1.3e154 m: such a pose gave V = ∞ and V̇ = NaN. Refused now.
+    let mut c = controller(VelocityLimits::unlimited(), Finish::RotateInPlace);
+    for pose in [
+        Pose2::new(1e154, 0.0, 0.0),
+        Pose2::new(0.0, -2e6, 0.0),
+        Pose2 {
+            x: 0.0,
+            y: 0.0,
+            yaw: 1e7,
+        },
+    ] {
+        assert!(
+            matches!(c.update(&pose, 0.0), Err(PlannerError::OutOfRange { .. })),
+            "{pose:?}"
+        );
+    }
+    // One million sub-steps at most: 10 000 s at 10 ms is accepted as a bound, a hair more is
+    // refused before any memory is taken.
+    let refused = simulate_docking(&mut c, Kinematics::Unicycle, paper_start(), 0.01, 10_000.1);
+    assert!(
+        matches!(refused, Err(PlannerError::InvalidConfig { name: "max_time", .. })),
+        "{refused:?}"
+    );
+}
+
+#[test]
 fn gains_refused_unless_positive_and_finite_and_warned_outside_the_printed_ranges() {
     for bad in [0.0, -0.1, f64::NAN, f64::INFINITY] {
         for (i, name) in ["gamma", "k", "h", "lambda"].into_iter().enumerate() {
@@ -440,5 +467,41 @@ proptest! {
         }
         prop_assert_eq!(run.end, DockingPhase::Docked);
         prop_assert!(run.time < 100.0);
+    }
+}
+
+/// Every field of a docking output is finite (the residual, if any, too).
+fn output_is_finite(o: &mobil_planner::DockingOutput) -> bool {
+    [
+        o.command.v,
+        o.command.omega,
+        o.scale,
+        o.polar.e,
+        o.polar.alpha,
+        o.polar.theta,
+        o.lyapunov,
+        o.lyapunov_rate,
+        o.heading_error,
+    ]
+    .iter()
+    .all(|v| v.is_finite())
+        && o.residual.is_none_or(|r| r.e.is_finite() && r.heading.is_finite())
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(512))]
+    #[test]
+    fn arbitrary_poses_and_goals_never_give_nan(
+        x in proptest::num::f64::ANY, y in proptest::num::f64::ANY, yaw in proptest::num::f64::ANY,
+        gx in proptest::num::f64::ANY, gy in proptest::num::f64::ANY, gyaw in proptest::num::f64::ANY,
+        t in proptest::num::f64::ANY,
+    ) {
+        let mut c = controller(VelocityLimits::unlimited(), Finish::RotateInPlace);
+        // Either the goal is refused, or every output is finite (or the pose/time refused).
+        if c.set_goal(Pose2::new(gx, gy, gyaw)).is_ok() {
+            if let Ok(out) = c.update(&Pose2::new(x, y, yaw), t) {
+                prop_assert!(output_is_finite(&out), "{:?}", out);
+            }
+        }
     }
 }
