@@ -5,9 +5,21 @@
 //! rule); δ_i = wrap(Ω_i − ϑ_i) held to ±δ_eff; ϑ_{i+1} = ϑ_i + v_i·tan δ_i / L; x, y advance
 //! by v_i along ϑ_{i+1}; v_{i+1} = v_i if Z_i ≥ v_i, else Z_i / 2. Here v_i is a path length per
 //! step. It stops when Z < Z_crit (reached), when the distance no longer falls by more than ε
-//! *and* the goal is within steering reach (Decision: |wrap(Ω − ϑ)| < δ_eff; the paper's literal
-//! rule stops after one step whenever the first step moves away from the goal), or after a
-//! maximum number of steps.
+//! once the goal has been within steering reach, or after a maximum number of steps.
+//!
+//! The progress stop (Decision: only within steering reach, |wrap(Ω − ϑ)| < δ_eff) is read as
+//! *armed from then on*: it arms at the first pose where the goal lies within steering reach
+//! and, from then on, ends the approach at the first step whose progress is ≤ ε. Read as "within
+//! reach at the same step" it never fires: a goal being passed sits near ±90°, outside δ_eff,
+//! exactly when the distance stops falling, and the car circles to the step limit. The
+//! paper's literal rule (no reach condition) stops after one step whenever the first step moves
+//! away from a goal behind the car; armed, a goal behind is first turned towards.
+//!
+//! Steering and the step are those of the model's origin (the rear axle); the distance Z (to
+//! Z_crit, and for the progress stop) is that of the reference point `offset` ahead of it
+//! ([`ChassisParams::reference_offset`], the point odometry reports): the reference point must
+//! come within Z_crit. Steering the origin at the goal puts the reference point on the line of
+//! sight.
 //!
 //! An omnidirectional chassis has no steering limit: it translates straight at the goal
 //! holding its heading, with the same step lengths and stops.
@@ -16,7 +28,14 @@ use mobil_chassis::ChassisParams;
 use mobil_geom::{wrap, Pose2};
 use nalgebra::Point2;
 
-use crate::error::{positive_finite, PlannerError};
+use crate::error::{bounded_length, check_coordinates, PlannerError, COORDINATE_LIMIT};
+
+/// Most steps one approach may take ([`ApproachConfig::max_steps`]): 20 000 km of 0.02 m steps
+/// is far beyond any route; it bounds the run time (about 50 ms per 10⁶ steps).
+pub const MAX_APPROACH_STEPS: usize = 1_000_000;
+
+/// Most steering samples of [`shortest_step`]: a 0.001° grid over ±δ_eff < ±90° needs fewer.
+pub const MAX_SHORTEST_STEP_SAMPLES: usize = 180_001;
 
 /// The steering geometry of a car-like or tricycle chassis.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -26,9 +45,17 @@ pub struct Steering {
 }
 
 impl Steering {
-    /// Wheelbase L (m) > 0 and steering limit δ_eff (rad) in (0, π/2).
+    /// Wheelbase L (m) in [0.001, 1000] (any real vehicle; the bounds keep every step finite)
+    /// and steering limit δ_eff (rad) in (0, π/2).
     pub fn new(wheelbase: f64, limit: f64) -> Result<Self, PlannerError> {
-        positive_finite("wheelbase", wheelbase)?;
+        bounded_length("wheelbase", wheelbase, 1000.0)?;
+        if wheelbase < 1e-3 {
+            return Err(PlannerError::InvalidConfig {
+                name: "wheelbase",
+                value: wheelbase,
+                reason: "must be at least 0.001 m",
+            });
+        }
         if !(limit > 0.0 && limit < std::f64::consts::FRAC_PI_2) {
             return Err(PlannerError::InvalidConfig {
                 name: "steering_limit",
@@ -119,10 +146,11 @@ impl Default for ApproachConfig {
 }
 
 impl ApproachConfig {
-    /// Checks every field: lengths finite and positive, ε finite and ≥ 0, at least one step.
+    /// Checks every field: lengths finite, positive and within [`COORDINATE_LIMIT`], ε finite
+    /// and ≥ 0, between 1 and [`MAX_APPROACH_STEPS`] steps.
     pub fn validate(&self) -> Result<(), PlannerError> {
-        positive_finite("step_length", self.step_length)?;
-        positive_finite("critical_distance", self.critical_distance)?;
+        bounded_length("step_length", self.step_length, COORDINATE_LIMIT)?;
+        bounded_length("critical_distance", self.critical_distance, COORDINATE_LIMIT)?;
         if !(self.progress_epsilon.is_finite() && self.progress_epsilon >= 0.0) {
             return Err(PlannerError::InvalidConfig {
                 name: "progress_epsilon",
@@ -130,11 +158,11 @@ impl ApproachConfig {
                 reason: "must be finite and non-negative",
             });
         }
-        if self.max_steps == 0 {
+        if self.max_steps == 0 || self.max_steps > MAX_APPROACH_STEPS {
             return Err(PlannerError::InvalidConfig {
                 name: "max_steps",
-                value: 0.0,
-                reason: "must be at least 1",
+                value: self.max_steps as f64,
+                reason: "must lie in 1..=MAX_APPROACH_STEPS",
             });
         }
         Ok(())
@@ -164,10 +192,35 @@ pub fn bearing(pose: &Pose2, goal: &Point2<f64>) -> f64 {
     wrap((goal.y - pose.y).atan2(goal.x - pose.x) - pose.yaw)
 }
 
-/// One step of path length `v` toward `goal` (SPEC §4, steps 2–12 of 004 §4.2.1).
-pub fn approach_step(pose: &Pose2, goal: &Point2<f64>, v: f64, motion: &Motion) -> ApproachStep {
+/// One step of path length `v` (finite, positive, at most [`COORDINATE_LIMIT`]) toward `goal`
+/// (SPEC §4, steps 2–12 of 004 §4.2.1), `pose` being the model's origin. Refuses a non-finite or
+/// out-of-range pose, goal or step.
+pub fn approach_step(pose: &Pose2, goal: &Point2<f64>, v: f64, motion: &Motion) -> Result<ApproachStep, PlannerError> {
+    check_coordinates("pose", pose.x, pose.y, pose.yaw)?;
+    check_point("goal", goal)?;
+    bounded_length("step_length", v, COORDINATE_LIMIT)?;
     let z = distance(pose, goal);
-    let (steering, next) = match motion {
+    let (steering, next) = step(pose, goal, v, motion);
+    Ok(ApproachStep {
+        distance: z,
+        steering,
+        pose: next,
+        next_step_length: next_step_length(z, v),
+    })
+}
+
+/// v_{i+1} = v_i if Z_i ≥ v_i, else Z_i / 2.
+fn next_step_length(z: f64, v: f64) -> f64 {
+    if z >= v {
+        v
+    } else {
+        z / 2.0
+    }
+}
+
+/// The steering angle and the pose after one step of `v` (inputs taken as checked).
+fn step(pose: &Pose2, goal: &Point2<f64>, v: f64, motion: &Motion) -> (f64, Pose2) {
+    match motion {
         Motion::Steered(s) => {
             let delta = bearing(pose, goal).clamp(-s.limit, s.limit);
             let yaw = pose.yaw + v * delta.tan() / s.wheelbase;
@@ -180,12 +233,6 @@ pub fn approach_step(pose: &Pose2, goal: &Point2<f64>, v: f64, motion: &Motion) 
                 Pose2::new(pose.x + v * sight.cos(), pose.y + v * sight.sin(), pose.yaw),
             )
         }
-    };
-    ApproachStep {
-        distance: z,
-        steering,
-        pose: next,
-        next_step_length: if z >= v { v } else { z / 2.0 },
     }
 }
 
@@ -194,8 +241,8 @@ pub fn approach_step(pose: &Pose2, goal: &Point2<f64>, v: f64, motion: &Motion) 
 pub enum ApproachEnd {
     /// Z < Z_crit.
     Reached,
-    /// Within steering reach, the distance stopped falling by more than ε: the closest approach
-    /// has passed outside Z_crit.
+    /// After the goal had been within steering reach, the distance stopped falling by more than
+    /// ε: the closest approach has passed outside Z_crit.
     NoProgress,
     /// The step limit (or a caller's budget) ran out.
     StepLimit,
@@ -229,26 +276,29 @@ pub struct ApproachOutcome {
     pub travelled: f64,
 }
 
-/// Drives the approach from `start` to `goal`, calling `visit` with every new pose and the
-/// path length so far; `visit` returns false to stop early (reported as
-/// [`ApproachEnd::StepLimit`]). The configuration is taken as valid
-/// ([`ApproachConfig::validate`]).
-pub fn approach_with(
+/// Drives the approach of the model's origin from `start` to `goal`, the distance being that
+/// of the reference point `offset` ahead of the origin; calls `visit` with every new origin pose
+/// and the path length so far; `visit` returns false to stop early (reported as
+/// [`ApproachEnd::StepLimit`]). Inputs are taken as checked (by the public callers).
+pub(crate) fn approach_with(
     start: &Pose2,
     goal: &Point2<f64>,
     motion: &Motion,
+    offset: f64,
     config: &ApproachConfig,
     mut visit: impl FnMut(&Pose2, f64) -> bool,
 ) -> ApproachOutcome {
     let mut pose = *start;
     let mut v = config.step_length;
-    let mut z = distance(&pose, goal);
+    let reference_distance = |p: &Pose2| distance(&p.ahead(offset), goal);
+    let mut z = reference_distance(&pose);
     let mut closest = z;
     let mut travelled = 0.0;
     let reach = match motion {
         Motion::Steered(s) => s.limit,
         Motion::Holonomic => std::f64::consts::PI + 1.0,
     };
+    let mut armed = bearing(&pose, goal).abs() < reach;
     let outcome = |end, pose, closest, travelled| ApproachOutcome {
         end,
         pose,
@@ -259,11 +309,10 @@ pub fn approach_with(
         if z < config.critical_distance {
             return outcome(ApproachEnd::Reached, pose, closest, travelled);
         }
-        let step = approach_step(&pose, goal, v, motion);
+        pose = step(&pose, goal, v, motion).1;
         travelled += v;
-        pose = step.pose;
-        v = step.next_step_length;
-        let z_next = distance(&pose, goal);
+        v = next_step_length(z, v);
+        let z_next = reference_distance(&pose);
         closest = closest.min(z_next);
         let progress = z - z_next;
         z = z_next;
@@ -273,14 +322,17 @@ pub fn approach_with(
         if z < config.critical_distance {
             return outcome(ApproachEnd::Reached, pose, closest, travelled);
         }
-        if bearing(&pose, goal).abs() < reach && progress <= config.progress_epsilon {
+        if armed && progress <= config.progress_epsilon {
             return outcome(ApproachEnd::NoProgress, pose, closest, travelled);
         }
+        armed |= bearing(&pose, goal).abs() < reach;
     }
     outcome(ApproachEnd::StepLimit, pose, closest, travelled)
 }
 
-/// Drives the approach from `start` to `goal` and records the path.
+/// Drives the approach from `start` (the model's origin, whose distance counts) to `goal` and
+/// records the path. Refuses an invalid configuration and a non-finite or out-of-range pose or
+/// goal.
 pub fn approach(
     start: &Pose2,
     goal: &Point2<f64>,
@@ -291,7 +343,7 @@ pub fn approach(
     crate::docking::check_pose("start", start)?;
     check_point("goal", goal)?;
     let mut path = vec![*start];
-    let out = approach_with(start, goal, motion, config, |p, _| {
+    let out = approach_with(start, goal, motion, 0.0, config, |p, _| {
         path.push(*p);
         true
     });
@@ -318,8 +370,26 @@ pub struct ShortestStep {
 /// Shortest step (SPEC §4; 004 §4.2.2): of `samples` steering angles evenly spread over
 /// [−δ_eff, δ_eff] (at least 3, made odd so δ = 0 is one), the one whose step of path length
 /// `ds` ends nearest `goal`: dϑ = ds·tan δ / L, dx = ds·cos(ϑ + dϑ), dy = ds·sin(ϑ + dϑ)
-/// (Decision: world frame). Ties go to the smallest |δ|, then to the left (δ > 0).
-pub fn shortest_step(pose: &Pose2, goal: &Point2<f64>, ds: f64, steering: &Steering, samples: usize) -> ShortestStep {
+/// (Decision: world frame). Ties go to the smallest |δ|, then to the left (δ > 0). Refuses a
+/// non-finite or out-of-range pose or goal, a `ds` that is not finite and positive or exceeds
+/// [`COORDINATE_LIMIT`], and more than [`MAX_SHORTEST_STEP_SAMPLES`] samples.
+pub fn shortest_step(
+    pose: &Pose2,
+    goal: &Point2<f64>,
+    ds: f64,
+    steering: &Steering,
+    samples: usize,
+) -> Result<ShortestStep, PlannerError> {
+    check_coordinates("pose", pose.x, pose.y, pose.yaw)?;
+    check_point("goal", goal)?;
+    bounded_length("ds", ds, COORDINATE_LIMIT)?;
+    if samples > MAX_SHORTEST_STEP_SAMPLES {
+        return Err(PlannerError::InvalidConfig {
+            name: "samples",
+            value: samples as f64,
+            reason: "must be at most MAX_SHORTEST_STEP_SAMPLES",
+        });
+    }
     let half = (samples.max(3) - 1).div_ceil(2);
     let candidate = |delta: f64| {
         let yaw = pose.yaw + ds * delta.tan() / steering.wheelbase;
@@ -340,18 +410,9 @@ pub fn shortest_step(pose: &Pose2, goal: &Point2<f64>, ds: f64, steering: &Steer
             }
         }
     }
-    best
+    Ok(best)
 }
 
 pub(crate) fn check_point(what: &str, p: &Point2<f64>) -> Result<(), PlannerError> {
-    if p.x.is_finite() && p.y.is_finite() {
-        Ok(())
-    } else {
-        Err(PlannerError::NonFinite {
-            what: what.to_owned(),
-            x: p.x,
-            y: p.y,
-            yaw: 0.0,
-        })
-    }
+    check_coordinates(what, p.x, p.y, 0.0)
 }

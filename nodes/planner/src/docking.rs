@@ -126,8 +126,10 @@ pub struct DockingGains {
 
 impl DockingGains {
     /// The paper's printed ranges in its printed order γ, λ, k, h: (0,1), (0,1), (0,6), (0,1).
-    /// Which range belongs to which gain is garbled in the source; this is the reading in which
-    /// the paper's own run (γ 0.5, λ 0.55, k 0.3, h 0.5) lies inside all four.
+    /// Which range belongs to which gain is garbled in the source; this is a chosen reading,
+    /// the printed order. The paper's own run (γ 0.5, λ 0.55, k 0.3, h 0.5) lies inside all four
+    /// ranges, but with every gain below 1 it would in most other assignments too: the run does
+    /// not single this reading out.
     pub const PRINTED_RANGES: [(&'static str, (f64, f64)); 4] = [
         ("gamma", (0.0, 1.0)),
         ("lambda", (0.0, 1.0)),
@@ -403,6 +405,15 @@ impl DockingFailure {
     }
 }
 
+/// Where a failed docking stood when it failed: what a node reports with the reason.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Residual {
+    /// Distance e (m) to the goal position.
+    pub e: f64,
+    /// wrap(ϑ_G − ϑ) (rad): the heading still to turn.
+    pub heading: f64,
+}
+
 /// Where a docking stands.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum DockingPhase {
@@ -430,7 +441,8 @@ pub struct DockingOutput {
     pub phase: DockingPhase,
     /// The command, within the limits (zero in a terminal phase).
     pub command: Velocity,
-    /// The common factor s applied to the law's command (1 when within the limits).
+    /// The common factor s applied to the command (the law's while approaching, the in-place
+    /// rotation's while rotating; 1 when within the limits, 0 once ended).
     pub scale: f64,
     /// The polar error at this pose.
     pub polar: PolarError,
@@ -440,6 +452,8 @@ pub struct DockingOutput {
     pub lyapunov_rate: f64,
     /// wrap(ϑ_G − ϑ) (rad): the heading still to turn.
     pub heading_error: f64,
+    /// After a failure: e and the heading error at the step it failed (kept from then on).
+    pub residual: Option<Residual>,
 }
 
 /// The docking state machine around the law: approach, rotate, docked or failed.
@@ -454,6 +468,7 @@ pub struct DockingController {
     start_t: Option<f64>,
     best: f64,
     best_t: f64,
+    residual: Option<Residual>,
 }
 
 impl DockingController {
@@ -477,6 +492,7 @@ impl DockingController {
             start_t: None,
             best: f64::INFINITY,
             best_t: 0.0,
+            residual: None,
         })
     }
 
@@ -487,6 +503,7 @@ impl DockingController {
         self.phase = DockingPhase::Approach;
         self.start_t = None;
         self.best = f64::INFINITY;
+        self.residual = None;
         Ok(())
     }
 
@@ -521,10 +538,11 @@ impl DockingController {
         self.limits.apply(self.gains.law(&polar_error(pose, &self.goal)))
     }
 
-    /// The in-place rotation command at `pose`: ω = k_rot·wrap(ϑ_G − ϑ), limited.
-    pub fn rotate_command(&self, pose: &Pose2) -> Velocity {
+    /// The in-place rotation command at `pose`: ω = k_rot·wrap(ϑ_G − ϑ), limited, and the
+    /// factor applied.
+    pub fn rotate_command(&self, pose: &Pose2) -> (Velocity, f64) {
         let cmd = Velocity::new(0.0, self.config.rotate_gain * wrap(self.goal.yaw - pose.yaw));
-        self.limits.apply(cmd).0
+        self.limits.apply(cmd)
     }
 
     fn restart_progress(&mut self, measure: f64, t: f64) {
@@ -566,7 +584,13 @@ impl DockingController {
                     self.phase = DockingPhase::Failed(DockingFailure::HeadingResidual);
                 }
             },
-            DockingPhase::Rotate if polar.e > cfg.rotate_exit_factor * cfg.position_tolerance => {
+            // Back to the law when the position drifted too far, or when it drifted out of ε_e
+            // with the heading already within ε_ϑ: the rotation would command ω ≈ 0 there and
+            // never bring e back.
+            DockingPhase::Rotate
+                if polar.e > cfg.rotate_exit_factor * cfg.position_tolerance
+                    || (polar.e >= cfg.position_tolerance && heading_error.abs() < cfg.heading_tolerance) =>
+            {
                 self.phase = DockingPhase::Approach;
                 self.restart_progress(lyapunov, t);
             }
@@ -577,7 +601,10 @@ impl DockingController {
                 let (cmd, s) = self.limits.apply(self.gains.law(&polar));
                 (cmd, s, self.gains.lyapunov_rate(&polar, s), lyapunov)
             }
-            DockingPhase::Rotate => (self.rotate_command(pose), 1.0, 0.0, heading_error.abs()),
+            DockingPhase::Rotate => {
+                let (cmd, s) = self.rotate_command(pose);
+                (cmd, s, 0.0, heading_error.abs())
+            }
             DockingPhase::Docked | DockingPhase::Failed(_) => (Velocity::ZERO, 0.0, 0.0, 0.0),
         };
         if !self.phase.is_terminal() {
@@ -592,6 +619,12 @@ impl DockingController {
         } else {
             command
         };
+        if matches!(self.phase, DockingPhase::Failed(_)) && self.residual.is_none() {
+            self.residual = Some(Residual {
+                e: polar.e,
+                heading: heading_error,
+            });
+        }
         Ok(DockingOutput {
             phase: self.phase,
             command,
@@ -600,19 +633,11 @@ impl DockingController {
             lyapunov,
             lyapunov_rate: rate,
             heading_error,
+            residual: self.residual,
         })
     }
 }
 
 pub(crate) fn check_pose(what: &str, p: &Pose2) -> Result<(), PlannerError> {
-    if p.is_finite() {
-        Ok(())
-    } else {
-        Err(PlannerError::NonFinite {
-            what: what.to_owned(),
-            x: p.x,
-            y: p.y,
-            yaw: p.yaw,
-        })
-    }
+    crate::error::check_coordinates(what, p.x, p.y, p.yaw)
 }

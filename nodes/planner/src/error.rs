@@ -35,9 +35,64 @@ pub enum PlannerError {
         /// Heading (rad; 0 for a point).
         yaw: f64,
     },
+    /// A pose, goal or waypoint lies further than [`COORDINATE_LIMIT`] from the origin on an
+    /// axis (or a heading beyond it): outside any map the suite drives, and where squared
+    /// distances would overflow.
+    #[error("{what} is out of range: ({x}, {y}, {yaw}); every coordinate must lie within ±{limit}")]
+    OutOfRange {
+        /// What the value is (e.g. `goal`, `waypoint 3`).
+        what: String,
+        /// x (m).
+        x: f64,
+        /// y (m).
+        y: f64,
+        /// Heading (rad; 0 for a point).
+        yaw: f64,
+        /// The bound, [`COORDINATE_LIMIT`].
+        limit: f64,
+    },
     /// A route without waypoints.
     #[error("the route has no waypoints")]
     EmptyRoute,
+}
+
+/// Largest |x|, |y| (m) and |ϑ| (rad) the library accepts: 1000 km, far beyond any map, and
+/// far below where e² (≈ 1.3e154 m) overflows, so V, V̇ and every distance stay finite.
+pub const COORDINATE_LIMIT: f64 = 1e6;
+
+/// Refuses a non-finite or out-of-range pose (x, y, yaw).
+pub(crate) fn check_coordinates(what: &str, x: f64, y: f64, yaw: f64) -> Result<(), PlannerError> {
+    if !(x.is_finite() && y.is_finite() && yaw.is_finite()) {
+        return Err(PlannerError::NonFinite {
+            what: what.to_owned(),
+            x,
+            y,
+            yaw,
+        });
+    }
+    if x.abs() > COORDINATE_LIMIT || y.abs() > COORDINATE_LIMIT || yaw.abs() > COORDINATE_LIMIT {
+        return Err(PlannerError::OutOfRange {
+            what: what.to_owned(),
+            x,
+            y,
+            yaw,
+            limit: COORDINATE_LIMIT,
+        });
+    }
+    Ok(())
+}
+
+/// Refuses a length that is not finite and positive or that exceeds `max`.
+pub(crate) fn bounded_length(name: &'static str, value: f64, max: f64) -> Result<f64, PlannerError> {
+    positive_finite(name, value)?;
+    if value > max {
+        return Err(PlannerError::InvalidConfig {
+            name,
+            value,
+            reason: "too large (see the crate's limits)",
+        });
+    }
+    Ok(value)
 }
 
 pub(crate) fn positive_finite(name: &'static str, value: f64) -> Result<f64, PlannerError> {

@@ -18,31 +18,42 @@
 //! - **e = 0**: the line of sight Ω is undefined at the goal position; it is taken as ϑ_G, so
 //!   Θ = 0 and α is the plain heading error.
 //! - **Gain ranges**: the printed ranges (0,1), (0,1), (0,6), (0,1) are read in the printed
-//!   order γ, λ, k, h — the one reading that holds the paper's own gains; outside them a
-//!   [`GainWarning`], never a refusal.
+//!   order γ, λ, k, h — a chosen reading (the source garbles the assignment, and the paper's
+//!   gains, all below 1, fit most readings); outside them a [`GainWarning`], never a refusal.
 //! - **Common factor**: v_max, ω_max and, from a chassis, its wheel-speed limit (wheel speeds
 //!   are homogeneous of degree one in (v, ω)) — all three by one factor s, V̇ = s·V̇_law. A
 //!   car-like chassis' curvature limit cannot be met by any factor (ω/v is kept): its
 //!   LOW-LEVEL clamps the curvature, the law is then not followed, and the docking ends in
 //!   FAILED with its residual.
 //! - **Docking ends**: in-place rotation ω = k_rot·wrap(ϑ_G − ϑ) once e < ε_e (handing back to
-//!   the law if e exceeds 2ε_e); FAILED on a time limit, on the progress measure (V, or the
+//!   the law if e exceeds 2ε_e, or if e ≥ ε_e with the heading already within ε_ϑ, where the
+//!   rotation would stand still); a failure carries e and the heading error at that step; FAILED on a time limit, on the progress measure (V, or the
 //!   heading error while rotating) not falling by 0.1 % within `stall_time_s`, or, on a
 //!   chassis that cannot turn in place, on reaching ε_e with the heading outside ε_ϑ.
 //! - **Integration**: RK4 on the closed loop in sub-steps of h (the tests use 10 and 5 ms); a
 //!   command held over a control period (exact arcs) also keeps V falling at 10–50 ms on the
 //!   paper's run (tested).
+//! - **Progress stop**: "only within steering reach" is read as armed from the first pose where
+//!   the goal is within δ_eff, then the first step with progress ≤ ε ends the approach (a goal
+//!   being passed lies near ±90°, outside δ_eff, so the same-step reading never fires).
+//! - **Reference point**: the approach steers the model's origin; the route pre-check converts
+//!   the start from the reference point (`reference_offset` ahead, as odometry reports it) to
+//!   the origin, tests clearance at the reference point, and needs the reference point within
+//!   Z_crit. The footprint radius is the chassis' `robot_radius`, a required argument.
+//! - **Bad input**: coordinates beyond ±[`error::COORDINATE_LIMIT`], step counts beyond the
+//!   crate's caps, non-finite or non-positive lengths are refused with a [`PlannerError`].
 //! - **Omni goal approach**: straight translation at the goal, heading held, same steps and
 //!   stops as the car.
 //! - **Shortest step**: a finite set of δ samples evenly over [−δ_eff, δ_eff] including 0; ties
 //!   to the smallest |δ|, then to the left.
 //! - **Route pre-check**: the virtual robot is the planner's own goal approach on the chassis
-//!   model (δ within δ_eff, steps of path length), with the collision geometry of
-//!   `mobil_sim`'s [`World`](mobil_sim::world::World). `mobil_sim`'s wheel-level plant is not
+//!   model (δ within δ_eff, steps of path length) at the model's origin, with the collision
+//!   geometry (a disc at the reference point) of `mobil_sim`'s [`World`](mobil_sim::world::World). `mobil_sim`'s wheel-level plant is not
 //!   used: it stops at the first contact (so later problems would stay hidden) and the robot
-//!   will run this same approach law. Collisions are checked at every step (0.02 m). A missed
-//!   waypoint is classified by the single arc from the leg's start pose through it: below the
-//!   minimum radius → turn radius, otherwise unreachable (blocked, passed by, or bound).
+//!   will run this same approach law. Collisions are checked at every step (0.02 m). A
+//!   waypoint whose single arc from the leg's start pose is below the minimum radius is a turn
+//!   radius problem, reached or not; any other missed one is unreachable (blocked, passed by,
+//!   or bound).
 //!
 //! ```
 //! use mobil_chassis::ChassisParams;
@@ -72,8 +83,9 @@
 //! assert_eq!(run.end, DockingPhase::Docked);
 //!
 //! // A waypoint 0.3 m beside MOBIL-II is inside its turning circle: reported, with its index.
+//! // MOBIL-II's footprint radius is 0.53 m (params/mobil2.yaml).
 //! let route = [Point2::new(2.0, 0.0), Point2::new(2.0, 0.3)];
-//! let report = check_route(&Pose2::identity(), &route, &ChassisParams::mobil2(), &World::default(), &RouteCheckConfig::default()).unwrap();
+//! let report = check_route(&Pose2::identity(), &route, &ChassisParams::mobil2(), &World::default(), &RouteCheckConfig::new(0.53)).unwrap();
 //! assert_eq!(report.problems.len(), 1);
 //! assert_eq!((report.problems[0].index, report.problems[0].kind.as_str()), (1, "turn_radius"));
 //! ```
@@ -87,14 +99,14 @@ pub mod route;
 pub mod sim;
 
 pub use approach::{
-    approach, approach_step, approach_with, shortest_step, ApproachConfig, ApproachEnd, ApproachOutcome, ApproachRun,
-    ApproachStep, Motion, ShortestStep, Steering,
+    approach, approach_step, shortest_step, ApproachConfig, ApproachEnd, ApproachOutcome, ApproachRun, ApproachStep,
+    Motion, ShortestStep, Steering, MAX_APPROACH_STEPS, MAX_SHORTEST_STEP_SAMPLES,
 };
 
 pub use docking::{
     polar_error, sinc, wrap_alpha, DockingConfig, DockingController, DockingFailure, DockingGains, DockingOutput,
-    DockingPhase, Finish, GainWarning, PolarError, Velocity, VelocityLimits,
+    DockingPhase, Finish, GainWarning, PolarError, Residual, Velocity, VelocityLimits,
 };
-pub use error::PlannerError;
+pub use error::{PlannerError, COORDINATE_LIMIT};
 pub use route::{arc_radius, check_route, ProblemKind, RouteCheckConfig, RouteProblem, RouteReport, UnreachableCause};
-pub use sim::{advance, rk4_step, simulate_docking, DockingRun, DockingSample, Kinematics};
+pub use sim::{advance, rk4_step, simulate_docking, DockingRun, DockingSample, Kinematics, MAX_SIMULATION_STEPS};

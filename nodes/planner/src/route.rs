@@ -4,19 +4,27 @@
 //! map (a [`mobil_sim::world::World`], the sim's world format and geometry) and every problem is
 //! reported with the index of its waypoint:
 //!
+//! Poses are those of the chassis' reference point, `reference_offset` ahead of the kinematic
+//! origin ([`ChassisParams::reference_offset`]): the point odometry reports, the centre of the
+//! sim's collision disc, and the point a route's waypoints are meant for. The start is converted
+//! to the model's origin, the model is driven there (the goal approach steers the origin), and
+//! clearance is tested at the reference point; a waypoint counts as reached when the
+//! **reference point** comes within Z_crit of it.
+//!
 //! - [`ProblemKind::Collision`]: the robot's footprint (a disc of `robot_radius` around the
 //!   reference point) overlaps an obstacle on the leg into waypoint i. Each stretch of overlap
 //!   is one problem, at the point where it begins. The virtual robot drives on through it (a
 //!   ghost), so one collision does not hide the problems behind it.
-//! - [`ProblemKind::TurnRadius`]: waypoint i was not reached and the arc from where the leg
-//!   began (tangent to the heading there) through waypoint i has a radius below the chassis'
-//!   minimum L / tan δ_eff.
+//! - [`ProblemKind::TurnRadius`]: the arc the origin must drive from where the leg began
+//!   (tangent to the heading there) so that the reference point passes through waypoint i
+//!   ([`arc_radius`]) is tighter than the chassis' minimum L / tan δ_eff — reported whether or
+//!   not the virtual robot came within Z_crit of the waypoint.
 //! - [`ProblemKind::Unreachable`]: waypoint i was not reached for another cause: its own
 //!   footprint overlaps an obstacle (blocked), the closest approach passed outside Z_crit, or
 //!   the leg's distance bound ran out.
 //!
-//! After a waypoint that was not reached the virtual robot is set down on it, heading along the
-//! leg's chord, so later legs are checked as if it had been reached. The check is deterministic:
+//! After a waypoint that was not reached the virtual robot is set down with its reference point
+//! on it, heading along the leg's chord, so later legs are checked as if it had been reached. The check is deterministic:
 //! no clock, no randomness; the leg bound is a path length.
 
 use std::f64::consts::TAU;
@@ -34,8 +42,9 @@ use crate::error::{positive_finite, PlannerError};
 pub struct RouteCheckConfig {
     /// The virtual robot's goal approach (step length, Z_crit, ε, step limit).
     pub approach: ApproachConfig,
-    /// Radius (m) of the footprint disc around the reference point. Default 0.25: OMR-III, as
-    /// `mobil_local_nav`; MOBIL-II sets 0.53.
+    /// Radius (m) of the footprint disc around the reference point: the params file's
+    /// `robot_radius` of the chassis (MOBIL-II 0.53, the tricycle 0.40, OMR-III 0.25). No
+    /// default: [`RouteCheckConfig::new`] takes it.
     pub robot_radius: f64,
     /// A leg may be at most this many times its straight length, plus one full circle at the
     /// minimum turning radius (a car-like chassis may need one loop to line up). Default 2.
@@ -45,18 +54,17 @@ pub struct RouteCheckConfig {
     pub max_leg_length: f64,
 }
 
-impl Default for RouteCheckConfig {
-    fn default() -> Self {
+impl RouteCheckConfig {
+    /// The defaults for a robot whose footprint disc has radius `robot_radius` (m).
+    pub fn new(robot_radius: f64) -> Self {
         RouteCheckConfig {
             approach: ApproachConfig::default(),
-            robot_radius: 0.25,
+            robot_radius,
             detour_factor: 2.0,
             max_leg_length: 50.0,
         }
     }
-}
 
-impl RouteCheckConfig {
     /// Checks every field.
     pub fn validate(&self) -> Result<(), PlannerError> {
         self.approach.validate()?;
@@ -107,7 +115,8 @@ pub enum ProblemKind {
     },
     /// The waypoint needs a tighter turn than the chassis can make.
     TurnRadius {
-        /// The radius (m) of the arc from the leg's start pose through the waypoint.
+        /// The radius (m) of the origin's arc from the leg's start pose on which the reference
+        /// point passes through the waypoint ([`arc_radius`]).
         required: f64,
         /// The chassis' minimum L / tan δ_eff (m).
         minimum: f64,
@@ -187,20 +196,24 @@ impl RouteReport {
     }
 }
 
-/// Radius (m) of the arc that starts at `pose` tangent to its heading and passes through `p`:
-/// with p at (x_b, y_b) in the body frame, (x_b² + y_b²) / (2|y_b|); infinite on the centre line.
-pub fn arc_radius(pose: &Pose2, p: &Point2<f64>) -> f64 {
-    let body = pose.inverse().transform_point(*p);
+/// Radius (m) of the arc that the origin drives from `origin` (tangent to its heading) so that
+/// the reference point `offset` ahead passes through `p`. With p at (x_b, y_b) in the origin's
+/// body frame: the origin circles the centre (0, R) and the reference point then the same centre
+/// at radius √(R² + d²), so |p − (0, R)|² = R² + d² gives R = |x_b² + y_b² − d²| / (2|y_b|)
+/// (d = 0: the arc through p itself). Infinite on the centre line.
+pub fn arc_radius(origin: &Pose2, p: &Point2<f64>, offset: f64) -> f64 {
+    let body = origin.inverse().transform_point(*p);
     let y = body.y.abs();
     if y == 0.0 {
         f64::INFINITY
     } else {
-        (body.x * body.x + body.y * body.y) / (2.0 * y)
+        (body.x * body.x + body.y * body.y - offset * offset).abs() / (2.0 * y)
     }
 }
 
-/// Pre-checks `waypoints` driven in order from `start` by the virtual robot of `chassis` in
-/// `world` (module documentation). Refuses an empty route and non-finite input.
+/// Pre-checks `waypoints` driven in order from `start` (the reference point's pose, as odometry
+/// reports it) by the virtual robot of `chassis` in `world` (module documentation). Refuses an
+/// empty route, an invalid configuration and non-finite or out-of-range input.
 pub fn check_route(
     start: &Pose2,
     waypoints: &[Point2<f64>],
@@ -218,13 +231,15 @@ pub fn check_route(
     }
     let motion = Motion::from_chassis(chassis);
     let min_radius = motion.min_radius();
+    let d = chassis.reference_offset();
     let radius = config.robot_radius;
     let clearance = |p: &Point2<f64>| world.distance_to(*p) - radius;
 
     let mut problems = Vec::new();
     let mut path = vec![*start];
     let mut reached = Vec::with_capacity(waypoints.len());
-    let mut pose = *start;
+    // The model's origin, d behind the reference point.
+    let mut origin = start.ahead(-d);
     let mut in_collision = clearance(&start.position()) < 0.0;
     if in_collision {
         problems.push(RouteProblem {
@@ -236,11 +251,13 @@ pub fn check_route(
         });
     }
     for (index, goal) in waypoints.iter().enumerate() {
-        let leg_start = pose;
-        let straight = distance(&leg_start, goal);
+        let leg_start = origin;
+        let leg_start_reference = leg_start.ahead(d);
+        let straight = distance(&leg_start_reference, goal);
         let budget = (config.detour_factor * straight + TAU * min_radius).min(config.max_leg_length);
-        let out = approach_with(&leg_start, goal, &motion, &config.approach, |p, s| {
-            path.push(*p);
+        let out = approach_with(&leg_start, goal, &motion, d, &config.approach, |o, s| {
+            let p = o.ahead(d);
+            path.push(p);
             let c = clearance(&p.position());
             if c < 0.0 && !in_collision {
                 problems.push(RouteProblem {
@@ -255,35 +272,45 @@ pub fn check_route(
             s < budget
         });
         let blocked = clearance(goal);
+        let required = arc_radius(&leg_start, goal, d);
         let ok = out.end == ApproachEnd::Reached && blocked >= 0.0;
         reached.push(ok);
-        if ok {
-            pose = out.pose;
-            continue;
-        }
-        let required = arc_radius(&leg_start, goal);
         let kind = if blocked < 0.0 {
-            ProblemKind::Unreachable(UnreachableCause::Blocked { clearance: blocked })
+            Some(ProblemKind::Unreachable(UnreachableCause::Blocked {
+                clearance: blocked,
+            }))
         } else if required < min_radius {
-            ProblemKind::TurnRadius {
+            Some(ProblemKind::TurnRadius {
                 required,
                 minimum: min_radius,
-            }
-        } else if out.end == ApproachEnd::NoProgress {
-            ProblemKind::Unreachable(UnreachableCause::PassedBy { closest: out.closest })
-        } else {
-            ProblemKind::Unreachable(UnreachableCause::DistanceBound {
-                travelled: out.travelled,
-                remaining: distance(&out.pose, goal),
             })
+        } else if ok {
+            None
+        } else if out.end == ApproachEnd::NoProgress {
+            Some(ProblemKind::Unreachable(UnreachableCause::PassedBy {
+                closest: out.closest,
+            }))
+        } else {
+            Some(ProblemKind::Unreachable(UnreachableCause::DistanceBound {
+                travelled: out.travelled,
+                remaining: distance(&out.pose.ahead(d), goal),
+            }))
         };
-        problems.push(RouteProblem { index, kind });
-        // Set down on the waypoint, heading along the leg's chord, and go on from there.
-        let chord = (goal.y - leg_start.y).atan2(goal.x - leg_start.x);
+        if let Some(kind) = kind {
+            problems.push(RouteProblem { index, kind });
+        }
+        if ok {
+            origin = out.pose;
+            continue;
+        }
+        // Set the reference point down on the waypoint, heading along the leg's chord, and go
+        // on from there.
+        let chord = (goal.y - leg_start_reference.y).atan2(goal.x - leg_start_reference.x);
         let yaw = if straight > 0.0 { chord } else { leg_start.yaw };
-        pose = Pose2::new(goal.x, goal.y, yaw);
-        path.push(pose);
-        in_collision = clearance(goal) < 0.0;
+        let set_down = Pose2::new(goal.x, goal.y, yaw);
+        origin = set_down.ahead(-d);
+        path.push(set_down);
+        in_collision = blocked < 0.0;
     }
     Ok(RouteReport {
         problems,

@@ -100,9 +100,15 @@ pub struct DockingRun {
     pub path_length: f64,
 }
 
+/// Most sub-steps of one [`simulate_docking`] (`max_time / h`): 10⁴ s at 10 ms; the recorded
+/// run then holds about 100 MB.
+pub const MAX_SIMULATION_STEPS: f64 = 1e6;
+
 /// Drives `controller` from `start` with sub-steps of `h` seconds until the docking ends or
 /// `max_time` passes. Every sub-step is a control decision (`update`), then the motion: RK4 on
-/// the closed loop while approaching, the exact arc of the held command otherwise.
+/// the closed loop while approaching, the exact arc of the held command otherwise. Refuses h or
+/// `max_time` not finite and positive, `max_time / h` above [`MAX_SIMULATION_STEPS`], and a
+/// non-finite or out-of-range start.
 pub fn simulate_docking(
     controller: &mut DockingController,
     kinematics: Kinematics,
@@ -112,6 +118,14 @@ pub fn simulate_docking(
 ) -> Result<DockingRun, PlannerError> {
     positive_finite("h", h)?;
     positive_finite("max_time", max_time)?;
+    if max_time / h > MAX_SIMULATION_STEPS {
+        return Err(PlannerError::InvalidConfig {
+            name: "max_time",
+            value: max_time,
+            reason: "more than MAX_SIMULATION_STEPS sub-steps of h",
+        });
+    }
+    crate::docking::check_pose("start", &start)?;
     let mut pose = start;
     let mut samples = Vec::new();
     let mut path_length = 0.0;

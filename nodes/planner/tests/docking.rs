@@ -7,7 +7,7 @@ use mobil_chassis::ChassisParams;
 use mobil_geom::Pose2;
 use mobil_planner::{
     polar_error, simulate_docking, sinc, DockingConfig, DockingController, DockingFailure, DockingGains, DockingPhase,
-    DockingRun, Finish, Kinematics, PlannerError, Velocity, VelocityLimits,
+    DockingRun, Finish, Kinematics, PlannerError, Residual, Velocity, VelocityLimits,
 };
 use proptest::prelude::*;
 
@@ -234,8 +234,26 @@ fn v_never_increases_under_tight_limits() {
     assert!(rise <= 1e-12, "V rose by {rise}");
     for s in &run.samples {
         assert!(s.output.command.v.abs() <= 0.1 + 1e-12 && s.output.command.omega.abs() <= 0.2 + 1e-12);
-        assert!(s.output.lyapunov_rate <= 0.0);
     }
+    // The reported V̇ (the limited command's) against a second method: the change of V between
+    // consecutive approach samples over h, compared with the trapezoid mean of V̇ at both ends
+    // (exact to O(h²·V̈); the scale factor has kinks where the binding limit changes).
+    let mut checked = 0;
+    for w in run.samples.windows(2) {
+        if w[0].output.phase != DockingPhase::Approach || w[1].output.phase != DockingPhase::Approach {
+            continue;
+        }
+        let h = w[1].t - w[0].t;
+        let difference = (w[1].output.lyapunov - w[0].output.lyapunov) / h;
+        let trapezoid = 0.5 * (w[0].output.lyapunov_rate + w[1].output.lyapunov_rate);
+        assert!(
+            (difference - trapezoid).abs() <= 1e-3 * trapezoid.abs() + 1e-5,
+            "t = {}: ΔV/h = {difference}, mean V̇ = {trapezoid}",
+            w[0].t
+        );
+        checked += 1;
+    }
+    assert!(checked > 1000, "{checked}");
     // The limit binds at the start: s₀ = min(0.1/0.707107, 0.2/0.942478) = 0.141421.
     assert_relative_eq!(run.samples[0].output.scale, 0.141_421_356, epsilon = 1e-9);
     assert_eq!(run.end, DockingPhase::Docked);
@@ -256,20 +274,110 @@ fn omni_chassis_docks_with_a_final_rotation() {
 
 #[test]
 fn car_like_chassis_reports_its_residual() {
-    // MOBIL-II cannot follow the law: the path needs radii below 0.73 m and a cusp where v = 0
-    // while ω ≠ 0 (the LOW-LEVEL turns that into a stop). The docking must end in FAILED with
-    // the residual that the final pose really has.
+    // MOBIL-II cannot follow the law: from the paper's start the law reverses and turns
+    // (v₀ = −0.707, ω₀ = −0.942: radius 0.75 m), then v = γe·cos α falls to 0 as |α| → π/2
+    // while ω stays ≠ 0 — a cusp, a turn in place. The car-like LOW-LEVEL keeps the curvature
+    // within 1/0.73 m⁻¹, so near the cusp it barely moves: V stops falling, and after
+    // stall_time_s (5 s) of V falling by less than 0.1 % the docking fails as not converging,
+    // far from the goal (e ≫ ε_e), with |α| near π/2. The residual reported is the final pose's.
     let params = ChassisParams::mobil2();
     let mut c = controller(VelocityLimits::from_chassis(&params), Finish::for_chassis(&params));
     let run = simulate_docking(&mut c, Kinematics::Chassis(params), paper_start(), 0.01, 120.0).expect("valid run");
     let last = run.samples.last().expect("samples").output;
-    assert!(matches!(run.end, DockingPhase::Failed(_)), "{:?}", run.end);
-    let dx = run.final_pose.x.hypot(run.final_pose.y);
-    assert_relative_eq!(last.polar.e, dx, epsilon = 1e-12);
-    assert_relative_eq!(last.heading_error, -run.final_pose.yaw, epsilon = 1e-12);
+    assert_eq!(run.end, DockingPhase::Failed(DockingFailure::NotConverging));
+    assert!(last.polar.e > 0.1, "{:?}", last.polar);
+    assert!(last.polar.alpha.cos().abs() < 0.05, "{:?}", last.polar);
+    // The stall window: over the last 5 s V fell by less than 0.1 %.
+    let v_end = last.lyapunov;
+    let before = run
+        .samples
+        .iter()
+        .rev()
+        .find(|s| s.t <= run.time - 5.0)
+        .expect("longer than 5 s")
+        .output
+        .lyapunov;
+    assert!(v_end >= 0.999 * before, "V {before} → {v_end}");
+    // The residual: e = |G − q| and wrap(0 − ϑ) of the final pose, computed here.
+    let residual = last.residual.expect("a failure carries its residual");
+    assert_relative_eq!(residual.e, run.final_pose.x.hypot(run.final_pose.y), epsilon = 1e-12);
+    assert_relative_eq!(residual.heading, mobil_geom::wrap(-run.final_pose.yaw), epsilon = 1e-12);
     println!(
         "MOBIL-II docking from the paper's start: {:?} after {:.2} s, residual e = {:.3} m, heading {:.3} rad",
-        run.end, run.time, last.polar.e, last.heading_error
+        run.end, run.time, residual.e, residual.heading
+    );
+}
+
+#[test]
+fn heading_residual_failure_carries_e_and_heading() {
+    // A chassis that cannot turn in place, 0.01 m short of G (e < ε_e = 0.02) with the heading
+    // 0.5 rad off (> ε_ϑ = 0.03): FAILED with the residual (0.01, wrap(0 − 0.5) = −0.5), and the
+    // same residual on every later step, wherever the robot is.
+    let mut c = controller(VelocityLimits::unlimited(), Finish::ReportResidual);
+    let out = c.update(&Pose2::new(-0.01, 0.0, 0.5), 0.0).expect("finite");
+    assert_eq!(out.phase, DockingPhase::Failed(DockingFailure::HeadingResidual));
+    assert_eq!(out.command, Velocity::ZERO);
+    let expected = Residual { e: 0.01, heading: -0.5 };
+    assert_eq!(out.residual, Some(expected));
+    let later = c.update(&Pose2::new(1.0, 0.0, 0.0), 0.1).expect("finite");
+    assert_eq!(later.residual, Some(expected));
+}
+
+#[test]
+fn rotation_reports_its_real_scale() {
+    // In place 0.005 m from G (< ε_e) with the heading 2 rad off: ω = 1.5·2 = 3 rad/s, limit
+    // 0.5 rad/s → s = 0.5 / 3 = 1/6, ω = 0.5.
+    let mut c = controller(VelocityLimits::new(1.0, 0.5).expect("valid"), Finish::RotateInPlace);
+    let out = c.update(&Pose2::new(0.005, 0.0, -2.0), 0.0).expect("finite");
+    assert_eq!(out.phase, DockingPhase::Rotate);
+    assert_relative_eq!(out.scale, 1.0 / 6.0, epsilon = 1e-15);
+    assert_relative_eq!(out.command.omega, 0.5, epsilon = 1e-15);
+    assert_eq!(out.command.v, 0.0);
+}
+
+#[test]
+fn drifting_out_of_the_position_tolerance_with_the_heading_right_goes_back_to_the_law() {
+    // Rotating (e = 0.01 < ε_e, heading 0.5 rad off), the robot is then found 1.5·ε_e = 0.03 m
+    // behind G with the heading already right: the rotation would command ω = 1.5·0 = 0 and
+    // stall. Back to the law instead: α = Θ = 0, v = γe = 0.5·0.03 = 0.015 m/s, ω = 0; driving
+    // straight, e = 0.03·e^(−0.5t) falls below ε_e = 0.02 at t = 2 ln 1.5 = 0.8109 s: docked.
+    let mut c = controller(VelocityLimits::unlimited(), Finish::RotateInPlace);
+    let out = c.update(&Pose2::new(-0.01, 0.0, 0.5), 0.0).expect("finite");
+    assert_eq!(out.phase, DockingPhase::Rotate);
+    let run = simulate_docking(&mut c, Kinematics::Unicycle, Pose2::new(-0.03, 0.0, 0.0), 0.01, 10.0).expect("valid");
+    let first = run.samples[0].output;
+    assert_eq!(first.phase, DockingPhase::Approach);
+    assert_relative_eq!(first.command.v, 0.015, epsilon = 1e-15);
+    assert_eq!(first.command.omega, 0.0);
+    assert_eq!(run.end, DockingPhase::Docked);
+    // Docked at the first 10 ms sample after 0.8109 s.
+    assert_relative_eq!(run.time, 0.82, epsilon = 1e-9);
+}
+
+#[test]
+fn huge_but_finite_poses_and_simulation_lengths_are_refused() {
+    // e² overflows above about 1.3e154 m: such a pose gave V = ∞ and V̇ = NaN. Refused now.
+    let mut c = controller(VelocityLimits::unlimited(), Finish::RotateInPlace);
+    for pose in [
+        Pose2::new(1e154, 0.0, 0.0),
+        Pose2::new(0.0, -2e6, 0.0),
+        Pose2 {
+            x: 0.0,
+            y: 0.0,
+            yaw: 1e7,
+        },
+    ] {
+        assert!(
+            matches!(c.update(&pose, 0.0), Err(PlannerError::OutOfRange { .. })),
+            "{pose:?}"
+        );
+    }
+    // One million sub-steps at most: 10 000 s at 10 ms is accepted as a bound, a hair more is
+    // refused before any memory is taken.
+    let refused = simulate_docking(&mut c, Kinematics::Unicycle, paper_start(), 0.01, 10_000.1);
+    assert!(
+        matches!(refused, Err(PlannerError::InvalidConfig { name: "max_time", .. })),
+        "{refused:?}"
     );
 }
 
@@ -331,18 +439,69 @@ proptest! {
     #![proptest_config(ProptestConfig::with_cases(48))]
     #[test]
     fn random_starts_converge_with_v_never_increasing(
-        x in -3.0..3.0f64, y in -3.0..3.0f64, yaw in -PI..PI, gx in -1.0..1.0f64, gyaw in -PI..PI,
+        x in -3.0..3.0f64, y in -3.0..3.0f64, yaw in -PI..PI, gx in -1.0..1.0f64, gy in -1.0..1.0f64,
+        gyaw in -PI..PI,
     ) {
-        let goal = Pose2::new(gx, 0.5, gyaw);
+        let goal = Pose2::new(gx, gy, gyaw);
         let start = Pose2::new(x, y, yaw);
         prop_assume!((start.x - goal.x).hypot(start.y - goal.y) > 0.05);
         let mut c = DockingController::new(
             DockingGains::paper(), DockingConfig::default(), VelocityLimits::unlimited(), Finish::RotateInPlace, goal,
         ).unwrap();
         let run = simulate_docking(&mut c, Kinematics::Unicycle, start, 0.01, 100.0).unwrap();
-        let rise = largest_rise(&run);
-        prop_assert!(rise <= 1e-12 * run.samples[0].output.lyapunov.max(1.0), "V rose by {}", rise);
+        // Θ = wrap(Ω − ϑ_G) jumps from ∓π to ±π when the line of sight swings past the goal's
+        // back; ω = … + γ·cos α·sinc α·hΘ jumps with it by up to 2πγh = 1.571 rad/s. V itself is
+        // continuous there and falls on both sides, but an RK4 step straddling the jump has an
+        // O(h) error: up to h·Δω = 0.0157 rad in α, so V may rise by up to
+        // |α|·0.0157 + 0.0157²/2 ≤ π·0.0157 + 0.000123 = 0.0495 on that one step. Everywhere else V
+        // never rises.
+        let v0 = run.samples[0].output.lyapunov.max(1.0);
+        for w in run.samples.windows(2) {
+            if w[1].output.phase != DockingPhase::Approach {
+                continue;
+            }
+            let rise = w[1].output.lyapunov - w[0].output.lyapunov;
+            let wrapped = (w[1].output.polar.theta - w[0].output.polar.theta).abs() > PI;
+            let bound = if wrapped { 0.0495 } else { 1e-12 * v0 };
+            prop_assert!(rise <= bound, "V rose by {} at t = {} (Θ wrapped: {})", rise, w[0].t, wrapped);
+        }
         prop_assert_eq!(run.end, DockingPhase::Docked);
         prop_assert!(run.time < 100.0);
+    }
+}
+
+/// Every field of a docking output is finite (the residual, if any, too).
+fn output_is_finite(o: &mobil_planner::DockingOutput) -> bool {
+    [
+        o.command.v,
+        o.command.omega,
+        o.scale,
+        o.polar.e,
+        o.polar.alpha,
+        o.polar.theta,
+        o.lyapunov,
+        o.lyapunov_rate,
+        o.heading_error,
+    ]
+    .iter()
+    .all(|v| v.is_finite())
+        && o.residual.is_none_or(|r| r.e.is_finite() && r.heading.is_finite())
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(512))]
+    #[test]
+    fn arbitrary_poses_and_goals_never_give_nan(
+        x in proptest::num::f64::ANY, y in proptest::num::f64::ANY, yaw in proptest::num::f64::ANY,
+        gx in proptest::num::f64::ANY, gy in proptest::num::f64::ANY, gyaw in proptest::num::f64::ANY,
+        t in proptest::num::f64::ANY,
+    ) {
+        let mut c = controller(VelocityLimits::unlimited(), Finish::RotateInPlace);
+        // Either the goal is refused, or every output is finite (or the pose/time refused).
+        if c.set_goal(Pose2::new(gx, gy, gyaw)).is_ok() {
+            if let Ok(out) = c.update(&Pose2::new(x, y, yaw), t) {
+                prop_assert!(output_is_finite(&out), "{:?}", out);
+            }
+        }
     }
 }

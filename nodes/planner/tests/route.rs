@@ -6,13 +6,14 @@ mod demo_loop;
 use std::f64::consts::PI;
 
 use approx::assert_relative_eq;
-use mobil_chassis::ChassisParams;
+use mobil_chassis::{ChassisConfig, ChassisParams};
 use mobil_geom::Pose2;
 use mobil_planner::{
-    arc_radius, check_route, PlannerError, ProblemKind, RouteCheckConfig, RouteReport, UnreachableCause,
+    arc_radius, check_route, ApproachConfig, PlannerError, ProblemKind, RouteCheckConfig, RouteReport, UnreachableCause,
 };
-use mobil_sim::world::World;
+use mobil_sim::world::{Obstacle, World};
 use nalgebra::Point2;
+use proptest::prelude::*;
 
 fn default_world() -> World {
     World::load(concat!(env!("CARGO_MANIFEST_DIR"), "/../../params/worlds/default.yaml")).expect("default world")
@@ -39,9 +40,12 @@ fn arc_radius_by_hand() {
     // From (1, 0) facing +x through (1 + 0.5 sin 30°, 0.5 − 0.5 cos 30°) = (1.25, 0.066987):
     // body (0.25, 0.066987), r = (0.0625 + 0.0044873) / (2·0.066987) = 0.5, the circle itself.
     let p = Point2::new(1.25, 0.5 - 0.5 * (PI / 6.0).cos());
-    assert_relative_eq!(arc_radius(&Pose2::new(1.0, 0.0, 0.0), &p), 0.5, epsilon = 1e-12);
+    assert_relative_eq!(arc_radius(&Pose2::new(1.0, 0.0, 0.0), &p, 0.0), 0.5, epsilon = 1e-12);
     // A point on the centre line needs no turn.
-    assert_eq!(arc_radius(&Pose2::identity(), &Point2::new(-2.0, 0.0)), f64::INFINITY);
+    assert_eq!(
+        arc_radius(&Pose2::identity(), &Point2::new(-2.0, 0.0), 0.0),
+        f64::INFINITY
+    );
 }
 
 #[test]
@@ -49,16 +53,36 @@ fn half_metre_turn_rejected_for_mobil2_accepted_for_omr3() {
     let world = World::default();
     let route = tight_turn_route();
     let start = Pose2::identity();
-    let config = RouteCheckConfig::default();
-
-    let omni = check_route(&start, &route, &ChassisParams::omr3(), &world, &config).expect("valid");
+    // Footprint radii of params/*.yaml (they do not matter in the empty world).
+    let omni = check_route(
+        &start,
+        &route,
+        &ChassisParams::omr3(),
+        &world,
+        &RouteCheckConfig::new(0.25),
+    )
+    .expect("valid");
     assert!(omni.is_ok(), "{:?}", omni.problems);
     assert!(omni.reached.iter().all(|r| *r));
     // The tricycle preset turns down to 0.50 / tan 60° = 0.289 m: the 0.5 m turn is fine too.
-    let tricycle = check_route(&start, &route, &ChassisParams::tricycle(), &world, &config).expect("valid");
+    let tricycle = check_route(
+        &start,
+        &route,
+        &ChassisParams::tricycle(),
+        &world,
+        &RouteCheckConfig::new(0.40),
+    )
+    .expect("valid");
     assert!(tricycle.is_ok(), "{:?}", tricycle.problems);
 
-    let car = check_route(&start, &route, &ChassisParams::mobil2(), &world, &config).expect("valid");
+    let car = check_route(
+        &start,
+        &route,
+        &ChassisParams::mobil2(),
+        &world,
+        &RouteCheckConfig::new(0.53),
+    )
+    .expect("valid");
     assert!(!car.is_ok());
     for p in &car.problems {
         // Only the arc's waypoints (1…6) can be too tight; (1, 0) and (0, 1) are wide.
@@ -85,7 +109,7 @@ fn collision_reported_on_the_leg_that_hits_the_pillar() {
         &route,
         &ChassisParams::omr3(),
         &world,
-        &RouteCheckConfig::default(),
+        &RouteCheckConfig::new(0.25),
     )
     .expect("valid");
     assert_eq!(kinds(&report), [(1, "collision")]);
@@ -111,7 +135,7 @@ fn blocked_waypoint_is_unreachable_with_its_index() {
         &route,
         &ChassisParams::omr3(),
         &world,
-        &RouteCheckConfig::default(),
+        &RouteCheckConfig::new(0.25),
     )
     .expect("valid");
     // Driving into the box collides on leg 1; the waypoint itself is unreachable; leaving the
@@ -135,7 +159,7 @@ fn waypoint_beyond_the_distance_bound_is_unreachable() {
         &route,
         &ChassisParams::omr3(),
         &World::default(),
-        &RouteCheckConfig::default(),
+        &RouteCheckConfig::new(0.25),
     )
     .expect("valid");
     assert_eq!(kinds(&report), [(1, "unreachable")]);
@@ -164,10 +188,7 @@ fn every_problem_of_one_route_is_reported() {
     // 3: (5, 60.25) is 60 m on: beyond the 50 m leg bound (on the way it crosses the north
     //    wall, one more collision on that leg).
     let world = default_world();
-    let config = RouteCheckConfig {
-        robot_radius: 0.53,
-        ..RouteCheckConfig::default()
-    };
+    let config = RouteCheckConfig::new(0.53);
     let route = [
         Point2::new(0.0, -0.3),
         Point2::new(1.0, 3.2),
@@ -226,21 +247,181 @@ fn the_demo_loop_passes_on_both_chassis() {
     assert_relative_eq!(route[4].y, 0.520_574, epsilon = 1e-6);
     assert_relative_eq!((route[19] - Point2::new(0.0, 0.0)).norm(), 0.0, epsilon = 1e-12);
     let world = default_world();
-    for (params, radius) in [(ChassisParams::mobil2(), 0.53), (ChassisParams::omr3(), 0.25)] {
-        let config = RouteCheckConfig {
-            robot_radius: radius,
-            ..RouteCheckConfig::default()
-        };
-        let report = check_route(&Pose2::identity(), &route, &params, &world, &config).expect("valid");
-        assert!(report.is_ok(), "{}: {:?}", params.model(), report.problems);
-        assert_eq!(report.reached, [true; 20]);
+    let omni = check_route(
+        &Pose2::identity(),
+        &route,
+        &ChassisParams::omr3(),
+        &world,
+        &RouteCheckConfig::new(0.25),
+    )
+    .expect("valid");
+    assert!(omni.is_ok(), "{:?}", omni.problems);
+    assert_eq!(omni.reached, [true; 20]);
+    // 12 waypoints, 12.2832 / 12 = 1.024 m apart, pass for MOBIL-II too (the paper's remedy:
+    // waypoints far enough apart).
+    let car = check_route(
+        &Pose2::identity(),
+        &demo_loop::demo_loop(12),
+        &ChassisParams::mobil2(),
+        &world,
+        &RouteCheckConfig::new(0.53),
+    )
+    .expect("valid");
+    assert!(car.is_ok(), "{:?}", car.problems);
+    assert_eq!(car.reached, [true; 12]);
+    // At 20 (0.614 m apart) MOBIL-II still reaches every one within Z_crit, but some corner
+    // waypoints need a tighter arc from where the previous one was taken (0.16 m short of it,
+    // heading along the chord): reported as turn radius, nothing else.
+    let car = check_route(
+        &Pose2::identity(),
+        &route,
+        &ChassisParams::mobil2(),
+        &world,
+        &RouteCheckConfig::new(0.53),
+    )
+    .expect("valid");
+    assert_eq!(car.reached, [true; 20]);
+    assert!(!car.is_ok());
+    assert!(
+        car.problems.iter().all(|p| p.kind.as_str() == "turn_radius"),
+        "{:?}",
+        car.problems
+    );
+}
+
+#[test]
+fn a_tight_turn_is_reported_even_when_the_waypoint_is_reached() {
+    // From (0, 0) facing +x, MOBIL-II (R_min 0.73): the waypoint (0.6 sin 60°, 0.6(1 − cos 60°))
+    // = (0.519615, 0.3) lies on the arc of radius (0.27 + 0.09) / (2·0.3) = 0.60 m. The full-lock
+    // circle (centre (0, 0.73)) passes 0.73 − √(0.27 + 0.1849) = 0.73 − 0.674463 = 0.0555 m from it,
+    // well within Z_crit = 0.16: the virtual robot reaches it, and the turn is still too tight.
+    let w = Point2::new(0.6 * (PI / 3.0).sin(), 0.3);
+    let report = check_route(
+        &Pose2::identity(),
+        &[w],
+        &ChassisParams::mobil2(),
+        &World::default(),
+        &RouteCheckConfig::new(0.53),
+    )
+    .expect("valid");
+    assert_eq!(report.reached, [true]);
+    assert_eq!(kinds(&report), [(0, "turn_radius")]);
+    match report.problems[0].kind {
+        ProblemKind::TurnRadius { required, minimum } => {
+            assert_relative_eq!(required, 0.60, epsilon = 1e-12);
+            assert_relative_eq!(minimum, 0.73, epsilon = 1e-12);
+        }
+        other => panic!("{other:?}"),
+    }
+}
+
+#[test]
+fn arc_radius_with_a_reference_offset_by_hand() {
+    // Origin (−0.3, 0) facing +x, d = 0.3: the reference point passes through (−0.3, 0.73) when
+    // the origin circles (−0.3, R) with |(0, 0.73 − R)|² = R² + 0.09 → R = (0.5329 − 0.09) / 1.46
+    // = 0.303356. Check: the reference point's radius √(0.303356² + 0.09) = 0.426644 = 0.73 − R.
+    let r = arc_radius(&Pose2::new(-0.3, 0.0, 0.0), &Point2::new(-0.3, 0.73), 0.3);
+    assert_relative_eq!(r, 0.4429 / 1.46, epsilon = 1e-12);
+    assert_relative_eq!((r * r + 0.09).sqrt(), 0.73 - r, epsilon = 1e-12);
+}
+
+#[test]
+fn only_the_front_of_the_robot_hits_a_pillar() {
+    // MOBIL-II with its reference point 0.30 m ahead of the rear axle (params/mobil2.yaml), the
+    // start (0, 0) facing +x being the reference point's pose: the origin is at (−0.3, 0). The
+    // waypoint (−0.3, 0.73) is the centre of the origin's full-lock circle, so the goal stays
+    // near 90° (outside δ_eff: full lock, the progress stop never arms) and the robot circles
+    // until the leg bound, 2·0.789240 + 2π·0.73 = 6.165 m, more than one 4.587 m circle.
+    // Each step turns Δϑ = 0.02·tan δ_eff / 0.6 = 0.02 / 0.73 = 0.0273973 rad, then moves 0.02 m
+    // straight: the origin's vertices lie on a circle of radius ρ = 0.02 / (2 sin(Δϑ/2)) =
+    // 0.730023 about c = (−0.3 − ρ sin(Δϑ/2), ρ cos(Δϑ/2)) = (−0.310000, 0.729954); the reference
+    // point, 0.3 m along the chord just driven (Δϑ/2 outward of the tangent), at radius
+    // √(ρ² + 0.09 + 2·0.3·ρ·sin(Δϑ/2)) = √0.628934 = 0.793054.
+    // A pillar of radius 0.1 at (−1.35, 0.73), 1.040000 m from c: a 0.2 m disc at the origin
+    // keeps 1.04 − 0.730 − 0.1 − 0.2 = +0.010 m clear; at the reference point it comes
+    // 1.04 − 0.793 − 0.3 = −0.053 m into the pillar: a collision.
+    let params = ChassisParams::new(ChassisConfig {
+        reference_offset: 0.30,
+        ..ChassisConfig::mobil2()
+    })
+    .expect("valid chassis");
+    let pillar = Point2::new(-1.35, 0.73);
+    let world = World {
+        obstacles: vec![Obstacle::Circle {
+            center: [pillar.x, pillar.y],
+            radius: 0.1,
+        }],
+    };
+    let route = [Point2::new(-0.3, 0.73)];
+    let config = RouteCheckConfig::new(0.2);
+    let report = check_route(&Pose2::identity(), &route, &params, &world, &config).expect("valid");
+    // The turn: the reference point through (−0.3, 0.73) needs R = 0.303356 m < 0.73 m.
+    assert_eq!(
+        kinds(&report),
+        [(0, "collision"), (0, "turn_radius")],
+        "{:?}",
+        report.problems
+    );
+    let ProblemKind::Collision { at, clearance } = report.problems[0].kind else {
+        unreachable!()
+    };
+    // Where the disc first touches: 0.1 + 0.2 = 0.3 m from the pillar's centre, at most one
+    // 0.02 m step inside; on the reference point's circle.
+    let d = (at - pillar).norm();
+    assert!(d < 0.3 && d > 0.28, "{d}");
+    assert_relative_eq!(clearance, d - 0.3, epsilon = 1e-12);
+    assert!(
+        ((at - Point2::new(-0.310_000, 0.729_954)).norm() - 0.793_054).abs() < 1e-4,
+        "{at:?}"
+    );
+    // The path is the reference point's: it starts at the given start.
+    assert_eq!(report.path[0], Pose2::identity());
+    // Read as a rear-axle start (d = 0), the same route passes the pillar.
+    let rear = check_route(&Pose2::identity(), &route, &ChassisParams::mobil2(), &world, &config).expect("valid");
+    assert!(
+        rear.problems.iter().all(|p| p.kind.as_str() != "collision"),
+        "{:?}",
+        rear.problems
+    );
+}
+
+#[test]
+fn a_waypoint_passed_by_is_unreachable_with_the_closest_approach() {
+    // The paper's start S = [−1, 1, 3π/4], waypoint (0, 0): it lies straight behind the car
+    // (body (−√2, 0)), so no turn radius applies (infinite). With Z_crit 0.001 the car turns
+    // round, passes G a few centimetres off (004 §4.3.1: about 0.16 m at most) and the armed
+    // progress stop ends the leg: passed by, the closest approach between 0.001 and 0.16 m.
+    let config = RouteCheckConfig {
+        approach: ApproachConfig {
+            critical_distance: 1e-3,
+            ..ApproachConfig::default()
+        },
+        ..RouteCheckConfig::new(0.53)
+    };
+    let start = Pose2::new(-1.0, 1.0, 0.75 * PI);
+    // Straight behind up to rounding (y_b ≈ 1e-16): an arc far wider than any chassis' minimum.
+    assert!(arc_radius(&start, &Point2::new(0.0, 0.0), 0.0) > 1e12);
+    let report = check_route(
+        &start,
+        &[Point2::new(0.0, 0.0)],
+        &ChassisParams::mobil2(),
+        &World::default(),
+        &config,
+    )
+    .expect("valid");
+    assert_eq!(kinds(&report), [(0, "unreachable")]);
+    match report.problems[0].kind {
+        ProblemKind::Unreachable(UnreachableCause::PassedBy { closest }) => {
+            assert!(closest > 1e-3 && closest < 0.16, "{closest}")
+        }
+        other => panic!("{other:?}"),
     }
 }
 
 #[test]
 fn bad_routes_are_refused() {
     let world = World::default();
-    let c = RouteCheckConfig::default();
+    let c = RouteCheckConfig::new(0.25);
     let p = ChassisParams::omr3();
     assert_eq!(
         check_route(&Pose2::identity(), &[], &p, &world, &c),
@@ -256,4 +437,33 @@ fn bad_routes_are_refused() {
         ..c
     };
     assert!(check_route(&Pose2::identity(), &[Point2::new(1.0, 0.0)], &p, &world, &bad).is_err());
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(256))]
+    #[test]
+    fn arbitrary_routes_never_give_nan(
+        x in proptest::num::f64::ANY, y in proptest::num::f64::ANY, yaw in proptest::num::f64::ANY,
+        w in proptest::collection::vec((proptest::num::f64::ANY, proptest::num::f64::ANY), 1..4),
+        radius in proptest::num::f64::ANY, car in proptest::bool::ANY,
+    ) {
+        let route: Vec<_> = w.iter().map(|&(a, b)| Point2::new(a, b)).collect();
+        let params = if car { ChassisParams::mobil2() } else { ChassisParams::omr3() };
+        if let Ok(r) = check_route(&Pose2 { x, y, yaw }, &route, &params, &default_world(), &RouteCheckConfig::new(radius)) {
+            prop_assert!(r.path.iter().all(|p| p.x.is_finite() && p.y.is_finite() && p.yaw.is_finite()));
+            prop_assert_eq!(r.reached.len(), route.len());
+            for p in &r.problems {
+                let finite = match p.kind {
+                    ProblemKind::Collision { at, clearance } => at.x.is_finite() && at.y.is_finite() && clearance.is_finite(),
+                    ProblemKind::TurnRadius { required, minimum } => !required.is_nan() && minimum.is_finite(),
+                    ProblemKind::Unreachable(UnreachableCause::Blocked { clearance }) => clearance.is_finite(),
+                    ProblemKind::Unreachable(UnreachableCause::PassedBy { closest }) => closest.is_finite(),
+                    ProblemKind::Unreachable(UnreachableCause::DistanceBound { travelled, remaining }) => {
+                        travelled.is_finite() && remaining.is_finite()
+                    }
+                };
+                prop_assert!(finite, "{:?}", p);
+            }
+        }
+    }
 }
