@@ -100,25 +100,14 @@ SCENARIOS: dict[str, dict[str, Scenario]] = {
                                 slow=True),
                "mobil2": Scenario("local_nav_u_trap_wide.yaml", (9.0, 0.0), 80.0, SUCCEEDED,
                                   "RLT", slow=True)},
-    # (e) the enclosed goal: NO_PATH after 46 s (OMR-III), 79 s (MOBIL-II).
+    # (e) the enclosed goal: NO_PATH after 41 s (OMR-III, modes RLRLT), 79 s (MOBIL-II).
     "enclosed": {"omr3": Scenario("local_nav_enclosed.yaml", (5.0, 0.0), 75.0, FAILED, "RLT",
                                   slow=True),
                  "mobil2": Scenario("local_nav_enclosed.yaml", (5.0, 0.0), 120.0, FAILED,
                                     "RLT", slow=True)},
 }
-# A known defect of the library, not of the test: on OMR-III in the enclosure, boundary following
-# sometimes stalls on the box's far side (moved < 0.5 m in 10 s: the node's progress checker ends
-# the goal ABORTED, robot at rest) instead of coming back to H (NO_PATH), and the R/L modes
-# chatter at the box's edges (12 flips in one run). Seen in 3 of 3 runs of the whole file, 0 of 5
-# runs of this case alone; the Rust closed loop (no delays) reaches NO_PATH. Until the library
-# keeps the boundary in view (the corner falls in the 270° scanner's rear blind spot while the
-# omni holds its heading), the case runs but may fail.
-KNOWN_DEFECTS = {("enclosed", "omr3"): "OMR-III's boundary following can stall on the enclosure's "
-                 "far side (ABORTED by the progress checker instead of NO_PATH)"}
 CASES = [pytest.param(name, robot, id=f"{name}-{robot}",
-                      marks=([pytest.mark.slow_scenario] if s.slow else [])
-                      + ([pytest.mark.xfail(reason=KNOWN_DEFECTS[(name, robot)], strict=False)]
-                         if (name, robot) in KNOWN_DEFECTS else []))
+                      marks=[pytest.mark.slow_scenario] if s.slow else [])
          for name, per_robot in SCENARIOS.items() for robot, s in per_robot.items()]
 
 

@@ -114,7 +114,8 @@ pub struct NavConfig {
     /// Gain (rad/m) that bends the tracking direction toward or away from the boundary per metre
     /// of distance error in T-mode. Default 1.5: a 0.35 m error gives the full ±π/6 correction.
     pub track_gain: f64,
-    /// Gain (1/s) of the omni chassis' turn toward a direction outside the field of view.
+    /// Gain (1/s) of the omni chassis' turn toward a direction outside the field of view, and in
+    /// T-mode toward its direction of motion.
     /// Default 1.5.
     pub heading_gain: f64,
 }

@@ -37,7 +37,10 @@
 //!   H and G (∠HLG = 180°, eq. 3.59).
 //! - **NO_PATH on return to H** only after the robot has been twice `hit_radius` away.
 //! - **Omni and the field of view**: an omni chassis holds its heading, but turns in place
-//!   toward a direction of motion outside the field of view rather than drive there blind.
+//!   toward a direction of motion outside the field of view rather than drive there blind. In
+//!   T-mode it turns to face its direction of motion: the boundary it follows is then abeam, in
+//!   the field of view, where holding the heading would carry it into the rear blind spot (the
+//!   far side of an enclosure) and lose it.
 //! - **Car-like**: pure-pursuit curvature toward a point d_sa along the direction, clipped to
 //!   tan δ_eff / L. The speed and the hard stop look along the arc the car will drive (a
 //!   circle swept along the arc against the scan points, [`motion::arc_free_distance`]; its

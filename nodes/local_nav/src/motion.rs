@@ -144,7 +144,8 @@ pub struct SpeedProfile {
     pub safe_distance: f64,
     /// Inside this distance (m) to the goal, the speed falls linearly toward zero.
     pub slow_down_radius: f64,
-    /// Gain (1/s) of an omni chassis' turn toward a direction outside the field of view.
+    /// Gain (1/s) of an omni chassis' turn toward a direction outside the field of view (the
+    /// navigator also turns an omni in T-mode toward its direction of motion with it).
     pub heading_gain: f64,
     /// Radius (m) of the circle swept along a car-like chassis' arcs: the robot's, or more for
     /// a margin to the side as well as ahead (the navigator sweeps the robot radius plus half

@@ -473,7 +473,15 @@ impl Navigator {
             Drive::Omni => false,
             Drive::CarLike { max_curvature } => car_arc(input.obstacles, bearing, max_curvature, &profile).against,
         };
-        (command_along(&input, &profile, &self.limits), against)
+        let mut command = command_along(&input, &profile, &self.limits);
+        if matches!(self.limits.drive, Drive::Omni) && matches!(self.mode, Mode::Track(_)) {
+            // T-mode follows the boundary beside the robot: an omni holding its heading would
+            // carry it into the scanner's rear blind spot (going back along the box's far side
+            // of a goal ahead), lose the nearest reading and stall. Facing the direction of
+            // motion keeps the boundary abeam, in the middle of the field of view.
+            command.omega = (profile.heading_gain * wrap(bearing)).clamp(-self.limits.omega_max, self.limits.omega_max);
+        }
+        (command.limited(&self.limits), against)
     }
 }
 
