@@ -36,6 +36,7 @@ from geometry_msgs.msg import PoseStamped, Twist
 from nav_msgs.msg import Odometry
 from rclpy.action import ActionClient
 from sensor_msgs.msg import LaserScan
+from visualization_msgs.msg import Marker, MarkerArray
 
 from mobil_msgs.msg import NavStatus
 from nav2_msgs.action import NavigateToPose
@@ -134,6 +135,7 @@ def test_goal_pose_in_open_space(start_scenario, start_node, sim_clock, ros_node
     pub = ros_node.create_publisher(PoseStamped, "goal_pose", 10)
     with subscribe(ros_node, NavStatus, "local_nav/status", qos=qos_latched()) as status, \
             subscribe(ros_node, Twist, "cmd_vel", qos=DEEP) as cmd, \
+            subscribe(ros_node, MarkerArray, "local_nav/markers", qos=DEEP) as markers, \
             subscribe(ros_node, Odometry, "ground_truth") as truth:
         sim_clock.wait_started()
         # The latched IDLE status proves local_nav_node is up and matched; no goal yet, no cmd_vel.
@@ -149,6 +151,8 @@ def test_goal_pose_in_open_space(start_scenario, start_node, sim_clock, ros_node
         # The zero command (reliable: it may take a repair), then 1 simulated second more, for
         # a stray command to show and the robot to come to rest (motor lag τ = 0.05 s).
         cmd.wait_for(is_zero, REPLY_TIMEOUT)
+        # A finished goal clears its markers (RViz shows no sectors of it).
+        markers.wait_for(lambda a: any(m.action == Marker.DELETEALL for m in a.markers), REPLY_TIMEOUT)
         sim_clock.wait_until(sim_clock.now() + 1.0)
         factor = sim_clock.factor(since=mark)
         rest = truth.wait_for(lambda m: speed(m) < 1e-3, REPLY_TIMEOUT, start=len(truth))
@@ -159,11 +163,19 @@ def test_goal_pose_in_open_space(start_scenario, start_node, sim_clock, ros_node
         nav.stop()
         time.sleep(0.5)  # acknowledged before the exit; this lets this reader's callback run
         assert len(cmd) == before_exit, "an idle local_nav_node sent a cmd_vel at exit"
-        statuses, cmds = status.snapshot(), cmd.snapshot()
+        statuses, cmds, arrays = status.snapshot(), cmd.snapshot(), markers.snapshot()
         # sim_node first, so that no ground truth or clock is in flight when the readers close.
         sim.stop()
 
     assert factor >= MIN_FACTOR, f"{factor:.2f}× real time"
+    # While active: the sector vectors (8 lines from the robot, base_link) and the goal's sphere
+    # at G (odom); the goal's end clears them with DELETEALL.
+    drawn = [m for a in arrays for m in a.markers if m.action == Marker.ADD]
+    assert any(m.type == Marker.LINE_LIST and m.header.frame_id == "base_link" and len(m.points) == 16
+               for m in drawn), arrays[:1]
+    assert any(m.type == Marker.SPHERE and m.header.frame_id == "odom"
+               and (m.pose.position.x, m.pose.position.y) == goal for m in drawn), "no marker at G"
+    assert any(m.action == Marker.DELETEALL for m in arrays[-1].markers)
     x, y = position(rest)
     # The goal is reached when odometry is within 0.10 m; a noise-free odometry and the coast
     # toward the goal after the stop (≤ 0.083 m/s · τ) keep the ground truth inside it.
