@@ -816,6 +816,11 @@ pub fn status_message(view: &StatusView, stamp: Time, frame: &str) -> NavStatus 
         hit_point: view.hit_point.map(point).unwrap_or_default(),
         has_leave_point: view.leave_point.is_some(),
         leave_point: view.leave_point.map(point).unwrap_or_default(),
+        waypoint_index: -1,
+        e: 0.0,
+        alpha: 0.0,
+        theta: 0.0,
+        lyapunov: 0.0,
     }
 }
 
