@@ -9,9 +9,9 @@ use mobil_msgs::nav_msgs::msg::Odometry;
 use mobil_ros::geometry::yaw_of;
 use mobil_ros::params::ParamValues;
 use mobil_ros::{qos, run_node, shutdown_signal, NodeDecl, ParamSpec, RosNode};
-use mobil_sim::plot::{write_svg, Track};
 use mobil_sim::world::World;
 use mobil_tools::route::{default_loop, parse_route, path_length, twist_at};
+use mobil_tools_node::plot::{write_file, MapView, Stroke, Svg};
 use std::process::ExitCode;
 use std::time::Duration;
 use tracing::info;
@@ -51,6 +51,29 @@ fn pose(m: &Odometry) -> (f64, f64, f64) {
         m.pose.pose.position.y,
         yaw_of(&m.pose.pose.orientation),
     )
+}
+
+/// The plot: both tracks over the world at 60 px/m, the title and the legend below.
+fn plot(world: &World, truth: &[(f64, f64)], odom: &[(f64, f64)], title: &str) -> String {
+    let map = MapView::fit(world, truth.iter().chain(odom).copied(), 60.0, 0.5);
+    let base = map.height();
+    let mut s = Svg::new(map.width(), base + 60.0);
+    s.world(&map, world);
+    s.metre_axes(&map);
+    s.path(&map, truth, Stroke::solid("#141414", 2.0));
+    s.path(&map, odom, Stroke::solid("#DC3220", 2.0));
+    s.text(10.0, base + 22.0, 16.0, title);
+    s.polyline(
+        &[(10.0, base + 44.0), (40.0, base + 44.0)],
+        Stroke::solid("#141414", 2.0),
+    );
+    s.text(46.0, base + 49.0, 14.0, "ground truth");
+    s.polyline(
+        &[(160.0, base + 44.0), (190.0, base + 44.0)],
+        Stroke::solid("#DC3220", 2.0),
+    );
+    s.text(196.0, base + 49.0, 14.0, "odometry");
+    s.finish()
 }
 
 async fn drive(node: &mut RosNode) -> anyhow::Result<()> {
@@ -132,26 +155,10 @@ async fn drive(node: &mut RosNode) -> anyhow::Result<()> {
     let distance = path_length(&xy(&truth_track));
     let error = (o.0 - g.0).hypot(o.1 - g.1);
     let heading_error = wrap(o.2 - g.2).abs().to_degrees();
-    if let Some(dir) = std::path::Path::new(&svg).parent() {
-        std::fs::create_dir_all(dir).ok();
-    }
-    write_svg(
-        std::path::Path::new(&svg),
-        &world,
-        &[
-            Track {
-                label: "ground truth".into(),
-                points: xy(&truth_track),
-                color: (20, 20, 20),
-            },
-            Track {
-                label: "odometry".into(),
-                points: xy(&odom_track),
-                color: (220, 50, 32),
-            },
-        ],
-        &format!("{}: odometry vs ground truth", node.names().fully_qualified_node()),
-    )?;
+    let (truth_xy, odom_xy) = (xy(&truth_track), xy(&odom_track));
+    let title = format!("{}: odometry vs ground truth", node.names().fully_qualified_node());
+    write_file(&svg, &plot(&world, &truth_xy, &odom_xy, &title))
+        .map_err(|e| anyhow::anyhow!("cannot write {svg}: {e}"))?;
     println!(
         "demo: drove {distance:.2} m; final odometry error {error:.3} m ({:.2} % of distance), heading {heading_error:.2}°; plot {svg}",
         if distance > 0.0 { 100.0 * error / distance } else { 0.0 }

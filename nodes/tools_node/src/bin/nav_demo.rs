@@ -11,8 +11,8 @@ use mobil_msgs::nav_msgs::msg::Odometry;
 use mobil_ros::params::ParamValues;
 use mobil_ros::time::stamp_from_nanos;
 use mobil_ros::{qos, run_node, shutdown_signal, NodeDecl, ParamSpec, RosNode};
-use mobil_sim::world::{Obstacle, World};
-use std::fmt::Write as _;
+use mobil_sim::world::World;
+use mobil_tools_node::plot::{write_file, MapView, Stroke, Svg};
 use std::process::ExitCode;
 use std::time::{Duration, Instant};
 use tracing::info;
@@ -74,122 +74,33 @@ struct Run {
     goal: (f64, f64),
 }
 
-/// The plot as plain SVG: 1 m = `scale` px, y up, everything in view with a 0.5 m margin.
+/// The plot: 1 m = 60 px, y up, everything in view with a 0.5 m margin, the caption below.
 fn svg(world: &World, run: &Run, title: &str) -> String {
-    let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
-    let mut grow = |x: f64, y: f64| {
-        if x.is_finite() && y.is_finite() {
-            lo = [lo[0].min(x), lo[1].min(y)];
-            hi = [hi[0].max(x), hi[1].max(y)];
-        }
-    };
-    for o in &world.obstacles {
-        let (a, b) = o.bounds();
-        grow(a[0], a[1]);
-        grow(b[0], b[1]);
-    }
-    for &(x, y) in run.path.iter().chain(std::iter::once(&run.goal)) {
-        grow(x, y);
-    }
-    if lo[0] > hi[0] {
-        (lo, hi) = ([-1.0; 2], [1.0; 2]);
-    }
-    let margin = 0.5;
-    let scale = 60.0;
-    let (w, h) = (hi[0] - lo[0] + 2.0 * margin, hi[1] - lo[1] + 2.0 * margin);
-    let px = |x: f64| (x - lo[0] + margin) * scale;
-    let py = |y: f64| (hi[1] + margin - y) * scale;
-    let (width, height) = (w * scale, h * scale + 60.0);
-    let mut s = String::new();
-    let _ = writeln!(
-        s,
-        r#"<svg xmlns="http://www.w3.org/2000/svg" width="{width:.0}" height="{height:.0}" viewBox="0 0 {width:.0} {height:.0}" font-family="sans-serif">"#
-    );
-    let _ = writeln!(s, r#"<rect width="100%" height="100%" fill="white"/>"#);
-    for o in &world.obstacles {
-        match o {
-            Obstacle::Circle { center, radius } => {
-                let _ = writeln!(
-                    s,
-                    r##"<circle cx="{:.1}" cy="{:.1}" r="{:.1}" fill="#969696"/>"##,
-                    px(center[0]),
-                    py(center[1]),
-                    radius * scale
-                );
-            }
-            Obstacle::Polygon { points } => {
-                let pts: Vec<String> = points
-                    .iter()
-                    .map(|p| format!("{:.1},{:.1}", px(p[0]), py(p[1])))
-                    .collect();
-                let _ = writeln!(s, r##"<polygon points="{}" fill="#969696"/>"##, pts.join(" "));
-            }
-        }
-    }
-    let pts: Vec<String> = run
-        .path
-        .iter()
-        .filter(|(x, y)| x.is_finite() && y.is_finite())
-        .map(|&(x, y)| format!("{:.1},{:.1}", px(x), py(y)))
-        .collect();
-    let _ = writeln!(
-        s,
-        r##"<polyline points="{}" fill="none" stroke="#141414" stroke-width="2"/>"##,
-        pts.join(" ")
-    );
+    let shown = run.path.iter().copied().chain(std::iter::once(run.goal));
+    let map = MapView::fit(world, shown, 60.0, 0.5);
+    let base = map.height();
+    let mut s = Svg::new(map.width(), base + 60.0);
+    s.world(&map, world);
+    s.metre_axes(&map);
+    s.path(&map, &run.path, Stroke::solid("#141414", 2.0));
     for &(x, y, letter) in &run.changes {
-        let _ = writeln!(
-            s,
-            r#"<circle cx="{:.1}" cy="{:.1}" r="6" fill="{}" stroke="black"><title>{letter}</title></circle>"#,
-            px(x),
-            py(y),
-            mode_color(letter)
-        );
+        s.dot(map.x(x), map.y(y), 6.0, mode_color(letter), Some(&letter.to_string()));
     }
-    let (gx, gy) = (px(run.goal.0), py(run.goal.1));
-    let _ = writeln!(
-        s,
-        r#"<path d="M {:.1} {:.1} L {:.1} {:.1} M {:.1} {:.1} L {:.1} {:.1}" stroke="black" stroke-width="3"/>"#,
-        gx - 8.0,
-        gy - 8.0,
-        gx + 8.0,
-        gy + 8.0,
-        gx - 8.0,
-        gy + 8.0,
-        gx + 8.0,
-        gy - 8.0
-    );
-    let base = h * scale;
-    let _ = writeln!(
-        s,
-        r#"<text x="10" y="{:.0}" font-size="16">{}</text>"#,
-        base + 22.0,
-        escape(title)
-    );
+    s.cross(map.x(run.goal.0), map.y(run.goal.1), 8.0, "black", 3.0);
+    s.text(10.0, base + 22.0, 16.0, title);
     let mut x = 10.0;
     for (letter, label) in [('R', "R: rotate"), ('L', "L: lock"), ('T', "T: track")] {
-        let _ = writeln!(
-            s,
-            r#"<circle cx="{:.0}" cy="{:.0}" r="6" fill="{}" stroke="black"/><text x="{:.0}" y="{:.0}" font-size="14">{label}</text>"#,
-            x + 6.0,
-            base + 44.0,
-            mode_color(letter),
-            x + 16.0,
-            base + 49.0
-        );
+        s.dot(x + 6.0, base + 44.0, 6.0, mode_color(letter), None);
+        s.text(x + 16.0, base + 49.0, 14.0, label);
         x += 110.0;
     }
-    let _ = writeln!(
-        s,
-        r#"<text x="{x:.0}" y="{:.0}" font-size="14">✕ goal; line: ground truth; dot: mode entered there</text>"#,
-        base + 49.0
+    s.text(
+        x,
+        base + 49.0,
+        14.0,
+        "✕ goal; line: ground truth; dot: mode entered there",
     );
-    s.push_str("</svg>\n");
-    s
-}
-
-fn escape(text: &str) -> String {
-    text.replace('&', "&amp;").replace('<', "&lt;").replace('>', "&gt;")
+    s.finish()
 }
 
 async fn run(node: &mut RosNode) -> anyhow::Result<()> {
@@ -281,16 +192,13 @@ async fn run(node: &mut RosNode) -> anyhow::Result<()> {
     } else {
         format!("failed ({reason})")
     };
-    if let Some(dir) = std::path::Path::new(&out).parent() {
-        std::fs::create_dir_all(dir).ok();
-    }
     let title = format!(
         "{}: local_nav to ({}, {}), {outcome}; modes {modes}",
         node.names().fully_qualified_node(),
         goal.0,
         goal.1
     );
-    std::fs::write(&out, svg(&world, &record, &title)).map_err(|e| anyhow::anyhow!("cannot write {out}: {e}"))?;
+    write_file(&out, &svg(&world, &record, &title)).map_err(|e| anyhow::anyhow!("cannot write {out}: {e}"))?;
     println!(
         "demo: local_nav {outcome} goal ({}, {}) in {sim_s:.1} simulated s, {length:.2} m driven, modes {}; plot {out}",
         goal.0,
@@ -303,6 +211,7 @@ async fn run(node: &mut RosNode) -> anyhow::Result<()> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use mobil_sim::world::Obstacle;
 
     #[test]
     fn mode_letters_from_status_text() {
@@ -339,7 +248,16 @@ mod tests {
             s.contains(r##"<circle cx="150.0" cy="60.0" r="30.0" fill="#969696"/>"##),
             "{s}"
         );
-        assert!(s.contains(r#"points="30.0,60.0 270.0,60.0""#), "{s}");
+        // Metre ticks along the bottom (y = −1 m at 120 px): x = 0 at 30 px, x = 4 at 270 px.
+        assert!(s.contains(r#"<line x1="30.0" y1="120.0" x2="30.0" y2="115.0""#), "{s}");
+        assert!(
+            s.contains(r#"<line x1="270.0" y1="120.0" x2="270.0" y2="115.0""#),
+            "{s}"
+        );
+        assert!(
+            s.contains(r##"points="30.0,60.0 270.0,60.0" fill="none" stroke="#141414""##),
+            "{s}"
+        );
         // The mode marks at x = 1 (90 px, orange L) and x = 3 (210 px, blue R).
         assert!(s.contains(r##"cx="90.0" cy="60.0" r="6" fill="#E69F00""##), "{s}");
         assert!(s.contains(r##"cx="210.0" cy="60.0" r="6" fill="#005AB5""##), "{s}");

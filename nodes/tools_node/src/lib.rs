@@ -1,0 +1,6 @@
+//! What the demo's executables share: [`plot`], the SVG figures (map panel with the world's
+//! obstacles, time-series panels). ROS-free, so it is tested on recorded data; the binaries in
+//! `src/bin` are the shells.
+#![warn(missing_docs)]
+
+pub mod plot;
