@@ -29,7 +29,7 @@ from visualization_msgs.msg import Marker, MarkerArray
 
 from mobil_msgs.msg import NavStatus, RouteProblem
 from mobil_msgs.srv import CheckRoute
-from nav2_msgs.action import DockRobot, FollowWaypoints
+from nav2_msgs.action import DockRobot, FollowWaypoints, UndockRobot
 
 REAL_TIME_FACTOR = 5.0
 MIN_FACTOR = 4.0
@@ -73,6 +73,16 @@ def wrap(a: float) -> float:
 
 def is_zero(t: Twist) -> bool:
     return (t.linear.x, t.linear.y, t.linear.z, t.angular.x, t.angular.y, t.angular.z) == (0.0,) * 6
+
+
+def stamp(m) -> float:
+    return m.header.stamp.sec + m.header.stamp.nanosec * 1e-9
+
+
+def rest_after(truth, t: float):
+    """The first ground truth at rest stamped at simulated time ``t`` or later (the recorder
+    may run behind a 1000-sample/s stream, so its length says nothing of the time)."""
+    return truth.wait_for(lambda m: stamp(m) >= t and speed(m) < 1e-3, REPLY_TIMEOUT)
 
 
 def speed(m: Odometry) -> float:
@@ -126,6 +136,17 @@ def send_until_answered(client: ActionClient, goal, feedback=None, attempts: int
     raise AssertionError(f"no goal response to {attempts} goals")
 
 
+def cancel_until_answered(handle, attempts: int = 4) -> list:
+    """Cancels until a cancel response arrives, each attempt 3 s (rclpy drops a response that
+    comes back before it filed the request; see test_local_nav.py)."""
+    futures = []
+    for _ in range(attempts):
+        futures.append(handle.cancel_goal_async())
+        if wait_until(lambda: any(f.done() for f in futures), 3.0):
+            return [f.result() for f in futures if f.done()]
+    raise AssertionError(f"no cancel response to {attempts} requests")
+
+
 def call(client, request, attempts: int = 4):
     """A service call, re-sent after 3 s without a reply (ROS2-NOTES: the first call after
     discovery may stall)."""
@@ -137,14 +158,14 @@ def call(client, request, attempts: int = 4):
     raise AssertionError("no reply from the service")
 
 
-def check_commands(cmds, ends: int, v_max: float, omega_max: float, offset: float = 0.0) -> None:
-    """Limits (the speed of the kinematic origin, `offset` behind base_link: its sideways
-    speed vy − ω·offset is zero on a steered chassis); one zero command per goal end, the last
-    command zero."""
+def check_commands(cmds, ends: int, v_max: float, omega_max: float, steered: bool = False) -> None:
+    """Limits (on a steered chassis linear.x and angular.z are the kinematic origin's and
+    linear.y is never sent); one zero command per goal end, the last command zero."""
     for t in cmds:
         assert all(math.isfinite(v) for v in (t.linear.x, t.linear.y, t.angular.z))
-        assert math.hypot(t.linear.x, t.linear.y - t.angular.z * offset) <= v_max + 1e-9
+        assert math.hypot(t.linear.x, t.linear.y) <= v_max + 1e-9
         assert abs(t.angular.z) <= omega_max + 1e-9
+        assert not steered or t.linear.y == 0.0
     zeros = sum(1 for t in cmds if is_zero(t))
     assert zeros == ends, f"{zeros} zero commands for {ends} goal end(s)"
     assert cmds and is_zero(cmds[-1]), "the last cmd_vel is not zero"
@@ -172,7 +193,7 @@ def test_omr3_docking_actions_route_check_and_refusals(start_scenario, start_nod
     0.1 rad, at rest); check_route accepts the U-turn; bad goals are refused; DockRobot
     (feedback CONTROLLING, docking_time growing, success) and FollowWaypoints (current_waypoint
     advancing, no missed waypoint; a waypoint in the pillar is reported missed with its index);
-    a docking canceled mid-way stops the robot."""
+    UndockRobot backs straight out; a docking canceled mid-way stops the robot."""
     world = tmp_path / "world.yaml"
     world.write_text(WORLD)
     params = "params/omr3.yaml"
@@ -199,8 +220,10 @@ def test_omr3_docking_actions_route_check_and_refusals(start_scenario, start_nod
         assert done.state == NavStatus.SUCCEEDED, done.reason
         cmd.wait_for(is_zero, REPLY_TIMEOUT)
         sim_clock.wait_until(sim_clock.now() + 1.0)
-        rest = truth.wait_for(lambda m: speed(m) < 1e-3, REPLY_TIMEOUT, start=len(truth))
-        docking = [s for s in status.snapshot() if s.state == NavStatus.ACTIVE and s.mode == "dock"]
+        rest = rest_after(truth, sim_clock.now())
+        # (NaN before the planner's first odometry.)
+        docking = [s for s in status.snapshot()
+                   if s.state == NavStatus.ACTIVE and s.mode == "dock" and math.isfinite(s.e)]
 
         # 3. The route pre-check accepts the U-turn for OMR-III (from a given start: no driving).
         checker = ros_node.create_client(CheckRoute, "planner/check_route")
@@ -263,6 +286,14 @@ def test_omr3_docking_actions_route_check_and_refusals(start_scenario, start_nod
         res = result_of(handle)
         assert res.status == GoalStatus.STATUS_SUCCEEDED, res.result.error_msg
         assert res.result.success and res.result.error_code == 0
+        # UndockRobot: straight back out 0.5 m (staging_distance in params/omr3.yaml) along the
+        # docked heading −0.5 rad.
+        docked = rest_after(truth, sim_clock.now())
+        undock = ActionClient(ros_node, UndockRobot, "undock_robot")
+        assert undock.wait_for_server(timeout_sec=20.0)
+        res = result_of(send_until_answered(undock, UndockRobot.Goal()))
+        assert res.status == GoalStatus.STATUS_SUCCEEDED and res.result.success, res.result.error_msg
+        undocked = rest_after(truth, sim_clock.now())
 
         # FollowWaypoints: four waypoints, current_waypoint advancing, nothing missed.
         follow = ActionClient(ros_node, FollowWaypoints, "follow_waypoints")
@@ -289,16 +320,19 @@ def test_omr3_docking_actions_route_check_and_refusals(start_scenario, start_nod
 
         # Cancel mid-dock: the robot stops.
         far = DockRobot.Goal()
-        far.use_dock_id, far.dock_pose = False, stamped(2.0, 1.5, 0.0)
+        far.use_dock_id, far.dock_pose = False, stamped(2.5, 1.5, 0.0)
+        n = len(status)
         handle = send_until_answered(dock_client, far)
         assert handle.accepted
-        truth.wait_for(lambda m: speed(m) > 0.1, REPLY_TIMEOUT, start=len(truth))
+        # Under way: 0.3 m nearer the dock, 2.4 m from where the route ended.
+        status.wait_for(lambda s: s.state == NavStatus.ACTIVE and s.goal.position.x == 2.5 and s.e < 2.1,
+                        REPLY_TIMEOUT, start=n)
         t_cancel = sim_clock.now()
-        wait_future(handle.cancel_goal_async(), "cancel response")
+        cancel_until_answered(handle)
         res = result_of(handle)
         assert res.status == GoalStatus.STATUS_CANCELED
-        stopped = truth.wait_for(lambda m: speed(m) < 1e-3, REPLY_TIMEOUT, start=len(truth))
-        stopped_after = stopped.header.stamp.sec + stopped.header.stamp.nanosec * 1e-9 - t_cancel
+        stopped = rest_after(truth, t_cancel)
+        stopped_after = stamp(stopped) - t_cancel
         assert wait_until(lambda: cmd.latest is not None and is_zero(cmd.latest), REPLY_TIMEOUT)
         sim_clock.wait_until(sim_clock.now() + 0.5)
         started = log_count(planner, STARTED)
@@ -308,7 +342,7 @@ def test_omr3_docking_actions_route_check_and_refusals(start_scenario, start_nod
     assert factor >= MIN_FACTOR, f"{factor:.2f}× real time"
     # Docking by dock_pose: e, V reported; V never rises by more than noise while docking.
     assert len(docking) >= 3
-    assert all(s.e > 0.0 and s.lyapunov > 0.0 for s in docking)
+    assert all(s.e > 0.0 and s.lyapunov > 0.0 for s in docking), [(s.e, s.lyapunov) for s in docking]
     vs = [s.lyapunov for s in docking]
     assert all(b <= a + 1e-3 for a, b in zip(vs, vs[1:])), vs
     # V at the start by hand: e = √1.25 = 1.1180, Ω = atan2(0.5, 1) = 0.4636, α = 0.4636,
@@ -323,6 +357,13 @@ def test_omr3_docking_actions_route_check_and_refusals(start_scenario, start_nod
     times = [f.feedback.docking_time.sec + f.feedback.docking_time.nanosec * 1e-9 for f in dock_fb]
     assert all(f.feedback.state == DockRobot.Feedback.CONTROLLING for f in dock_fb)
     assert times[-1] > times[0] and all(b >= a for a, b in zip(times, times[1:]))
+    # Undocked: 0.5 m back along the docked heading (within 1 cm: the stop at 0.005 m and the
+    # coast at the final 0.03 m/s), no sideways drift beyond 1 cm.
+    yaw = yaw_of(docked.pose.pose.orientation)
+    dx = undocked.pose.pose.position.x - docked.pose.pose.position.x
+    dy = undocked.pose.pose.position.y - docked.pose.pose.position.y
+    assert -(dx * math.cos(yaw) + dy * math.sin(yaw)) == pytest.approx(0.5, abs=0.01)
+    assert abs(-dx * math.sin(yaw) + dy * math.cos(yaw)) < 0.01
     # FollowWaypoints feedback runs 0 → 3 in order.
     seen = [f.feedback.current_waypoint for f in follow_fb]
     assert seen[0] == 0 and seen[-1] == 3 and sorted(seen) == seen, seen
@@ -336,8 +377,8 @@ def test_omr3_docking_actions_route_check_and_refusals(start_scenario, start_nod
     assert any(m.type == Marker.TEXT_VIEW_FACING and "waypoint 1" in m.text for m in drawn)
     # One zero command per started goal (the refused ones moved nothing and sent none).
     check_commands(cmds, started, v_max, omega_max)
-    # dock_pose, DockRobot, FollowWaypoints, the canceled DockRobot.
-    assert started == 4, started
+    # dock_pose, DockRobot, UndockRobot, FollowWaypoints, the canceled DockRobot.
+    assert started == 5, started
 
 
 def test_mobil2_docking_residual_and_route_rejected(start_scenario, start_node, sim_clock, ros_node,
@@ -358,11 +399,11 @@ def test_mobil2_docking_residual_and_route_rejected(start_scenario, start_node, 
         checker = ros_node.create_client(CheckRoute, "planner/check_route")
         assert checker.wait_for_service(timeout_sec=20.0)
         reply = call(checker, route_request(U_TURN))
-        publish_until_taken(dock_pub, planner, stamped(0.8, 0.4, 0.5))
+        publish_until_taken(dock_pub, planner, stamped(1.5, -0.5, 0.0))
         done = status.wait_for(lambda s: s.state in (NavStatus.SUCCEEDED, NavStatus.FAILED), 40.0)
         cmd.wait_for(is_zero, REPLY_TIMEOUT)
         sim_clock.wait_until(sim_clock.now() + 1.0)
-        rest = truth.wait_for(lambda m: speed(m) < 1e-3, REPLY_TIMEOUT, start=len(truth))
+        rest = rest_after(truth, sim_clock.now())
         cmds = cmd.snapshot()
         sim.stop()
 
@@ -373,16 +414,18 @@ def test_mobil2_docking_residual_and_route_rejected(start_scenario, start_node, 
     assert (reply.problems[0].position.x, reply.problems[0].position.y) == U_TURN[2]
     assert done.state == NavStatus.FAILED
     assert done.reason.startswith("RESIDUAL: "), done.reason
-    # The figures: e below ε_e (0.02, printed to the mm) and the heading still to turn beyond
-    # ε_ϑ (0.03 rad), in rad and degrees.
+    # The figures: e and the heading still to turn, in rad and degrees. RESIDUAL ends a docking
+    # that reaches ε_e = 0.02 m off heading (beyond ε_ϑ = 0.03 rad), or one whose V stopped
+    # falling because the law asked for turns MOBIL-II cannot make; either way near the dock.
     m = re.search(r"e = ([0-9.]+) m, heading error (-?[0-9.]+) rad \((-?[0-9.]+)°\)", done.reason)
-    assert m and float(m.group(1)) <= 0.02 and abs(float(m.group(2))) >= 0.03, done.reason
-    assert float(m.group(3)) == pytest.approx(math.degrees(float(m.group(2))), abs=0.1)
-    # The status carries the docking state at the end: e and V small, the residual in α or Θ.
-    assert done.mode == "dock" and 0.0 < done.e <= 0.02 + 1e-9
+    assert m, done.reason
+    e, heading = float(m.group(1)), float(m.group(2))
+    assert e < 0.15 and (e > 0.02 or abs(heading) >= 0.03), done.reason
+    assert float(m.group(3)) == pytest.approx(math.degrees(heading), abs=0.1)
+    assert done.mode == "dock" and done.e == pytest.approx(e, abs=5e-4)
     assert rest is not None
     # MOBIL-II: v ≤ 0.5 at the origin, 0.30 m behind base_link; ω ≤ ω_max = 1.0, and within
     # v·tan δ_eff / L = v / 0.73 (the minimum radius).
-    check_commands(cmds, 1, 0.5, 1.0, offset=0.30)
+    check_commands(cmds, 1, 0.5, 1.0, steered=True)
     for t in cmds:
         assert abs(t.angular.z) <= abs(t.linear.x) / 0.73 + 1e-9

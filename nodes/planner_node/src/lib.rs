@@ -23,8 +23,8 @@ use mobil_msgs::nav_msgs::msg::Path;
 use mobil_msgs::std_msgs::msg::{ColorRGBA, Header};
 use mobil_msgs::visualization_msgs::msg::{Marker, MarkerArray};
 use mobil_planner::{
-    DockingConfig, DockingFailure, DockingGains, FollowConfig, ProblemKind, Residual, RouteCheckConfig, RouteProblem,
-    RouteReport, UnreachableCause,
+    DockingConfig, DockingFailure, DockingGains, Finish, FollowConfig, ProblemKind, Residual, RouteCheckConfig,
+    RouteProblem, RouteReport, UnreachableCause,
 };
 use mobil_ros::config::{Config, ConfigError, Decl};
 use mobil_ros::geometry::{yaw_of, yaw_quaternion};
@@ -621,6 +621,9 @@ pub enum Outcome {
     },
     /// The docking failed.
     DockingFailed(DockingFailure, Residual),
+    /// A steered chassis stalled (V no longer falling): the law asks for turns the chassis
+    /// cannot make, the residual stays ([`docking_outcome`]).
+    ResidualStall(Residual),
     /// The route stalled (the robot did not move).
     Stalled {
         /// The waypoint pursued.
@@ -656,7 +659,7 @@ impl Outcome {
             Outcome::Docked { .. } | Outcome::RouteDone { .. } | Outcome::Undocked { .. } => "SUCCEEDED",
             Outcome::DockingFailed(DockingFailure::TimeLimit, _) => "TIME_LIMIT",
             Outcome::DockingFailed(DockingFailure::NotConverging, _) => "NOT_CONVERGING",
-            Outcome::DockingFailed(DockingFailure::HeadingResidual, _) => "RESIDUAL",
+            Outcome::DockingFailed(DockingFailure::HeadingResidual, _) | Outcome::ResidualStall(_) => "RESIDUAL",
             Outcome::Stalled { .. } => "STALLED",
             Outcome::RouteInfeasible(_) => "ROUTE_INFEASIBLE",
             Outcome::UndockTimeout { .. } => "TIME_LIMIT",
@@ -701,6 +704,13 @@ impl Outcome {
                 r.heading,
                 r.heading.to_degrees()
             ),
+            Outcome::ResidualStall(r) => format!(
+                "V stopped falling: the law asks for turns tighter than the chassis' minimum radius (no turn \
+                 in place): e = {:.3} m, heading error {:.3} rad ({:.1}°)",
+                r.e,
+                r.heading,
+                r.heading.to_degrees()
+            ),
             Outcome::Stalled { index } => {
                 format!("the robot did not move on its way to waypoint {index}: robot stopped")
             }
@@ -736,7 +746,9 @@ impl Outcome {
     /// DOCK_NOT_VALID for a bad pose; UNKNOWN at shutdown; NONE otherwise.
     pub fn dock_result(&self) -> DockRobotResult {
         let error_code = match self {
-            Outcome::DockingFailed(..) | Outcome::Stale | Outcome::Refused(_) => DockRobotResult::FAILED_TO_CONTROL,
+            Outcome::DockingFailed(..) | Outcome::ResidualStall(_) | Outcome::Stale | Outcome::Refused(_) => {
+                DockRobotResult::FAILED_TO_CONTROL
+            }
             Outcome::Invalid(GoalError::NoDockDatabase) => DockRobotResult::DOCK_NOT_IN_DB,
             Outcome::Invalid(_) => DockRobotResult::DOCK_NOT_VALID,
             Outcome::ShuttingDown => DockRobotResult::UNKNOWN,
@@ -797,6 +809,22 @@ impl Outcome {
             error_code,
             error_msg: self.reason(),
         }
+    }
+}
+
+/// How a failed docking is reported. On a chassis that cannot turn in place
+/// ([`Finish::ReportResidual`]) V stops falling for one reason: the law asks for a turn tighter
+/// than the minimum radius (near the goal v = γ·e·cos α → 0 while ω does not; elsewhere a
+/// sharp turn), the chassis' curvature limit holds ω, and the robot runs on a line that passes
+/// the goal, backing and filling, with the position and heading residual the law cannot remove
+/// (under the common factor alone V̇ ≤ 0 holds: SPEC §3). That stall is reported as
+/// [`Outcome::ResidualStall`] (RESIDUAL, with e and the heading error); every other failure as
+/// the controller gives it.
+pub fn docking_outcome(failure: DockingFailure, residual: Residual, finish: Finish) -> Outcome {
+    if failure == DockingFailure::NotConverging && finish == Finish::ReportResidual {
+        Outcome::ResidualStall(residual)
+    } else {
+        Outcome::DockingFailed(failure, residual)
     }
 }
 
@@ -918,7 +946,8 @@ pub struct StatusView {
     pub reason: String,
     /// The waypoint pursued (request index), -1 without a route.
     pub waypoint_index: i32,
-    /// The docking's e, α, Θ and V (zero when not docking).
+    /// The docking's e, α, Θ and V: `None` when not docking (sent as zeros); NaN while docking
+    /// before the first pose is known.
     pub docking: Option<[f64; 4]>,
 }
 
@@ -1252,6 +1281,25 @@ mod tests {
         assert_eq!((o.code(), o.dock_result().error_code), ("NOT_CONVERGING", 905));
         let o = Outcome::DockingFailed(DockingFailure::TimeLimit, residual);
         assert_eq!((o.code(), o.dock_result().error_code), ("TIME_LIMIT", 905));
+        // A steered chassis whose V stopped falling is stuck on its residual (RESIDUAL); the omni
+        // chassis, which can follow the law, is not converging.
+        let stall = DockingFailure::NotConverging;
+        let o = docking_outcome(stall, residual, Finish::ReportResidual);
+        assert_eq!(o, Outcome::ResidualStall(residual));
+        assert_eq!((o.code(), o.dock_result().error_code), ("RESIDUAL", 905));
+        assert!(
+            o.reason().ends_with("e = 0.015 m, heading error 0.500 rad (28.6°)"),
+            "{}",
+            o.reason()
+        );
+        assert_eq!(
+            docking_outcome(stall, residual, Finish::RotateInPlace),
+            Outcome::DockingFailed(stall, residual)
+        );
+        assert_eq!(
+            docking_outcome(DockingFailure::TimeLimit, residual, Finish::ReportResidual),
+            Outcome::DockingFailed(DockingFailure::TimeLimit, residual)
+        );
         let o = Outcome::Invalid(GoalError::NoDockDatabase);
         assert_eq!((o.code(), o.dock_result().error_code), ("INVALID_GOAL", 901));
         let o = Outcome::Invalid(GoalError::NotFinite {

@@ -30,13 +30,13 @@ use mobil_msgs::nav2_msgs::action::{
 use mobil_msgs::nav_msgs::msg::{Odometry, Path};
 use mobil_msgs::visualization_msgs::msg::MarkerArray;
 use mobil_planner::{
-    check_route, DockingController, DockingOutput, DockingPhase, Finish, FollowEnd, FollowEvent, ProblemKind,
-    RouteReport, VelocityLimits, WaypointFollower,
+    check_route, polar_error, DockingController, DockingOutput, DockingPhase, Finish, FollowEnd, FollowEvent,
+    ProblemKind, RouteReport, VelocityLimits, WaypointFollower,
 };
 use mobil_planner_node::{
-    backed_out, check_reply, clamp_twist, dock_goal, docking_offset, duration_msg, load_world, markers,
-    missed_from_report, odom_pose, pose_in_odom, refused_reply, route_from_path, route_from_poses, status_message,
-    CommandGate, GoalError, MarkerView, Missed, Mode, Outcome, PlannerConfig, Route, StatusView,
+    backed_out, check_reply, clamp_twist, dock_goal, docking_offset, docking_outcome, duration_msg, load_world,
+    markers, missed_from_report, odom_pose, pose_in_odom, refused_reply, route_from_path, route_from_poses,
+    status_message, CommandGate, GoalError, MarkerView, Missed, Mode, Outcome, PlannerConfig, Route, StatusView,
 };
 use mobil_ros::action::{ActionEvent, GoalEnd, GoalRequest, GoalServer, GoalServerConfig};
 use mobil_ros::input::{decoded, Input};
@@ -472,12 +472,21 @@ impl Shell {
                 controller,
                 last,
                 offset,
-            } => (
-                Some(controller.goal().ahead(*offset)),
-                last.map_or(f64::NAN, |o| o.polar.e),
-                -1,
-                last.map(|o| [o.polar.e, o.polar.alpha, o.polar.theta, o.lyapunov]),
-            ),
+            } => {
+                // Before the first step, the figures at the latest pose.
+                let figures = last.map(|o| (o.polar, o.lyapunov)).or_else(|| {
+                    self.odom.value().map(|p| {
+                        let polar = polar_error(&p.ahead(-*offset), &controller.goal());
+                        (polar, controller.gains().lyapunov(&polar))
+                    })
+                });
+                (
+                    Some(controller.goal().ahead(*offset)),
+                    figures.map_or(f64::NAN, |(p, _)| p.e),
+                    -1,
+                    Some(figures.map_or([f64::NAN; 4], |(p, v)| [p.e, p.alpha, p.theta, v])),
+                )
+            }
             Task::Follow {
                 follower,
                 route,
@@ -947,6 +956,7 @@ impl Shell {
         active.t += dt.unwrap_or(0.0);
         let t = active.t;
         let chassis = self.chassis;
+        let finish = Finish::for_chassis(&chassis);
         let mut ended: Option<Outcome> = None;
         let mut changed = false;
         let command: Result<BodyTwist, String> = match &mut active.task {
@@ -966,13 +976,11 @@ impl Shell {
                             })
                         }
                         DockingPhase::Failed(f) => {
-                            ended = Some(Outcome::DockingFailed(
-                                f,
-                                o.residual.unwrap_or(mobil_planner::Residual {
-                                    e: o.polar.e,
-                                    heading: o.heading_error,
-                                }),
-                            ))
+                            let residual = o.residual.unwrap_or(mobil_planner::Residual {
+                                e: o.polar.e,
+                                heading: o.heading_error,
+                            });
+                            ended = Some(docking_outcome(f, residual, finish));
                         }
                         _ => {}
                     }
