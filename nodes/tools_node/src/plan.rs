@@ -174,16 +174,22 @@ impl Summary {
             ),
         };
         let (e, heading) = self.residual.unwrap_or((f64::NAN, f64::NAN));
+        let heading = heading.abs();
         let dock = match &self.dock.0 {
-            Outcome::Succeeded => format!("docked in {:.1} s at e {e:.3} m, heading {heading:.3} rad", self.dock.1),
+            Outcome::Succeeded => format!(
+                "docked in {:.1} s at e {e:.3} m, heading error {heading:.3} rad",
+                self.dock.1
+            ),
             Outcome::Failed(reason) => {
+                // The status reason is "CODE: detail"; the detail repeats e and the heading.
+                let code = reason.split(':').next().unwrap_or_default().trim();
                 let why = if car_like {
-                    "; a car cannot turn in place, so the law leaves this residual"
+                    ": a car cannot turn in place, so the law cannot converge and leaves this residual"
                 } else {
                     ""
                 };
                 format!(
-                    "docking ended after {:.1} s at e {e:.3} m, heading {heading:.3} rad ({reason}{why})",
+                    "docking ended after {:.1} s at e {e:.3} m, heading error {heading:.3} rad ({code}{why})",
                     self.dock.1
                 )
             }
@@ -390,7 +396,7 @@ mod tests {
         assert_eq!(
             s.line("demo_out/omr3_planner.svg", false),
             "demo: planner followed 3 waypoints (1 missed) in 21.3 simulated s, docked in 5.5 s at e 0.018 m, \
-             heading 0.020 rad; V fell from 1.43 to 0.000100; plot demo_out/omr3_planner.svg"
+             heading error 0.020 rad; V fell from 1.43 to 0.000100; plot demo_out/omr3_planner.svg"
         );
     }
 
@@ -398,21 +404,23 @@ mod tests {
     fn summary_line_of_a_car_that_stops_with_a_residual() {
         let mut run = recorded(
             Outcome::Failed("ROUTE: waypoint 2 unreachable".into()),
-            Outcome::Failed("HEADING_RESIDUAL: e 0.018 m, heading 0.020 rad".into()),
+            Outcome::Failed("RESIDUAL: V stopped falling: e = 0.030 m, heading error 0.150 rad".into()),
         );
         run.docking.truncate(2);
+        // The heading error is printed unsigned: Θ − α = 0.2 − 0.05 here; −0.15 reads the same.
+        run.docking[1].heading = -run.docking[1].heading;
         let line = Summary::of(&run, 0.16).line("p.svg", true);
         assert_eq!(
             line,
             "demo: planner's route of 3 waypoints failed after 21.3 simulated s (ROUTE: waypoint 2 unreachable), \
-             docking ended after 4.0 s at e 0.030 m, heading 0.150 rad (HEADING_RESIDUAL: e 0.018 m, heading 0.020 rad; \
-             a car cannot turn in place, so the law leaves this residual); V fell from 1.43 to 0.0200; plot p.svg"
+             docking ended after 4.0 s at e 0.030 m, heading error 0.150 rad (RESIDUAL: a car cannot turn in place, \
+             so the law cannot converge and leaves this residual); V fell from 1.43 to 0.0200; plot p.svg"
         );
         // No docking status at all, and V rising, are said as such.
         run.docking.clear();
         assert!(Summary::of(&run, 0.16)
             .line("p.svg", false)
-            .contains("e NaN m, heading NaN rad"));
+            .contains("e NaN m, heading error NaN rad"));
         assert!(Summary::of(&run, 0.16)
             .line("p.svg", false)
             .contains("; no docking status received;"));
