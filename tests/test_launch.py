@@ -73,10 +73,10 @@ def test_robot_script_starts_its_nodes_and_stopping_it_stops_them_all(robot, mod
         log.close()
 
 
-@pytest.mark.timeout(120)
+@pytest.mark.timeout(170)
 def test_demo_drives_the_route_and_plots_it():
     out = subprocess.run([str(ROOT / "launch_scripts" / "demo")], env=_script_env(), capture_output=True,
-                         text=True, timeout=110)
+                         text=True, timeout=160)
     assert out.returncode == 0, out.stdout + out.stderr
     m = re.search(r"demo: drove ([\d.]+) m; final odometry error ([\d.]+) m", out.stdout)
     assert m, out.stdout
@@ -88,6 +88,22 @@ def test_demo_drives_the_route_and_plots_it():
     assert error < 0.02 * driven
     svg = (ROOT / "demo_out" / "mobil2_run.svg").read_text()
     assert "ground truth" in svg and "odometry" in svg and svg.count("<polyline") >= 2
+    # Third act: the planner's route and docking on the car-like MOBIL-II.
+    assert "pre-check: route of 5 waypoints feasible" in out.stdout, out.stdout
+    m = re.search(r"demo: planner followed 5 waypoints \((\d+) missed\) in ([\d.]+) simulated s, docking ended "
+                  r"after [\d.]+ s at e ([\d.]+) m, heading error ([\d.]+) rad \(RESIDUAL: a car", out.stdout)
+    assert m, out.stdout
+    missed, route_s, e, heading = int(m.group(1)), float(m.group(2)), float(m.group(3)), float(m.group(4))
+    assert missed == 0
+    # The straight legs from (3, 3.9) through the waypoints sum to 10.50 m; each may end
+    # Z_crit = 0.16 m short and the start lies within 0.14 m of (3, 3.9): at least 9.56 m at no
+    # more than the planner's 0.3 m/s cruise speed, 31.9 s; the turns and the slow-down add.
+    assert 31.0 < route_s < 60.0
+    # A car ends near the dock with a residual (e ≈ 0.07 m, 0.14 rad in mobil_planner's own
+    # simulation of this docking), never docked.
+    assert e < 0.2 and heading < 0.6
+    svg = (ROOT / "demo_out" / "mobil2_planner.svg").read_text()
+    assert "V = ½(λe² + α² + hΘ²)" in svg and 'stroke-dasharray="8 5"' in svg, svg[:2000]
 
 
 def test_describe_parameters_answers_a_stock_client(start_node, ros_node):
