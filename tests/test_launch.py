@@ -91,7 +91,7 @@ def test_demo_drives_the_route_and_plots_it():
     # Third act: the planner's route and docking on the car-like MOBIL-II.
     assert "pre-check: route of 5 waypoints feasible" in out.stdout, out.stdout
     m = re.search(r"demo: planner followed 5 waypoints \((\d+) missed\) in ([\d.]+) simulated s, docking ended "
-                  r"after [\d.]+ s at e ([\d.]+) m, heading error ([\d.]+) rad \(RESIDUAL: a car", out.stdout)
+                  r"after [\d.]+ s at e ([\d.]+) m, heading error ([\d.]+) rad \(RESIDUAL: a steered chassis", out.stdout)
     assert m, out.stdout
     missed, route_s, e, heading = int(m.group(1)), float(m.group(2)), float(m.group(3)), float(m.group(4))
     assert missed == 0

@@ -159,8 +159,9 @@ impl Summary {
         }
     }
 
-    /// The demo's line for this act; `car_like` adds why a car's docking ends with a residual.
-    pub fn line(&self, plot: &str, car_like: bool) -> String {
+    /// The demo's line for this act; `steered` (a car-like or tricycle chassis) adds why its
+    /// docking ends with a residual.
+    pub fn line(&self, plot: &str, steered: bool) -> String {
         let route = match &self.route.0 {
             Outcome::Succeeded => format!(
                 "planner followed {} waypoints ({} missed) in {:.1} simulated s",
@@ -183,8 +184,8 @@ impl Summary {
             Outcome::Failed(reason) => {
                 // The status reason is "CODE: detail"; the detail repeats e and the heading.
                 let code = reason.split(':').next().unwrap_or_default().trim();
-                let why = if car_like {
-                    ": a car cannot turn in place, so the law cannot converge and leaves this residual"
+                let why = if steered {
+                    ": a steered chassis cannot turn in place, so the law cannot converge and leaves this residual"
                 } else {
                     ""
                 };
@@ -413,8 +414,8 @@ mod tests {
         assert_eq!(
             line,
             "demo: planner's route of 3 waypoints failed after 21.3 simulated s (ROUTE: waypoint 2 unreachable), \
-             docking ended after 4.0 s at e 0.030 m, heading error 0.150 rad (RESIDUAL: a car cannot turn in place, \
-             so the law cannot converge and leaves this residual); V fell from 1.43 to 0.0200; plot p.svg"
+             docking ended after 4.0 s at e 0.030 m, heading error 0.150 rad (RESIDUAL: a steered chassis cannot \
+             turn in place, so the law cannot converge and leaves this residual); V fell from 1.43 to 0.0200; plot p.svg"
         );
         // No docking status at all, and V rising, are said as such.
         run.docking.clear();

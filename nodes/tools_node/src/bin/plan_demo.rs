@@ -54,7 +54,7 @@ fn decl() -> NodeDecl {
     .param(ParamSpec::string(
         "model",
         "",
-        "chassis model (from the params file's /** section); car_like explains the docking residual",
+        "chassis model (from the params file's /** section); a steered one (car_like, tricycle) explains the docking residual",
     ))
     .param(
         ParamSpec::double(
@@ -184,7 +184,7 @@ async fn run(node: &mut RosNode) -> anyhow::Result<()> {
     };
     let out = p.string("output_svg").map_err(map_err)?;
     let world_file = p.string("world_file").map_err(map_err)?;
-    let car_like = p.string("model").map_err(map_err)? == "car_like";
+    let steered = matches!(p.string("model").map_err(map_err)?.as_str(), "car_like" | "tricycle");
     let tolerance = p.f64("reach_tolerance").map_err(map_err)?;
     let timeout = Duration::from_secs_f64(p.f64("timeout_s").map_err(map_err)?);
     let world = if world_file.is_empty() {
@@ -334,6 +334,6 @@ async fn run(node: &mut RosNode) -> anyhow::Result<()> {
         node.names().fully_qualified_node()
     );
     write_file(&out, &figure(&world, &record, &title)).map_err(|e| anyhow::anyhow!("cannot write {out}: {e}"))?;
-    println!("{}", summary.line(&out, car_like));
+    println!("{}", summary.line(&out, steered));
     Ok(())
 }
