@@ -1,0 +1,328 @@
+//! The assessment of SPEC §6: σ of the feet's z, the three planes, the angles between them
+//! (eq. 17–19 with |N_i·N_j|), each plane's tilt, the class and the advised gait.
+
+use crate::config::TerrainConfig;
+use crate::error::{check_point, PlaneId, TerrainError, MIN_EDGE, MIN_SINE};
+use crate::leg::Leg;
+use nalgebra::{Point3, Vector3};
+
+/// The terrain class (`TerrainAssessment.terrain_class`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum TerrainClass {
+    /// All angles within ε_α and σ ≤ σ_flat: the feet lie in one plane parallel to the body.
+    Flat = 0,
+    /// α12 within ε_α, α13 ≈ α23 beyond it: the feet coplanar, the plane tilted.
+    Slope = 1,
+    /// α12 beyond ε_α (the feet not coplanar), or the two tripods level at different heights.
+    Uneven = 2,
+    /// σ > σ_max or a foot plane tilted more than tilt_max: choose another route.
+    BeyondLimits = 3,
+}
+
+impl TerrainClass {
+    /// The message's constant (FLAT = 0 … BEYOND_LIMITS = 3).
+    pub fn as_u8(self) -> u8 {
+        self as u8
+    }
+
+    /// The message constant's name (`"FLAT"`, …).
+    pub fn name(self) -> &'static str {
+        match self {
+            TerrainClass::Flat => "FLAT",
+            TerrainClass::Slope => "SLOPE",
+            TerrainClass::Uneven => "UNEVEN",
+            TerrainClass::BeyondLimits => "BEYOND_LIMITS",
+        }
+    }
+}
+
+/// The advised gait (`TerrainAssessment.advised_gait`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum Gait {
+    /// The fastest gait, three legs at a time; reactive control (flat ground).
+    Tripod = 0,
+    /// Slower and safer, one leg of each side at a time; deliberative control (moderate σ).
+    Ripple = 1,
+    /// The slowest and safest, one leg at a time (large σ).
+    Wave = 2,
+    /// Beyond the limits: choose another route.
+    Reroute = 3,
+}
+
+impl Gait {
+    /// The message's constant (GAIT_TRIPOD = 0 … GAIT_REROUTE = 3).
+    pub fn as_u8(self) -> u8 {
+        self as u8
+    }
+
+    /// The message constant's name without its prefix (`"TRIPOD"`, …).
+    pub fn name(self) -> &'static str {
+        match self {
+            Gait::Tripod => "TRIPOD",
+            Gait::Ripple => "RIPPLE",
+            Gait::Wave => "WAVE",
+            Gait::Reroute => "REROUTE",
+        }
+    }
+}
+
+/// One plane a·x + b·y + c·z + d = 0 and its inclination to the body's xy-plane
+/// (`mobil_msgs/PlaneTilt`). (a, b, c) is the unit normal, oriented with c ≥ 0.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PlaneTilt {
+    /// Normal's x component.
+    pub a: f64,
+    /// Normal's y component.
+    pub b: f64,
+    /// Normal's z component (≥ 0).
+    pub c: f64,
+    /// −N·P1: with a unit normal, minus the signed distance of the origin from the plane along N (m).
+    pub d: f64,
+    /// Inclination along body x: atan2(a, c) (rad).
+    pub theta_x: f64,
+    /// Inclination along body y: atan2(b, c) (rad).
+    pub theta_y: f64,
+    /// Downhill direction in the body's xy-plane: atan2(b, a) (rad; 0 for a level plane).
+    pub downhill: f64,
+}
+
+impl PlaneTilt {
+    /// The plane through three points: N = (P2 − P1) × (P3 − P1), d = −N·P1 (SPEC §6, the
+    /// paper's d with its sign corrected), N scaled to unit length and turned to c ≥ 0.
+    /// Coincident points (an edge shorter than [`MIN_EDGE`]) or collinear ones (sine of the
+    /// angle at P1 below [`MIN_SINE`]) are refused; the points must be finite.
+    pub fn through(plane: PlaneId, p1: &Point3<f64>, p2: &Point3<f64>, p3: &Point3<f64>) -> Result<Self, TerrainError> {
+        let e1 = p2 - p1;
+        let e2 = p3 - p1;
+        let (l1, l2, l3) = (e1.norm(), e2.norm(), (p3 - p2).norm());
+        if l1 < MIN_EDGE || l2 < MIN_EDGE || l3 < MIN_EDGE {
+            return Err(TerrainError::CoincidentPoints {
+                plane,
+                min_edge: MIN_EDGE,
+            });
+        }
+        let n = e1.cross(&e2);
+        let sine = n.norm() / (l1 * l2);
+        if sine < MIN_SINE {
+            return Err(TerrainError::CollinearPoints { plane, sine });
+        }
+        let mut n = n / n.norm();
+        if n.z < 0.0 {
+            n = -n;
+        }
+        Ok(PlaneTilt {
+            a: n.x,
+            b: n.y,
+            c: n.z,
+            d: -n.dot(&p1.coords),
+            theta_x: n.x.atan2(n.z),
+            theta_y: n.y.atan2(n.z),
+            downhill: n.y.atan2(n.x),
+        })
+    }
+
+    /// The unit normal (a, b, c).
+    pub fn normal(&self) -> Vector3<f64> {
+        Vector3::new(self.a, self.b, self.c)
+    }
+
+    /// Inclination (rad) to the body's xy-plane: the angle between the normal and z,
+    /// atan2(√(a² + b²), c), in [0, π/2].
+    pub fn inclination(&self) -> f64 {
+        self.a.hypot(self.b).atan2(self.c)
+    }
+}
+
+/// Angle between two planes by their normals, arccos(|N_i·N_j| / (|N_i||N_j|)) (eq. 17–19 with
+/// the SPEC's absolute value), in [0, π/2]. Computed as atan2(|N_i × N_j|, |N_i·N_j|), the same
+/// angle without arccos' loss of precision near 0.
+pub fn angle_between(n_i: &Vector3<f64>, n_j: &Vector3<f64>) -> f64 {
+    n_i.cross(n_j).norm().atan2(n_i.dot(n_j).abs())
+}
+
+/// Population and sample standard deviation of the six feet's z (m).
+/// Heights are taken relative to the first (σ does not change), so equal heights give exactly 0
+/// and a large common offset costs no precision.
+pub fn sigma_of_heights(z: &[f64; 6]) -> (f64, f64) {
+    let dz = z.map(|v| v - z[0]);
+    let mean = dz.iter().sum::<f64>() / 6.0;
+    let ss: f64 = dz.iter().map(|z| (z - mean) * (z - mean)).sum();
+    ((ss / 6.0).sqrt(), (ss / 5.0).sqrt())
+}
+
+/// The class by SPEC §6's corrected rule: BEYOND_LIMITS if σ > σ_max or tilt > tilt_max;
+/// otherwise UNEVEN if α12 > ε_α; otherwise FLAT if α13 ≤ ε_α, α23 ≤ ε_α and σ ≤ σ_flat, UNEVEN
+/// if only σ exceeds σ_flat (the tripods level at different heights), else SLOPE. All angles
+/// are ≥ 0 (eq. 17–19 with |N_i·N_j|).
+pub fn classify(
+    config: &TerrainConfig,
+    sigma: f64,
+    alpha12: f64,
+    alpha13: f64,
+    alpha23: f64,
+    tilt: f64,
+) -> TerrainClass {
+    let eps = config.epsilon_alpha;
+    if sigma > config.sigma_max || tilt > config.tilt_max {
+        TerrainClass::BeyondLimits
+    } else if alpha12 > eps {
+        TerrainClass::Uneven
+    } else if alpha13 <= eps && alpha23 <= eps {
+        if sigma <= config.sigma_flat {
+            TerrainClass::Flat
+        } else {
+            TerrainClass::Uneven
+        }
+    } else {
+        TerrainClass::Slope
+    }
+}
+
+/// The advised gait: FLAT → tripod (keep speed, direction and gait); SLOPE and UNEVEN → ripple
+/// up to σ_wave, wave above; BEYOND_LIMITS → reroute.
+pub fn advise(config: &TerrainConfig, class: TerrainClass, sigma: f64) -> Gait {
+    match class {
+        TerrainClass::Flat => Gait::Tripod,
+        TerrainClass::Slope | TerrainClass::Uneven if sigma <= config.sigma_wave => Gait::Ripple,
+        TerrainClass::Slope | TerrainClass::Uneven => Gait::Wave,
+        TerrainClass::BeyondLimits => Gait::Reroute,
+    }
+}
+
+/// One assessment, field for field `mobil_msgs/TerrainAssessment` (plus the sample σ).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Assessment {
+    /// The feet (m, body frame), in [`Leg::ALL`] order.
+    pub feet: [Point3<f64>; 6],
+    /// Population standard deviation of the feet's z (m), the SPEC's σ.
+    pub sigma: f64,
+    /// Sample standard deviation (divisor 5) of the feet's z (m); not in the message.
+    pub sigma_sample: f64,
+    /// Angle between planes 1 and 2 (rad).
+    pub alpha12: f64,
+    /// Angle between planes 2 and 3 (rad).
+    pub alpha23: f64,
+    /// Angle between planes 1 and 3 (rad).
+    pub alpha13: f64,
+    /// Planes 1 (KP, KG, DV), 2 (DP, DG, KV) and 3 (body points).
+    pub planes: [PlaneTilt; 3],
+    /// Largest inclination of planes 1 and 2 to the body's xy-plane (rad).
+    pub tilt: f64,
+    /// The class.
+    pub class: TerrainClass,
+    /// The advised gait.
+    pub advice: Gait,
+}
+
+/// Assesses the six feet against a validated configuration; plane 3 is built once.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Assessor {
+    config: TerrainConfig,
+    body_plane: PlaneTilt,
+}
+
+impl Assessor {
+    /// Validates the configuration and builds plane 3 from its body points.
+    pub fn new(config: TerrainConfig) -> Result<Self, TerrainError> {
+        config.validate()?;
+        let [p1, p2, p3] = config.body_points();
+        let body_plane = PlaneTilt::through(PlaneId::Body, &p1, &p2, &p3)?;
+        Ok(Assessor { config, body_plane })
+    }
+
+    /// The configuration.
+    pub fn config(&self) -> &TerrainConfig {
+        &self.config
+    }
+
+    /// Plane 3, through the body points.
+    pub fn body_plane(&self) -> &PlaneTilt {
+        &self.body_plane
+    }
+
+    /// Assesses the feet (m, body frame, [`Leg::ALL`] order). A non-finite or out-of-range foot,
+    /// or a degenerate foot plane, is an error; the output holds no NaN.
+    pub fn assess(&self, feet: &[Point3<f64>; 6]) -> Result<Assessment, TerrainError> {
+        for (leg, p) in Leg::ALL.iter().zip(feet) {
+            check_point(|| format!("foot {leg}"), p.x, p.y, p.z)?;
+        }
+        let foot = |leg: Leg| &feet[leg.index()];
+        let [a1, a2, a3] = Leg::PLANE1.map(foot);
+        let plane1 = PlaneTilt::through(PlaneId::Feet1, a1, a2, a3)?;
+        let [b1, b2, b3] = Leg::PLANE2.map(foot);
+        let plane2 = PlaneTilt::through(PlaneId::Feet2, b1, b2, b3)?;
+        let plane3 = self.body_plane;
+        let (n1, n2, n3) = (plane1.normal(), plane2.normal(), plane3.normal());
+        let alpha12 = angle_between(&n1, &n2);
+        let alpha23 = angle_between(&n2, &n3);
+        let alpha13 = angle_between(&n1, &n3);
+        let (sigma, sigma_sample) = sigma_of_heights(&feet.map(|p| p.z));
+        let tilt = plane1.inclination().max(plane2.inclination());
+        let class = classify(&self.config, sigma, alpha12, alpha13, alpha23, tilt);
+        let advice = advise(&self.config, class, sigma);
+        Ok(Assessment {
+            feet: *feet,
+            sigma,
+            sigma_sample,
+            alpha12,
+            alpha23,
+            alpha13,
+            planes: [plane1, plane2, plane3],
+            tilt,
+            class,
+            advice,
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A plane through (0,0,0), (1,0,1), (0,1,0): z = x, so N ∝ (−1, 0, 1)/√2 after turning
+    /// c > 0; inclination 45° along x; downhill along −x (the normal's horizontal part): π.
+    #[test]
+    fn plane_through_three_points() {
+        let p = PlaneTilt::through(
+            PlaneId::Feet1,
+            &Point3::new(0.0, 0.0, 0.0),
+            &Point3::new(1.0, 0.0, 1.0),
+            &Point3::new(0.0, 1.0, 0.0),
+        )
+        .unwrap();
+        let h = std::f64::consts::FRAC_1_SQRT_2;
+        assert!((p.a + h).abs() < 1e-15 && p.b.abs() < 1e-15 && (p.c - h).abs() < 1e-15);
+        assert!(p.d.abs() < 1e-15);
+        assert!((p.theta_x + std::f64::consts::FRAC_PI_4).abs() < 1e-15);
+        assert!((p.downhill - std::f64::consts::PI).abs() < 1e-15);
+        assert!((p.inclination() - std::f64::consts::FRAC_PI_4).abs() < 1e-15);
+    }
+
+    /// With N_1 = (0,0,1) and N_2 = −(0, sin 30°, cos 30°) (opposite orientation), eq. 17 with
+    /// the absolute value gives 30°, not 150°.
+    #[test]
+    fn angle_ignores_orientation() {
+        let n1 = Vector3::new(0.0, 0.0, 1.0);
+        let n2 = -Vector3::new(0.0, 0.5, 0.75f64.sqrt());
+        assert!((angle_between(&n1, &n2) - 30f64.to_radians()).abs() < 1e-15);
+        assert!(angle_between(&n1, &n1).abs() < 1e-15);
+        assert!(angle_between(&n1, &(-n1)).abs() < 1e-15);
+    }
+
+    #[test]
+    fn classes_at_their_boundaries() {
+        let c = TerrainConfig::default();
+        let e = c.epsilon_alpha;
+        assert_eq!(classify(&c, 0.0, 0.0, 0.0, 0.0, 0.0), TerrainClass::Flat);
+        assert_eq!(classify(&c, c.sigma_flat, e, e, e, e), TerrainClass::Flat);
+        assert_eq!(classify(&c, 0.011, 0.0, 0.0, 0.0, 0.0), TerrainClass::Uneven);
+        assert_eq!(classify(&c, 0.02, 0.0, 0.1, 0.1, 0.1), TerrainClass::Slope);
+        assert_eq!(classify(&c, 0.02, e * 1.01, 0.1, 0.1, 0.1), TerrainClass::Uneven);
+        assert_eq!(classify(&c, 0.041, 0.0, 0.0, 0.0, 0.0), TerrainClass::BeyondLimits);
+        assert_eq!(classify(&c, 0.02, 0.0, 0.27, 0.27, 0.27), TerrainClass::BeyondLimits);
+        assert_eq!(advise(&c, TerrainClass::Flat, 0.0), Gait::Tripod);
+        assert_eq!(advise(&c, TerrainClass::Slope, 0.02), Gait::Ripple);
+        assert_eq!(advise(&c, TerrainClass::Uneven, 0.0201), Gait::Wave);
+        assert_eq!(advise(&c, TerrainClass::BeyondLimits, 0.0), Gait::Reroute);
+    }
+}

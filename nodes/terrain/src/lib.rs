@@ -1,0 +1,58 @@
+//! Terrain irregularity of a hexapod from its posture (SPEC §6; Luneckas, source 001).
+//! ROS-free: no ROS types, no clock, no I/O (`tests/check_ros_free.sh` proves it). The feet (body frame) are the input; σ, the
+//! angles between the three planes, each plane's tilt, the class and the advised gait are the
+//! output, field for field `mobil_msgs/TerrainAssessment`. `terrain_node` wires it to topics.
+//!
+//! - [`leg`]: the legs by the paper's names (KP … DG), in the message's order, with a parser.
+//! - [`assess`]: σ (population; the sample σ beside it), planes 1 (KP, KG, DV), 2 (DP, DG, KV)
+//!   and 3 (body points), α12, α23, α13 by eq. 17–19 with |N_i·N_j|, tilts, the class by the
+//!   SPEC's corrected rule and the advice.
+//! - [`tracker`]: [`FootTracker`], the latest touchdown of each leg, an assessment at every
+//!   touchdown once all six are known, refused inputs counted.
+//! - [`config`]: [`TerrainConfig`] (thresholds, body points, frame) and [`HexapodGeometry`]
+//!   (footholds, body height), every default justified; `params/hexapod.yaml` holds them.
+//!
+//! Choices beyond the SPEC:
+//! - **FLAT also needs σ ≤ σ_flat.** The angles cannot see the two tripods standing level at
+//!   different heights (a step between them: α12 = α13 = α23 = 0); with σ > σ_flat that stance
+//!   is UNEVEN. σ_flat (1 cm) lies above the σ of any plane tilted within ε_α with the default
+//!   footholds (0.70 cm), so a coplanar stance within ε_α is still FLAT. (A step between the
+//!   tripods on a slope, parallel planes offset, stays SLOPE: no threshold of the SPEC sees it.)
+//! - **Ripple or wave by σ_wave**, a fifth threshold: SLOPE and UNEVEN get ripple up to
+//!   σ_wave (2 cm, between Table 1's small and large columns), wave above; FLAT keeps the tripod
+//!   gait; BEYOND_LIMITS advises another route.
+//! - **tilt** (the message's) is the larger inclination of planes 1 and 2 to the body's
+//!   xy-plane; tilt_max bounds it.
+//! - **Planes** carry a unit normal (a, b, c) turned to c ≥ 0; d = −N·P1. A level plane's
+//!   downhill direction is atan2(0, 0) = 0.
+//! - **Angles** are computed as atan2(|N_i × N_j|, |N_i·N_j|), the arccos of eq. 17–19 with the
+//!   SPEC's absolute value without its loss of precision near 0 (1e-8 rad for arccos).
+//! - **Degenerate input**: a coordinate beyond ±1 km or not finite, two points of a plane
+//!   closer than 1 µm, or three points whose edges at the first vertex make an angle with
+//!   sine below 1e-5: a typed [`TerrainError`], never a NaN.
+//!
+//! ```
+//! use mobil_terrain::{Assessor, Gait, HexapodGeometry, TerrainClass, TerrainConfig};
+//!
+//! let assessor = Assessor::new(TerrainConfig::default()).unwrap();
+//! // The standing hexapod on flat ground: σ = 0, every plane parallel to the body.
+//! let a = assessor.assess(&HexapodGeometry::default().standing_feet()).unwrap();
+//! assert_eq!(a.sigma, 0.0);
+//! assert_eq!((a.class, a.advice), (TerrainClass::Flat, Gait::Tripod));
+//! ```
+
+#![warn(missing_docs)]
+
+pub mod assess;
+pub mod config;
+pub mod error;
+pub mod leg;
+pub mod tracker;
+
+pub use assess::{
+    advise, angle_between, classify, sigma_of_heights, Assessment, Assessor, Gait, PlaneTilt, TerrainClass,
+};
+pub use config::{Footholds, HexapodGeometry, TerrainConfig};
+pub use error::{PlaneId, TerrainError, COORDINATE_LIMIT, MIN_EDGE, MIN_SINE};
+pub use leg::{Leg, Tripod};
+pub use tracker::FootTracker;
