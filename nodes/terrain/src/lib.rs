@@ -1,5 +1,6 @@
-//! Terrain irregularity of a hexapod from its posture (SPEC §6; Luneckas, source 001).
-//! ROS-free: no ROS types, no clock, no I/O (`tests/check_ros_free.sh` proves it). The feet (body frame) are the input; σ, the
+//! Terrain irregularity of a hexapod from its posture (SPEC §6; Luneckas, source 001), and a
+//! tripod-gait hexapod walking over a height map to feed it. ROS-free: no ROS types, no clock,
+//! no I/O (`tests/check_ros_free.sh` proves it). The feet (body frame) are the input; σ, the
 //! angles between the three planes, each plane's tilt, the class and the advised gait are the
 //! output, field for field `mobil_msgs/TerrainAssessment`. `terrain_node` wires it to topics.
 //!
@@ -11,6 +12,8 @@
 //!   touchdown once all six are known, refused inputs counted.
 //! - [`config`]: [`TerrainConfig`] (thresholds, body points, frame) and [`HexapodGeometry`]
 //!   (footholds, body height), every default justified; `params/hexapod.yaml` holds them.
+//! - [`ground`], [`walker`]: height maps (flat, a plane in any direction, seeded rough ground, a
+//!   course of sections) and the walking hexapod.
 //!
 //! Choices beyond the SPEC:
 //! - **FLAT also needs σ ≤ σ_flat.** The angles cannot see the two tripods standing level at
@@ -30,6 +33,11 @@
 //! - **Degenerate input**: a coordinate beyond ±1 km or not finite, two points of a plane
 //!   closer than 1 µm, or three points whose edges at the first vertex make an angle with
 //!   sine below 1e-5: a typed [`TerrainError`], never a NaN.
+//! - **The walker's body stays level** (as a levelling controller keeps it), at a set height
+//!   above the mean ground under its footholds; see [`walker`]. It lives here, not in
+//!   `mobil_sim` (the wheeled chassis and its 2D world): it shares the legs, the footholds and
+//!   the assessment its tests check against, and a hexapod simulator node depends on this
+//!   ROS-free crate alone.
 //!
 //! ```
 //! use mobil_terrain::{Assessor, Gait, HexapodGeometry, TerrainClass, TerrainConfig};
@@ -46,13 +54,17 @@
 pub mod assess;
 pub mod config;
 pub mod error;
+pub mod ground;
 pub mod leg;
 pub mod tracker;
+pub mod walker;
 
 pub use assess::{
     advise, angle_between, classify, sigma_of_heights, Assessment, Assessor, Gait, PlaneTilt, TerrainClass,
 };
 pub use config::{Footholds, HexapodGeometry, TerrainConfig};
 pub use error::{PlaneId, TerrainError, COORDINATE_LIMIT, MIN_EDGE, MIN_SINE};
+pub use ground::{Course, Ground, RoughGround, Section};
 pub use leg::{Leg, Tripod};
 pub use tracker::FootTracker;
+pub use walker::{BodyPose, Touchdown, Walker, WalkerConfig};
