@@ -129,7 +129,7 @@ impl PlaneTilt {
     /// Inclination (rad) to the body's xy-plane: the angle between the normal and z,
     /// atan2(√(a² + b²), c), in [0, π/2].
     pub fn inclination(&self) -> f64 {
-        self.a.hypot(self.b).atan2(self.c)
+        (self.a * self.a + self.b * self.b).sqrt().atan2(self.c)
     }
 }
 
