@@ -31,12 +31,12 @@ impl RoughGround {
 
     /// Height of grid node (i, j) (m).
     pub fn node(&self, i: i64, j: i64) -> f64 {
-        let mut rng = ChaCha8Rng::seed_from_u64(self.seed);
-        // Two 32-bit halves: every node of a ±2·10⁹-cell grid has its own stream.
-        rng.set_stream(((i as u32 as u64) << 32) | (j as u32 as u64));
         if self.amplitude == 0.0 {
             return 0.0;
         }
+        let mut rng = ChaCha8Rng::seed_from_u64(self.seed);
+        // Two 32-bit halves: every node of a ±2·10⁹-cell grid has its own stream.
+        rng.set_stream(((i as u32 as u64) << 32) | (j as u32 as u64));
         rng.random_range(-self.amplitude..=self.amplitude)
     }
 
@@ -78,7 +78,7 @@ impl Course {
     /// A course of `(length m, section)` from `start_x`; needs at least one section, positive
     /// finite lengths and ramps steeper than −90° and less than 90°.
     pub fn new(start_x: f64, sections: Vec<(f64, Section)>) -> Result<Self, TerrainError> {
-        positive("course start_x", start_x.abs(), true)?;
+        finite("course start_x", start_x)?;
         if sections.is_empty() {
             return Err(TerrainError::InvalidConfig {
                 name: "course",
@@ -168,7 +168,7 @@ impl Ground {
                 reason: "must be within [0, π/2)",
             });
         }
-        positive("uphill", uphill.abs(), true)?;
+        finite("uphill", uphill)?;
         Ok(Ground::Plane { slope, uphill })
     }
 
@@ -180,6 +180,18 @@ impl Ground {
             Ground::Rough(r) => r.height(x, y),
             Ground::Course(c) => c.height(x, y),
         }
+    }
+}
+
+fn finite(name: &'static str, value: f64) -> Result<f64, TerrainError> {
+    if value.is_finite() {
+        Ok(value)
+    } else {
+        Err(TerrainError::InvalidConfig {
+            name,
+            value,
+            reason: "must be finite",
+        })
     }
 }
 
