@@ -33,6 +33,11 @@
 //! - **Degenerate input**: a coordinate beyond ±1 km or not finite, two points of a plane
 //!   closer than 1 µm, or three points whose edges at the first vertex make an angle with
 //!   sine below 1e-5: a typed [`TerrainError`], never a NaN.
+//! - **Each stored foot is in the body frame of its own touchdown** (SPEC §6: the control stores
+//!   each foot as it lands). The tracker does not move older feet into the current frame: it has
+//!   no odometry, and on a plane walked at a constant height above it the frames agree exactly.
+//!   On rough ground the other tripod's feet are up to half a gait period old, and the body's
+//!   height has changed by a few millimetres since; that is part of the measured σ.
 //! - **The walker's body stays level** (as a levelling controller keeps it), at a set height
 //!   above the mean ground under its footholds; see [`walker`]. It lives here, not in
 //!   `mobil_sim` (the wheeled chassis and its 2D world): it shares the legs, the footholds and
