@@ -543,6 +543,8 @@ pub fn docking_offset(params: &ChassisParams) -> f64 {
 pub enum Mode {
     /// No goal.
     Idle,
+    /// A route's pre-check (the virtual robot drives it first; the robot waits).
+    PreCheck,
     /// Docking by the Lyapunov law.
     Dock,
     /// Docking's final in-place rotation.
@@ -558,6 +560,7 @@ impl Mode {
     pub fn as_str(self) -> &'static str {
         match self {
             Mode::Idle => "idle",
+            Mode::PreCheck => "pre_check",
             Mode::Dock => "dock",
             Mode::Rotate => "rotate",
             Mode::Approach => "approach",
