@@ -322,12 +322,13 @@ def test_omr3_docking_actions_route_check_and_refusals(start_scenario, start_nod
 
         # Cancel mid-dock: the robot stops.
         far = DockRobot.Goal()
-        far.use_dock_id, far.dock_pose = False, stamped(2.5, 1.5, 0.0)
+        far.use_dock_id, far.dock_pose = False, stamped(-3.5, 3.0, 0.0)
         n = len(status)
         handle = send_until_answered(dock_client, far)
         assert handle.accepted
-        # Under way: 0.3 m nearer the dock, 2.4 m from where the route ended.
-        status.wait_for(lambda s: s.state == NavStatus.ACTIVE and s.goal.position.x == 2.5 and s.e < 2.1,
+        # Under way: 0.35 m nearer the dock, 4.55 m from where the route ended (so far that it
+        # cannot dock before the goal response, even one re-sent after 3 s).
+        status.wait_for(lambda s: s.state == NavStatus.ACTIVE and s.goal.position.x == -3.5 and s.e < 4.2,
                         REPLY_TIMEOUT, start=n)
         t_cancel = sim_clock.now()
         cancel_until_answered(handle)
