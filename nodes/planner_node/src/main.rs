@@ -35,7 +35,7 @@ use mobil_planner::{
 };
 use mobil_planner_node::{
     backed_out, check_reply, clamp_twist, dock_goal, docking_offset, docking_outcome, duration_msg, load_world,
-    markers, missed_from_report, odom_pose, pose_in_odom, refused_reply, route_from_path, route_from_poses,
+    markers, missed_from_report, odom_pose, odom_stale, pose_in_odom, refused_reply, route_from_path, route_from_poses,
     status_message, CommandGate, GoalError, MarkerView, Missed, Mode, Outcome, PlannerConfig, Route, StatusView,
 };
 use mobil_ros::action::{ActionEvent, GoalEnd, GoalRequest, GoalServer, GoalServerConfig};
@@ -1207,8 +1207,7 @@ impl Shell {
         let Some(active) = &self.active else { return };
         let now = Instant::now();
         let goal_age = now.saturating_duration_since(active.started);
-        let odom_age = self.odom.age_at(now).map_or(goal_age, |a| a.min(goal_age));
-        if odom_age > self.config.odom_timeout() {
+        if odom_stale(self.odom.age_at(now), goal_age, self.config.odom_timeout()) {
             return self.end_goal(node, out, servers, Outcome::Stale);
         }
         let status_period = Duration::from_secs_f64(1.0 / self.config.status_rate_hz);
