@@ -38,19 +38,26 @@ trap 'mobil_stop_all' EXIT
 trap 'exit 130' INT
 trap 'exit 143' TERM
 
-# mobil_robot PARAMS_FILE [--no-sim] [--nav] [extra --ros-args...]: run a robot's nodes until
-# Ctrl-C; --nav adds local_nav_node (goals from goal_pose / navigate_to_pose).
+# mobil_robot PARAMS_FILE [--no-sim] [--nav] [--plan] [extra --ros-args...]: run a robot's
+# nodes until Ctrl-C; --nav adds local_nav_node (goals from goal_pose / navigate_to_pose),
+# --plan adds planner_node (dock_pose, waypoints, dock_robot, undock_robot, follow_waypoints).
+# Both publish cmd_vel only while a goal of theirs runs.
 mobil_robot() {
   local params="$1"; shift
-  local sim=1 nav=0
-  while [ "${1:-}" = "--no-sim" ] || [ "${1:-}" = "--nav" ]; do
-    if [ "$1" = "--no-sim" ]; then sim=0; else nav=1; fi
+  local sim=1 nav=0 plan=0
+  while [ "${1:-}" = "--no-sim" ] || [ "${1:-}" = "--nav" ] || [ "${1:-}" = "--plan" ]; do
+    case "$1" in
+      --no-sim) sim=0 ;;
+      --nav) nav=1 ;;
+      --plan) plan=1 ;;
+    esac
     shift
   done
   mobil_build
   [ "$sim" = 1 ] && mobil_start sim_node --ros-args --params-file "$params" "$@"
   mobil_start chassis_node --ros-args --params-file "$params" "$@"
   [ "$nav" = 1 ] && mobil_start local_nav_node --ros-args --params-file "$params" "$@"
+  [ "$plan" = 1 ] && mobil_start planner_node --ros-args --params-file "$params" "$@"
   echo "running (Ctrl-C stops every node): pids ${MOBIL_PIDS[*]}" >&2
   # Return as soon as any node exits, so a crash is not hidden.
   wait -n "${MOBIL_PIDS[@]}" || true

@@ -9,6 +9,10 @@
 //! - [`sim`]: continuous-time integration of a docking (RK4 sub-steps on the closed loop).
 //! - [`mod@approach`]: the goal approach without final heading for a steered chassis (δ within
 //!   δ_eff, atan2, progress stop only within steering reach, Z_crit) and the shortest step.
+//! - [`follow`]: the same goal approach online, one control tick at a time on the real robot's
+//!   pose ([`WaypointFollower`]: waypoints in order, reached within Z_crit, missed by the
+//!   progress stop or the leg's distance bound, slow-down at the last one), so the robot drives
+//!   the law the pre-check's virtual robot drove.
 //! - [`route`]: the route pre-check — a virtual robot drives the route on the chassis model
 //!   against a [`mobil_sim::world::World`] and reports every collision, turn below the minimum
 //!   radius and unreachable waypoint with its index.
@@ -95,6 +99,7 @@
 pub mod approach;
 pub mod docking;
 pub mod error;
+pub mod follow;
 pub mod route;
 pub mod sim;
 
@@ -108,5 +113,6 @@ pub use docking::{
     DockingPhase, Finish, GainWarning, PolarError, Residual, Velocity, VelocityLimits,
 };
 pub use error::{PlannerError, COORDINATE_LIMIT};
+pub use follow::{FollowConfig, FollowEnd, FollowEvent, FollowOutput, WaypointFollower};
 pub use route::{arc_radius, check_route, ProblemKind, RouteCheckConfig, RouteProblem, RouteReport, UnreachableCause};
 pub use sim::{advance, rk4_step, simulate_docking, DockingRun, DockingSample, Kinematics, MAX_SIMULATION_STEPS};

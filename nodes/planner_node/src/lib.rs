@@ -1,0 +1,1512 @@
+//! The ROS side of [`mobil_planner`]: the `planner_node` executable (src/main.rs) and what its
+//! shell does that can be checked without DDS — the configuration (every parameter declared
+//! once), goal and route validation, the command clamp, how a goal ends (status reason, Nav2
+//! result codes), the status, the route pre-check's reply and the markers.
+//!
+//! The methods themselves (Lyapunov docking, the goal approach, the online follower, the route
+//! pre-check) are in [`mobil_planner`]; nothing here decides where the robot goes.
+
+#![warn(missing_docs)]
+
+use mobil_chassis::kinematics::{twist_at_origin, twist_at_reference};
+use mobil_chassis::model::ChassisConfig;
+use mobil_chassis::{clamp_command, BodyTwist, ChassisParams};
+use mobil_chassis_node::{chassis_params, declare_chassis};
+use mobil_geom::Pose2;
+use mobil_msgs::builtin_interfaces::msg::Time;
+use mobil_msgs::geometry_msgs::msg::{Point, Pose, PoseStamped, Twist, Vector3};
+use mobil_msgs::mobil_msgs::msg::{NavStatus, RouteProblem as ProblemMsg};
+use mobil_msgs::mobil_msgs::srv::CheckRouteResponse;
+use mobil_msgs::nav2_msgs::action::{DockRobotResult, FollowWaypointsResult, UndockRobotResult};
+use mobil_msgs::nav2_msgs::msg::MissedWaypoint;
+use mobil_msgs::nav_msgs::msg::Path;
+use mobil_msgs::std_msgs::msg::{ColorRGBA, Header};
+use mobil_msgs::visualization_msgs::msg::{Marker, MarkerArray};
+use mobil_planner::{
+    DockingConfig, DockingFailure, DockingGains, Finish, FollowConfig, ProblemKind, Residual, RouteCheckConfig,
+    RouteProblem, RouteReport, UnreachableCause,
+};
+use mobil_ros::config::{Config, ConfigError, Decl};
+use mobil_ros::geometry::{yaw_of, yaw_quaternion};
+use mobil_sim::world::World;
+use nalgebra::Point2;
+use std::time::Duration;
+use thiserror::Error;
+
+pub use mobil_local_nav_node::{duration_msg, odom_pose, seconds, CommandGate, OdomError};
+
+/// Everything the node is configured with, each field filled by one declared parameter.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct PlannerConfig {
+    /// The chassis geometry and limits (the params file's `/**` section).
+    pub chassis: ChassisConfig,
+    /// Footprint radius around the reference point (m), for the route pre-check.
+    pub robot_radius: f64,
+    /// Lyapunov gains γ, k, h, λ.
+    pub gamma: f64,
+    /// k.
+    pub k: f64,
+    /// h.
+    pub h: f64,
+    /// λ.
+    pub lambda: f64,
+    /// The docking's thresholds and timers.
+    pub docking: DockingConfig,
+    /// The online follower's settings.
+    pub follow: FollowConfig,
+    /// The world file of the pre-check: empty = the sim's built-in world, `none` = no obstacles.
+    pub world_file: String,
+    /// Drive a route the pre-check found problems on (default false: refused).
+    pub execute_infeasible_routes: bool,
+    /// How far `undock_robot` backs out (m).
+    pub staging_distance: f64,
+    /// Reversing speed of `undock_robot` (m/s).
+    pub undock_speed: f64,
+    /// A goal fails STALE_INPUT when no valid odometry arrived for this long (steady clock), s.
+    pub odom_timeout_s: f64,
+    /// Status rate while a goal is active (Hz).
+    pub status_rate_hz: f64,
+    /// Markers rate while a goal is active (Hz).
+    pub markers_rate_hz: f64,
+    /// How long a finished action goal's result waits for the client to ask for it (s).
+    pub result_timeout_s: f64,
+    /// Frame of odometry and of every goal.
+    pub odom_frame: String,
+    /// The robot frame (reference point).
+    pub base_frame: String,
+}
+
+/// The largest `odom_timeout_s` (s).
+pub const MAX_INPUT_TIMEOUT_S: f64 = 60.0;
+/// The largest `result_timeout_s` (s).
+pub const MAX_RESULT_TIMEOUT_S: f64 = 3600.0;
+/// Most waypoints of one route (after `number_of_loops`): the pre-check of 200 legs each at the
+/// 50 m leg bound is at most 500 000 virtual steps, about 25 ms; a real route is far shorter
+/// (20 waypoints: 0.36 ms), so the check runs on the event loop.
+pub const MAX_WAYPOINTS: usize = 200;
+/// Most poses of `simulated_path` in a `check_route` reply (about 90 bytes each: 36 KB, well
+/// under the 64 KB a reply should stay below).
+pub const MAX_REPLY_POSES: usize = 400;
+/// Most problems listed in a reply, a result or the markers (the rest are counted in `reason`).
+pub const MAX_LISTED_PROBLEMS: usize = 50;
+
+impl Config for PlannerConfig {
+    fn declare(d: &mut Decl<Self>) {
+        let g = DockingGains::paper();
+        let dc = DockingConfig::default();
+        let f = FollowConfig::default();
+        d.nest(|c: &mut PlannerConfig| &mut c.chassis, declare_chassis);
+        d.double(
+            "robot_radius",
+            0.53,
+            "radius of the footprint around the reference point, for the route pre-check [m]",
+            |c, v| c.robot_radius = v,
+        )
+        .above(0.0);
+        d.double("gamma", g.gamma(), "γ: v = γ·e·cos α (eq. 3.43) [1/s]", |c, v| {
+            c.gamma = v
+        })
+        .above(0.0);
+        d.double("k", g.k(), "k: the turn gain on α (eq. 3.46) [1/s]", |c, v| c.k = v)
+            .above(0.0);
+        d.double(
+            "h",
+            g.h(),
+            "h: the weight of Θ in V and ω (eq. 3.41, 3.46)",
+            |c, v| c.h = v,
+        )
+        .above(0.0);
+        d.double("lambda", g.lambda(), "λ: the weight of e² in V (eq. 3.41)", |c, v| {
+            c.lambda = v
+        })
+        .above(0.0);
+        d.double(
+            "position_tolerance",
+            dc.position_tolerance,
+            "ε_e: docked needs e below this [m]",
+            |c, v| c.docking.position_tolerance = v,
+        )
+        .above(0.0);
+        d.double(
+            "heading_tolerance",
+            dc.heading_tolerance,
+            "ε_ϑ: docked needs the heading error below this [rad]",
+            |c, v| c.docking.heading_tolerance = v,
+        )
+        .above(0.0);
+        d.double(
+            "rotate_gain",
+            dc.rotate_gain,
+            "gain of the final in-place rotation (omni) [1/s]",
+            |c, v| c.docking.rotate_gain = v,
+        )
+        .above(0.0);
+        d.double(
+            "stall_time_s",
+            dc.stall_time_s,
+            "a docking whose V has not fallen by 0.1 % for this long fails NOT_CONVERGING; a route on \
+             which the robot drove less than step_length for this long fails STALLED [s, ROS time]",
+            |c, v| {
+                c.docking.stall_time_s = v;
+                c.follow.stall_time_s = v;
+            },
+        )
+        .above(0.0);
+        d.double(
+            "time_limit_s",
+            dc.time_limit_s,
+            "a docking not done after this long fails TIME_LIMIT [s, ROS time]",
+            |c, v| c.docking.time_limit_s = v,
+        )
+        .above(0.0);
+        d.double(
+            "approach_speed",
+            f.speed,
+            "cruise speed of the waypoint approach [m/s]",
+            |c, v| c.follow.speed = v,
+        )
+        .above(0.0);
+        d.double(
+            "min_speed",
+            f.min_speed,
+            "slowest speed of the slow-down at the last waypoint [m/s]",
+            |c, v| c.follow.min_speed = v,
+        )
+        .above(0.0);
+        d.double(
+            "slow_down_distance",
+            f.slow_down_distance,
+            "the speed falls linearly inside this distance to the last waypoint (0: no slow-down) [m]",
+            |c, v| c.follow.slow_down_distance = v,
+        )
+        .min(0.0);
+        d.double(
+            "critical_distance",
+            f.critical_distance,
+            "Z_crit: a waypoint nearer than this is reached (pre-check and run) [m]",
+            |c, v| c.follow.critical_distance = v,
+        )
+        .above(0.0);
+        d.double(
+            "step_length",
+            f.check_length,
+            "the pre-check's step, and the path between two progress checks of the run [m]",
+            |c, v| c.follow.check_length = v,
+        )
+        .above(0.0);
+        d.double(
+            "progress_epsilon",
+            f.progress_epsilon,
+            "ε: within steering reach, a step that brings the waypoint no nearer than this misses it [m]",
+            |c, v| c.follow.progress_epsilon = v,
+        )
+        .min(0.0);
+        d.string(
+            "world_file",
+            "",
+            "world YAML of the pre-check (the sim's format); empty: the sim's built-in world; none: no obstacles",
+            |c, v| c.world_file = v,
+        )
+        .read_only();
+        d.boolean(
+            "execute_infeasible_routes",
+            false,
+            "drive a route the pre-check found problems on (false: refused, FAILED ROUTE_INFEASIBLE)",
+            |c, v| c.execute_infeasible_routes = v,
+        );
+        d.double(
+            "staging_distance",
+            0.5,
+            "undock_robot backs straight out this far [m]",
+            |c, v| c.staging_distance = v,
+        )
+        .above(0.0)
+        .max(10.0);
+        d.double("undock_speed", 0.15, "undock_robot's reversing speed [m/s]", |c, v| {
+            c.undock_speed = v
+        })
+        .above(0.0);
+        d.double(
+            "odom_timeout_s",
+            0.5,
+            "a goal fails STALE_INPUT when no valid odom arrived for this long (steady clock) [s]",
+            |c, v| c.odom_timeout_s = v,
+        )
+        .above(0.0)
+        .max(MAX_INPUT_TIMEOUT_S);
+        d.double(
+            "status_rate_hz",
+            5.0,
+            "planner/status rate while a goal is active (and on every change) [Hz]",
+            |c, v| c.status_rate_hz = v,
+        )
+        .within(0.1, 50.0);
+        d.double(
+            "markers_rate_hz",
+            1.0,
+            "planner/markers rate while a goal is active [Hz]",
+            |c, v| c.markers_rate_hz = v,
+        )
+        .within(0.1, 10.0);
+        d.double(
+            "result_timeout_s",
+            10.0,
+            "how long a finished action goal's result waits for the client to ask for it [s]",
+            |c, v| c.result_timeout_s = v,
+        )
+        .above(0.0)
+        .max(MAX_RESULT_TIMEOUT_S)
+        .read_only();
+        d.string(
+            "odom_frame",
+            "odom",
+            "frame of odom; goals in any other frame are refused",
+            |c, v| c.odom_frame = v,
+        )
+        .read_only();
+        d.string("base_frame", "base_link", "robot frame (reference point)", |c, v| {
+            c.base_frame = v
+        })
+        .read_only();
+    }
+
+    fn validate(&self) -> Result<(), ConfigError> {
+        self.chassis_params()?;
+        self.gains()?;
+        self.docking.validate().map_err(ConfigError::inconsistent)?;
+        self.follow.validate().map_err(ConfigError::inconsistent)?;
+        self.route_check().validate().map_err(ConfigError::inconsistent)?;
+        Ok(())
+    }
+}
+
+impl PlannerConfig {
+    /// The chassis (from `/**`).
+    pub fn chassis_params(&self) -> Result<ChassisParams, ConfigError> {
+        chassis_params(&self.chassis)
+    }
+
+    /// The Lyapunov gains.
+    pub fn gains(&self) -> Result<DockingGains, ConfigError> {
+        DockingGains::new(self.gamma, self.k, self.h, self.lambda).map_err(ConfigError::inconsistent)
+    }
+
+    /// The pre-check's settings: the run's Z_crit, ε and step, the footprint radius.
+    pub fn route_check(&self) -> RouteCheckConfig {
+        let mut c = RouteCheckConfig::new(self.robot_radius);
+        c.approach.step_length = self.follow.check_length;
+        c.approach.critical_distance = self.follow.critical_distance;
+        c.approach.progress_epsilon = self.follow.progress_epsilon;
+        c.detour_factor = self.follow.detour_factor;
+        c.max_leg_length = self.follow.max_leg_length;
+        c
+    }
+
+    /// The odometry timeout.
+    pub fn odom_timeout(&self) -> Duration {
+        seconds(self.odom_timeout_s, MAX_INPUT_TIMEOUT_S)
+    }
+
+    /// How long a finished action goal's result waits for the client.
+    pub fn result_timeout(&self) -> Duration {
+        seconds(self.result_timeout_s, MAX_RESULT_TIMEOUT_S)
+    }
+}
+
+/// The pre-check's world: `""` the sim's built-in world, `none` no obstacles, else the file.
+pub fn load_world(world_file: &str) -> Result<World, mobil_sim::world::WorldError> {
+    match world_file {
+        "" => Ok(World::builtin()),
+        "none" => Ok(World::default()),
+        path => World::load(path),
+    }
+}
+
+/// Why a goal or route is refused.
+#[derive(Debug, Clone, PartialEq, Error)]
+pub enum GoalError {
+    /// Not in the odometry frame.
+    #[error("{what} in frame `{got}`, but goals must be in `{want}`")]
+    Frame {
+        /// What (`dock pose`, `waypoint 2`, `route`).
+        what: String,
+        /// Its frame.
+        got: String,
+        /// The odometry frame.
+        want: String,
+    },
+    /// NaN or infinity.
+    #[error("{what} is not finite")]
+    NotFinite {
+        /// What.
+        what: String,
+    },
+    /// Beyond ±[`MAX_GOAL_COORD`].
+    #[error("{what} ({x}, {y}) is beyond ±{MAX_GOAL_COORD} m")]
+    TooFar {
+        /// What.
+        what: String,
+        /// x (m).
+        x: f64,
+        /// y (m).
+        y: f64,
+    },
+    /// A route without waypoints.
+    #[error("the route has no waypoints")]
+    EmptyRoute,
+    /// A route longer than [`MAX_WAYPOINTS`].
+    #[error("the route has {0} waypoints; at most {MAX_WAYPOINTS} are taken")]
+    TooLong(usize),
+    /// A route whose waypoints all lie on the start point: nothing to drive.
+    #[error("zero-length route: every waypoint lies within {0} m of the first and of the start")]
+    ZeroLength(f64),
+    /// Nav2's dock database is not available here.
+    #[error("use_dock_id is true, but this planner has no dock database (give dock_pose with use_dock_id false)")]
+    NoDockDatabase,
+    /// `goal_index` beyond the poses.
+    #[error("goal_index {index} is not below the {len} poses")]
+    GoalIndex {
+        /// The index asked for.
+        index: u32,
+        /// How many poses there are.
+        len: usize,
+    },
+}
+
+/// The largest |x| and |y| of a goal or waypoint (m, odom).
+pub const MAX_GOAL_COORD: f64 = 1e4;
+
+fn same_frame(got: &str, want: &str) -> bool {
+    got.trim_start_matches('/') == want.trim_start_matches('/')
+}
+
+/// The pose of `p` in the odometry frame, or why not: `frame` must be `odom_frame` (a leading
+/// `/` ignored), everything finite, |x|, |y| within [`MAX_GOAL_COORD`].
+pub fn pose_in_odom(what: &str, frame: &str, p: &Pose, odom_frame: &str) -> Result<Pose2, GoalError> {
+    if !same_frame(frame, odom_frame) {
+        return Err(GoalError::Frame {
+            what: what.to_owned(),
+            got: frame.to_owned(),
+            want: odom_frame.to_owned(),
+        });
+    }
+    let (a, q) = (&p.position, &p.orientation);
+    if ![a.x, a.y, a.z, q.x, q.y, q.z, q.w].iter().all(|v| v.is_finite()) {
+        return Err(GoalError::NotFinite { what: what.to_owned() });
+    }
+    if a.x.abs() > MAX_GOAL_COORD || a.y.abs() > MAX_GOAL_COORD {
+        return Err(GoalError::TooFar {
+            what: what.to_owned(),
+            x: a.x,
+            y: a.y,
+        });
+    }
+    Ok(Pose2::new(a.x, a.y, yaw_of(q)))
+}
+
+/// The dock pose of a PoseStamped (frame `odom_frame`, finite, in range).
+pub fn dock_goal(goal: &PoseStamped, odom_frame: &str) -> Result<Pose2, GoalError> {
+    pose_in_odom("dock pose", &goal.header.frame_id, &goal.pose, odom_frame)
+}
+
+/// A route to drive: the waypoints and, for each, its index in the request (FollowWaypoints
+/// with `goal_index` or `number_of_loops` repeats or skips poses).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Route {
+    /// The waypoints in driving order (odom).
+    pub points: Vec<Point2<f64>>,
+    /// For each, its index in the request's poses.
+    pub request_index: Vec<usize>,
+    /// The request's poses (for the results' missed waypoints).
+    pub poses: Vec<PoseStamped>,
+}
+
+/// A route from `poses` (each in `odom_frame`; an empty frame takes `default_frame`, the path's
+/// own header), starting at `goal_index` and driven `1 + number_of_loops` times (Nav2's
+/// FollowWaypoints: later rounds from index 0). Refuses an empty route, frames, NaN, far points,
+/// more than [`MAX_WAYPOINTS`] in all, and a route of zero length: every waypoint within
+/// `min_length` of the first and of `start` (when known).
+pub fn route_from_poses(
+    poses: &[PoseStamped],
+    default_frame: &str,
+    odom_frame: &str,
+    goal_index: u32,
+    number_of_loops: u32,
+    start: Option<Point2<f64>>,
+    min_length: f64,
+) -> Result<Route, GoalError> {
+    if poses.is_empty() {
+        return Err(GoalError::EmptyRoute);
+    }
+    let mut points = Vec::with_capacity(poses.len());
+    for (i, p) in poses.iter().enumerate() {
+        let frame = if p.header.frame_id.is_empty() {
+            default_frame
+        } else {
+            &p.header.frame_id
+        };
+        let pose = pose_in_odom(&format!("waypoint {i}"), frame, &p.pose, odom_frame)?;
+        points.push(pose.position());
+    }
+    let first = goal_index as usize;
+    if first >= poses.len() {
+        return Err(GoalError::GoalIndex {
+            index: goal_index,
+            len: poses.len(),
+        });
+    }
+    let total = (poses.len() - first).saturating_add(poses.len().saturating_mul(number_of_loops as usize));
+    if total > MAX_WAYPOINTS {
+        return Err(GoalError::TooLong(total));
+    }
+    let mut request_index: Vec<usize> = (first..poses.len()).collect();
+    for _ in 0..number_of_loops {
+        request_index.extend(0..poses.len());
+    }
+    let route_points: Vec<Point2<f64>> = request_index.iter().map(|&i| points[i]).collect();
+    let anchor = route_points[0];
+    let near = |p: &Point2<f64>| (p - anchor).norm() < min_length && start.is_none_or(|s| (p - s).norm() < min_length);
+    if route_points.iter().all(near) {
+        return Err(GoalError::ZeroLength(min_length));
+    }
+    Ok(Route {
+        points: route_points,
+        request_index,
+        poses: poses.to_vec(),
+    })
+}
+
+/// A `nav_msgs/Path` as a route (its header's frame for poses without one).
+pub fn route_from_path(
+    path: &Path,
+    odom_frame: &str,
+    start: Option<Point2<f64>>,
+    min_length: f64,
+) -> Result<Route, GoalError> {
+    if !path.header.frame_id.is_empty() && !same_frame(&path.header.frame_id, odom_frame) {
+        return Err(GoalError::Frame {
+            what: "route".into(),
+            got: path.header.frame_id.clone(),
+            want: odom_frame.to_owned(),
+        });
+    }
+    let frame = if path.header.frame_id.is_empty() {
+        odom_frame
+    } else {
+        &path.header.frame_id
+    };
+    route_from_poses(&path.poses, frame, odom_frame, 0, 0, start, min_length)
+}
+
+/// The command as a Twist at the reference point, held to the chassis limits as chassis_node
+/// holds them: on a steered chassis `linear.x` and `angular.z` are the kinematic origin's (the
+/// reference point's sideways speed ω·d is implied, never sent: chassis_node drops a `linear.y`
+/// there), on the omni chassis the twist is moved to the origin and back; in between,
+/// [`clamp_command`] (speed, turn rate, minimum radius, wheel speeds). Anything non-finite gives
+/// zero.
+pub fn clamp_twist(twist: BodyTwist, params: &ChassisParams) -> Twist {
+    let d = params.reference_offset();
+    let steered = params.model().is_nonholonomic();
+    let origin = if steered {
+        BodyTwist::new(twist.vx, 0.0, twist.wz)
+    } else {
+        twist_at_origin(twist, d)
+    };
+    let clamped = clamp_command(params, origin).twist;
+    let out = if steered {
+        BodyTwist::new(clamped.vx, 0.0, clamped.wz)
+    } else {
+        twist_at_reference(clamped, d)
+    };
+    let out = if out.is_finite() { out } else { BodyTwist::ZERO };
+    let mut t = Twist::default();
+    t.linear.x = out.vx;
+    t.linear.y = out.vy;
+    t.angular.z = out.wz;
+    t
+}
+
+/// The offset (m) of the point the docking law steers, behind the reference point: on a steered
+/// chassis the kinematic origin (`reference_offset` behind), the one point that moves as the
+/// law's unicycle does (no sideways speed), so V̇ ≤ 0 holds wherever the curvature limit does
+/// not bind; on the omni chassis the reference point itself (any twist is executed there).
+pub fn docking_offset(params: &ChassisParams) -> f64 {
+    if params.model().is_nonholonomic() {
+        params.reference_offset()
+    } else {
+        0.0
+    }
+}
+
+/// What the node is doing.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Mode {
+    /// No goal.
+    Idle,
+    /// A route's pre-check (the virtual robot drives it first; the robot waits).
+    PreCheck,
+    /// Docking by the Lyapunov law.
+    Dock,
+    /// Docking's final in-place rotation.
+    Rotate,
+    /// Following waypoints by the goal approach.
+    Approach,
+    /// Backing out of the dock.
+    Undock,
+}
+
+impl Mode {
+    /// The status' mode string.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Mode::Idle => "idle",
+            Mode::PreCheck => "pre_check",
+            Mode::Dock => "dock",
+            Mode::Rotate => "rotate",
+            Mode::Approach => "approach",
+            Mode::Undock => "undock",
+        }
+    }
+}
+
+/// A waypoint the route did not take: its index in the request and why.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Missed {
+    /// Index in the request's poses.
+    pub index: usize,
+    /// Where (odom).
+    pub position: Point2<f64>,
+    /// The problem (from the pre-check or the run).
+    pub kind: ProblemKind,
+    /// True when the pre-check found it, false when the run missed it.
+    pub pre_check: bool,
+}
+
+impl Missed {
+    /// "waypoint 2: turn_radius: turn radius 0.50 m below the chassis minimum 0.73 m".
+    pub fn describe(&self) -> String {
+        format!("waypoint {}: {}: {}", self.index, self.kind.as_str(), self.kind)
+    }
+
+    /// The MissedWaypoint error code: the pre-check's problems are Nav2's ComputePathToPose
+    /// codes (a waypoint inside an obstacle 206 GOAL_OCCUPIED, any other 208 NO_VALID_PATH);
+    /// a waypoint the run gave up is FollowPath's 105 FAILED_TO_MAKE_PROGRESS.
+    pub fn error_code(&self) -> u16 {
+        match (self.pre_check, self.kind) {
+            (true, ProblemKind::Unreachable(UnreachableCause::Blocked { .. })) => 206,
+            (true, _) => 208,
+            (false, _) => 105,
+        }
+    }
+}
+
+/// How a goal ended.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Outcome {
+    /// Docked (e and the heading error at the end).
+    Docked {
+        /// e (m).
+        e: f64,
+        /// Heading error (rad).
+        heading: f64,
+    },
+    /// The route was driven to its end (missed waypoints listed).
+    RouteDone {
+        /// Waypoints in the route.
+        count: usize,
+        /// Those missed.
+        missed: Vec<Missed>,
+    },
+    /// Backed out to the staging distance.
+    Undocked {
+        /// Distance backed (m).
+        distance: f64,
+    },
+    /// The docking failed.
+    DockingFailed(DockingFailure, Residual),
+    /// A steered chassis stalled (V no longer falling): the law asks for turns the chassis
+    /// cannot make, the residual stays ([`docking_outcome`]).
+    ResidualStall(Residual),
+    /// The route stalled (the robot did not move).
+    Stalled {
+        /// The waypoint pursued.
+        index: usize,
+    },
+    /// The route pre-check found problems (and `execute_infeasible_routes` is false).
+    RouteInfeasible(Vec<Missed>),
+    /// Undocking not done within `max_undocking_time`.
+    UndockTimeout {
+        /// The limit (s).
+        limit: f64,
+        /// Distance backed so far (m).
+        distance: f64,
+    },
+    /// No valid odometry for `odom_timeout_s`.
+    Stale,
+    /// The client canceled.
+    Canceled,
+    /// A newer goal took over.
+    Preempted(&'static str),
+    /// Refused.
+    Invalid(GoalError),
+    /// The library refused its input (the pose), on too many ticks in a row.
+    Refused(String),
+    /// The node shut down.
+    ShuttingDown,
+}
+
+impl Outcome {
+    /// The reason code of the status.
+    pub fn code(&self) -> &'static str {
+        match self {
+            Outcome::Docked { .. } | Outcome::RouteDone { .. } | Outcome::Undocked { .. } => "SUCCEEDED",
+            Outcome::DockingFailed(DockingFailure::TimeLimit, _) => "TIME_LIMIT",
+            Outcome::DockingFailed(DockingFailure::NotConverging, _) => "NOT_CONVERGING",
+            Outcome::DockingFailed(DockingFailure::HeadingResidual, _) | Outcome::ResidualStall(_) => "RESIDUAL",
+            Outcome::Stalled { .. } => "STALLED",
+            Outcome::RouteInfeasible(_) => "ROUTE_INFEASIBLE",
+            Outcome::UndockTimeout { .. } => "TIME_LIMIT",
+            Outcome::Stale => "STALE_INPUT",
+            Outcome::Canceled => "CANCELED",
+            Outcome::Preempted(_) => "PREEMPTED",
+            Outcome::Invalid(_) => "INVALID_GOAL",
+            Outcome::Refused(_) => "INVALID_INPUT",
+            Outcome::ShuttingDown => "SHUTDOWN",
+        }
+    }
+
+    /// The status reason: the code, a colon and the detail with the figures.
+    pub fn reason(&self) -> String {
+        let list = |m: &[Missed]| {
+            let mut s = m
+                .iter()
+                .take(MAX_LISTED_PROBLEMS)
+                .map(Missed::describe)
+                .collect::<Vec<_>>()
+                .join("; ");
+            if m.len() > MAX_LISTED_PROBLEMS {
+                s += &format!("; and {} more", m.len() - MAX_LISTED_PROBLEMS);
+            }
+            s
+        };
+        let detail = match self {
+            Outcome::Docked { e, heading } => format!("docked: e = {e:.3} m, heading error {heading:.3} rad"),
+            Outcome::RouteDone { count, missed } if missed.is_empty() => {
+                format!("route done: all {count} waypoints reached")
+            }
+            Outcome::RouteDone { count, missed } => format!(
+                "route done: {} of {count} waypoints missed: {}",
+                missed.len(),
+                list(missed)
+            ),
+            Outcome::Undocked { distance } => format!("undocked: backed out {distance:.3} m"),
+            Outcome::DockingFailed(f, r) => format!(
+                "{}: e = {:.3} m, heading error {:.3} rad ({:.1}°)",
+                f.as_str(),
+                r.e,
+                r.heading,
+                r.heading.to_degrees()
+            ),
+            Outcome::ResidualStall(r) => format!(
+                "V stopped falling: the law asks for turns tighter than the chassis' minimum radius (no turn \
+                 in place): e = {:.3} m, heading error {:.3} rad ({:.1}°)",
+                r.e,
+                r.heading,
+                r.heading.to_degrees()
+            ),
+            Outcome::Stalled { index } => {
+                format!("the robot did not move on its way to waypoint {index}: robot stopped")
+            }
+            Outcome::RouteInfeasible(m) => format!("{} problem(s): {}", m.len(), list(m)),
+            Outcome::UndockTimeout { limit, distance } => {
+                format!("not undocked within max_undocking_time {limit:.1} s (backed out {distance:.3} m)")
+            }
+            Outcome::Stale => "odom stale: robot stopped".to_owned(),
+            Outcome::Canceled => "canceled by the client".to_owned(),
+            Outcome::Preempted(by) => format!("preempted by a newer goal ({by})"),
+            Outcome::Invalid(e) => e.to_string(),
+            Outcome::Refused(e) => format!("the planner refused its input: {e}; robot stopped"),
+            Outcome::ShuttingDown => "the node is shutting down".to_owned(),
+        };
+        format!("{}: {detail}", self.code())
+    }
+
+    /// The NavStatus state it leaves.
+    pub fn state(&self) -> u8 {
+        match self {
+            Outcome::Docked { .. } | Outcome::RouteDone { .. } | Outcome::Undocked { .. } => NavStatus::SUCCEEDED,
+            _ => NavStatus::FAILED,
+        }
+    }
+
+    /// Whether an action goal ending so succeeded (else canceled or aborted).
+    pub fn succeeded(&self) -> bool {
+        self.state() == NavStatus::SUCCEEDED
+    }
+
+    /// DockRobot's result: FAILED_TO_CONTROL for a docking that failed (V not falling, time
+    /// limit, residual), stale odometry or refused input; DOCK_NOT_IN_DB for `use_dock_id`;
+    /// DOCK_NOT_VALID for a bad pose; UNKNOWN at shutdown; NONE otherwise.
+    pub fn dock_result(&self) -> DockRobotResult {
+        let error_code = match self {
+            Outcome::DockingFailed(..) | Outcome::ResidualStall(_) | Outcome::Stale | Outcome::Refused(_) => {
+                DockRobotResult::FAILED_TO_CONTROL
+            }
+            Outcome::Invalid(GoalError::NoDockDatabase) => DockRobotResult::DOCK_NOT_IN_DB,
+            Outcome::Invalid(_) => DockRobotResult::DOCK_NOT_VALID,
+            Outcome::ShuttingDown => DockRobotResult::UNKNOWN,
+            _ => DockRobotResult::NONE,
+        };
+        DockRobotResult {
+            success: self.succeeded(),
+            error_code,
+            num_retries: 0,
+            error_msg: self.reason(),
+        }
+    }
+
+    /// UndockRobot's result: FAILED_TO_CONTROL on a time-out, stale odometry or refused input;
+    /// UNKNOWN at shutdown; NONE otherwise.
+    pub fn undock_result(&self) -> UndockRobotResult {
+        let error_code = match self {
+            Outcome::UndockTimeout { .. } | Outcome::Stale | Outcome::Refused(_) => {
+                UndockRobotResult::FAILED_TO_CONTROL
+            }
+            Outcome::ShuttingDown => UndockRobotResult::UNKNOWN,
+            _ => UndockRobotResult::NONE,
+        };
+        UndockRobotResult {
+            success: self.succeeded(),
+            error_code,
+            error_msg: self.reason(),
+        }
+    }
+
+    /// FollowWaypoints' result: the missed waypoints (the run's, or the pre-check's for a
+    /// refused route) each with its pose and code; error_code NONE when the route was driven
+    /// to its end (Nav2 then lists what it missed), TASK_EXECUTOR_FAILED (601) for a route the
+    /// pre-check refused, a stall, stale odometry or refused input, UNKNOWN (600) for an
+    /// invalid goal or shutdown.
+    pub fn follow_result(&self, poses: &[PoseStamped]) -> FollowWaypointsResult {
+        let missed: &[Missed] = match self {
+            Outcome::RouteDone { missed, .. } | Outcome::RouteInfeasible(missed) => missed,
+            _ => &[],
+        };
+        let error_code = match self {
+            Outcome::RouteDone { .. } | Outcome::Canceled | Outcome::Preempted(_) => FollowWaypointsResult::NONE,
+            Outcome::RouteInfeasible(_) | Outcome::Stalled { .. } | Outcome::Stale | Outcome::Refused(_) => {
+                FollowWaypointsResult::TASK_EXECUTOR_FAILED
+            }
+            _ => FollowWaypointsResult::UNKNOWN,
+        };
+        FollowWaypointsResult {
+            missed_waypoints: missed
+                .iter()
+                .take(MAX_LISTED_PROBLEMS)
+                .map(|m| MissedWaypoint {
+                    index: u32::try_from(m.index).unwrap_or(u32::MAX),
+                    goal: poses.get(m.index).cloned().unwrap_or_default(),
+                    error_code: m.error_code(),
+                })
+                .collect(),
+            error_code,
+            error_msg: self.reason(),
+        }
+    }
+}
+
+/// How a failed docking is reported. On a chassis that cannot turn in place
+/// ([`Finish::ReportResidual`]) V stops falling for one reason: the law asks for a turn tighter
+/// than the minimum radius (near the goal v = γ·e·cos α → 0 while ω does not; elsewhere a
+/// sharp turn), the chassis' curvature limit holds ω, and the robot runs on a line that passes
+/// the goal, backing and filling, with the position and heading residual the law cannot remove
+/// (under the common factor alone V̇ ≤ 0 holds: SPEC §3). That stall is reported as
+/// [`Outcome::ResidualStall`] (RESIDUAL, with e and the heading error); every other failure as
+/// the controller gives it.
+pub fn docking_outcome(failure: DockingFailure, residual: Residual, finish: Finish) -> Outcome {
+    if failure == DockingFailure::NotConverging && finish == Finish::ReportResidual {
+        Outcome::ResidualStall(residual)
+    } else {
+        Outcome::DockingFailed(failure, residual)
+    }
+}
+
+/// The pre-check's problems as missed waypoints (indices mapped to the request's).
+pub fn missed_from_report(problems: &[RouteProblem], route: &Route) -> Vec<Missed> {
+    problems
+        .iter()
+        .map(|p| Missed {
+            index: route.request_index.get(p.index).copied().unwrap_or(p.index),
+            position: problem_position(p, &route.points),
+            kind: p.kind,
+            pre_check: true,
+        })
+        .collect()
+}
+
+/// Where a problem is: a collision where it begins, else its waypoint.
+pub fn problem_position(p: &RouteProblem, waypoints: &[Point2<f64>]) -> Point2<f64> {
+    match p.kind {
+        ProblemKind::Collision { at, .. } => at,
+        _ => waypoints.get(p.index).copied().unwrap_or_else(Point2::origin),
+    }
+}
+
+fn point(p: Point2<f64>) -> Point {
+    Point { x: p.x, y: p.y, z: 0.0 }
+}
+
+fn pose_msg(p: &Pose2) -> Pose {
+    Pose {
+        position: point(p.position()),
+        orientation: yaw_quaternion(p.yaw),
+    }
+}
+
+/// At most `max` items of `items`, evenly spread, the first and the last always kept.
+pub fn downsample<T: Clone>(items: &[T], max: usize) -> Vec<T> {
+    if items.len() <= max || max < 2 {
+        return items.iter().take(max.max(items.len().min(max))).cloned().collect();
+    }
+    let last = items.len() - 1;
+    (0..max).map(|i| items[i * last / (max - 1)].clone()).collect()
+}
+
+/// Path length (m) of the reference point's poses, without the jumps where the virtual robot
+/// was set down on a waypoint it missed (longer than 2 steps).
+pub fn path_length(path: &[Pose2], step: f64) -> f64 {
+    path.windows(2)
+        .map(|w| (w[1].position() - w[0].position()).norm())
+        .filter(|d| *d <= 2.0 * step)
+        .sum()
+}
+
+/// The `check_route` reply of a report: every problem (up to [`MAX_LISTED_PROBLEMS`]) with its
+/// index, kind, detail and position; `feasible`, `failed_waypoint`, the simulated path
+/// (downsampled to [`MAX_REPLY_POSES`]) and its length.
+pub fn check_reply(report: &RouteReport, route: &Route, stamp: Time, frame: &str, step: f64) -> CheckRouteResponse {
+    let missed = missed_from_report(&report.problems, route);
+    let header = Header {
+        stamp,
+        frame_id: frame.to_owned(),
+    };
+    let problems = missed
+        .iter()
+        .take(MAX_LISTED_PROBLEMS)
+        .map(|m| ProblemMsg {
+            index: i32::try_from(m.index).unwrap_or(i32::MAX),
+            kind: m.kind.as_str().to_owned(),
+            detail: m.kind.to_string(),
+            position: point(m.position),
+        })
+        .collect();
+    let poses = downsample(&report.path, MAX_REPLY_POSES)
+        .iter()
+        .map(|p| PoseStamped {
+            header: header.clone(),
+            pose: pose_msg(p),
+        })
+        .collect();
+    let feasible = missed.is_empty();
+    CheckRouteResponse {
+        feasible,
+        reason: if feasible {
+            String::new()
+        } else {
+            Outcome::RouteInfeasible(missed.clone()).reason()
+        },
+        failed_waypoint: missed
+            .first()
+            .map_or(-1, |m| i32::try_from(m.index).unwrap_or(i32::MAX)),
+        problems,
+        simulated_path: Path { header, poses },
+        length: path_length(&report.path, step),
+    }
+}
+
+/// A refused `check_route` request: infeasible with the reason, nothing else.
+pub fn refused_reply(reason: String) -> CheckRouteResponse {
+    CheckRouteResponse {
+        feasible: false,
+        reason,
+        failed_waypoint: -1,
+        ..Default::default()
+    }
+}
+
+/// What a status message says.
+#[derive(Debug, Clone, PartialEq)]
+pub struct StatusView {
+    /// NavStatus state.
+    pub state: u8,
+    /// The mode.
+    pub mode: Mode,
+    /// The goal: the dock pose or the waypoint pursued (odom).
+    pub goal: Option<Pose2>,
+    /// Distance to it (m), NaN when unknown.
+    pub distance_to_goal: f64,
+    /// Reason (empty while active).
+    pub reason: String,
+    /// The waypoint pursued (request index), -1 without a route.
+    pub waypoint_index: i32,
+    /// The docking's e, α, Θ and V: `None` when not docking (sent as zeros); NaN while docking
+    /// before the first pose is known.
+    pub docking: Option<[f64; 4]>,
+}
+
+/// The NavStatus message of a view, stamped `stamp`, in `frame`.
+pub fn status_message(view: &StatusView, stamp: Time, frame: &str) -> NavStatus {
+    let goal = view.goal.map_or_else(
+        || {
+            let mut p = Pose::default();
+            p.orientation.w = 1.0;
+            p
+        },
+        |g| pose_msg(&g),
+    );
+    let [e, alpha, theta, lyapunov] = view.docking.unwrap_or_default();
+    NavStatus {
+        header: Header {
+            stamp,
+            frame_id: frame.to_owned(),
+        },
+        state: view.state,
+        mode: view.mode.as_str().to_owned(),
+        goal,
+        distance_to_goal: view.distance_to_goal,
+        reason: view.reason.clone(),
+        has_hit_point: false,
+        hit_point: Point::default(),
+        has_leave_point: false,
+        leave_point: Point::default(),
+        waypoint_index: view.waypoint_index,
+        e,
+        alpha,
+        theta,
+        lyapunov,
+    }
+}
+
+fn color(r: f32, g: f32, b: f32) -> ColorRGBA {
+    ColorRGBA { r, g, b, a: 1.0 }
+}
+
+fn marker(header: &Header, ns: &str, id: i32, kind: i32, scale: f64, c: ColorRGBA) -> Marker {
+    let mut m = Marker {
+        header: header.clone(),
+        ns: ns.into(),
+        id,
+        r#type: kind,
+        action: Marker::ADD,
+        color: c,
+        scale: Vector3 {
+            x: scale,
+            y: scale,
+            z: scale,
+        },
+        ..Default::default()
+    };
+    m.pose.orientation = yaw_quaternion(0.0);
+    m
+}
+
+/// Most points of the predicted path drawn.
+pub const MAX_DRAWN_PATH: usize = 300;
+
+/// What the markers show.
+#[derive(Debug, Clone, Default)]
+pub struct MarkerView<'a> {
+    /// The route's waypoints.
+    pub route: &'a [Point2<f64>],
+    /// The virtual robot's predicted path.
+    pub predicted: &'a [Pose2],
+    /// The problems (position and text).
+    pub problems: &'a [Missed],
+    /// The dock pose.
+    pub dock: Option<Pose2>,
+}
+
+/// The marker array: a DELETEALL first (so nothing stale stays), the route as a LINE_STRIP and
+/// a SPHERE_LIST of its waypoints, the predicted path as a LINE_STRIP (at most
+/// [`MAX_DRAWN_PATH`] points), each problem (at most [`MAX_LISTED_PROBLEMS`]) as a red SPHERE
+/// and a TEXT_VIEW_FACING at its place, the dock pose as an ARROW. With 200 waypoints and 50
+/// problems about 30 KB.
+pub fn markers(view: &MarkerView<'_>, stamp: Time, frame: &str) -> MarkerArray {
+    let header = Header {
+        stamp,
+        frame_id: frame.to_owned(),
+    };
+    let mut out = vec![clear_marker(&header)];
+    if !view.route.is_empty() {
+        let mut line = marker(&header, "route", 0, Marker::LINE_STRIP, 0.02, color(0.2, 0.6, 1.0));
+        line.points = view.route.iter().map(|p| point(*p)).collect();
+        let mut dots = marker(&header, "route", 1, Marker::SPHERE_LIST, 0.12, color(0.2, 0.6, 1.0));
+        dots.points = line.points.clone();
+        out.push(line);
+        out.push(dots);
+    }
+    if !view.predicted.is_empty() {
+        let mut path = marker(&header, "predicted", 0, Marker::LINE_STRIP, 0.015, color(0.0, 0.8, 0.0));
+        path.points = downsample(view.predicted, MAX_DRAWN_PATH)
+            .iter()
+            .map(|p| point(p.position()))
+            .collect();
+        out.push(path);
+    }
+    for (i, m) in view.problems.iter().take(MAX_LISTED_PROBLEMS).enumerate() {
+        let id = i32::try_from(i).unwrap_or(i32::MAX);
+        let mut dot = marker(&header, "problems", id, Marker::SPHERE, 0.2, color(0.9, 0.0, 0.0));
+        dot.pose.position = point(m.position);
+        let mut text = marker(
+            &header,
+            "problem_text",
+            id,
+            Marker::TEXT_VIEW_FACING,
+            0.12,
+            color(1.0, 1.0, 1.0),
+        );
+        text.pose.position = Point {
+            x: m.position.x,
+            y: m.position.y,
+            z: 0.3,
+        };
+        text.text = m.describe();
+        out.push(dot);
+        out.push(text);
+    }
+    if let Some(d) = view.dock {
+        let mut arrow = marker(&header, "dock", 0, Marker::ARROW, 0.0, color(1.0, 0.5, 0.0));
+        arrow.pose = pose_msg(&d);
+        arrow.scale = Vector3 {
+            x: 0.4,
+            y: 0.06,
+            z: 0.06,
+        };
+        out.push(arrow);
+    }
+    MarkerArray { markers: out }
+}
+
+fn clear_marker(header: &Header) -> Marker {
+    let mut m = marker(header, "", 0, Marker::SPHERE, 0.0, color(0.0, 0.0, 0.0));
+    m.action = Marker::DELETEALL;
+    m
+}
+
+/// Whether a running goal's odometry is stale (steady clock): older than `timeout`, counted as
+/// old as the goal at most (`None`: none yet), so a goal gets one timeout from its start for
+/// odometry to arrive and never fails at once for an old one.
+pub fn odom_stale(odom_age: Option<Duration>, goal_age: Duration, timeout: Duration) -> bool {
+    odom_age.map_or(goal_age, |a| a.min(goal_age)) > timeout
+}
+
+/// The signed distance backed out along the start heading: how far the reference point moved
+/// against `start`'s heading (m).
+pub fn backed_out(start: &Pose2, now: &Pose2) -> f64 {
+    let (s, c) = start.yaw.sin_cos();
+    -((now.x - start.x) * c + (now.y - start.y) * s)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use approx::assert_relative_eq;
+    use mobil_ros::params::ParamValues;
+
+    fn stamped(frame: &str, x: f64, y: f64) -> PoseStamped {
+        let mut g = PoseStamped::default();
+        g.header.frame_id = frame.into();
+        g.pose.position.x = x;
+        g.pose.position.y = y;
+        g.pose.orientation.w = 1.0;
+        g
+    }
+
+    #[test]
+    fn defaults_are_the_library_s_and_bad_gains_are_refused() {
+        let values = ParamValues::defaults(&Decl::<PlannerConfig>::of().specs());
+        let c: PlannerConfig = mobil_ros::config::load(&values).expect("defaults valid");
+        assert_eq!(c.gains().expect("valid"), DockingGains::paper());
+        assert_eq!(c.docking, DockingConfig::default());
+        assert_eq!(c.follow, FollowConfig::default());
+        assert_eq!(c.route_check(), RouteCheckConfig::new(0.53));
+        let mut bad = values.clone();
+        bad.set("gamma", ros2_client::ParameterValue::Double(0.0));
+        assert!(mobil_ros::config::load::<PlannerConfig>(&bad).is_err());
+        let mut bad = values;
+        bad.set("min_speed", ros2_client::ParameterValue::Double(0.4));
+        // min_speed above approach_speed (0.3) is inconsistent.
+        assert!(mobil_ros::config::load::<PlannerConfig>(&bad).is_err());
+    }
+
+    #[test]
+    fn dock_poses_outside_odom_or_with_nan_are_refused() {
+        let g = dock_goal(&stamped("odom", 1.5, -0.5), "odom").expect("valid");
+        assert_eq!((g.x, g.y, g.yaw), (1.5, -0.5, 0.0));
+        assert_eq!(
+            dock_goal(&stamped("map", 1.0, 0.0), "odom"),
+            Err(GoalError::Frame {
+                what: "dock pose".into(),
+                got: "map".into(),
+                want: "odom".into()
+            })
+        );
+        assert!(matches!(
+            dock_goal(&stamped("", 1.0, 0.0), "odom"),
+            Err(GoalError::Frame { .. })
+        ));
+        assert!(matches!(
+            dock_goal(&stamped("odom", f64::NAN, 0.0), "odom"),
+            Err(GoalError::NotFinite { .. })
+        ));
+        assert!(matches!(
+            dock_goal(&stamped("odom", 2e4, 0.0), "odom"),
+            Err(GoalError::TooFar { .. })
+        ));
+        let mut q = stamped("odom", 1.0, 0.0);
+        q.pose.orientation.z = f64::INFINITY;
+        assert!(matches!(dock_goal(&q, "odom"), Err(GoalError::NotFinite { .. })));
+    }
+
+    #[test]
+    fn routes_are_checked_and_loops_repeat_from_the_first_pose() {
+        let poses = vec![
+            stamped("odom", 1.0, 0.0),
+            stamped("", 2.0, 0.0),
+            stamped("odom", 2.0, 1.0),
+        ];
+        let r = route_from_poses(&poses, "odom", "odom", 1, 1, None, 0.01).expect("valid");
+        // From index 1, then one more round from 0: 1, 2, 0, 1, 2.
+        assert_eq!(r.request_index, vec![1, 2, 0, 1, 2]);
+        assert_eq!(r.points[2], Point2::new(1.0, 0.0));
+        assert_eq!(
+            route_from_poses(&poses, "odom", "odom", 3, 0, None, 0.01),
+            Err(GoalError::GoalIndex { index: 3, len: 3 })
+        );
+        assert_eq!(
+            route_from_poses(&[], "odom", "odom", 0, 0, None, 0.01),
+            Err(GoalError::EmptyRoute)
+        );
+        let mut bad = poses.clone();
+        bad[2].header.frame_id = "map".into();
+        assert!(matches!(
+            route_from_poses(&bad, "odom", "odom", 0, 0, None, 0.01),
+            Err(GoalError::Frame { what, .. }) if what == "waypoint 2"
+        ));
+        bad[2] = stamped("odom", 0.0, f64::NAN);
+        assert!(matches!(
+            route_from_poses(&bad, "odom", "odom", 0, 0, None, 0.01),
+            Err(GoalError::NotFinite { .. })
+        ));
+        // 100 poses × (1 + 1 loop) = 200 is the most; one loop more is refused.
+        let many: Vec<_> = (0..100).map(|i| stamped("odom", i as f64, 0.0)).collect();
+        assert!(route_from_poses(&many, "odom", "odom", 0, 1, None, 0.01).is_ok());
+        assert_eq!(
+            route_from_poses(&many, "odom", "odom", 0, 2, None, 0.01),
+            Err(GoalError::TooLong(300))
+        );
+        // Zero length: every point on the first and on the robot.
+        let same = vec![stamped("odom", 0.0, 0.0), stamped("odom", 0.001, 0.0)];
+        assert_eq!(
+            route_from_poses(&same, "odom", "odom", 0, 0, Some(Point2::origin()), 0.01),
+            Err(GoalError::ZeroLength(0.01))
+        );
+        // A single waypoint away from the robot is a route.
+        assert!(route_from_poses(&same[..1], "odom", "odom", 0, 0, Some(Point2::new(1.0, 0.0)), 0.01).is_ok());
+        // A Path in `map` is refused as a whole.
+        let path = Path {
+            header: Header {
+                frame_id: "map".into(),
+                ..Default::default()
+            },
+            poses: poses.clone(),
+        };
+        assert!(matches!(
+            route_from_path(&path, "odom", None, 0.01),
+            Err(GoalError::Frame { what, .. }) if what == "route"
+        ));
+    }
+
+    #[test]
+    fn commands_are_held_to_the_chassis_limits() {
+        // OMR-III: v_max 0.5. (0.6, 0.8) m/s is 1.0 m/s: scaled to (0.3, 0.4).
+        let omr3 = ChassisParams::omr3();
+        let t = clamp_twist(BodyTwist::new(0.6, 0.8, 0.0), &omr3);
+        assert_relative_eq!(t.linear.x, 0.3, epsilon = 1e-12);
+        assert_relative_eq!(t.linear.y, 0.4, epsilon = 1e-12);
+        // MOBIL-II with its reference point 0.30 m ahead: at v = 0.3 the tightest turn is
+        // ω = 0.3 / 0.73 = 0.410959 rad/s (linear.x and angular.z are the origin's). A request
+        // for ω = 2 is held to that; a linear.y (the implied ω·d, or any) is never sent.
+        let mobil2 = ChassisParams::new(ChassisConfig {
+            reference_offset: 0.30,
+            ..ChassisConfig::mobil2()
+        })
+        .expect("valid");
+        let t = clamp_twist(BodyTwist::new(0.3, 2.0 * 0.3, 2.0), &mobil2);
+        assert_relative_eq!(t.linear.x, 0.3, epsilon = 1e-12);
+        assert_relative_eq!(t.angular.z, 0.3 / 0.73, epsilon = 1e-9);
+        assert_eq!(t.linear.y, 0.0);
+        // A feasible command passes unchanged.
+        let t = clamp_twist(BodyTwist::new(0.2, 0.0, 0.1), &mobil2);
+        assert_eq!((t.linear.x, t.linear.y, t.angular.z), (0.2, 0.0, 0.1));
+        // A turn in place is a stop on a car (v = 0 allows no ω).
+        let t = clamp_twist(BodyTwist::new(0.0, 0.0, 0.5), &mobil2);
+        assert_eq!((t.linear.x, t.angular.z), (0.0, 0.0));
+        // An omni with its reference point 0.2 m ahead: (0.5, 0, 0.25) at the reference point is
+        // (0.5, −0.05, 0.25) at the origin, |v| = 0.502494 > 0.5: the translation is scaled by
+        // s = 0.995037, ω (within 1.5) kept (the fastest wheel, at most (|v| + R·ω) / r =
+        // (0.5 + 0.05) / 0.05 = 11 < 12 rad/s, does not bind); back at the reference point
+        // vy = −0.05·s + 0.2·0.25 = 0.05·(1 − s) = 0.000248.
+        let omni = ChassisParams::new(ChassisConfig {
+            reference_offset: 0.2,
+            ..ChassisConfig::omr3()
+        })
+        .expect("valid");
+        let t = clamp_twist(BodyTwist::new(0.5, 0.0, 0.25), &omni);
+        let s = 0.5 / 0.5f64.hypot(0.05);
+        assert_relative_eq!(s, 0.995_037, epsilon = 1e-6);
+        assert_relative_eq!(t.linear.x, 0.5 * s, epsilon = 1e-9);
+        assert_relative_eq!(t.linear.y, 0.05 * (1.0 - s), epsilon = 1e-12);
+        assert_relative_eq!(t.angular.z, 0.25, epsilon = 1e-12);
+        assert_eq!(docking_offset(&mobil2), 0.30);
+        assert_eq!(docking_offset(&omni), 0.0);
+        // Non-finite → zero.
+        let t = clamp_twist(BodyTwist::new(f64::NAN, 0.0, 1.0), &omr3);
+        assert_eq!((t.linear.x, t.linear.y, t.angular.z), (0.0, 0.0, 0.0));
+        let t = clamp_twist(BodyTwist::new(0.1, 0.0, f64::INFINITY), &mobil2);
+        assert_eq!((t.linear.x, t.linear.y, t.angular.z), (0.0, 0.0, 0.0));
+    }
+
+    #[test]
+    fn outcomes_give_status_reasons_and_nav2_codes() {
+        let residual = Residual { e: 0.015, heading: 0.5 };
+        let o = Outcome::DockingFailed(DockingFailure::HeadingResidual, residual);
+        assert_eq!(o.state(), NavStatus::FAILED);
+        assert!(o.reason().starts_with("RESIDUAL: "), "{}", o.reason());
+        assert!(o.reason().contains("e = 0.015 m"));
+        assert!(o.reason().contains("0.500 rad (28.6°)"));
+        let r = o.dock_result();
+        assert_eq!((r.success, r.error_code), (false, 905));
+        let o = Outcome::DockingFailed(DockingFailure::NotConverging, residual);
+        assert_eq!((o.code(), o.dock_result().error_code), ("NOT_CONVERGING", 905));
+        let o = Outcome::DockingFailed(DockingFailure::TimeLimit, residual);
+        assert_eq!((o.code(), o.dock_result().error_code), ("TIME_LIMIT", 905));
+        // A steered chassis whose V stopped falling is stuck on its residual (RESIDUAL); the omni
+        // chassis, which can follow the law, is not converging.
+        let stall = DockingFailure::NotConverging;
+        let o = docking_outcome(stall, residual, Finish::ReportResidual);
+        assert_eq!(o, Outcome::ResidualStall(residual));
+        assert_eq!((o.code(), o.dock_result().error_code), ("RESIDUAL", 905));
+        assert!(
+            o.reason().ends_with("e = 0.015 m, heading error 0.500 rad (28.6°)"),
+            "{}",
+            o.reason()
+        );
+        assert_eq!(
+            docking_outcome(stall, residual, Finish::RotateInPlace),
+            Outcome::DockingFailed(stall, residual)
+        );
+        assert_eq!(
+            docking_outcome(DockingFailure::TimeLimit, residual, Finish::ReportResidual),
+            Outcome::DockingFailed(DockingFailure::TimeLimit, residual)
+        );
+        let o = Outcome::Invalid(GoalError::NoDockDatabase);
+        assert_eq!((o.code(), o.dock_result().error_code), ("INVALID_GOAL", 901));
+        let o = Outcome::Invalid(GoalError::NotFinite {
+            what: "dock pose".into(),
+        });
+        assert_eq!(o.dock_result().error_code, 902);
+        assert_eq!(o.reason(), "INVALID_GOAL: dock pose is not finite");
+        let o = Outcome::Docked { e: 0.01, heading: 0.02 };
+        let r = o.dock_result();
+        assert_eq!((r.success, r.error_code, o.state()), (true, 0, NavStatus::SUCCEEDED));
+        assert_eq!(Outcome::Stale.dock_result().error_code, 905);
+        assert_eq!(Outcome::Stale.reason(), "STALE_INPUT: odom stale: robot stopped");
+        assert_eq!(Outcome::Canceled.dock_result().error_code, 0);
+        let o = Outcome::UndockTimeout {
+            limit: 30.0,
+            distance: 0.2,
+        };
+        assert_eq!((o.code(), o.undock_result().error_code), ("TIME_LIMIT", 905));
+        assert!(Outcome::Undocked { distance: 0.5 }.undock_result().success);
+        // A refused route lists every problem, each with the request's index and its pose.
+        let poses = vec![stamped("odom", 2.0, 0.0), stamped("odom", 2.0, 0.3)];
+        let missed = vec![Missed {
+            index: 1,
+            position: Point2::new(2.0, 0.3),
+            kind: ProblemKind::TurnRadius {
+                required: 0.2,
+                minimum: 0.73,
+            },
+            pre_check: true,
+        }];
+        let o = Outcome::RouteInfeasible(missed.clone());
+        assert_eq!(
+            o.reason(),
+            "ROUTE_INFEASIBLE: 1 problem(s): waypoint 1: turn_radius: turn radius 0.20 m below the chassis minimum 0.73 m"
+        );
+        let r = o.follow_result(&poses);
+        assert_eq!(r.error_code, 601);
+        assert_eq!(r.missed_waypoints.len(), 1);
+        assert_eq!(
+            (r.missed_waypoints[0].index, r.missed_waypoints[0].error_code),
+            (1, 208)
+        );
+        assert_eq!(r.missed_waypoints[0].goal.pose.position.y, 0.3);
+        let ran = Missed {
+            pre_check: false,
+            ..missed[0].clone()
+        };
+        let o = Outcome::RouteDone {
+            count: 2,
+            missed: vec![ran],
+        };
+        assert_eq!(o.state(), NavStatus::SUCCEEDED);
+        let r = o.follow_result(&poses);
+        assert_eq!((r.error_code, r.missed_waypoints[0].error_code), (0, 105));
+        assert!(o.reason().starts_with("SUCCEEDED: route done: 1 of 2 waypoints missed"));
+        assert_eq!(
+            Outcome::Preempted("dock_pose").reason(),
+            "PREEMPTED: preempted by a newer goal (dock_pose)"
+        );
+    }
+
+    #[test]
+    fn downsampling_keeps_the_ends_and_the_count() {
+        let v: Vec<usize> = (0..1001).collect();
+        let d = downsample(&v, 5);
+        assert_eq!(d, vec![0, 250, 500, 750, 1000]);
+        assert_eq!(downsample(&v[..3], 5), vec![0, 1, 2]);
+        // Path length without the set-down jumps: 3 steps of 0.02 and a 1 m jump → 0.06.
+        let p = [
+            Pose2::new(0.0, 0.0, 0.0),
+            Pose2::new(0.02, 0.0, 0.0),
+            Pose2::new(0.04, 0.0, 0.0),
+            Pose2::new(1.04, 0.0, 0.0),
+            Pose2::new(1.06, 0.0, 0.0),
+        ];
+        assert_relative_eq!(path_length(&p, 0.02), 0.06, epsilon = 1e-12);
+    }
+
+    #[test]
+    fn the_reply_stays_small_and_names_each_problem() {
+        // A long straight report: 20 000 poses are sent as 400; one problem at waypoint 1.
+        let path: Vec<Pose2> = (0..20_000).map(|i| Pose2::new(i as f64 * 0.02, 0.0, 0.0)).collect();
+        let route = Route {
+            points: vec![Point2::new(200.0, 0.0), Point2::new(399.98, 0.0)],
+            request_index: vec![0, 1],
+            poses: vec![],
+        };
+        let report = RouteReport {
+            problems: vec![RouteProblem {
+                index: 1,
+                kind: ProblemKind::Collision {
+                    at: Point2::new(300.0, 0.0),
+                    clearance: -0.1,
+                },
+            }],
+            path,
+            reached: vec![true, true],
+        };
+        let reply = check_reply(&report, &route, Time::default(), "odom", 0.02);
+        assert!(!reply.feasible);
+        assert_eq!(reply.failed_waypoint, 1);
+        assert_eq!(reply.problems.len(), 1);
+        assert_eq!(reply.problems[0].kind, "collision");
+        assert_eq!(reply.problems[0].position.x, 300.0);
+        assert_eq!(reply.simulated_path.poses.len(), MAX_REPLY_POSES);
+        assert_relative_eq!(reply.length, 19_999.0 * 0.02, epsilon = 1e-6);
+        assert!(reply
+            .reason
+            .starts_with("ROUTE_INFEASIBLE: 1 problem(s): waypoint 1: collision"));
+    }
+
+    #[test]
+    fn markers_stay_small() {
+        let route: Vec<Point2<f64>> = (0..MAX_WAYPOINTS).map(|i| Point2::new(i as f64, 0.0)).collect();
+        let predicted: Vec<Pose2> = (0..50_000).map(|i| Pose2::new(i as f64 * 0.01, 0.0, 0.0)).collect();
+        let problems: Vec<Missed> = (0..80)
+            .map(|i| Missed {
+                index: i,
+                position: Point2::new(i as f64, 0.0),
+                kind: ProblemKind::Unreachable(UnreachableCause::PassedBy { closest: 0.3 }),
+                pre_check: true,
+            })
+            .collect();
+        let view = MarkerView {
+            route: &route,
+            predicted: &predicted,
+            problems: &problems,
+            dock: Some(Pose2::new(1.0, 2.0, 0.5)),
+        };
+        let a = markers(&view, Time::default(), "odom");
+        // DELETEALL, route line and dots, predicted path, 50 problems × 2, the dock arrow.
+        assert_eq!(a.markers.len(), 1 + 2 + 1 + 2 * MAX_LISTED_PROBLEMS + 1);
+        assert_eq!(a.markers[0].action, Marker::DELETEALL);
+        let points: usize = a.markers.iter().map(|m| m.points.len()).sum();
+        assert_eq!(points, 2 * MAX_WAYPOINTS + MAX_DRAWN_PATH);
+        let arrow = a.markers.last().expect("arrow");
+        assert_eq!(arrow.r#type, Marker::ARROW);
+        assert_relative_eq!(yaw_of(&arrow.pose.orientation), 0.5, epsilon = 1e-12);
+    }
+
+    #[test]
+    fn odometry_is_stale_after_one_timeout_from_the_goal_s_start() {
+        let ms = Duration::from_millis;
+        let timeout = ms(500);
+        // Fresh: 0.1 s old. Stale: 0.6 s old on a goal 2 s old.
+        assert!(!odom_stale(Some(ms(100)), ms(2000), timeout));
+        assert!(odom_stale(Some(ms(600)), ms(2000), timeout));
+        // A goal 0.3 s old with odometry 5 s old (or none yet) has its grace.
+        assert!(!odom_stale(Some(ms(5000)), ms(300), timeout));
+        assert!(!odom_stale(None, ms(300), timeout));
+        assert!(odom_stale(None, ms(501), timeout));
+        // Exactly the timeout is not yet stale.
+        assert!(!odom_stale(Some(ms(500)), ms(2000), timeout));
+    }
+
+    #[test]
+    fn backing_out_is_measured_against_the_start_heading() {
+        // Start facing +y at (1, 1); 0.4 m back along −y, 0.1 m sideways: 0.4 backed out.
+        let start = Pose2::new(1.0, 1.0, std::f64::consts::FRAC_PI_2);
+        assert_relative_eq!(backed_out(&start, &Pose2::new(1.1, 0.6, 1.5)), 0.4, epsilon = 1e-12);
+        assert_relative_eq!(backed_out(&start, &Pose2::new(1.0, 1.2, 1.5)), -0.2, epsilon = 1e-12);
+    }
+
+    #[test]
+    fn status_carries_the_docking_state_and_the_waypoint() {
+        let view = StatusView {
+            state: NavStatus::ACTIVE,
+            mode: Mode::Dock,
+            goal: Some(Pose2::new(1.0, 0.0, 0.0)),
+            distance_to_goal: 1.0,
+            reason: String::new(),
+            waypoint_index: -1,
+            docking: Some([1.0, 0.5, -0.25, 0.7]),
+        };
+        let m = status_message(&view, Time::default(), "odom");
+        assert_eq!(m.mode, "dock");
+        assert_eq!((m.e, m.alpha, m.theta, m.lyapunov), (1.0, 0.5, -0.25, 0.7));
+        assert_eq!(m.waypoint_index, -1);
+        assert_eq!(m.goal.position.x, 1.0);
+        let idle = StatusView {
+            mode: Mode::Approach,
+            goal: None,
+            waypoint_index: 3,
+            docking: None,
+            ..view
+        };
+        let m = status_message(&idle, Time::default(), "odom");
+        assert_eq!(
+            (m.mode.as_str(), m.waypoint_index, m.e, m.goal.orientation.w),
+            ("approach", 3, 0.0, 1.0)
+        );
+    }
+
+    #[test]
+    fn the_world_file_names_the_builtin_none_or_a_file() {
+        assert_eq!(load_world("").expect("builtin"), World::builtin());
+        assert!(load_world("none").expect("empty").obstacles.is_empty());
+        assert!(load_world("/nonexistent/world.yaml").is_err());
+    }
+}
