@@ -121,6 +121,12 @@ impl PlaneTilt {
         })
     }
 
+    /// Signed distance (m) of a point from the plane, a·x + b·y + c·z + d with the unit normal:
+    /// positive on the side the normal points to (above, as c ≥ 0).
+    pub fn distance(&self, p: &Point3<f64>) -> f64 {
+        self.a * p.x + self.b * p.y + self.c * p.z + self.d
+    }
+
     /// The unit normal (a, b, c).
     pub fn normal(&self) -> Vector3<f64> {
         Vector3::new(self.a, self.b, self.c)
@@ -150,25 +156,56 @@ pub fn sigma_of_heights(z: &[f64; 6]) -> (f64, f64) {
     ((ss / 6.0).sqrt(), (ss / 5.0).sqrt())
 }
 
-/// The class by SPEC §6's corrected rule: BEYOND_LIMITS if σ > σ_max or tilt > tilt_max;
-/// otherwise UNEVEN if α12 > ε_α; otherwise FLAT if α13 ≤ ε_α, α23 ≤ ε_α and σ ≤ σ_flat, UNEVEN
-/// if only σ exceeds σ_flat (the tripods level at different heights), else SLOPE. All angles
-/// are ≥ 0 (eq. 17–19 with |N_i·N_j|).
-pub fn classify(
-    config: &TerrainConfig,
-    sigma: f64,
-    alpha12: f64,
-    alpha13: f64,
-    alpha23: f64,
-    tilt: f64,
-) -> TerrainClass {
+/// What the class is decided from, in the order of `mobil_msgs/TerrainAssessment` (σ, α12,
+/// α23, α13, tilt), plus the offset between the two foot planes, which the message does not carry.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Measures {
+    /// Population standard deviation of the feet's z (m).
+    pub sigma: f64,
+    /// Angle between planes 1 and 2 (rad, ≥ 0).
+    pub alpha12: f64,
+    /// Angle between planes 2 and 3 (rad, ≥ 0).
+    pub alpha23: f64,
+    /// Angle between planes 1 and 3 (rad, ≥ 0).
+    pub alpha13: f64,
+    /// Largest inclination of planes 1 and 2 to the body's xy-plane (rad).
+    pub tilt: f64,
+    /// Offset between planes 1 and 2 (m, ≥ 0): see [`plane_offset`].
+    pub plane_offset: f64,
+}
+
+/// Offset (m) between the two foot planes: the larger distance of each tripod's foot centroid
+/// from the other tripod's plane (unit normals). 0 when all six feet are coplanar; for two
+/// parallel planes, their distance. Only meaningful when α12 is small (within ε_α), where it
+/// tells a step between the tripods from one plane.
+pub fn plane_offset(plane1: &PlaneTilt, feet1: &[Point3<f64>; 3], plane2: &PlaneTilt, feet2: &[Point3<f64>; 3]) -> f64 {
+    let centroid = |f: &[Point3<f64>; 3]| Point3::from((f[0].coords + f[1].coords + f[2].coords) / 3.0);
+    plane2
+        .distance(&centroid(feet1))
+        .abs()
+        .max(plane1.distance(&centroid(feet2)).abs())
+}
+
+/// The class by SPEC §6's corrected rule, with the step between the tripods seen by the planes'
+/// offset:
+/// 1. BEYOND_LIMITS if σ > σ_max or tilt > tilt_max, or if any measure is
+///    NaN, infinite or negative (an undefined stance never passes as safe ground);
+/// 2. otherwise UNEVEN if α12 > ε_α (the planes cross) or the plane offset exceeds
+///    `plane_offset_max` (parallel planes at different heights: a step between the tripods,
+///    level or on a slope);
+/// 3. otherwise FLAT if α13 ≤ ε_α, α23 ≤ ε_α and σ ≤ σ_flat, UNEVEN if only σ exceeds σ_flat,
+///    else SLOPE.
+pub fn classify(config: &TerrainConfig, m: &Measures) -> TerrainClass {
     let eps = config.epsilon_alpha;
-    if sigma > config.sigma_max || tilt > config.tilt_max {
+    let values = [m.sigma, m.alpha12, m.alpha23, m.alpha13, m.tilt, m.plane_offset];
+    // NaN fails `is_finite`, so it cannot reach the comparisons below, which it would pass.
+    let defined = values.iter().all(|v| v.is_finite() && *v >= 0.0);
+    if !defined || m.sigma > config.sigma_max || m.tilt > config.tilt_max {
         TerrainClass::BeyondLimits
-    } else if alpha12 > eps {
+    } else if m.alpha12 > eps || m.plane_offset > config.plane_offset_max {
         TerrainClass::Uneven
-    } else if alpha13 <= eps && alpha23 <= eps {
-        if sigma <= config.sigma_flat {
+    } else if m.alpha13 <= eps && m.alpha23 <= eps {
+        if m.sigma <= config.sigma_flat {
             TerrainClass::Flat
         } else {
             TerrainClass::Uneven
@@ -208,6 +245,8 @@ pub struct Assessment {
     pub planes: [PlaneTilt; 3],
     /// Largest inclination of planes 1 and 2 to the body's xy-plane (rad).
     pub tilt: f64,
+    /// Offset between planes 1 and 2 (m, see [`plane_offset`]); not in the message.
+    pub plane_offset: f64,
     /// The class.
     pub class: TerrainClass,
     /// The advised gait.
@@ -258,7 +297,16 @@ impl Assessor {
         let alpha13 = angle_between(&n1, &n3);
         let (sigma, sigma_sample) = sigma_of_heights(&feet.map(|p| p.z));
         let tilt = plane1.inclination().max(plane2.inclination());
-        let class = classify(&self.config, sigma, alpha12, alpha13, alpha23, tilt);
+        let offset = plane_offset(&plane1, &[*a1, *a2, *a3], &plane2, &[*b1, *b2, *b3]);
+        let measures = Measures {
+            sigma,
+            alpha12,
+            alpha23,
+            alpha13,
+            tilt,
+            plane_offset: offset,
+        };
+        let class = classify(&self.config, &measures);
         let advice = advise(&self.config, class, sigma);
         Ok(Assessment {
             feet: *feet,
@@ -269,6 +317,7 @@ impl Assessor {
             alpha13,
             planes: [plane1, plane2, plane3],
             tilt,
+            plane_offset: offset,
             class,
             advice,
         })
@@ -309,20 +358,71 @@ mod tests {
         assert!(angle_between(&n1, &(-n1)).abs() < 1e-15);
     }
 
+    /// Measures in the message's order, the offset last.
+    fn m(sigma: f64, alpha12: f64, alpha23: f64, alpha13: f64, tilt: f64, plane_offset: f64) -> Measures {
+        Measures {
+            sigma,
+            alpha12,
+            alpha23,
+            alpha13,
+            tilt,
+            plane_offset,
+        }
+    }
+
     #[test]
     fn classes_at_their_boundaries() {
         let c = TerrainConfig::default();
         let e = c.epsilon_alpha;
-        assert_eq!(classify(&c, 0.0, 0.0, 0.0, 0.0, 0.0), TerrainClass::Flat);
-        assert_eq!(classify(&c, c.sigma_flat, e, e, e, e), TerrainClass::Flat);
-        assert_eq!(classify(&c, 0.011, 0.0, 0.0, 0.0, 0.0), TerrainClass::Uneven);
-        assert_eq!(classify(&c, 0.02, 0.0, 0.1, 0.1, 0.1), TerrainClass::Slope);
-        assert_eq!(classify(&c, 0.02, e * 1.01, 0.1, 0.1, 0.1), TerrainClass::Uneven);
-        assert_eq!(classify(&c, 0.041, 0.0, 0.0, 0.0, 0.0), TerrainClass::BeyondLimits);
-        assert_eq!(classify(&c, 0.02, 0.0, 0.27, 0.27, 0.27), TerrainClass::BeyondLimits);
+        let o = c.plane_offset_max;
+        assert_eq!(classify(&c, &m(0.0, 0.0, 0.0, 0.0, 0.0, 0.0)), TerrainClass::Flat);
+        assert_eq!(classify(&c, &m(c.sigma_flat, e, e, e, e, o)), TerrainClass::Flat);
+        assert_eq!(classify(&c, &m(0.011, 0.0, 0.0, 0.0, 0.0, 0.0)), TerrainClass::Uneven);
+        assert_eq!(classify(&c, &m(0.02, 0.0, 0.1, 0.1, 0.1, 0.0)), TerrainClass::Slope);
+        assert_eq!(classify(&c, &m(0.02, 0.0, 0.1, 0.1, 0.1, o)), TerrainClass::Slope);
+        assert_eq!(
+            classify(&c, &m(0.02, 0.0, 0.1, 0.1, 0.1, o * 1.01)),
+            TerrainClass::Uneven
+        );
+        assert_eq!(
+            classify(&c, &m(0.005, 0.0, 0.0, 0.0, 0.0, o * 1.01)),
+            TerrainClass::Uneven
+        );
+        assert_eq!(
+            classify(&c, &m(0.02, e * 1.01, 0.1, 0.1, 0.1, 0.0)),
+            TerrainClass::Uneven
+        );
+        assert_eq!(
+            classify(&c, &m(0.041, 0.0, 0.0, 0.0, 0.0, 0.0)),
+            TerrainClass::BeyondLimits
+        );
+        assert_eq!(
+            classify(&c, &m(0.02, 0.0, 0.27, 0.27, 0.27, 0.0)),
+            TerrainClass::BeyondLimits
+        );
         assert_eq!(advise(&c, TerrainClass::Flat, 0.0), Gait::Tripod);
         assert_eq!(advise(&c, TerrainClass::Slope, 0.02), Gait::Ripple);
         assert_eq!(advise(&c, TerrainClass::Uneven, 0.0201), Gait::Wave);
         assert_eq!(advise(&c, TerrainClass::BeyondLimits, 0.0), Gait::Reroute);
+    }
+
+    /// The order is the message's: α23 (plane 2 to the body) before α13. Each field reaches
+    /// the rule: a NaN, an infinity or a negative value in any one of them is BEYOND_LIMITS
+    /// (fails closed, never FLAT or SLOPE).
+    #[test]
+    fn any_undefined_measure_is_beyond_limits() {
+        let c = TerrainConfig::default();
+        assert_eq!(classify(&c, &m(0.0, 0.0, 0.0, 0.0, 0.0, 0.0)), TerrainClass::Flat);
+        // α13 = 0.1 rad alone: SLOPE; α23 = 0.1 rad alone: SLOPE too.
+        assert_eq!(classify(&c, &m(0.01, 0.0, 0.0, 0.1, 0.1, 0.0)), TerrainClass::Slope);
+        assert_eq!(classify(&c, &m(0.01, 0.0, 0.1, 0.0, 0.1, 0.0)), TerrainClass::Slope);
+        for k in 0..6 {
+            for bad in [f64::NAN, -1e-3, f64::INFINITY, f64::NEG_INFINITY] {
+                let mut v = [0.0; 6];
+                v[k] = bad;
+                let x = m(v[0], v[1], v[2], v[3], v[4], v[5]);
+                assert_eq!(classify(&c, &x), TerrainClass::BeyondLimits, "field {k} = {bad}");
+            }
+        }
     }
 }

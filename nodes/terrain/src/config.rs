@@ -19,12 +19,27 @@ const DEG: f64 = std::f64::consts::PI / 180.0;
 #[serde(default)]
 pub struct TerrainConfig {
     /// σ_flat (m): the largest σ of the feet that still counts as flat. FLAT needs all three
-    /// angles within ε_α *and* σ ≤ σ_flat: two tripods level but at different heights (a step
-    /// between them) have α12 = α13 = α23 = 0, and only σ sees it. Default 0.010: above the
-    /// 0.70 cm that a plane tilted by ε_α (3°) gives with the default footholds
-    /// (0.1347 m × tan 3°, the largest over directions), so a coplanar stance within ε_α is never
-    /// refused by σ, and well above leg kinematics' millimetre noise.
+    /// angles within ε_α, the planes' offset within `plane_offset_max` *and* σ ≤ σ_flat: a cap
+    /// on the height spread the tripod gait must clear, however it arises. With the default
+    /// thresholds and footholds it cannot bind (the angle and offset tests already keep σ below
+    /// 0.94 cm: parallel planes tilted 3° along y, 1 cm apart), but it still does for a larger
+    /// ε_α or plane_offset_max. Default 0.010: above the 0.70 cm that a plane tilted by ε_α (3°)
+    /// gives with the default footholds (0.1347 m × tan 3°, the largest over directions), so a
+    /// coplanar stance within ε_α is never refused by σ, and well above leg kinematics'
+    /// millimetre noise. **Depends on the footholds**: wider ones need a larger σ_flat (see
+    /// [`TerrainConfig::warnings`]).
     pub sigma_flat: f64,
+    /// Largest offset (m) between the two foot planes that still counts as one plane, when they
+    /// are parallel within ε_α (see [`plane_offset`](crate::assess::plane_offset): the larger
+    /// distance of each tripod's foot centroid from the other's plane). Above it the stance is
+    /// UNEVEN: a step between the tripods, which no angle sees, level or on a slope. Default
+    /// 0.010: ten times leg kinematics' millimetre noise, and more than three times the 2.8 mm
+    /// that two planes crossing at ε_α put between them at the default footholds' tripod
+    /// centroids (0.053 m apart: 0.053 × tan 3°), so a coplanar stance is never refused by it; a
+    /// 1 cm step is a tenth of the default body height. A new parameter rather than σ_flat: it is
+    /// a distance between planes, independent of the footholds' spread, while σ is a spread of
+    /// heights (a level step h gives σ = h/2, so σ_flat = 1 cm saw only steps over 2 cm).
+    pub plane_offset_max: f64,
     /// σ (m) between the ripple and the wave gait: SLOPE and UNEVEN get ripple up to it, wave
     /// above (the paper names both for irregular ground without choosing; wave is the slower,
     /// safer one). Default 0.020: between Table 1's "small" (1.29 cm, ripple) and "large"
@@ -59,6 +74,7 @@ impl Default for TerrainConfig {
     fn default() -> Self {
         TerrainConfig {
             sigma_flat: 0.010,
+            plane_offset_max: 0.010,
             sigma_wave: 0.020,
             sigma_max: 0.040,
             epsilon_alpha: 3.0 * DEG,
@@ -88,11 +104,17 @@ impl TerrainConfig {
         ]
     }
 
-    /// Checks 0 < σ_flat ≤ σ_wave ≤ σ_max, 0 < ε_α < tilt_max < 90°, finite body points and a
+    /// Checks 0 < σ_flat ≤ σ_wave ≤ σ_max, plane_offset_max > 0, 0 < ε_α < tilt_max < 90°, finite body points and a
     /// non-empty frame name. Degenerate body points are refused by
     /// [`Assessor::new`](crate::Assessor::new), which builds plane 3.
     pub fn validate(&self) -> Result<(), TerrainError> {
         check("sigma_flat", self.sigma_flat, self.sigma_flat > 0.0, "must be > 0")?;
+        check(
+            "plane_offset_max",
+            self.plane_offset_max,
+            self.plane_offset_max > 0.0,
+            "must be > 0",
+        )?;
         check(
             "sigma_wave",
             self.sigma_wave,
