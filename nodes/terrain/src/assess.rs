@@ -89,13 +89,19 @@ pub struct PlaneTilt {
 impl PlaneTilt {
     /// The plane through three points: N = (P2 − P1) × (P3 − P1), d = −N·P1 (SPEC §6, the
     /// paper's d with its sign corrected), N scaled to unit length and turned to c ≥ 0.
-    /// Coincident points (an edge shorter than [`MIN_EDGE`]) or collinear ones (sine of the
-    /// angle at P1 below [`MIN_SINE`]) are refused; the points must be finite.
+    /// A point that is not finite or has a coordinate beyond
+    /// [`COORDINATE_LIMIT`](crate::error::COORDINATE_LIMIT) is refused,
+    /// as are coincident points (an edge shorter than [`MIN_EDGE`]) and collinear ones (sine of
+    /// the angle at P1 below [`MIN_SINE`]): the result never holds a NaN or an infinity.
     pub fn through(plane: PlaneId, p1: &Point3<f64>, p2: &Point3<f64>, p3: &Point3<f64>) -> Result<Self, TerrainError> {
+        for (k, p) in [p1, p2, p3].into_iter().enumerate() {
+            check_point(|| format!("point {} of {plane}", k + 1), p.x, p.y, p.z)?;
+        }
         let e1 = p2 - p1;
         let e2 = p3 - p1;
         let (l1, l2, l3) = (e1.norm(), e2.norm(), (p3 - p2).norm());
-        if l1 < MIN_EDGE || l2 < MIN_EDGE || l3 < MIN_EDGE {
+        // Written so that a NaN would fail them too.
+        if !(l1 >= MIN_EDGE && l2 >= MIN_EDGE && l3 >= MIN_EDGE) {
             return Err(TerrainError::CoincidentPoints {
                 plane,
                 min_edge: MIN_EDGE,
@@ -103,7 +109,7 @@ impl PlaneTilt {
         }
         let n = e1.cross(&e2);
         let sine = n.norm() / (l1 * l2);
-        if sine < MIN_SINE {
+        if sine.is_nan() || sine < MIN_SINE {
             return Err(TerrainError::CollinearPoints { plane, sine });
         }
         let mut n = n / n.norm();
@@ -141,19 +147,46 @@ impl PlaneTilt {
 
 /// Angle between two planes by their normals, arccos(|N_i·N_j| / (|N_i||N_j|)) (eq. 17–19 with
 /// the SPEC's absolute value), in [0, π/2]. Computed as atan2(|N_i × N_j|, |N_i·N_j|), the same
-/// angle without arccos' loss of precision near 0.
+/// angle without arccos' loss of precision near 0, on each normal scaled by its largest
+/// component first, so that no length of normal overflows or underflows. A normal that is zero
+/// or not finite has no direction: the angle is then NaN, which [`classify`] treats as
+/// BEYOND_LIMITS.
 pub fn angle_between(n_i: &Vector3<f64>, n_j: &Vector3<f64>) -> f64 {
-    n_i.cross(n_j).norm().atan2(n_i.dot(n_j).abs())
+    let scaled = |n: &Vector3<f64>| {
+        let m = n.amax();
+        if m > 0.0 && m.is_finite() {
+            Some(n / m)
+        } else {
+            None
+        }
+    };
+    match (scaled(n_i), scaled(n_j)) {
+        (Some(a), Some(b)) => a.cross(&b).norm().atan2(a.dot(&b).abs()),
+        _ => f64::NAN,
+    }
 }
 
 /// Population and sample standard deviation of the six feet's z (m).
 /// Heights are taken relative to the first (σ does not change), so equal heights give exactly 0
-/// and a large common offset costs no precision.
+/// and a large common offset costs no precision. The differences are halved (exact in binary)
+/// and scaled by their largest before squaring, so that no finite heights overflow: σ is finite
+/// unless the spread itself exceeds f64's range. A height that is NaN or infinite gives NaN,
+/// which [`classify`] treats as BEYOND_LIMITS ([`Assessor::assess`] refuses such feet before).
 pub fn sigma_of_heights(z: &[f64; 6]) -> (f64, f64) {
-    let dz = z.map(|v| v - z[0]);
-    let mean = dz.iter().sum::<f64>() / 6.0;
-    let ss: f64 = dz.iter().map(|z| (z - mean) * (z - mean)).sum();
-    ((ss / 6.0).sqrt(), (ss / 5.0).sqrt())
+    if !z.iter().all(|v| v.is_finite()) {
+        return (f64::NAN, f64::NAN);
+    }
+    // |v/2 − z0/2| ≤ f64::MAX for finite v, z0: no difference overflows.
+    let half = z.map(|v| v / 2.0 - z[0] / 2.0);
+    let scale = half.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    if scale == 0.0 {
+        return (0.0, 0.0);
+    }
+    let u = half.map(|v| v / scale);
+    let mean = u.iter().sum::<f64>() / 6.0;
+    let ss: f64 = u.iter().map(|v| (v - mean) * (v - mean)).sum();
+    // Scaled back last-but-one, so 2·scale itself cannot overflow.
+    ((ss / 6.0).sqrt() * scale * 2.0, (ss / 5.0).sqrt() * scale * 2.0)
 }
 
 /// What the class is decided from, in the order of `mobil_msgs/TerrainAssessment` (σ, α12,
@@ -356,6 +389,74 @@ mod tests {
         assert!((angle_between(&n1, &n2) - 30f64.to_radians()).abs() < 1e-15);
         assert!(angle_between(&n1, &n1).abs() < 1e-15);
         assert!(angle_between(&n1, &(-n1)).abs() < 1e-15);
+    }
+
+    /// NaN or huge points: refused with a typed error, never a plane holding NaN. (Before the
+    /// check, a NaN point gave Ok with NaN in every field, and 1e300 overflowed the cross
+    /// product to ∞ and the normal to NaN.)
+    #[test]
+    fn through_refuses_nan_and_huge_points() {
+        let o = Point3::new(0.0, 0.0, 0.0);
+        let x = Point3::new(1.0, 0.0, 0.0);
+        for bad in [
+            Point3::new(f64::NAN, 1.0, 0.0),
+            Point3::new(0.0, f64::NAN, f64::NAN),
+            Point3::new(0.0, 1.0, f64::INFINITY),
+        ] {
+            assert!(matches!(
+                PlaneTilt::through(PlaneId::Feet1, &o, &x, &bad),
+                Err(TerrainError::NonFinite { .. })
+            ));
+        }
+        let huge = Point3::new(0.0, 1e300, 0.0);
+        assert!(matches!(
+            PlaneTilt::through(PlaneId::Feet2, &o, &huge, &x),
+            Err(TerrainError::OutOfRange { ref what, .. }) if what == "point 2 of plane 2 (DP, DG, KV)"
+        ));
+        // Just within the limit (1 km) still works: z = x through (0,0,0), (1000,0,1000),
+        // (0,1000,0) is the 45° plane of `plane_through_three_points`.
+        let p = PlaneTilt::through(
+            PlaneId::Feet1,
+            &o,
+            &Point3::new(1e3, 0.0, 1e3),
+            &Point3::new(0.0, 1e3, 0.0),
+        )
+        .unwrap();
+        assert!((p.theta_x + std::f64::consts::FRAC_PI_4).abs() < 1e-15);
+    }
+
+    /// Normals of any length give the same angle: 30° between (0, 0, 1) and (0, 1/2, √3/2)
+    /// scaled by 1e300 (their cross product would overflow to ∞, atan2(∞, ∞) = 45°) or by
+    /// 1e-300 (it would underflow to 0, giving 0°). A zero or NaN normal has no angle: NaN.
+    #[test]
+    fn angle_between_huge_tiny_and_undefined_normals() {
+        let n1 = Vector3::new(0.0, 0.0, 1.0);
+        let n2 = Vector3::new(0.0, 0.5, 0.75f64.sqrt());
+        for s in [1e300, 1e-300, 1.0] {
+            let a = angle_between(&(n1 * s), &(n2 * s));
+            assert!((a - 30f64.to_radians()).abs() < 1e-15, "scale {s}: {a}");
+        }
+        assert!(angle_between(&n1, &Vector3::zeros()).is_nan());
+        assert!(angle_between(&Vector3::new(f64::NAN, 0.0, 1.0), &n1).is_nan());
+        assert!(angle_between(&n1, &Vector3::new(0.0, f64::INFINITY, 1.0)).is_nan());
+    }
+
+    /// σ of [h, −h, h, −h, h, −h]: mean 0, every deviation h, so σ = h and the sample σ
+    /// = h·√(6/5). With h = 1e200 the squares (1e400) would overflow to ∞; with h = 1e308 even
+    /// the differences (2e308) would. A NaN or an infinite height gives NaN.
+    #[test]
+    fn sigma_of_huge_and_undefined_heights() {
+        for h in [0.01, 1e200, 1e308] {
+            let (pop, sample) = sigma_of_heights(&[h, -h, h, -h, h, -h]);
+            assert!((pop / h - 1.0).abs() < 1e-15, "h {h}: {pop}");
+            assert!((sample / h - 1.2f64.sqrt()).abs() < 1e-15, "h {h}: {sample}");
+        }
+        for bad in [f64::NAN, f64::INFINITY] {
+            let (pop, sample) = sigma_of_heights(&[bad, 0.0, 0.0, 0.0, 0.0, 0.0]);
+            assert!(pop.is_nan() && sample.is_nan());
+            let (pop, _) = sigma_of_heights(&[0.0, 0.0, 0.0, 0.0, 0.0, bad]);
+            assert!(pop.is_nan());
+        }
     }
 
     /// Measures in the message's order, the offset last.
