@@ -67,7 +67,13 @@ impl Gait {
 }
 
 /// One plane a·x + b·y + c·z + d = 0 and its inclination to the body's xy-plane
-/// (`mobil_msgs/PlaneTilt`). (a, b, c) is the unit normal, oriented with c ≥ 0.
+/// (`mobil_msgs/PlaneTilt`). (a, b, c) is the unit normal, oriented with c ≥ 0 (upward; c = 0
+/// only for a vertical plane).
+///
+/// Signs: the normal's horizontal part (a, b) points downhill. Ground rising along +x
+/// (z = tan 10°·x) has N ∝ (−tan 10°, 0, 1): θ_x = −10°, downhill = π. So θ_x > 0 means the
+/// ground falls toward +x (descends ahead), θ_y > 0 that it falls toward +y (to the left), and
+/// downhill is the body-frame direction of steepest descent, 0 (by atan2(0, 0)) for a level plane.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct PlaneTilt {
     /// Normal's x component.
@@ -78,11 +84,13 @@ pub struct PlaneTilt {
     pub c: f64,
     /// −N·P1: with a unit normal, minus the signed distance of the origin from the plane along N (m).
     pub d: f64,
-    /// Inclination along body x: atan2(a, c) (rad).
+    /// Inclination along body x: atan2(a, c) (rad); > 0 when the ground falls toward +x
+    /// (−10° for ground rising 10° ahead).
     pub theta_x: f64,
-    /// Inclination along body y: atan2(b, c) (rad).
+    /// Inclination along body y: atan2(b, c) (rad); > 0 when the ground falls toward +y (left).
     pub theta_y: f64,
-    /// Downhill direction in the body's xy-plane: atan2(b, a) (rad; 0 for a level plane).
+    /// Direction of steepest descent in the body's xy-plane: atan2(b, a) (rad, from +x toward
+    /// +y); 0 for a level plane.
     pub downhill: f64,
 }
 
@@ -363,6 +371,9 @@ mod tests {
 
     /// A plane through (0,0,0), (1,0,1), (0,1,0): z = x, so N ∝ (−1, 0, 1)/√2 after turning
     /// c > 0; inclination 45° along x; downhill along −x (the normal's horizontal part): π.
+    /// Ground rising along +x has θ_x < 0. Then z = y (through (0,0,0), (1,0,0), (0,1,1); the
+    /// vertex order gives N ∝ (0, 1, −1), turned to (0, −1, 1)/√2): θ_y = −45°, θ_x = 0,
+    /// downhill −π/2 (toward −y, the right).
     #[test]
     fn plane_through_three_points() {
         let p = PlaneTilt::through(
@@ -378,6 +389,16 @@ mod tests {
         assert!((p.theta_x + std::f64::consts::FRAC_PI_4).abs() < 1e-15);
         assert!((p.downhill - std::f64::consts::PI).abs() < 1e-15);
         assert!((p.inclination() - std::f64::consts::FRAC_PI_4).abs() < 1e-15);
+        let p = PlaneTilt::through(
+            PlaneId::Feet1,
+            &Point3::new(0.0, 0.0, 0.0),
+            &Point3::new(1.0, 0.0, 0.0),
+            &Point3::new(0.0, 1.0, 1.0),
+        )
+        .unwrap();
+        assert!(p.a.abs() < 1e-15 && (p.b + h).abs() < 1e-15 && (p.c - h).abs() < 1e-15);
+        assert!((p.theta_y + std::f64::consts::FRAC_PI_4).abs() < 1e-15 && p.theta_x.abs() < 1e-15);
+        assert!((p.downhill + std::f64::consts::FRAC_PI_2).abs() < 1e-15);
     }
 
     /// With N_1 = (0,0,1) and N_2 = −(0, sin 30°, cos 30°) (opposite orientation), eq. 17 with

@@ -34,8 +34,11 @@
 //!   gait; BEYOND_LIMITS advises another route.
 //! - **tilt** (the message's) is the larger inclination of planes 1 and 2 to the body's
 //!   xy-plane; tilt_max bounds it.
-//! - **Planes** carry a unit normal (a, b, c) turned to c ≥ 0; d = −N·P1. A level plane's
-//!   downhill direction is atan2(0, 0) = 0.
+//! - **Planes** carry a unit normal (a, b, c) turned to c ≥ 0 (upward); d = −N·P1. Its
+//!   horizontal part points downhill, so θ_x = atan2(a, c) > 0 when the ground falls toward
+//!   +x (ground rising 10° ahead gives θ_x = −10°), θ_y = atan2(b, c) > 0 when it falls toward
+//!   +y (left), and downhill = atan2(b, a) is the direction of steepest descent in the body's
+//!   xy-plane; a level plane's is atan2(0, 0) = 0.
 //! - **Angles** are computed as atan2(|N_i × N_j|, |N_i·N_j|), the arccos of eq. 17–19 with the
 //!   SPEC's absolute value without its loss of precision near 0 (1e-8 rad for arccos).
 //! - **Degenerate input**: a coordinate beyond ±1 km or not finite, two points of a plane
