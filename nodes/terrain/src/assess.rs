@@ -523,8 +523,10 @@ mod tests {
             TerrainClass::BeyondLimits
         );
         assert_eq!(advise(&c, TerrainClass::Flat, 0.0), Gait::Tripod);
-        assert_eq!(advise(&c, TerrainClass::Slope, 0.02), Gait::Ripple);
-        assert_eq!(advise(&c, TerrainClass::Uneven, 0.0201), Gait::Wave);
+        // σ_wave = 2.5 cm: a 10° slope's 2.37 cm is ripple, 2.51 cm wave.
+        assert_eq!(advise(&c, TerrainClass::Slope, 0.0237), Gait::Ripple);
+        assert_eq!(advise(&c, TerrainClass::Slope, 0.025), Gait::Ripple);
+        assert_eq!(advise(&c, TerrainClass::Uneven, 0.0251), Gait::Wave);
         assert_eq!(advise(&c, TerrainClass::BeyondLimits, 0.0), Gait::Reroute);
     }
 

@@ -42,8 +42,9 @@ pub struct TerrainConfig {
     pub plane_offset_max: f64,
     /// σ (m) between the ripple and the wave gait: SLOPE and UNEVEN get ripple up to it, wave
     /// above (the paper names both for irregular ground without choosing; wave is the slower,
-    /// safer one). Default 0.020: between Table 1's "small" (1.29 cm, ripple) and "large"
-    /// (2.77 cm, wave) columns.
+    /// safer one). Default 0.025: a plain 10° slope (σ 2.16–2.37 cm with the default footholds,
+    /// coplanar feet) keeps the ripple gait, as do Table 1's "small" feet (1.29 cm), while its
+    /// "large" feet (2.77 cm) get the wave gait. (At 2 cm every plain 10° slope got wave.)
     pub sigma_wave: f64,
     /// σ_max (m): above it the ground is BEYOND_LIMITS (reroute). Default 0.040: above Table 1's
     /// "large" feet (2.77 cm, UNEVEN) and a plain 10° slope in any direction (at most 2.37 cm
@@ -75,7 +76,7 @@ impl Default for TerrainConfig {
         TerrainConfig {
             sigma_flat: 0.010,
             plane_offset_max: 0.010,
-            sigma_wave: 0.020,
+            sigma_wave: 0.025,
             sigma_max: 0.040,
             epsilon_alpha: 3.0 * DEG,
             tilt_max: 15.0 * DEG,
@@ -104,8 +105,8 @@ impl TerrainConfig {
         ]
     }
 
-    /// Checks 0 < σ_flat ≤ σ_wave ≤ σ_max, plane_offset_max > 0, 0 < ε_α < tilt_max < 90°, finite body points and a
-    /// non-empty frame name. Degenerate body points are refused by
+    /// Checks 0 < σ_flat ≤ σ_wave ≤ σ_max, plane_offset_max > 0, 0 < ε_α < tilt_max < 90°,
+    /// finite body points and a non-empty frame name. Degenerate body points are refused by
     /// [`Assessor::new`](crate::Assessor::new), which builds plane 3.
     pub fn validate(&self) -> Result<(), TerrainError> {
         check("sigma_flat", self.sigma_flat, self.sigma_flat > 0.0, "must be > 0")?;

@@ -30,7 +30,8 @@
 //!   angle and offset tests already keep σ under 0.94 cm on FLAT ground, so it binds only for
 //!   a larger ε_α or plane_offset_max.
 //! - **Ripple or wave by σ_wave**, a fifth threshold: SLOPE and UNEVEN get ripple up to
-//!   σ_wave (2 cm, between Table 1's small and large columns), wave above; FLAT keeps the tripod
+//!   σ_wave (2.5 cm: above a plain 10° slope's 2.16–2.37 cm, below Table 1's large column's
+//!   2.77 cm), wave above; FLAT keeps the tripod
 //!   gait; BEYOND_LIMITS advises another route.
 //! - **tilt** (the message's) is the larger inclination of planes 1 and 2 to the body's
 //!   xy-plane; tilt_max bounds it.
