@@ -67,7 +67,13 @@ impl Gait {
 }
 
 /// One plane a·x + b·y + c·z + d = 0 and its inclination to the body's xy-plane
-/// (`mobil_msgs/PlaneTilt`). (a, b, c) is the unit normal, oriented with c ≥ 0.
+/// (`mobil_msgs/PlaneTilt`). (a, b, c) is the unit normal, oriented with c ≥ 0 (upward; c = 0
+/// only for a vertical plane).
+///
+/// Signs: the normal's horizontal part (a, b) points downhill. Ground rising along +x
+/// (z = tan 10°·x) has N ∝ (−tan 10°, 0, 1): θ_x = −10°, downhill = π. So θ_x > 0 means the
+/// ground falls toward +x (descends ahead), θ_y > 0 that it falls toward +y (to the left), and
+/// downhill is the body-frame direction of steepest descent, 0 (by atan2(0, 0)) for a level plane.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct PlaneTilt {
     /// Normal's x component.
@@ -78,24 +84,32 @@ pub struct PlaneTilt {
     pub c: f64,
     /// −N·P1: with a unit normal, minus the signed distance of the origin from the plane along N (m).
     pub d: f64,
-    /// Inclination along body x: atan2(a, c) (rad).
+    /// Inclination along body x: atan2(a, c) (rad); > 0 when the ground falls toward +x
+    /// (−10° for ground rising 10° ahead).
     pub theta_x: f64,
-    /// Inclination along body y: atan2(b, c) (rad).
+    /// Inclination along body y: atan2(b, c) (rad); > 0 when the ground falls toward +y (left).
     pub theta_y: f64,
-    /// Downhill direction in the body's xy-plane: atan2(b, a) (rad; 0 for a level plane).
+    /// Direction of steepest descent in the body's xy-plane: atan2(b, a) (rad, from +x toward
+    /// +y); 0 for a level plane.
     pub downhill: f64,
 }
 
 impl PlaneTilt {
     /// The plane through three points: N = (P2 − P1) × (P3 − P1), d = −N·P1 (SPEC §6, the
     /// paper's d with its sign corrected), N scaled to unit length and turned to c ≥ 0.
-    /// Coincident points (an edge shorter than [`MIN_EDGE`]) or collinear ones (sine of the
-    /// angle at P1 below [`MIN_SINE`]) are refused; the points must be finite.
+    /// A point that is not finite or has a coordinate beyond
+    /// [`COORDINATE_LIMIT`](crate::error::COORDINATE_LIMIT) is refused,
+    /// as are coincident points (an edge shorter than [`MIN_EDGE`]) and collinear ones (sine of
+    /// the angle at P1 below [`MIN_SINE`]): the result never holds a NaN or an infinity.
     pub fn through(plane: PlaneId, p1: &Point3<f64>, p2: &Point3<f64>, p3: &Point3<f64>) -> Result<Self, TerrainError> {
+        for (k, p) in [p1, p2, p3].into_iter().enumerate() {
+            check_point(|| format!("point {} of {plane}", k + 1), p.x, p.y, p.z)?;
+        }
         let e1 = p2 - p1;
         let e2 = p3 - p1;
         let (l1, l2, l3) = (e1.norm(), e2.norm(), (p3 - p2).norm());
-        if l1 < MIN_EDGE || l2 < MIN_EDGE || l3 < MIN_EDGE {
+        // Written so that a NaN would fail them too.
+        if !(l1 >= MIN_EDGE && l2 >= MIN_EDGE && l3 >= MIN_EDGE) {
             return Err(TerrainError::CoincidentPoints {
                 plane,
                 min_edge: MIN_EDGE,
@@ -103,7 +117,7 @@ impl PlaneTilt {
         }
         let n = e1.cross(&e2);
         let sine = n.norm() / (l1 * l2);
-        if sine < MIN_SINE {
+        if sine.is_nan() || sine < MIN_SINE {
             return Err(TerrainError::CollinearPoints { plane, sine });
         }
         let mut n = n / n.norm();
@@ -121,6 +135,12 @@ impl PlaneTilt {
         })
     }
 
+    /// Signed distance (m) of a point from the plane, a·x + b·y + c·z + d with the unit normal:
+    /// positive on the side the normal points to (above, as c ≥ 0).
+    pub fn distance(&self, p: &Point3<f64>) -> f64 {
+        self.a * p.x + self.b * p.y + self.c * p.z + self.d
+    }
+
     /// The unit normal (a, b, c).
     pub fn normal(&self) -> Vector3<f64> {
         Vector3::new(self.a, self.b, self.c)
@@ -135,40 +155,98 @@ impl PlaneTilt {
 
 /// Angle between two planes by their normals, arccos(|N_i·N_j| / (|N_i||N_j|)) (eq. 17–19 with
 /// the SPEC's absolute value), in [0, π/2]. Computed as atan2(|N_i × N_j|, |N_i·N_j|), the same
-/// angle without arccos' loss of precision near 0.
+/// angle without arccos' loss of precision near 0, on each normal scaled by its largest
+/// component first, so that no length of normal overflows or underflows. A normal that is zero
+/// or not finite has no direction: the angle is then NaN, which [`classify`] treats as
+/// BEYOND_LIMITS.
 pub fn angle_between(n_i: &Vector3<f64>, n_j: &Vector3<f64>) -> f64 {
-    n_i.cross(n_j).norm().atan2(n_i.dot(n_j).abs())
+    let scaled = |n: &Vector3<f64>| {
+        let m = n.amax();
+        if m > 0.0 && m.is_finite() {
+            Some(n / m)
+        } else {
+            None
+        }
+    };
+    match (scaled(n_i), scaled(n_j)) {
+        (Some(a), Some(b)) => a.cross(&b).norm().atan2(a.dot(&b).abs()),
+        _ => f64::NAN,
+    }
 }
 
 /// Population and sample standard deviation of the six feet's z (m).
 /// Heights are taken relative to the first (σ does not change), so equal heights give exactly 0
-/// and a large common offset costs no precision.
+/// and a large common offset costs no precision. The differences are halved (exact in binary)
+/// and scaled by their largest before squaring, so that no finite heights overflow: σ is finite
+/// unless the spread itself exceeds f64's range. A height that is NaN or infinite gives NaN,
+/// which [`classify`] treats as BEYOND_LIMITS ([`Assessor::assess`] refuses such feet before).
 pub fn sigma_of_heights(z: &[f64; 6]) -> (f64, f64) {
-    let dz = z.map(|v| v - z[0]);
-    let mean = dz.iter().sum::<f64>() / 6.0;
-    let ss: f64 = dz.iter().map(|z| (z - mean) * (z - mean)).sum();
-    ((ss / 6.0).sqrt(), (ss / 5.0).sqrt())
+    if !z.iter().all(|v| v.is_finite()) {
+        return (f64::NAN, f64::NAN);
+    }
+    // |v/2 − z0/2| ≤ f64::MAX for finite v, z0: no difference overflows.
+    let half = z.map(|v| v / 2.0 - z[0] / 2.0);
+    let scale = half.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    if scale == 0.0 {
+        return (0.0, 0.0);
+    }
+    let u = half.map(|v| v / scale);
+    let mean = u.iter().sum::<f64>() / 6.0;
+    let ss: f64 = u.iter().map(|v| (v - mean) * (v - mean)).sum();
+    // Scaled back last-but-one, so 2·scale itself cannot overflow.
+    ((ss / 6.0).sqrt() * scale * 2.0, (ss / 5.0).sqrt() * scale * 2.0)
 }
 
-/// The class by SPEC §6's corrected rule: BEYOND_LIMITS if σ > σ_max or tilt > tilt_max;
-/// otherwise UNEVEN if α12 > ε_α; otherwise FLAT if α13 ≤ ε_α, α23 ≤ ε_α and σ ≤ σ_flat, UNEVEN
-/// if only σ exceeds σ_flat (the tripods level at different heights), else SLOPE. All angles
-/// are ≥ 0 (eq. 17–19 with |N_i·N_j|).
-pub fn classify(
-    config: &TerrainConfig,
-    sigma: f64,
-    alpha12: f64,
-    alpha13: f64,
-    alpha23: f64,
-    tilt: f64,
-) -> TerrainClass {
+/// What the class is decided from, in the order of `mobil_msgs/TerrainAssessment` (σ, α12,
+/// α23, α13, tilt), plus the offset between the two foot planes, which the message does not carry.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Measures {
+    /// Population standard deviation of the feet's z (m).
+    pub sigma: f64,
+    /// Angle between planes 1 and 2 (rad, ≥ 0).
+    pub alpha12: f64,
+    /// Angle between planes 2 and 3 (rad, ≥ 0).
+    pub alpha23: f64,
+    /// Angle between planes 1 and 3 (rad, ≥ 0).
+    pub alpha13: f64,
+    /// Largest inclination of planes 1 and 2 to the body's xy-plane (rad).
+    pub tilt: f64,
+    /// Offset between planes 1 and 2 (m, ≥ 0): see [`plane_offset`].
+    pub plane_offset: f64,
+}
+
+/// Offset (m) between the two foot planes: the larger distance of each tripod's foot centroid
+/// from the other tripod's plane (unit normals). 0 when all six feet are coplanar; for two
+/// parallel planes, their distance. Only meaningful when α12 is small (within ε_α), where it
+/// tells a step between the tripods from one plane.
+pub fn plane_offset(plane1: &PlaneTilt, feet1: &[Point3<f64>; 3], plane2: &PlaneTilt, feet2: &[Point3<f64>; 3]) -> f64 {
+    let centroid = |f: &[Point3<f64>; 3]| Point3::from((f[0].coords + f[1].coords + f[2].coords) / 3.0);
+    plane2
+        .distance(&centroid(feet1))
+        .abs()
+        .max(plane1.distance(&centroid(feet2)).abs())
+}
+
+/// The class by SPEC §6's corrected rule, with the step between the tripods seen by the planes'
+/// offset:
+/// 1. BEYOND_LIMITS if σ > σ_max or tilt > tilt_max, or if any measure is
+///    NaN, infinite or negative (an undefined stance never passes as safe ground);
+/// 2. otherwise UNEVEN if α12 > ε_α (the planes cross) or the plane offset exceeds
+///    `plane_offset_max` (parallel planes at different heights: a step between the tripods,
+///    level or on a slope);
+/// 3. otherwise FLAT if α13 ≤ ε_α, α23 ≤ ε_α and σ ≤ σ_flat, UNEVEN if only σ exceeds σ_flat,
+///    else SLOPE.
+pub fn classify(config: &TerrainConfig, m: &Measures) -> TerrainClass {
     let eps = config.epsilon_alpha;
-    if sigma > config.sigma_max || tilt > config.tilt_max {
+    let values = [m.sigma, m.alpha12, m.alpha23, m.alpha13, m.tilt, m.plane_offset];
+    // NaN fails `is_finite`, so it cannot reach the comparisons below, which it would pass.
+    let defined = values.iter().all(|v| v.is_finite() && *v >= 0.0);
+    if !defined || m.sigma > config.sigma_max || m.tilt > config.tilt_max {
         TerrainClass::BeyondLimits
-    } else if alpha12 > eps {
+    } else if m.alpha12 > eps || m.plane_offset > config.plane_offset_max {
         TerrainClass::Uneven
-    } else if alpha13 <= eps && alpha23 <= eps {
-        if sigma <= config.sigma_flat {
+    } else if m.alpha13 <= eps && m.alpha23 <= eps {
+        if m.sigma <= config.sigma_flat {
             TerrainClass::Flat
         } else {
             TerrainClass::Uneven
@@ -208,6 +286,8 @@ pub struct Assessment {
     pub planes: [PlaneTilt; 3],
     /// Largest inclination of planes 1 and 2 to the body's xy-plane (rad).
     pub tilt: f64,
+    /// Offset between planes 1 and 2 (m, see [`plane_offset`]); not in the message.
+    pub plane_offset: f64,
     /// The class.
     pub class: TerrainClass,
     /// The advised gait.
@@ -258,7 +338,16 @@ impl Assessor {
         let alpha13 = angle_between(&n1, &n3);
         let (sigma, sigma_sample) = sigma_of_heights(&feet.map(|p| p.z));
         let tilt = plane1.inclination().max(plane2.inclination());
-        let class = classify(&self.config, sigma, alpha12, alpha13, alpha23, tilt);
+        let offset = plane_offset(&plane1, &[*a1, *a2, *a3], &plane2, &[*b1, *b2, *b3]);
+        let measures = Measures {
+            sigma,
+            alpha12,
+            alpha23,
+            alpha13,
+            tilt,
+            plane_offset: offset,
+        };
+        let class = classify(&self.config, &measures);
         let advice = advise(&self.config, class, sigma);
         Ok(Assessment {
             feet: *feet,
@@ -269,6 +358,7 @@ impl Assessor {
             alpha13,
             planes: [plane1, plane2, plane3],
             tilt,
+            plane_offset: offset,
             class,
             advice,
         })
@@ -281,6 +371,9 @@ mod tests {
 
     /// A plane through (0,0,0), (1,0,1), (0,1,0): z = x, so N ∝ (−1, 0, 1)/√2 after turning
     /// c > 0; inclination 45° along x; downhill along −x (the normal's horizontal part): π.
+    /// Ground rising along +x has θ_x < 0. Then z = y (through (0,0,0), (1,0,0), (0,1,1); the
+    /// vertex order gives N ∝ (0, 1, −1), turned to (0, −1, 1)/√2): θ_y = −45°, θ_x = 0,
+    /// downhill −π/2 (toward −y, the right).
     #[test]
     fn plane_through_three_points() {
         let p = PlaneTilt::through(
@@ -296,6 +389,16 @@ mod tests {
         assert!((p.theta_x + std::f64::consts::FRAC_PI_4).abs() < 1e-15);
         assert!((p.downhill - std::f64::consts::PI).abs() < 1e-15);
         assert!((p.inclination() - std::f64::consts::FRAC_PI_4).abs() < 1e-15);
+        let p = PlaneTilt::through(
+            PlaneId::Feet1,
+            &Point3::new(0.0, 0.0, 0.0),
+            &Point3::new(1.0, 0.0, 0.0),
+            &Point3::new(0.0, 1.0, 1.0),
+        )
+        .unwrap();
+        assert!(p.a.abs() < 1e-15 && (p.b + h).abs() < 1e-15 && (p.c - h).abs() < 1e-15);
+        assert!((p.theta_y + std::f64::consts::FRAC_PI_4).abs() < 1e-15 && p.theta_x.abs() < 1e-15);
+        assert!((p.downhill + std::f64::consts::FRAC_PI_2).abs() < 1e-15);
     }
 
     /// With N_1 = (0,0,1) and N_2 = −(0, sin 30°, cos 30°) (opposite orientation), eq. 17 with
@@ -309,20 +412,141 @@ mod tests {
         assert!(angle_between(&n1, &(-n1)).abs() < 1e-15);
     }
 
+    /// NaN or huge points: refused with a typed error, never a plane holding NaN. (Before the
+    /// check, a NaN point gave Ok with NaN in every field, and 1e300 overflowed the cross
+    /// product to ∞ and the normal to NaN.)
+    #[test]
+    fn through_refuses_nan_and_huge_points() {
+        let o = Point3::new(0.0, 0.0, 0.0);
+        let x = Point3::new(1.0, 0.0, 0.0);
+        for bad in [
+            Point3::new(f64::NAN, 1.0, 0.0),
+            Point3::new(0.0, f64::NAN, f64::NAN),
+            Point3::new(0.0, 1.0, f64::INFINITY),
+        ] {
+            assert!(matches!(
+                PlaneTilt::through(PlaneId::Feet1, &o, &x, &bad),
+                Err(TerrainError::NonFinite { .. })
+            ));
+        }
+        let huge = Point3::new(0.0, 1e300, 0.0);
+        assert!(matches!(
+            PlaneTilt::through(PlaneId::Feet2, &o, &huge, &x),
+            Err(TerrainError::OutOfRange { ref what, .. }) if what == "point 2 of plane 2 (DP, DG, KV)"
+        ));
+        // Just within the limit (1 km) still works: z = x through (0,0,0), (1000,0,1000),
+        // (0,1000,0) is the 45° plane of `plane_through_three_points`.
+        let p = PlaneTilt::through(
+            PlaneId::Feet1,
+            &o,
+            &Point3::new(1e3, 0.0, 1e3),
+            &Point3::new(0.0, 1e3, 0.0),
+        )
+        .unwrap();
+        assert!((p.theta_x + std::f64::consts::FRAC_PI_4).abs() < 1e-15);
+    }
+
+    /// Normals of any length give the same angle: 30° between (0, 0, 1) and (0, 1/2, √3/2)
+    /// scaled by 1e300 (their cross product would overflow to ∞, atan2(∞, ∞) = 45°) or by
+    /// 1e-300 (it would underflow to 0, giving 0°). A zero or NaN normal has no angle: NaN.
+    #[test]
+    fn angle_between_huge_tiny_and_undefined_normals() {
+        let n1 = Vector3::new(0.0, 0.0, 1.0);
+        let n2 = Vector3::new(0.0, 0.5, 0.75f64.sqrt());
+        for s in [1e300, 1e-300, 1.0] {
+            let a = angle_between(&(n1 * s), &(n2 * s));
+            assert!((a - 30f64.to_radians()).abs() < 1e-15, "scale {s}: {a}");
+        }
+        assert!(angle_between(&n1, &Vector3::zeros()).is_nan());
+        assert!(angle_between(&Vector3::new(f64::NAN, 0.0, 1.0), &n1).is_nan());
+        assert!(angle_between(&n1, &Vector3::new(0.0, f64::INFINITY, 1.0)).is_nan());
+    }
+
+    /// σ of [h, −h, h, −h, h, −h]: mean 0, every deviation h, so σ = h and the sample σ
+    /// = h·√(6/5). With h = 1e200 the squares (1e400) would overflow to ∞; with h = 1e308 even
+    /// the differences (2e308) would. A NaN or an infinite height gives NaN.
+    #[test]
+    fn sigma_of_huge_and_undefined_heights() {
+        for h in [0.01, 1e200, 1e308] {
+            let (pop, sample) = sigma_of_heights(&[h, -h, h, -h, h, -h]);
+            assert!((pop / h - 1.0).abs() < 1e-15, "h {h}: {pop}");
+            assert!((sample / h - 1.2f64.sqrt()).abs() < 1e-15, "h {h}: {sample}");
+        }
+        for bad in [f64::NAN, f64::INFINITY] {
+            let (pop, sample) = sigma_of_heights(&[bad, 0.0, 0.0, 0.0, 0.0, 0.0]);
+            assert!(pop.is_nan() && sample.is_nan());
+            let (pop, _) = sigma_of_heights(&[0.0, 0.0, 0.0, 0.0, 0.0, bad]);
+            assert!(pop.is_nan());
+        }
+    }
+
+    /// Measures in the message's order, the offset last.
+    fn m(sigma: f64, alpha12: f64, alpha23: f64, alpha13: f64, tilt: f64, plane_offset: f64) -> Measures {
+        Measures {
+            sigma,
+            alpha12,
+            alpha23,
+            alpha13,
+            tilt,
+            plane_offset,
+        }
+    }
+
     #[test]
     fn classes_at_their_boundaries() {
         let c = TerrainConfig::default();
         let e = c.epsilon_alpha;
-        assert_eq!(classify(&c, 0.0, 0.0, 0.0, 0.0, 0.0), TerrainClass::Flat);
-        assert_eq!(classify(&c, c.sigma_flat, e, e, e, e), TerrainClass::Flat);
-        assert_eq!(classify(&c, 0.011, 0.0, 0.0, 0.0, 0.0), TerrainClass::Uneven);
-        assert_eq!(classify(&c, 0.02, 0.0, 0.1, 0.1, 0.1), TerrainClass::Slope);
-        assert_eq!(classify(&c, 0.02, e * 1.01, 0.1, 0.1, 0.1), TerrainClass::Uneven);
-        assert_eq!(classify(&c, 0.041, 0.0, 0.0, 0.0, 0.0), TerrainClass::BeyondLimits);
-        assert_eq!(classify(&c, 0.02, 0.0, 0.27, 0.27, 0.27), TerrainClass::BeyondLimits);
+        let o = c.plane_offset_max;
+        assert_eq!(classify(&c, &m(0.0, 0.0, 0.0, 0.0, 0.0, 0.0)), TerrainClass::Flat);
+        assert_eq!(classify(&c, &m(c.sigma_flat, e, e, e, e, o)), TerrainClass::Flat);
+        assert_eq!(classify(&c, &m(0.011, 0.0, 0.0, 0.0, 0.0, 0.0)), TerrainClass::Uneven);
+        assert_eq!(classify(&c, &m(0.02, 0.0, 0.1, 0.1, 0.1, 0.0)), TerrainClass::Slope);
+        assert_eq!(classify(&c, &m(0.02, 0.0, 0.1, 0.1, 0.1, o)), TerrainClass::Slope);
+        assert_eq!(
+            classify(&c, &m(0.02, 0.0, 0.1, 0.1, 0.1, o * 1.01)),
+            TerrainClass::Uneven
+        );
+        assert_eq!(
+            classify(&c, &m(0.005, 0.0, 0.0, 0.0, 0.0, o * 1.01)),
+            TerrainClass::Uneven
+        );
+        assert_eq!(
+            classify(&c, &m(0.02, e * 1.01, 0.1, 0.1, 0.1, 0.0)),
+            TerrainClass::Uneven
+        );
+        assert_eq!(
+            classify(&c, &m(0.041, 0.0, 0.0, 0.0, 0.0, 0.0)),
+            TerrainClass::BeyondLimits
+        );
+        assert_eq!(
+            classify(&c, &m(0.02, 0.0, 0.27, 0.27, 0.27, 0.0)),
+            TerrainClass::BeyondLimits
+        );
         assert_eq!(advise(&c, TerrainClass::Flat, 0.0), Gait::Tripod);
-        assert_eq!(advise(&c, TerrainClass::Slope, 0.02), Gait::Ripple);
-        assert_eq!(advise(&c, TerrainClass::Uneven, 0.0201), Gait::Wave);
+        // σ_wave = 2.5 cm: a 10° slope's 2.37 cm is ripple, 2.51 cm wave.
+        assert_eq!(advise(&c, TerrainClass::Slope, 0.0237), Gait::Ripple);
+        assert_eq!(advise(&c, TerrainClass::Slope, 0.025), Gait::Ripple);
+        assert_eq!(advise(&c, TerrainClass::Uneven, 0.0251), Gait::Wave);
         assert_eq!(advise(&c, TerrainClass::BeyondLimits, 0.0), Gait::Reroute);
+    }
+
+    /// The order is the message's: α23 (plane 2 to the body) before α13. Each field reaches
+    /// the rule: a NaN, an infinity or a negative value in any one of them is BEYOND_LIMITS
+    /// (fails closed, never FLAT or SLOPE).
+    #[test]
+    fn any_undefined_measure_is_beyond_limits() {
+        let c = TerrainConfig::default();
+        assert_eq!(classify(&c, &m(0.0, 0.0, 0.0, 0.0, 0.0, 0.0)), TerrainClass::Flat);
+        // α13 = 0.1 rad alone: SLOPE; α23 = 0.1 rad alone: SLOPE too.
+        assert_eq!(classify(&c, &m(0.01, 0.0, 0.0, 0.1, 0.1, 0.0)), TerrainClass::Slope);
+        assert_eq!(classify(&c, &m(0.01, 0.0, 0.1, 0.0, 0.1, 0.0)), TerrainClass::Slope);
+        for k in 0..6 {
+            for bad in [f64::NAN, -1e-3, f64::INFINITY, f64::NEG_INFINITY] {
+                let mut v = [0.0; 6];
+                v[k] = bad;
+                let x = m(v[0], v[1], v[2], v[3], v[4], v[5]);
+                assert_eq!(classify(&c, &x), TerrainClass::BeyondLimits, "field {k} = {bad}");
+            }
+        }
     }
 }

@@ -19,16 +19,32 @@ const DEG: f64 = std::f64::consts::PI / 180.0;
 #[serde(default)]
 pub struct TerrainConfig {
     /// σ_flat (m): the largest σ of the feet that still counts as flat. FLAT needs all three
-    /// angles within ε_α *and* σ ≤ σ_flat: two tripods level but at different heights (a step
-    /// between them) have α12 = α13 = α23 = 0, and only σ sees it. Default 0.010: above the
-    /// 0.70 cm that a plane tilted by ε_α (3°) gives with the default footholds
-    /// (0.1347 m × tan 3°, the largest over directions), so a coplanar stance within ε_α is never
-    /// refused by σ, and well above leg kinematics' millimetre noise.
+    /// angles within ε_α, the planes' offset within `plane_offset_max` *and* σ ≤ σ_flat: a cap
+    /// on the height spread the tripod gait must clear, however it arises. With the default
+    /// thresholds and footholds it cannot bind (the angle and offset tests already keep σ below
+    /// 0.94 cm: parallel planes tilted 3° along y, 1 cm apart), but it still does for a larger
+    /// ε_α or plane_offset_max. Default 0.010: above the 0.70 cm that a plane tilted by ε_α (3°)
+    /// gives with the default footholds (0.1347 m × tan 3°, the largest over directions), so a
+    /// coplanar stance within ε_α is never refused by σ, and well above leg kinematics'
+    /// millimetre noise. **Depends on the footholds**: wider ones need a larger σ_flat (see
+    /// [`TerrainConfig::warnings`]).
     pub sigma_flat: f64,
+    /// Largest offset (m) between the two foot planes that still counts as one plane, when they
+    /// are parallel within ε_α (see [`plane_offset`](crate::assess::plane_offset): the larger
+    /// distance of each tripod's foot centroid from the other's plane). Above it the stance is
+    /// UNEVEN: a step between the tripods, which no angle sees, level or on a slope. Default
+    /// 0.010: ten times leg kinematics' millimetre noise, and more than three times the 2.8 mm
+    /// that two planes crossing at ε_α put between them at the default footholds' tripod
+    /// centroids (0.053 m apart: 0.053 × tan 3°), so a coplanar stance is never refused by it; a
+    /// 1 cm step is a tenth of the default body height. A new parameter rather than σ_flat: it is
+    /// a distance between planes, independent of the footholds' spread, while σ is a spread of
+    /// heights (a level step h gives σ = h/2, so σ_flat = 1 cm saw only steps over 2 cm).
+    pub plane_offset_max: f64,
     /// σ (m) between the ripple and the wave gait: SLOPE and UNEVEN get ripple up to it, wave
     /// above (the paper names both for irregular ground without choosing; wave is the slower,
-    /// safer one). Default 0.020: between Table 1's "small" (1.29 cm, ripple) and "large"
-    /// (2.77 cm, wave) columns.
+    /// safer one). Default 0.025: a plain 10° slope (σ 2.16–2.37 cm with the default footholds,
+    /// coplanar feet) keeps the ripple gait, as do Table 1's "small" feet (1.29 cm), while its
+    /// "large" feet (2.77 cm) get the wave gait. (At 2 cm every plain 10° slope got wave.)
     pub sigma_wave: f64,
     /// σ_max (m): above it the ground is BEYOND_LIMITS (reroute). Default 0.040: above Table 1's
     /// "large" feet (2.77 cm, UNEVEN) and a plain 10° slope in any direction (at most 2.37 cm
@@ -59,7 +75,8 @@ impl Default for TerrainConfig {
     fn default() -> Self {
         TerrainConfig {
             sigma_flat: 0.010,
-            sigma_wave: 0.020,
+            plane_offset_max: 0.010,
+            sigma_wave: 0.025,
             sigma_max: 0.040,
             epsilon_alpha: 3.0 * DEG,
             tilt_max: 15.0 * DEG,
@@ -78,6 +95,27 @@ fn check(name: &'static str, value: f64, ok: bool, reason: &'static str) -> Resu
 }
 
 impl TerrainConfig {
+    /// What in this configuration does not fit `geometry`, as sentences for a log (empty when
+    /// all fits): σ_flat below the σ that a plane tilted by ε_α gives with these footholds
+    /// (their [largest directional spread](HexapodGeometry::largest_spread) × tan ε_α), where a
+    /// coplanar stance within ε_α would be refused as UNEVEN by σ alone. Not an error: the
+    /// configuration still works, FLAT is only stricter than ε_α says.
+    pub fn warnings(&self, geometry: &HexapodGeometry) -> Vec<String> {
+        let mut out = Vec::new();
+        let needed = geometry.largest_spread() * self.epsilon_alpha.tan();
+        if self.sigma_flat < needed {
+            out.push(format!(
+                "sigma_flat = {} m is below the {:.4} m that a plane tilted by epsilon_alpha gives \
+                 with these footholds (largest spread {:.4} m × tan epsilon_alpha): a coplanar \
+                 stance within epsilon_alpha may be classed UNEVEN; raise sigma_flat to at least that",
+                self.sigma_flat,
+                needed,
+                geometry.largest_spread()
+            ));
+        }
+        out
+    }
+
     /// The three body points.
     pub fn body_points(&self) -> [Point3<f64>; 3] {
         let p = &self.body_points;
@@ -88,11 +126,17 @@ impl TerrainConfig {
         ]
     }
 
-    /// Checks 0 < σ_flat ≤ σ_wave ≤ σ_max, 0 < ε_α < tilt_max < 90°, finite body points and a
-    /// non-empty frame name. Degenerate body points are refused by
+    /// Checks 0 < σ_flat ≤ σ_wave ≤ σ_max, plane_offset_max > 0, 0 < ε_α < tilt_max < 90°,
+    /// finite body points and a non-empty frame name. Degenerate body points are refused by
     /// [`Assessor::new`](crate::Assessor::new), which builds plane 3.
     pub fn validate(&self) -> Result<(), TerrainError> {
         check("sigma_flat", self.sigma_flat, self.sigma_flat > 0.0, "must be > 0")?;
+        check(
+            "plane_offset_max",
+            self.plane_offset_max,
+            self.plane_offset_max > 0.0,
+            "must be > 0",
+        )?;
         check(
             "sigma_wave",
             self.sigma_wave,
@@ -214,6 +258,27 @@ impl HexapodGeometry {
         check("body_height", self.body_height, self.body_height > 0.0, "must be > 0")
     }
 
+    /// Largest directional standard deviation (m) of the six footholds: the square root of the
+    /// larger eigenvalue of their 2 × 2 covariance (population). A plane of slope tan θ under
+    /// the feet, rising in the worst direction, gives σ = this × tan θ. Default footholds:
+    /// √0.018133 = 0.1347 m (along y).
+    pub fn largest_spread(&self) -> f64 {
+        let p = Leg::ALL.map(|leg| self.footholds.get(leg));
+        let (mx, my) = (
+            p.iter().map(|q| q.x).sum::<f64>() / 6.0,
+            p.iter().map(|q| q.y).sum::<f64>() / 6.0,
+        );
+        let (mut vx, mut vy, mut cxy) = (0.0, 0.0, 0.0);
+        for q in &p {
+            let (dx, dy) = (q.x - mx, q.y - my);
+            vx += dx * dx / 6.0;
+            vy += dy * dy / 6.0;
+            cxy += dx * dy / 6.0;
+        }
+        let half_diff = (vx - vy) / 2.0;
+        ((vx + vy) / 2.0 + (half_diff * half_diff + cxy * cxy).sqrt()).sqrt()
+    }
+
     /// The nominal feet on flat ground: the footholds at z = −body_height, in [`Leg::ALL`] order.
     pub fn standing_feet(&self) -> [Point3<f64>; 6] {
         Leg::ALL.map(|leg| {
@@ -278,5 +343,60 @@ mod tests {
         assert!((vx - 0.015).abs() < 1e-12);
         assert!((vy - 0.018_133_333_333).abs() < 1e-9);
         assert!((vy.sqrt() - 0.134_66).abs() < 1e-5);
+        assert!((HexapodGeometry::default().largest_spread() - 0.134_66).abs() < 1e-5);
+    }
+
+    /// Footholds sheared along x by y (x' = x + y): var(x') = var x + var y + 2 cov = 0.015 +
+    /// 0.018133 = 0.033133, var(y) = 0.018133, cov(x', y) = var y = 0.018133. Larger eigenvalue
+    /// (0.033133 + 0.018133)/2 + √(0.0075² + 0.018133²) = 0.025633 + 0.019623 = 0.045257:
+    /// spread √0.045257 = 0.21274 m, above both axis spreads (0.1820, 0.1347), so the
+    /// covariance counts.
+    #[test]
+    fn largest_spread_sees_the_covariance() {
+        let mut g = HexapodGeometry::default();
+        for leg in Leg::ALL {
+            let [x, y] = match leg {
+                Leg::KP => &mut g.footholds.KP,
+                Leg::KV => &mut g.footholds.KV,
+                Leg::KG => &mut g.footholds.KG,
+                Leg::DP => &mut g.footholds.DP,
+                Leg::DV => &mut g.footholds.DV,
+                Leg::DG => &mut g.footholds.DG,
+            };
+            *x += *y;
+        }
+        assert!((g.largest_spread() - 0.212_74).abs() < 1e-5, "{}", g.largest_spread());
+    }
+
+    /// σ_flat (1 cm) against the footholds: the default spread 0.1347 m × tan 3° = 0.706 cm
+    /// fits; footholds 1.5 times wider spread 0.2020 m, × tan 3° = 1.059 cm > 1 cm: a warning
+    /// naming sigma_flat. σ_flat = 1.1 cm fits them again.
+    #[test]
+    fn sigma_flat_is_checked_against_the_footholds() {
+        let c = TerrainConfig::default();
+        assert!(c.warnings(&HexapodGeometry::default()).is_empty());
+        let mut wide = HexapodGeometry::default();
+        for f in [
+            &mut wide.footholds.KP,
+            &mut wide.footholds.KV,
+            &mut wide.footholds.KG,
+            &mut wide.footholds.DP,
+            &mut wide.footholds.DV,
+            &mut wide.footholds.DG,
+        ] {
+            *f = f.map(|v| v * 1.5);
+        }
+        let w = c.warnings(&wide);
+        assert_eq!(w.len(), 1);
+        assert!(
+            w[0].starts_with("sigma_flat = 0.01 m is below the 0.0106 m"),
+            "{}",
+            w[0]
+        );
+        let c = TerrainConfig {
+            sigma_flat: 0.011,
+            ..TerrainConfig::default()
+        };
+        assert!(c.warnings(&wide).is_empty());
     }
 }

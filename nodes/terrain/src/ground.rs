@@ -29,6 +29,11 @@ impl RoughGround {
         self.amplitude
     }
 
+    /// The grid's cell size (m).
+    pub fn cell(&self) -> f64 {
+        self.cell
+    }
+
     /// Height of grid node (i, j) (m).
     pub fn node(&self, i: i64, j: i64) -> f64 {
         if self.amplitude == 0.0 {
@@ -61,7 +66,9 @@ pub enum Section {
     Flat,
     /// A plane rising along +x at this angle (rad; negative descends).
     Ramp(f64),
-    /// Rough ground around the level the previous section ended at.
+    /// Rough ground around the level the previous section ended at, its roughness tapered
+    /// linearly from 0 to full over its first grid cell and back to 0 over its last (a last
+    /// section runs on and has no end taper), so that the course has no step at its ends.
     Rough(RoughGround),
 }
 
@@ -126,7 +133,15 @@ impl Course {
                     + match section {
                         Section::Flat => 0.0,
                         Section::Ramp(angle) => angle.tan() * u,
-                        Section::Rough(r) => r.height(x, y),
+                        Section::Rough(r) => {
+                            let from_start = u / r.cell();
+                            let taper = if k == last {
+                                from_start
+                            } else {
+                                from_start.min((length - u) / r.cell())
+                            };
+                            taper.clamp(0.0, 1.0) * r.height(x, y)
+                        }
                     };
             }
             if let Section::Ramp(angle) = section {
@@ -257,6 +272,41 @@ mod tests {
         assert!((c.height(3.0, 0.0) - 2.0 * t).abs() < 1e-12);
         assert!((c.height(9.0, -3.0) - 2.0 * t).abs() < 1e-12);
         assert!(matches!(c.section_at(2.5), (s, Section::Ramp(_)) if s == 1.0));
+    }
+
+    /// Flat to x = 1, rough (±5 cm, 0.10 m cells) from 1 to 2, flat after. Untapered, the
+    /// height would jump from 0 to the rough ground's (up to 5 cm) at x = 1 and back at x = 2.
+    /// Tapered over one cell, within δ of either end it is at most 0.05 · δ / 0.10 (δ = 1 µm:
+    /// 5e-7 m) from the base 0; halfway into the first cell (x = 1.05) half the rough height;
+    /// from one cell in (x = 1.1 … 1.9) the rough height itself.
+    #[test]
+    fn a_rough_section_is_tapered_to_its_neighbours() {
+        let r = RoughGround::new(0.05, 0.10, 11).unwrap();
+        let c = Course::new(
+            0.0,
+            vec![(1.0, Section::Flat), (1.0, Section::Rough(r)), (1.0, Section::Flat)],
+        )
+        .unwrap();
+        let ys = [-0.33, -0.1, 0.0, 0.17, 0.42];
+        // The step the taper removes: the rough ground at the ends is not near 0 everywhere.
+        assert!(ys
+            .iter()
+            .any(|&y| r.height(1.0, y).abs() > 1e-3 && r.height(2.0, y).abs() > 1e-3));
+        let d = 1e-6;
+        for y in ys {
+            for x in [1.0 - d, 1.0, 1.0 + d, 2.0 - d, 2.0, 2.0 + d] {
+                assert!(c.height(x, y).abs() <= 5e-7 + 1e-15, "x {x}, y {y}: {}", c.height(x, y));
+            }
+            assert!((c.height(1.05, y) - 0.5 * r.height(1.05, y)).abs() < 1e-12);
+            assert!((c.height(1.95, y) - 0.5 * r.height(1.95, y)).abs() < 1e-12);
+            for x in [1.1, 1.5, 1.9] {
+                assert!((c.height(x, y) - r.height(x, y)).abs() < 1e-12, "x {x}");
+            }
+        }
+        // A rough last section tapers in only: full height from one cell in, for ever.
+        let c = Course::new(0.0, vec![(1.0, Section::Flat), (0.5, Section::Rough(r))]).unwrap();
+        assert!(c.height(1.0 + d, 0.17).abs() <= 5e-7 + 1e-15);
+        assert!((c.height(7.3, 0.17) - r.height(7.3, 0.17)).abs() < 1e-12);
     }
 
     /// A 10° plane rising toward 90° (world +y): z = tan 10° · y.

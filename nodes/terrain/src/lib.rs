@@ -16,18 +16,30 @@
 //!   course of sections) and the walking hexapod.
 //!
 //! Choices beyond the SPEC:
-//! - **FLAT also needs σ ≤ σ_flat.** The angles cannot see the two tripods standing level at
-//!   different heights (a step between them: α12 = α13 = α23 = 0); with σ > σ_flat that stance
-//!   is UNEVEN. σ_flat (1 cm) lies above the σ of any plane tilted within ε_α with the default
-//!   footholds (0.70 cm), so a coplanar stance within ε_α is still FLAT. (A step between the
-//!   tripods on a slope, parallel planes offset, stays SLOPE: no threshold of the SPEC sees it.)
+//! - **A step between the tripods is UNEVEN, level or on a slope** (a departure from the
+//!   SPEC's Decision, which sees only the angles). Two tripods on parallel planes at different
+//!   heights have α12 = 0, so the SPEC's rule calls them FLAT (level) or SLOPE (tilted), though
+//!   the feet are not coplanar. When α12 ≤ ε_α the assessment also measures the planes'
+//!   offset, the larger distance of each tripod's foot centroid from the other tripod's plane
+//!   ([`plane_offset`]), and classes the stance UNEVEN above `plane_offset_max` (1 cm). Tripod A
+//!   on z = tan 10°·x − 0.10 and tripod B 3 cm lower: offset 3 cm · cos 10° = 2.95 cm, UNEVEN
+//!   (the SPEC's rule: SLOPE).
+//! - **FLAT also needs σ ≤ σ_flat**, a cap on the height spread the tripod gait must clear.
+//!   σ_flat (1 cm) lies above the σ of any plane tilted within ε_α with the default footholds
+//!   (0.70 cm), so a coplanar stance within ε_α is still FLAT; with the default thresholds the
+//!   angle and offset tests already keep σ under 0.94 cm on FLAT ground, so it binds only for
+//!   a larger ε_α or plane_offset_max.
 //! - **Ripple or wave by σ_wave**, a fifth threshold: SLOPE and UNEVEN get ripple up to
-//!   σ_wave (2 cm, between Table 1's small and large columns), wave above; FLAT keeps the tripod
+//!   σ_wave (2.5 cm: above a plain 10° slope's 2.16–2.37 cm, below Table 1's large column's
+//!   2.77 cm), wave above; FLAT keeps the tripod
 //!   gait; BEYOND_LIMITS advises another route.
 //! - **tilt** (the message's) is the larger inclination of planes 1 and 2 to the body's
 //!   xy-plane; tilt_max bounds it.
-//! - **Planes** carry a unit normal (a, b, c) turned to c ≥ 0; d = −N·P1. A level plane's
-//!   downhill direction is atan2(0, 0) = 0.
+//! - **Planes** carry a unit normal (a, b, c) turned to c ≥ 0 (upward); d = −N·P1. Its
+//!   horizontal part points downhill, so θ_x = atan2(a, c) > 0 when the ground falls toward
+//!   +x (ground rising 10° ahead gives θ_x = −10°), θ_y = atan2(b, c) > 0 when it falls toward
+//!   +y (left), and downhill = atan2(b, a) is the direction of steepest descent in the body's
+//!   xy-plane; a level plane's is atan2(0, 0) = 0.
 //! - **Angles** are computed as atan2(|N_i × N_j|, |N_i·N_j|), the arccos of eq. 17–19 with the
 //!   SPEC's absolute value without its loss of precision near 0 (1e-8 rad for arccos).
 //! - **Degenerate input**: a coordinate beyond ±1 km or not finite, two points of a plane
@@ -65,7 +77,8 @@ pub mod tracker;
 pub mod walker;
 
 pub use assess::{
-    advise, angle_between, classify, sigma_of_heights, Assessment, Assessor, Gait, PlaneTilt, TerrainClass,
+    advise, angle_between, classify, plane_offset, sigma_of_heights, Assessment, Assessor, Gait, Measures, PlaneTilt,
+    TerrainClass,
 };
 pub use config::{Footholds, HexapodGeometry, TerrainConfig};
 pub use error::{PlaneId, TerrainError, COORDINATE_LIMIT, MIN_EDGE, MIN_SINE};

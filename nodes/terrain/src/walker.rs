@@ -166,28 +166,38 @@ impl Walker {
 
     /// Every touchdown with t0 < t ≤ t1, in time order and, at one instant, in [`Leg::ALL`]
     /// order: the six standing feet at t = 0, then tripod B at odd multiples of T/2 and tripod A
-    /// at even ones. Successive calls with adjoining intervals give each touchdown once.
-    pub fn touchdowns_in(&self, t0: f64, t1: f64) -> Vec<Touchdown> {
-        let mut out = Vec::new();
-        if !(t0.is_finite() && t1.is_finite()) || t1 <= t0 {
-            return out;
-        }
-        if t0 < 0.0 && t1 >= 0.0 {
-            out.extend(Leg::ALL.iter().map(|&leg| self.touchdown(0.0, leg, 0.0)));
-        }
+    /// at even ones. Successive calls with adjoining intervals give each touchdown once. Lazy:
+    /// nothing is computed or stored before it is asked for, so an interval of any length (a
+    /// clock jumping far ahead) costs only the touchdowns taken from it. A non-finite or empty
+    /// interval gives none.
+    pub fn touchdowns_in(&self, t0: f64, t1: f64) -> impl Iterator<Item = Touchdown> + '_ {
+        let valid = t0.is_finite() && t1.is_finite() && t1 > t0;
+        let standing = valid && t0 < 0.0 && t1 >= 0.0;
+        let standing = Leg::ALL
+            .into_iter()
+            .filter(move |_| standing)
+            .map(move |leg| self.touchdown(0.0, leg, 0.0));
         let half = self.config.gait_period / 2.0;
-        let first = ((t0.max(0.0) / half).floor() as i64 + 1).max(1);
-        let last = (t1 / half).floor() as i64;
-        for k in first..=last {
-            let t = k as f64 * half;
-            if t <= t0 || t > t1 {
-                continue;
-            }
-            let tripod = if k % 2 == 1 { Tripod::B } else { Tripod::A };
-            for &leg in Leg::ALL.iter().filter(|l| l.tripod() == tripod) {
-                out.push(self.touchdown(t, leg, self.stride() / 2.0));
-            }
-        }
-        out
+        // Float-to-int casts saturate, and the + 1 saturates too: no overflow for any t0, t1.
+        let (first, last) = if valid {
+            (
+                ((t0.max(0.0) / half).floor() as i64).saturating_add(1).max(1),
+                (t1 / half).floor() as i64,
+            )
+        } else {
+            (1, 0)
+        };
+        let ahead = self.stride() / 2.0;
+        let steps = (first..=last)
+            .map(move |k| (k, k as f64 * half))
+            .filter(move |&(_, t)| t > t0 && t <= t1)
+            .flat_map(move |(k, t)| {
+                let tripod = if k % 2 == 1 { Tripod::B } else { Tripod::A };
+                Leg::ALL
+                    .into_iter()
+                    .filter(move |l| l.tripod() == tripod)
+                    .map(move |leg| self.touchdown(t, leg, ahead))
+            });
+        standing.chain(steps)
     }
 }

@@ -61,8 +61,8 @@ fn a_tilted_plane_is_slope_with_its_downhill_direction() {
         let sigma = t * (0.015 * phi.cos().powi(2) + 0.018_133_333_333 * phi.sin().powi(2)).sqrt();
         assert!((r.sigma - sigma).abs() < 1e-9, "σ {} vs {sigma}", r.sigma);
         assert_eq!(r.class, TerrainClass::Slope, "uphill {uphill}");
-        // σ = 2.16–2.37 cm > σ_wave (2 cm): the wave gait.
-        assert_eq!(r.advice, Gait::Wave);
+        // σ = 2.16–2.37 cm ≤ σ_wave (2.5 cm): the ripple gait.
+        assert_eq!(r.advice, Gait::Ripple);
     }
     let r = a.assess(&on_plane(10.0, 0.0)).unwrap();
     assert!((r.sigma - 0.021_596).abs() < 1e-6);
@@ -83,8 +83,9 @@ fn gentle_tilts_are_flat_and_moderate_ones_slope() {
     assert_eq!((r.class, r.advice), (TerrainClass::Slope, Gait::Ripple));
 }
 
-/// Tripod A level at −0.10 m, tripod B level at −0.13 m: every angle 0, but σ = 1.5 cm (three
-/// feet 1.5 cm above the mean −0.115, three below) > σ_flat: UNEVEN, ripple.
+/// Tripod A level at −0.10 m, tripod B level at −0.13 m: every angle 0, σ = 1.5 cm (three
+/// feet 1.5 cm above the mean −0.115, three below); the planes z = −0.10 and z = −0.13 are
+/// 3 cm apart > plane_offset_max (1 cm): UNEVEN, ripple.
 #[test]
 fn a_step_between_the_tripods_is_uneven() {
     let mut feet = HexapodGeometry::default().standing_feet();
@@ -94,7 +95,55 @@ fn a_step_between_the_tripods_is_uneven() {
     let r = assessor().assess(&feet).unwrap();
     assert!(r.alpha12 < 1e-12 && r.alpha13 < 1e-12 && r.alpha23 < 1e-12);
     assert!((r.sigma - 0.015).abs() < 1e-12);
+    assert!((r.plane_offset - 0.03).abs() < 1e-12);
     assert_eq!((r.class, r.advice), (TerrainClass::Uneven, Gait::Ripple));
+}
+
+/// A 0.9 cm step is within plane_offset_max: still FLAT (σ = 0.45 cm ≤ σ_flat); 1.2 cm is
+/// beyond it: UNEVEN, though σ = 0.6 cm ≤ σ_flat (the σ gate alone let steps up to 2 cm pass).
+#[test]
+fn a_level_step_is_uneven_from_plane_offset_max_on() {
+    for (step, class) in [(0.009, TerrainClass::Flat), (0.012, TerrainClass::Uneven)] {
+        let mut feet = HexapodGeometry::default().standing_feet();
+        for leg in Leg::PLANE2 {
+            feet[leg.index()].z = -0.10 - step;
+        }
+        let r = assessor().assess(&feet).unwrap();
+        assert!((r.sigma - step / 2.0).abs() < 1e-12);
+        assert!((r.plane_offset - step).abs() < 1e-12);
+        assert_eq!(r.class, class, "step {step}");
+    }
+}
+
+/// Tripod A on z = t·x − 0.10 (t = tan 10° = 0.176327), tripod B 3 cm lower, z = t·x − 0.13:
+/// parallel planes, α12 = 0, α13 = α23 = tilt = 10°. Unit normal (−t, 0, 1)/√(1 + t²), so A's
+/// centroid (0, 0.02667, −0.10) lies 0.03 · cos 10° = 0.029544 m from plane 2 (and B's from
+/// plane 1 the same). σ² = t²·var(x) + var(step) (x and the tripod are uncorrelated: each
+/// tripod has x = 0.15, −0.15, 0) = 0.031091 · 0.015 + 0.015² = 6.9137e-4, σ = 2.6294 cm.
+/// Feet not coplanar: UNEVEN (the SPEC's angle rule alone said SLOPE); σ > σ_wave (2.5 cm): wave.
+#[test]
+fn a_step_between_the_tripods_on_a_slope_is_uneven() {
+    let t = 10f64.to_radians().tan();
+    let mut feet = HexapodGeometry::default().standing_feet();
+    for (k, f) in feet.iter_mut().enumerate() {
+        let lower = if Leg::PLANE2.contains(&Leg::ALL[k]) { 0.03 } else { 0.0 };
+        f.z = t * f.x - 0.10 - lower;
+    }
+    let r = assessor().assess(&feet).unwrap();
+    assert!(r.alpha12 < 1e-9);
+    assert!((r.alpha13 - 10f64.to_radians()).abs() < 1e-9);
+    assert!((r.alpha23 - 10f64.to_radians()).abs() < 1e-9);
+    assert!((r.plane_offset - 0.029_544).abs() < 1e-6, "offset {}", r.plane_offset);
+    assert!((r.sigma - 0.026_294).abs() < 1e-6, "σ {}", r.sigma);
+    assert_eq!((r.class, r.advice), (TerrainClass::Uneven, Gait::Wave));
+}
+
+/// The same slope without the step: all six feet on z = t·x − 0.10, offset 0: SLOPE.
+#[test]
+fn a_plain_slope_has_no_plane_offset() {
+    let r = assessor().assess(&on_plane(10.0, 0.0)).unwrap();
+    assert!(r.plane_offset < 1e-12);
+    assert_eq!(r.class, TerrainClass::Slope);
 }
 
 /// 16° along x: tilt 16° > 15° while σ = 0.1225 · tan 16° = 3.51 cm < σ_max: BEYOND by tilt.

@@ -39,8 +39,13 @@ fn the_file_holds_the_documented_defaults() {
     assert!((config.epsilon_alpha - d.epsilon_alpha).abs() < 1e-7);
     assert!((config.tilt_max - d.tilt_max).abs() < 1e-7);
     assert_eq!(
-        (config.sigma_flat, config.sigma_wave, config.sigma_max),
-        (d.sigma_flat, d.sigma_wave, d.sigma_max)
+        (
+            config.sigma_flat,
+            config.plane_offset_max,
+            config.sigma_wave,
+            config.sigma_max
+        ),
+        (d.sigma_flat, d.plane_offset_max, d.sigma_wave, d.sigma_max)
     );
     assert_eq!(
         (config.body_points, config.body_frame.as_str()),

@@ -124,6 +124,28 @@ proptest! {
         prop_assert!((a.alpha13 - incl).abs() < 1e-7);
     }
 
+    /// Feet on a plane z = p·x + q·y + r, tripod B then raised by h: two parallel planes whose
+    /// vertical gap is h, so their distance (unit normal (−p, −q, 1)/√(1 + p² + q²)) is
+    /// |h| / √(1 + p² + q²); without the raise the six feet are coplanar, offset 0.
+    #[test]
+    fn a_raised_tripod_is_offset_by_its_raise_times_cos_tilt(
+        p in -0.3..0.3f64,
+        q in -0.3..0.3f64,
+        r in -0.2..0.2f64,
+        h in -0.05..0.05f64,
+    ) {
+        let on_plane = HexapodGeometry::default().standing_feet().map(|f| Point3::new(f.x, f.y, p * f.x + q * f.y + r));
+        prop_assert!(assess(&on_plane).plane_offset < 1e-12);
+        let mut raised = on_plane;
+        for leg in Leg::PLANE2 {
+            raised[leg.index()].z += h;
+        }
+        let a = assess(&raised);
+        let expected = h.abs() / (1.0 + p * p + q * q).sqrt();
+        prop_assert!((a.plane_offset - expected).abs() < 1e-12, "{} vs {expected}", a.plane_offset);
+        prop_assert!(a.alpha12 < 1e-9);
+    }
+
     /// No finite stance within range gives a NaN: either an error or finite numbers.
     #[test]
     fn finite_stances_give_finite_numbers(
@@ -131,7 +153,7 @@ proptest! {
     ) {
         let feet = feet.map(|(x, y, z)| Point3::new(x, y, z));
         if let Ok(a) = assessor().assess(&feet) {
-            let mut all = vec![a.sigma, a.sigma_sample, a.alpha12, a.alpha13, a.alpha23, a.tilt];
+            let mut all = vec![a.sigma, a.sigma_sample, a.alpha12, a.alpha13, a.alpha23, a.tilt, a.plane_offset];
             for p in a.planes {
                 all.extend([p.a, p.b, p.c, p.d, p.theta_x, p.theta_y, p.downhill]);
             }

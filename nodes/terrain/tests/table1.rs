@@ -15,9 +15,9 @@
 //! The angles by a second method (planes as z = p·x + q·y + r solved by Cramer's rule, normals
 //! (−p, −q, 1), eq. 17 with |N_1·N_2|; worked out outside the library):
 //! - small: plane 1 p = 0.13333, q = −0.035714; plane 2 p = 0, q = −0.035714; α12 = 7.590°,
-//!   α13 = 7.859°, α23 = 2.045°: UNEVEN (α12 > ε_α = 3°), σ 1.29 cm ≤ σ_wave → ripple.
+//!   α13 = 7.859°, α23 = 2.045°: UNEVEN (α12 > ε_α = 3°), σ 1.29 cm ≤ σ_wave (2.5 cm) → ripple.
 //! - large: plane 1 p = 0.1, q = 0.089286; plane 2 p = −0.2, q = −0.071429; α12 = 19.276°,
-//!   α13 = 7.636°, α23 = 11.990° (tilt 11.99° < 15°): UNEVEN, σ 2.77 cm > σ_wave → wave.
+//!   α13 = 7.636°, α23 = 11.990° (tilt 11.99° < 15°): UNEVEN, σ 2.77 cm > σ_wave (2.5 cm) → wave.
 
 use mobil_terrain::{Assessment, Assessor, Gait, HexapodGeometry, TerrainClass, TerrainConfig};
 

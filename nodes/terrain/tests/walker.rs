@@ -44,7 +44,7 @@ fn the_tripod_gait_lands_each_foot_half_a_stride_ahead() {
     };
     let w = Walker::new(config, Ground::Flat(0.0)).unwrap();
     assert!((w.stride() - 0.05).abs() < 1e-15);
-    let all = w.touchdowns_in(-1.0, 2.0);
+    let all: Vec<Touchdown> = w.touchdowns_in(-1.0, 2.0).collect();
     assert_eq!(all.len(), 18);
     let times: Vec<f64> = all.iter().map(|t| t.t).collect();
     let mut expected = vec![0.0; 6];
@@ -60,7 +60,7 @@ fn the_tripod_gait_lands_each_foot_half_a_stride_ahead() {
     // Flat ground at 0, body 0.10 m above it: every foot at z = −0.10 in the body frame.
     assert!(all.iter().all(|t| (t.position.z + 0.10).abs() < 1e-15));
     // Adjoining intervals give every touchdown once.
-    let mut parts = w.touchdowns_in(-1.0, 0.7);
+    let mut parts: Vec<Touchdown> = w.touchdowns_in(-1.0, 0.7).collect();
     parts.extend(w.touchdowns_in(0.7, 1.5));
     parts.extend(w.touchdowns_in(1.5, 2.0));
     assert_eq!(parts, all);
@@ -68,6 +68,28 @@ fn the_tripod_gait_lands_each_foot_half_a_stride_ahead() {
     // landed, which at lift-off (t + T/2) is L/2 behind its foothold in the body frame.
     let lift_off = w.body_pose(kv.t + 0.5);
     assert!((lift_off.position.y - (kv.world.y + 0.025)).abs() < 1e-12);
+}
+
+/// A clock jumping far ahead: the touchdowns up to t = 10³⁰⁰ s are produced one at a time, and
+/// the first of them are those of an ordinary walk: six standing feet at 0, then tripod B
+/// (KV, DP, DG) at 0.5 s and tripod A (KP, KG, DV) at 1 s. (Collected into a vector they would
+/// never end.) An interval starting at 10¹⁸ s still yields touchdowns after its start. Empty,
+/// reversed and non-finite intervals give none.
+#[test]
+fn a_huge_interval_is_walked_lazily() {
+    let w = Walker::new(WalkerConfig::default(), Ground::Flat(0.0)).unwrap();
+    let first: Vec<(f64, Leg)> = w.touchdowns_in(-1.0, 1e300).take(12).map(|t| (t.t, t.leg)).collect();
+    let mut expected: Vec<(f64, Leg)> = Leg::ALL.iter().map(|&l| (0.0, l)).collect();
+    expected.extend([Leg::KV, Leg::DP, Leg::DG].map(|l| (0.5, l)));
+    expected.extend([Leg::KP, Leg::KG, Leg::DV].map(|l| (1.0, l)));
+    assert_eq!(first, expected);
+    let far: Vec<Touchdown> = w.touchdowns_in(1e18, 1e300).take(3).collect();
+    assert_eq!(far.len(), 3);
+    assert!(far.iter().all(|t| t.t > 1e18), "{far:?}");
+    assert_eq!(w.touchdowns_in(1.0, 1.0).count(), 0);
+    assert_eq!(w.touchdowns_in(2.0, 1.0).count(), 0);
+    assert_eq!(w.touchdowns_in(f64::NAN, 1.0).count(), 0);
+    assert_eq!(w.touchdowns_in(0.0, f64::INFINITY).count(), 0);
 }
 
 #[test]
