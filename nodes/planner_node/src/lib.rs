@@ -543,6 +543,8 @@ pub fn docking_offset(params: &ChassisParams) -> f64 {
 pub enum Mode {
     /// No goal.
     Idle,
+    /// A route's pre-check (the virtual robot drives it first; the robot waits).
+    PreCheck,
     /// Docking by the Lyapunov law.
     Dock,
     /// Docking's final in-place rotation.
@@ -558,6 +560,7 @@ impl Mode {
     pub fn as_str(self) -> &'static str {
         match self {
             Mode::Idle => "idle",
+            Mode::PreCheck => "pre_check",
             Mode::Dock => "dock",
             Mode::Rotate => "rotate",
             Mode::Approach => "approach",
@@ -1090,6 +1093,13 @@ fn clear_marker(header: &Header) -> Marker {
     m
 }
 
+/// Whether a running goal's odometry is stale (steady clock): older than `timeout`, counted as
+/// old as the goal at most (`None`: none yet), so a goal gets one timeout from its start for
+/// odometry to arrive and never fails at once for an old one.
+pub fn odom_stale(odom_age: Option<Duration>, goal_age: Duration, timeout: Duration) -> bool {
+    odom_age.map_or(goal_age, |a| a.min(goal_age)) > timeout
+}
+
 /// The signed distance backed out along the start heading: how far the reference point moved
 /// against `start`'s heading (m).
 pub fn backed_out(start: &Pose2, now: &Pose2) -> f64 {
@@ -1438,6 +1448,21 @@ mod tests {
         let arrow = a.markers.last().expect("arrow");
         assert_eq!(arrow.r#type, Marker::ARROW);
         assert_relative_eq!(yaw_of(&arrow.pose.orientation), 0.5, epsilon = 1e-12);
+    }
+
+    #[test]
+    fn odometry_is_stale_after_one_timeout_from_the_goal_s_start() {
+        let ms = Duration::from_millis;
+        let timeout = ms(500);
+        // Fresh: 0.1 s old. Stale: 0.6 s old on a goal 2 s old.
+        assert!(!odom_stale(Some(ms(100)), ms(2000), timeout));
+        assert!(odom_stale(Some(ms(600)), ms(2000), timeout));
+        // A goal 0.3 s old with odometry 5 s old (or none yet) has its grace.
+        assert!(!odom_stale(Some(ms(5000)), ms(300), timeout));
+        assert!(!odom_stale(None, ms(300), timeout));
+        assert!(odom_stale(None, ms(501), timeout));
+        // Exactly the timeout is not yet stale.
+        assert!(!odom_stale(Some(ms(500)), ms(2000), timeout));
     }
 
     #[test]

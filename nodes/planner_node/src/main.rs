@@ -35,7 +35,7 @@ use mobil_planner::{
 };
 use mobil_planner_node::{
     backed_out, check_reply, clamp_twist, dock_goal, docking_offset, docking_outcome, duration_msg, load_world,
-    markers, missed_from_report, odom_pose, pose_in_odom, refused_reply, route_from_path, route_from_poses,
+    markers, missed_from_report, odom_pose, odom_stale, pose_in_odom, refused_reply, route_from_path, route_from_poses,
     status_message, CommandGate, GoalError, MarkerView, Missed, Mode, Outcome, PlannerConfig, Route, StatusView,
 };
 use mobil_ros::action::{ActionEvent, GoalEnd, GoalRequest, GoalServer, GoalServerConfig};
@@ -44,12 +44,15 @@ use mobil_ros::latest::Latest;
 use mobil_ros::stop::{final_stop, FINAL_STOP_WAIT};
 use mobil_ros::ticker::Ticker;
 use mobil_ros::time::{DtClock, DtError};
+use mobil_ros::OffLoop;
 use mobil_ros::{qos, run_node, shutdown_signal, warn_throttled, ConfigError, LogThrottle, NodeDecl, RosNode};
 use mobil_sim::world::World;
 use nalgebra::Point2;
-use ros2_client::{Publisher, Server};
+use ros2_client::{Publisher, RmwRequestId, Server};
 use std::process::ExitCode;
+use std::sync::Arc;
 use std::time::{Duration, Instant};
+use tokio::sync::mpsc;
 use tracing::{info, warn};
 
 /// The watchdog tick (steady clock): stale odometry is noticed within 50 ms of its timeout.
@@ -104,6 +107,8 @@ impl Source {
 /// What the active goal does.
 #[allow(clippy::large_enum_variant)]
 enum Task {
+    /// A route waiting for its pre-check (off the event loop); no command meanwhile.
+    PreCheck { route: Route, start: Pose2, seq: u64 },
     Dock {
         controller: DockingController,
         last: Option<DockingOutput>,
@@ -132,6 +137,8 @@ struct Active {
     clock: DtClock,
     t: f64,
     refused: u32,
+    /// Whether this goal has sent a command (its end then sends the zero one).
+    commanded: bool,
 }
 
 impl Active {
@@ -141,6 +148,7 @@ impl Active {
                 Some(DockingPhase::Rotate) => Mode::Rotate,
                 _ => Mode::Dock,
             },
+            Task::PreCheck { .. } => Mode::PreCheck,
             Task::Follow { .. } => Mode::Approach,
             Task::Undock { .. } => Mode::Undock,
         }
@@ -159,6 +167,25 @@ struct Servers {
     follow: GoalServer<FollowWaypoints>,
 }
 
+/// A route pre-check done off the event loop, for the goal numbered `seq`.
+struct PreCheckDone {
+    seq: u64,
+    report: Result<RouteReport, String>,
+}
+
+/// Most `planner/check_route` requests computed at once; more are answered busy at once.
+const MAX_PENDING_CHECKS: usize = 4;
+
+/// The pre-checks off the event loop: the goal's (a newer goal discards the older one's) and
+/// the service's (each request answered, in any order).
+struct Jobs {
+    goal: OffLoop<PreCheckDone>,
+    seq: u64,
+    replies_tx: mpsc::UnboundedSender<(RmwRequestId, CheckRouteResponse)>,
+    replies: mpsc::UnboundedReceiver<(RmwRequestId, CheckRouteResponse)>,
+    pending: usize,
+}
+
 /// What the markers show between goals: the last route, its prediction and problems, the dock.
 #[derive(Default)]
 struct Drawing {
@@ -172,7 +199,7 @@ struct Drawing {
 struct Shell {
     config: PlannerConfig,
     chassis: ChassisParams,
-    world: World,
+    world: Arc<World>,
     active: Option<Active>,
     odom: Latest<Pose2>,
     odom_refused: bool,
@@ -193,7 +220,9 @@ enum Event {
     Dock(ActionEvent<DockRobotGoal>),
     Undock(ActionEvent<UndockRobotGoal>),
     Follow(ActionEvent<FollowWaypointsGoal>),
-    Check(ros2_client::RmwRequestId, CheckRouteRequest),
+    Check(RmwRequestId, CheckRouteRequest),
+    Checked(RmwRequestId, CheckRouteResponse),
+    PreChecked(PreCheckDone),
     Tick,
     Nothing,
 }
@@ -249,7 +278,7 @@ async fn start(node: &mut RosNode, out: &Outputs, config: PlannerConfig) -> anyh
     let mut shell = Shell {
         config,
         chassis,
-        world,
+        world: Arc::new(world),
         active: None,
         odom: Latest::new(),
         odom_refused: false,
@@ -260,14 +289,21 @@ async fn start(node: &mut RosNode, out: &Outputs, config: PlannerConfig) -> anyh
         throttle: LogThrottle::new(Duration::from_secs(2)),
     };
     shell.send_idle_status(node, out);
+    let (replies_tx, replies) = mpsc::unbounded_channel();
+    let mut jobs = Jobs {
+        goal: OffLoop::new(),
+        seq: 0,
+        replies_tx,
+        replies,
+        pending: 0,
+    };
     let outcome = event_loop(
         node,
         out,
         &mut shell,
         &mut servers,
-        &odom_sub,
-        &dock_sub,
-        &route_sub,
+        &mut jobs,
+        (&odom_sub, &dock_sub, &route_sub),
         &check,
     )
     .await;
@@ -288,9 +324,12 @@ async fn event_loop(
     out: &Outputs,
     shell: &mut Shell,
     servers: &mut Servers,
-    odom_sub: &ros2_client::Subscription<Odometry>,
-    dock_sub: &ros2_client::Subscription<PoseStamped>,
-    route_sub: &ros2_client::Subscription<Path>,
+    jobs: &mut Jobs,
+    (odom_sub, dock_sub, route_sub): (
+        &ros2_client::Subscription<Odometry>,
+        &ros2_client::Subscription<PoseStamped>,
+        &ros2_client::Subscription<Path>,
+    ),
     check: &Server<CheckRouteRequest, CheckRouteResponse>,
 ) -> anyhow::Result<()> {
     let odoms = decoded(odom_sub.async_stream(), "odom", "odom-read", "sample ignored");
@@ -327,6 +366,8 @@ async fn event_loop(
                 }
                 None => anyhow::bail!("the planner/check_route service ended"),
             },
+            done = jobs.goal.result() => Event::PreChecked(done),
+            Some((id, reply)) = jobs.replies.recv() => Event::Checked(id, reply),
             e = servers.dock.next_event() => Event::Dock(e),
             e = servers.undock.next_event() => Event::Undock(e),
             e = servers.follow.next_event() => Event::Follow(e),
@@ -352,11 +393,11 @@ async fn event_loop(
                     start.map(|p| p.position()),
                     MIN_ROUTE_LENGTH,
                 );
-                shell.start_route(node, out, servers, route, start, Source::Waypoints);
+                shell.start_route(node, out, servers, jobs, route, start, Source::Waypoints);
             }
             Event::Dock(ActionEvent::Goal(request)) => shell.dock_action(node, out, servers, request).await,
             Event::Undock(ActionEvent::Goal(request)) => shell.undock_action(node, out, servers, request).await,
-            Event::Follow(ActionEvent::Goal(request)) => shell.follow_action(node, out, servers, request).await,
+            Event::Follow(ActionEvent::Goal(request)) => shell.follow_action(node, out, servers, jobs, request).await,
             Event::Dock(ActionEvent::CancelRequested(id)) => {
                 let is_active = servers.dock.active_id() == Some(id);
                 shell.cancel(node, out, servers, Source::DockAction, is_active)
@@ -369,18 +410,66 @@ async fn event_loop(
                 let is_active = servers.follow.active_id() == Some(id);
                 shell.cancel(node, out, servers, Source::FollowAction, is_active)
             }
-            Event::Check(id, req) => {
-                let reply = shell.check_route(node, &req);
-                if let Err(e) = check.send_response(id, reply) {
-                    warn_throttled!(
-                        shell.throttle,
-                        "check-reply",
-                        "planner/check_route: cannot send the reply: {e:?}"
-                    );
+            Event::Check(id, req) => match shell.check_request(&req) {
+                Err(reply) => respond(check, id, reply, &mut shell.throttle),
+                Ok(_) if jobs.pending >= MAX_PENDING_CHECKS => {
+                    let reply = refused_reply(format!(
+                        "BUSY: {MAX_PENDING_CHECKS} route checks are already being computed; ask again"
+                    ));
+                    respond(check, id, reply, &mut shell.throttle)
                 }
+                Ok((start, route)) => {
+                    jobs.pending += 1;
+                    let tx = jobs.replies_tx.clone();
+                    let (world, chassis, config) = (shell.world.clone(), shell.chassis, shell.config.route_check());
+                    let (stamp, frame, step) = (
+                        node.stamp(),
+                        shell.config.odom_frame.clone(),
+                        shell.config.follow.check_length,
+                    );
+                    tokio::task::spawn_blocking(move || {
+                        let began = Instant::now();
+                        let reply = match check_route(&start, &route.points, &chassis, &world, &config) {
+                            Ok(report) => check_reply(&report, &route, stamp, &frame, step),
+                            Err(e) => refused_reply(Outcome::Refused(e.to_string()).reason()),
+                        };
+                        info!(
+                            "planner/check_route: {} waypoints, {} in {:.2} ms",
+                            route.points.len(),
+                            if reply.feasible {
+                                "feasible".to_owned()
+                            } else {
+                                format!("{} problem(s)", reply.problems.len())
+                            },
+                            began.elapsed().as_secs_f64() * 1e3
+                        );
+                        // The receiver lives as long as the loop; if it is gone nobody waits.
+                        let _ = tx.send((id, reply));
+                    });
+                }
+            },
+            Event::Checked(id, reply) => {
+                jobs.pending = jobs.pending.saturating_sub(1);
+                respond(check, id, reply, &mut shell.throttle);
             }
+            Event::PreChecked(done) => shell.pre_checked(node, out, servers, done),
             Event::Tick => shell.tick(node, out, servers).await,
         }
+    }
+}
+
+fn respond(
+    check: &Server<CheckRouteRequest, CheckRouteResponse>,
+    id: RmwRequestId,
+    reply: CheckRouteResponse,
+    throttle: &mut LogThrottle,
+) {
+    if let Err(e) = check.send_response(id, reply) {
+        warn_throttled!(
+            throttle,
+            "check-reply",
+            "planner/check_route: cannot send the reply: {e:?}"
+        );
     }
 }
 
@@ -416,6 +505,9 @@ impl Shell {
     }
 
     fn publish_cmd(&mut self, out: &Outputs, twist: Twist) {
+        if let Some(a) = self.active.as_mut() {
+            a.commanded = true;
+        }
         self.gate.sent(&twist);
         if let Err(e) = out.cmd.publish(twist) {
             warn_throttled!(self.throttle, "cmd", "cannot publish cmd_vel: {e:?}");
@@ -503,6 +595,15 @@ impl Shell {
                 )
             }
             Task::Undock { distance, backed, .. } => (None, distance - backed, -1, None),
+            Task::PreCheck { route, .. } => (
+                route.points.first().map(|p| Pose2::new(p.x, p.y, 0.0)),
+                f64::NAN,
+                route
+                    .request_index
+                    .first()
+                    .map_or(-1, |&i| i32::try_from(i).unwrap_or(i32::MAX)),
+                None,
+            ),
         };
         StatusView {
             state,
@@ -548,9 +649,10 @@ impl Shell {
         self.last_markers = Some(Instant::now());
     }
 
-    /// Ends the active goal: one zero command, the status with the reason, the action's result.
+    /// Ends the active goal: one zero command (if it commanded the robot at all), the status
+    /// with the reason, the action's result.
     fn end_goal(&mut self, node: &RosNode, out: &Outputs, servers: &mut Servers, outcome: Outcome) {
-        if self.active.is_some() {
+        if self.active.as_ref().is_some_and(|a| a.commanded) {
             self.zero(out);
         }
         self.end_goal_without_zero(node, out, servers, outcome);
@@ -568,7 +670,7 @@ impl Shell {
             (Source::UndockAction, _) => {
                 servers.undock.finish(end, outcome.undock_result());
             }
-            (Source::FollowAction, Task::Follow { route, .. }) => {
+            (Source::FollowAction, Task::Follow { route, .. } | Task::PreCheck { route, .. }) => {
                 servers.follow.finish(end, outcome.follow_result(&route.poses));
             }
             (Source::FollowAction, _) => {
@@ -598,7 +700,9 @@ impl Shell {
         if active.source == source && matches!(source, Source::DockAction | Source::UndockAction | Source::FollowAction)
         {
             let old = active.source;
-            self.zero(out);
+            if active.commanded {
+                self.zero(out);
+            }
             info!("goal ({}) ends: {}", old.name(), outcome.reason());
             self.publish_status(node, out, NavStatus::FAILED, outcome.reason());
             self.active = None;
@@ -617,6 +721,7 @@ impl Shell {
             clock: DtClock::new(),
             t: 0.0,
             refused: 0,
+            commanded: false,
         });
     }
 
@@ -703,12 +808,14 @@ impl Shell {
         self.publish_refusal(node, out, &outcome);
     }
 
-    /// Pre-checks and starts a route (or refuses it).
+    /// Validates a route and starts its pre-check off the event loop (or refuses it).
+    #[allow(clippy::too_many_arguments)]
     fn start_route(
         &mut self,
         node: &RosNode,
         out: &Outputs,
         servers: &mut Servers,
+        jobs: &mut Jobs,
         route: Result<Route, GoalError>,
         start: Option<Pose2>,
         source: Source,
@@ -720,9 +827,53 @@ impl Shell {
         let Some(start) = start else {
             return self.refuse(node, out, servers, source, Outcome::Stale);
         };
-        let report = match self.pre_check(&start, &route.points) {
+        jobs.seq += 1;
+        let seq = jobs.seq;
+        let (points, world, chassis, config) = (
+            route.points.clone(),
+            self.world.clone(),
+            self.chassis,
+            self.config.route_check(),
+        );
+        jobs.goal.start(move |_| PreCheckDone {
+            seq,
+            report: check_route(&start, &points, &chassis, &world, &config).map_err(|e| e.to_string()),
+        });
+        info!(
+            "goal ({}): pre-check of {} waypoints (the virtual robot drives them first)",
+            source.name(),
+            route.points.len()
+        );
+        self.activate(node, Task::PreCheck { route, start, seq }, source);
+        self.publish_status(node, out, NavStatus::ACTIVE, String::new());
+    }
+
+    /// A pre-check is done: the route it was for (if still the active goal) starts or is
+    /// refused.
+    fn pre_checked(&mut self, node: &RosNode, out: &Outputs, servers: &mut Servers, done: PreCheckDone) {
+        let Some(Active {
+            task: Task::PreCheck { seq, .. },
+            source,
+            ..
+        }) = self.active.as_ref()
+        else {
+            return;
+        };
+        if *seq != done.seq {
+            return;
+        }
+        let source = *source;
+        let Some(Active {
+            task: Task::PreCheck { route, start, .. },
+            ..
+        }) = self.active.as_ref()
+        else {
+            return;
+        };
+        let (route, start) = (route.clone(), *start);
+        let report = match done.report {
             Ok(r) => r,
-            Err(e) => return self.refuse(node, out, servers, source, Outcome::Refused(e)),
+            Err(e) => return self.end_goal(node, out, servers, Outcome::Refused(e)),
         };
         let problems = missed_from_report(&report.problems, &route);
         self.drawing = Drawing {
@@ -734,8 +885,7 @@ impl Shell {
         if !problems.is_empty() {
             let outcome = Outcome::RouteInfeasible(problems.clone());
             if !self.config.execute_infeasible_routes {
-                self.publish_markers(node, out);
-                return self.refuse(node, out, servers, source, outcome);
+                return self.end_goal(node, out, servers, outcome);
             }
             warn!(
                 "goal ({}): driven although execute_infeasible_routes: {}",
@@ -745,7 +895,7 @@ impl Shell {
         }
         let follower = match WaypointFollower::new(self.config.follow, &self.chassis, route.points.clone()) {
             Ok(f) => f,
-            Err(e) => return self.refuse(node, out, servers, source, Outcome::Refused(e.to_string())),
+            Err(e) => return self.end_goal(node, out, servers, Outcome::Refused(e.to_string())),
         };
         info!(
             "goal ({}): {} waypoints, pre-check {} ({:.2} m predicted)",
@@ -759,22 +909,16 @@ impl Shell {
             mobil_planner_node::path_length(&report.path, self.config.follow.check_length)
         );
         let distance = (route.points[0] - start.position()).norm();
-        self.activate(
-            node,
-            Task::Follow {
+        if let Some(active) = self.active.as_mut() {
+            active.task = Task::Follow {
                 follower,
                 route,
                 missed: Vec::new(),
                 distance,
-            },
-            source,
-        );
+            };
+        }
         self.publish_status(node, out, NavStatus::ACTIVE, String::new());
         self.publish_markers(node, out);
-    }
-
-    fn pre_check(&self, start: &Pose2, points: &[Point2<f64>]) -> Result<RouteReport, String> {
-        check_route(start, points, &self.chassis, &self.world, &self.config.route_check()).map_err(|e| e.to_string())
     }
 
     async fn dock_action(
@@ -853,6 +997,7 @@ impl Shell {
         node: &RosNode,
         out: &Outputs,
         servers: &mut Servers,
+        jobs: &mut Jobs,
         request: GoalRequest<FollowWaypointsGoal>,
     ) {
         let start = self.fresh_odom();
@@ -872,7 +1017,7 @@ impl Shell {
             warn_throttled!(self.throttle, "accept", "follow_waypoints goal not started: {e}");
             return;
         }
-        self.start_route(node, out, servers, route, start, Source::FollowAction);
+        self.start_route(node, out, servers, jobs, route, start, Source::FollowAction);
     }
 
     fn cancel(&mut self, node: &RosNode, out: &Outputs, servers: &mut Servers, source: Source, is_active: bool) {
@@ -881,43 +1026,23 @@ impl Shell {
         }
     }
 
-    /// The route pre-check service: never hangs, refuses with the reason.
-    fn check_route(&mut self, node: &RosNode, req: &CheckRouteRequest) -> CheckRouteResponse {
-        let frame = self.config.odom_frame.clone();
+    /// A `planner/check_route` request: the start and route to check, or the reply refusing it
+    /// (at once, never hanging).
+    fn check_request(&self, req: &CheckRouteRequest) -> Result<(Pose2, Route), CheckRouteResponse> {
+        let frame = &self.config.odom_frame;
         let start = if req.use_start {
-            match pose_in_odom("start", &frame, &req.start, &frame) {
-                Ok(p) => p,
-                Err(e) => return refused_reply(Outcome::Invalid(e).reason()),
-            }
+            pose_in_odom("start", frame, &req.start, frame).map_err(|e| refused_reply(Outcome::Invalid(e).reason()))?
         } else {
-            match self.fresh_odom() {
-                Some(p) => p,
-                None => return refused_reply(
+            self.fresh_odom().ok_or_else(|| {
+                refused_reply(
                     "STALE_INPUT: no fresh odometry for the start (set use_start and start to check from a given pose)"
                         .to_owned(),
-                ),
-            }
+                )
+            })?
         };
-        let route = match route_from_path(&req.route, &frame, Some(start.position()), MIN_ROUTE_LENGTH) {
-            Ok(r) => r,
-            Err(e) => return refused_reply(Outcome::Invalid(e).reason()),
-        };
-        let began = Instant::now();
-        let reply = match self.pre_check(&start, &route.points) {
-            Ok(report) => check_reply(&report, &route, node.stamp(), &frame, self.config.follow.check_length),
-            Err(e) => refused_reply(Outcome::Refused(e).reason()),
-        };
-        info!(
-            "planner/check_route: {} waypoints, {} in {:.2} ms",
-            route.points.len(),
-            if reply.feasible {
-                "feasible".to_owned()
-            } else {
-                format!("{} problem(s)", reply.problems.len())
-            },
-            began.elapsed().as_secs_f64() * 1e3
-        );
-        reply
+        let route = route_from_path(&req.route, frame, Some(start.position()), MIN_ROUTE_LENGTH)
+            .map_err(|e| refused_reply(Outcome::Invalid(e).reason()))?;
+        Ok((start, route))
     }
 
     fn odom_in(&mut self, node: &RosNode, out: &Outputs, servers: &mut Servers, m: &Odometry) {
@@ -960,6 +1085,7 @@ impl Shell {
         let mut ended: Option<Outcome> = None;
         let mut changed = false;
         let command: Result<BodyTwist, String> = match &mut active.task {
+            Task::PreCheck { .. } => return,
             Task::Dock {
                 controller,
                 last,
@@ -1081,8 +1207,7 @@ impl Shell {
         let Some(active) = &self.active else { return };
         let now = Instant::now();
         let goal_age = now.saturating_duration_since(active.started);
-        let odom_age = self.odom.age_at(now).map_or(goal_age, |a| a.min(goal_age));
-        if odom_age > self.config.odom_timeout() {
+        if odom_stale(self.odom.age_at(now), goal_age, self.config.odom_timeout()) {
             return self.end_goal(node, out, servers, Outcome::Stale);
         }
         let status_period = Duration::from_secs_f64(1.0 / self.config.status_rate_hz);
@@ -1120,6 +1245,15 @@ impl Shell {
             (Task::Follow { follower, route, .. }, Source::FollowAction) => {
                 let i = follower.index().min(route.points.len().saturating_sub(1));
                 let index = route.request_index.get(i).copied().unwrap_or(0);
+                servers
+                    .follow
+                    .feedback(FollowWaypointsFeedback {
+                        current_waypoint: u32::try_from(index).unwrap_or(u32::MAX),
+                    })
+                    .await
+            }
+            (Task::PreCheck { route, .. }, Source::FollowAction) => {
+                let index = route.request_index.first().copied().unwrap_or(0);
                 servers
                     .follow
                     .feedback(FollowWaypointsFeedback {
