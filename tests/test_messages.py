@@ -26,6 +26,7 @@ def terrain() -> TerrainAssessment:
     m.tilt = 0.2
     m.terrain_class = TerrainAssessment.UNEVEN
     m.advised_gait = TerrainAssessment.GAIT_WAVE
+    m.rejected_touchdowns, m.failed_assessments = 3, 4_000_000_000
     return m
 
 

@@ -5,7 +5,7 @@
 
 use byteorder::LittleEndian;
 use mobil_msgs::geometry_msgs::msg::Twist;
-use mobil_msgs::mobil_msgs::msg::{GaitPlan, TerrainAssessment};
+use mobil_msgs::mobil_msgs::msg::{FootTouchdown, GaitPlan, TerrainAssessment};
 use mobil_msgs::nav_msgs::msg::Odometry;
 use mobil_msgs::sensor_msgs::msg::{JointState, LaserScan};
 use mobil_msgs::visualization_msgs::msg::Marker;
@@ -120,20 +120,33 @@ fn marker_with_keyword_field_and_nested_image_from_rclpy() {
 #[test]
 fn terrain_assessment_with_fixed_arrays_of_messages_from_rclpy() {
     let a: TerrainAssessment = decode(concat!(
-        "000000000000000001000000000100000000000000000000000000000000000000000000000000000000000000000000",
+        "010000000000000001000000000000000000000000000000000000000000000000000000000000000000000000000000",
         "00000000000000000000000000000000000000000000000000000000000000007b14ae47e17a94bf0000000000000000",
         "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
         "00000000000000000000000000000000b37bf2b0506b8a3f000000000000000000000000000000000000000000000000",
         "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
         "000000000000000000000000000000000000000000000000000000000000000000000000000000009a9999999999b93f",
         "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
-        "00000000000000000000000000000000000000000000000000000000000000000201"
+        "0000000000000000000000000000000000000000000000000000000000000000020100000300000001000000"
     ));
     assert_eq!(a.feet[2].z, -0.02);
     assert_eq!(a.sigma, 0.0129);
     assert_eq!(a.planes[1].theta_x, 0.1);
     assert_eq!(a.terrain_class, TerrainAssessment::UNEVEN);
     assert_eq!(a.advised_gait, TerrainAssessment::GAIT_RIPPLE);
+    // The counters at the end, after two bytes of padding to their 4-byte alignment.
+    assert_eq!((a.rejected_touchdowns, a.failed_assessments), (3, 1));
+}
+
+#[test]
+fn foot_touchdown_from_rclpy() {
+    let t: FootTouchdown = decode(concat!(
+        "07000000000000000a000000626173655f6c696e6b00f3b8030000004b4700b8333333333333c3bfb81e85eb51b8be3f",
+        "0ad7a3703d0ab7bf"
+    ));
+    assert_eq!((t.header.stamp.sec, t.header.frame_id.as_str()), (7, "base_link"));
+    assert_eq!(t.leg, "KG");
+    assert_eq!((t.position.x, t.position.y, t.position.z), (-0.15, 0.12, -0.09));
 }
 
 #[test]

@@ -1,0 +1,914 @@
+//! The ROS side of [`mobil_terrain`]: the `terrain_node` executable (src/main.rs), the walking
+//! hexapod `hexapod_sim` (src/bin/hexapod_sim.rs), and what their shells do that can be checked
+//! without DDS — the configurations (every parameter declared once), the touchdown message's
+//! checks, the assessment and marker messages, and the simulator's ground and messages.
+//!
+//! The method (σ, the planes, the angles, the class, the advice) and the walker are in
+//! [`mobil_terrain`]; nothing here judges the ground.
+//!
+//! What `terrain_node` does with each `terrain/touchdown` ([`TerrainState::touchdown`]):
+//! - **frame_id** must be the configured body frame (a leading `/` is ignored, as tf2 does);
+//!   another frame, or none, is refused: the node has no transforms, and a foot in another
+//!   frame would silently bend the planes.
+//! - **an unknown leg name** or **a non-finite or out-of-range coordinate** is refused.
+//! - a refusal changes no foot and is counted in `rejected_touchdowns`; a stance that cannot be
+//!   assessed (three collinear feet) keeps the foot, is counted in `failed_assessments`, and
+//!   the last good assessment stays. Either way the last good assessment is published again
+//!   with the new counts (same stamp, so a reader sees it is not a new one).
+//! - **a stamp older than the leg's previous touchdown is accepted** (and logged): on a
+//!   reliable topic one writer's samples arrive in order, so an older stamp means the sender's
+//!   clock went back (a simulator restarted, a bag looped), and the new touchdown is where the
+//!   foot is now. Dropping it would freeze that leg until the clock caught up again.
+//!
+//! Why `hexapod_sim` lives in this crate and not in `sim_node`: it is the walker of
+//! [`mobil_terrain`] with a clock, and it writes the very message this crate reads;
+//! `sim_node` is the wheeled chassis' plant and would gain the terrain crate for nothing.
+
+#![warn(missing_docs)]
+
+use mobil_msgs::builtin_interfaces::msg::Time;
+use mobil_msgs::geometry_msgs::msg::{Point, Vector3};
+use mobil_msgs::mobil_msgs::msg::{FootTouchdown, PlaneTilt as PlaneTiltMsg, TerrainAssessment};
+use mobil_msgs::std_msgs::msg::{ColorRGBA, Header};
+use mobil_msgs::visualization_msgs::msg::{Marker, MarkerArray};
+use mobil_ros::config::{Config, ConfigError, Decl};
+use mobil_ros::geometry::yaw_quaternion;
+use mobil_terrain::{
+    Assessment, Assessor, Course, FootTracker, Ground, HexapodGeometry, Leg, PlaneTilt, RoughGround, Section,
+    TerrainConfig, TerrainError, Touchdown, WalkerConfig,
+};
+use nalgebra::{Point3, Vector3 as V3};
+use thiserror::Error;
+
+/// Declares the assessment's parameters: thresholds (the params file's `terrain` section), body
+/// points and body frame (its `/**` section).
+fn declare_terrain(d: &mut Decl<TerrainConfig>) {
+    let c = TerrainConfig::default();
+    d.double(
+        "sigma_flat",
+        c.sigma_flat,
+        "σ_flat: FLAT needs σ ≤ σ_flat and every angle within ε_α [m]",
+        |c, v| c.sigma_flat = v,
+    )
+    .above(0.0);
+    d.double(
+        "sigma_wave",
+        c.sigma_wave,
+        "SLOPE and UNEVEN ground: ripple gait up to this σ, wave above [m]",
+        |c, v| c.sigma_wave = v,
+    )
+    .above(0.0);
+    d.double(
+        "sigma_max",
+        c.sigma_max,
+        "σ_max: above it BEYOND_LIMITS (another route) [m]",
+        |c, v| c.sigma_max = v,
+    )
+    .above(0.0);
+    d.double(
+        "epsilon_alpha",
+        c.epsilon_alpha,
+        "ε_α: angles within it count as 0 [rad]",
+        |c, v| c.epsilon_alpha = v,
+    )
+    .above(0.0);
+    d.double(
+        "tilt_max",
+        c.tilt_max,
+        "a foot plane inclined more than this is BEYOND_LIMITS [rad]",
+        |c, v| c.tilt_max = v,
+    )
+    .above(0.0);
+    d.doubles(
+        "body_points",
+        c.body_points,
+        "body points 1, 2, 3 of plane 3 in the body frame, x1 y1 z1 x2 y2 z2 x3 y3 z3 [m]",
+        |c, v| c.body_points = v,
+    );
+    d.string(
+        "body_frame",
+        &c.body_frame,
+        "frame of the touchdowns and of the assessment (the body frame)",
+        |c, v| c.body_frame = v,
+    );
+}
+
+/// `terrain_node`'s configuration: the assessment's thresholds, body points and body frame.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct TerrainNodeConfig {
+    /// Thresholds, body points and frame.
+    pub terrain: TerrainConfig,
+}
+
+impl Config for TerrainNodeConfig {
+    fn declare(d: &mut Decl<Self>) {
+        d.nest(|c: &mut TerrainNodeConfig| &mut c.terrain, declare_terrain);
+    }
+
+    fn validate(&self) -> Result<(), ConfigError> {
+        Assessor::new(self.terrain.clone())
+            .map(|_| ())
+            .map_err(ConfigError::inconsistent)
+    }
+}
+
+/// Why a touchdown message was refused.
+#[derive(Debug, Clone, PartialEq, Error)]
+pub enum TouchdownRefusal {
+    /// frame_id is not the body frame.
+    #[error("touchdown of {leg} in frame `{got}`, expected the body frame `{expected}` (the node has no transforms)")]
+    WrongFrame {
+        /// The leg name as sent.
+        leg: String,
+        /// The message's frame_id.
+        got: String,
+        /// The configured body frame.
+        expected: String,
+    },
+    /// Unknown leg, non-finite or out-of-range position.
+    #[error("{0}")]
+    Invalid(TerrainError),
+}
+
+/// What one touchdown led to. One lives at a time, returned and matched at once, so the size of
+/// the assessment in it costs nothing worth a box.
+#[derive(Debug, Clone, PartialEq)]
+#[allow(clippy::large_enum_variant)]
+pub enum TouchdownOutcome {
+    /// A new assessment (all six feet known).
+    Assessed(Assessment),
+    /// Stored; this many legs have touched down so far (fewer than six).
+    Waiting(usize),
+    /// Refused; nothing changed but the counter.
+    Refused(TouchdownRefusal),
+    /// Stored, but the stance could not be assessed; the last good assessment stays.
+    Failed(TerrainError),
+}
+
+/// The node's memory: the feet (by [`FootTracker`]), the stamp of the last good assessment and
+/// of each leg's latest touchdown, and the refusals the tracker does not see (wrong frame).
+#[derive(Debug, Clone)]
+pub struct TerrainState {
+    tracker: FootTracker,
+    stamps: [Option<Time>; 6],
+    last_stamp: Time,
+    wrong_frame: u64,
+    /// Counts carried over from trackers replaced by a reconfiguration …
+    carried: (u64, u64),
+    /// … and the current tracker's counts from replaying the feet into it (not counted).
+    offset: (u64, u64),
+}
+
+fn nanos(t: &Time) -> i128 {
+    i128::from(t.sec) * 1_000_000_000 + i128::from(t.nanosec)
+}
+
+impl TerrainState {
+    /// A state that knows no foot; refuses an invalid configuration.
+    pub fn new(config: TerrainConfig) -> Result<Self, TerrainError> {
+        Ok(TerrainState {
+            tracker: FootTracker::new(Assessor::new(config)?),
+            stamps: Default::default(),
+            last_stamp: Time::default(),
+            wrong_frame: 0,
+            carried: (0, 0),
+            offset: (0, 0),
+        })
+    }
+
+    /// The configuration in use.
+    pub fn config(&self) -> &TerrainConfig {
+        self.tracker.assessor().config()
+    }
+
+    /// Handles one touchdown message (see the crate docs for every rule), and tells whether the
+    /// leg's stamp went backwards (accepted; the caller logs it).
+    pub fn touchdown(&mut self, msg: &FootTouchdown) -> (TouchdownOutcome, bool) {
+        let expected = &self.tracker.assessor().config().body_frame;
+        if msg.header.frame_id.trim_start_matches('/') != expected.trim_start_matches('/') {
+            self.wrong_frame += 1;
+            let refusal = TouchdownRefusal::WrongFrame {
+                leg: msg.leg.clone(),
+                got: msg.header.frame_id.clone(),
+                expected: expected.clone(),
+            };
+            return (TouchdownOutcome::Refused(refusal), false);
+        }
+        let p = Point3::new(msg.position.x, msg.position.y, msg.position.z);
+        let result = self.tracker.touchdown_named(&msg.leg, p);
+        if let Err(
+            e @ (TerrainError::UnknownLeg(_) | TerrainError::NonFinite { .. } | TerrainError::OutOfRange { .. }),
+        ) = &result
+        {
+            return (TouchdownOutcome::Refused(TouchdownRefusal::Invalid(e.clone())), false);
+        }
+        // Stored: the leg parsed.
+        let mut backwards = false;
+        if let Ok(leg) = Leg::parse(&msg.leg) {
+            let slot = &mut self.stamps[leg.index()];
+            backwards = slot.as_ref().is_some_and(|old| nanos(&msg.header.stamp) < nanos(old));
+            *slot = Some(msg.header.stamp.clone());
+        }
+        let outcome = match result {
+            Ok(Some(a)) => {
+                self.last_stamp = msg.header.stamp.clone();
+                TouchdownOutcome::Assessed(a)
+            }
+            Ok(None) => TouchdownOutcome::Waiting(self.stamps.iter().filter(|s| s.is_some()).count()),
+            Err(e) => TouchdownOutcome::Failed(e),
+        };
+        (outcome, backwards)
+    }
+
+    /// Takes a new configuration: the stored feet are assessed again with it (the counts go on).
+    /// Returns the new assessment when all six feet are known and assessable.
+    pub fn reconfigure(&mut self, config: TerrainConfig) -> Result<Option<Assessment>, TerrainError> {
+        let mut tracker = FootTracker::new(Assessor::new(config)?);
+        let mut last = None;
+        for leg in Leg::ALL {
+            if let Some(p) = self.tracker.foot(leg) {
+                last = tracker.touchdown(leg, p).ok().flatten();
+            }
+        }
+        // The counts go on from their totals; the replay's own (none for stored feet, which
+        // were valid) are not added.
+        self.carried = (self.rejected_touchdowns_u64(), self.failed_assessments_u64());
+        self.offset = (tracker.rejected(), tracker.failed());
+        self.wrong_frame = 0;
+        self.tracker = tracker;
+        Ok(last)
+    }
+
+    fn rejected_touchdowns_u64(&self) -> u64 {
+        self.carried.0 + self.tracker.rejected().saturating_sub(self.offset.0) + self.wrong_frame
+    }
+
+    fn failed_assessments_u64(&self) -> u64 {
+        self.carried.1 + self.tracker.failed().saturating_sub(self.offset.1)
+    }
+
+    /// Touchdowns refused so far (wrong frame, unknown leg, bad coordinate).
+    pub fn rejected_touchdowns(&self) -> u32 {
+        u32::try_from(self.rejected_touchdowns_u64()).unwrap_or(u32::MAX)
+    }
+
+    /// Stances that could not be assessed so far.
+    pub fn failed_assessments(&self) -> u32 {
+        u32::try_from(self.failed_assessments_u64()).unwrap_or(u32::MAX)
+    }
+
+    /// The last good assessment and the stamp of the touchdown that made it.
+    pub fn last(&self) -> Option<(&Assessment, &Time)> {
+        self.tracker.last().map(|a| (a, &self.last_stamp))
+    }
+
+    /// The last good assessment as a message with the current counts.
+    pub fn last_message(&self) -> Option<TerrainAssessment> {
+        self.last().map(|(a, stamp)| {
+            assessment_message(
+                a,
+                stamp.clone(),
+                &self.config().body_frame,
+                self.rejected_touchdowns(),
+                self.failed_assessments(),
+            )
+        })
+    }
+}
+
+fn point(p: &Point3<f64>) -> Point {
+    Point { x: p.x, y: p.y, z: p.z }
+}
+
+fn plane_message(p: &PlaneTilt) -> PlaneTiltMsg {
+    PlaneTiltMsg {
+        a: p.a,
+        b: p.b,
+        c: p.c,
+        d: p.d,
+        theta_x: p.theta_x,
+        theta_y: p.theta_y,
+        downhill: p.downhill,
+    }
+}
+
+/// `terrain/assessment` from an assessment, field for field, with the counts.
+pub fn assessment_message(a: &Assessment, stamp: Time, frame: &str, rejected: u32, failed: u32) -> TerrainAssessment {
+    TerrainAssessment {
+        header: Header {
+            stamp,
+            frame_id: frame.to_owned(),
+        },
+        feet: a.feet.map(|p| point(&p)),
+        sigma: a.sigma,
+        alpha12: a.alpha12,
+        alpha23: a.alpha23,
+        alpha13: a.alpha13,
+        planes: a.planes.map(|p| plane_message(&p)),
+        tilt: a.tilt,
+        terrain_class: a.class.as_u8(),
+        advised_gait: a.advice.as_u8(),
+        rejected_touchdowns: rejected,
+        failed_assessments: failed,
+    }
+}
+
+fn color(r: f32, g: f32, b: f32, a: f32) -> ColorRGBA {
+    ColorRGBA { r, g, b, a }
+}
+
+fn marker(header: &Header, id: i32, kind: i32, scale: [f64; 3], c: ColorRGBA) -> Marker {
+    let mut m = Marker {
+        header: header.clone(),
+        ns: "terrain".into(),
+        id,
+        r#type: kind,
+        action: Marker::ADD,
+        color: c,
+        scale: Vector3 {
+            x: scale[0],
+            y: scale[1],
+            z: scale[2],
+        },
+        ..Default::default()
+    };
+    m.pose.orientation = yaw_quaternion(0.0);
+    m
+}
+
+/// Length of the drawn normals (m).
+pub const NORMAL_LENGTH: f64 = 0.08;
+
+/// `terrain/markers`, in the body frame: the three planes as triangles through their points
+/// (ids 0–2: plane 1 blue, plane 2 orange, plane 3 grey, half transparent), their unit normals
+/// as arrows of [`NORMAL_LENGTH`] from each triangle's centroid (ids 3–5), and the six feet as
+/// spheres (id 6: tripod A blue, tripod B orange). Seven markers, 21 points: about 2 KB.
+pub fn markers(a: &Assessment, body_points: &[Point3<f64>; 3], stamp: Time, frame: &str) -> MarkerArray {
+    let header = Header {
+        stamp,
+        frame_id: frame.to_owned(),
+    };
+    let foot = |leg: Leg| a.feet[leg.index()];
+    let triangles = [Leg::PLANE1.map(foot), Leg::PLANE2.map(foot), *body_points];
+    let colors = [
+        color(0.0, 0.35, 0.71, 0.5),
+        color(0.9, 0.62, 0.0, 0.5),
+        color(0.6, 0.6, 0.6, 0.5),
+    ];
+    let mut out = Vec::with_capacity(7);
+    for (i, (tri, c)) in triangles.iter().zip(&colors).enumerate() {
+        let mut m = marker(&header, i as i32, Marker::TRIANGLE_LIST, [1.0; 3], c.clone());
+        m.points = tri.iter().map(point).collect();
+        out.push(m);
+    }
+    for (i, (tri, c)) in triangles.iter().zip(colors).enumerate() {
+        let centroid = Point3::from((tri[0].coords + tri[1].coords + tri[2].coords) / 3.0);
+        let n: V3<f64> = a.planes[i].normal();
+        let mut m = marker(
+            &header,
+            3 + i as i32,
+            Marker::ARROW,
+            [0.006, 0.012, 0.015],
+            color(c.r, c.g, c.b, 1.0),
+        );
+        m.points = vec![point(&centroid), point(&(centroid + n * NORMAL_LENGTH))];
+        out.push(m);
+    }
+    let mut feet = marker(&header, 6, Marker::SPHERE_LIST, [0.02; 3], color(1.0, 1.0, 1.0, 1.0));
+    feet.points = a.feet.iter().map(point).collect();
+    feet.colors = Leg::ALL
+        .iter()
+        .map(|l| {
+            if Leg::PLANE1.contains(l) {
+                color(0.0, 0.35, 0.71, 1.0)
+            } else {
+                color(0.9, 0.62, 0.0, 1.0)
+            }
+        })
+        .collect();
+    out.push(feet);
+    MarkerArray { markers: out }
+}
+
+/// The ground `hexapod_sim` walks on, by name.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum GroundKind {
+    /// Level ground.
+    #[default]
+    Flat,
+    /// A plane at `slope_deg` rising toward `slope_direction_deg`.
+    Slope,
+    /// Seeded rough ground.
+    Rough,
+    /// Flat, then a ramp at `slope_deg`, then rough, along world x.
+    Course,
+}
+
+impl std::str::FromStr for GroundKind {
+    type Err = String;
+
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        match s {
+            "flat" => Ok(GroundKind::Flat),
+            "slope" => Ok(GroundKind::Slope),
+            "rough" => Ok(GroundKind::Rough),
+            "course" => Ok(GroundKind::Course),
+            _ => Err(format!("unknown ground `{s}` (flat, slope, rough or course)")),
+        }
+    }
+}
+
+/// `hexapod_sim`'s configuration.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct HexapodSimConfig {
+    /// Footholds and body height (the params file's `/**` section).
+    pub geometry: HexapodGeometry,
+    /// The ground.
+    pub ground: GroundKind,
+    /// Slope of `slope` and of the course's ramp (degrees).
+    pub slope_deg: f64,
+    /// Direction the `slope` ground rises toward, in the world (degrees; 0 = +x, ahead).
+    pub slope_direction_deg: f64,
+    /// Rough ground: node heights in ±this (m).
+    pub rough_amplitude: f64,
+    /// Rough ground: node spacing (m).
+    pub rough_cell: f64,
+    /// Rough ground's seed.
+    pub seed: i64,
+    /// Course: lengths of the flat, ramp and rough sections along x (m).
+    pub course_lengths: [f64; 3],
+    /// Body speed (m/s).
+    pub speed: f64,
+    /// Gait period (s).
+    pub gait_period: f64,
+    /// Frame of the touchdowns (the body frame).
+    pub body_frame: String,
+    /// Frame of the body pose (`odom`).
+    pub world_frame: String,
+    /// Publish `/clock` (simulated time from 0).
+    pub publish_clock: bool,
+    /// Simulated seconds per wall second.
+    pub real_time_factor: f64,
+    /// Steps per wall second: pose, clock and touchdowns are due on them.
+    pub tick_rate_hz: f64,
+    /// Start the walk (t = 0) only once `terrain/touchdown` has a subscriber.
+    pub wait_for_subscriber: bool,
+}
+
+impl Config for HexapodSimConfig {
+    fn declare(d: &mut Decl<Self>) {
+        let g = HexapodGeometry::default();
+        let w = WalkerConfig::default();
+        for leg in Leg::ALL {
+            let p = g.footholds.get(leg);
+            d.doubles(
+                &format!("footholds.{leg}"),
+                [p.x, p.y],
+                &format!("nominal foothold of {leg} (x, y) in the body frame [m]"),
+                move |c: &mut HexapodSimConfig, v| match leg {
+                    Leg::KP => c.geometry.footholds.KP = v,
+                    Leg::KV => c.geometry.footholds.KV = v,
+                    Leg::KG => c.geometry.footholds.KG = v,
+                    Leg::DP => c.geometry.footholds.DP = v,
+                    Leg::DV => c.geometry.footholds.DV = v,
+                    Leg::DG => c.geometry.footholds.DG = v,
+                },
+            )
+            .read_only();
+        }
+        d.double(
+            "body_height",
+            g.body_height,
+            "body origin above the mean ground under the footholds [m]",
+            |c, v| c.geometry.body_height = v,
+        )
+        .above(0.0)
+        .read_only();
+        d.parsed(
+            "ground",
+            "flat",
+            "flat, slope (slope_deg toward slope_direction_deg), rough (seeded) or course (flat → ramp → rough along x)",
+            |c, v| c.ground = v,
+        )
+        .choices(&["flat", "slope", "rough", "course"])
+        .read_only();
+        d.double(
+            "slope_deg",
+            10.0,
+            "slope of `slope` and of the course's ramp [deg]",
+            |c, v| c.slope_deg = v,
+        )
+        .within(-60.0, 60.0)
+        .read_only();
+        d.double(
+            "slope_direction_deg",
+            0.0,
+            "direction the `slope` ground rises toward, world frame (0: +x, ahead) [deg]",
+            |c, v| c.slope_direction_deg = v,
+        )
+        .within(-360.0, 360.0)
+        .read_only();
+        d.double(
+            "rough_amplitude",
+            0.03,
+            "rough ground: node heights within ±this [m]",
+            |c, v| c.rough_amplitude = v,
+        )
+        .within(0.0, 0.5)
+        .read_only();
+        d.double("rough_cell", 0.10, "rough ground: node spacing [m]", |c, v| {
+            c.rough_cell = v
+        })
+        .within(0.01, 10.0)
+        .read_only();
+        d.integer("seed", 1, "rough ground's seed", |c, v| c.seed = v)
+            .read_only();
+        d.doubles(
+            "course_lengths",
+            [1.0, 1.5, 1.5],
+            "course: lengths of the flat, ramp and rough sections along x from the start [m]",
+            |c, v| c.course_lengths = v,
+        )
+        .read_only();
+        d.double("speed", w.speed, "body speed [m/s]", |c, v| c.speed = v)
+            .within(0.0, 1.0)
+            .read_only();
+        d.double(
+            "gait_period",
+            w.gait_period,
+            "gait period: one step of each tripod [s]",
+            |c, v| c.gait_period = v,
+        )
+        .within(0.1, 10.0)
+        .read_only();
+        d.string(
+            "body_frame",
+            "base_link",
+            "frame of the touchdowns (the body frame)",
+            |c, v| c.body_frame = v,
+        )
+        .read_only();
+        d.string("world_frame", "odom", "frame of the body pose", |c, v| {
+            c.world_frame = v
+        })
+        .read_only();
+        d.boolean(
+            "publish_clock",
+            false,
+            "publish /clock (simulated time from 0)",
+            |c, v| c.publish_clock = v,
+        )
+        .read_only();
+        d.double("real_time_factor", 1.0, "simulated seconds per wall second", |c, v| {
+            c.real_time_factor = v
+        })
+        .within(0.01, 100.0);
+        d.double(
+            "tick_rate_hz",
+            50.0,
+            "steps per wall second (pose, clock; touchdowns carry their own times) [Hz]",
+            |c, v| c.tick_rate_hz = v,
+        )
+        .within(1.0, 1000.0)
+        .read_only();
+        d.boolean(
+            "wait_for_subscriber",
+            false,
+            "start the walk (t = 0) only once terrain/touchdown has a subscriber",
+            |c, v| c.wait_for_subscriber = v,
+        )
+        .read_only();
+    }
+
+    fn validate(&self) -> Result<(), ConfigError> {
+        self.walker().map(|_| ()).map_err(ConfigError::inconsistent)
+    }
+}
+
+impl HexapodSimConfig {
+    /// The ground named by `ground`.
+    pub fn ground(&self) -> Result<Ground, TerrainError> {
+        let slope = self.slope_deg.to_radians();
+        let rough = || RoughGround::new(self.rough_amplitude, self.rough_cell, self.seed as u64);
+        Ok(match self.ground {
+            GroundKind::Flat => Ground::Flat(0.0),
+            GroundKind::Slope => {
+                // A negative slope is the same plane rising the other way.
+                let uphill =
+                    self.slope_direction_deg.to_radians() + if slope < 0.0 { std::f64::consts::PI } else { 0.0 };
+                Ground::plane(slope.abs(), uphill)?
+            }
+            GroundKind::Rough => Ground::Rough(rough()?),
+            GroundKind::Course => {
+                let [flat, ramp, rough_len] = self.course_lengths;
+                Ground::Course(Course::new(
+                    0.0,
+                    vec![
+                        (flat, Section::Flat),
+                        (ramp, Section::Ramp(slope)),
+                        (rough_len, Section::Rough(rough()?)),
+                    ],
+                )?)
+            }
+        })
+    }
+
+    /// The walker's configuration: straight ahead along world x from the origin.
+    pub fn walker_config(&self) -> WalkerConfig {
+        WalkerConfig {
+            geometry: self.geometry.clone(),
+            gait_period: self.gait_period,
+            speed: self.speed,
+            heading: 0.0,
+            start: [0.0, 0.0],
+        }
+    }
+
+    /// The walker on the configured ground.
+    pub fn walker(&self) -> Result<mobil_terrain::Walker, TerrainError> {
+        mobil_terrain::Walker::new(self.walker_config(), self.ground()?)
+    }
+}
+
+/// `terrain/touchdown` for one of the walker's touchdowns.
+pub fn touchdown_message(td: &Touchdown, stamp: Time, body_frame: &str) -> FootTouchdown {
+    FootTouchdown {
+        header: Header {
+            stamp,
+            frame_id: body_frame.to_owned(),
+        },
+        leg: td.leg.name().to_owned(),
+        position: point(&td.position),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use mobil_msgs::mobil_msgs::msg::TerrainAssessment as TA;
+    use mobil_ros::params::ParamValues;
+
+    /// Table 1's small column (cm) at the default footholds, 0.10 m below the body.
+    const SMALL: [f64; 6] = [2.0, -1.0, -2.0, 0.0, 1.0, 0.0];
+
+    fn td(leg: &str, x: f64, y: f64, z: f64, sec: i32) -> FootTouchdown {
+        FootTouchdown {
+            header: Header {
+                stamp: Time { sec, nanosec: 0 },
+                frame_id: "base_link".into(),
+            },
+            leg: leg.into(),
+            position: Point { x, y, z },
+        }
+    }
+
+    fn column(z_cm: [f64; 6]) -> Vec<FootTouchdown> {
+        let g = HexapodGeometry::default();
+        Leg::ALL
+            .iter()
+            .zip(z_cm)
+            .map(|(&leg, z)| {
+                let p = g.footholds.get(leg);
+                td(leg.name(), p.x, p.y, -0.10 + z / 100.0, 1)
+            })
+            .collect()
+    }
+
+    fn state() -> TerrainState {
+        TerrainState::new(TerrainConfig::default()).unwrap()
+    }
+
+    #[test]
+    fn the_defaults_load_from_parameters() {
+        let defaults = ParamValues::defaults(&Decl::<TerrainNodeConfig>::of().specs());
+        let c: TerrainNodeConfig = mobil_ros::config::load(&defaults).unwrap();
+        assert_eq!(c.terrain, TerrainConfig::default());
+        let defaults = ParamValues::defaults(&Decl::<HexapodSimConfig>::of().specs());
+        let s: HexapodSimConfig = mobil_ros::config::load(&defaults).unwrap();
+        assert_eq!(s.geometry, HexapodGeometry::default());
+        assert_eq!((s.ground, s.speed, s.gait_period), (GroundKind::Flat, 0.10, 1.0));
+    }
+
+    #[test]
+    fn inconsistent_thresholds_and_collinear_body_points_are_refused() {
+        let mut values = ParamValues::defaults(&Decl::<TerrainNodeConfig>::of().specs());
+        values.set("sigma_max", ros2_client::ParameterValue::Double(0.015));
+        let e = mobil_ros::config::load::<TerrainNodeConfig>(&values).unwrap_err();
+        assert!(e.to_string().contains("sigma_max"), "{e}");
+        let mut values = ParamValues::defaults(&Decl::<TerrainNodeConfig>::of().specs());
+        let line = vec![0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 2.0, 0.0, 0.0];
+        values.set("body_points", ros2_client::ParameterValue::DoubleArray(line));
+        let e = mobil_ros::config::load::<TerrainNodeConfig>(&values).unwrap_err();
+        assert!(e.to_string().contains("collinear"), "{e}");
+    }
+
+    #[test]
+    fn nothing_is_assessed_before_all_six_feet() {
+        let mut s = state();
+        let msgs = column([0.0; 6]);
+        for (k, m) in msgs.iter().take(5).enumerate() {
+            assert_eq!(s.touchdown(m).0, TouchdownOutcome::Waiting(k + 1));
+        }
+        assert!(s.last_message().is_none());
+        assert!(matches!(s.touchdown(&msgs[5]).0, TouchdownOutcome::Assessed(_)));
+    }
+
+    /// Table 1's small column through the message path: σ √(10/6) = 1.2910 cm, UNEVEN (α12
+    /// 7.590° > 3°, worked out by Cramer's rule in the library's tests/table1.rs), ripple.
+    #[test]
+    fn table1_small_column_becomes_the_message() {
+        let mut s = state();
+        let mut last = None;
+        for m in column(SMALL) {
+            last = Some(s.touchdown(&m).0);
+        }
+        assert!(matches!(last, Some(TouchdownOutcome::Assessed(_))));
+        let msg = s.last_message().unwrap();
+        assert!((msg.sigma - (10.0f64 / 6.0).sqrt() / 100.0).abs() < 1e-12);
+        assert!((msg.alpha12.to_degrees() - 7.590).abs() < 1e-3);
+        assert_eq!((msg.terrain_class, msg.advised_gait), (TA::UNEVEN, TA::GAIT_RIPPLE));
+        assert_eq!(msg.header.frame_id, "base_link");
+        assert_eq!(msg.header.stamp.sec, 1);
+        // KG (index 2) at z = −0.10 − 0.02.
+        assert!((msg.feet[2].z + 0.12).abs() < 1e-15 && (msg.feet[2].x + 0.15).abs() < 1e-15);
+        // Plane 3 is the body plane: normal (0, 0, 1), level.
+        assert_eq!((msg.planes[2].c, msg.planes[2].theta_x), (1.0, 0.0));
+        assert_eq!((msg.rejected_touchdowns, msg.failed_assessments), (0, 0));
+    }
+
+    #[test]
+    fn refusals_are_counted_and_keep_the_last_good_assessment() {
+        let mut s = state();
+        for m in column(SMALL) {
+            s.touchdown(&m);
+        }
+        let good = s.last_message().unwrap();
+        let bad = [
+            td("XX", 0.1, 0.1, -0.1, 2),
+            td("kp", 0.1, 0.1, -0.1, 2),
+            td("KP", f64::NAN, 0.1, -0.1, 2),
+            td("KV", 0.0, 0.16, f64::INFINITY, 2),
+            td("DG", 0.0, 0.16, 2e3, 2),
+        ];
+        for (k, m) in bad.iter().enumerate() {
+            let (outcome, _) = s.touchdown(m);
+            assert!(
+                matches!(outcome, TouchdownOutcome::Refused(TouchdownRefusal::Invalid(_))),
+                "{m:?}"
+            );
+            assert_eq!(s.rejected_touchdowns(), k as u32 + 1);
+        }
+        let mut wrong = td("KP", 0.15, 0.12, -0.1, 2);
+        wrong.header.frame_id = "odom".into();
+        let (outcome, _) = s.touchdown(&wrong);
+        let TouchdownOutcome::Refused(r) = outcome else {
+            panic!("accepted a foot in odom")
+        };
+        assert!(
+            r.to_string().contains("`odom`") && r.to_string().contains("`base_link`"),
+            "{r}"
+        );
+        wrong.header.frame_id = String::new();
+        assert!(matches!(s.touchdown(&wrong).0, TouchdownOutcome::Refused(_)));
+        let after = s.last_message().unwrap();
+        assert_eq!((after.rejected_touchdowns, after.failed_assessments), (7, 0));
+        // Everything else is the last good assessment, stamp included.
+        let strip = |mut m: TerrainAssessment| {
+            m.rejected_touchdowns = 0;
+            m
+        };
+        assert_eq!(strip(after), good);
+        // A leading slash is the same frame (tf2 ignores it).
+        let mut slash = td("KP", 0.15, 0.12, -0.08, 3);
+        slash.header.frame_id = "/base_link".into();
+        assert!(matches!(s.touchdown(&slash).0, TouchdownOutcome::Assessed(_)));
+    }
+
+    /// KP moved onto the line through KG and DV: plane 1 is undefined. The foot is stored, the
+    /// failure counted, and the last good assessment stays.
+    #[test]
+    fn a_degenerate_stance_keeps_the_last_assessment() {
+        let mut s = state();
+        for m in column([0.0; 6]) {
+            s.touchdown(&m);
+        }
+        let good = s.last_message().unwrap();
+        // KG (−0.15, 0.12, −0.10), DV (0, −0.16, −0.10): the point beyond DV by the same step is
+        // (0.15, −0.44, −0.10).
+        let (outcome, _) = s.touchdown(&td("KP", 0.15, -0.44, -0.10, 2));
+        assert!(matches!(
+            outcome,
+            TouchdownOutcome::Failed(TerrainError::CollinearPoints { .. })
+        ));
+        let after = s.last_message().unwrap();
+        assert_eq!((after.rejected_touchdowns, after.failed_assessments), (0, 1));
+        assert_eq!(after.header.stamp.sec, 1, "the last good one's stamp");
+        assert_eq!(after.sigma, good.sigma);
+    }
+
+    #[test]
+    fn a_stamp_going_back_is_accepted_and_reported() {
+        let mut s = state();
+        for m in column([0.0; 6]) {
+            s.touchdown(&m);
+        }
+        let (outcome, backwards) = s.touchdown(&td("KP", 0.15, 0.12, -0.09, 0));
+        assert!(backwards);
+        let TouchdownOutcome::Assessed(a) = outcome else {
+            panic!("not assessed")
+        };
+        assert!((a.feet[0].z + 0.09).abs() < 1e-15);
+        assert!(
+            !s.touchdown(&td("KP", 0.15, 0.12, -0.09, 0)).1,
+            "same stamp: not backwards"
+        );
+    }
+
+    /// Σ_max lowered below the small column's σ (1.29 cm): the stored feet become BEYOND_LIMITS
+    /// at once, and the counts go on.
+    #[test]
+    fn a_new_configuration_reassesses_the_stored_feet() {
+        let mut s = state();
+        for m in column(SMALL) {
+            s.touchdown(&m);
+        }
+        s.touchdown(&td("XX", 0.0, 0.0, 0.0, 2));
+        let c = TerrainConfig {
+            sigma_flat: 0.005,
+            sigma_wave: 0.008,
+            sigma_max: 0.012,
+            ..TerrainConfig::default()
+        };
+        let a = s.reconfigure(c).unwrap().unwrap();
+        assert_eq!(a.class, mobil_terrain::TerrainClass::BeyondLimits);
+        assert_eq!(s.last_message().unwrap().terrain_class, TA::BEYOND_LIMITS);
+        assert_eq!(s.rejected_touchdowns(), 1);
+    }
+
+    #[test]
+    fn markers_draw_three_planes_their_normals_and_the_feet() {
+        let mut s = state();
+        for m in column([0.0; 6]) {
+            s.touchdown(&m);
+        }
+        let (a, _) = s.last().unwrap();
+        let body = s.config().body_points();
+        let m = markers(a, &body, Time::default(), "base_link");
+        assert_eq!(m.markers.len(), 7);
+        // Plane 1's triangle is KP, KG, DV.
+        let t = &m.markers[0];
+        assert_eq!(t.r#type, Marker::TRIANGLE_LIST);
+        assert_eq!((t.points[1].x, t.points[1].y), (-0.15, 0.12));
+        // Level ground: plane 1's normal is +z from its centroid ((0.15 − 0.15 + 0)/3,
+        // (0.12 + 0.12 − 0.16)/3, −0.10).
+        let n = &m.markers[3];
+        assert_eq!(n.r#type, Marker::ARROW);
+        assert!((n.points[0].y - 0.08 / 3.0).abs() < 1e-15);
+        assert!((n.points[1].z - (-0.10 + NORMAL_LENGTH)).abs() < 1e-15);
+        assert_eq!(m.markers[6].points.len(), 6);
+        assert!(m.markers.iter().all(|k| k.header.frame_id == "base_link"));
+    }
+
+    /// A 10° slope rising toward +x: z = tan 10° · x; a negative slope the same plane rising
+    /// toward −x. The course: flat to x = 1, the ramp to 2.5 (at x = 2 it is 1 · tan 10° high),
+    /// then rough ground within ±3 cm of the ramp's top, 1.5 · tan 10° = 0.2645 m.
+    #[test]
+    fn grounds_by_name() {
+        let mut c = HexapodSimConfig {
+            ground: GroundKind::Slope,
+            ..mobil_ros::config::load(&ParamValues::defaults(&Decl::<HexapodSimConfig>::of().specs())).unwrap()
+        };
+        let t = 10f64.to_radians().tan();
+        assert!((c.ground().unwrap().height(2.0, 5.0) - 2.0 * t).abs() < 1e-12);
+        c.slope_deg = -10.0;
+        assert!((c.ground().unwrap().height(2.0, 5.0) + 2.0 * t).abs() < 1e-12);
+        c.slope_deg = 10.0;
+        c.ground = GroundKind::Course;
+        let g = c.ground().unwrap();
+        assert_eq!(g.height(0.5, 0.0), 0.0);
+        assert!((g.height(2.0, 0.0) - t).abs() < 1e-12);
+        assert!((g.height(3.2, 0.1) - 1.5 * t).abs() <= 0.03);
+        assert!((g.height(3.2, 0.1) - 1.5 * t).abs() > 0.0, "rough, not level");
+        assert_eq!("course".parse::<GroundKind>(), Ok(GroundKind::Course));
+        assert!("hilly".parse::<GroundKind>().is_err());
+    }
+
+    /// The walker's first touchdowns, turned into messages and fed back: the node's own check
+    /// accepts what the simulator sends, and six feet on flat ground are FLAT, σ 0.
+    #[test]
+    fn the_simulators_touchdowns_are_what_the_node_accepts() {
+        let c: HexapodSimConfig =
+            mobil_ros::config::load(&ParamValues::defaults(&Decl::<HexapodSimConfig>::of().specs())).unwrap();
+        let w = c.walker().unwrap();
+        let mut s = state();
+        let mut last = None;
+        for td in w.touchdowns_in(-1.0, 0.0) {
+            last = Some(s.touchdown(&touchdown_message(&td, Time::default(), &c.body_frame)).0);
+        }
+        let Some(TouchdownOutcome::Assessed(a)) = last else {
+            panic!("not assessed: {last:?}")
+        };
+        assert_eq!(a.sigma, 0.0);
+        assert_eq!(a.class, mobil_terrain::TerrainClass::Flat);
+    }
+}
