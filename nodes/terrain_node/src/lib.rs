@@ -47,8 +47,15 @@ fn declare_terrain(d: &mut Decl<TerrainConfig>) {
     d.double(
         "sigma_flat",
         c.sigma_flat,
-        "σ_flat: FLAT needs σ ≤ σ_flat and every angle within ε_α [m]",
+        "σ_flat: FLAT needs σ ≤ σ_flat, every angle within ε_α and the foot planes within plane_offset_max [m]",
         |c, v| c.sigma_flat = v,
+    )
+    .above(0.0);
+    d.double(
+        "plane_offset_max",
+        c.plane_offset_max,
+        "foot planes 1 and 2 parallel within ε_α but further apart than this are UNEVEN (a step between the tripods) [m]",
+        |c, v| c.plane_offset_max = v,
     )
     .above(0.0);
     d.double(

@@ -373,8 +373,8 @@ mod tests {
         );
         assert!(s.contains(r#"points="70.0,240.0 870.0,160.0""#), "{s}");
         assert!(s.contains("870.0,426.7"), "{s}");
-        // σ_wave = 2 cm: the dashed line at y = 160.
-        assert!(s.contains(r#"y1="160.0""#), "{s}");
+        // σ_wave = 2.5 cm: the dashed line at y = 240 − 200 · 2.5/5 = 140.
+        assert!(s.contains(r#"y1="140.0""#), "{s}");
         assert!(s.contains("t &lt;&amp;&gt;"));
     }
 }
