@@ -503,14 +503,15 @@ impl ChassisController {
         };
         let twist = forward(&self.config.params, &wheels)?;
         self.check_plausible(&wheels)?;
-        if let Some(last) = self.odometry.last_stamp() {
-            if since < last && since >= last - self.max_gap() {
-                return Err(OdometryError::TimeNotIncreasing {
-                    previous: last,
-                    now: since,
-                }
-                .into());
+        if let Some(last) = self.odometry.last_stamp()
+            && since < last
+            && since >= last - self.max_gap()
+        {
+            return Err(OdometryError::TimeNotIncreasing {
+                previous: last,
+                now: since,
             }
+            .into());
         }
         let gap = stamp - since;
         let outcome = if wrapped && gap * self.max_feedback_wheel_speed() >= PI {

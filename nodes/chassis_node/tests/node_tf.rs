@@ -37,7 +37,9 @@ fn feedback(t: f64, wheels: [f64; 3]) -> JointState {
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 async fn odom_and_tf_agree_with_the_wheels() {
     let domain = 200 + (std::process::id() % 30);
-    std::env::set_var("ROS_DOMAIN_ID", domain.to_string());
+    // SAFETY: the binary's only test, before it starts a task or a process; no thread reads the
+    // environment meanwhile.
+    unsafe { std::env::set_var("ROS_DOMAIN_ID", domain.to_string()) };
     let params = concat!(env!("CARGO_MANIFEST_DIR"), "/../../params/omr3.yaml");
     let _chassis = Node(
         Command::new(env!("CARGO_BIN_EXE_chassis_node"))

@@ -312,11 +312,11 @@ impl Navigator {
                 if from_hit > 2.0 * self.config.hit_radius {
                     self.left_hit = true;
                 }
-                if let Some(l) = previous.and_then(|p| crossing_of_segment(p, q, hit, goal)) {
-                    if (goal - l).norm() < hit_distance - margin {
-                        self.leave = Some(l);
-                        self.enter(Mode::Rotate, goal_distance);
-                    }
+                if let Some(l) = previous.and_then(|p| crossing_of_segment(p, q, hit, goal))
+                    && (goal - l).norm() < hit_distance - margin
+                {
+                    self.leave = Some(l);
+                    self.enter(Mode::Rotate, goal_distance);
                 }
                 if matches!(self.mode, Mode::Track(_)) {
                     // Goal sector clear: also nearer G than H, or a trap's mouth leads back in.

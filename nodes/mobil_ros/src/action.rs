@@ -254,13 +254,13 @@ where
     /// this can be one branch of a `tokio::select!` that other branches win.
     pub async fn next_event(&mut self) -> ActionEvent<A::Goal> {
         loop {
-            if let Some((handle, goal)) = self.pending_cancel.take() {
-                if let Err(e) = self.server.respond_to_cancel_requests(&handle, goal.into_iter()).await {
-                    self.warn(
-                        "cancel-response",
-                        format_args!("{}: cannot answer a cancel request: {e:?}", self.name),
-                    );
-                }
+            if let Some((handle, goal)) = self.pending_cancel.take()
+                && let Err(e) = self.server.respond_to_cancel_requests(&handle, goal.into_iter()).await
+            {
+                self.warn(
+                    "cancel-response",
+                    format_args!("{}: cannot answer a cancel request: {e:?}", self.name),
+                );
             }
             if let Some(id) = self.unreported_cancel.take() {
                 // The goal may have ended since (pre-empted while this future was dropped).

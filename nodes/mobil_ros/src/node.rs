@@ -419,10 +419,10 @@ impl RosNode {
         drop(clock);
         // Dropping the node tells its spinner to stop; then the context (participant) goes.
         drop(node);
-        if let Some(handle) = spinner {
-            if tokio::time::timeout(Duration::from_secs(2), handle).await.is_err() {
-                warn!("spinner did not stop within 2 s");
-            }
+        if let Some(handle) = spinner
+            && tokio::time::timeout(Duration::from_secs(2), handle).await.is_err()
+        {
+            warn!("spinner did not stop within 2 s");
         }
         drop(context);
         info!("{} shut down", names.fully_qualified_node());
@@ -456,8 +456,8 @@ pub async fn shutdown_signal() {
 /// `ROS_DISTRO` (this build speaks Jazzy) and installs logging.
 pub fn init_process(args: &RosArgs) {
     if std::env::var_os("ROS_DISTRO").is_none() {
-        // Safe: called at the top of main, before any other thread exists.
-        std::env::set_var("ROS_DISTRO", "jazzy");
+        // SAFETY: called at the top of main, before any other thread exists.
+        unsafe { std::env::set_var("ROS_DISTRO", "jazzy") };
     }
     crate::log::init(args.log_level.as_deref());
 }

@@ -255,29 +255,29 @@ impl ParamSpec {
             Constraint::Any => {}
             Constraint::Range { min, max } => {
                 for x in &numbers {
-                    if let Some((m, inclusive)) = min {
-                        if *x < *m || (!inclusive && *x == *m) {
-                            return Err(format!(
-                                "{x} is below the minimum ({} {m})",
-                                if *inclusive { "≥" } else { ">" }
-                            ));
-                        }
+                    if let Some((m, inclusive)) = min
+                        && (*x < *m || (!inclusive && *x == *m))
+                    {
+                        return Err(format!(
+                            "{x} is below the minimum ({} {m})",
+                            if *inclusive { "≥" } else { ">" }
+                        ));
                     }
-                    if let Some((m, inclusive)) = max {
-                        if *x > *m || (!inclusive && *x == *m) {
-                            return Err(format!(
-                                "{x} is above the maximum ({} {m})",
-                                if *inclusive { "≤" } else { "<" }
-                            ));
-                        }
+                    if let Some((m, inclusive)) = max
+                        && (*x > *m || (!inclusive && *x == *m))
+                    {
+                        return Err(format!(
+                            "{x} is above the maximum ({} {m})",
+                            if *inclusive { "≤" } else { "<" }
+                        ));
                     }
                 }
             }
             Constraint::Choices(choices) => {
-                if let ParameterValue::String(s) = &value {
-                    if !choices.contains(s) {
-                        return Err(format!("`{s}` is not one of {}", choices.join(", ")));
-                    }
+                if let ParameterValue::String(s) = &value
+                    && !choices.contains(s)
+                {
+                    return Err(format!("`{s}` is not one of {}", choices.join(", ")));
                 }
             }
             Constraint::Length(n) => {

@@ -24,8 +24,8 @@ use common::{domain_id, participant};
 
 /// A RosNode on the test's domain with these ROS arguments.
 fn ros_node(name: &str, ros_args: &[&str]) -> RosNode {
-    // Safe: set before any thread of this test reads the environment; every test sets the same.
-    std::env::set_var("ROS_DOMAIN_ID", domain_id().to_string());
+    // SAFETY: set before any thread of this test reads the environment; every test sets the same.
+    unsafe { std::env::set_var("ROS_DOMAIN_ID", domain_id().to_string()) };
     let decl = NodeDecl::new(name, "test node");
     let argv: Vec<String> = [name, "--ros-args"]
         .into_iter()

@@ -498,10 +498,10 @@ proptest! {
     ) {
         let mut c = controller(VelocityLimits::unlimited(), Finish::RotateInPlace);
         // Either the goal is refused, or every output is finite (or the pose/time refused).
-        if c.set_goal(Pose2::new(gx, gy, gyaw)).is_ok() {
-            if let Ok(out) = c.update(&Pose2::new(x, y, yaw), t) {
-                prop_assert!(output_is_finite(&out), "{:?}", out);
-            }
+        if c.set_goal(Pose2::new(gx, gy, gyaw)).is_ok()
+            && let Ok(out) = c.update(&Pose2::new(x, y, yaw), t)
+        {
+            prop_assert!(output_is_finite(&out), "{:?}", out);
         }
     }
 }

@@ -450,24 +450,24 @@ async fn run(node: &mut RosNode) -> anyhow::Result<()> {
                     );
                     let _ = truth_pub.publish(truth);
                 }
-                if let (Some(l), Some(cfg)) = (lidar.as_mut(), config.lidar()) {
-                    if t + 1e-9 >= next_scan {
-                        next_scan += 1.0 / cfg.rate_hz;
-                        let pose = plant.reference_pose();
-                        let scan = l.scan(&world, (pose.x, pose.y, pose.z));
-                        let _ = scan_pub.publish(LaserScan {
-                            header: Header { stamp: stamp_at(t, config.publish_clock), frame_id: config.laser_frame.clone() },
-                            angle_min: scan.angle_min as f32,
-                            angle_max: scan.angle_max as f32,
-                            angle_increment: scan.angle_increment as f32,
-                            time_increment: 0.0,
-                            scan_time: (1.0 / cfg.rate_hz) as f32,
-                            range_min: scan.range_min as f32,
-                            range_max: scan.range_max as f32,
-                            ranges: scan.ranges,
-                            intensities: Vec::new(),
-                        });
-                    }
+                if let (Some(l), Some(cfg)) = (lidar.as_mut(), config.lidar())
+                    && t + 1e-9 >= next_scan
+                {
+                    next_scan += 1.0 / cfg.rate_hz;
+                    let pose = plant.reference_pose();
+                    let scan = l.scan(&world, (pose.x, pose.y, pose.z));
+                    let _ = scan_pub.publish(LaserScan {
+                        header: Header { stamp: stamp_at(t, config.publish_clock), frame_id: config.laser_frame.clone() },
+                        angle_min: scan.angle_min as f32,
+                        angle_max: scan.angle_max as f32,
+                        angle_increment: scan.angle_increment as f32,
+                        time_increment: 0.0,
+                        scan_time: (1.0 / cfg.rate_hz) as f32,
+                        range_min: scan.range_min as f32,
+                        range_max: scan.range_max as f32,
+                        ranges: scan.ranges,
+                        intensities: Vec::new(),
+                    });
                 }
             }
         }

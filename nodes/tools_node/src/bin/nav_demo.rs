@@ -167,12 +167,12 @@ async fn run(node: &mut RosNode) -> anyhow::Result<()> {
                     continue;
                 }
                 if s.state == NavStatus::ACTIVE {
-                    if let Some(letter) = mode_letter(&s.mode) {
-                        if last_letter != Some(letter) {
-                            let &(x, y) = record.path.last().unwrap_or(&(f64::NAN, f64::NAN));
-                            record.changes.push((x, y, letter));
-                            last_letter = Some(letter);
-                        }
+                    if let Some(letter) = mode_letter(&s.mode)
+                        && last_letter != Some(letter)
+                    {
+                        let &(x, y) = record.path.last().unwrap_or(&(f64::NAN, f64::NAN));
+                        record.changes.push((x, y, letter));
+                        last_letter = Some(letter);
                     }
                 } else if s.state == NavStatus::SUCCEEDED || s.state == NavStatus::FAILED {
                     break (s.state, s.reason);
