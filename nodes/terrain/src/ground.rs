@@ -95,14 +95,14 @@ impl Course {
         }
         for (length, section) in &sections {
             positive("course section length", *length, false)?;
-            if let Section::Ramp(angle) = section {
-                if !(angle.is_finite() && angle.abs() < std::f64::consts::FRAC_PI_2) {
-                    return Err(TerrainError::InvalidConfig {
-                        name: "ramp angle",
-                        value: *angle,
-                        reason: "must be within (−π/2, π/2)",
-                    });
-                }
+            if let Section::Ramp(angle) = section
+                && !(angle.is_finite() && angle.abs() < std::f64::consts::FRAC_PI_2)
+            {
+                return Err(TerrainError::InvalidConfig {
+                    name: "ramp angle",
+                    value: *angle,
+                    reason: "must be within (−π/2, π/2)",
+                });
             }
         }
         Ok(Course { start_x, sections })

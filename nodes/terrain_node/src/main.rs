@@ -158,10 +158,10 @@ impl Shell {
 
     /// The last good assessment again, with the current counts (nothing before the first).
     fn publish_last(&mut self, out: &Outputs) {
-        if let Some(msg) = self.state.last_message() {
-            if let Err(e) = out.assessment.publish(msg) {
-                warn_throttled!(self.throttle, "publish", "cannot publish terrain/assessment: {e:?}");
-            }
+        if let Some(msg) = self.state.last_message()
+            && let Err(e) = out.assessment.publish(msg)
+        {
+            warn_throttled!(self.throttle, "publish", "cannot publish terrain/assessment: {e:?}");
         }
     }
 }
