@@ -131,20 +131,28 @@ def result_of(handle, timeout: float = 40.0):
 ACTION_ANSWERED = r"(?:dock_robot|undock_robot|follow_waypoints): goal .*(?:accepted|rejected)"
 
 
-def send_until_answered(client: ActionClient, goal, planner, feedback=None, attempts: int = 4):
-    """Sends ``goal`` until a goal response arrives, each attempt 3 s. Only a request the node
-    never answered (its log says so: lost during discovery) is sent again; a second copy of a
-    goal the node took would pre-empt the first and run again (an undock would back out twice),
-    so a response lost after the node answered fails the test instead. The clients are made
-    right after launch, so discovery is done long before they are used (see test_actions.py)."""
+def send_until_answered(client: ActionClient, goal, planner, feedback=None, attempts: int = 4,
+                        resent=None, before_resend=None):
+    """Sends ``goal`` until a goal response arrives, each attempt 3 s. A request the node never
+    answered (its log says so: lost during discovery; the clients are made right after launch so
+    that discovery is done long before use) is simply sent again. A request the node answered
+    is waited for 3 s more: rclpy drops a response that comes back before it filed the request
+    ("Ignoring unexpected goal response"), and then only a second goal gets a handle; that one
+    pre-empts the first, which ran: it is appended to ``resent`` (the goals started are counted
+    from the log) and ``before_resend`` runs first (an undock measures from where the first one
+    left the robot)."""
     for _ in range(attempts):
         before = log_count(planner, ACTION_ANSWERED)
         future = client.send_goal_async(goal, feedback_callback=feedback)
         if wait_until(future.done, 3.0):
             return future.result()
         if log_count(planner, ACTION_ANSWERED) > before:
-            assert wait_until(future.done, 3.0), "the node answered the goal but no response arrived"
-            return future.result()
+            if wait_until(future.done, 3.0):
+                return future.result()
+            if resent is not None:
+                resent.append(goal)
+            if before_resend is not None:
+                before_resend()
     raise AssertionError(f"no goal response to {attempts} goals")
 
 
@@ -219,6 +227,7 @@ def test_omr3_docking_actions_route_check_and_refusals(start_scenario, start_nod
     undock = ActionClient(ros_node, UndockRobot, "undock_robot")
     follow = ActionClient(ros_node, FollowWaypoints, "follow_waypoints")
     dock_fb, follow_fb = [], []
+    resent = []  # goals that drive, sent twice because rclpy dropped the first response
     with subscribe(ros_node, NavStatus, "planner/status", qos=qos_latched()) as status, \
             subscribe(ros_node, Twist, "cmd_vel", qos=DEEP) as cmd, \
             subscribe(ros_node, MarkerArray, "planner/markers", qos=DEEP) as markers, \
@@ -297,7 +306,7 @@ def test_omr3_docking_actions_route_check_and_refusals(start_scenario, start_nod
         assert "INVALID_GOAL" in res.result.error_msg
         back = DockRobot.Goal()
         back.use_dock_id, back.dock_pose = False, stamped(0.2, -0.3, -0.5)
-        handle = send_until_answered(dock_client, back, planner, feedback=dock_fb.append)
+        handle = send_until_answered(dock_client, back, planner, feedback=dock_fb.append, resent=resent)
         assert handle.accepted
         res = result_of(handle)
         assert res.status == GoalStatus.STATUS_SUCCEEDED, res.result.error_msg
@@ -305,8 +314,13 @@ def test_omr3_docking_actions_route_check_and_refusals(start_scenario, start_nod
         # UndockRobot: straight back out 0.5 m (staging_distance in params/omr3.yaml) along the
         # docked heading −0.5 rad.
         docked = rest_after(truth, sim_clock.now())
+
+        def rest_again():
+            nonlocal docked
+            docked = rest_after(truth, sim_clock.now())
         assert undock.wait_for_server(timeout_sec=20.0)
-        res = result_of(send_until_answered(undock, UndockRobot.Goal(), planner))
+        res = result_of(send_until_answered(undock, UndockRobot.Goal(), planner, resent=resent,
+                                           before_resend=rest_again))
         assert res.status == GoalStatus.STATUS_SUCCEEDED and res.result.success, res.result.error_msg
         undocked = rest_after(truth, sim_clock.now())
 
@@ -314,7 +328,7 @@ def test_omr3_docking_actions_route_check_and_refusals(start_scenario, start_nod
         assert follow.wait_for_server(timeout_sec=20.0)
         goal = FollowWaypoints.Goal()
         goal.poses = [stamped(x, y) for x, y in [(1.0, -0.3), (1.5, 0.3), (1.0, 0.8), (0.3, 0.5)]]
-        handle = send_until_answered(follow, goal, planner, feedback=follow_fb.append)
+        handle = send_until_answered(follow, goal, planner, feedback=follow_fb.append, resent=resent)
         assert handle.accepted
         res = result_of(handle)
         assert res.status == GoalStatus.STATUS_SUCCEEDED, res.result.error_msg
@@ -336,7 +350,7 @@ def test_omr3_docking_actions_route_check_and_refusals(start_scenario, start_nod
         far = DockRobot.Goal()
         far.use_dock_id, far.dock_pose = False, stamped(-3.5, 3.0, 0.0)
         n = len(status)
-        handle = send_until_answered(dock_client, far, planner)
+        handle = send_until_answered(dock_client, far, planner, resent=resent)
         assert handle.accepted
         # Under way, v_max is lowered to 0.2 m/s: the running goal keeps the limits it began
         # with (the law, far from the dock, asks for more than 0.2), the next goal takes 0.2.
@@ -425,8 +439,9 @@ def test_omr3_docking_actions_route_check_and_refusals(start_scenario, start_nod
     assert any(m.type == Marker.TEXT_VIEW_FACING and "waypoint 1" in m.text for m in drawn)
     # One zero command per started goal (the refused ones moved nothing and sent none).
     check_commands(cmds, started, v_max, omega_max)
-    # dock_pose, DockRobot, UndockRobot, FollowWaypoints, the canceled DockRobot, waypoints.
-    assert started == 6, started
+    # dock_pose, DockRobot, UndockRobot, FollowWaypoints, the canceled DockRobot, waypoints, and
+    # any of the four action goals sent again after rclpy dropped its response.
+    assert started == 6 + len(resent), (started, len(resent))
 
 
 def test_mobil2_docking_residual_and_route_rejected(start_scenario, start_node, sim_clock, ros_node,
