@@ -2,7 +2,8 @@
 //!
 //! [`OffLoop::start`] runs a job on tokio's blocking pool with a [`CancelToken`] the algorithm
 //! checks now and then; starting a newer job cancels the running one, and a cancelled (stale)
-//! job's result is discarded, never delivered. [`OffLoop::result`] is cancel-safe, so it sits in
+//! job's result is discarded, never delivered. One thread at most: the newer job waits until
+//! the cancelled one has returned, and a still newer one replaces it. [`OffLoop::result`] is cancel-safe, so it sits in
 //! the node's `select!` beside the ticker and the subscriptions, which keep being served while
 //! the search runs.
 //!
@@ -43,13 +44,34 @@ impl CancelToken {
     }
 }
 
-/// One computation at a time off the event loop; the newest request wins.
-#[derive(Debug)]
+/// A job waiting for the thread of a cancelled one.
+type Job<R> = Box<dyn FnOnce(&CancelToken) -> R + Send>;
+
+/// One computation at a time off the event loop; the newest request wins. At most one thread
+/// runs: a newer request cancels the running job and waits (pending) until that job has
+/// noticed its token and returned; a still newer request replaces the pending one, which then
+/// never runs. So requests at any rate cost one running job and one pending, never a pile of
+/// stale threads.
 pub struct OffLoop<R> {
     generation: u64,
+    /// The newest job, wanted (not cancelled), running or pending.
     running: Option<(u64, CancelToken)>,
-    tx: mpsc::UnboundedSender<(u64, R)>,
-    rx: mpsc::UnboundedReceiver<(u64, R)>,
+    /// Whether a thread is running (maybe a cancelled job that has not yet returned).
+    busy: bool,
+    pending: Option<(u64, CancelToken, Job<R>)>,
+    tx: mpsc::UnboundedSender<(u64, Option<R>)>,
+    rx: mpsc::UnboundedReceiver<(u64, Option<R>)>,
+}
+
+impl<R> std::fmt::Debug for OffLoop<R> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("OffLoop")
+            .field("generation", &self.generation)
+            .field("running", &self.running)
+            .field("busy", &self.busy)
+            .field("pending", &self.pending.as_ref().map(|(g, _, _)| *g))
+            .finish()
+    }
 }
 
 impl<R: Send + 'static> Default for OffLoop<R> {
@@ -65,43 +87,64 @@ impl<R: Send + 'static> OffLoop<R> {
         OffLoop {
             generation: 0,
             running: None,
+            busy: false,
+            pending: None,
             tx,
             rx,
         }
     }
 
     /// Starts `job` on the blocking pool, cancelling the job still running (whose result will
-    /// be discarded). Must be called inside a tokio runtime.
+    /// be discarded). While the cancelled job's thread has not returned, `job` waits as the
+    /// pending one and starts from [`OffLoop::result`] when that thread is done. Must be called
+    /// inside a tokio runtime.
     pub fn start(&mut self, job: impl FnOnce(&CancelToken) -> R + Send + 'static) {
         self.cancel();
         self.generation += 1;
         let generation = self.generation;
         let token = CancelToken::new();
         self.running = Some((generation, token.clone()));
+        if self.busy {
+            self.pending = Some((generation, token, Box::new(job)));
+        } else {
+            self.spawn(generation, token, Box::new(job));
+        }
+    }
+
+    fn spawn(&mut self, generation: u64, token: CancelToken, job: Job<R>) {
+        self.busy = true;
         let tx = self.tx.clone();
         tokio::task::spawn_blocking(move || {
             let result = job(&token);
-            if !token.is_cancelled() {
-                // The receiver lives as long as the OffLoop; if it is gone nobody waits.
-                let _ = tx.send((generation, result));
-            }
+            let result = (!token.is_cancelled()).then_some(result);
+            // The receiver lives as long as the OffLoop; if it is gone nobody waits.
+            let _ = tx.send((generation, result));
         });
     }
 
-    /// Cancels the running job, if any; its result will be discarded.
+    /// Cancels the running job, if any (its result will be discarded), and drops a pending one.
     pub fn cancel(&mut self) {
         if let Some((_, token)) = self.running.take() {
             token.cancel();
         }
+        self.pending = None;
     }
 
-    /// Whether a job is running (started, not cancelled, result not yet taken).
+    /// Whether a job is wanted (started, not cancelled, result not yet taken), running or
+    /// pending.
     pub fn is_running(&self) -> bool {
         self.running.is_some()
     }
 
+    /// Threads of the blocking pool in use: 1 while a job (maybe a cancelled one not yet
+    /// returned) runs, else 0. For a limit shared with other computations.
+    pub fn threads(&self) -> usize {
+        usize::from(self.busy)
+    }
+
     /// The result of the newest job, when it is done; pending for ever while nothing runs.
-    /// Cancel-safe (for `select!`).
+    /// Starts the pending job when the thread before it returns, so it must be polled (it sits
+    /// in the node's `select!`). Cancel-safe (for `select!`).
     pub async fn result(&mut self) -> R {
         loop {
             let Some((generation, result)) = self.rx.recv().await else {
@@ -109,9 +152,15 @@ impl<R: Send + 'static> OffLoop<R> {
                 std::future::pending::<()>().await;
                 continue;
             };
-            if self.running.as_ref().is_some_and(|(g, _)| *g == generation) {
-                self.running = None;
-                return result;
+            self.busy = false;
+            if let Some((g, token, job)) = self.pending.take() {
+                self.spawn(g, token, job);
+            }
+            if let Some(result) = result {
+                if self.running.as_ref().is_some_and(|(g, _)| *g == generation) {
+                    self.running = None;
+                    return result;
+                }
             }
         }
     }
@@ -195,5 +244,53 @@ mod tests {
         assert!(tokio::time::timeout(Duration::from_millis(50), off.result())
             .await
             .is_err());
+    }
+
+    /// Requests at a high rate keep one thread busy, never more: the first job runs until it
+    /// sees its token, the middle ones are replaced while pending and never run, the newest
+    /// runs after the first has returned.
+    #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+    async fn requests_at_a_high_rate_run_one_job_at_a_time() {
+        use std::sync::atomic::AtomicUsize;
+        let (now, most, ran) = (
+            Arc::new(AtomicUsize::new(0)),
+            Arc::new(AtomicUsize::new(0)),
+            Arc::new(std::sync::Mutex::new(Vec::new())),
+        );
+        let job = |label: u32, now: Arc<AtomicUsize>, most: Arc<AtomicUsize>, ran: Arc<std::sync::Mutex<Vec<u32>>>| {
+            move |cancel: &CancelToken| {
+                let n = now.fetch_add(1, Ordering::SeqCst) + 1;
+                most.fetch_max(n, Ordering::SeqCst);
+                if let Ok(mut r) = ran.lock() {
+                    r.push(label);
+                }
+                // 30 ms of work, checking the token every millisecond.
+                for _ in 0..30 {
+                    if cancel.is_cancelled() {
+                        break;
+                    }
+                    std::thread::sleep(Duration::from_millis(1));
+                }
+                now.fetch_sub(1, Ordering::SeqCst);
+                label
+            }
+        };
+        let mut off = OffLoop::new();
+        off.start(job(0, now.clone(), most.clone(), ran.clone()));
+        assert_eq!(off.threads(), 1);
+        for label in 1..=10 {
+            off.start(job(label, now.clone(), most.clone(), ran.clone()));
+        }
+        assert!(off.is_running());
+        assert_eq!(off.threads(), 1, "the cancelled first job still holds the one thread");
+        let result = tokio::time::timeout(Duration::from_secs(5), off.result()).await;
+        assert_eq!(result.ok(), Some(10));
+        assert_eq!(most.load(Ordering::SeqCst), 1, "never two jobs at once");
+        assert_eq!(
+            ran.lock().map(|r| r.clone()).ok(),
+            Some(vec![0, 10]),
+            "jobs 1–9 never ran"
+        );
+        assert_eq!((off.threads(), off.is_running()), (0, false));
     }
 }

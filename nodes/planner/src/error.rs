@@ -54,6 +54,10 @@ pub enum PlannerError {
     /// A route without waypoints.
     #[error("the route has no waypoints")]
     EmptyRoute,
+    /// A computation was stopped by its caller before it finished (a newer request superseded
+    /// it); its partial result is not given.
+    #[error("stopped by the caller before the end")]
+    Stopped,
 }
 
 /// Largest |x|, |y| (m) and |ϑ| (rad) the library accepts: 1000 km, far beyond any map, and

@@ -6,8 +6,8 @@
 //! tick and the time itself, and gives a body twist at the reference point. Inside, the pose is
 //! moved to the model's origin (`reference_offset` behind), [`approach_step`] takes one step of
 //! path length `speed · dt` toward the current waypoint, and the twist is the one that drives
-//! that step in `dt`: on a steered chassis v = step / dt and ω = Δϑ / dt at the origin (so δ
-//! within δ_eff, exactly the step's turn), on the omni chassis the step's translation, heading
+//! that step in `dt`: on a steered chassis v = step / dt = speed and ω = speed·tan δ / L at the
+//! origin (so δ within δ_eff, exactly the step's turn, whatever the length of the tick), on the omni chassis the step's translation, heading
 //! held. The twist is then moved to the reference point (vy += ω·d), where `cmd_vel` is
 //! expressed. Holding it over the tick drives the step's arc rather than the step's
 //! straight chord: the two differ by O(step²/R), under 0.3 mm for MOBIL-II's 0.73 m radius at
@@ -35,7 +35,7 @@ use std::f64::consts::TAU;
 
 use mobil_chassis::kinematics::twist_at_reference;
 use mobil_chassis::{BodyTwist, ChassisParams};
-use mobil_geom::{wrap, Pose2};
+use mobil_geom::Pose2;
 use nalgebra::Point2;
 
 use crate::approach::{approach_step, bearing, check_point, distance, Motion};
@@ -318,8 +318,10 @@ impl WaypointFollower {
         let origin = pose.ahead(-self.offset);
         let step = approach_step(&origin, &goal, speed * dt, &self.motion)?;
         let twist = match self.motion {
-            Motion::Steered(_) => {
-                let omega = wrap(step.pose.yaw - origin.yaw) / dt;
+            Motion::Steered(steering) => {
+                // The step's turn rate, not its heading change over dt: the same for any dt,
+                // where wrap(Δϑ)/dt would fold a turn beyond π in a long tick.
+                let omega = speed * step.steering.tan() / steering.wheelbase();
                 twist_at_reference(BodyTwist::new(speed, 0.0, omega), self.offset)
             }
             Motion::Holonomic => {

@@ -114,5 +114,8 @@ pub use docking::{
 };
 pub use error::{PlannerError, COORDINATE_LIMIT};
 pub use follow::{FollowConfig, FollowEnd, FollowEvent, FollowOutput, WaypointFollower};
-pub use route::{arc_radius, check_route, ProblemKind, RouteCheckConfig, RouteProblem, RouteReport, UnreachableCause};
+pub use route::{
+    arc_radius, check_route, check_route_until, ProblemKind, RouteCheckConfig, RouteProblem, RouteReport,
+    UnreachableCause,
+};
 pub use sim::{advance, rk4_step, simulate_docking, DockingRun, DockingSample, Kinematics, MAX_SIMULATION_STEPS};

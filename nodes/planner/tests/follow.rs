@@ -313,3 +313,19 @@ fn bad_input_is_refused() {
     // Steering must be a real chassis' (the constructor of Motion::Steered checks it).
     assert!(Steering::new(0.6, 2.0).is_err());
 }
+
+#[test]
+fn a_long_tick_turns_at_the_steering_rate() {
+    // MOBIL-II at the origin facing +x, the waypoint 5 m to the left: the bearing (about 90°)
+    // is beyond δ_eff, so δ = δ_eff and the origin turns at speed / R_min = speed·tan δ_eff / L
+    // whatever the tick's length. At dt = 30 s the step's heading change (0.3·30 / 0.73 ≈
+    // 12 rad) is far beyond π; the turn rate must not depend on it.
+    let p = ChassisParams::mobil2();
+    let by_hand = 0.3 * p.effective_steering_limit().tan() / p.wheelbase();
+    for dt in [0.02, 1.0, 30.0] {
+        let mut follower = WaypointFollower::new(plain(), &p, vec![Point2::new(0.0, 5.0)]).expect("valid");
+        let out = follower.update(&Pose2::identity(), dt, 0.0).expect("valid tick");
+        assert_relative_eq!(out.twist.vx, 0.3, epsilon = 1e-12);
+        assert_relative_eq!(out.twist.wz, by_hand, epsilon = 1e-12);
+    }
+}

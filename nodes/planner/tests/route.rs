@@ -9,7 +9,8 @@ use approx::assert_relative_eq;
 use mobil_chassis::{ChassisConfig, ChassisParams};
 use mobil_geom::Pose2;
 use mobil_planner::{
-    arc_radius, check_route, ApproachConfig, PlannerError, ProblemKind, RouteCheckConfig, RouteReport, UnreachableCause,
+    arc_radius, check_route, check_route_until, ApproachConfig, PlannerError, ProblemKind, RouteCheckConfig,
+    RouteReport, UnreachableCause,
 };
 use mobil_sim::world::{Obstacle, World};
 use nalgebra::Point2;
@@ -437,6 +438,41 @@ fn bad_routes_are_refused() {
         ..c
     };
     assert!(check_route(&Pose2::identity(), &[Point2::new(1.0, 0.0)], &p, &world, &bad).is_err());
+}
+
+#[test]
+fn a_stopped_check_ends_at_once_with_stopped() {
+    // A long route: 20 legs of 10 m back and forth; each leg ends within Z_crit = 0.16 m of its
+    // waypoint and starts within it of the last, so it drives at least (10 − 2·0.16) / 0.02 =
+    // 484 virtual steps of 0.02 m.
+    let route: Vec<Point2<f64>> = (0..20)
+        .map(|i| Point2::new(if i % 2 == 0 { 10.0 } else { 0.0 }, 0.0))
+        .collect();
+    let (p, world, c) = (ChassisParams::omr3(), World::default(), RouteCheckConfig::new(0.25));
+    // Never stopped: the same report as check_route, after one question per leg plus one per
+    // step (20 legs × ≥ 484 steps).
+    let mut asked = 0usize;
+    let full = check_route_until(&Pose2::identity(), &route, &p, &world, &c, || {
+        asked += 1;
+        false
+    });
+    assert_eq!(full, check_route(&Pose2::identity(), &route, &p, &world, &c));
+    assert!(asked > 20 * 484, "{asked}");
+    // Stopped at the 100th question (in the first leg): the answer is Stopped and stop is not
+    // asked again, so no further step was driven.
+    let mut asked = 0usize;
+    let stopped = check_route_until(&Pose2::identity(), &route, &p, &world, &c, || {
+        asked += 1;
+        asked >= 100
+    });
+    assert_eq!((stopped, asked), (Err(PlannerError::Stopped), 100));
+    // Stopped before the first leg.
+    let mut asked = 0usize;
+    let stopped = check_route_until(&Pose2::identity(), &route, &p, &world, &c, || {
+        asked += 1;
+        true
+    });
+    assert_eq!((stopped, asked), (Err(PlannerError::Stopped), 1));
 }
 
 proptest! {

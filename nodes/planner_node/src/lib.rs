@@ -81,14 +81,19 @@ pub const MAX_INPUT_TIMEOUT_S: f64 = 60.0;
 /// The largest `result_timeout_s` (s).
 pub const MAX_RESULT_TIMEOUT_S: f64 = 3600.0;
 /// Most waypoints of one route (after `number_of_loops`): the pre-check of 200 legs each at the
-/// 50 m leg bound is at most 500 000 virtual steps, about 25 ms; a real route is far shorter
-/// (20 waypoints: 0.36 ms), so the check runs on the event loop.
+/// 50 m leg bound takes 0.47–0.64 s at worst (measured; a real route is far shorter: 20
+/// waypoints, 0.36 ms), so every check runs off the event loop, a superseded goal's check
+/// stopped within one virtual step.
 pub const MAX_WAYPOINTS: usize = 200;
 /// Most poses of `simulated_path` in a `check_route` reply (about 90 bytes each: 36 KB, well
 /// under the 64 KB a reply should stay below).
 pub const MAX_REPLY_POSES: usize = 400;
-/// Most problems listed in a reply, a result or the markers (the rest are counted in `reason`).
+/// Most problems listed in a reply, a reason or the markers (the rest are counted in `reason`).
 pub const MAX_LISTED_PROBLEMS: usize = 50;
+/// Most missed waypoints in a FollowWaypoints result: every one a route of [`MAX_WAYPOINTS`]
+/// can miss while driving, and twice that from a pre-check; about 90 bytes each (index, pose,
+/// code), 36 KB, well under the 64 KB a reply should stay below.
+pub const MAX_RESULT_MISSED: usize = 2 * MAX_WAYPOINTS;
 
 impl Config for PlannerConfig {
     fn declare(d: &mut Decl<Self>) {
@@ -419,6 +424,26 @@ pub struct Route {
     pub request_index: Vec<usize>,
     /// The request's poses (for the results' missed waypoints).
     pub poses: Vec<PoseStamped>,
+}
+
+impl Route {
+    /// The index (in the request) of the first waypoint whose orientation is not the identity:
+    /// the goal approach reaches a point, not a heading, so such an orientation is ignored (and
+    /// the node says so once per route). An all-zero quaternion (an orientation never set) and
+    /// one within 1e-6 of ±identity count as none.
+    pub fn first_oriented(&self) -> Option<usize> {
+        self.poses
+            .iter()
+            .enumerate()
+            .find(|(_, p)| {
+                let q = &p.pose.orientation;
+                let unset = q.x == 0.0 && q.y == 0.0 && q.z == 0.0 && q.w == 0.0;
+                let identity =
+                    q.x.abs() < 1e-6 && q.y.abs() < 1e-6 && q.z.abs() < 1e-6 && (q.w.abs() - 1.0).abs() < 1e-6;
+                !(unset || identity)
+            })
+            .map(|(i, _)| i)
+    }
 }
 
 /// A route from `poses` (each in `odom_frame`; an empty frame takes `default_frame`, the path's
@@ -783,14 +808,16 @@ impl Outcome {
     }
 
     /// FollowWaypoints' result: the missed waypoints (the run's, or the pre-check's for a
-    /// refused route) each with its pose and code; error_code NONE when the route was driven
+    /// refused route; for an outcome that carries none, such as a cancel or a pre-emption,
+    /// `so_far`, those the run had missed until then), up to [`MAX_RESULT_MISSED`], each with
+    /// its pose and code; error_code NONE when the route was driven
     /// to its end (Nav2 then lists what it missed), TASK_EXECUTOR_FAILED (601) for a route the
     /// pre-check refused, a stall, stale odometry or refused input, UNKNOWN (600) for an
     /// invalid goal or shutdown.
-    pub fn follow_result(&self, poses: &[PoseStamped]) -> FollowWaypointsResult {
+    pub fn follow_result(&self, poses: &[PoseStamped], so_far: &[Missed]) -> FollowWaypointsResult {
         let missed: &[Missed] = match self {
             Outcome::RouteDone { missed, .. } | Outcome::RouteInfeasible(missed) => missed,
-            _ => &[],
+            _ => so_far,
         };
         let error_code = match self {
             Outcome::RouteDone { .. } | Outcome::Canceled | Outcome::Preempted(_) => FollowWaypointsResult::NONE,
@@ -802,7 +829,7 @@ impl Outcome {
         FollowWaypointsResult {
             missed_waypoints: missed
                 .iter()
-                .take(MAX_LISTED_PROBLEMS)
+                .take(MAX_RESULT_MISSED)
                 .map(|m| MissedWaypoint {
                     index: u32::try_from(m.index).unwrap_or(u32::MAX),
                     goal: poses.get(m.index).cloned().unwrap_or_default(),
@@ -1113,6 +1140,38 @@ mod tests {
     use approx::assert_relative_eq;
     use mobil_ros::params::ParamValues;
 
+    #[test]
+    fn a_waypoint_orientation_is_noticed() {
+        let pose = |x: f64, y: f64, z: f64, w: f64| {
+            let mut p = PoseStamped::default();
+            p.pose.orientation.x = x;
+            p.pose.orientation.y = y;
+            p.pose.orientation.z = z;
+            p.pose.orientation.w = w;
+            p
+        };
+        let route = |poses: Vec<PoseStamped>| Route {
+            points: vec![Point2::origin(); poses.len()],
+            request_index: (0..poses.len()).collect(),
+            poses,
+        };
+        // Identity, −identity and never set (all zero): none.
+        let plain = route(vec![
+            pose(0.0, 0.0, 0.0, 1.0),
+            pose(0.0, 0.0, 0.0, -1.0),
+            pose(0.0, 0.0, 0.0, 0.0),
+        ]);
+        assert_eq!(plain.first_oriented(), None);
+        // 90° about z: (0, 0, sin 45°, cos 45°) at index 1.
+        let h = std::f64::consts::FRAC_1_SQRT_2;
+        let turned = route(vec![
+            pose(0.0, 0.0, 0.0, 1.0),
+            pose(0.0, 0.0, h, h),
+            pose(0.0, 0.0, 0.0, 1.0),
+        ]);
+        assert_eq!(turned.first_oriented(), Some(1));
+    }
+
     fn stamped(frame: &str, x: f64, y: f64) -> PoseStamped {
         let mut g = PoseStamped::default();
         g.header.frame_id = frame.into();
@@ -1345,7 +1404,7 @@ mod tests {
             o.reason(),
             "ROUTE_INFEASIBLE: 1 problem(s): waypoint 1: turn_radius: turn radius 0.20 m below the chassis minimum 0.73 m"
         );
-        let r = o.follow_result(&poses);
+        let r = o.follow_result(&poses, &[]);
         assert_eq!(r.error_code, 601);
         assert_eq!(r.missed_waypoints.len(), 1);
         assert_eq!(
@@ -1362,8 +1421,33 @@ mod tests {
             missed: vec![ran],
         };
         assert_eq!(o.state(), NavStatus::SUCCEEDED);
-        let r = o.follow_result(&poses);
+        let r = o.follow_result(&poses, &[]);
         assert_eq!((r.error_code, r.missed_waypoints[0].error_code), (0, 105));
+        // A cancel or a pre-emption lists what the run had missed until then.
+        let so_far = [Missed {
+            pre_check: false,
+            ..missed[0].clone()
+        }];
+        for o in [Outcome::Canceled, Outcome::Preempted("dock_pose")] {
+            let r = o.follow_result(&poses, &so_far);
+            let codes: Vec<(u32, u16)> = r.missed_waypoints.iter().map(|m| (m.index, m.error_code)).collect();
+            assert_eq!((r.error_code, codes), (0, vec![(1, 105)]));
+        }
+        // More missed than the 50 a reason lists: every one is in the result (60 here).
+        let many: Vec<Missed> = (0..60)
+            .map(|i| Missed {
+                index: i,
+                pre_check: false,
+                ..missed[0].clone()
+            })
+            .collect();
+        let r = Outcome::RouteDone {
+            count: 60,
+            missed: many,
+        }
+        .follow_result(&poses, &[]);
+        assert_eq!(r.missed_waypoints.len(), 60);
+        assert_eq!(r.missed_waypoints[59].index, 59);
         assert!(o.reason().starts_with("SUCCEEDED: route done: 1 of 2 waypoints missed"));
         assert_eq!(
             Outcome::Preempted("dock_pose").reason(),

@@ -30,7 +30,7 @@ use mobil_msgs::nav2_msgs::action::{
 use mobil_msgs::nav_msgs::msg::{Odometry, Path};
 use mobil_msgs::visualization_msgs::msg::MarkerArray;
 use mobil_planner::{
-    check_route, polar_error, DockingController, DockingOutput, DockingPhase, Finish, FollowEnd, FollowEvent,
+    check_route_until, polar_error, DockingController, DockingOutput, DockingPhase, Finish, FollowEnd, FollowEvent,
     ProblemKind, RouteReport, VelocityLimits, WaypointFollower,
 };
 use mobil_planner_node::{
@@ -60,6 +60,9 @@ const WATCHDOG_RATE_HZ: f64 = 20.0;
 /// The follower's `dt` on a goal's first step, before ROS time has ticked twice (it sets only
 /// the step's length, not its direction or speed).
 const FIRST_DT: f64 = 0.02;
+/// The follower's longest `dt` (s): a tick after a gap in odometry (five 50 Hz periods) steps
+/// no further than this, so one step stays a short one of the approach.
+const MAX_FOLLOW_DT: f64 = 0.1;
 /// After this many refused steps in a row the goal ends.
 const MAX_REFUSED_STEPS: u32 = 20;
 /// A route shorter than this (m), start included, is refused as zero-length.
@@ -132,8 +135,11 @@ enum Task {
 struct Active {
     task: Task,
     source: Source,
+    /// The chassis and parameters when the goal began: a parameter change applies from the
+    /// next goal, so the limits the controller scales by stay those the commands are held to.
+    chassis: ChassisParams,
+    config: PlannerConfig,
     started: Instant,
-    started_ros_nanos: i64,
     clock: DtClock,
     t: f64,
     refused: u32,
@@ -173,10 +179,13 @@ struct PreCheckDone {
     report: Result<RouteReport, String>,
 }
 
-/// Most `planner/check_route` requests computed at once; more are answered busy at once.
-const MAX_PENDING_CHECKS: usize = 4;
+/// Most route checks computed at once, goal pre-checks and `planner/check_route` requests
+/// together (each may take up to 0.6 s of one core). The goal's pre-check keeps one of them
+/// (its [`OffLoop`] runs one at a time, a newer goal's waiting until the superseded check has
+/// stopped); service requests beyond the rest are answered BUSY at once.
+const MAX_CHECKS: usize = 4;
 
-/// The pre-checks off the event loop: the goal's (a newer goal discards the older one's) and
+/// The pre-checks off the event loop: the goal's (a newer goal stops the older one's) and
 /// the service's (each request answered, in any order).
 struct Jobs {
     goal: OffLoop<PreCheckDone>,
@@ -234,17 +243,12 @@ async fn serve(node: &mut RosNode) -> anyhow::Result<()> {
         status: node.publisher::<NavStatus>("planner/status", &qos::latched())?,
         markers: node.publisher::<MarkerArray>("planner/markers", &qos::default_qos())?,
     };
-    let (outcome, was_active) = match start(node, &outputs, config).await {
-        Ok(r) => r,
-        Err(e) => (Err(e), false),
-    };
-    if was_active {
-        final_stop(&outputs.cmd, Twist::default(), FINAL_STOP_WAIT).await;
-    }
-    outcome
+    start(node, &outputs, config).await?
 }
 
-async fn start(node: &mut RosNode, out: &Outputs, config: PlannerConfig) -> anyhow::Result<(anyhow::Result<()>, bool)> {
+/// Runs the node; the outer error is a start-up failure (no goal can have run), the inner one
+/// the event loop's.
+async fn start(node: &mut RosNode, out: &Outputs, config: PlannerConfig) -> anyhow::Result<anyhow::Result<()>> {
     let chassis = config.chassis_params()?;
     let world =
         load_world(&config.world_file).map_err(|e| anyhow::anyhow!("world_file `{}`: {e}", config.world_file))?;
@@ -307,15 +311,22 @@ async fn start(node: &mut RosNode, out: &Outputs, config: PlannerConfig) -> anyh
         &check,
     )
     .await;
-    let was_active = shell.active.is_some();
-    if was_active {
+    // A goal under way (a pre-check included: a command may be in flight from a goal it
+    // pre-empted) ends, and its zero command, waited for, goes out before anything that may
+    // take time; then the three servers close at once (each waits up to 2 s for its results).
+    jobs.goal.cancel();
+    if shell.active.is_some() {
         shell.end_goal_without_zero(node, out, &mut servers, Outcome::ShuttingDown);
+        final_stop(&out.cmd, Twist::default(), FINAL_STOP_WAIT).await;
     }
     let down = Outcome::ShuttingDown;
-    servers.dock.close(down.dock_result()).await;
-    servers.undock.close(down.undock_result()).await;
-    servers.follow.close(down.follow_result(&[])).await;
-    Ok((outcome, was_active))
+    let Servers { dock, undock, follow } = servers;
+    tokio::join!(
+        dock.close(down.dock_result()),
+        undock.close(down.undock_result()),
+        follow.close(down.follow_result(&[], &[])),
+    );
+    Ok(outcome)
 }
 
 #[allow(clippy::too_many_arguments)]
@@ -412,9 +423,10 @@ async fn event_loop(
             }
             Event::Check(id, req) => match shell.check_request(&req) {
                 Err(reply) => respond(check, id, reply, &mut shell.throttle),
-                Ok(_) if jobs.pending >= MAX_PENDING_CHECKS => {
+                Ok(_) if jobs.pending + 1 >= MAX_CHECKS => {
                     let reply = refused_reply(format!(
-                        "BUSY: {MAX_PENDING_CHECKS} route checks are already being computed; ask again"
+                        "BUSY: {} route checks are already being computed; ask again",
+                        jobs.pending
                     ));
                     respond(check, id, reply, &mut shell.throttle)
                 }
@@ -429,7 +441,8 @@ async fn event_loop(
                     );
                     tokio::task::spawn_blocking(move || {
                         let began = Instant::now();
-                        let reply = match check_route(&start, &route.points, &chassis, &world, &config) {
+                        let reply = match check_route_until(&start, &route.points, &chassis, &world, &config, || false)
+                        {
                             Ok(report) => check_reply(&report, &route, stamp, &frame, step),
                             Err(e) => refused_reply(Outcome::Refused(e.to_string()).reason()),
                         };
@@ -670,11 +683,14 @@ impl Shell {
             (Source::UndockAction, _) => {
                 servers.undock.finish(end, outcome.undock_result());
             }
-            (Source::FollowAction, Task::Follow { route, .. } | Task::PreCheck { route, .. }) => {
-                servers.follow.finish(end, outcome.follow_result(&route.poses));
+            (Source::FollowAction, Task::Follow { route, missed, .. }) => {
+                servers.follow.finish(end, outcome.follow_result(&route.poses, missed));
+            }
+            (Source::FollowAction, Task::PreCheck { route, .. }) => {
+                servers.follow.finish(end, outcome.follow_result(&route.poses, &[]));
             }
             (Source::FollowAction, _) => {
-                servers.follow.finish(end, outcome.follow_result(&[]));
+                servers.follow.finish(end, outcome.follow_result(&[], &[]));
             }
             _ => {}
         }
@@ -711,13 +727,14 @@ impl Shell {
         }
     }
 
-    fn activate(&mut self, node: &RosNode, task: Task, source: Source) {
+    fn activate(&mut self, task: Task, source: Source) {
         self.gate = CommandGate::default();
         self.active = Some(Active {
             task,
             source,
+            chassis: self.chassis,
+            config: self.config.clone(),
             started: Instant::now(),
-            started_ros_nanos: node.now_nanos(),
             clock: DtClock::new(),
             t: 0.0,
             refused: 0,
@@ -768,7 +785,6 @@ impl Shell {
                     ..Drawing::default()
                 };
                 self.activate(
-                    node,
                     Task::Dock {
                         controller,
                         last: None,
@@ -799,9 +815,10 @@ impl Shell {
                     Outcome::RouteInfeasible(_) => servers.follow.active_goal().map(|g| g.poses.clone()),
                     _ => None,
                 };
-                servers
-                    .follow
-                    .finish(GoalEnd::Aborted, outcome.follow_result(poses.as_deref().unwrap_or(&[])));
+                servers.follow.finish(
+                    GoalEnd::Aborted,
+                    outcome.follow_result(poses.as_deref().unwrap_or(&[]), &[]),
+                );
             }
             _ => {}
         }
@@ -824,6 +841,13 @@ impl Shell {
             Ok(r) => r,
             Err(e) => return self.refuse(node, out, servers, source, Outcome::Invalid(e)),
         };
+        if let Some(i) = route.first_oriented() {
+            info!(
+                "goal ({}): waypoint {i} (and any other) carries an orientation: ignored, the goal approach \
+                 reaches each waypoint's position only",
+                source.name()
+            );
+        }
         let Some(start) = start else {
             return self.refuse(node, out, servers, source, Outcome::Stale);
         };
@@ -835,16 +859,17 @@ impl Shell {
             self.chassis,
             self.config.route_check(),
         );
-        jobs.goal.start(move |_| PreCheckDone {
+        jobs.goal.start(move |cancel| PreCheckDone {
             seq,
-            report: check_route(&start, &points, &chassis, &world, &config).map_err(|e| e.to_string()),
+            report: check_route_until(&start, &points, &chassis, &world, &config, || cancel.is_cancelled())
+                .map_err(|e| e.to_string()),
         });
         info!(
             "goal ({}): pre-check of {} waypoints (the virtual robot drives them first)",
             source.name(),
             route.points.len()
         );
-        self.activate(node, Task::PreCheck { route, start, seq }, source);
+        self.activate(Task::PreCheck { route, start, seq }, source);
         self.publish_status(node, out, NavStatus::ACTIVE, String::new());
     }
 
@@ -865,12 +890,20 @@ impl Shell {
         let source = *source;
         let Some(Active {
             task: Task::PreCheck { route, start, .. },
+            chassis,
+            config,
             ..
         }) = self.active.as_ref()
         else {
             return;
         };
-        let (route, start) = (route.clone(), *start);
+        let (route, start, chassis, follow, execute_infeasible) = (
+            route.clone(),
+            *start,
+            *chassis,
+            config.follow,
+            config.execute_infeasible_routes,
+        );
         let report = match done.report {
             Ok(r) => r,
             Err(e) => return self.end_goal(node, out, servers, Outcome::Refused(e)),
@@ -884,7 +917,7 @@ impl Shell {
         };
         if !problems.is_empty() {
             let outcome = Outcome::RouteInfeasible(problems.clone());
-            if !self.config.execute_infeasible_routes {
+            if !execute_infeasible {
                 return self.end_goal(node, out, servers, outcome);
             }
             warn!(
@@ -893,7 +926,7 @@ impl Shell {
                 outcome.reason()
             );
         }
-        let follower = match WaypointFollower::new(self.config.follow, &self.chassis, route.points.clone()) {
+        let follower = match WaypointFollower::new(follow, &chassis, route.points.clone()) {
             Ok(f) => f,
             Err(e) => return self.end_goal(node, out, servers, Outcome::Refused(e.to_string())),
         };
@@ -906,7 +939,7 @@ impl Shell {
             } else {
                 format!("{} problem(s)", problems.len())
             },
-            mobil_planner_node::path_length(&report.path, self.config.follow.check_length)
+            mobil_planner_node::path_length(&report.path, follow.check_length)
         );
         let distance = (route.points[0] - start.position()).norm();
         if let Some(active) = self.active.as_mut() {
@@ -980,7 +1013,6 @@ impl Shell {
         info!("goal (undock_robot): back out {distance:.3} m along the heading, within {limit_s:.1} s");
         self.drawing = Drawing::default();
         self.activate(
-            node,
             Task::Undock {
                 start: None,
                 distance,
@@ -1011,8 +1043,16 @@ impl Shell {
             start.map(|p| p.position()),
             MIN_ROUTE_LENGTH,
         );
+        // A follow_waypoints goal pre-empted by this one lists what it had missed.
+        let preempted = match &self.active {
+            Some(Active {
+                task: Task::Follow { route, missed, .. },
+                source: Source::FollowAction,
+                ..
+            }) => Outcome::Preempted("follow_waypoints").follow_result(&route.poses, missed),
+            _ => Outcome::Preempted("follow_waypoints").follow_result(&[], &[]),
+        };
         self.new_goal(node, out, servers, Source::FollowAction).await;
-        let preempted = Outcome::Preempted("follow_waypoints").follow_result(&[]);
         if let Err(e) = servers.follow.accept(request, |_| preempted).await {
             warn_throttled!(self.throttle, "accept", "follow_waypoints goal not started: {e}");
             return;
@@ -1080,7 +1120,8 @@ impl Shell {
         };
         active.t += dt.unwrap_or(0.0);
         let t = active.t;
-        let chassis = self.chassis;
+        let chassis = active.chassis;
+        let undock_speed = active.config.undock_speed;
         let finish = Finish::for_chassis(&chassis);
         let mut ended: Option<Outcome> = None;
         let mut changed = false;
@@ -1119,7 +1160,7 @@ impl Shell {
                 route,
                 missed,
                 distance,
-            } => match follower.update(&pose, dt.unwrap_or(FIRST_DT), t) {
+            } => match follower.update(&pose, dt.unwrap_or(FIRST_DT).min(MAX_FOLLOW_DT), t) {
                 Ok(o) => {
                     for event in &o.events {
                         changed = true;
@@ -1172,7 +1213,7 @@ impl Shell {
                         distance: *backed,
                     });
                 }
-                let speed = self.config.undock_speed.min(remaining.max(UNDOCK_MIN_SPEED));
+                let speed = undock_speed.min(remaining.max(UNDOCK_MIN_SPEED));
                 Ok(BodyTwist::new(-speed, 0.0, 0.0))
             }
         };
@@ -1207,7 +1248,7 @@ impl Shell {
         let Some(active) = &self.active else { return };
         let now = Instant::now();
         let goal_age = now.saturating_duration_since(active.started);
-        if odom_stale(self.odom.age_at(now), goal_age, self.config.odom_timeout()) {
+        if odom_stale(self.odom.age_at(now), goal_age, active.config.odom_timeout()) {
             return self.end_goal(node, out, servers, Outcome::Stale);
         }
         let status_period = Duration::from_secs_f64(1.0 / self.config.status_rate_hz);
@@ -1224,13 +1265,15 @@ impl Shell {
         {
             self.publish_markers(node, out);
         }
-        self.feedback(node, servers).await;
+        self.feedback(servers).await;
     }
 
     /// Action feedback, on every watchdog tick (20 Hz) while an action goal is active.
-    async fn feedback(&mut self, node: &RosNode, servers: &Servers) {
+    async fn feedback(&mut self, servers: &Servers) {
         let Some(active) = &self.active else { return };
-        let elapsed = (node.now_nanos().saturating_sub(active.started_ros_nanos)) as f64 * 1e-9;
+        // The goal's own time: ROS time summed step by step, never running backwards (a step
+        // whose clock went back is skipped), so docking_time never falls on a clock reset.
+        let elapsed = active.t;
         let sent = match (&active.task, active.source) {
             (Task::Dock { .. }, Source::DockAction) => {
                 servers
