@@ -62,16 +62,30 @@ def is_last_of(sec: int):
 def start_terrain(start_node, ros_node):
     start_node("terrain_node", params_file=PARAMS)
     pub = ros_node.create_publisher(FootTouchdown, "terrain/touchdown", TOUCHDOWN_QOS)
-    # Reliable and matched: from here on no touchdown is lost.
     wait_until(lambda: pub.get_subscription_count() > 0, timeout=10)
     return pub
+
+
+def send_first_column(pub, rec, z_cm: list[float], sec: int):
+    """The first column, sent again (same stamps, so the same assessment) until assessed: our
+    writer sees the node's reader before the node's reader has matched our writer, and a
+    volatile reader does not get what was written before it matched. Once one assessment is
+    back, both sides are matched and no later touchdown is lost (reliable)."""
+    for _ in range(20):
+        send_column(pub, z_cm, sec)
+        try:
+            return rec.wait_for(is_last_of(sec), timeout=0.5)
+        except TimeoutError:
+            continue
+    return rec.wait_for(is_last_of(sec), timeout=5)
 
 
 def test_table1_columns_give_the_papers_sigma_and_a_late_subscriber_gets_the_last(start_node, ros_node):
     pub = start_terrain(start_node, ros_node)
     with subscribe(ros_node, TerrainAssessment, "terrain/assessment", qos=RECORD_QOS) as rec:
         got = {}
-        for sec, column in [(1, ZERO), (2, SMALL), (3, LARGE)]:
+        got[1] = send_first_column(pub, rec, ZERO, 1)
+        for sec, column in [(2, SMALL), (3, LARGE)]:
             send_column(pub, column, sec)
             got[sec] = rec.wait_for(is_last_of(sec), timeout=10)
     zero, small, large = got[1], got[2], got[3]
@@ -102,8 +116,7 @@ def test_table1_columns_give_the_papers_sigma_and_a_late_subscriber_gets_the_las
 def test_an_unknown_leg_a_nan_a_foreign_frame_and_collinear_feet_are_counted(start_node, ros_node):
     pub = start_terrain(start_node, ros_node)
     with subscribe(ros_node, TerrainAssessment, "terrain/assessment", qos=RECORD_QOS) as rec:
-        send_column(pub, SMALL, 1)
-        good = rec.wait_for(is_last_of(1), timeout=10)
+        good = send_first_column(pub, rec, SMALL, 1)
         pub.publish(touchdown("XY", 0.0, 2))
         after_leg = rec.wait_for(lambda a: a.rejected_touchdowns == 1, timeout=10)
         pub.publish(touchdown("KP", 0.0, 3, x=math.nan))
