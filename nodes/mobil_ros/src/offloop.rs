@@ -156,11 +156,11 @@ impl<R: Send + 'static> OffLoop<R> {
             if let Some((g, token, job)) = self.pending.take() {
                 self.spawn(g, token, job);
             }
-            if let Some(result) = result {
-                if self.running.as_ref().is_some_and(|(g, _)| *g == generation) {
-                    self.running = None;
-                    return result;
-                }
+            if let Some(result) = result
+                && self.running.as_ref().is_some_and(|(g, _)| *g == generation)
+            {
+                self.running = None;
+                return result;
             }
         }
     }
