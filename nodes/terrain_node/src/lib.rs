@@ -164,6 +164,9 @@ pub struct TerrainState {
     carried: (u64, u64),
     /// … and the current tracker's counts from replaying the feet into it (not counted).
     offset: (u64, u64),
+    /// The last good assessment carried over a reconfiguration whose replay of the stored
+    /// feet assessed nothing (a degenerate stance stored): the last good one stays.
+    kept: Option<Assessment>,
 }
 
 fn nanos(t: &Time) -> i128 {
@@ -180,6 +183,7 @@ impl TerrainState {
             wrong_frame: 0,
             carried: (0, 0),
             offset: (0, 0),
+            kept: None,
         })
     }
 
@@ -237,6 +241,15 @@ impl TerrainState {
                 last = tracker.touchdown(leg, p).ok().flatten();
             }
         }
+        // The stored stance could not be assessed: the last good assessment stays, its feet
+        // assessed again with the new configuration where they can be.
+        self.kept = match (&last, self.last().map(|(a, _)| *a)) {
+            (None, Some(old)) => Some(tracker.assessor().assess(&old.feet).unwrap_or(old)),
+            _ => None,
+        };
+        if last.is_none() {
+            last = self.kept;
+        }
         // The counts go on from their totals; the replay's own (none for stored feet, which
         // were valid) are not added.
         self.carried = (self.rejected_touchdowns_u64(), self.failed_assessments_u64());
@@ -266,7 +279,10 @@ impl TerrainState {
 
     /// The last good assessment and the stamp of the touchdown that made it.
     pub fn last(&self) -> Option<(&Assessment, &Time)> {
-        self.tracker.last().map(|a| (a, &self.last_stamp))
+        self.tracker
+            .last()
+            .or(self.kept.as_ref())
+            .map(|a| (a, &self.last_stamp))
     }
 
     /// The last good assessment as a message with the current counts.
@@ -588,6 +604,24 @@ impl Config for HexapodSimConfig {
     }
 
     fn validate(&self) -> Result<(), ConfigError> {
+        if !self.publish_clock && self.real_time_factor != 1.0 {
+            // Without /clock the stamps are the wall clock's: a faster walk would stamp its
+            // touchdowns, odom and tf ever further in the future.
+            return Err(ConfigError::inconsistent(format!(
+                "real_time_factor {} needs publish_clock:=true (without /clock stamps are wall time, so the \
+                 factor must be 1)",
+                self.real_time_factor
+            )));
+        }
+        if self.body_frame.trim_start_matches('/').is_empty()
+            || self.world_frame.trim_start_matches('/').is_empty()
+            || self.body_frame.trim_start_matches('/') == self.world_frame.trim_start_matches('/')
+        {
+            return Err(ConfigError::inconsistent(format!(
+                "body_frame `{}` and world_frame `{}` must be non-empty and differ",
+                self.body_frame, self.world_frame
+            )));
+        }
         self.walker().map(|_| ()).map_err(ConfigError::inconsistent)
     }
 }
@@ -850,6 +884,65 @@ mod tests {
         assert_eq!(a.class, mobil_terrain::TerrainClass::BeyondLimits);
         assert_eq!(s.last_message().unwrap().terrain_class, TA::BEYOND_LIMITS);
         assert_eq!(s.rejected_touchdowns(), 1);
+    }
+
+    /// Flat feet, then KP on the line through KG (−0.15, 0.12, −0.10) and DV (0, −0.16, −0.10)
+    /// (one more step beyond DV: (0.15, −0.44, −0.10)) stored, then new thresholds: the replay
+    /// assesses nothing, so the last good assessment stays (σ 0, FLAT) and the counts still
+    /// publish.
+    #[test]
+    fn a_new_configuration_over_a_degenerate_stance_keeps_the_last_assessment() {
+        let mut s = state();
+        for m in column([0.0; 6]) {
+            s.touchdown(&m);
+        }
+        let good = s.last_message().unwrap();
+        assert!(matches!(
+            s.touchdown(&td("KP", 0.15, -0.44, -0.10, 2)).0,
+            TouchdownOutcome::Failed(TerrainError::CollinearPoints { .. })
+        ));
+        let c = TerrainConfig {
+            sigma_flat: 0.005,
+            sigma_wave: 0.008,
+            sigma_max: 0.012,
+            ..TerrainConfig::default()
+        };
+        let a = s.reconfigure(c).unwrap().unwrap();
+        assert_eq!((a.class, a.sigma), (mobil_terrain::TerrainClass::Flat, 0.0));
+        let kept = s.last_message().unwrap();
+        assert_eq!(kept.terrain_class, TA::FLAT);
+        assert_eq!((kept.sigma, kept.failed_assessments), (good.sigma, 1));
+        assert_eq!(kept.header.stamp.sec, 1, "the last good one's stamp");
+        s.touchdown(&td("XX", 0.0, 0.0, 0.0, 3));
+        assert_eq!(s.last_message().unwrap().rejected_touchdowns, 1);
+    }
+
+    /// Without /clock the stamps are wall time: a factor other than 1 would stamp into the
+    /// future; empty or equal frames would refuse every touchdown.
+    #[test]
+    fn hexapod_sim_refuses_a_factor_without_clock_and_bad_frames() {
+        let base: HexapodSimConfig =
+            mobil_ros::config::load(&ParamValues::defaults(&Decl::<HexapodSimConfig>::of().specs())).unwrap();
+        assert!(base.validate().is_ok());
+        let fast = HexapodSimConfig {
+            real_time_factor: 8.0,
+            ..base.clone()
+        };
+        assert!(fast.validate().unwrap_err().to_string().contains("publish_clock"));
+        assert!(HexapodSimConfig {
+            publish_clock: true,
+            ..fast
+        }
+        .validate()
+        .is_ok());
+        for (body, world) in [("", "odom"), ("base_link", "/"), ("base_link", "/base_link")] {
+            let c = HexapodSimConfig {
+                body_frame: body.into(),
+                world_frame: world.into(),
+                ..base.clone()
+            };
+            assert!(c.validate().is_err(), "{body} / {world}");
+        }
     }
 
     #[test]

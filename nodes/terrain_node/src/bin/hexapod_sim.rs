@@ -10,7 +10,10 @@
 //! (`real_time_factor`) for nodes started with `use_sim_time:=true`. Simulated time advances by
 //! the wall time between steps times the factor, so a late step catches up; each touchdown is
 //! sent once, with its own time, whatever the step. With `wait_for_subscriber` the walk (t = 0)
-//! starts once `terrain/touchdown` has a subscriber, so that discovery loses no touchdown.
+//! starts once `terrain/touchdown` has a subscriber. That narrows what discovery can lose but
+//! does not close it: this writer can see the reader before the reader has matched the writer,
+//! and a volatile reader gets nothing written before that; the walk's first touchdowns may be
+//! lost, and a tripod later every foot is known again.
 //! Stops on SIGINT/SIGTERM.
 
 use mobil_msgs::geometry_msgs::msg::{Transform, TransformStamped, Vector3};
@@ -62,15 +65,6 @@ async fn run(node: &mut RosNode) -> anyhow::Result<()> {
             ""
         }
     );
-    // Wall time of simulated t = 0, for stamps when there is no simulated clock.
-    let epoch_nanos = node.now_nanos();
-    let stamp_at = |t: f64, publish_clock: bool| {
-        if publish_clock {
-            stamp_from_secs(t)
-        } else {
-            stamp_from_nanos(epoch_nanos + (t * 1e9) as i64)
-        }
-    };
     let shutdown = shutdown_signal();
     tokio::pin!(shutdown);
     let mut tick = Ticker::with_missed_tick_behavior(config.tick_rate_hz, MissedTickBehavior::Delay)?;
@@ -85,6 +79,16 @@ async fn run(node: &mut RosNode) -> anyhow::Result<()> {
             _ = matched => info!("terrain/touchdown has a subscriber: walking"),
         }
     }
+    // Wall time of simulated t = 0, for stamps when there is no simulated clock: read when the
+    // walk starts (after any wait for a subscriber), so the stamps keep pace with the wall clock.
+    let epoch_nanos = node.now_nanos();
+    let stamp_at = |t: f64, publish_clock: bool| {
+        if publish_clock {
+            stamp_from_secs(t)
+        } else {
+            stamp_from_nanos(epoch_nanos + (t * 1e9) as i64)
+        }
+    };
     let mut last_wall = Instant::now();
     enum Event {
         Shutdown,
