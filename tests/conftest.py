@@ -2,7 +2,8 @@
 
 Fixtures:
 * ``ros_domain_id`` (session): the ROS_DOMAIN_ID of this run, random in 100..199 unless
-  MOBIL_TEST_DOMAIN_ID is set; it is put in os.environ before rclpy starts and is inherited by
+  MOBIL_TEST_DOMAIN_ID is set (under pytest-xdist: one domain per worker, the base plus the
+  worker's number); it is put in os.environ before rclpy starts and is inherited by
   every child process.
 * ``rclpy_context`` (session): one ``rclpy.init()`` for the run.
 * ``spinner``: a background executor for the test; fails the test if a callback raised.
@@ -38,9 +39,17 @@ import rosutil
 
 
 def _choose_domain_id() -> int:
+    # Under pytest-xdist (tests/run_all runs two workers) each worker is a process with a domain
+    # of its own, so one worker's nodes never answer another's tests: the run's base domain (the
+    # same for every worker: from the run's id) plus the worker's number (gw0, gw1, ...).
+    worker = os.environ.get("PYTEST_XDIST_WORKER", "")
+    index = int(worker[2:]) if worker.startswith("gw") and worker[2:].isdigit() else 0
     value = os.environ.get("MOBIL_TEST_DOMAIN_ID")
     if value:
-        return int(value)
+        return int(value) + index
+    run_id = os.environ.get("PYTEST_XDIST_TESTRUNUID")
+    if run_id:
+        return 100 + int(run_id[:8], 16) % (100 - 8) + index
     return random.SystemRandom().randrange(100, 200)
 
 

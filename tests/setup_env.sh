@@ -34,7 +34,7 @@ PIP_PACKAGES=(
   ros-jazzy-ament-package ros-jazzy-ament-cmake-include-directories ros-jazzy-rosidl-core-generators
   ros-jazzy-ament-cmake-ros ros-jazzy-ament-cmake-gmock ros-jazzy-ament-cmake-gtest
   ros-jazzy-ament-cmake-pytest ros-jazzy-python-cmake-module
-  pytest pytest-timeout pyyaml
+  pytest pytest-timeout pytest-xdist pyyaml
 )
 stamp_pip="$VENV/.mobil-pip-stamp"
 want_pip="$(printf '%s\n' "${PIP_PACKAGES[@]}" | sha256sum | cut -d' ' -f1)"
