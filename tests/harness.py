@@ -62,6 +62,21 @@ STOP_TIMEOUT = 5.0
 _live_processes: list["NodeProcess"] = []
 
 
+def thread_stacks(pid: int, timeout: float = 20.0) -> str:
+    """Every thread's backtrace of a running process (gdb in batch mode), for the report of a
+    process that hangs; a line saying why when gdb is missing or cannot attach."""
+    if shutil.which("gdb") is None:
+        return "(gdb is not installed: no backtraces)"
+    try:
+        out = subprocess.run(["gdb", "-p", str(pid), "-batch", "-nx", "-ex", "set pagination off",
+                              "-ex", "thread apply all bt 12"],
+                             capture_output=True, text=True, timeout=timeout)
+    except subprocess.TimeoutExpired:
+        return f"(gdb did not finish within {timeout:g} s)"
+    lines = [line for line in out.stdout.splitlines()
+             if line.startswith(("Thread ", "#"))]
+    return "\n".join(lines[-400:]) or f"(gdb could not attach: {out.stderr.strip()[-300:]})"
+
 class NodeProcessError(AssertionError):
     """A node process misbehaved: did not stop on SIGINT, crashed, or exited early."""
 
@@ -155,10 +170,12 @@ class NodeProcess:
             try:
                 self.proc.wait(timeout)
             except subprocess.TimeoutExpired:
+                stacks = thread_stacks(self.pid)
                 self.proc.kill()
                 self.proc.wait(5.0)
                 self.killed = True
-                problems.append(f"did not exit within {timeout:g} s of SIGINT: killed (SIGKILL)")
+                problems.append(f"did not exit within {timeout:g} s of SIGINT: killed (SIGKILL)"
+                                f"\n--- where its threads were ---\n{stacks}")
         self.returncode = self.proc.returncode
         if (self.check_exit_code and not self.killed and early is None
                 and self.returncode not in CLEAN_EXIT_CODES):
