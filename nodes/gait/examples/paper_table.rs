@@ -2,7 +2,7 @@
 //! (−10, 10); set A from φ = π/4 and set B from φ = 3π/2; evaluations (1), (2), (3) with the
 //! paper's k; under both readings of Tab. 1's "max angle". One complete search per row.
 //!
-//!     cargo run --release -p mobil_gait --example paper_table [-- --margin M]
+//!     cargo run --release -p mobil_gait --example paper_table [-- --margin M] [--reading forward|rearward]
 
 use mobil_gait::{plan, BodyPose, Evaluation, GaitConfig, GaitState, LegAngleReading, QuadrupedModel, RuleSet};
 use nalgebra::Point2;
@@ -45,7 +45,11 @@ fn main() {
         cfg.stability_margin, cfg.key_quantum, cfg.goal_tolerance, cfg.max_expansions
     );
     println!("reading  | row   | paper exp / len | ours exp / gen / len | leg moves | CPU ms | wall ms | result");
-    for reading in [LegAngleReading::Forward, LegAngleReading::Rearward] {
+    let readings: Vec<LegAngleReading> = match args.iter().position(|a| a == "--reading") {
+        Some(i) => args.get(i + 1).and_then(|r| r.parse().ok()).into_iter().collect(),
+        None => vec![LegAngleReading::Forward, LegAngleReading::Rearward],
+    };
+    for reading in readings {
         let cfg = GaitConfig { reading, ..cfg.clone() };
         let model = QuadrupedModel::paper(reading);
         for (set, e, p_exp, p_len) in PAPER {

@@ -508,6 +508,15 @@ fn exit_sinusoid(a: f64, b: f64, c: f64, limit: f64) -> f64 {
 fn exit_quadratic(a: f64, b: f64, c: f64, limit: f64) -> f64 {
     let g = |s: f64| (a * s + b) * s + c;
     let tau = g(0.0).min(0.0);
+    // Fast path, the common case: g ≥ τ at both ends, and a convex g's vertex inside, if any,
+    // too (a linear or concave g is then ≥ τ throughout). The root search below would return
+    // `limit` as well.
+    if g(limit) >= tau {
+        let vertex = if a > 0.0 { -b / (2.0 * a) } else { f64::NAN };
+        if !(vertex > 0.0 && vertex < limit) || g(vertex) >= tau {
+            return limit;
+        }
+    }
     let cc = c - tau;
     let mut roots = Roots::default();
     if a.abs() < 1e-15 {
