@@ -15,7 +15,7 @@
 //!   the law the pre-check's virtual robot drove.
 //! - [`vfo`]: VFO waypoint following in clutter (SPEC §5): the law with collision avoidance,
 //!   path quality, Algorithm 2 (virtual robots choose each obstacle's side), the online
-//!   [`vfo::VfoFollower`].
+//!   [`vfo::VfoFollower`] and obstacles from a laser scan.
 //! - [`route`]: the route pre-check — a virtual robot drives the route on the chassis model
 //!   against a [`mobil_sim::world::World`] and reports every collision, turn below the minimum
 //!   radius and unreachable waypoint with its index.

@@ -8,6 +8,7 @@
 //! - [`optimise`]: Algorithm 2 (findSigmas) with cycle detection, caps and parallel batches.
 //! - [`follower`]: [`VfoFollower`], the online follower: one control tick at a time, Σ per
 //!   segment, re-optimised on new obstacles; the last optimisation for display.
+//! - [`scan`]: obstacles from a laser scan (clusters → circles) merged over time in odom.
 //!
 //! ```
 //! use mobil_geom::Pose2;
@@ -28,6 +29,7 @@ pub mod follower;
 pub mod obstacles;
 pub mod optimise;
 pub mod quality;
+pub mod scan;
 
 pub use controller::{
     convergence_field, field_rate, integrate_unicycle, ControlStep, Field, StepOutcome, VfoController, VfoGains,
@@ -40,3 +42,4 @@ pub use optimise::{
     PathFate, RobotEnd, Segment, VirtualRobot,
 };
 pub use quality::{normalise, normalised, path_score, PathIndices, QualityWeights};
+pub use scan::{extract_circles, fit_circle, Circle, MapUpdate, ObstacleMap, ScanObstacleConfig};
