@@ -9,9 +9,9 @@ use std::f64::consts::{FRAC_PI_2, PI};
 use approx::assert_relative_eq;
 use mobil_geom::{wrap, Pose2};
 use mobil_planner::vfo::{
-    convergence_field, field_rate, find_sigmas, potential, potential_derivative, simulate_uninterrupted, Obstacle,
-    OptimiseConfig, OptimiseWarning, PathFate, PathIndices, QualityWeights, RobotEnd, Segment, Sigma, VfoController,
-    VfoEnd, VfoEvent, VfoFollower, VfoGains, VfoWaypoint,
+    convergence_field, field_rate, find_sigmas, path_time_limit, potential, potential_derivative,
+    simulate_uninterrupted, Obstacle, OptimiseConfig, OptimiseWarning, PathFate, PathIndices, QualityWeights, RobotEnd,
+    Segment, Sigma, VfoController, VfoEnd, VfoEvent, VfoFollower, VfoGains, VfoWaypoint,
 };
 use mobil_planner::PlannerError;
 use nalgebra::{Point2, Vector2};
@@ -385,7 +385,7 @@ fn a_cyclic_decision_path_is_cut_by_the_cycle_check() {
     // The last waypoint sits just outside p2's forbidden zone, behind p1: the virtual robots
     // that go round p2 on its left orbit the waypoint, leaving and re-entering p1's zone with
     // the same Σ. The second such entry repeats an edge: the path is dropped as cyclic long
-    // before the 120 s time cap (without the check it would run into the cap).
+    // before the path's time limit (without the check it would run into it).
     let obstacles = [ob(3.18, -1.49, 0.29, 1.03), ob(3.52, -0.78, 0.26, 1.06)];
     let segment = Segment {
         waypoint: wp(3.78, -0.83, 0.0),
@@ -394,6 +394,9 @@ fn a_cyclic_decision_path_is_cut_by_the_cycle_check() {
     };
     let config = OptimiseConfig::default();
     let r = find_sigmas(&Pose2::identity(), &controller(), &segment, &config).expect("valid");
+    // 3 × 3.88 m / 0.3 m/s + 20 s = 58.8 s.
+    let limit = path_time_limit(&Pose2::identity(), &segment, &controller(), &config);
+    assert_relative_eq!(limit, 3.0 * (3.78f64.hypot(0.83)) / 0.3 + 20.0, epsilon = 1e-9);
     let cyclic: Vec<_> = r
         .paths
         .iter()
@@ -407,7 +410,7 @@ fn a_cyclic_decision_path_is_cut_by_the_cycle_check() {
         // Re-entering p1's zone from p1's own stop, with Σ already complete.
         assert_eq!((edge.from, edge.to), (Some(0), 0));
         assert!(edge.sigmas.iter().all(|s| *s != Sigma::Undecided));
-        assert!(p.time < 0.5 * config.max_path_time_s, "cut at {} s", p.time);
+        assert!(p.time < 0.5 * limit, "cut at {} s of {limit}", p.time);
     }
     assert!(!r.paths.iter().any(|p| p.fate == PathFate::TimeCap));
     assert_eq!(r.best, None);

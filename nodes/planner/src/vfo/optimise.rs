@@ -11,7 +11,7 @@
 //!   is undecided, the branch continues with σ_j = +1 and a copy with σ_j = −1 is pushed.
 //! - A path ends as a candidate when the law reaches the waypoint (Algorithm 1, or the end test
 //!   at the last waypoint), or is dropped on a collision (d ≤ r), a cycle, or when its simulated
-//!   time exceeds `max_path_time_s` (a warning).
+//!   time exceeds [`path_time_limit`] (a warning).
 //! - Candidates are normalised together and the largest Ψ_z wins; ties (within 1e-12) go to
 //!   fewer decided σ, then to the lexicographically smaller Σ (undecided < +1 < −1).
 //! - Caps: at most `max_virtual_robots` virtual robots and `max_total_time_s` of simulated time
@@ -54,6 +54,16 @@ pub struct OptimiseConfig {
     /// A path whose simulated time from the segment start exceeds this (s) is dropped with a
     /// warning. Default 120 s: 36 m at 0.3 m/s, beyond any segment the planner is given.
     pub max_path_time_s: f64,
+    /// A path is also dropped (with the same warning) once its simulated time exceeds
+    /// `path_time_factor` × the straight drive time (‖e*‖ at the start / U_2) plus
+    /// `path_time_margin_s`, whichever limit is lower. Virtual robots that circle inside one
+    /// zone never re-enter a zone, so the cycle check cannot cut them; without this bound each
+    /// would run to `max_path_time_s` and dominate the optimisation's time. Default 3: a
+    /// detour of three times the straight way is no path worth choosing.
+    pub path_time_factor: f64,
+    /// See `path_time_factor` (s). Default 20: the slow final approach at the last waypoint
+    /// (v = min(U_2, ‖H*‖)·cos e_a) plus turning round at the start.
+    pub path_time_margin_s: f64,
     /// Most simulated time over all virtual robots of one optimisation (s). Default 20 000 s:
     /// about a second of computation at 50 steps per simulated second.
     pub max_total_time_s: f64,
@@ -73,6 +83,8 @@ impl Default for OptimiseConfig {
             time_step: 0.01,
             max_virtual_robots: 4096,
             max_path_time_s: 120.0,
+            path_time_factor: 3.0,
+            path_time_margin_s: 20.0,
             max_total_time_s: 20_000.0,
             batch: 8,
             threads: 0,
@@ -87,6 +99,8 @@ impl OptimiseConfig {
         self.weights.validate()?;
         positive_finite("time_step", self.time_step)?;
         positive_finite("max_path_time_s", self.max_path_time_s)?;
+        positive_finite("path_time_factor", self.path_time_factor)?;
+        positive_finite("path_time_margin_s", self.path_time_margin_s)?;
         positive_finite("max_total_time_s", self.max_total_time_s)?;
         positive_finite("path_resolution", self.path_resolution)?;
         for (name, value) in [("max_virtual_robots", self.max_virtual_robots), ("batch", self.batch)] {
@@ -128,7 +142,7 @@ pub enum RobotEnd {
         /// The obstacle's index.
         obstacle: usize,
     },
-    /// Its path's simulated time exceeded `max_path_time_s`.
+    /// Its path's simulated time exceeded [`path_time_limit`].
     TimeCap,
 }
 
@@ -176,7 +190,7 @@ pub enum PathFate {
         /// The repeated edge.
         edge: DecisionEdge,
     },
-    /// Its simulated time exceeded `max_path_time_s`.
+    /// Its simulated time exceeded [`path_time_limit`].
     TimeCap,
 }
 
@@ -217,7 +231,7 @@ pub enum OptimiseWarning {
         /// Branches left unexplored.
         pending: usize,
     },
-    /// Path `path` was dropped on `max_path_time_s`.
+    /// Path `path` was dropped on [`path_time_limit`].
     PathTimeCap {
         /// Its index in [`Optimisation::paths`].
         path: usize,
@@ -320,6 +334,7 @@ struct Piece {
 fn simulate(
     segment: &Segment<'_>,
     config: &OptimiseConfig,
+    time_limit: f64,
     mut state: RobotState,
     sigmas: &[Sigma],
     stop_at_entries: bool,
@@ -343,7 +358,7 @@ fn simulate(
             StepOutcome::Collision { obstacle } => break RobotEnd::Collided { obstacle },
             StepOutcome::Drive => {}
         }
-        if state.time >= config.max_path_time_s {
+        if state.time >= time_limit {
             break RobotEnd::TimeCap;
         }
         state.pose = integrate_unicycle(&state.pose, step.v, step.omega, dt);
@@ -401,6 +416,7 @@ pub fn find_sigmas(
     crate::docking::check_pose("virtual robot start", start)?;
     let n = segment.obstacles.len();
     let threads = config.thread_count();
+    let time_limit = path_time_limit(start, segment, controller, config);
     let mut stack = vec![Branch {
         state: RobotState {
             pose: *start,
@@ -442,7 +458,7 @@ pub fn find_sigmas(
             .min(stack.len())
             .min(config.max_virtual_robots - result.robots.len());
         let batch: Vec<Branch> = (0..take).filter_map(|_| stack.pop()).collect();
-        let pieces = simulate_batch(segment, config, &batch, threads);
+        let pieces = simulate_batch(segment, config, time_limit, &batch, threads);
         for (mut branch, piece) in batch.into_iter().zip(pieces) {
             let id = result.robots.len();
             result.simulated_time += piece.time;
@@ -512,10 +528,27 @@ pub fn find_sigmas(
     Ok(result)
 }
 
+/// The simulated time a path may take from `start` (see `path_time_factor`).
+pub fn path_time_limit(
+    start: &Pose2,
+    segment: &Segment<'_>,
+    controller: &VfoController,
+    config: &OptimiseConfig,
+) -> f64 {
+    let straight = (segment.waypoint.position - start.position()).norm() / controller.gains().speed;
+    (config.path_time_factor * straight + config.path_time_margin_s).min(config.max_path_time_s)
+}
+
 /// Simulates every branch of a batch to its next stop, on up to `threads` threads; the
 /// results come back in the batch's order.
-fn simulate_batch(segment: &Segment<'_>, config: &OptimiseConfig, batch: &[Branch], threads: usize) -> Vec<Piece> {
-    let run = |b: &Branch| simulate(segment, config, b.state.clone(), &b.sigmas, true);
+fn simulate_batch(
+    segment: &Segment<'_>,
+    config: &OptimiseConfig,
+    time_limit: f64,
+    batch: &[Branch],
+    threads: usize,
+) -> Vec<Piece> {
+    let run = |b: &Branch| simulate(segment, config, time_limit, b.state.clone(), &b.sigmas, true);
     let workers = threads.min(batch.len());
     if workers <= 1 {
         return batch.iter().map(run).collect();
@@ -593,6 +626,7 @@ pub fn simulate_uninterrupted(
         inside: vec![false; segment.obstacles.len()],
         time: 0.0,
     };
-    let piece = simulate(segment, config, state, sigmas, false);
+    let limit = path_time_limit(start, segment, controller, config);
+    let piece = simulate(segment, config, limit, state, sigmas, false);
     Ok((piece.indices, piece.path, piece.end))
 }
