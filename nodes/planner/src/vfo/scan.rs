@@ -264,13 +264,12 @@ impl ObstacleMap {
 
     /// The obstacles λ = {p, r_p + r_r, R} for the law, by index (the same as [`Self::circles`]).
     pub fn obstacles(&self) -> Vec<Obstacle> {
-        self.tracked
-            .iter()
-            .filter_map(|t| {
-                let r = t.circle.radius + self.config.robot_radius;
-                Obstacle::new(t.circle.centre, r, r + self.config.influence_margin).ok()
-            })
-            .collect()
+        self.tracked.iter().filter_map(|t| self.model(&t.circle)).collect()
+    }
+
+    fn model(&self, c: &Circle) -> Option<Obstacle> {
+        let r = c.radius + self.config.robot_radius;
+        Obstacle::new(c.centre, r, r + self.config.influence_margin).ok()
     }
 
     /// Adds the circles of a checked scan taken at `odom_from_base`.
@@ -328,6 +327,9 @@ impl ObstacleMap {
                     t.circle.radius += (c.radius - t.circle.radius) * w;
                     update.seen += 1;
                 }
+                // A circle the law cannot take (beyond the coordinate limit) is not kept, so
+                // `obstacles()` has an entry for every circle and the indices agree.
+                None if self.model(c).is_none() => {}
                 None => {
                     update.new.push(self.tracked.len());
                     self.tracked.push(Tracked {
