@@ -87,6 +87,12 @@ impl VfoGains {
     }
 }
 
+/// A default guiding coefficient μ for waypoints that come without one (the paper gives
+/// none): 0.5 makes the virtual velocity half of k_p·‖e*‖, so the approach bends toward θ_r
+/// without the long swing-out a μ near 1 makes to line up (at μ = 1, h* vanishes on the
+/// approach line itself, behind the waypoint).
+pub const DEFAULT_GUIDING: f64 = 0.5;
+
 /// A waypoint w_i = {q_ri, μ_i} (eq. 2).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct VfoWaypoint {

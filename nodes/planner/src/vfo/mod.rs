@@ -33,7 +33,7 @@ pub mod scan;
 
 pub use controller::{
     convergence_field, field_rate, integrate_unicycle, ControlStep, Field, StepOutcome, VfoController, VfoGains,
-    VfoWaypoint,
+    VfoWaypoint, DEFAULT_GUIDING,
 };
 pub use follower::{Reoptimised, VfoEnd, VfoEvent, VfoFollower, VfoOutput};
 pub use obstacles::{potential, potential_derivative, Obstacle, Sigma};
