@@ -104,3 +104,46 @@ fn obstacles_from_a_scan_recover_known_circles_and_merge_over_time() {
     assert_eq!((update.new.len(), update.seen), (0, 0));
     assert_eq!(map.circles().len(), 3);
 }
+
+#[test]
+fn a_wall_is_covered_by_a_chain_of_circles_holding_every_echo() {
+    // A straight wall x = 2 from y = −1.5 to 1.5, seen from the origin: no circle fits it
+    // (the fit's radius is far beyond max_radius), so pieces at most 2·max_radius = 1 m long
+    // are covered: at least three circles, every echo inside one of them.
+    let beams = 181;
+    let fov = PI / 2.0;
+    let inc = fov / (beams - 1) as f64;
+    let ranges: Vec<f32> = (0..beams)
+        .map(|i| {
+            let a = -fov / 2.0 + i as f64 * inc;
+            let t = 2.0 / a.cos();
+            if (t * a.sin()).abs() <= 1.5 {
+                t as f32
+            } else {
+                f32::INFINITY
+            }
+        })
+        .collect();
+    let mut map = ObstacleMap::new(ScanObstacleConfig::default()).expect("valid");
+    let laser = Pose2::identity();
+    let update = map
+        .update_from_ranges(&ranges, -fov / 2.0, inc, 0.06, 10.0, &laser)
+        .expect("valid scan");
+    let circles = map.circles();
+    assert!(circles.len() >= 3, "{circles:?}");
+    assert_eq!(update.new.len(), circles.len());
+    for (i, r) in ranges.iter().enumerate() {
+        if r.is_finite() {
+            let a = -fov / 2.0 + i as f64 * inc;
+            let p = Point2::new(f64::from(*r) * a.cos(), f64::from(*r) * a.sin());
+            assert!(
+                circles.iter().any(|c| (p - c.centre).norm() <= c.radius + 1e-9),
+                "echo {p:?} outside every circle"
+            );
+        }
+    }
+    for c in &circles {
+        // The centroid of a piece at most 1 m long lies on the wall, within 1 m of its ends.
+        assert!(c.radius <= 1.0 && (c.centre.x - 2.0).abs() < 1e-6, "{c:?}");
+    }
+}

@@ -309,9 +309,11 @@ impl ObstacleMap {
     /// Merges detected circles (odom frame) into the map.
     pub fn merge(&mut self, circles: &[Circle]) -> MapUpdate {
         let mut update = MapUpdate::default();
+        // Only obstacles known before this scan: the circles of one scan are distinct (a
+        // wall's chain overlaps by design).
+        let known = self.tracked.len();
         for c in circles {
-            let near = self
-                .tracked
+            let near = self.tracked[..known]
                 .iter()
                 .enumerate()
                 .map(|(i, t)| (i, (t.circle.centre - c.centre).norm(), t.circle.radius))
