@@ -39,7 +39,7 @@ pub use follower::{Reoptimised, VfoEnd, VfoEvent, VfoFollower, VfoOutput};
 pub use obstacles::{potential, potential_derivative, Obstacle, Sigma};
 pub use optimise::{
     find_sigmas, path_time_limit, simulate_uninterrupted, DecisionEdge, ExploredPath, Optimisation, OptimiseConfig,
-    OptimiseWarning, PathFate, RobotEnd, Segment, VirtualRobot,
+    OptimiseWarning, PathFate, RobotEnd, Segment, VirtualRobot, PARALLEL_MIN_BATCH,
 };
 pub use quality::{normalise, normalised, path_score, PathIndices, QualityWeights};
 pub use scan::{extract_circles, fit_circle, Circle, MapUpdate, ObstacleMap, ScanObstacleConfig};

@@ -24,9 +24,9 @@
 //! (`std::thread::scope`), then handles the results in pop order, pushing each one's children
 //! (−1 first, so +1 is on top). The schedule depends on `batch` alone, never on the number of
 //! threads, so the result (Σ, every virtual robot, every warning) is the same on any machine;
-//! the caps are checked between batches. Threads pay only for batches of two or more virtual
-//! robots of a few hundred steps each (a scoped thread costs about 20 µs); the bench measures
-//! it. `std::thread::scope` needs no dependency: each task is a whole virtual robot, coarse
+//! the caps are checked between batches. Threads are used for batches of at least
+//! [`PARALLEL_MIN_BATCH`] branches, where they can pay (the bench measures it).
+//! `std::thread::scope` needs no dependency: each task is a whole virtual robot, coarse
 //! enough that a work-stealing pool (rayon) would have nothing to balance.
 
 use std::num::NonZeroUsize;
@@ -539,6 +539,12 @@ pub fn path_time_limit(
     (config.path_time_factor * straight + config.path_time_margin_s).min(config.max_path_time_s)
 }
 
+/// Fewest branches in a batch worth spreading over threads: below, the scoped threads'
+/// start-up (tens of µs each, more on a loaded machine) costs about what the few virtual
+/// robots of a small layout take (the bench: with up to 4 obstacles, Algorithm 2 took
+/// 0.4–2 ms on one thread and 1.4–17 ms on two, at a load of 4–5 other builds).
+pub const PARALLEL_MIN_BATCH: usize = 4;
+
 /// Simulates every branch of a batch to its next stop, on up to `threads` threads; the
 /// results come back in the batch's order.
 fn simulate_batch(
@@ -550,7 +556,7 @@ fn simulate_batch(
 ) -> Vec<Piece> {
     let run = |b: &Branch| simulate(segment, config, time_limit, b.state.clone(), &b.sigmas, true);
     let workers = threads.min(batch.len());
-    if workers <= 1 {
+    if workers <= 1 || batch.len() < PARALLEL_MIN_BATCH {
         return batch.iter().map(run).collect();
     }
     let chunk = batch.len().div_ceil(workers);
