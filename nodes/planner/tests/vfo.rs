@@ -591,3 +591,35 @@ fn bad_input_is_refused() {
         Some(VfoEnd::NoSafePath { index: 0 }) | Some(VfoEnd::Collision { obstacle: 0 })
     ));
 }
+
+#[test]
+fn entering_a_zone_the_optimisation_did_not_foresee_reoptimises() {
+    // The straight way to (5, 0) meets no zone (p at (2.5, 2), R = 1), so its σ stays
+    // undecided. Pushed sideways to (2.5, 1.2) — 0.8 m from p, inside R, outside r — the robot
+    // is in a zone with no decision: the follower re-optimises from there and decides it.
+    let obstacles = vec![ob(2.5, 2.0, 0.5, 1.0)];
+    let mut f = VfoFollower::new(
+        VfoGains::default(),
+        OptimiseConfig::default(),
+        vec![wp(5.0, 0.0, 0.0)],
+        obstacles,
+    )
+    .expect("valid");
+    let first = f.update(&Pose2::identity(), 0.0).expect("valid");
+    assert_eq!(f.sigmas(), &[Sigma::Undecided]);
+    assert_eq!(first.events.len(), 1);
+    let pushed = f.update(&Pose2::new(2.5, 1.2, 0.0), 0.01).expect("valid");
+    assert!(
+        pushed.events.iter().any(|e| matches!(
+            e,
+            VfoEvent::Optimised {
+                reason: mobil_planner::vfo::Reoptimised::UndecidedZone,
+                ..
+            }
+        )),
+        "{:?}",
+        pushed.events
+    );
+    assert_ne!(f.sigmas()[0], Sigma::Undecided);
+    assert!(pushed.end.is_none() && pushed.v != 0.0);
+}
