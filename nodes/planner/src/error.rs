@@ -54,6 +54,9 @@ pub enum PlannerError {
     /// A route without waypoints.
     #[error("the route has no waypoints")]
     EmptyRoute,
+    /// A laser scan is malformed (empty, bad angles or range limits).
+    #[error("scan refused: {0}")]
+    Scan(#[from] mobil_geom::ScanError),
     /// A computation was stopped by its caller before it finished (a newer request superseded
     /// it); its partial result is not given.
     #[error("stopped by the caller before the end")]

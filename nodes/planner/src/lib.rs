@@ -13,6 +13,9 @@
 //!   pose ([`WaypointFollower`]: waypoints in order, reached within Z_crit, missed by the
 //!   progress stop or the leg's distance bound, slow-down at the last one), so the robot drives
 //!   the law the pre-check's virtual robot drove.
+//! - [`vfo`]: VFO waypoint following in clutter (SPEC §5): the law with collision avoidance,
+//!   path quality, Algorithm 2 (virtual robots choose each obstacle's side), the online
+//!   [`vfo::VfoFollower`] and obstacles from a laser scan.
 //! - [`route`]: the route pre-check — a virtual robot drives the route on the chassis model
 //!   against a [`mobil_sim::world::World`] and reports every collision, turn below the minimum
 //!   radius and unreachable waypoint with its index.
@@ -102,6 +105,7 @@ pub mod error;
 pub mod follow;
 pub mod route;
 pub mod sim;
+pub mod vfo;
 
 pub use approach::{
     approach, approach_step, shortest_step, ApproachConfig, ApproachEnd, ApproachOutcome, ApproachRun, ApproachStep,

@@ -1,0 +1,304 @@
+//! The VFO waypoint follower online: one control tick at a time on the real robot's pose,
+//! Algorithm 2 at every segment start and whenever the obstacles change.
+//!
+//! Each [`VfoFollower::update`] takes the robot's pose (q = [θ, x, y], as odometry gives it)
+//! and the time. When a segment starts (the first tick, a waypoint switch), when the caller
+//! reports a new obstacle ([`VfoFollower::set_obstacles`] with `new_obstacles`,
+//! [`VfoFollower::add_obstacle`]) or when the robot enters an influence zone whose σ the last
+//! optimisation left undecided (it did not foresee that zone), the segment is re-optimised from
+//! the real state ([`find_sigmas`]) before the command is worked out. The tick then applies the
+//! law with the segment's Σ: Algorithm 3, Algorithm 1 (the next waypoint in the same tick) or
+//! the end test, u = [ω, v].
+//!
+//! Safety: on a collision (d ≤ r), or when no safe Σ exists for the segment, the command is
+//! zero and the route ends ([`VfoEnd`]); the caller reports it. Bad input (a non-finite pose,
+//! time going backwards) is refused with a [`PlannerError`] and changes nothing; the caller
+//! commands zero.
+
+use mobil_geom::Pose2;
+
+use super::controller::{ControlStep, StepOutcome, VfoController, VfoGains, VfoWaypoint};
+use super::obstacles::{Obstacle, Sigma};
+use super::optimise::{find_sigmas, Optimisation, OptimiseConfig, OptimiseWarning, Segment};
+use crate::error::PlannerError;
+
+/// Something that happened during a tick.
+#[derive(Debug, Clone, PartialEq)]
+pub enum VfoEvent {
+    /// Waypoint `index` was reached (Algorithm 1; `vortex`: with ϵ_i enlarged by Algorithm 3).
+    Reached {
+        /// The waypoint's index.
+        index: usize,
+        /// Algorithm 3 fired.
+        vortex: bool,
+    },
+    /// Segment `index` was optimised (why: [`Reoptimised`]); the result is
+    /// [`VfoFollower::last_optimisation`].
+    Optimised {
+        /// The segment's waypoint index.
+        index: usize,
+        /// Why.
+        reason: Reoptimised,
+        /// Ψ_z of the chosen Σ (`None`: no safe Σ).
+        score: Option<f64>,
+        /// Limits the optimisation hit.
+        warnings: Vec<OptimiseWarning>,
+    },
+}
+
+/// Why a segment was optimised.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Reoptimised {
+    /// A segment started.
+    SegmentStart,
+    /// The caller reported a new obstacle.
+    NewObstacle,
+    /// The robot entered a zone whose σ was undecided.
+    UndecidedZone,
+}
+
+/// How a route ended.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum VfoEnd {
+    /// The last waypoint was reached within ϵ.
+    Done,
+    /// The robot is inside the forbidden zone of obstacle `obstacle`.
+    Collision {
+        /// The obstacle's index.
+        obstacle: usize,
+    },
+    /// No candidate path for segment `index`: no safe Σ exists (or none within the caps).
+    NoSafePath {
+        /// The waypoint index.
+        index: usize,
+    },
+}
+
+/// One tick's result.
+#[derive(Debug, Clone, PartialEq)]
+pub struct VfoOutput {
+    /// Angular velocity ω (rad/s); 0 once ended.
+    pub omega: f64,
+    /// Linear velocity v (m/s); 0 once ended.
+    pub v: f64,
+    /// The waypoint pursued after this tick (`len()` once done).
+    pub index: usize,
+    /// ‖e*_i‖ (m) to the pursued waypoint (0 once ended).
+    pub distance: f64,
+    /// The law's step (`None` once ended).
+    pub step: Option<ControlStep>,
+    /// What happened, in order.
+    pub events: Vec<VfoEvent>,
+    /// Set once the route has ended.
+    pub end: Option<VfoEnd>,
+}
+
+/// The VFO follower: waypoints, known obstacles, the segment's Σ and the last optimisation.
+#[derive(Debug, Clone)]
+pub struct VfoFollower {
+    config: OptimiseConfig,
+    controller: VfoController,
+    waypoints: Vec<VfoWaypoint>,
+    obstacles: Vec<Obstacle>,
+    sigmas: Vec<Sigma>,
+    index: usize,
+    optimise: Option<Reoptimised>,
+    last: Option<Optimisation>,
+    last_t: Option<f64>,
+    end: Option<VfoEnd>,
+}
+
+impl VfoFollower {
+    /// A follower through `waypoints` (at least one) with the law's `gains` and Algorithm 2's
+    /// `config`, knowing `obstacles` from the start.
+    pub fn new(
+        gains: VfoGains,
+        config: OptimiseConfig,
+        waypoints: Vec<VfoWaypoint>,
+        obstacles: Vec<Obstacle>,
+    ) -> Result<Self, PlannerError> {
+        config.validate()?;
+        if waypoints.is_empty() {
+            return Err(PlannerError::EmptyRoute);
+        }
+        for (i, w) in waypoints.iter().enumerate() {
+            VfoWaypoint::new(w.position.x, w.position.y, w.heading, w.guiding).map_err(|e| match e {
+                PlannerError::NonFinite { x, y, yaw, .. } => PlannerError::NonFinite {
+                    what: format!("waypoint {i}"),
+                    x,
+                    y,
+                    yaw,
+                },
+                other => other,
+            })?;
+        }
+        let n = obstacles.len();
+        Ok(VfoFollower {
+            config,
+            controller: VfoController::new(gains)?,
+            waypoints,
+            obstacles,
+            sigmas: vec![Sigma::Undecided; n],
+            index: 0,
+            optimise: Some(Reoptimised::SegmentStart),
+            last: None,
+            last_t: None,
+            end: None,
+        })
+    }
+
+    /// The waypoints.
+    pub fn waypoints(&self) -> &[VfoWaypoint] {
+        &self.waypoints
+    }
+
+    /// The waypoint pursued (`waypoints().len()` once done).
+    pub fn index(&self) -> usize {
+        self.index
+    }
+
+    /// The known obstacles (σ indices follow them).
+    pub fn obstacles(&self) -> &[Obstacle] {
+        &self.obstacles
+    }
+
+    /// The current segment's Σ.
+    pub fn sigmas(&self) -> &[Sigma] {
+        &self.sigmas
+    }
+
+    /// The last optimisation: every virtual robot's path with its Σ, every path's fate, Ψ_z
+    /// and the χ's.
+    pub fn last_optimisation(&self) -> Option<&Optimisation> {
+        self.last.as_ref()
+    }
+
+    /// How the route ended, once it has.
+    pub fn end(&self) -> Option<VfoEnd> {
+        self.end
+    }
+
+    /// Adds one obstacle; the segment is re-optimised at the next tick.
+    pub fn add_obstacle(&mut self, obstacle: Obstacle) {
+        self.obstacles.push(obstacle);
+        self.sigmas.push(Sigma::Undecided);
+        self.optimise.get_or_insert(Reoptimised::NewObstacle);
+    }
+
+    /// Replaces the obstacles (an updated map: the same indices for the same obstacles, new
+    /// ones appended). With `new_obstacles` the segment is re-optimised at the next tick;
+    /// without, Σ is kept (new entries undecided).
+    pub fn set_obstacles(&mut self, obstacles: Vec<Obstacle>, new_obstacles: bool) {
+        self.sigmas.resize(obstacles.len(), Sigma::Undecided);
+        self.obstacles = obstacles;
+        if new_obstacles {
+            self.optimise.get_or_insert(Reoptimised::NewObstacle);
+        }
+    }
+
+    fn optimise(&mut self, pose: &Pose2, reason: Reoptimised, events: &mut Vec<VfoEvent>) -> Result<(), PlannerError> {
+        let Some(waypoint) = self.waypoints.get(self.index).copied() else {
+            return Ok(());
+        };
+        let segment = Segment {
+            waypoint,
+            last: self.index + 1 == self.waypoints.len(),
+            obstacles: &self.obstacles,
+        };
+        let result = find_sigmas(pose, &self.controller, &segment, &self.config)?;
+        self.sigmas = result.sigmas.clone();
+        events.push(VfoEvent::Optimised {
+            index: self.index,
+            reason,
+            score: result.score(),
+            warnings: result.warnings.clone(),
+        });
+        if result.best.is_none() {
+            self.end = Some(VfoEnd::NoSafePath { index: self.index });
+        }
+        self.last = Some(result);
+        Ok(())
+    }
+
+    /// One control tick at `pose` (θ, x, y of the robot's guide point) at time `t` (s,
+    /// non-decreasing). Refuses a non-finite or out-of-range pose or time.
+    pub fn update(&mut self, pose: &Pose2, t: f64) -> Result<VfoOutput, PlannerError> {
+        crate::docking::check_pose("pose", pose)?;
+        if !t.is_finite() || self.last_t.is_some_and(|last| t < last) {
+            return Err(PlannerError::InvalidConfig {
+                name: "t",
+                value: t,
+                reason: "time must be finite and must not go backwards",
+            });
+        }
+        self.last_t = Some(t);
+        let mut events = Vec::new();
+        loop {
+            if self.end.is_some() {
+                return Ok(self.stopped(events));
+            }
+            let Some(waypoint) = self.waypoints.get(self.index).copied() else {
+                self.end = Some(VfoEnd::Done);
+                continue;
+            };
+            if let Some(reason) = self.optimise.take() {
+                self.optimise(pose, reason, &mut events)?;
+                continue;
+            }
+            // A zone the optimisation did not foresee: decide it now.
+            let position = pose.position();
+            let undecided = self
+                .obstacles
+                .iter()
+                .zip(&self.sigmas)
+                .any(|(o, s)| *s == Sigma::Undecided && o.distance(&position) <= o.influence_radius());
+            if undecided && !matches!(events.last(), Some(VfoEvent::Optimised { .. })) {
+                self.optimise = Some(Reoptimised::UndecidedZone);
+                continue;
+            }
+            let last = self.index + 1 == self.waypoints.len();
+            let step = self
+                .controller
+                .step(pose, &waypoint, last, &self.obstacles, &self.sigmas);
+            match step.outcome {
+                StepOutcome::Drive => {
+                    return Ok(VfoOutput {
+                        omega: step.omega,
+                        v: step.v,
+                        index: self.index,
+                        distance: step.field.error.norm(),
+                        step: Some(step),
+                        events,
+                        end: None,
+                    });
+                }
+                StepOutcome::Reached { vortex } => {
+                    events.push(VfoEvent::Reached {
+                        index: self.index,
+                        vortex,
+                    });
+                    self.index += 1;
+                    self.controller.start_segment();
+                    if self.index < self.waypoints.len() {
+                        self.optimise = Some(Reoptimised::SegmentStart);
+                    }
+                }
+                StepOutcome::Collision { obstacle } => {
+                    self.end = Some(VfoEnd::Collision { obstacle });
+                }
+            }
+        }
+    }
+
+    fn stopped(&self, events: Vec<VfoEvent>) -> VfoOutput {
+        VfoOutput {
+            omega: 0.0,
+            v: 0.0,
+            index: self.index,
+            distance: 0.0,
+            step: None,
+            events,
+            end: self.end,
+        }
+    }
+}

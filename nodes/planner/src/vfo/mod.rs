@@ -1,0 +1,45 @@
+//! VFO waypoint following in clutter, optimised by simulating virtual robots (SPEC §5; the VFO
+//! paper, source 002), ROS-free: poses and times are inputs, commands and reports outputs.
+//!
+//! - [`obstacles`]: λ = {p, r, R} and σ, the potential V(d) (eq. 16) and V'(d).
+//! - [`controller`]: the VFO law (eq. 5–13) with avoidance, Algorithm 1 and Algorithm 3,
+//!   one step at a time ([`VfoController`]), and the unicycle's exact arc.
+//! - [`quality`]: χ_D, χ_B, χ_E, χ_S (eq. 14–19), merge, normalisation (20–21), Ψ_z (22).
+//! - [`optimise`]: Algorithm 2 (findSigmas) with cycle detection, caps and parallel batches.
+//! - [`follower`]: [`VfoFollower`], the online follower: one control tick at a time, Σ per
+//!   segment, re-optimised on new obstacles; the last optimisation for display.
+//! - [`scan`]: obstacles from a laser scan (clusters → circles) merged over time in odom.
+//!
+//! ```
+//! use mobil_geom::Pose2;
+//! use mobil_planner::vfo::{find_sigmas, Obstacle, OptimiseConfig, Segment, Sigma, VfoController, VfoGains, VfoWaypoint};
+//! use nalgebra::Point2;
+//!
+//! // One obstacle straight ahead on the way to (4, 0): two ways round it, both safe.
+//! let obstacles = [Obstacle::new(Point2::new(2.0, 0.0), 0.5, 1.0).unwrap()];
+//! let segment = Segment { waypoint: VfoWaypoint::new(4.0, 0.0, 0.0, 0.5).unwrap(), last: true, obstacles: &obstacles };
+//! let controller = VfoController::new(VfoGains::default()).unwrap();
+//! let result = find_sigmas(&Pose2::identity(), &controller, &segment, &OptimiseConfig::default()).unwrap();
+//! assert_eq!(result.candidates(), 2);
+//! assert_ne!(result.sigmas[0], Sigma::Undecided);
+//! ```
+
+pub mod controller;
+pub mod follower;
+pub mod obstacles;
+pub mod optimise;
+pub mod quality;
+pub mod scan;
+
+pub use controller::{
+    convergence_field, field_rate, integrate_unicycle, ControlStep, Field, StepOutcome, VfoController, VfoGains,
+    VfoWaypoint, DEFAULT_GUIDING,
+};
+pub use follower::{Reoptimised, VfoEnd, VfoEvent, VfoFollower, VfoOutput};
+pub use obstacles::{potential, potential_derivative, Obstacle, Sigma};
+pub use optimise::{
+    find_sigmas, path_time_limit, simulate_uninterrupted, DecisionEdge, ExploredPath, Optimisation, OptimiseConfig,
+    OptimiseWarning, PathFate, RobotEnd, Segment, VirtualRobot, PARALLEL_MIN_BATCH,
+};
+pub use quality::{normalise, normalised, path_score, PathIndices, QualityWeights};
+pub use scan::{extract_circles, fit_circle, Circle, MapUpdate, ObstacleMap, ScanObstacleConfig};

@@ -1,0 +1,346 @@
+//! Obstacles from a laser scan: returns clustered into circles, merged over time in the odom
+//! frame (SPEC §5: obstacles are detected online).
+//!
+//! - **Clusters**: consecutive valid echoes (REP-117: NaN, ±inf and out-of-limits beams break
+//!   a cluster) whose points lie within `cluster_gap` + `range · increment · 2` of each other
+//!   (the gap grows with range, where neighbouring beams lie further apart). A cluster of fewer
+//!   than `min_points` echoes is noise and dropped.
+//! - **Circle fit**: the algebraic (Kåsa) least-squares circle as a start, then Gauss–Newton
+//!   iterations of the geometric fit, which minimise Σ(‖p − c‖ − ρ)². A LIDAR sees less than
+//!   half of a circle, and there the algebraic fit alone is biased under noise (it shrinks
+//!   the radius); the geometric fit is unbiased and exact on noise-free points. The fit is
+//!   taken when it converges, its radius is at most `max_radius`, and its centre lies beyond
+//!   the arc as seen from the sensor (an obstacle's echoes face the sensor). Otherwise — a
+//!   wall, a corner, a shape that is no circle — the cluster is covered by a chain of circles:
+//!   pieces at most 2·`max_radius` long, each the circle round its points' centroid through
+//!   its farthest point. So every echo lies inside some obstacle.
+//! - **Merging**: a circle whose centre lies within `association_distance` of a known
+//!   obstacle's centre, or that overlaps it by more than half the smaller radius, is the same
+//!   obstacle: centre and radius become the running mean over its detections (at most the
+//!   last `memory` detections weigh in). Any other circle is a new obstacle, appended (indices
+//!   never change) and reported, so the caller re-optimises.
+//! - **Obstacle model**: r = r_p + `robot_radius`, R = r + `influence_margin`.
+
+use mobil_geom::{Pose2, Scan};
+use nalgebra::{Matrix3, Point2, Vector3};
+
+use super::obstacles::Obstacle;
+use crate::error::{positive_finite, PlannerError};
+
+/// Settings of the extraction and the merge; every default justified.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ScanObstacleConfig {
+    /// r_r (m), the robot's radius, added to each obstacle's (no default that fits every robot:
+    /// MOBIL-II's footprint is 0.53 m; here 0.3).
+    pub robot_radius: f64,
+    /// R − r (m). Default 0.4: at 0.3 m/s the law has more than a second in the zone to turn.
+    pub influence_margin: f64,
+    /// Largest gap (m) between neighbouring echoes of one cluster, plus two beam spacings at
+    /// their range. Default 0.1: less than the narrowest gap the robot could pass.
+    pub cluster_gap: f64,
+    /// Fewest echoes in a cluster. Default 3, the fewest that define a circle.
+    pub min_points: usize,
+    /// Largest fitted radius (m); a larger fit is covered by a chain of circles. Default 0.5.
+    pub max_radius: f64,
+    /// Centres nearer than this (m) are one obstacle. Default 0.2.
+    pub association_distance: f64,
+    /// Detections the running mean remembers. Default 20 (half a second of a 40 Hz scanner).
+    pub memory: usize,
+}
+
+impl Default for ScanObstacleConfig {
+    fn default() -> Self {
+        ScanObstacleConfig {
+            robot_radius: 0.3,
+            influence_margin: 0.4,
+            cluster_gap: 0.1,
+            min_points: 3,
+            max_radius: 0.5,
+            association_distance: 0.2,
+            memory: 20,
+        }
+    }
+}
+
+impl ScanObstacleConfig {
+    /// Checks every field.
+    pub fn validate(&self) -> Result<(), PlannerError> {
+        positive_finite("robot_radius", self.robot_radius)?;
+        positive_finite("influence_margin", self.influence_margin)?;
+        positive_finite("cluster_gap", self.cluster_gap)?;
+        positive_finite("max_radius", self.max_radius)?;
+        positive_finite("association_distance", self.association_distance)?;
+        if self.min_points < 3 || self.memory == 0 {
+            return Err(PlannerError::InvalidConfig {
+                name: "min_points/memory",
+                value: self.min_points as f64,
+                reason: "need at least 3 points per cluster and a memory of at least 1",
+            });
+        }
+        Ok(())
+    }
+}
+
+/// A circle (m).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Circle {
+    /// Its centre.
+    pub centre: Point2<f64>,
+    /// Its radius.
+    pub radius: f64,
+}
+
+/// Circles from the echoes of `scan` (see the module docs), in the frame `frame_from_base`
+/// maps the base frame to (the odom frame, with the robot's pose in it).
+pub fn extract_circles(scan: &Scan, frame_from_base: &Pose2, config: &ScanObstacleConfig) -> Vec<Circle> {
+    let frame_from_laser = *frame_from_base * scan.base_from_laser();
+    let sensor = frame_from_laser.position();
+    let spacing = 2.0 * scan_increment(scan);
+    let mut circles = Vec::new();
+    let mut cluster: Vec<Point2<f64>> = Vec::new();
+    let mut previous: Option<(Point2<f64>, f64)> = None;
+    for i in 0..scan.len() {
+        let echo = scan
+            .point_in_laser(i)
+            .map(|p| (frame_from_laser.transform_point(p), p.coords.norm()));
+        match (echo, previous) {
+            (Some((p, range)), Some((q, _))) if (p - q).norm() <= config.cluster_gap + spacing * range => {
+                cluster.push(p)
+            }
+            (Some((p, _)), _) => {
+                flush(&mut cluster, sensor, config, &mut circles);
+                cluster.push(p);
+            }
+            (None, _) => flush(&mut cluster, sensor, config, &mut circles),
+        }
+        previous = echo;
+    }
+    flush(&mut cluster, sensor, config, &mut circles);
+    circles
+}
+
+fn scan_increment(scan: &Scan) -> f64 {
+    if scan.len() > 1 {
+        scan.angle(1) - scan.angle(0)
+    } else {
+        0.0
+    }
+}
+
+fn flush(cluster: &mut Vec<Point2<f64>>, sensor: Point2<f64>, config: &ScanObstacleConfig, out: &mut Vec<Circle>) {
+    if cluster.len() >= config.min_points {
+        match fit_circle(cluster) {
+            Some(c) if c.radius <= config.max_radius && faces(cluster, &c, sensor) => out.push(c),
+            _ => cover(cluster, config.max_radius, out),
+        }
+    }
+    cluster.clear();
+}
+
+/// Whether the arc faces the sensor: the centre lies further from the sensor than the points'
+/// centroid.
+fn faces(points: &[Point2<f64>], circle: &Circle, sensor: Point2<f64>) -> bool {
+    let centroid = centroid(points);
+    (circle.centre - sensor).norm() > (centroid - sensor).norm()
+}
+
+fn centroid(points: &[Point2<f64>]) -> Point2<f64> {
+    let sum = points.iter().fold(nalgebra::Vector2::zeros(), |s, p| s + p.coords);
+    Point2::from(sum / points.len().max(1) as f64)
+}
+
+/// Covers points by circles round the centroids of pieces at most 2·`max_radius` long.
+fn cover(points: &[Point2<f64>], max_radius: f64, out: &mut Vec<Circle>) {
+    let mut start = 0;
+    while start < points.len() {
+        let mut end = start + 1;
+        while end < points.len() && (points[end] - points[start]).norm() <= 2.0 * max_radius {
+            end += 1;
+        }
+        let piece = &points[start..end];
+        let c = centroid(piece);
+        let radius = piece.iter().map(|p| (p - c).norm()).fold(0.0, f64::max);
+        out.push(Circle {
+            centre: c,
+            radius: radius.max(0.01),
+        });
+        start = end;
+    }
+}
+
+/// The geometric least-squares circle through `points` (Kåsa start, Gauss–Newton); `None`
+/// for fewer than three points, (nearly) collinear points or no convergence.
+pub fn fit_circle(points: &[Point2<f64>]) -> Option<Circle> {
+    if points.len() < 3 {
+        return None;
+    }
+    // Work relative to the centroid, for conditioning.
+    let c0 = centroid(points);
+    // Kåsa: x² + y² + D·x + E·y + F = 0, linear least squares by the normal equations.
+    let mut ata = Matrix3::zeros();
+    let mut atb = Vector3::zeros();
+    for p in points {
+        let (x, y) = (p.x - c0.x, p.y - c0.y);
+        let row = Vector3::new(x, y, 1.0);
+        ata += row * row.transpose();
+        atb += row * -(x * x + y * y);
+    }
+    let sol = ata.lu().solve(&atb)?;
+    let (cx, cy) = (-sol.x / 2.0, -sol.y / 2.0);
+    let rr = cx * cx + cy * cy - sol.z;
+    if !(rr.is_finite() && rr > 0.0) {
+        return None;
+    }
+    let (mut a, mut b, mut r) = (cx, cy, rr.sqrt());
+    // Gauss–Newton on residuals ‖p − c‖ − ρ.
+    for _ in 0..50 {
+        let mut jtj = Matrix3::zeros();
+        let mut jtr = Vector3::zeros();
+        for p in points {
+            let (dx, dy) = (p.x - c0.x - a, p.y - c0.y - b);
+            let d = dx.hypot(dy);
+            if d < 1e-12 {
+                return None;
+            }
+            let j = Vector3::new(-dx / d, -dy / d, -1.0);
+            let res = d - r;
+            jtj += j * j.transpose();
+            jtr += j * res;
+        }
+        let delta = jtj.lu().solve(&(-jtr))?;
+        a += delta.x;
+        b += delta.y;
+        r += delta.z;
+        if !(a.is_finite() && b.is_finite() && r.is_finite()) {
+            return None;
+        }
+        if delta.norm() < 1e-12 * (1.0 + r.abs()) {
+            break;
+        }
+    }
+    (r > 0.0).then(|| Circle {
+        centre: Point2::new(a + c0.x, b + c0.y),
+        radius: r,
+    })
+}
+
+/// One tracked obstacle: the running mean of its detections.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct Tracked {
+    circle: Circle,
+    detections: usize,
+}
+
+/// What a scan changed.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct MapUpdate {
+    /// Indices of the obstacles this scan added (the caller re-optimises when not empty).
+    pub new: Vec<usize>,
+    /// How many known obstacles it saw again.
+    pub seen: usize,
+}
+
+/// The obstacles seen so far, in the odom frame, merged over time (module docs).
+#[derive(Debug, Clone, PartialEq)]
+pub struct ObstacleMap {
+    config: ScanObstacleConfig,
+    tracked: Vec<Tracked>,
+}
+
+impl ObstacleMap {
+    /// An empty map.
+    pub fn new(config: ScanObstacleConfig) -> Result<Self, PlannerError> {
+        config.validate()?;
+        Ok(ObstacleMap {
+            config,
+            tracked: Vec::new(),
+        })
+    }
+
+    /// The circles as detected (r_p, without the robot's radius), by index.
+    pub fn circles(&self) -> Vec<Circle> {
+        self.tracked.iter().map(|t| t.circle).collect()
+    }
+
+    /// The obstacles λ = {p, r_p + r_r, R} for the law, by index (the same as [`Self::circles`]).
+    pub fn obstacles(&self) -> Vec<Obstacle> {
+        self.tracked.iter().filter_map(|t| self.model(&t.circle)).collect()
+    }
+
+    fn model(&self, c: &Circle) -> Option<Obstacle> {
+        let r = c.radius + self.config.robot_radius;
+        Obstacle::new(c.centre, r, r + self.config.influence_margin).ok()
+    }
+
+    /// Adds the circles of a checked scan taken at `odom_from_base`.
+    pub fn update(&mut self, scan: &Scan, odom_from_base: &Pose2) -> Result<MapUpdate, PlannerError> {
+        crate::docking::check_pose("odom_from_base", odom_from_base)?;
+        let circles = extract_circles(scan, odom_from_base, &self.config);
+        Ok(self.merge(&circles))
+    }
+
+    /// Adds the circles of a scan given as plain LaserScan fields: `ranges` from `angle_min`
+    /// every `angle_increment`, valid within [`range_min`, `range_max`], the laser at
+    /// `odom_from_laser`. A malformed scan (empty, bad angles or limits, non-finite pose) is
+    /// refused and changes nothing; NaN and ±inf ranges are no echoes (REP-117).
+    pub fn update_from_ranges(
+        &mut self,
+        ranges: &[f32],
+        angle_min: f64,
+        angle_increment: f64,
+        range_min: f64,
+        range_max: f64,
+        odom_from_laser: &Pose2,
+    ) -> Result<MapUpdate, PlannerError> {
+        let angle_max = angle_min + ranges.len().saturating_sub(1) as f64 * angle_increment;
+        let scan = Scan::new(
+            angle_min,
+            angle_max,
+            angle_increment,
+            range_min,
+            range_max,
+            ranges.to_vec(),
+            Vec::new(),
+            Pose2::identity(),
+        )?;
+        self.update(&scan, odom_from_laser)
+    }
+
+    /// Merges detected circles (odom frame) into the map.
+    pub fn merge(&mut self, circles: &[Circle]) -> MapUpdate {
+        let mut update = MapUpdate::default();
+        // Only obstacles known before this scan: the circles of one scan are distinct (a
+        // wall's chain overlaps by design).
+        let known = self.tracked.len();
+        for c in circles {
+            let near = self.tracked[..known]
+                .iter()
+                .enumerate()
+                .map(|(i, t)| (i, (t.circle.centre - c.centre).norm(), t.circle.radius))
+                // Near centres, or an overlap r1 + r2 − d of more than half the smaller radius.
+                .filter(|&(_, d, r)| d <= self.config.association_distance || r + c.radius - d > 0.5 * r.min(c.radius))
+                .min_by(|a, b| a.1.total_cmp(&b.1));
+            match near {
+                Some((i, _, _)) => {
+                    let t = &mut self.tracked[i];
+                    t.detections = (t.detections + 1).min(self.config.memory);
+                    let w = 1.0 / t.detections as f64;
+                    t.circle.centre += (c.centre - t.circle.centre) * w;
+                    t.circle.radius += (c.radius - t.circle.radius) * w;
+                    update.seen += 1;
+                }
+                // A circle the law cannot take (beyond the coordinate limit) is not kept, so
+                // `obstacles()` has an entry for every circle and the indices agree.
+                None if self.model(c).is_none() => {}
+                None => {
+                    update.new.push(self.tracked.len());
+                    self.tracked.push(Tracked {
+                        circle: *c,
+                        detections: 1,
+                    });
+                }
+            }
+        }
+        update
+    }
+}

@@ -1,0 +1,625 @@
+//! The VFO waypoint follower (SPEC §5): the potential and the field's derivative against
+//! finite differences, convergence, the sides σ = ±1 pass on, Algorithm 2 on the paper's
+//! layouts (Fig. 2, Fig. 4/5), Algorithm 3, the cycle check, the merge, the caps, the online
+//! follower and obstacles from a scan. Expected numbers are worked out by hand in the comments
+//! or by a second method in the test itself.
+
+use std::f64::consts::{FRAC_PI_2, PI};
+
+use approx::assert_relative_eq;
+use mobil_geom::{wrap, Pose2};
+use mobil_planner::vfo::{
+    convergence_field, field_rate, find_sigmas, path_time_limit, potential, potential_derivative,
+    simulate_uninterrupted, Obstacle, OptimiseConfig, OptimiseWarning, PathFate, PathIndices, QualityWeights, RobotEnd,
+    Segment, Sigma, VfoController, VfoEnd, VfoEvent, VfoFollower, VfoGains, VfoWaypoint,
+};
+use mobil_planner::PlannerError;
+use nalgebra::{Point2, Vector2};
+
+fn ob(x: f64, y: f64, r: f64, big_r: f64) -> Obstacle {
+    Obstacle::new(Point2::new(x, y), r, big_r).expect("valid obstacle")
+}
+
+fn wp(x: f64, y: f64, heading: f64) -> VfoWaypoint {
+    VfoWaypoint::new(x, y, heading, 0.5).expect("valid waypoint")
+}
+
+fn controller() -> VfoController {
+    VfoController::new(VfoGains::default()).expect("valid gains")
+}
+
+/// Drives a unicycle with the follower at `dt` (s) per tick. The test integrates on its own,
+/// a second method: ten Euler sub-steps per tick of the held command. Returns the poses and
+/// every event, and how it ended (None: `max_t` ran out).
+fn drive(
+    follower: &mut VfoFollower,
+    start: Pose2,
+    dt: f64,
+    max_t: f64,
+    mut on_tick: impl FnMut(f64, &mut VfoFollower),
+) -> (Vec<Pose2>, Vec<VfoEvent>, Option<VfoEnd>) {
+    let mut pose = start;
+    let mut poses = vec![pose];
+    let mut events = Vec::new();
+    let mut t = 0.0;
+    while t < max_t {
+        on_tick(t, follower);
+        let out = follower.update(&pose, t).expect("valid tick");
+        events.extend(out.events.iter().cloned());
+        if out.end.is_some() {
+            return (poses, events, out.end);
+        }
+        for _ in 0..10 {
+            let h = dt / 10.0;
+            pose = Pose2::new(
+                pose.x + out.v * pose.yaw.cos() * h,
+                pose.y + out.v * pose.yaw.sin() * h,
+                pose.yaw + out.omega * h,
+            );
+        }
+        poses.push(pose);
+        t += dt;
+    }
+    (poses, events, None)
+}
+
+fn clearance(poses: &[Pose2], o: &Obstacle) -> f64 {
+    poses
+        .iter()
+        .map(|p| o.distance(&p.position()))
+        .fold(f64::INFINITY, f64::min)
+}
+
+/// Ψ_z of every candidate worked out again here from their χ's (eq. 20–22), a second method.
+fn scores_by_hand(indices: &[PathIndices], k: &QualityWeights) -> Vec<f64> {
+    let max = |f: fn(&PathIndices) -> f64| indices.iter().map(f).fold(0.0, f64::max);
+    let (md, mb, me, ms) = (
+        max(|x| x.length),
+        max(|x| x.danger),
+        max(|x| x.control),
+        max(|x| x.smoothness),
+    );
+    let psi = |x: f64, m: f64| if m == 0.0 { 0.0 } else { 1.0 - x / m };
+    indices
+        .iter()
+        .map(|x| {
+            k.length * psi(x.length, md)
+                + k.danger * psi(x.danger, mb)
+                + k.control * psi(x.control, me)
+                + k.smoothness * psi(x.smoothness, ms)
+        })
+        .collect()
+}
+
+fn polyline_length(points: &[Point2<f64>]) -> f64 {
+    points.windows(2).map(|w| (w[1] - w[0]).norm()).sum()
+}
+
+#[test]
+fn potential_and_its_derivative_match_hand_values_and_finite_differences() {
+    // r = 0.5, R = 1, d = 0.75: (0.5625 − 1)/(0.5625 − 0.25) = −1.4, V = 1.96;
+    // V' = 4·0.75·0.75·(−0.4375)/0.3125³ = −0.984375/0.030517578125 = −32.256.
+    assert_relative_eq!(potential(0.75, 0.5, 1.0), 1.96, epsilon = 1e-12);
+    assert_relative_eq!(potential_derivative(0.75, 0.5, 1.0), -32.256, epsilon = 1e-9);
+    assert_eq!(potential(1.0, 0.5, 1.0), 0.0);
+    assert_eq!(potential(1.5, 0.5, 1.0), 0.0);
+    assert_eq!(potential(0.5, 0.5, 1.0), f64::INFINITY);
+    assert_eq!(potential_derivative(1.2, 0.5, 1.0), 0.0);
+    // Central differences over the zone (away from r, where V' blows up).
+    for i in 1..100 {
+        let d = 0.55 + 0.45 * i as f64 / 100.0;
+        let h = 1e-6;
+        let fd = (potential(d + h, 0.5, 1.0) - potential(d - h, 0.5, 1.0)) / (2.0 * h);
+        let an = potential_derivative(d, 0.5, 1.0);
+        assert!(
+            (fd - an).abs() <= 1e-5 * (1.0 + an.abs()),
+            "d {d}: fd {fd} analytic {an}"
+        );
+    }
+}
+
+#[test]
+fn the_fields_derivative_matches_finite_differences() {
+    // Ḣ* = (∂H*/∂q*)·q̇* against (H*(q + εq̇) − H*(q − εq̇))/2ε at points inside one or two
+    // zones, σ of either sign, every direction of motion.
+    let obstacles = [ob(2.0, 0.3, 0.4, 1.2), ob(2.6, -0.6, 0.3, 1.0)];
+    let w = VfoWaypoint::new(4.0, 0.5, 0.7, 0.6).expect("valid");
+    for sigmas in [
+        [Sigma::Right, Sigma::Left],
+        [Sigma::Left, Sigma::Left],
+        [Sigma::Right, Sigma::Right],
+    ] {
+        for (x, y) in [(1.3, 0.0), (2.0, -0.5), (1.6, 1.0), (3.0, 0.2), (0.0, 0.0)] {
+            let q = Point2::new(x, y);
+            for a in 0..8 {
+                let vel = 0.3 * Vector2::new((a as f64 * 0.8).cos(), (a as f64 * 0.8).sin());
+                let f = convergence_field(&q, &w, 1.3, &obstacles, &sigmas);
+                assert!(f.collision.is_none());
+                let an = field_rate(&f, &q, &vel, &w, 1.3, &obstacles, &sigmas);
+                let e = 1e-7;
+                let plus = convergence_field(&(q + e * vel), &w, 1.3, &obstacles, &sigmas).big_h;
+                let minus = convergence_field(&(q - e * vel), &w, 1.3, &obstacles, &sigmas).big_h;
+                let fd = (plus - minus) / (2.0 * e);
+                assert!(
+                    (fd - an).norm() <= 1e-5 * (1.0 + an.norm()),
+                    "at ({x}, {y}) σ {sigmas:?}: fd {fd:?} analytic {an:?}"
+                );
+            }
+        }
+    }
+}
+
+#[test]
+fn with_no_obstacles_the_robot_converges_to_one_point() {
+    // One waypoint behind and to the left, facing north: ‖q_N − q‖ < ϵ = 0.05 (heading in rad,
+    // position in m), measured here from the test's own integration.
+    let goal = wp(-1.0, 2.0, FRAC_PI_2);
+    let mut f =
+        VfoFollower::new(VfoGains::default(), OptimiseConfig::default(), vec![goal], Vec::new()).expect("valid");
+    let (poses, events, end) = drive(&mut f, Pose2::new(0.0, 0.0, 0.3), 0.01, 120.0, |_, _| {});
+    assert_eq!(end, Some(VfoEnd::Done));
+    let last = poses.last().expect("poses");
+    let error = (wrap(FRAC_PI_2 - last.yaw).powi(2) + (last.x + 1.0).powi(2) + (last.y - 2.0).powi(2)).sqrt();
+    assert!(error < 0.05, "final error {error}");
+    // No zone on the way: one optimisation, Ψ_z = 0 (|D| = 1).
+    let optimised: Vec<_> = events
+        .iter()
+        .filter_map(|e| match e {
+            VfoEvent::Optimised { score, .. } => Some(*score),
+            _ => None,
+        })
+        .collect();
+    assert_eq!(optimised, vec![Some(0.0)]);
+    // Once done, the command stays zero.
+    let out = f.update(last, 1000.0).expect("valid");
+    assert_eq!((out.v, out.omega, out.end), (0.0, 0.0, Some(VfoEnd::Done)));
+}
+
+#[test]
+fn intermediate_waypoints_switch_within_their_epsilon() {
+    // Three waypoints, no obstacles: each intermediate one is passed within ϵ_i = 0.05 m
+    // (Algorithm 1), the last one reached within ϵ.
+    let route = vec![wp(2.0, 0.0, 0.0), wp(3.0, 2.0, FRAC_PI_2), wp(1.0, 3.0, PI)];
+    let mut f = VfoFollower::new(
+        VfoGains::default(),
+        OptimiseConfig::default(),
+        route.clone(),
+        Vec::new(),
+    )
+    .expect("valid");
+    let (poses, events, end) = drive(&mut f, Pose2::identity(), 0.01, 200.0, |_, _| {});
+    assert_eq!(end, Some(VfoEnd::Done));
+    let reached: Vec<usize> = events
+        .iter()
+        .filter_map(|e| match e {
+            VfoEvent::Reached { index, vortex: false } => Some(*index),
+            _ => None,
+        })
+        .collect();
+    assert_eq!(reached, vec![0, 1, 2]);
+    for w in &route[..2] {
+        let closest = poses
+            .iter()
+            .map(|p| (p.position() - w.position).norm())
+            .fold(f64::INFINITY, f64::min);
+        assert!(closest < 0.05 + 0.003, "closest {closest} to {:?}", w.position);
+    }
+}
+
+#[test]
+fn sigma_plus_one_passes_on_the_right_and_minus_one_on_the_left() {
+    // Heading +x toward (4, 0) with an obstacle on the line at (2, 0): the robot's right is
+    // −y. σ = +1 must pass below the obstacle (y < −r where x = 2), σ = −1 above.
+    let obstacles = [ob(2.0, 0.0, 0.5, 1.0)];
+    let segment = Segment {
+        waypoint: wp(4.0, 0.0, 0.0),
+        last: true,
+        obstacles: &obstacles,
+    };
+    let config = OptimiseConfig::default();
+    for (sigma, side) in [(Sigma::Right, -1.0), (Sigma::Left, 1.0)] {
+        let (_, path, end) =
+            simulate_uninterrupted(&Pose2::identity(), &controller(), &segment, &[sigma], &config).expect("valid");
+        assert_eq!(end, RobotEnd::Reached { vortex: false }, "σ {sigma:?}");
+        let abeam = path
+            .windows(2)
+            .find(|w| w[0].x <= 2.0 && w[1].x > 2.0)
+            .expect("passes x = 2");
+        assert!(side * abeam[0].y > 0.5, "σ {sigma:?}: at x = 2, y = {}", abeam[0].y);
+        let closest = path
+            .iter()
+            .map(|p| obstacles[0].distance(p))
+            .fold(f64::INFINITY, f64::min);
+        assert!(closest > 0.5, "σ {sigma:?} came within {closest}");
+    }
+}
+
+/// A layout like the paper's Fig. 2: p1 just left of the straight way, p2 beyond it on the
+/// left, p3 far to the right, out of reach.
+fn fig2() -> [Obstacle; 3] {
+    [ob(2.0, 0.15, 0.4, 0.9), ob(2.6, 1.3, 0.4, 0.9), ob(4.0, -2.5, 0.4, 0.9)]
+}
+
+#[test]
+fn algorithm_2_on_the_papers_fig_2_explores_three_paths_and_drops_the_collision() {
+    let obstacles = fig2();
+    let segment = Segment {
+        waypoint: wp(5.0, 0.0, 0.0),
+        last: false,
+        obstacles: &obstacles,
+    };
+    let config = OptimiseConfig::default();
+    let r = find_sigmas(&Pose2::identity(), &controller(), &segment, &config).expect("valid");
+    use Sigma::{Left, Right, Undecided};
+    // W1 to p1's zone; W2 (σ1 = +1) reaches; W3 (σ1 = −1) to p2's zone; W4 (σ2 = +1) reaches;
+    // W5 (σ2 = −1) collides with p2. σ3 is never decided.
+    assert_eq!(r.robots.len(), 5);
+    assert_eq!(r.paths.len(), 3);
+    let fates: Vec<(Vec<Sigma>, &PathFate)> = r.paths.iter().map(|p| (p.sigmas.clone(), &p.fate)).collect();
+    assert_eq!(
+        fates,
+        vec![
+            (
+                vec![Right, Undecided, Undecided],
+                &PathFate::Candidate { vortex: false }
+            ),
+            (vec![Left, Right, Undecided], &PathFate::Candidate { vortex: false }),
+            (vec![Left, Left, Undecided], &PathFate::Collided { obstacle: 1 }),
+        ]
+    );
+    assert_eq!(r.robots[0].end, RobotEnd::Entry { obstacle: 0 });
+    assert_eq!(r.robots[2].end, RobotEnd::Entry { obstacle: 1 });
+    assert_eq!(r.paths[1].robots, vec![0, 2, 3]);
+    // The better of the two by Ψ_z worked out again from the χ's.
+    let indices = [r.paths[0].indices, r.paths[1].indices];
+    let by_hand = scores_by_hand(&indices, &config.weights);
+    for (p, s) in r.paths.iter().zip(&by_hand) {
+        assert_relative_eq!(p.score.expect("candidate"), s, epsilon = 1e-12);
+    }
+    let best = if by_hand[0] > by_hand[1] { 0 } else { 1 };
+    assert_eq!(r.best, Some(best));
+    assert_eq!(r.sigmas, r.paths[best].sigmas);
+    // The right way round p1 is the paper's optimum too: shorter and further from p2.
+    assert_eq!(best, 0);
+    // χ_D against the length of the drawn path (points every 5 cm on curves of radius ≥ 0.1 m:
+    // chords shorter than the arcs by < 0.2 %).
+    for p in &r.paths[..2] {
+        let drawn = polyline_length(&r.path_points(p));
+        assert_relative_eq!(p.indices.length, drawn, max_relative = 0.003);
+    }
+    // The right way stays right of p1 (below y = 0.15 − 0.4), the left way left of it.
+    let ys = |i: usize| r.path_points(&r.paths[i]).iter().map(|p| p.y).collect::<Vec<f64>>();
+    assert!(ys(0).iter().all(|&y| y <= 1e-9) && ys(0).iter().any(|&y| y < -0.25));
+    assert!(ys(1).iter().all(|&y| y >= -1e-9) && ys(1).iter().any(|&y| y > 0.55));
+}
+
+#[test]
+fn merged_indices_equal_one_uninterrupted_run() {
+    // Each candidate of Fig. 2 driven again with its Σ fixed and no stops: the same χ's (the
+    // stops do not change the integration; merge adds lengths and costs, takes maxima).
+    let obstacles = fig2();
+    let segment = Segment {
+        waypoint: wp(5.0, 0.0, 0.0),
+        last: false,
+        obstacles: &obstacles,
+    };
+    let config = OptimiseConfig::default();
+    let r = find_sigmas(&Pose2::identity(), &controller(), &segment, &config).expect("valid");
+    let mut checked = 0;
+    for p in r.paths.iter().filter(|p| p.score.is_some()) {
+        let (x, path, end) =
+            simulate_uninterrupted(&Pose2::identity(), &controller(), &segment, &p.sigmas, &config).expect("valid");
+        assert_eq!(end, RobotEnd::Reached { vortex: false });
+        assert_relative_eq!(x.length, p.indices.length, max_relative = 1e-12);
+        assert_relative_eq!(x.control, p.indices.control, max_relative = 1e-12);
+        assert_eq!(x.danger, p.indices.danger);
+        assert_eq!(x.smoothness, p.indices.smoothness);
+        assert_eq!(path.last(), r.path_points(p).last());
+        checked += 1;
+    }
+    assert_eq!(checked, 2);
+}
+
+/// Two obstacles with overlapping zones; the gap between them lies a little right of the
+/// straight way (the paper's Fig. 4/5 layout, our coordinates).
+fn fig45() -> [Obstacle; 2] {
+    [ob(2.5, 0.3, 0.3, 1.6), ob(2.5, -1.1, 0.3, 1.6)]
+}
+
+fn choose_with(weights: QualityWeights) -> (Vec<Sigma>, Vec<Point2<f64>>) {
+    let obstacles = fig45();
+    let segment = Segment {
+        waypoint: wp(5.0, 0.0, 0.0),
+        last: false,
+        obstacles: &obstacles,
+    };
+    let config = OptimiseConfig {
+        weights,
+        ..OptimiseConfig::default()
+    };
+    let r = find_sigmas(&Pose2::new(0.0, 0.05, 0.0), &controller(), &segment, &config).expect("valid");
+    // The choice is the largest Ψ_z worked out again from the χ's.
+    let cands: Vec<usize> = (0..r.paths.len()).filter(|&i| r.paths[i].score.is_some()).collect();
+    let by_hand = scores_by_hand(&cands.iter().map(|&i| r.paths[i].indices).collect::<Vec<_>>(), &weights);
+    let top = by_hand.iter().cloned().fold(f64::NEG_INFINITY, f64::max);
+    let best = cands[by_hand.iter().position(|&s| s == top).expect("a best")];
+    assert_eq!(r.best, Some(best));
+    (r.sigmas.clone(), r.best_path())
+}
+
+#[test]
+fn weights_choose_the_short_way_between_or_the_safer_way_round() {
+    // Fig. 4: {K_B = 2, K_D = 1, K_S = 1} (K_E = 0, SPEC Decision): between the two obstacles
+    // (p1 on the robot's left: σ1 = +1; p2 on its right: σ2 = −1).
+    let fig4 = QualityWeights {
+        length: 1.0,
+        danger: 2.0,
+        control: 0.0,
+        smoothness: 1.0,
+    };
+    let (sigmas, path) = choose_with(fig4);
+    assert_eq!(sigmas, vec![Sigma::Right, Sigma::Left]);
+    let abeam = path.iter().find(|p| p.x >= 2.5).expect("passes x = 2.5");
+    assert!(
+        abeam.y < 0.3 - 0.3 && abeam.y > -1.1 + 0.3,
+        "between: y {} at x = 2.5",
+        abeam.y
+    );
+    let short = polyline_length(&path);
+    // Fig. 5: {K_B = 2, K_D = 0, K_S = 1.5}: round p1 on its left (north), longer and safer.
+    let fig5 = QualityWeights {
+        length: 0.0,
+        danger: 2.0,
+        control: 0.0,
+        smoothness: 1.5,
+    };
+    let (sigmas, path) = choose_with(fig5);
+    assert_eq!(sigmas[0], Sigma::Left);
+    let abeam = path.iter().find(|p| p.x >= 2.5).expect("passes x = 2.5");
+    assert!(abeam.y > 0.3 + 0.3, "round the north side: y {} at x = 2.5", abeam.y);
+    assert!(polyline_length(&path) > short + 0.5);
+}
+
+#[test]
+fn a_cyclic_decision_path_is_cut_by_the_cycle_check() {
+    // The last waypoint sits just outside p2's forbidden zone, behind p1: the virtual robots
+    // that go round p2 on its left orbit the waypoint, leaving and re-entering p1's zone with
+    // the same Σ. The second such entry repeats an edge: the path is dropped as cyclic long
+    // before the path's time limit (without the check it would run into it).
+    let obstacles = [ob(3.18, -1.49, 0.29, 1.03), ob(3.52, -0.78, 0.26, 1.06)];
+    let segment = Segment {
+        waypoint: wp(3.78, -0.83, 0.0),
+        last: true,
+        obstacles: &obstacles,
+    };
+    let config = OptimiseConfig::default();
+    let r = find_sigmas(&Pose2::identity(), &controller(), &segment, &config).expect("valid");
+    // 3 × 3.88 m / 0.3 m/s + 20 s = 58.8 s.
+    let limit = path_time_limit(&Pose2::identity(), &segment, &controller(), &config);
+    assert_relative_eq!(limit, 3.0 * (3.78f64.hypot(0.83)) / 0.3 + 20.0, epsilon = 1e-9);
+    let cyclic: Vec<_> = r
+        .paths
+        .iter()
+        .filter(|p| matches!(p.fate, PathFate::Cyclic { .. }))
+        .collect();
+    assert_eq!(cyclic.len(), 2, "{:#?}", r.paths);
+    for p in &cyclic {
+        let PathFate::Cyclic { edge } = &p.fate else {
+            unreachable!()
+        };
+        // Re-entering p1's zone from p1's own stop, with Σ already complete.
+        assert_eq!((edge.from, edge.to), (Some(0), 0));
+        assert!(edge.sigmas.iter().all(|s| *s != Sigma::Undecided));
+        assert!(p.time < 0.5 * limit, "cut at {} s of {limit}", p.time);
+    }
+    assert!(!r.paths.iter().any(|p| p.fate == PathFate::TimeCap));
+    assert_eq!(r.best, None);
+    assert!(r.warnings.contains(&OptimiseWarning::NoSafeSigma));
+}
+
+#[test]
+fn caps_return_the_best_so_far_with_a_warning() {
+    // Fig. 2 with at most two virtual robots: W1, then the top of the stack, σ1 = +1, which
+    // reaches the waypoint; σ1 = −1 is left pending.
+    let obstacles = fig2();
+    let segment = Segment {
+        waypoint: wp(5.0, 0.0, 0.0),
+        last: false,
+        obstacles: &obstacles,
+    };
+    let config = OptimiseConfig {
+        max_virtual_robots: 2,
+        ..OptimiseConfig::default()
+    };
+    let r = find_sigmas(&Pose2::identity(), &controller(), &segment, &config).expect("valid");
+    assert_eq!(r.robots.len(), 2);
+    assert_eq!(
+        r.warnings,
+        vec![OptimiseWarning::VirtualRobotCap { limit: 2, pending: 1 }]
+    );
+    assert_eq!(r.sigmas, vec![Sigma::Right, Sigma::Undecided, Sigma::Undecided]);
+    // A path time cap drops the path with a warning.
+    let config = OptimiseConfig {
+        max_path_time_s: 5.0,
+        ..OptimiseConfig::default()
+    };
+    let r = find_sigmas(&Pose2::identity(), &controller(), &segment, &config).expect("valid");
+    assert!(r
+        .paths
+        .iter()
+        .all(|p| p.fate == PathFate::TimeCap || matches!(p.fate, PathFate::Collided { .. })));
+    assert!(r.warnings.contains(&OptimiseWarning::PathTimeCap { path: 0 }));
+    assert!(r.warnings.contains(&OptimiseWarning::NoSafeSigma));
+}
+
+#[test]
+fn the_result_does_not_depend_on_the_number_of_threads() {
+    // Twelve obstacles scattered over the way: the whole result, every virtual robot and every
+    // path, is the same on one thread and on four.
+    let mut seed: u64 = 7;
+    let mut rnd = move || {
+        seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+        (seed >> 11) as f64 / (1u64 << 53) as f64
+    };
+    let obstacles: Vec<Obstacle> = (0..12)
+        .map(|_| {
+            let r = 0.2 + 0.15 * rnd();
+            ob(1.0 + 6.0 * rnd(), -1.5 + 3.0 * rnd(), r, r + 0.5)
+        })
+        .filter(|o| o.distance(&Point2::origin()) > o.influence_radius())
+        .collect();
+    let segment = Segment {
+        waypoint: wp(8.0, 0.0, 0.0),
+        last: true,
+        obstacles: &obstacles,
+    };
+    let run = |threads| {
+        let config = OptimiseConfig {
+            threads,
+            ..OptimiseConfig::default()
+        };
+        find_sigmas(&Pose2::identity(), &controller(), &segment, &config).expect("valid")
+    };
+    let one = run(1);
+    assert!(
+        one.robots.len() > 8,
+        "too few virtual robots to batch: {}",
+        one.robots.len()
+    );
+    assert_eq!(one, run(4));
+}
+
+#[test]
+fn algorithm_3_escapes_a_vortex_and_the_robot_still_reaches_the_end() {
+    // Waypoint 1 lies 0.5 m from p1's centre (r 0.4, R 1): at d = 0.5 V = (0.75/0.09)² ≈ 69,
+    // far above √99 ≈ 9.95, where ‖h*‖² < 0.01‖H*‖². Close to it the field whirls round p1;
+    // Algorithm 3 switches early (ϵ_1 = 2‖e*_1‖) and the robot goes on through the clutter
+    // to the last waypoint, reached within ϵ = 0.05.
+    let obstacles = vec![
+        ob(3.0, 0.5, 0.4, 1.0),
+        ob(1.5, -0.9, 0.3, 0.8),
+        ob(4.4, -0.6, 0.3, 0.8),
+        ob(4.0, 1.9, 0.35, 0.9),
+        ob(5.6, 0.9, 0.3, 0.8),
+    ];
+    let route = vec![wp(3.0, 0.0, 0.0), wp(6.5, 0.0, 0.0)];
+    let mut f =
+        VfoFollower::new(VfoGains::default(), OptimiseConfig::default(), route, obstacles.clone()).expect("valid");
+    let (poses, events, end) = drive(&mut f, Pose2::identity(), 0.01, 200.0, |_, _| {});
+    assert!(
+        events.contains(&VfoEvent::Reached { index: 0, vortex: true }),
+        "{events:#?}"
+    );
+    assert_eq!(end, Some(VfoEnd::Done));
+    let last = poses.last().expect("poses");
+    let error = (wrap(-last.yaw).powi(2) + (last.x - 6.5).powi(2) + last.y.powi(2)).sqrt();
+    assert!(error < 0.05, "final error {error}");
+    for o in &obstacles {
+        assert!(clearance(&poses, o) > o.forbidden_radius(), "{o:?}");
+    }
+}
+
+#[test]
+fn a_new_obstacle_reoptimises_the_segment_and_is_avoided() {
+    // Straight to (5, 0); at t = 2 s an obstacle appears on the way at (3, 0).
+    let mut f = VfoFollower::new(
+        VfoGains::default(),
+        OptimiseConfig::default(),
+        vec![wp(5.0, 0.0, 0.0)],
+        Vec::new(),
+    )
+    .expect("valid");
+    let blocker = ob(3.0, 0.0, 0.5, 1.0);
+    let (poses, events, end) = drive(&mut f, Pose2::identity(), 0.01, 120.0, |t, f| {
+        if (t - 2.0).abs() < 0.005 {
+            f.add_obstacle(blocker);
+        }
+    });
+    assert_eq!(end, Some(VfoEnd::Done));
+    let reasons: Vec<_> = events
+        .iter()
+        .filter_map(|e| match e {
+            VfoEvent::Optimised { reason, .. } => Some(*reason),
+            _ => None,
+        })
+        .collect();
+    use mobil_planner::vfo::Reoptimised::{NewObstacle, SegmentStart};
+    assert_eq!(reasons, vec![SegmentStart, NewObstacle]);
+    assert!(clearance(&poses, &blocker) > 0.5);
+    let last = f.last_optimisation().expect("optimised");
+    assert_eq!(last.candidates(), 2);
+    assert_ne!(f.sigmas()[0], Sigma::Undecided);
+}
+
+#[test]
+fn bad_input_is_refused() {
+    assert!(VfoWaypoint::new(1.0, 0.0, 0.0, 1.0).is_err());
+    assert!(VfoWaypoint::new(f64::NAN, 0.0, 0.0, 0.5).is_err());
+    assert!(Obstacle::new(Point2::new(0.0, 0.0), 0.5, 0.5).is_err());
+    assert!(Obstacle::new(Point2::new(0.0, f64::INFINITY), 0.5, 1.0).is_err());
+    assert!(VfoController::new(VfoGains {
+        k_a: 0.0,
+        ..VfoGains::default()
+    })
+    .is_err());
+    assert!(matches!(
+        VfoFollower::new(VfoGains::default(), OptimiseConfig::default(), Vec::new(), Vec::new()),
+        Err(PlannerError::EmptyRoute)
+    ));
+    let mut f = VfoFollower::new(
+        VfoGains::default(),
+        OptimiseConfig::default(),
+        vec![wp(1.0, 0.0, 0.0)],
+        Vec::new(),
+    )
+    .expect("valid");
+    assert!(f.update(&Pose2::new(f64::NAN, 0.0, 0.0), 0.0).is_err());
+    assert!(f.update(&Pose2::identity(), 1.0).is_ok());
+    assert!(f.update(&Pose2::identity(), 0.5).is_err(), "time went backwards");
+    // Inside a forbidden zone: zero command and the route ends.
+    let mut f = VfoFollower::new(
+        VfoGains::default(),
+        OptimiseConfig::default(),
+        vec![wp(3.0, 0.0, 0.0)],
+        vec![ob(0.2, 0.0, 0.5, 1.0)],
+    )
+    .expect("valid");
+    let out = f.update(&Pose2::identity(), 0.0).expect("valid");
+    assert_eq!((out.v, out.omega), (0.0, 0.0));
+    assert!(matches!(
+        out.end,
+        Some(VfoEnd::NoSafePath { index: 0 }) | Some(VfoEnd::Collision { obstacle: 0 })
+    ));
+}
+
+#[test]
+fn entering_a_zone_the_optimisation_did_not_foresee_reoptimises() {
+    // The straight way to (5, 0) meets no zone (p at (2.5, 2), R = 1), so its σ stays
+    // undecided. Pushed sideways to (2.5, 1.2) — 0.8 m from p, inside R, outside r — the robot
+    // is in a zone with no decision: the follower re-optimises from there and decides it.
+    let obstacles = vec![ob(2.5, 2.0, 0.5, 1.0)];
+    let mut f = VfoFollower::new(
+        VfoGains::default(),
+        OptimiseConfig::default(),
+        vec![wp(5.0, 0.0, 0.0)],
+        obstacles,
+    )
+    .expect("valid");
+    let first = f.update(&Pose2::identity(), 0.0).expect("valid");
+    assert_eq!(f.sigmas(), &[Sigma::Undecided]);
+    assert_eq!(first.events.len(), 1);
+    let pushed = f.update(&Pose2::new(2.5, 1.2, 0.0), 0.01).expect("valid");
+    assert!(
+        pushed.events.iter().any(|e| matches!(
+            e,
+            VfoEvent::Optimised {
+                reason: mobil_planner::vfo::Reoptimised::UndecidedZone,
+                ..
+            }
+        )),
+        "{:?}",
+        pushed.events
+    );
+    assert_ne!(f.sigmas()[0], Sigma::Undecided);
+    assert!(pushed.end.is_none() && pushed.v != 0.0);
+}
