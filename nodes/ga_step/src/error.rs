@@ -1,0 +1,39 @@
+//! Errors of the genetic-algorithm library: each names what was refused and why.
+
+use thiserror::Error;
+
+/// A refused configuration, individual, input file or run state.
+#[derive(Debug, Clone, PartialEq, Error)]
+pub enum GaError {
+    /// A configuration value out of its range.
+    #[error("invalid {name} = {value}: {reason}")]
+    InvalidConfig {
+        /// The parameter's name.
+        name: &'static str,
+        /// Its value.
+        value: f64,
+        /// What it must be.
+        reason: &'static str,
+    },
+    /// A standing-pose angle outside its servo's limits.
+    #[error("standing pose of {servo} = {value} rad is outside the servo's limits [{min}, {max}]")]
+    StandingPoseOutOfLimits {
+        /// The servo's name.
+        servo: &'static str,
+        /// The angle (rad).
+        value: f64,
+        /// Lower limit (rad).
+        min: f64,
+        /// Upper limit (rad).
+        max: f64,
+    },
+    /// An individual with a knot outside the limits, not finite, or ends off the standing pose.
+    #[error("invalid individual: {0}")]
+    InvalidIndividual(String),
+    /// An unknown crossover name.
+    #[error("unknown crossover `{0}` (expected blx, arithmetic, one-point, geometric or linear)")]
+    UnknownCrossover(String),
+    /// A run state that does not fit the configuration it is continued with.
+    #[error("run state does not fit: {0}")]
+    StateMismatch(String),
+}
