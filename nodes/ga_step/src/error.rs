@@ -37,3 +37,30 @@ pub enum GaError {
     #[error("run state does not fit: {0}")]
     StateMismatch(String),
 }
+
+/// Why a checkpoint could not be written or read.
+#[derive(Debug, Error)]
+pub enum CheckpointError {
+    /// The file system refused (the path names the file).
+    #[error("{path}: {source}")]
+    Io {
+        /// The file.
+        path: String,
+        /// The operating system's error.
+        source: std::io::Error,
+    },
+    /// The file is not a checkpoint of this program (not JSON, or no or another format tag).
+    #[error("not a ga_step checkpoint ({0})")]
+    Foreign(String),
+    /// A checkpoint of another format version.
+    #[error("checkpoint format version {found}, this program reads version {expected}")]
+    UnsupportedVersion {
+        /// The file's version.
+        found: u64,
+        /// The version this library reads.
+        expected: u64,
+    },
+    /// A checkpoint whose content is damaged or inconsistent.
+    #[error("corrupt checkpoint: {0}")]
+    Corrupt(String),
+}

@@ -1,9 +1,9 @@
 //! A humanoid's forward step evolved by a genetic algorithm (SPEC §8; Chikishev and Sizikov,
 //! source 003): a Nao's ten leg servos as piecewise-linear functions of time, five crossovers,
 //! the source's mutation, roulette selection, best-N replacement, stop rules, parallel and
-//! reproducible evaluation. ROS-free: no ROS types, no clock (`tests/check_ros_free.sh` proves
-//! it); the fitness comes from an [`Evaluator`] (a physics simulation, an external simulator)
-//! supplied by the caller.
+//! reproducible evaluation, and checkpoints. ROS-free: no ROS types, no clock
+//! (`tests/check_ros_free.sh` proves it); the fitness comes from an [`Evaluator`] (a physics
+//! simulation, an external simulator) supplied by the caller.
 //!
 //! - [`model`]: the servos in the SPEC's order with Table 1's limits and Webots' joint names,
 //!   [`NaoModel`] (standing pose, step time T), [`Individual`] (10 × 21 knots) and its angles at
@@ -14,6 +14,7 @@
 //! - [`evaluate`]: [`Evaluation`], [`Evaluator`], [`evaluate_all`] over the cores, and
 //!   [`TestLandscape`], an analytic **test** evaluator (not physics) for tests and benchmarks.
 //! - [`ga`]: [`GaState`], the generation loop, statistics, stop rules.
+//! - [`checkpoint`]: the state as tagged, versioned JSON, written atomically.
 //! - [`config`]: [`GaConfig`], [`FitnessConfig`], every default justified; `params/nao_step.yaml`
 //!   holds the same values.
 //!
@@ -49,8 +50,8 @@
 //!   has G + 1 rows of history.
 //! - **Reproducibility**: one ChaCha8 generator per run seeded by `seed_from_u64`, drawn only by
 //!   the main thread in the order [`ga`] documents; evaluations run on scoped threads and are
-//!   stored by index. Same seed → same run with 1 or N threads; [`GaState::from_parts`] restores
-//!   the generator at its stream position, so a resumed run continues the same stream.
+//!   stored by index. Same seed → same run with 1 or N threads; a checkpoint stores the
+//!   generator's stream position, so a resumed run continues the same stream.
 //! - **Parallelism**: `std::thread::scope` with an atomic work counter, not rayon (see
 //!   [`evaluate`]).
 //!
@@ -70,6 +71,7 @@
 
 #![warn(missing_docs)]
 
+pub mod checkpoint;
 pub mod config;
 pub mod error;
 pub mod evaluate;
@@ -78,8 +80,9 @@ pub mod model;
 pub mod operators;
 pub mod selection;
 
+pub use checkpoint::{read_checkpoint, write_checkpoint, CHECKPOINT_FORMAT, CHECKPOINT_VERSION};
 pub use config::{BlxVariant, Crossover, FitnessConfig, GaConfig};
-pub use error::GaError;
+pub use error::{CheckpointError, GaError};
 pub use evaluate::{evaluate_all, resolve_threads, Evaluation, Evaluator, TestLandscape};
 pub use ga::{GaRng, GaSetup, GaState, GenerationStats, StopReason};
 pub use model::{joint_names, Individual, NaoModel, Servo, INTERVALS, KNOTS, SERVO_COUNT};
