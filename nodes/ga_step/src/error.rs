@@ -64,3 +64,22 @@ pub enum CheckpointError {
     #[error("corrupt checkpoint: {0}")]
     Corrupt(String),
 }
+
+/// Why a motion file could not be read.
+#[derive(Debug, Clone, PartialEq, Error)]
+pub enum MotionError {
+    /// Reading failed.
+    #[error("read failed: {0}")]
+    Io(String),
+    /// The first line is not `#WEBOTS_MOTION,V1.0,` followed by joint names.
+    #[error("line 1: not a Webots motion header (expected `#WEBOTS_MOTION,V1.0,<joint>,…`)")]
+    BadHeader,
+    /// A row that does not parse.
+    #[error("line {line}: {reason}")]
+    BadRow {
+        /// Line number (from 1).
+        line: usize,
+        /// What is wrong.
+        reason: String,
+    },
+}

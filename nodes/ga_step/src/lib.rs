@@ -1,9 +1,9 @@
 //! A humanoid's forward step evolved by a genetic algorithm (SPEC §8; Chikishev and Sizikov,
 //! source 003): a Nao's ten leg servos as piecewise-linear functions of time, five crossovers,
 //! the source's mutation, roulette selection, best-N replacement, stop rules, parallel and
-//! reproducible evaluation, and checkpoints. ROS-free: no ROS types, no clock
-//! (`tests/check_ros_free.sh` proves it); the fitness comes from an [`Evaluator`] (a physics
-//! simulation, an external simulator) supplied by the caller.
+//! reproducible evaluation, checkpoints, and the result as a Webots motion file. ROS-free: no
+//! ROS types, no clock (`tests/check_ros_free.sh` proves it); the fitness comes from an
+//! [`Evaluator`] (a physics simulation, an external simulator) supplied by the caller.
 //!
 //! - [`model`]: the servos in the SPEC's order with Table 1's limits and Webots' joint names,
 //!   [`NaoModel`] (standing pose, step time T), [`Individual`] (10 × 21 knots) and its angles at
@@ -15,6 +15,7 @@
 //!   [`TestLandscape`], an analytic **test** evaluator (not physics) for tests and benchmarks.
 //! - [`ga`]: [`GaState`], the generation loop, statistics, stop rules.
 //! - [`checkpoint`]: the state as tagged, versioned JSON, written atomically.
+//! - [`output`]: `fitness.csv`, Webots motion files (writer and reader), JointTrajectory YAML.
 //! - [`config`]: [`GaConfig`], [`FitnessConfig`], every default justified; `params/nao_step.yaml`
 //!   holds the same values.
 //!
@@ -54,6 +55,9 @@
 //!   generator's stream position, so a resumed run continues the same stream.
 //! - **Parallelism**: `std::thread::scope` with an atomic work counter, not rayon (see
 //!   [`evaluate`]).
+//! - **Motion files** list only the ten evolved joints (Webots leaves the others where they are)
+//!   and write `-0.0000` as `0.0000`. The JointTrajectory YAML gives the 21 knots, exact for a
+//!   linearly interpolating follower.
 //!
 //! ```
 //! use mobil_ga_step::{GaSetup, GaState, StopReason, TestLandscape};
@@ -78,11 +82,12 @@ pub mod evaluate;
 pub mod ga;
 pub mod model;
 pub mod operators;
+pub mod output;
 pub mod selection;
 
 pub use checkpoint::{read_checkpoint, write_checkpoint, CHECKPOINT_FORMAT, CHECKPOINT_VERSION};
 pub use config::{BlxVariant, Crossover, FitnessConfig, GaConfig};
-pub use error::{CheckpointError, GaError};
+pub use error::{CheckpointError, GaError, MotionError};
 pub use evaluate::{evaluate_all, resolve_threads, Evaluation, Evaluator, TestLandscape};
 pub use ga::{GaRng, GaSetup, GaState, GenerationStats, StopReason};
 pub use model::{joint_names, Individual, NaoModel, Servo, INTERVALS, KNOTS, SERVO_COUNT};
@@ -90,4 +95,5 @@ pub use operators::{
     arithmetic, best_two_of_three, blx, blx_value, geometric, linear_candidates, mutate, one_point, one_point_at,
     MutationPick,
 };
+pub use output::{read_motion, write_fitness_csv, write_joint_trajectory_yaml, write_motion, Motion, MotionRow};
 pub use selection::{choose_operator, replace_best, roulette, roulette_excluding, Operator, Scored};
