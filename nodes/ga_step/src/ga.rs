@@ -17,6 +17,7 @@ use crate::selection::{choose_operator, replace_best, roulette, roulette_excludi
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use serde::{Deserialize, Serialize};
+use std::ops::ControlFlow;
 
 /// The generator of a run.
 pub type GaRng = ChaCha8Rng;
@@ -72,6 +73,8 @@ pub enum StopReason {
     Levelled,
     /// The requested number of generations is done.
     MaxGenerations,
+    /// The caller asked to stop (see [`GaState::run`]); the run can be resumed.
+    Interrupted,
 }
 
 /// A run between generations: what a checkpoint holds.
@@ -341,21 +344,25 @@ impl GaState {
     }
 
     /// Runs generations until a stop rule holds, calling `after` after each one (to write a
-    /// checkpoint, a progress line); returns why it stopped. A state that already meets a rule
-    /// returns at once, so a resumed run ends where the uninterrupted one does.
+    /// checkpoint, a progress line); returns why it stopped. `after` returning
+    /// `ControlFlow::Break` stops the run between generations ([`StopReason::Interrupted`]: an
+    /// interrupt loses no finished generation). A state that already meets a rule returns at
+    /// once, so a resumed run ends where the uninterrupted one does.
     pub fn run<E: Evaluator + ?Sized>(
         &mut self,
         evaluator: &E,
         threads: usize,
         max_generations: u32,
-        mut after: impl FnMut(&GaState),
+        mut after: impl FnMut(&GaState) -> ControlFlow<()>,
     ) -> StopReason {
         loop {
             if let Some(r) = self.stop_reason(max_generations) {
                 return r;
             }
             self.next_generation(evaluator, threads);
-            after(self);
+            if after(self).is_break() {
+                return StopReason::Interrupted;
+            }
         }
     }
 }

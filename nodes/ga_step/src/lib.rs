@@ -47,8 +47,8 @@
 //! - **Stop rules**, tested after every generation in this order: the best individual makes a
 //!   forward step (`stop_at_step`, default on); the mean fitness rose by less than 0.1 % over
 //!   the last 20 generations (under best-N replacement it cannot fall); the requested number of
-//!   generations. Generation 0 is the evaluated initial population, so a run to G generations
-//!   has G + 1 rows of history.
+//!   generations; and the caller's interrupt, between generations. Generation 0 is the evaluated
+//!   initial population, so a run to G generations has G + 1 rows of history.
 //! - **Reproducibility**: one ChaCha8 generator per run seeded by `seed_from_u64`, drawn only by
 //!   the main thread in the order [`ga`] documents; evaluations run on scoped threads and are
 //!   stored by index. Same seed → same run with 1 or N threads; a checkpoint stores the
@@ -61,13 +61,14 @@
 //!
 //! ```
 //! use mobil_ga_step::{GaSetup, GaState, StopReason, TestLandscape};
+//! use std::ops::ControlFlow;
 //!
 //! let setup = GaSetup::default();
 //! // The analytic test landscape, not a physics simulation.
 //! let evaluator = TestLandscape::new(setup.model.clone(), setup.fitness.clone());
 //! let mut state = GaState::start(setup, 7, &evaluator, 1).unwrap();
 //! let first_best = state.best().fitness();
-//! let reason = state.run(&evaluator, 1, 5, |_| {});
+//! let reason = state.run(&evaluator, 1, 5, |_| ControlFlow::Continue(()));
 //! assert_eq!((reason, state.generation, state.history.len()), (StopReason::MaxGenerations, 5, 6));
 //! // Best-N replacement never loses the best individual.
 //! assert!(state.best().fitness() >= first_best);

@@ -64,14 +64,19 @@ fn spin<R: Rng + ?Sized>(n: usize, w: impl Fn(usize) -> f64, skip: Option<usize>
 
 /// Roulette selection: index i with probability f_i / Σf (fitness must be ≥ 0; a negative or
 /// non-finite value counts as 0). When every fitness is 0 the choice is uniform. One draw.
-/// `fitness` must not be empty.
+///
+/// # Panics
+/// If `fitness` is empty (there is nothing to choose; a population has at least 2).
 pub fn roulette<R: Rng + ?Sized>(fitness: &[f64], rng: &mut R) -> usize {
     spin(fitness.len(), |i| fitness[i], None, rng)
 }
 
 /// Roulette selection among all indices but `exclude` (the second parent of a crossover, so the
 /// two parents differ): probability f_i / Σ_{j≠exclude} f_j, uniform over the others when they
-/// all have fitness 0. One draw. `fitness` needs at least two entries.
+/// all have fitness 0. One draw.
+///
+/// # Panics
+/// If `fitness` has fewer than two entries (there is no other parent).
 pub fn roulette_excluding<R: Rng + ?Sized>(fitness: &[f64], exclude: usize, rng: &mut R) -> usize {
     spin(fitness.len(), |i| fitness[i], Some(exclude), rng)
 }

@@ -4,8 +4,9 @@
 use mobil_ga_step::checkpoint::{from_json, temp_path, to_json};
 use mobil_ga_step::{
     read_checkpoint, write_checkpoint, CheckpointError, Crossover, FitnessConfig, GaConfig, GaSetup, GaState, NaoModel,
-    TestLandscape,
+    StopReason, TestLandscape,
 };
+use std::ops::ControlFlow;
 use std::path::PathBuf;
 
 fn dir(name: &str) -> PathBuf {
@@ -44,6 +45,7 @@ fn resume_equals_uninterrupted() {
         full.run(&e, 1, 12, |s| {
             write_checkpoint(s, &path).unwrap();
             saved.push(std::fs::read_to_string(&path).unwrap());
+            ControlFlow::Continue(())
         });
         assert_eq!(full.generation, 12);
         assert_eq!(saved.len(), 13);
@@ -52,11 +54,40 @@ fn resume_equals_uninterrupted() {
         for (g, text) in saved.iter().enumerate() {
             let mut resumed = from_json(text).unwrap();
             assert_eq!(resumed.generation as usize, g);
-            resumed.run(&e, 3, 12, |_| {});
+            resumed.run(&e, 3, 12, |_| ControlFlow::Continue(()));
             assert_eq!(resumed, full, "{c}, resumed from generation {g}");
             assert_eq!(resumed.rng_word_pos(), full.rng_word_pos());
         }
     }
+    std::fs::remove_dir_all(&d).unwrap();
+}
+
+/// An interrupt (the callback breaks after generation 4) stops the run there, with its
+/// checkpoint written; resuming from that file finishes as the uninterrupted run does.
+#[test]
+fn an_interrupted_run_resumes_to_the_same_end() {
+    let d = dir("interrupt");
+    let e = landscape();
+    let path = d.join("checkpoint.json");
+    let mut full = GaState::start(setup(Crossover::Arithmetic), 4, &e, 2).unwrap();
+    full.run(&e, 2, 10, |_| ControlFlow::Continue(()));
+    let mut cut = GaState::start(setup(Crossover::Arithmetic), 4, &e, 2).unwrap();
+    let reason = cut.run(&e, 2, 10, |s| {
+        write_checkpoint(s, &path).unwrap();
+        if s.generation == 4 {
+            ControlFlow::Break(())
+        } else {
+            ControlFlow::Continue(())
+        }
+    });
+    assert_eq!((reason, cut.generation), (StopReason::Interrupted, 4));
+    let mut resumed = read_checkpoint(&path).unwrap();
+    assert_eq!(resumed, cut);
+    assert_eq!(
+        resumed.run(&e, 1, 10, |_| ControlFlow::Continue(())),
+        StopReason::MaxGenerations
+    );
+    assert_eq!(resumed, full);
     std::fs::remove_dir_all(&d).unwrap();
 }
 
@@ -66,7 +97,7 @@ fn resume_equals_uninterrupted() {
 fn a_checkpoint_round_trips_exactly() {
     let e = landscape();
     let mut s = GaState::start(setup(Crossover::Geometric), 5, &e, 2).unwrap();
-    s.run(&e, 2, 3, |_| {});
+    s.run(&e, 2, 3, |_| ControlFlow::Continue(()));
     let back = from_json(&to_json(&s)).unwrap();
     for (a, b) in s.population.iter().zip(&back.population) {
         for (x, y) in a
@@ -115,7 +146,7 @@ fn the_write_is_atomic_and_failures_are_typed() {
 fn foreign_and_corrupt_files_are_refused() {
     let e = landscape();
     let mut s = GaState::start(setup(Crossover::Blx), 1, &e, 1).unwrap();
-    s.run(&e, 1, 2, |_| {});
+    s.run(&e, 1, 2, |_| ControlFlow::Continue(()));
     let good = to_json(&s);
 
     for text in [

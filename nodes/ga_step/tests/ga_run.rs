@@ -5,6 +5,7 @@ use mobil_ga_step::{
     Crossover, Evaluation, Evaluator, FitnessConfig, GaConfig, GaSetup, GaState, Individual, NaoModel, StopReason,
     TestLandscape,
 };
+use std::ops::ControlFlow;
 use std::sync::Mutex;
 
 fn setup(crossover: Crossover) -> GaSetup {
@@ -25,7 +26,7 @@ fn landscape() -> TestLandscape {
 fn run(setup: GaSetup, seed: u64, threads: usize, generations: u32) -> GaState {
     let e = landscape();
     let mut s = GaState::start(setup, seed, &e, threads).unwrap();
-    s.run(&e, threads, generations, |_| {});
+    s.run(&e, threads, generations, |_| ControlFlow::Continue(()));
     s
 }
 
@@ -75,7 +76,7 @@ fn blx_reaches_a_forward_step_and_stops() {
     let mut s = GaState::start(setup, 1, &e, 2).unwrap();
     let d0 = e.distance(&s.best().individual);
     assert!(d0 > 0.25, "{d0}");
-    let reason = s.run(&e, 2, 200, |_| {});
+    let reason = s.run(&e, 2, 200, |_| ControlFlow::Continue(()));
     assert_eq!(reason, StopReason::ForwardStep);
     let g = s.generation;
     assert_eq!(s.first_step_generation, Some(g));
@@ -107,7 +108,10 @@ fn a_flat_landscape_levels_off_after_the_window() {
         }
     }
     let mut s = GaState::start(setup(Crossover::Arithmetic), 3, &Flat, 1).unwrap();
-    assert_eq!(s.run(&Flat, 1, 100, |_| {}), StopReason::Levelled);
+    assert_eq!(
+        s.run(&Flat, 1, 100, |_| ControlFlow::Continue(())),
+        StopReason::Levelled
+    );
     assert_eq!(s.generation, 20);
 }
 
@@ -194,7 +198,7 @@ fn bad_fitness_counts_as_zero() {
     let h0 = &s.history[0];
     assert!(h0.invalid_fitness > 10 && h0.invalid_fitness < 70, "{h0:?}");
     assert_eq!(h0.min, 0.0);
-    s.run(&e, 2, 3, |_| {});
+    s.run(&e, 2, 3, |_| ControlFlow::Continue(()));
     assert!(s
         .population
         .iter()
