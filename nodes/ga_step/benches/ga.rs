@@ -1,11 +1,12 @@
 //! Operators per second, and one generation of 100 (offspring, evaluation, replacement) with the
 //! analytic test landscape as evaluator — the GA's own cost, not a physics simulation's — on one
-//! thread and on every core.
+//! thread and on every core; and a batch of 100 costlier evaluations on one thread and on
+//! every core, for the parallel speed-up.
 
 use criterion::{criterion_group, criterion_main, BatchSize, Criterion};
 use mobil_ga_step::{
     arithmetic, blx, evaluate_all, geometric, linear_candidates, mutate, one_point, resolve_threads, roulette,
-    BlxVariant, Crossover, GaConfig, GaSetup, GaState, Individual, TestLandscape,
+    BlxVariant, Crossover, Evaluation, Evaluator, GaConfig, GaSetup, GaState, Individual, TestLandscape,
 };
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
@@ -79,6 +80,31 @@ fn generation(c: &mut Criterion) {
     g.bench_function("evaluation only, 100 individuals, 1 thread", |b| {
         b.iter(|| black_box(evaluate_all(&e, &batch, 1)))
     });
+    g.finish();
+
+    // The parallel evaluation's speed-up once an evaluation costs more than a thread's start:
+    // the landscape evaluated 200 times per individual (about 50 µs, still far below a
+    // simulated step).
+    struct Costly(TestLandscape);
+    impl Evaluator for Costly {
+        fn evaluate(&self, i: &Individual) -> Evaluation {
+            let mut last = self.0.evaluate(i);
+            for _ in 1..200 {
+                last = self.0.evaluate(black_box(i));
+            }
+            last
+        }
+    }
+    let costly = Costly(e);
+    let mut g = c.benchmark_group("evaluation of 100, test landscape × 200 per individual");
+    for threads in [1, cores] {
+        g.bench_function(format!("{threads} thread(s)"), |b| {
+            b.iter(|| black_box(evaluate_all(&costly, &batch, threads)))
+        });
+        if cores == 1 {
+            break;
+        }
+    }
     g.finish();
 }
 
