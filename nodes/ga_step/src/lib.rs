@@ -55,6 +55,9 @@
 //!   generator's stream position, so a resumed run continues the same stream.
 //! - **Parallelism**: `std::thread::scope` with an atomic work counter, not rayon (see
 //!   [`evaluate`]).
+//! - **Checkpoint**: one JSON document (readable, and with serde_json's exact float parsing
+//!   every f64 comes back to the same bits), tagged `mobil_ga_step checkpoint`, version 1,
+//!   written to `<file>.tmp`, synced and renamed. See [`checkpoint`].
 //! - **Motion files** list only the ten evolved joints (Webots leaves the others where they are)
 //!   and write `-0.0000` as `0.0000`. The JointTrajectory YAML gives the 21 knots, exact for a
 //!   linearly interpolating follower.

@@ -122,7 +122,7 @@ pub struct NaoModel {
     /// hip and ankle pitch −0.4 rad each, rolls 0. Hip + knee + ankle pitch = 0, so the torso is
     /// parallel to the flat feet (upright); bent knees leave the servos room both ways (a
     /// straight knee sits on its 0 limit and can only bend), as Nao's own stance does; the legs
-    /// stay 0.925 of their straight length (cos 0.4).
+    /// stay 0.92 of their straight length (cos 0.4 = 0.921).
     pub standing_pose: [f64; SERVO_COUNT],
 }
 
