@@ -1,0 +1,202 @@
+//! The run's files, as pure functions over writers and readers: `fitness.csv`, Webots motion
+//! files (writer and reader) and the best individual as a `trajectory_msgs/JointTrajectory`
+//! in YAML.
+
+use crate::error::MotionError;
+use crate::ga::GenerationStats;
+use crate::model::{joint_names, Individual, NaoModel, INTERVALS, KNOTS, SAMPLE_PERIOD_MS};
+use std::io::{self, BufRead, Write};
+
+/// The header line of `fitness.csv`.
+pub const FITNESS_CSV_HEADER: &str = "generation,max,mean,min";
+
+/// One row of `fitness.csv` (no newline): the generation, then max, mean and min fitness in
+/// their shortest round-trip decimal form.
+pub fn fitness_csv_row(stats: &GenerationStats) -> String {
+    format!("{},{},{},{}", stats.generation, stats.max, stats.mean, stats.min)
+}
+
+/// `fitness.csv`: the header and one row per generation.
+pub fn write_fitness_csv<W: Write>(mut w: W, history: &[GenerationStats]) -> io::Result<()> {
+    writeln!(w, "{FITNESS_CSV_HEADER}")?;
+    for h in history {
+        writeln!(w, "{}", fitness_csv_row(h))?;
+    }
+    Ok(())
+}
+
+/// The first field of a motion file's header.
+pub const MOTION_TAG: &str = "#WEBOTS_MOTION";
+/// The motion format's version field.
+pub const MOTION_VERSION: &str = "V1.0";
+
+/// A row's time as Webots writes it, `MM:SS:mmm` (minutes, seconds, milliseconds).
+pub fn motion_time(ms: u64) -> String {
+    format!("{:02}:{:02}:{:03}", ms / 60_000, (ms / 1000) % 60, ms % 1000)
+}
+
+/// An angle with 4 decimals; a value that rounds to zero is written `0.0000`, never `-0.0000`.
+fn angle(v: f64) -> String {
+    let s = format!("{v:.4}");
+    if s == "-0.0000" {
+        "0.0000".to_owned()
+    } else {
+        s
+    }
+}
+
+/// A Webots motion file of the individual (SPEC §8): the header `#WEBOTS_MOTION,V1.0,` followed
+/// by the ten joint names (Webots' names, genome order), then a row every 40 ms from 0 to T
+/// inclusive: `MM:SS:mmm,Pose<k>,` (k from 1) and the ten angles in rad with 4 decimals, all
+/// separated by commas without spaces (the standard form; the source's writer adds spaces and an
+/// empty field after the version). Only the ten evolved joints are listed: Webots leaves the
+/// others (hip yaw-pitch, arms, head) where they are, at the standing pose.
+pub fn write_motion<W: Write>(mut w: W, model: &NaoModel, individual: &Individual) -> io::Result<()> {
+    writeln!(w, "{MOTION_TAG},{MOTION_VERSION},{}", joint_names().join(","))?;
+    for (k, (ms, angles)) in individual.sample(model).into_iter().enumerate() {
+        let values: Vec<String> = angles.iter().map(|&v| angle(v)).collect();
+        writeln!(w, "{},Pose{},{}", motion_time(ms), k + 1, values.join(","))?;
+    }
+    Ok(())
+}
+
+/// One row of a motion file.
+#[derive(Debug, Clone, PartialEq)]
+pub struct MotionRow {
+    /// Time from the start (ms).
+    pub time_ms: u64,
+    /// The pose's label, as written (`Pose1`, …).
+    pub label: String,
+    /// One angle (rad) per joint, in the header's order.
+    pub values: Vec<f64>,
+}
+
+/// A motion file's content.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Motion {
+    /// The joints' names, in column order.
+    pub joint_names: Vec<String>,
+    /// The rows, times strictly increasing.
+    pub rows: Vec<MotionRow>,
+}
+
+fn parse_time(s: &str) -> Option<u64> {
+    let mut parts = s.split(':');
+    let (m, sec, ms) = (parts.next()?, parts.next()?, parts.next()?);
+    if parts.next().is_some() || sec.len() != 2 || ms.len() != 3 || m.len() < 2 {
+        return None;
+    }
+    let digits = |t: &str| {
+        t.bytes()
+            .all(|b| b.is_ascii_digit())
+            .then(|| t.parse::<u64>().ok())
+            .flatten()
+    };
+    let (m, sec, ms) = (digits(m)?, digits(sec)?, digits(ms)?);
+    (sec < 60).then(|| m.checked_mul(60_000)?.checked_add(sec * 1000 + ms))?
+}
+
+/// Reads a Webots motion file: the header `#WEBOTS_MOTION,V1.0,` and at least one joint name
+/// (fields are trimmed and empty header fields skipped, so the source's spaced form reads too),
+/// then rows of a `MM:SS:mmm` time, a label and one finite value per joint, times strictly
+/// increasing. Blank lines are skipped.
+pub fn read_motion<R: BufRead>(r: R) -> Result<Motion, MotionError> {
+    let mut lines = r.lines().enumerate();
+    let header = match lines.next() {
+        Some((_, Ok(l))) => l,
+        Some((_, Err(e))) => return Err(MotionError::Io(e.to_string())),
+        None => return Err(MotionError::BadHeader),
+    };
+    let mut fields = header.split(',').map(str::trim);
+    if fields.next() != Some(MOTION_TAG) || fields.next() != Some(MOTION_VERSION) {
+        return Err(MotionError::BadHeader);
+    }
+    let joint_names: Vec<String> = fields.filter(|f| !f.is_empty()).map(str::to_owned).collect();
+    if joint_names.is_empty() {
+        return Err(MotionError::BadHeader);
+    }
+    let mut rows: Vec<MotionRow> = Vec::new();
+    for (i, line) in lines {
+        let line = line.map_err(|e| MotionError::Io(e.to_string()))?;
+        if line.trim().is_empty() {
+            continue;
+        }
+        let bad = |reason: String| MotionError::BadRow { line: i + 1, reason };
+        let fields: Vec<&str> = line.split(',').map(str::trim).collect();
+        if fields.len() != joint_names.len() + 2 {
+            return Err(bad(format!(
+                "{} fields, expected a time, a label and {} values",
+                fields.len(),
+                joint_names.len()
+            )));
+        }
+        let time_ms = parse_time(fields[0]).ok_or_else(|| bad(format!("time `{}` is not MM:SS:mmm", fields[0])))?;
+        if let Some(prev) = rows.last()
+            && time_ms <= prev.time_ms
+        {
+            return Err(bad(format!(
+                "time {} is not after {}",
+                fields[0],
+                motion_time(prev.time_ms)
+            )));
+        }
+        if fields[1].is_empty() {
+            return Err(bad("empty pose label".into()));
+        }
+        let values = fields[2..]
+            .iter()
+            .map(|f| f.parse::<f64>().ok().filter(|v| v.is_finite()))
+            .collect::<Option<Vec<f64>>>()
+            .ok_or_else(|| bad("a joint value is not a finite number".into()))?;
+        rows.push(MotionRow {
+            time_ms,
+            label: fields[1].to_owned(),
+            values,
+        });
+    }
+    Ok(Motion { joint_names, rows })
+}
+
+/// A float as YAML 1.1 (PyYAML, which `ros2 topic pub` uses) reads it back as a float: the
+/// shortest round-trip decimal, never in exponent form, always with a point.
+fn yaml_float(v: f64) -> String {
+    let s = format!("{v}");
+    if s.contains('.') {
+        s
+    } else {
+        s + ".0"
+    }
+}
+
+/// The individual as a `trajectory_msgs/JointTrajectory` in YAML (the form `ros2 topic pub`
+/// takes): `joint_names` (genome order) and one point per knot (21, at i·T/20) with
+/// `positions` (rad, shortest round-trip decimals, never in exponent form) and `time_from_start` as `{sec, nanosec}`.
+/// The knots describe the piecewise-linear trajectory exactly for a follower that interpolates
+/// linearly between positions-only points, as ros2_controllers' joint trajectory controller
+/// does. The header is left empty (stamp 0: start on receipt).
+pub fn write_joint_trajectory_yaml<W: Write>(mut w: W, model: &NaoModel, individual: &Individual) -> io::Result<()> {
+    writeln!(w, "header:")?;
+    writeln!(w, "  stamp: {{sec: 0, nanosec: 0}}")?;
+    writeln!(w, "  frame_id: ''")?;
+    writeln!(w, "joint_names: [{}]", joint_names().join(", "))?;
+    writeln!(w, "points:")?;
+    // Knot i at i·T/20: in ns, i·T_ms·1e6/20 = i·T_ms·50 000 (exact in integers).
+    let step_ns = model.step_time_ms() * 1_000_000 / INTERVALS as u64;
+    for k in 0..KNOTS {
+        let ns = k as u64 * step_ns;
+        let positions: Vec<String> = individual.knots.iter().map(|s| yaml_float(s[k])).collect();
+        writeln!(w, "  - positions: [{}]", positions.join(", "))?;
+        writeln!(
+            w,
+            "    time_from_start: {{sec: {}, nanosec: {}}}",
+            ns / 1_000_000_000,
+            ns % 1_000_000_000
+        )?;
+    }
+    Ok(())
+}
+
+/// Rows a motion file of `model`'s step has: T/40 ms + 1.
+pub fn motion_rows(model: &NaoModel) -> u64 {
+    model.step_time_ms() / SAMPLE_PERIOD_MS + 1
+}

@@ -1,0 +1,193 @@
+//! Checkpoints: a resumed run equals the uninterrupted one; the file is written atomically and a
+//! foreign, other-version or damaged file is a typed error.
+
+use mobil_ga_step::checkpoint::{from_json, temp_path, to_json};
+use mobil_ga_step::{
+    read_checkpoint, write_checkpoint, CheckpointError, Crossover, FitnessConfig, GaConfig, GaSetup, GaState, NaoModel,
+    StopReason, TestLandscape,
+};
+use std::ops::ControlFlow;
+use std::path::PathBuf;
+
+fn dir(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("mobil_ga_step_{name}_{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+fn setup(crossover: Crossover) -> GaSetup {
+    GaSetup {
+        ga: GaConfig {
+            crossover,
+            stop_at_step: false,
+            ..GaConfig::default()
+        },
+        ..GaSetup::default()
+    }
+}
+
+fn landscape() -> TestLandscape {
+    TestLandscape::new(NaoModel::default(), FitnessConfig::default())
+}
+
+/// A run to 12 generations writes a checkpoint after each; reading the one of generation 5 and
+/// resuming to 12 (on another thread count) gives exactly the uninterrupted run's state, and so
+/// does resuming from every other generation.
+#[test]
+fn resume_equals_uninterrupted() {
+    let d = dir("resume");
+    let e = landscape();
+    for c in [Crossover::Blx, Crossover::Linear] {
+        let path = d.join("checkpoint.json");
+        let mut full = GaState::start(setup(c), 99, &e, 1).unwrap();
+        let mut saved = vec![to_json(&full)];
+        full.run(&e, 1, 12, |s| {
+            write_checkpoint(s, &path).unwrap();
+            saved.push(std::fs::read_to_string(&path).unwrap());
+            ControlFlow::Continue(())
+        });
+        assert_eq!(full.generation, 12);
+        assert_eq!(saved.len(), 13);
+        // The last file on disk is the finished run.
+        assert_eq!(read_checkpoint(&path).unwrap(), full);
+        for (g, text) in saved.iter().enumerate() {
+            let mut resumed = from_json(text).unwrap();
+            assert_eq!(resumed.generation as usize, g);
+            resumed.run(&e, 3, 12, |_| ControlFlow::Continue(()));
+            assert_eq!(resumed, full, "{c}, resumed from generation {g}");
+            assert_eq!(resumed.rng_word_pos(), full.rng_word_pos());
+        }
+    }
+    std::fs::remove_dir_all(&d).unwrap();
+}
+
+/// An interrupt (the callback breaks after generation 4) stops the run there, with its
+/// checkpoint written; resuming from that file finishes as the uninterrupted run does.
+#[test]
+fn an_interrupted_run_resumes_to_the_same_end() {
+    let d = dir("interrupt");
+    let e = landscape();
+    let path = d.join("checkpoint.json");
+    let mut full = GaState::start(setup(Crossover::Arithmetic), 4, &e, 2).unwrap();
+    full.run(&e, 2, 10, |_| ControlFlow::Continue(()));
+    let mut cut = GaState::start(setup(Crossover::Arithmetic), 4, &e, 2).unwrap();
+    let reason = cut.run(&e, 2, 10, |s| {
+        write_checkpoint(s, &path).unwrap();
+        if s.generation == 4 {
+            ControlFlow::Break(())
+        } else {
+            ControlFlow::Continue(())
+        }
+    });
+    assert_eq!((reason, cut.generation), (StopReason::Interrupted, 4));
+    let mut resumed = read_checkpoint(&path).unwrap();
+    assert_eq!(resumed, cut);
+    assert_eq!(
+        resumed.run(&e, 1, 10, |_| ControlFlow::Continue(())),
+        StopReason::MaxGenerations
+    );
+    assert_eq!(resumed, full);
+    std::fs::remove_dir_all(&d).unwrap();
+}
+
+/// Every f64 of the state survives the round trip bit for bit (knots, fitness, history), and
+/// so does the generator's position.
+#[test]
+fn a_checkpoint_round_trips_exactly() {
+    let e = landscape();
+    let mut s = GaState::start(setup(Crossover::Geometric), 5, &e, 2).unwrap();
+    s.run(&e, 2, 3, |_| ControlFlow::Continue(()));
+    let back = from_json(&to_json(&s)).unwrap();
+    for (a, b) in s.population.iter().zip(&back.population) {
+        for (x, y) in a
+            .individual
+            .knots
+            .iter()
+            .flatten()
+            .zip(b.individual.knots.iter().flatten())
+        {
+            assert_eq!(x.to_bits(), y.to_bits());
+        }
+        assert_eq!(a.fitness().to_bits(), b.fitness().to_bits());
+    }
+    assert_eq!(back, s);
+    assert_eq!(back.rng_word_pos(), s.rng_word_pos());
+}
+
+/// The write goes through `<file>.tmp` and a rename: afterwards no temporary file is left, and
+/// a directory that does not exist is an I/O error with no file written.
+#[test]
+fn the_write_is_atomic_and_failures_are_typed() {
+    let d = dir("atomic");
+    let e = landscape();
+    let s = GaState::start(setup(Crossover::Blx), 1, &e, 1).unwrap();
+    let path = d.join("state.json");
+    write_checkpoint(&s, &path).unwrap();
+    assert_eq!(temp_path(&path), d.join("state.json.tmp"));
+    assert!(!temp_path(&path).exists());
+    let missing = d.join("no_such_dir").join("state.json");
+    assert!(matches!(
+        write_checkpoint(&s, &missing),
+        Err(CheckpointError::Io { .. })
+    ));
+    assert!(!missing.exists());
+    assert!(matches!(
+        read_checkpoint(&d.join("absent.json")),
+        Err(CheckpointError::Io { .. })
+    ));
+    std::fs::remove_dir_all(&d).unwrap();
+}
+
+/// Foreign files (not JSON, JSON without the tag, another tag, binary), another version, and
+/// damaged checkpoints (truncated, a knot beyond its limit, a population of the wrong size, a
+/// bad generator position) are each refused with their own error.
+#[test]
+fn foreign_and_corrupt_files_are_refused() {
+    let e = landscape();
+    let mut s = GaState::start(setup(Crossover::Blx), 1, &e, 1).unwrap();
+    s.run(&e, 1, 2, |_| ControlFlow::Continue(()));
+    let good = to_json(&s);
+
+    for text in [
+        "generation,max,mean,min\n0,1,1,1\n",
+        "{\"generation\": 3}",
+        "[1, 2]",
+        "",
+    ] {
+        assert!(matches!(from_json(text), Err(CheckpointError::Foreign(_))), "{text}");
+    }
+    let other_tag = good.replacen("mobil_ga_step checkpoint", "something else", 1);
+    assert!(matches!(from_json(&other_tag), Err(CheckpointError::Foreign(_))));
+    let v2 = good.replacen("\"version\":1", "\"version\":2", 1);
+    assert!(matches!(
+        from_json(&v2),
+        Err(CheckpointError::UnsupportedVersion { found: 2, expected: 1 })
+    ));
+
+    let truncated = &good[..good.len() / 2];
+    assert!(matches!(from_json(truncated), Err(CheckpointError::Corrupt(_))));
+
+    let mut v: serde_json::Value = serde_json::from_str(&good).unwrap();
+    v["population"][3]["individual"]["knots"][2][5] = serde_json::json!(3.0); // knee limit 2.2689
+    assert!(matches!(from_json(&v.to_string()), Err(CheckpointError::Corrupt(m)) if m.contains("RKneePitch")));
+
+    let mut v: serde_json::Value = serde_json::from_str(&good).unwrap();
+    v["population"].as_array_mut().unwrap().pop();
+    assert!(matches!(from_json(&v.to_string()), Err(CheckpointError::Corrupt(m)) if m.contains("99 individuals")));
+
+    let mut v: serde_json::Value = serde_json::from_str(&good).unwrap();
+    v["rng_word_pos"] = serde_json::json!("-5");
+    assert!(matches!(from_json(&v.to_string()), Err(CheckpointError::Corrupt(_))));
+
+    let mut v: serde_json::Value = serde_json::from_str(&good).unwrap();
+    v["history"].as_array_mut().unwrap().pop();
+    assert!(matches!(from_json(&v.to_string()), Err(CheckpointError::Corrupt(m)) if m.contains("history")));
+
+    // Binary garbage on disk.
+    let d = dir("foreign");
+    let path = d.join("bin");
+    std::fs::write(&path, [0xff, 0xfe, 0x00, 0x12]).unwrap();
+    assert!(matches!(read_checkpoint(&path), Err(CheckpointError::Foreign(_))));
+    std::fs::remove_dir_all(&d).unwrap();
+}
