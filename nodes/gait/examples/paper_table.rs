@@ -1,0 +1,74 @@
+//! Reproduces the paper's experiment (SPEC §7): start at the origin with the legs nominal, goal
+//! (−10, 10); set A from φ = π/4 and set B from φ = 3π/2; evaluations (1), (2), (3) with the
+//! paper's k; under both readings of Tab. 1's "max angle". One complete search per row.
+//!
+//!     cargo run --release -p mobil_gait --example paper_table [-- --margin M]
+
+use mobil_gait::{plan, BodyPose, Evaluation, GaitConfig, GaitState, LegAngleReading, QuadrupedModel, RuleSet};
+use nalgebra::Point2;
+use std::f64::consts::PI;
+use std::time::Instant;
+
+/// The paper's (expanded, plan length) for each row.
+const PAPER: [(RuleSet, u8, u32, u32); 6] = [
+    (RuleSet::A, 1, 284, 45),
+    (RuleSet::A, 2, 284, 45),
+    (RuleSet::A, 3, 39826, 40),
+    (RuleSet::B, 1, 18948, 211),
+    (RuleSet::B, 2, 9072, 168),
+    (RuleSet::B, 3, 36672, 100),
+];
+
+fn main() {
+    let mut cfg = GaitConfig::default();
+    let args: Vec<String> = std::env::args().collect();
+    if let Some(i) = args.iter().position(|a| a == "--margin") {
+        cfg.stability_margin = args
+            .get(i + 1)
+            .and_then(|m| m.parse().ok())
+            .unwrap_or(cfg.stability_margin);
+    }
+    println!(
+        "margin {} key {} tolerance {} limit {}",
+        cfg.stability_margin, cfg.key_quantum, cfg.goal_tolerance, cfg.max_expansions
+    );
+    println!("reading  | row   | paper exp / len | ours exp / gen / len | leg moves | time ms | result");
+    for reading in [LegAngleReading::Forward, LegAngleReading::Rearward] {
+        let cfg = GaitConfig { reading, ..cfg.clone() };
+        let model = QuadrupedModel::paper(reading);
+        for (set, e, p_exp, p_len) in PAPER {
+            let phi = match set {
+                RuleSet::A => PI / 4.0,
+                RuleSet::B => 1.5 * PI,
+            };
+            let start = GaitState::nominal(&model, BodyPose { x: 0.0, y: 0.0, phi });
+            let eval = Evaluation::try_from(e).expect("1..=3");
+            let t = Instant::now();
+            let p = plan(
+                &model,
+                &cfg,
+                &start,
+                Point2::new(-10.0, 10.0),
+                set,
+                eval,
+                0,
+                &mut || false,
+            );
+            let ms = t.elapsed().as_secs_f64() * 1e3;
+            println!(
+                "{:8} | {},({}) | {:6} / {:3}    | {:6} / {:7} / {:3} | {:9} | {:7.1} | {}",
+                format!("{reading:?}"),
+                set,
+                e,
+                p_exp,
+                p_len,
+                p.expanded,
+                p.generated,
+                p.steps.len(),
+                p.leg_moves(),
+                ms,
+                p.failure.map_or("goal".to_string(), |f| f.to_string())
+            );
+        }
+    }
+}

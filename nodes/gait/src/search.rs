@@ -1,0 +1,315 @@
+//! Best-first search (algorithm A, Mařík 1993, as the paper's seven steps), generic over the
+//! problem: it knows states, keys, successors and values, nothing of legs.
+//!
+//! 1. OPEN ← {s0}, CLOSED ← ∅.
+//! 2. If OPEN is empty, there is no solution: stop.
+//! 3. Take the state i with least f(i) from OPEN; among ties prefer a goal state, then the one
+//!    generated first (FIFO).
+//! 4. Move i from OPEN to CLOSED.
+//! 5. If i is a goal, the solution is found: stop.
+//! 6. Expand i: for each successor j compute f(j). If j is in neither list, put it on OPEN. If it
+//!    is on OPEN or CLOSED with a larger f, set its f and parent and put it (back) on OPEN.
+//! 7. Go to 2.
+//!
+//! OPEN is a binary heap with lazy deletion: a state's entry is stale once the state is closed
+//! or re-entered under a newer generation number; both lists are one hash map on the key.
+//!
+//! ```
+//! use mobil_gait::search::{search, Problem, SearchEnd};
+//!
+//! /// Walk on the integers from 0 to 5 by +1 or +2, each move costing 1: f = moves + 0.
+//! struct Line;
+//! impl Problem for Line {
+//!     type State = i32;
+//!     type Key = i32;
+//!     type Step = i32;
+//!     fn key(&self, s: &i32) -> i32 { *s }
+//!     fn is_goal(&self, s: &i32) -> bool { *s == 5 }
+//!     fn start_value(&self, _: &i32) -> f64 { 0.0 }
+//!     fn successors(&self, s: &i32, out: &mut Vec<(i32, i32)>) {
+//!         if *s < 5 { out.push((1, s + 1)); out.push((2, s + 2)); }
+//!     }
+//!     fn value(&self, _: &i32, parent_f: f64, _: i32, _: &i32) -> f64 { parent_f + 1.0 }
+//!     fn remaining(&self, s: &i32) -> f64 { f64::from(5 - s) }
+//! }
+//! let r = search(&Line, 0, 1000, &mut || false);
+//! assert_eq!(r.end, SearchEnd::Goal);
+//! // 0 → 2 → 4 → 5: three moves, the fewest.
+//! assert_eq!(r.path.iter().map(|n| n.state).collect::<Vec<_>>(), vec![0, 2, 4, 5]);
+//! ```
+
+use std::cmp::Ordering;
+use std::collections::{BinaryHeap, HashMap};
+use std::hash::{BuildHasherDefault, Hash, Hasher};
+
+/// How often (in expansions) the stop callback is asked.
+pub const STOP_CHECK_EVERY: u32 = 256;
+
+/// A search problem: states, their keys, successors in order, the goal test and f.
+pub trait Problem {
+    /// A state.
+    type State: Clone;
+    /// The key duplicates are found by (e.g. a quantised state).
+    type Key: Hash + Eq;
+    /// The operator that made a successor (e.g. a rule).
+    type Step: Copy;
+    /// The key of a state.
+    fn key(&self, s: &Self::State) -> Self::Key;
+    /// Whether the state is a goal.
+    fn is_goal(&self, s: &Self::State) -> bool;
+    /// f of the start state.
+    fn start_value(&self, s: &Self::State) -> f64;
+    /// Appends the successors of `s` to `out`, in the order they are generated.
+    fn successors(&self, s: &Self::State, out: &mut Vec<(Self::Step, Self::State)>);
+    /// f of successor `child` made by `step` from `parent`, whose f is `parent_f`.
+    fn value(&self, parent: &Self::State, parent_f: f64, step: Self::Step, child: &Self::State) -> f64;
+    /// How far the state is from a goal, used only to choose the best partial path when the
+    /// search ends without a goal (lower is better).
+    fn remaining(&self, s: &Self::State) -> f64;
+}
+
+/// Why the search ended.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum SearchEnd {
+    /// A goal state was taken from OPEN (step 5).
+    Goal,
+    /// OPEN became empty (step 2): no solution.
+    OpenEmpty,
+    /// The expansion limit was reached.
+    ExpansionLimit,
+    /// The stop callback asked to stop.
+    Stopped,
+}
+
+/// One state of a returned path.
+#[derive(Debug, Clone)]
+pub struct PathNode<S, St> {
+    /// The state.
+    pub state: S,
+    /// The step that made it from the previous one; `None` for the start.
+    pub step: Option<St>,
+    /// Its f.
+    pub value: f64,
+}
+
+/// The result of a search.
+#[derive(Debug, Clone)]
+pub struct SearchResult<S, St> {
+    /// Start to goal, or, when no goal was found, start to the state with least
+    /// [`Problem::remaining`] among those generated (ties: the first generated).
+    pub path: Vec<PathNode<S, St>>,
+    /// Why it ended.
+    pub end: SearchEnd,
+    /// States moved to CLOSED (re-expansions of reopened states included).
+    pub expanded: u32,
+    /// Successors produced by the problem (duplicates of known states included).
+    pub generated: u32,
+    /// Distinct states seen (by key).
+    pub distinct: u32,
+}
+
+struct Node<S, St> {
+    state: S,
+    parent: u32,
+    step: Option<St>,
+    value: f64,
+    generation: u64,
+    goal: bool,
+    closed: bool,
+}
+
+/// An OPEN entry: least f first, then a goal, then the oldest generation.
+struct Entry {
+    value: f64,
+    goal: bool,
+    generation: u64,
+    node: u32,
+}
+
+impl PartialEq for Entry {
+    fn eq(&self, other: &Self) -> bool {
+        self.cmp(other) == Ordering::Equal
+    }
+}
+impl Eq for Entry {}
+impl PartialOrd for Entry {
+    fn partial_cmp(&self, other: &Self) -> Option<Ordering> {
+        Some(self.cmp(other))
+    }
+}
+impl Ord for Entry {
+    /// Reversed, for the max-heap: the entry to take first is the greatest.
+    fn cmp(&self, other: &Self) -> Ordering {
+        other
+            .value
+            .total_cmp(&self.value)
+            .then(self.goal.cmp(&other.goal))
+            .then(other.generation.cmp(&self.generation))
+    }
+}
+
+/// FxHash (rustc's): one multiply per word, ample for quantised integer keys.
+#[derive(Default, Clone, Copy)]
+pub struct FxHasher(u64);
+
+impl Hasher for FxHasher {
+    fn write(&mut self, bytes: &[u8]) {
+        for chunk in bytes.chunks(8) {
+            let mut w = [0u8; 8];
+            w[..chunk.len()].copy_from_slice(chunk);
+            self.write_u64(u64::from_le_bytes(w));
+        }
+    }
+    fn write_u64(&mut self, i: u64) {
+        self.0 = (self.0.rotate_left(5) ^ i).wrapping_mul(0x51_7c_c1_b7_27_22_0a_95);
+    }
+    fn write_i64(&mut self, i: i64) {
+        self.write_u64(i as u64);
+    }
+    fn finish(&self) -> u64 {
+        self.0
+    }
+}
+
+/// An improvement must beat the old f by this relative amount: (2) and (3) accumulate f along
+/// the path, and a rounding difference of an ulp must not re-parent a state.
+pub const IMPROVEMENT: f64 = 1e-9;
+
+/// Best-first search from `start` until a goal is taken from OPEN, OPEN is empty,
+/// `max_expansions` states have been expanded, or `stop()` returns true (asked every
+/// [`STOP_CHECK_EVERY`] expansions).
+pub fn search<P: Problem>(
+    problem: &P,
+    start: P::State,
+    max_expansions: u32,
+    stop: &mut dyn FnMut() -> bool,
+) -> SearchResult<P::State, P::Step> {
+    let mut nodes: Vec<Node<P::State, P::Step>> = Vec::new();
+    let mut index: HashMap<P::Key, u32, BuildHasherDefault<FxHasher>> = HashMap::default();
+    let mut open = BinaryHeap::new();
+    let mut generation: u64 = 0;
+    let (mut expanded, mut generated) = (0u32, 0u32);
+    let mut succ: Vec<(P::Step, P::State)> = Vec::new();
+
+    let f0 = problem.start_value(&start);
+    let goal0 = problem.is_goal(&start);
+    let mut best = (problem.remaining(&start), 0u32);
+    index.insert(problem.key(&start), 0);
+    nodes.push(Node {
+        state: start,
+        parent: u32::MAX,
+        step: None,
+        value: f0,
+        generation,
+        goal: goal0,
+        closed: false,
+    });
+    open.push(Entry {
+        value: f0,
+        goal: goal0,
+        generation,
+        node: 0,
+    });
+
+    let end = loop {
+        // Step 2.
+        let Some(e) = open.pop() else {
+            break SearchEnd::OpenEmpty;
+        };
+        let i = e.node as usize;
+        if nodes[i].closed || nodes[i].generation != e.generation {
+            continue; // stale entry: lazy deletion
+        }
+        // Steps 3–5.
+        nodes[i].closed = true;
+        if nodes[i].goal {
+            best = (0.0, e.node);
+            break SearchEnd::Goal;
+        }
+        if expanded >= max_expansions {
+            nodes[i].closed = false;
+            break SearchEnd::ExpansionLimit;
+        }
+        if expanded % STOP_CHECK_EVERY == 0 && expanded > 0 && stop() {
+            nodes[i].closed = false;
+            break SearchEnd::Stopped;
+        }
+        expanded += 1;
+        // Step 6.
+        succ.clear();
+        problem.successors(&nodes[i].state, &mut succ);
+        let parent_f = nodes[i].value;
+        for (step, child) in succ.drain(..) {
+            generated += 1;
+            let f = problem.value(&nodes[i].state, parent_f, step, &child);
+            let key = problem.key(&child);
+            match index.get(&key) {
+                None => {
+                    generation += 1;
+                    let id = nodes.len() as u32;
+                    let goal = problem.is_goal(&child);
+                    let rem = problem.remaining(&child);
+                    if rem < best.0 {
+                        best = (rem, id);
+                    }
+                    index.insert(key, id);
+                    nodes.push(Node {
+                        state: child,
+                        parent: i as u32,
+                        step: Some(step),
+                        value: f,
+                        generation,
+                        goal,
+                        closed: false,
+                    });
+                    open.push(Entry {
+                        value: f,
+                        goal,
+                        generation,
+                        node: id,
+                    });
+                }
+                Some(&id) => {
+                    let n = &mut nodes[id as usize];
+                    if f < n.value - IMPROVEMENT * n.value.abs().max(1.0) {
+                        generation += 1;
+                        n.value = f;
+                        n.parent = i as u32;
+                        n.step = Some(step);
+                        n.state = child;
+                        n.generation = generation;
+                        n.closed = false;
+                        open.push(Entry {
+                            value: f,
+                            goal: n.goal,
+                            generation,
+                            node: id,
+                        });
+                    }
+                }
+            }
+        }
+    };
+
+    let mut path = Vec::new();
+    let mut at = best.1;
+    // A parent chain is at most as long as the node list (a guard against a value function
+    // under which re-parenting could close a cycle).
+    while at != u32::MAX && path.len() <= nodes.len() {
+        let n = &nodes[at as usize];
+        path.push(PathNode {
+            state: n.state.clone(),
+            step: n.step,
+            value: n.value,
+        });
+        at = n.parent;
+    }
+    path.reverse();
+    SearchResult {
+        path,
+        end,
+        expanded,
+        generated,
+        distinct: nodes.len() as u32,
+    }
+}
