@@ -71,26 +71,26 @@ impl RecedingHorizon {
     }
 
     /// The next short-time plan from `current` toward `goal`, and its first moves. Empty when
-    /// `current` is already within the goal tolerance.
+    /// `current` is already within the goal tolerance. When no state generated within the cap
+    /// is nearer the goal than `current` (a plateau of leg configurations that tie under (1)
+    /// and (2)), the cap is doubled and the plan made again, up to `cfg.max_expansions`.
     pub fn next_chunk(&self, current: &GaitState, goal: Point2<f64>, stop: &mut dyn FnMut() -> bool) -> Chunk {
-        let plan = plan(
-            &self.model,
-            &self.cfg,
-            current,
-            goal,
-            self.set,
-            self.eval,
-            self.chunk_expansions.max(1),
-            stop,
-        );
-        let executed = plan
-            .steps
-            .iter()
-            .skip(1)
-            .take(self.execute_steps.max(1))
-            .cloned()
-            .collect();
-        Chunk { plan, executed }
+        let mut cap = self.chunk_expansions.max(1);
+        loop {
+            let plan = plan(&self.model, &self.cfg, current, goal, self.set, self.eval, cap, stop);
+            let executed: Vec<PlanStep> = plan
+                .steps
+                .iter()
+                .skip(1)
+                .take(self.execute_steps.max(1))
+                .cloned()
+                .collect();
+            let plateau = executed.is_empty() && matches!(plan.failure, Some(PlanFailure::ExpansionLimit(_)));
+            if !plateau || cap >= self.cfg.max_expansions {
+                return Chunk { plan, executed };
+            }
+            cap = cap.saturating_mul(2).min(self.cfg.max_expansions);
+        }
     }
 
     /// Plans and executes chunks from `start` until the goal is reached, `max_chunks` plans

@@ -8,7 +8,7 @@ use nalgebra::{Point2, Vector2};
 use serde::{Deserialize, Serialize};
 use std::f64::consts::{FRAC_PI_4, PI};
 
-/// Slack of every workspace and stability test ([j] or rad): rounding in the rules' arithmetic
+/// Slack of every workspace and stability test (\[j\] or rad): rounding in the rules' arithmetic
 /// (a foot placed on L = 2 exactly lands within 1e-15 of it) must not make a boundary state
 /// invalid. 1e-9 is a millionth of the key quantum's default, so it never merges two states.
 pub const TOLERANCE: f64 = 1e-9;
@@ -37,28 +37,80 @@ impl std::str::FromStr for LegAngleReading {
     }
 }
 
-/// One leg's workspace: an annular sector around its hip, in the body frame (Tab. 1).
+/// One leg's workspace: an annular sector around its hip, in the body frame (Tab. 1). Built by
+/// [`Workspace::new`], which also keeps the sector edges' unit vectors for the motion checks.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Workspace {
-    /// Shortest leg L_min [j].
-    pub l_min: f64,
-    /// Longest leg L_max [j].
-    pub l_max: f64,
-    /// The sector's forward extreme β (toward +y_r) [rad].
-    pub forward_angle: f64,
-    /// The sector's rearward extreme β [rad].
-    pub rearward_angle: f64,
-    /// The nominal angle β (inside the sector, halfway) [rad].
-    pub nominal_angle: f64,
-    /// The nominal ("middle") length [j].
-    pub nominal_length: f64,
+    l_min: f64,
+    l_max: f64,
+    forward_angle: f64,
+    rearward_angle: f64,
+    nominal_angle: f64,
+    nominal_length: f64,
+    /// Unit vectors of the clockwise and counter-clockwise edges.
+    edges: [Vector2<f64>; 2],
 }
 
 impl Workspace {
+    /// The sector L ∈ [l_min, l_max], β between `rearward_angle` and `forward_angle` through
+    /// `nominal_angle`, with the nominal ("middle") length `nominal_length`.
+    pub fn new(
+        l_min: f64,
+        l_max: f64,
+        forward_angle: f64,
+        rearward_angle: f64,
+        nominal_angle: f64,
+        nominal_length: f64,
+    ) -> Self {
+        let (lo, hi) = if wrap(forward_angle - nominal_angle) > 0.0 {
+            (rearward_angle, forward_angle)
+        } else {
+            (forward_angle, rearward_angle)
+        };
+        Workspace {
+            l_min,
+            l_max,
+            forward_angle,
+            rearward_angle,
+            nominal_angle,
+            nominal_length,
+            edges: [unit(lo), unit(hi)],
+        }
+    }
+
+    /// Shortest leg L_min \[j\].
+    pub fn l_min(&self) -> f64 {
+        self.l_min
+    }
+
+    /// Longest leg L_max \[j\].
+    pub fn l_max(&self) -> f64 {
+        self.l_max
+    }
+
+    /// The sector's forward extreme β (toward +y_r) \[rad\].
+    pub fn forward_angle(&self) -> f64 {
+        self.forward_angle
+    }
+
+    /// The sector's rearward extreme β \[rad\].
+    pub fn rearward_angle(&self) -> f64 {
+        self.rearward_angle
+    }
+
+    /// The nominal angle β, inside the sector \[rad\].
+    pub fn nominal_angle(&self) -> f64 {
+        self.nominal_angle
+    }
+
+    /// The nominal ("middle") length \[j\].
+    pub fn nominal_length(&self) -> f64 {
+        self.nominal_length
+    }
+
     /// The sector's clockwise and counter-clockwise extremes (lo, hi), hi − lo ∈ (0, π).
     pub fn sector(&self) -> (f64, f64) {
-        let f = wrap(self.forward_angle - self.nominal_angle);
-        if f > 0.0 {
+        if wrap(self.forward_angle - self.nominal_angle) > 0.0 {
             (self.rearward_angle, self.forward_angle)
         } else {
             (self.forward_angle, self.rearward_angle)
@@ -68,8 +120,7 @@ impl Workspace {
     /// Whether a foot at `p` from the hip (body frame) lies in the sector, within [`TOLERANCE`].
     pub fn contains(&self, p: Vector2<f64>) -> bool {
         let r2 = p.norm_squared();
-        let (lo, hi) = self.sector();
-        let (elo, ehi) = (unit(lo), unit(hi));
+        let [elo, ehi] = self.edges;
         r2 >= self.l_min * self.l_min - TOLERANCE
             && r2 <= self.l_max * self.l_max + TOLERANCE
             && cross(elo, p) >= -TOLERANCE
@@ -83,11 +134,11 @@ impl Workspace {
 /// (+x_r side); front is +y_r, the direction of motion. The centre of gravity is the body centre.
 #[derive(Debug, Clone, PartialEq)]
 pub struct QuadrupedModel {
-    /// Body width a along x_r [j].
+    /// Body width a along x_r \[j\].
     pub a: f64,
-    /// Body length b along y_r [j].
+    /// Body length b along y_r \[j\].
     pub b: f64,
-    /// Hip of each leg in the body frame [j].
+    /// Hip of each leg in the body frame \[j\].
     pub hips: [Vector2<f64>; 4],
     /// Workspace of each leg.
     pub workspaces: [Workspace; 4],
@@ -107,20 +158,8 @@ impl QuadrupedModel {
     /// The paper's robot (Tab. 1) under the given reading.
     pub fn paper(reading: LegAngleReading) -> Self {
         let (a, b) = (2.0, 3.0);
-        let left = Workspace {
-            l_min: 1.0,
-            l_max: 2.0,
-            forward_angle: 3.0 * FRAC_PI_4,
-            rearward_angle: 5.0 * FRAC_PI_4,
-            nominal_angle: PI,
-            nominal_length: 1.5,
-        };
-        let right = Workspace {
-            forward_angle: FRAC_PI_4,
-            rearward_angle: -FRAC_PI_4,
-            nominal_angle: 0.0,
-            ..left
-        };
+        let left = Workspace::new(1.0, 2.0, 3.0 * FRAC_PI_4, 5.0 * FRAC_PI_4, PI, 1.5);
+        let right = Workspace::new(1.0, 2.0, FRAC_PI_4, -FRAC_PI_4, 0.0, 1.5);
         QuadrupedModel {
             a,
             b,
@@ -210,14 +249,14 @@ impl QuadrupedModel {
     }
 }
 
-/// The body's pose in the world: centre (x, y) and φ, the angle of x_r to x [rad].
+/// The body's pose in the world: centre (x, y) and φ, the angle of x_r to x \[rad\].
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct BodyPose {
-    /// Centre x [j].
+    /// Centre x \[j\].
     pub x: f64,
-    /// Centre y [j].
+    /// Centre y \[j\].
     pub y: f64,
-    /// Angle of x_r to the world's x [rad].
+    /// Angle of x_r to the world's x \[rad\].
     pub phi: f64,
 }
 
@@ -305,9 +344,8 @@ pub fn triangle_margin(p: Point2<f64>, q: Point2<f64>, r: Point2<f64>, c: Point2
 
 /// Signed distance of `c` inside the convex hull of four points (negative outside).
 pub fn hull_margin(pts: &[Point2<f64>; 4], c: Point2<f64>) -> f64 {
-    // The hull of four points is the union of the four triangles of three of them; its margin
-    // is the largest distance to the outside, which for a convex hull is the least distance to
-    // a hull edge. A hull edge is a pair with every other point on one side.
+    // The margin of a convex polygon is the least distance to its edges; an edge of the hull of
+    // four points is a pair with the other two on one side (collinear counts as either side).
     let mut best = f64::INFINITY;
     let mut any = false;
     for i in 0..4 {
@@ -318,13 +356,17 @@ pub fn hull_margin(pts: &[Point2<f64>; 4], c: Point2<f64>) -> f64 {
             if len < 1e-12 {
                 continue;
             }
-            let sides: Vec<f64> = (0..4)
-                .filter(|&k| k != i && k != j)
-                .map(|k| cross(d, pts[k] - u))
-                .collect();
-            let sign = if sides.iter().all(|&s| s >= -1e-12) {
+            let (mut pos, mut neg) = (true, true);
+            for (k, p) in pts.iter().enumerate() {
+                if k != i && k != j {
+                    let s = cross(d, p - u);
+                    pos &= s >= -1e-12;
+                    neg &= s <= 1e-12;
+                }
+            }
+            let sign = if pos {
                 1.0
-            } else if sides.iter().all(|&s| s <= 1e-12) {
+            } else if neg {
                 -1.0
             } else {
                 continue;
@@ -344,8 +386,14 @@ pub fn hull_margin(pts: &[Point2<f64>; 4], c: Point2<f64>) -> f64 {
 /// the triangle of the other three feet by at least `margin` (SPEC §7 Decision).
 pub fn is_stable(model: &QuadrupedModel, margin: f64, state: &GaitState, lifted_leg: usize) -> bool {
     let _ = model;
-    let others: Vec<Point2<f64>> = (0..4).filter(|&k| k != lifted_leg).map(|k| state.feet[k]).collect();
-    triangle_margin(others[0], others[1], others[2], state.body.centre()) >= margin - TOLERANCE
+    let f = &state.feet;
+    let [p, q, r] = match lifted_leg {
+        0 => [f[1], f[2], f[3]],
+        1 => [f[0], f[2], f[3]],
+        2 => [f[0], f[1], f[3]],
+        _ => [f[0], f[1], f[2]],
+    };
+    triangle_margin(p, q, r, state.body.centre()) >= margin - TOLERANCE
 }
 
 /// Whether the state stands on all four feet: the centre inside their convex hull by `margin`.
@@ -354,7 +402,7 @@ pub fn is_supported(margin: f64, state: &GaitState) -> bool {
 }
 
 /// The largest rotation of the body about its centre in the direction `sign` (+1
-/// counter-clockwise, −1 clockwise), at most `limit` [rad] (≤ π), that keeps every foot in its
+/// counter-clockwise, −1 clockwise), at most `limit` \[rad\] (≤ π), that keeps every foot in its
 /// workspace along the whole motion. Exact: each boundary (|p|² = L², the two sector edges) is
 /// a sinusoid A cos t + B sin t + C of the rotation angle t, solved in closed form. A constraint
 /// the start state meets only within [`TOLERANCE`] may not get worse.
@@ -366,24 +414,23 @@ pub fn max_rotation(model: &QuadrupedModel, state: &GaitState, sign: f64, limit:
         let q = state.body.point_in_body(state.feet[leg]);
         let h = model.hips[leg];
         let w = &model.workspaces[leg];
-        // p(t) = R(−σt) q − h; u·p = cos t (u·q) + sin t σ (ux qy − uy qx) − u·h.
-        let lin = |u: Vector2<f64>| -> (f64, f64, f64) { (u.dot(&q), sign * cross(q, u), -u.dot(&h)) };
+        // p(t) = R(−σt) q − h; u·p = cos t (u·q) + σ sin t (ux qy − uy qx) − u·h.
+        let lin = |u: Vector2<f64>| -> (f64, f64, f64) { (u.dot(&q), sign * cross(u, q), -u.dot(&h)) };
         // |p|² = |q|² + |h|² − 2 h·R q.
         let (hc, hs, _) = lin(h);
         let qq = q.norm_squared() + h.norm_squared();
-        let (lo, hi) = w.sector();
-        let (elo, ehi) = (unit(lo), unit(hi));
+        let [elo, ehi] = w.edges;
         // cross(e, p) = (n·p) with n = (−e.y, e.x); cross(p, e) = (−n)·p.
         let nlo = Vector2::new(-elo.y, elo.x);
         let nhi = Vector2::new(ehi.y, -ehi.x);
-        let mut cons = vec![
+        let cons = [
             // l_max² − |p|² ≥ 0
             (2.0 * hc, 2.0 * hs, w.l_max * w.l_max - qq),
             // |p|² − l_min² ≥ 0
             (-2.0 * hc, -2.0 * hs, qq - w.l_min * w.l_min),
+            lin(nlo),
+            lin(nhi),
         ];
-        cons.push(lin(nlo));
-        cons.push(lin(nhi));
         for (a, b, c) in cons {
             t_max = t_max.min(exit_sinusoid(a, b, c, t_max));
         }
@@ -406,8 +453,7 @@ pub fn max_translation(model: &QuadrupedModel, margin: f64, state: &GaitState, s
         let (pp, py) = (p.norm_squared(), p.dot(&y));
         s_max = s_max.min(exit_quadratic(-1.0, -2.0 * py, w.l_max * w.l_max - pp, s_max));
         s_max = s_max.min(exit_quadratic(1.0, 2.0 * py, pp - w.l_min * w.l_min, s_max));
-        let (lo, hi) = w.sector();
-        let (elo, ehi) = (unit(lo), unit(hi));
+        let [elo, ehi] = w.edges;
         // cross(e, p0 + s y) = cross(e, p0) + s cross(e, y).
         s_max = s_max.min(exit_quadratic(0.0, cross(elo, y), cross(elo, p), s_max));
         s_max = s_max.min(exit_quadratic(0.0, cross(y, ehi), cross(p, ehi), s_max));
@@ -416,10 +462,8 @@ pub fn max_translation(model: &QuadrupedModel, margin: f64, state: &GaitState, s
     // hull's margin is concave along a line, so the set of s where it holds is an interval:
     // bisect its end (to 1e-12 [j]) when the end of the motion fails it.
     let dir = sign * state.body.forward();
-    let ok = |s: f64| {
-        hull_margin(&state.feet, state.body.centre() + s * dir)
-            >= margin.min(hull_margin(&state.feet, state.body.centre()))
-    };
+    let need = margin.min(hull_margin(&state.feet, state.body.centre()));
+    let ok = |s: f64| hull_margin(&state.feet, state.body.centre() + s * dir) >= need;
     if !ok(s_max) {
         let (mut lo, mut hi) = (0.0, s_max);
         while hi - lo > 1e-12 {
@@ -441,7 +485,7 @@ fn exit_sinusoid(a: f64, b: f64, c: f64, limit: f64) -> f64 {
     let tau = g(0.0).min(0.0);
     // g − τ = M cos(t − δ) + c − τ.
     let m = a.hypot(b);
-    let mut roots: Vec<f64> = Vec::with_capacity(4);
+    let mut roots = Roots::default();
     if m > 1e-15 {
         let k = (tau - c) / m;
         if (-1.0..=1.0).contains(&k) {
@@ -464,8 +508,17 @@ fn exit_sinusoid(a: f64, b: f64, c: f64, limit: f64) -> f64 {
 fn exit_quadratic(a: f64, b: f64, c: f64, limit: f64) -> f64 {
     let g = |s: f64| (a * s + b) * s + c;
     let tau = g(0.0).min(0.0);
+    // Fast path, the common case: g ≥ τ at both ends, and a convex g's vertex inside, if any,
+    // too (a linear or concave g is then ≥ τ throughout). The root search below would return
+    // `limit` as well.
+    if g(limit) >= tau {
+        let vertex = if a > 0.0 { -b / (2.0 * a) } else { f64::NAN };
+        if !(vertex > 0.0 && vertex < limit) || g(vertex) >= tau {
+            return limit;
+        }
+    }
     let cc = c - tau;
-    let mut roots: Vec<f64> = Vec::with_capacity(2);
+    let mut roots = Roots::default();
     if a.abs() < 1e-15 {
         if b.abs() > 1e-15 {
             roots.push(-cc / b);
@@ -478,21 +531,52 @@ fn exit_quadratic(a: f64, b: f64, c: f64, limit: f64) -> f64 {
             roots.push((-b - sq) / (2.0 * a));
         }
     }
-    roots.retain(|&t| t > 0.0 && t < limit);
+    roots.keep_within(limit);
     first_exit(&g, tau, &mut roots, limit)
+}
+
+/// A few roots on the stack (at most 20: two families × five periods, and the limit).
+#[derive(Default)]
+struct Roots {
+    t: [f64; 24],
+    n: usize,
+}
+
+impl Roots {
+    fn push(&mut self, t: f64) {
+        if self.n < self.t.len() {
+            self.t[self.n] = t;
+            self.n += 1;
+        }
+    }
+
+    fn keep_within(&mut self, limit: f64) {
+        let mut k = 0;
+        for i in 0..self.n {
+            let t = self.t[i];
+            if t > 0.0 && t < limit {
+                self.t[k] = t;
+                k += 1;
+            }
+        }
+        self.n = k;
+    }
 }
 
 /// Between consecutive roots g − τ keeps its sign: the first interval whose midpoint is below
 /// τ ends the motion at its start.
-fn first_exit(g: &dyn Fn(f64) -> f64, tau: f64, roots: &mut Vec<f64>, limit: f64) -> f64 {
-    roots.sort_by(f64::total_cmp);
+fn first_exit(g: &dyn Fn(f64) -> f64, tau: f64, roots: &mut Roots, limit: f64) -> f64 {
     roots.push(limit);
+    let r = &mut roots.t[..roots.n];
+    r.sort_unstable_by(f64::total_cmp);
+    // Intervals shorter than 1e-12 are rounding noise around a root at the start; a dip of
+    // 1e-12 below τ is within [`TOLERANCE`].
     let mut prev = 0.0;
-    for &r in roots.iter() {
-        if r > prev && g(0.5 * (prev + r)) < tau {
+    for &r in r.iter() {
+        if r > prev + 1e-12 && g(0.5 * (prev + r)) < tau - 1e-12 {
             return prev;
         }
-        prev = prev.max(r);
+        prev = f64::max(prev, r);
     }
     limit
 }

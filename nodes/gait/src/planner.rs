@@ -2,7 +2,7 @@
 //! functions (1), (2), (3), the quantised key and the goal test; [`plan`] runs it.
 
 use crate::config::{Evaluation, GaitConfig, RuleSet, Weights};
-use crate::model::{is_supported, GaitState, QuadrupedModel, TOLERANCE};
+use crate::model::{is_stable, is_supported, GaitState, QuadrupedModel, TOLERANCE};
 use crate::rules::{dev, vzd, Rule};
 use crate::search::{search, Problem, SearchEnd};
 use nalgebra::Point2;
@@ -58,7 +58,7 @@ impl std::fmt::Display for PlanFailure {
     }
 }
 
-/// A plan: the states from the start (steps[0]) to the goal, or the best partial plan.
+/// A plan: the states from the start (`steps[0]`) to the goal, or the best partial plan.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Plan {
     /// Start first; each later step made by one rule from the previous state.
@@ -155,7 +155,13 @@ impl Problem for GaitProblem<'_> {
     }
 
     fn successors(&self, s: &GaitState, out: &mut Vec<(Rule, GaitState)>) {
+        // A leg whose lift would lose stability gives no successor by any rule: test it once
+        // per leg, not once per rule (the successors and their order are unchanged).
+        let liftable: [bool; 4] = std::array::from_fn(|leg| is_stable(self.model, self.cfg.stability_margin, s, leg));
         for rule in Rule::all(self.set) {
+            if rule.moving_leg().is_some_and(|leg| !liftable[leg]) {
+                continue;
+            }
             for next in rule.apply(self.model, self.cfg, s, self.goal).into_iter().flatten() {
                 out.push((rule, next));
             }
@@ -165,11 +171,20 @@ impl Problem for GaitProblem<'_> {
     /// (1) h(i); (2) h(i) − h(j) + f(j); (3) h(i) − h(j) + k3·step(i) + f(j).
     fn value(&self, parent: &GaitState, parent_f: f64, step: Rule, child: &GaitState) -> f64 {
         let w = &self.weights;
+        // A leg move leaves the body where it was: vzd and dev are the parent's, bit for bit, so
+        // (1) gives the parent's f and the differences of (2), (3) are exactly 0. Skipping
+        // their computation changes no value.
+        let same_body = child.body == parent.body;
         match self.eval {
+            Evaluation::One if same_body => parent_f,
             Evaluation::One => self.h(child),
             Evaluation::Two | Evaluation::Three => {
-                let dv = w.k1 * (vzd(child, self.goal) - vzd(parent, self.goal))
-                    + w.k2 * (dev(child, self.goal) - dev(parent, self.goal));
+                let dv = if same_body {
+                    0.0
+                } else {
+                    w.k1 * (vzd(child, self.goal) - vzd(parent, self.goal))
+                        + w.k2 * (dev(child, self.goal) - dev(parent, self.goal))
+                };
                 let leg = if self.eval == Evaluation::Three && step.moving_leg().is_some() {
                     w.k3
                 } else {

@@ -222,25 +222,25 @@ pub fn leg_max_length_max_angle(
     leg: usize,
 ) -> Option<GaitState> {
     let w = &model.workspaces[leg];
-    place_leg(model, margin, state, leg, w.l_max, model.max_angle(leg))
+    place_leg(model, margin, state, leg, w.l_max(), model.max_angle(leg))
 }
 
 /// Rules 8..=11: leg `leg` to middle length and nominal angle.
 pub fn leg_nominal(model: &QuadrupedModel, margin: f64, state: &GaitState, leg: usize) -> Option<GaitState> {
     let w = &model.workspaces[leg];
-    place_leg(model, margin, state, leg, w.nominal_length, w.nominal_angle)
+    place_leg(model, margin, state, leg, w.nominal_length(), w.nominal_angle())
 }
 
 /// Rules 12..=15: leg `leg` to max length, keeping its angle.
 pub fn leg_max_length(model: &QuadrupedModel, margin: f64, state: &GaitState, leg: usize) -> Option<GaitState> {
     let (_, beta) = state.polar(model, leg);
-    place_leg(model, margin, state, leg, model.workspaces[leg].l_max, beta)
+    place_leg(model, margin, state, leg, model.workspaces[leg].l_max(), beta)
 }
 
 /// Rules 16..=19: leg `leg` to min length, keeping its angle.
 pub fn leg_min_length(model: &QuadrupedModel, margin: f64, state: &GaitState, leg: usize) -> Option<GaitState> {
     let (_, beta) = state.polar(model, leg);
-    place_leg(model, margin, state, leg, model.workspaces[leg].l_min, beta)
+    place_leg(model, margin, state, leg, model.workspaces[leg].l_min(), beta)
 }
 
 /// Rules 20..=23: leg `leg` to max angle, keeping its length.

@@ -3,7 +3,7 @@
 //!
 //! 1. OPEN ← {s0}, CLOSED ← ∅.
 //! 2. If OPEN is empty, there is no solution: stop.
-//! 3. Take the state i with least f(i) from OPEN; among ties prefer a goal state, then the one
+//! 3. Take the state i with least f(i) from OPEN (f on a 1e-7 grid, [`VALUE_QUANTUM`]); among ties prefer a goal state, then the one
 //!    generated first (FIFO).
 //! 4. Move i from OPEN to CLOSED.
 //! 5. If i is a goal, the solution is found: stop.
@@ -12,7 +12,11 @@
 //! 7. Go to 2.
 //!
 //! OPEN is a binary heap with lazy deletion: a state's entry is stale once the state is closed
-//! or re-entered under a newer generation number; both lists are one hash map on the key.
+//! or re-entered under a newer generation number; both lists are one hash map on the key. The
+//! first state generated under a key represents it: a later duplicate is evaluated as that
+//! state (with its own parent and step), and re-parenting changes the parent, step and f, not
+//! the stored state. A path's consecutive states are therefore one step apart up to the key's
+//! resolution (exactly, for a problem whose key is the state itself).
 //!
 //! ```
 //! use mobil_gait::search::{search, Problem, SearchEnd};
@@ -34,8 +38,10 @@
 //! }
 //! let r = search(&Line, 0, 1000, &mut || false);
 //! assert_eq!(r.end, SearchEnd::Goal);
-//! // 0 → 2 → 4 → 5: three moves, the fewest.
-//! assert_eq!(r.path.iter().map(|n| n.state).collect::<Vec<_>>(), vec![0, 2, 4, 5]);
+//! // Three moves, the fewest. 0 → 2 → 4 → 5 costs as much; ties go to the state generated
+//! // first (1 before 2, then 3 before 4), so the search returns 0 → 1 → 3 → 5.
+//! assert_eq!(r.path.iter().map(|n| n.state).collect::<Vec<_>>(), vec![0, 1, 3, 5]);
+//! assert_eq!(r.path[3].value, 3.0);
 //! ```
 
 use std::cmp::Ordering;
@@ -118,9 +124,10 @@ struct Node<S, St> {
     closed: bool,
 }
 
-/// An OPEN entry: least f first, then a goal, then the oldest generation.
+/// An OPEN entry: least f (on the [`VALUE_QUANTUM`] grid) first, then a goal, then the oldest
+/// generation.
 struct Entry {
-    value: f64,
+    value: i64,
     goal: bool,
     generation: u64,
     node: u32,
@@ -142,7 +149,7 @@ impl Ord for Entry {
     fn cmp(&self, other: &Self) -> Ordering {
         other
             .value
-            .total_cmp(&self.value)
+            .cmp(&self.value)
             .then(self.goal.cmp(&other.goal))
             .then(other.generation.cmp(&self.generation))
     }
@@ -171,9 +178,22 @@ impl Hasher for FxHasher {
     }
 }
 
-/// An improvement must beat the old f by this relative amount: (2) and (3) accumulate f along
-/// the path, and a rounding difference of an ulp must not re-parent a state.
-pub const IMPROVEMENT: f64 = 1e-9;
+/// f is compared on a grid of this size: (2) and (3) accumulate f along the path, so two
+/// states whose f is equal in exact arithmetic (the same body pose reached by different
+/// paths, which (1) ranks as an exact tie) differ by rounding noise of 1e-15..1e-12. On the
+/// grid they tie, and the tie rule (goal first, then FIFO) decides, as it does under (1); a
+/// state is re-parented only when its f improves by a grid step. No rule changes f by less
+/// than the key quantum's effect (≥ 1e-4 at the default 1e-3), far above the grid.
+pub const VALUE_QUANTUM: f64 = 1e-7;
+
+/// f on the [`VALUE_QUANTUM`] grid (a NaN ranks last).
+pub fn rank(f: f64) -> i64 {
+    if f.is_nan() {
+        i64::MAX
+    } else {
+        (f / VALUE_QUANTUM).round() as i64
+    }
+}
 
 /// Best-first search from `start` until a goal is taken from OPEN, OPEN is empty,
 /// `max_expansions` states have been expanded, or `stop()` returns true (asked every
@@ -205,7 +225,7 @@ pub fn search<P: Problem>(
         closed: false,
     });
     open.push(Entry {
-        value: f0,
+        value: rank(f0),
         goal: goal0,
         generation,
         node: 0,
@@ -241,10 +261,10 @@ pub fn search<P: Problem>(
         let parent_f = nodes[i].value;
         for (step, child) in succ.drain(..) {
             generated += 1;
-            let f = problem.value(&nodes[i].state, parent_f, step, &child);
             let key = problem.key(&child);
             match index.get(&key) {
                 None => {
+                    let f = problem.value(&nodes[i].state, parent_f, step, &child);
                     generation += 1;
                     let id = nodes.len() as u32;
                     let goal = problem.is_goal(&child);
@@ -263,24 +283,27 @@ pub fn search<P: Problem>(
                         closed: false,
                     });
                     open.push(Entry {
-                        value: f,
+                        value: rank(f),
                         goal,
                         generation,
                         node: id,
                     });
                 }
                 Some(&id) => {
+                    // The state first found under a key represents it: f is that state's, so a
+                    // state whose f does not depend on its path, as under (1), is never
+                    // re-parented by the quantum's difference between two of its copies.
+                    let f = problem.value(&nodes[i].state, parent_f, step, &nodes[id as usize].state);
                     let n = &mut nodes[id as usize];
-                    if f < n.value - IMPROVEMENT * n.value.abs().max(1.0) {
+                    if rank(f) < rank(n.value) {
                         generation += 1;
                         n.value = f;
                         n.parent = i as u32;
                         n.step = Some(step);
-                        n.state = child;
                         n.generation = generation;
                         n.closed = false;
                         open.push(Entry {
-                            value: f,
+                            value: rank(f),
                             goal: n.goal,
                             generation,
                             node: id,

@@ -1,0 +1,55 @@
+//! Short-time plans: the receding horizon walks to the paper's goal, one chunk at a time.
+
+use mobil_gait::{vzd, BodyPose, Evaluation, GaitConfig, GaitState, QuadrupedModel, RecedingHorizon, RuleSet};
+use nalgebra::Point2;
+use std::f64::consts::PI;
+
+#[test]
+fn the_receding_horizon_reaches_the_papers_goal() {
+    let goal = Point2::new(-10.0, 10.0);
+    for (set, phi) in [(RuleSet::A, PI / 4.0), (RuleSet::B, 1.5 * PI)] {
+        for eval in [Evaluation::One, Evaluation::Three] {
+            let h = RecedingHorizon {
+                chunk_expansions: 200,
+                ..RecedingHorizon::new(GaitConfig::default(), set, eval)
+            };
+            let start = GaitState::nominal(&QuadrupedModel::default(), BodyPose { x: 0.0, y: 0.0, phi });
+            let walk = h.run(&start, goal, 100, &mut || false);
+            assert!(walk.reached, "{set},{eval:?}: {:?}", walk.failure);
+            let last = walk.steps.last().unwrap().state;
+            assert!(vzd(&last, goal) <= h.cfg.goal_tolerance);
+            // Each chunk executes 1 to 4 moves (a partial plan may end after fewer).
+            assert!(walk.steps.len() - 1 <= 4 * walk.chunks as usize);
+            assert!(walk.steps.len() > walk.chunks as usize);
+            // Chunks are chained: each executed state follows from the one before by its rule.
+            for w in walk.steps.windows(2) {
+                let rule = w[1].rule.unwrap();
+                let next = rule.apply(&h.model, &h.cfg, &w[0].state, goal);
+                assert!(next
+                    .iter()
+                    .flatten()
+                    .any(|s| (s.body.centre() - w[1].state.body.centre()).norm() < 1e-3));
+            }
+        }
+    }
+}
+
+#[test]
+fn a_chunk_executes_the_first_moves_of_its_plan() {
+    let h = RecedingHorizon::new(GaitConfig::default(), RuleSet::B, Evaluation::Three);
+    let start = GaitState::nominal(
+        &h.model,
+        BodyPose {
+            x: 0.0,
+            y: 0.0,
+            phi: 1.5 * PI,
+        },
+    );
+    let chunk = h.next_chunk(&start, Point2::new(-10.0, 10.0), &mut || false);
+    assert_eq!(chunk.executed.len(), 4);
+    assert_eq!(chunk.executed[..], chunk.plan.steps[1..5]);
+    assert_eq!(chunk.reached(), Some(&chunk.plan.steps[4].state));
+    // At the goal already: nothing to execute.
+    let done = h.next_chunk(&start, Point2::new(0.1, 0.1), &mut || false);
+    assert!(done.executed.is_empty() && done.plan.success);
+}

@@ -1,0 +1,373 @@
+//! The search: optimality on small instances against an independent exhaustive search, every
+//! plan statically stable and made of single rules, (2) ranking states exactly as (1), the
+//! limits (expansions, stop callback, an exhausted state space) ending with a clear reason.
+
+use mobil_gait::planner::{state_key, GaitProblem, StateKey};
+use mobil_gait::search::{search, Problem, SearchEnd, STOP_CHECK_EVERY};
+use mobil_gait::{
+    is_stable, is_supported, plan, vzd, BodyPose, Evaluation, GaitConfig, GaitState, PlanFailure, QuadrupedModel, Rule,
+    RuleSet,
+};
+use nalgebra::Point2;
+use std::cell::RefCell;
+use std::collections::{HashMap, VecDeque};
+use std::f64::consts::PI;
+
+const GOAL: Point2<f64> = Point2::new(-10.0, 10.0);
+
+fn paper_start(model: &QuadrupedModel, set: RuleSet) -> GaitState {
+    let phi = match set {
+        RuleSet::A => PI / 4.0,
+        RuleSet::B => 1.5 * PI,
+    };
+    GaitState::nominal(model, BodyPose { x: 0.0, y: 0.0, phi })
+}
+
+/// Fewest leg moves from `start` to a state within `tol` of `goal`, by 0-1 breadth-first search
+/// over the rules (body moves cost 0, leg moves 1), states merged by the same key; `None` if
+/// none within `cap` states.
+fn fewest_leg_moves(
+    m: &QuadrupedModel,
+    cfg: &GaitConfig,
+    set: RuleSet,
+    start: GaitState,
+    goal: Point2<f64>,
+    cap: usize,
+) -> Option<u32> {
+    let mut best: HashMap<StateKey, u32> = HashMap::new();
+    let mut dq = VecDeque::new();
+    best.insert(state_key(&start, cfg.key_quantum), 0);
+    dq.push_back((start, 0u32));
+    while let Some((s, c)) = dq.pop_front() {
+        if best.get(&state_key(&s, cfg.key_quantum)).is_some_and(|&b| b < c) {
+            continue;
+        }
+        if vzd(&s, goal) <= cfg.goal_tolerance {
+            return Some(c);
+        }
+        if best.len() > cap {
+            return None;
+        }
+        for rule in Rule::all(set) {
+            for next in rule.apply(m, cfg, &s, goal).into_iter().flatten() {
+                let w = u32::from(rule.moving_leg().is_some());
+                let k = state_key(&next, cfg.key_quantum);
+                if best.get(&k).is_none_or(|&b| c + w < b) {
+                    best.insert(k, c + w);
+                    if w == 0 {
+                        dq.push_front((next, c));
+                    } else {
+                        dq.push_back((next, c + 1));
+                    }
+                }
+            }
+        }
+    }
+    None
+}
+
+#[test]
+fn uniform_cost_finds_the_fewest_leg_moves() {
+    // Evaluation (3) with k1 = k2 = 0 and k3 = 1 is f = leg moves on the path: the search is
+    // uniform-cost and must return a plan with the fewest leg moves, which an independent 0-1
+    // breadth-first search over the same rules finds too.
+    let m = QuadrupedModel::default();
+    let cfg = GaitConfig {
+        a3_k1: 0.0,
+        a3_k2: 0.0,
+        a3_k3: 1.0,
+        b3_k1: 0.0,
+        b3_k2: 0.0,
+        b3_k3: 1.0,
+        goal_tolerance: 0.3,
+        ..GaitConfig::default()
+    };
+    let start = GaitState::nominal(&m, BodyPose::default());
+    for (set, goal) in [
+        (RuleSet::A, Point2::new(0.0, 3.0)),
+        (RuleSet::A, Point2::new(0.0, 4.5)),
+        (RuleSet::A, Point2::new(-1.0, 3.0)),
+        (RuleSet::B, Point2::new(0.0, 3.0)),
+    ] {
+        let p = plan(&m, &cfg, &start, goal, set, Evaluation::Three, 500_000, &mut || false);
+        assert!(p.success, "{set} to {goal:?}: {:?}", p.failure);
+        let exhaustive = fewest_leg_moves(&m, &cfg, set, start, goal, 2_000_000).unwrap();
+        assert_eq!(p.leg_moves() as u32, exhaustive, "{set} to {goal:?}");
+        // f of the goal is the plan's leg moves (k3 = 1, no heuristic).
+        let last = p.steps.last().unwrap();
+        assert!((last.evaluation - exhaustive as f64).abs() < 1e-9);
+    }
+}
+
+/// Checks a plan: starts at `start`, each state valid and reached from the previous one by its
+/// rule (re-applied: a successor of that rule has the same key), a leg lifted only over a stable
+/// triangle, and the last state within the tolerance when `success`.
+fn check_plan(m: &QuadrupedModel, cfg: &GaitConfig, start: &GaitState, goal: Point2<f64>, p: &mobil_gait::Plan) {
+    assert_eq!(p.steps[0].state, *start);
+    assert!(p.steps[0].rule.is_none());
+    for w in p.steps.windows(2) {
+        let (a, b) = (&w[0].state, &w[1].state);
+        let rule = w[1].rule.expect("every later step has a rule");
+        assert!(b.in_workspaces(m) && is_supported(cfg.stability_margin - 1e-9, b));
+        if let Some(leg) = rule.moving_leg() {
+            assert!(
+                is_stable(m, cfg.stability_margin, a, leg),
+                "leg {leg} lifted off a stable triangle"
+            );
+        }
+        let again: Vec<StateKey> = rule
+            .apply(m, cfg, a, goal)
+            .into_iter()
+            .flatten()
+            .map(|s| state_key(&s, cfg.key_quantum))
+            .collect();
+        assert!(
+            again.contains(&state_key(b, cfg.key_quantum)),
+            "step by {rule} is not that rule applied to its parent"
+        );
+    }
+    if p.success {
+        assert!(vzd(&p.steps.last().unwrap().state, goal) <= cfg.goal_tolerance);
+        assert!(p.failure.is_none());
+    }
+}
+
+#[test]
+fn every_paper_row_gives_a_valid_plan() {
+    let cfg = GaitConfig::default();
+    let m = QuadrupedModel::paper(cfg.reading);
+    for set in [RuleSet::A, RuleSet::B] {
+        for e in 1..=3 {
+            let start = paper_start(&m, set);
+            let eval = Evaluation::try_from(e).unwrap();
+            let p = plan(&m, &cfg, &start, GOAL, set, eval, 0, &mut || false);
+            assert!(p.success, "{set},({e}): {:?}", p.failure);
+            check_plan(&m, &cfg, &start, GOAL, &p);
+            // The paper's goal is 14.1 away; a body move covers at most 2·√1.75 = 2.65 on the
+            // nominal stance's reach, so at least 6 body moves.
+            assert!(p.steps.len() >= 7 && p.expanded as usize >= p.steps.len() - 1);
+            assert!(p.generated >= p.expanded);
+        }
+    }
+}
+
+/// Records the states the search expands, in order.
+struct Recording<'a> {
+    inner: GaitProblem<'a>,
+    expanded: RefCell<Vec<StateKey>>,
+}
+
+impl Problem for Recording<'_> {
+    type State = GaitState;
+    type Key = StateKey;
+    type Step = Rule;
+    fn key(&self, s: &GaitState) -> StateKey {
+        self.inner.key(s)
+    }
+    fn is_goal(&self, s: &GaitState) -> bool {
+        self.inner.is_goal(s)
+    }
+    fn start_value(&self, s: &GaitState) -> f64 {
+        self.inner.start_value(s)
+    }
+    fn successors(&self, s: &GaitState, out: &mut Vec<(Rule, GaitState)>) {
+        self.expanded.borrow_mut().push(self.inner.key(s));
+        self.inner.successors(s, out)
+    }
+    fn value(&self, p: &GaitState, pf: f64, step: Rule, c: &GaitState) -> f64 {
+        self.inner.value(p, pf, step, c)
+    }
+    fn remaining(&self, s: &GaitState) -> f64 {
+        self.inner.remaining(s)
+    }
+}
+
+#[test]
+fn evaluation_2_expands_states_in_the_same_order_as_1() {
+    // (2) telescopes to (1) plus the constant h(s0) − h(s0) = 0 (SPEC §7), so both searches must
+    // expand the same states in the same order and return the same plan, on every instance.
+    let cfg = GaitConfig::default();
+    let m = QuadrupedModel::default();
+    let instances = [
+        (
+            RuleSet::A,
+            BodyPose {
+                x: 0.0,
+                y: 0.0,
+                phi: PI / 4.0,
+            },
+            GOAL,
+        ),
+        (
+            RuleSet::A,
+            BodyPose {
+                x: 1.0,
+                y: -2.0,
+                phi: 0.3,
+            },
+            Point2::new(6.0, 4.0),
+        ),
+        (
+            RuleSet::B,
+            BodyPose {
+                x: 0.0,
+                y: 0.0,
+                phi: 1.5 * PI,
+            },
+            GOAL,
+        ),
+        (
+            RuleSet::B,
+            BodyPose {
+                x: -3.0,
+                y: 1.0,
+                phi: 2.0,
+            },
+            Point2::new(2.0, -5.0),
+        ),
+        (
+            RuleSet::A,
+            BodyPose {
+                x: 0.0,
+                y: 0.0,
+                phi: PI,
+            },
+            Point2::new(0.0, 8.0),
+        ),
+    ];
+    for (set, body, goal) in instances {
+        let start = GaitState::nominal(&m, body);
+        let run = |eval| {
+            let rec = Recording {
+                inner: GaitProblem {
+                    model: &m,
+                    cfg: &cfg,
+                    goal,
+                    set,
+                    eval,
+                    weights: cfg.weights(set, eval),
+                },
+                expanded: RefCell::new(Vec::new()),
+            };
+            let r = search(&rec, start, 20_000, &mut || false);
+            let keys: Vec<StateKey> = r.path.iter().map(|n| state_key(&n.state, cfg.key_quantum)).collect();
+            (r.end, r.expanded, r.generated, rec.expanded.into_inner(), keys)
+        };
+        let (one, two) = (run(Evaluation::One), run(Evaluation::Two));
+        assert_eq!(one.0, SearchEnd::Goal, "{set} from {body:?}");
+        assert_eq!((one.1, one.2), (two.1, two.2), "{set} from {body:?}: counts differ");
+        assert!(one.3 == two.3, "{set} from {body:?}: expansion order differs");
+        assert_eq!(one.4, two.4, "{set} from {body:?}: plans differ");
+    }
+}
+
+#[test]
+fn a_tiny_expansion_cap_returns_the_best_partial_plan() {
+    let cfg = GaitConfig::default();
+    let m = QuadrupedModel::default();
+    let start = paper_start(&m, RuleSet::B);
+    let p = plan(&m, &cfg, &start, GOAL, RuleSet::B, Evaluation::One, 5, &mut || false);
+    assert!(!p.success);
+    assert_eq!(p.failure, Some(PlanFailure::ExpansionLimit(5)));
+    assert!(p.failure.as_ref().unwrap().to_string().contains("EXPANSION_LIMIT"));
+    assert_eq!(p.expanded, 5);
+    // Partial, yet valid, and nearer the goal than the start (14.14 away).
+    check_plan(&m, &cfg, &start, GOAL, &p);
+    assert!(p.steps.len() >= 2);
+    assert!(vzd(&p.steps.last().unwrap().state, GOAL) < vzd(&start, GOAL));
+}
+
+#[test]
+fn a_goal_tolerance_no_state_meets_ends_within_the_limit() {
+    // With a margin of 0.9 no leg can ever lift (the centre is at most 0.51 inside a lifting
+    // triangle once the body has shifted the 0.6 the hull allows), so the robot can only shift
+    // and turn on its first footholds: a goal 20 away is unreachable and the state space finite.
+    let cfg = GaitConfig {
+        stability_margin: 0.9,
+        ..GaitConfig::default()
+    };
+    let m = QuadrupedModel::default();
+    let start = GaitState::nominal(&m, BodyPose::default());
+    let p = plan(
+        &m,
+        &cfg,
+        &start,
+        Point2::new(0.0, 20.0),
+        RuleSet::B,
+        Evaluation::Three,
+        100_000,
+        &mut || false,
+    );
+    assert!(!p.success);
+    assert_eq!(p.failure, Some(PlanFailure::NoSuccessor));
+    assert!(p.expanded < 100_000);
+    assert!(p.leg_moves() == 0);
+    // The best partial plan ends at the hull's limit: 1.5 − 0.9 = 0.6 ahead.
+    let last = p.steps.last().unwrap().state;
+    assert!((last.body.y - 0.6).abs() < 1e-9, "{}", last.body.y);
+}
+
+#[test]
+fn the_stop_callback_stops_the_search() {
+    let cfg = GaitConfig::default();
+    let m = QuadrupedModel::default();
+    let start = paper_start(&m, RuleSet::B);
+    let mut asked = 0;
+    let p = plan(&m, &cfg, &start, GOAL, RuleSet::B, Evaluation::One, 0, &mut || {
+        asked += 1;
+        asked >= 2
+    });
+    assert!(!p.success);
+    assert_eq!(p.failure, Some(PlanFailure::Stopped));
+    assert_eq!(asked, 2);
+    assert_eq!(p.expanded, 2 * STOP_CHECK_EVERY);
+    assert!(p.failure.unwrap().to_string().starts_with("STOPPED"));
+}
+
+#[test]
+fn invalid_inputs_are_refused_with_a_reason() {
+    let cfg = GaitConfig::default();
+    let m = QuadrupedModel::default();
+    let mut start = GaitState::nominal(&m, BodyPose::default());
+    start.feet[2].x += 1.0; // L = 2.5 > 2
+    let p = plan(&m, &cfg, &start, GOAL, RuleSet::A, Evaluation::One, 0, &mut || false);
+    assert!(!p.success && p.steps.is_empty());
+    assert!(p.failure.unwrap().to_string().contains("leg 2"));
+    let ok = GaitState::nominal(&m, BodyPose::default());
+    let p = plan(
+        &m,
+        &cfg,
+        &ok,
+        Point2::new(f64::NAN, 0.0),
+        RuleSet::A,
+        Evaluation::One,
+        0,
+        &mut || false,
+    );
+    assert_eq!(p.failure, Some(PlanFailure::InvalidGoal));
+    let bad = GaitConfig {
+        goal_tolerance: 0.0,
+        ..cfg
+    };
+    let p = plan(&m, &bad, &ok, GOAL, RuleSet::A, Evaluation::One, 0, &mut || false);
+    assert!(p.failure.unwrap().to_string().contains("goal_tolerance"));
+}
+
+#[test]
+fn a_start_within_the_tolerance_is_its_own_plan() {
+    let cfg = GaitConfig::default();
+    let m = QuadrupedModel::default();
+    let start = GaitState::nominal(&m, BodyPose::default());
+    let p = plan(
+        &m,
+        &cfg,
+        &start,
+        Point2::new(0.3, 0.0),
+        RuleSet::A,
+        Evaluation::Three,
+        0,
+        &mut || false,
+    );
+    assert!(p.success);
+    assert_eq!((p.steps.len(), p.expanded, p.generated), (1, 0, 0));
+}
