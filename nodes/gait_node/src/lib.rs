@@ -6,17 +6,17 @@
 //! The method (rules, stability, the search, short-time plans) is in [`mobil_gait`]; nothing
 //! here plans.
 //!
-//! **Units.** The planner works in the paper's unit [j] (the body is 2 × 3 [j]). The service's
-//! request and reply and `gait/plan` are in [j], as `mobil_msgs/GaitStep` says; `goal_pose`,
-//! `gait/markers` and `gait/body` are in metres of the `frame` (`odom`), one [j] being
+//! **Units.** The planner works in the paper's unit \[j\] (the body is 2 × 3 \[j\]). The service's
+//! request and reply and `gait/plan` are in \[j\], as `mobil_msgs/GaitStep` says; `goal_pose`,
+//! `gait/markers` and `gait/body` are in metres of the `frame` (`odom`), one \[j\] being
 //! `unit_length` metres (default 1).
 //!
 //! What the node does with a bad request or message:
 //! - a `gait/compute_plan` request with a rule set other than "A"/"B", an evaluation other than
-//!   1/2/3, a non-finite number or a coordinate beyond ±[`MAX_COORDINATE`] [j] is answered at
+//!   1/2/3, a non-finite number or a coordinate beyond ±[`MAX_COORDINATE`] \[j\] is answered at
 //!   once with `success` false and the reason ([`query_from_request`]); `max_expansions` above
 //!   `max_expansions_limit` is capped to it (the reason says so if the limit is hit);
-//! - a `goal_pose` in another frame, with NaN or beyond ±[`MAX_COORDINATE`] [j] is refused and
+//! - a `goal_pose` in another frame, with NaN or beyond ±[`MAX_COORDINATE`] \[j\] is refused and
 //!   logged; the walk under way, if any, stops where it is (a quadruped standing on four feet
 //!   is safe);
 //! - a `terrain/assessment` with an unknown class is ignored (logged); the last known class
@@ -40,7 +40,7 @@ use nalgebra::Point2;
 use std::collections::VecDeque;
 use thiserror::Error;
 
-/// Largest coordinate of a start or goal accepted, [j] (the paper's experiments span 15 [j];
+/// Largest coordinate of a start or goal accepted, \[j\] (the paper's experiments span 15 \[j\];
 /// a goal this far is 10⁴ body lengths away and far beyond any expansion limit).
 pub const MAX_COORDINATE: f64 = 1e4;
 
@@ -53,9 +53,9 @@ pub const PREEMPTED: &str = "pre-empted";
 pub struct NodeParams {
     /// Most expansions one `gait/compute_plan` request may ask for; larger requests are capped.
     pub max_expansions_limit: u32,
-    /// Wall time one search may take before it is stopped with its best partial plan [s].
+    /// Wall time one search may take before it is stopped with its best partial plan \[s\].
     pub time_limit_s: f64,
-    /// Metres per [j]: `goal_pose`, the markers and `gait/body` are in metres.
+    /// Metres per \[j\]: `goal_pose`, the markers and `gait/body` are in metres.
     pub unit_length: f64,
     /// The frame of `goal_pose`, the markers and `gait/body` (and the header of `gait/plan`).
     pub frame: String,
@@ -67,16 +67,16 @@ pub struct NodeParams {
     pub walk_chunk_expansions: u32,
     /// Moves executed from each short-time plan before replanning.
     pub walk_execute_moves: u32,
-    /// Time per executed move of the simulated quadruped (its pace) [s].
+    /// Time per executed move of the simulated quadruped (its pace) \[s\].
     pub walk_move_period_s: f64,
     /// Short-time plans after which a walk that has not reached its goal gives up.
     pub walk_max_chunks: u32,
-    /// Where the simulated quadruped stands at start-up, legs nominal: x, y [j], φ [rad].
+    /// Where the simulated quadruped stands at start-up, legs nominal: x, y \[j\], φ \[rad\].
     pub walk_start: [f64; 3],
-    /// Stability margin of plans made while the ground is UNEVEN [j] (the larger of this and
+    /// Stability margin of plans made while the ground is UNEVEN \[j\] (the larger of this and
     /// `stability_margin` applies).
     pub uneven_stability_margin: f64,
-    /// Rule 2's ΔY of plans made while the ground is UNEVEN [j] (the smaller of this and
+    /// Rule 2's ΔY of plans made while the ground is UNEVEN \[j\] (the smaller of this and
     /// `translation_step` applies).
     pub uneven_translation_step: f64,
 }
@@ -407,7 +407,7 @@ pub enum RequestRefusal {
 pub struct GaitQuery {
     /// The start state: the request's body pose, legs nominal.
     pub start: GaitState,
-    /// The goal of the body centre [j].
+    /// The goal of the body centre \[j\].
     pub goal: Point2<f64>,
     /// The rule set.
     pub set: RuleSet,
@@ -539,7 +539,7 @@ pub fn plan_reason(plan: &Plan, cause: StopCause, query: &GaitQuery, time_limit_
     }
 }
 
-/// A plan state as a message step ([j]): rule 0 and "start" for the start, `moving_leg` −1
+/// A plan state as a message step (\[j\]): rule 0 and "start" for the start, `moving_leg` −1
 /// for a body move (and for the start).
 pub fn step_message(step: &PlanStep) -> GaitStep {
     let s = &step.state;
@@ -561,7 +561,7 @@ pub fn step_message(step: &PlanStep) -> GaitStep {
     }
 }
 
-/// A plan as the `GaitPlan` message ([j]).
+/// A plan as the `GaitPlan` message (\[j\]).
 pub fn plan_message(plan: &Plan, set: RuleSet, evaluation: Evaluation, header: Header, reason: String) -> GaitPlan {
     GaitPlan {
         header,
@@ -602,14 +602,14 @@ pub enum GoalRefusal {
     /// NaN or beyond the coordinate bound.
     #[error("goal_pose ({x}, {y}) m is not finite or beyond ±{MAX_COORDINATE} [j]")]
     Invalid {
-        /// x [m].
+        /// x \[m\].
         x: f64,
-        /// y [m].
+        /// y \[m\].
         y: f64,
     },
 }
 
-/// A `goal_pose` as the walk's goal [j]; the orientation is ignored (the goal is a position).
+/// A `goal_pose` as the walk's goal \[j\]; the orientation is ignored (the goal is a position).
 pub fn goal_from_pose(m: &PoseStamped, frame: &str, unit_length: f64) -> Result<Point2<f64>, GoalRefusal> {
     if m.header.frame_id.trim_start_matches('/') != frame.trim_start_matches('/') {
         return Err(GoalRefusal::Frame {
@@ -778,7 +778,7 @@ fn metres(p: Point2<f64>, unit: f64) -> Point {
     }
 }
 
-/// The body's outline: its four corners (the hips) and the first again, in the world [j].
+/// The body's outline: its four corners (the hips) and the first again, in the world \[j\].
 pub fn body_outline(model: &QuadrupedModel, body: &BodyPose) -> [Point2<f64>; 5] {
     let corner = |k: usize| body.centre() + body.to_world(model.hips[k]);
     // Hips 0 front left, 2 front right, 3 rear right, 1 rear left: round the rectangle.
@@ -794,7 +794,7 @@ pub fn support_triangle(state: &GaitState, leg: usize) -> Vec<Point2<f64>> {
     t
 }
 
-/// Markers of the walk in `header`'s frame (metres, `unit` m per [j]): a DELETEALL, then the
+/// Markers of the walk in `header`'s frame (metres, `unit` m per \[j\]): a DELETEALL, then the
 /// body outline (0), the feet (1), the support triangle of the move just made if it moved a
 /// leg (2), the planned body path (3) and the goal (4).
 pub fn markers(

@@ -12,10 +12,10 @@ use crate::plot::{MapView, Stroke, Svg};
 /// The demo's request: rule set B, evaluation (3), from the origin at φ = 3π/2 to (−10, 10)
 /// (SPEC §7, the paper's experiment B,(3), judged the best walking style).
 pub const DEMO_START: (f64, f64, f64) = (0.0, 0.0, 1.5 * std::f64::consts::PI);
-/// The demo's goal [j].
+/// The demo's goal \[j\].
 pub const DEMO_GOAL: (f64, f64) = (-10.0, 10.0);
 
-/// One state of the plan ([j]).
+/// One state of the plan (\[j\]).
 #[derive(Debug, Clone, PartialEq)]
 pub struct WalkState {
     /// Body centre x, y and φ (angle of x_r to x).
@@ -35,7 +35,7 @@ pub struct GaitWalk {
     pub rule_set: String,
     /// 1, 2 or 3.
     pub evaluation: u8,
-    /// The goal [j].
+    /// The goal \[j\].
     pub goal: (f64, f64),
     /// Whether the plan reaches the goal.
     pub success: bool,
@@ -47,9 +47,9 @@ pub struct GaitWalk {
     pub generated: u32,
     /// The plan, start first.
     pub steps: Vec<WalkState>,
-    /// Wall time of the call, request to reply [s].
+    /// Wall time of the call, request to reply \[s\].
     pub call_s: f64,
-    /// Body width a (along x_r) and length b (along y_r) [j]; the hips at its corners.
+    /// Body width a (along x_r) and length b (along y_r) \[j\]; the hips at its corners.
     pub body_size: (f64, f64),
 }
 
@@ -59,7 +59,7 @@ impl GaitWalk {
         self.steps.iter().filter(|s| s.moving_leg >= 0).count()
     }
 
-    /// The last body centre's distance to the goal [j].
+    /// The last body centre's distance to the goal \[j\].
     pub fn goal_distance(&self) -> f64 {
         self.steps
             .last()
@@ -119,7 +119,7 @@ const GOAL: &str = "#cc0000";
 
 /// Frames per row of the strip.
 const FRAMES_PER_ROW: usize = 6;
-/// A frame's scale (px per [j]) and size (px).
+/// A frame's scale (px per \[j\]) and size (px).
 const FRAME_SCALE: f64 = 19.0;
 const FRAME: f64 = 190.0;
 
@@ -240,8 +240,8 @@ pub fn support(s: &WalkState) -> Vec<(f64, f64)> {
         .collect()
 }
 
-/// A frame centred on the body, FRAME / FRAME_SCALE = 10 [j] across: the feet lie within
-/// 1.8 + 2 = 3.8 [j] of the centre (hip at (1, 1.5), leg at most 2 long), so they all show.
+/// A frame centred on the body, FRAME / FRAME_SCALE = 10 \[j\] across: the feet lie within
+/// 1.8 + 2 = 3.8 \[j\] of the centre (hip at (1, 1.5), leg at most 2 long), so they all show.
 fn frame_view(s: &WalkState, x: f64, y: f64) -> MapView {
     let half = (FRAME / FRAME_SCALE) / 2.0;
     let corners = [(s.body.0 - half, s.body.1 - half), (s.body.0 + half, s.body.1 + half)];
