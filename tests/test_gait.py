@@ -148,8 +148,14 @@ def test_compute_plan_the_papers_experiment_refusals_preemption_and_uneven_groun
     assert not slow.result().plan.steps
     check_plan(quick.result().plan, start, goal, 11)
 
+    # Parameters: an unknown name and invalid values are refused with the reason.
+    for name, value in (("no_such_parameter", 1.0), ("walk_evaluation", 4), ("walk_rule_set", "C"),
+                        ("uneven_stability_margin", 1.5)):
+        result = param_set(ros_node, "gait", name, value)
+        assert not result.successful and result.reason, (name, result.reason)
+
     # The time limit ends a search with its best partial plan.
-    param_set(ros_node, "gait", "time_limit_s", 0.2)
+    assert param_set(ros_node, "gait", "time_limit_s", 0.2).successful
     began = time.monotonic()
     limited = call(client, far).plan
     assert time.monotonic() - began < 3.0
