@@ -37,12 +37,18 @@ REPLY_TIMEOUT = 10.0
 
 def call(client, request, attempts: int = 4):
     """A service call, re-sent after 3 s without a reply (ROS2-NOTES: the first call after
-    discovery may stall)."""
+    discovery may stall). A stalled request that arrives after its re-sent copy is pre-empted by
+    it (or pre-empts it): the answer is the first reply that is not "pre-empted"."""
     futures = []
+
+    def answered():
+        return next((f.result() for f in futures
+                     if f.done() and f.result().plan.reason != "pre-empted"), None)
+
     for _ in range(attempts):
         futures.append(client.call_async(request))
-        if wait_until(lambda: any(f.done() for f in futures), 3.0):
-            return next(f for f in futures if f.done()).result()
+        if wait_until(lambda: answered() is not None, 3.0):
+            return answered()
     raise AssertionError("no reply from gait/compute_plan")
 
 
