@@ -262,7 +262,7 @@ fn declare_node(d: &mut Decl<NodeParams>) {
     d.doubles(
         "walk_start",
         c.walk_start,
-        "where the simulated quadruped stands at start-up, legs nominal: x, y [j], φ [rad] (read-only)",
+        "where the simulated quadruped stands at start-up, legs nominal: x, y [j], φ [rad]",
         |c, v| c.walk_start = v,
     )
     .read_only();
