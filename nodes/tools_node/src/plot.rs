@@ -364,6 +364,25 @@ impl Svg {
         let _ = writeln!(self.body, "</circle>");
     }
 
+    /// A closed polygon through the world points `points`, filled with `fill` at `opacity`,
+    /// outlined by `stroke` if given (non-finite points skipped).
+    pub fn polygon(&mut self, view: &MapView, points: &[(f64, f64)], fill: &str, opacity: f64, stroke: Option<Stroke>) {
+        let pts: Vec<String> = points
+            .iter()
+            .filter(|(x, y)| x.is_finite() && y.is_finite())
+            .map(|&(x, y)| format!("{:.1},{:.1}", view.x(x), view.y(y)))
+            .collect();
+        let outline = stroke.map_or_else(
+            || r#"stroke="none""#.to_owned(),
+            |s| s.attributes().replace(r#"fill="none" "#, ""),
+        );
+        let _ = writeln!(
+            self.body,
+            r#"<polygon points="{}" fill="{fill}" fill-opacity="{opacity}" {outline}/>"#,
+            pts.join(" ")
+        );
+    }
+
     /// A diagonal cross (✕) of half-size `half` px at the pixel (`x`, `y`).
     pub fn cross(&mut self, x: f64, y: f64, half: f64, color: &str, width: f64) {
         let _ = writeln!(
