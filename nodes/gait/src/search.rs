@@ -340,6 +340,8 @@ pub fn search<P: Problem>(
                         generation += 1;
                         let n = &mut nodes[id as usize];
                         if n.state != child {
+                            // The copy may lie on the other side of the goal's boundary.
+                            n.goal = problem.is_goal(&child);
                             n.state = child;
                             n.version = n.version.wrapping_add(1);
                         }

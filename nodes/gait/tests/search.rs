@@ -416,8 +416,10 @@ fn a_start_within_the_tolerance_is_its_own_plan() {
 /// then 0 →y 7 →x 8 →c 1.02 is a cheaper path to the key of 1.0 (f 0.7 < 1), and from 1.02 the
 /// goal's key is reached by g at 2.02 (or, with `drift`, g misses it: 2.12). f is a fixed value
 /// per step, so the goal is not re-parented when 1.02 is expanded: its stored link leaves 1.0.
+/// With `copy_is_goal`, the goal is (1.01, 1.05) instead: 1.02 is one, 1.0 under its key not.
 struct Merged {
     drift: bool,
+    copy_is_goal: bool,
 }
 
 impl Merged {
@@ -441,7 +443,11 @@ impl Problem for Merged {
         (s * 10.0).round() as i64
     }
     fn is_goal(&self, s: &f64) -> bool {
-        self.key(s) == 20
+        if self.copy_is_goal {
+            *s > 1.01 && *s < 1.05
+        } else {
+            self.key(s) == 20
+        }
     }
     fn start_value(&self, _: &f64) -> f64 {
         0.0
@@ -472,7 +478,10 @@ impl Problem for Merged {
 
 #[test]
 fn re_parenting_within_the_key_keeps_the_path_exact() {
-    let p = Merged { drift: false };
+    let p = Merged {
+        drift: false,
+        copy_is_goal: false,
+    };
     let r = search(&p, 0.0, 100, &mut || false);
     assert_eq!(r.end, SearchEnd::Goal);
     let steps: Vec<char> = r.path.iter().skip(1).map(|n| n.step.unwrap()).collect();
@@ -488,11 +497,26 @@ fn re_parenting_within_the_key_keeps_the_path_exact() {
     // (2.0, reached from 1.0) has no exact path and is not a solution. OPEN then empties. The
     // best partial path is to 2.0 (the nearest to 2), whose last link cannot be made again:
     // it ends at its exact prefix 0, 7, 8, 1.02.
-    let p = Merged { drift: true };
+    let p = Merged {
+        drift: true,
+        copy_is_goal: false,
+    };
     let r = search(&p, 0.0, 100, &mut || false);
     assert_eq!(r.end, SearchEnd::OpenEmpty);
     let states: Vec<f64> = r.path.iter().map(|n| n.state).collect();
     assert_eq!(states, vec![0.0, 7.0, 8.0, 1.02]);
+    // The copy that re-parenting stores is judged a goal by itself: 1.02 is one, though the 1.0
+    // first stored under its key was not. Found when taken from OPEN, before 2.0 (f 0.7 < 5).
+    let p = Merged {
+        drift: false,
+        copy_is_goal: true,
+    };
+    let r = search(&p, 0.0, 100, &mut || false);
+    assert_eq!(r.end, SearchEnd::Goal);
+    let states: Vec<f64> = r.path.iter().map(|n| n.state).collect();
+    assert_eq!(states, vec![0.0, 7.0, 8.0, 1.02]);
+    // Expanded 0, 1.0, 7, 8; generated a, y, g (from 1.0), x, c.
+    assert_eq!((r.expanded, r.generated), (4, 5));
     for w in r.path.windows(2) {
         assert_eq!(p.apply(w[1].step.unwrap(), w[0].state), w[1].state);
     }
