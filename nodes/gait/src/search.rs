@@ -124,7 +124,8 @@ pub struct SearchResult<S, St> {
     pub path: Vec<PathNode<S, St>>,
     /// Why it ended.
     pub end: SearchEnd,
-    /// States moved to CLOSED (re-expansions of reopened states included).
+    /// States expanded: moved to CLOSED and their successors generated (re-expansions of
+    /// reopened states included; the goal, closed at step 4 and never expanded, is not).
     pub expanded: u32,
     /// Successors produced by the problem (duplicates of known states included).
     pub generated: u32,
