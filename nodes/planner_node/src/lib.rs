@@ -291,6 +291,7 @@ impl Config for PlannerConfig {
         self.follow.validate().map_err(ConfigError::inconsistent)?;
         self.route_check().validate().map_err(ConfigError::inconsistent)?;
         self.vfo.gains.validate().map_err(ConfigError::inconsistent)?;
+        mobil_planner::vfo::VfoWaypoint::new(0.0, 0.0, 0.0, self.vfo.guiding).map_err(ConfigError::inconsistent)?;
         self.vfo.optimise.validate().map_err(ConfigError::inconsistent)?;
         self.vfo
             .scan_config(self.robot_radius)

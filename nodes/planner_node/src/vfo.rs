@@ -521,3 +521,337 @@ pub fn vfo_drawing(o: &Optimisation, obstacles: &[Obstacle]) -> VfoDrawing {
         obstacles: obstacles.to_vec(),
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::{markers, route_from_poses, status_message, MarkerView, Mode, Outcome, StatusView, MISSED_BY_THE_RUN};
+    use approx::assert_relative_eq;
+    use mobil_chassis::model::ChassisConfig;
+    use mobil_msgs::builtin_interfaces::msg::Time;
+    use mobil_msgs::geometry_msgs::msg::PoseStamped;
+    use mobil_msgs::mobil_msgs::msg::NavStatus;
+    use mobil_msgs::nav2_msgs::action::FollowWaypointsResult;
+    use mobil_msgs::visualization_msgs::msg::Marker;
+    use mobil_planner::vfo::{find_sigmas, Segment, VfoController, VfoEnd};
+    use mobil_ros::config::{load, Decl};
+    use mobil_ros::geometry::yaw_quaternion;
+    use mobil_ros::params::ParamValues;
+    use mobil_ros::OffLoop;
+    use ros2_client::ParameterValue;
+    use std::f64::consts::PI;
+
+    fn pose(x: f64, y: f64, yaw: Option<f64>) -> PoseStamped {
+        let mut p = PoseStamped::default();
+        p.header.frame_id = "odom".into();
+        p.pose.position.x = x;
+        p.pose.position.y = y;
+        p.pose.orientation = yaw.map_or_else(|| yaw_quaternion(0.0), yaw_quaternion);
+        p
+    }
+
+    #[test]
+    fn waypoint_method_parses_its_two_names_only() {
+        assert_eq!("vfo".parse::<WaypointMethod>(), Ok(WaypointMethod::Vfo));
+        assert_eq!("approach".parse::<WaypointMethod>(), Ok(WaypointMethod::Approach));
+        assert!("VFO".parse::<WaypointMethod>().is_err());
+        assert_eq!(WaypointMethod::Vfo.as_str(), "vfo");
+    }
+
+    #[test]
+    fn vfo_parameters_default_to_the_library_s_and_bad_ones_are_refused() {
+        let specs = Decl::<PlannerConfig>::of().specs();
+        let values = ParamValues::defaults(&specs);
+        let c: PlannerConfig = load(&values).expect("defaults valid");
+        assert_eq!(c.waypoint_method, WaypointMethod::Approach);
+        assert_eq!(c.vfo, VfoSettings::default());
+        assert_eq!(c.vfo.gains, VfoGains::default());
+        assert_eq!(c.vfo.optimise, OptimiseConfig::default());
+        // The library's figures, from its docs: k_p 1, k_a 5, U_2 0.3, |ω| ≤ 4, T_p 0.01,
+        // 4096 virtual robots, weights {K_D 1, K_B 2, K_E 1, K_S 1}.
+        assert_eq!((c.vfo.gains.k_p, c.vfo.gains.k_a, c.vfo.gains.speed), (1.0, 5.0, 0.3));
+        assert_eq!(
+            (c.vfo.optimise.time_step, c.vfo.optimise.max_virtual_robots),
+            (0.01, 4096)
+        );
+        let w = c.vfo.optimise.weights;
+        assert_eq!((w.length, w.danger, w.control, w.smoothness), (1.0, 2.0, 1.0, 1.0));
+        // The scan's obstacles carry the node's robot radius (0.53 by default).
+        assert_eq!(c.vfo.scan_config(c.robot_radius).robot_radius, 0.53);
+        assert_eq!(c.vfo.laser_pose(), Some(Pose2::new(0.0, 0.0, 0.0)));
+
+        let mut set = values.clone();
+        set.set("waypoint_method", ParameterValue::String("vfo".into()));
+        set.set("vfo.k_b", ParameterValue::Double(3.0));
+        set.set("vfo.time_step", ParameterValue::Double(0.02));
+        let c: PlannerConfig = load(&set).expect("valid");
+        assert_eq!(c.waypoint_method, WaypointMethod::Vfo);
+        assert_eq!(c.vfo.optimise.weights.danger, 3.0);
+        assert_eq!(c.vfo.optimise.time_step, 0.02);
+        for (name, value) in [
+            ("waypoint_method", ParameterValue::String("dwa".into())),
+            ("vfo.guiding", ParameterValue::Double(1.0)),
+            ("vfo.k_a", ParameterValue::Double(0.0)),
+            ("vfo.time_step", ParameterValue::Double(0.5)),
+            ("vfo.max_virtual_robots", ParameterValue::Integer(0)),
+            ("vfo.laser_pose", ParameterValue::DoubleArray(vec![0.1, 0.2])),
+        ] {
+            // Refused by the declaration's range (as -p and set_parameters are) or by the
+            // configuration's own checks.
+            let spec = specs.iter().find(|s| s.name == name).expect("declared");
+            let mut bad = values.clone();
+            bad.set(name, value.clone());
+            assert!(
+                spec.check(&value).is_err() || load::<PlannerConfig>(&bad).is_err(),
+                "{name} accepted"
+            );
+        }
+    }
+
+    #[test]
+    fn gains_are_held_to_the_chassis() {
+        // OMR-III: v_max 0.5, ω_max 1.5; U_2 0.3 stays, |ω| ≤ 4 becomes 1.5.
+        let g = vfo_gains(&VfoGains::default(), &ChassisParams::omr3());
+        assert_eq!((g.speed, g.omega_max, g.k_a), (0.3, 1.5, 5.0));
+        // A U_2 above v_max is held to it.
+        let fast = VfoGains {
+            speed: 0.8,
+            ..VfoGains::default()
+        };
+        assert_eq!(vfo_gains(&fast, &ChassisParams::omr3()).speed, 0.5);
+        // MOBIL-II turns no tighter than R_min = 0.73 m: |ω| ≤ 0.3 / 0.73 = 0.411 rad/s.
+        let mobil2 = ChassisParams::new(ChassisConfig::mobil2()).expect("valid");
+        assert_relative_eq!(mobil2.min_turning_radius(), 0.73, epsilon = 0.005);
+        let g = vfo_gains(&VfoGains::default(), &mobil2);
+        assert_relative_eq!(g.omega_max, 0.3 / mobil2.min_turning_radius(), epsilon = 1e-12);
+        assert_relative_eq!(g.omega_max, 0.411, epsilon = 0.003);
+    }
+
+    #[test]
+    fn waypoint_headings_follow_the_legs_unless_the_pose_carries_one() {
+        // From (0, 0) facing 0.3 rad: (1, 0) along +x (0); (1, 0) again keeps 0; (1, 2) carries
+        // 0.5 rad; (0, 2) along −x (π).
+        let poses = vec![
+            pose(1.0, 0.0, None),
+            pose(1.0, 0.0, None),
+            pose(1.0, 2.0, Some(0.5)),
+            pose(0.0, 2.0, None),
+        ];
+        let route = route_from_poses(&poses, "odom", "odom", 0, 0, None, 0.01).expect("valid");
+        let w = vfo_waypoints(&route, &Pose2::new(0.0, 0.0, 0.3), 0.4).expect("valid");
+        let headings: Vec<f64> = w.iter().map(|w| w.heading).collect();
+        assert_relative_eq!(headings[0], 0.0, epsilon = 1e-12);
+        assert_relative_eq!(headings[1], 0.0, epsilon = 1e-12);
+        assert_relative_eq!(headings[2], 0.5, epsilon = 1e-9);
+        assert_relative_eq!(headings[3], PI, epsilon = 1e-12);
+        assert!(w.iter().all(|w| w.guiding == 0.4));
+        assert_eq!(w[2].position, Point2::new(1.0, 2.0));
+        // A waypoint on the start keeps the start's heading.
+        let route = route_from_poses(
+            &[pose(0.0, 0.0, None), pose(1.0, 1.0, None)],
+            "odom",
+            "odom",
+            0,
+            0,
+            None,
+            0.01,
+        )
+        .expect("valid");
+        let w = vfo_waypoints(&route, &Pose2::new(0.0, 0.0, 0.3), 0.5).expect("valid");
+        assert_relative_eq!(w[0].heading, 0.3, epsilon = 1e-12);
+        assert_relative_eq!(w[1].heading, PI / 4.0, epsilon = 1e-12);
+    }
+
+    fn follower(obstacles: Vec<Obstacle>) -> VfoFollower {
+        let w = VfoWaypoint::new(4.0, 0.0, 0.0, 0.5).expect("valid");
+        VfoFollower::new(VfoGains::default(), OptimiseConfig::default(), vec![w], obstacles).expect("valid")
+    }
+
+    #[test]
+    fn the_slot_lends_once_and_a_late_command_becomes_zero() {
+        let t0 = Instant::now();
+        let ms = Duration::from_millis;
+        let mut slot = VfoSlot::new(follower(Vec::new()), ms(20));
+        let f = slot.lend(t0).expect("at home");
+        assert!(slot.is_lent());
+        // Out on a tick: the next tick gets nothing (the node commands zero).
+        assert!(slot.lend(t0 + ms(10)).is_none());
+        assert!(slot.follower().is_none());
+        assert_eq!(slot.give_back(f, t0 + ms(20)), Handback::Fresh);
+        let f = slot.lend(t0 + ms(30)).expect("home again");
+        assert_eq!(slot.give_back(f, t0 + ms(51)), Handback::Late);
+        assert!(!slot.is_lent());
+
+        let output = VfoOutput {
+            omega: 0.7,
+            v: 0.25,
+            index: 0,
+            distance: 1.0,
+            step: None,
+            events: Vec::new(),
+            end: None,
+        };
+        let c = vfo_command(&output, Handback::Fresh);
+        assert_eq!((c.vx, c.vy, c.wz), (0.25, 0.0, 0.7));
+        let c = vfo_command(&output, Handback::Late);
+        assert_eq!((c.vx, c.vy, c.wz), (0.0, 0.0, 0.0));
+        let ended = VfoOutput {
+            end: Some(VfoEnd::NoSafePath { index: 0 }),
+            ..output
+        };
+        let c = vfo_command(&ended, Handback::Fresh);
+        assert_eq!((c.vx, c.vy, c.wz), (0.0, 0.0, 0.0));
+    }
+
+    /// The hand-over through the kit's OffLoop on a single-threaded runtime: the follower goes to
+    /// the blocking pool, the loop meanwhile finds it out (zero command), and it comes back with
+    /// the tick's output, which optimised the segment (one obstacle on the way: two ways round,
+    /// three virtual robots — the first to the zone's edge, then one each way).
+    #[tokio::test(flavor = "current_thread")]
+    async fn a_tick_runs_off_the_loop_and_the_follower_comes_back() {
+        let obstacle = Obstacle::new(Point2::new(2.0, 0.0), 0.5, 1.0).expect("valid");
+        let mut slot = VfoSlot::new(follower(vec![obstacle]), Duration::from_secs(5));
+        let mut jobs: OffLoop<(Box<VfoFollower>, VfoOutput)> = OffLoop::new();
+        let mut f = slot.lend(Instant::now()).expect("at home");
+        jobs.start(move |_| {
+            let o = f.update(&Pose2::identity(), 0.0).expect("valid pose");
+            (f, o)
+        });
+        assert!(slot.lend(Instant::now()).is_none());
+        let (f, o) = jobs.result().await;
+        assert_eq!(slot.give_back(f, Instant::now()), Handback::Fresh);
+        assert!(o
+            .events
+            .iter()
+            .any(|e| matches!(e, mobil_planner::vfo::VfoEvent::Optimised { .. })));
+        let follower = slot.follower().expect("home");
+        let report = segment_report(follower.last_optimisation().expect("optimised"));
+        assert_eq!((report.virtual_robots, report.candidates), (3, 2));
+        assert!(report.psi_z.is_finite());
+        assert!(report.indices.iter().all(|x| x.is_finite()));
+        // At the start d = 2 > R = 1: no avoidance yet, H* = k_p·e* + v* = (4, 0) − 0.5·4·(1, 0)
+        // = (2, 0) points at the waypoint straight ahead, e_a = 0: ω = 0 and, the waypoint
+        // being the last, v = min(U_2, ‖H*‖)·cos 0 = 0.3.
+        assert_relative_eq!(o.omega, 0.0, epsilon = 1e-12);
+        assert_relative_eq!(o.v, 0.3, epsilon = 1e-12);
+    }
+
+    #[test]
+    fn the_report_and_the_drawing_of_an_optimisation() {
+        let obstacles = [Obstacle::new(Point2::new(2.0, 0.0), 0.5, 1.0).expect("valid")];
+        let segment = Segment {
+            waypoint: VfoWaypoint::new(4.0, 0.0, 0.0, 0.5).expect("valid"),
+            last: true,
+            obstacles: &obstacles,
+        };
+        let controller = VfoController::new(VfoGains::default()).expect("valid");
+        let o = find_sigmas(&Pose2::identity(), &controller, &segment, &OptimiseConfig::default()).expect("valid");
+        let d = vfo_drawing(&o, &obstacles);
+        assert_eq!(d.robots.len(), 3);
+        assert!(d.robots.iter().all(|r| !r.dropped && r.points.len() >= 2));
+        // The chosen path runs from the start to within ϵ of the waypoint.
+        let (first, last) = (d.chosen[0], d.chosen[d.chosen.len() - 1]);
+        assert!((first - Point2::origin()).norm() < 1e-9);
+        assert!((last - Point2::new(4.0, 0.0)).norm() < 0.1);
+        // It passes the obstacle outside r = 0.5.
+        assert!(d.chosen.iter().all(|p| (p - Point2::new(2.0, 0.0)).norm() > 0.5));
+        let r = SegmentReport::default();
+        assert!(r.psi_z.is_nan() && r.virtual_robots == 0);
+    }
+
+    #[test]
+    fn markers_draw_robots_the_chosen_path_and_r_and_r_big() {
+        let near = Obstacle::new(Point2::new(1.0, 0.0), 0.4, 0.8).expect("valid");
+        let far = Obstacle::new(Point2::new(5.0, 0.0), 0.3, 0.7).expect("valid");
+        let drawing = VfoDrawing {
+            robots: vec![
+                DrawnRobot {
+                    points: vec![Point2::new(0.0, 0.0), Point2::new(0.5, 0.2)],
+                    dropped: false,
+                },
+                DrawnRobot {
+                    points: vec![Point2::new(0.5, 0.2), Point2::new(0.9, 0.1)],
+                    dropped: true,
+                },
+            ],
+            chosen: vec![Point2::new(0.0, 0.0), Point2::new(0.5, 0.2), Point2::new(2.0, 0.6)],
+            obstacles: vec![far, near],
+        };
+        let view = MarkerView {
+            vfo: Some(&drawing),
+            robot: Some(Point2::new(0.0, 0.0)),
+            ..MarkerView::default()
+        };
+        let a = markers(&view, Time::default(), "odom");
+        let of = |ns: &str| a.markers.iter().filter(|m| m.ns == ns).collect::<Vec<_>>();
+        let robots = of("vfo_robots");
+        assert_eq!(robots.len(), 2);
+        assert_eq!((robots[0].color.r, robots[0].color.g), (0.6, 0.6));
+        assert_eq!((robots[1].color.r, robots[1].color.g), (1.0, 0.5));
+        assert_eq!(of("vfo_chosen")[0].points.len(), 3);
+        // The nearest obstacle (at 1 m) first: discs of diameter 2r = 0.8 and 2R = 1.6.
+        let (r, big) = (of("vfo_forbidden"), of("vfo_influence"));
+        assert_eq!((r.len(), big.len()), (2, 2));
+        assert_eq!(r[0].r#type, Marker::CYLINDER);
+        assert_eq!((r[0].pose.position.x, r[0].scale.x, big[0].scale.x), (1.0, 0.8, 1.6));
+        assert_eq!((r[1].pose.position.x, r[1].scale.x, big[1].scale.x), (5.0, 0.6, 1.4));
+    }
+
+    #[test]
+    fn status_carries_the_segment_s_psi_z_and_indices() {
+        let view = StatusView {
+            state: NavStatus::ACTIVE,
+            mode: Mode::Vfo,
+            goal: None,
+            distance_to_goal: 1.0,
+            reason: String::new(),
+            waypoint_index: 2,
+            docking: None,
+            vfo: Some(SegmentReport {
+                psi_z: 3.25,
+                indices: [4.5, 0.75, 1.5, 0.5],
+                virtual_robots: 9,
+                candidates: 5,
+            }),
+        };
+        let m = status_message(&view, Time::default(), "odom");
+        assert_eq!(m.mode, "vfo");
+        assert_eq!(
+            (m.psi_z, m.chi_length, m.chi_danger, m.chi_control, m.chi_smoothness),
+            (3.25, 4.5, 0.75, 1.5, 0.5)
+        );
+        assert_eq!((m.virtual_robots, m.candidates, m.waypoint_index), (9, 5, 2));
+        let m = status_message(&StatusView { vfo: None, ..view }, Time::default(), "odom");
+        assert!(m.psi_z.is_nan() && m.chi_length.is_nan() && m.virtual_robots == 0);
+    }
+
+    #[test]
+    fn an_early_end_lists_the_waypoints_not_reached() {
+        let poses: Vec<PoseStamped> = (0..4).map(|i| pose(i as f64, 1.0, None)).collect();
+        let outcome = Outcome::NoSafePath {
+            index: 2,
+            virtual_robots: 17,
+            unreached: vec![2, 3],
+        };
+        let r = outcome.follow_result(&poses, &[]);
+        assert_eq!(r.error_code, FollowWaypointsResult::TASK_EXECUTOR_FAILED);
+        let listed: Vec<(u32, u16)> = r.missed_waypoints.iter().map(|m| (m.index, m.error_code)).collect();
+        assert_eq!(listed, vec![(2, MISSED_BY_THE_RUN), (3, MISSED_BY_THE_RUN)]);
+        assert_eq!(r.missed_waypoints[1].goal.pose.position.x, 3.0);
+        assert!(r.error_msg.starts_with("NO_SAFE_PATH: "), "{}", r.error_msg);
+        assert!(r.error_msg.contains("waypoint 2") && r.error_msg.contains("17 virtual robots"));
+        let outcome = Outcome::Collision {
+            centre: Point2::new(2.0, -1.0),
+            radius: 0.6,
+            distance: 0.55,
+            unreached: vec![3],
+        };
+        assert_eq!(outcome.state(), NavStatus::FAILED);
+        let r = outcome.follow_result(&poses, &[]);
+        assert_eq!(r.missed_waypoints.len(), 1);
+        assert!(r
+            .error_msg
+            .starts_with("COLLISION: the robot is 0.55 m from the centre of the obstacle at (2.00, -1.00)"));
+        assert_eq!(Outcome::ScanStale.code(), "STALE_INPUT");
+    }
+}
