@@ -1,8 +1,11 @@
 //! `planner_node`: MOBIL-II's HIGH-LEVEL, the shell of [`mobil_planner`]. Lyapunov docking onto
 //! a pose (`dock_pose`, Nav2's `dock_robot`), backing out of a dock (`undock_robot`), and
-//! waypoint following by the goal approach (`waypoints`, Nav2's `follow_waypoints`), each route
+//! waypoint following (`waypoints`, Nav2's `follow_waypoints`) by the goal approach, each route
 //! first driven by a virtual robot against the known map (the pre-check, also served as
-//! `planner/check_route`). Every source feeds one session: a new goal from any of them
+//! `planner/check_route`), or with `waypoint_method: vfo` by VFO round the obstacles the LIDAR
+//! sees (`scan`), each segment's left/right decisions optimised by virtual robots
+//! ([`mobil_planner_node::vfo`]: the ticks run off the event loop and the robot stops while a
+//! segment is optimised). Every source feeds one session: a new goal from any of them
 //! pre-empts the running one.
 //!
 //! **One step per odometry message**: each valid `odom` (50 Hz from chassis_node) is one
@@ -85,8 +88,8 @@ fn decl() -> NodeDecl {
     NodeDecl::for_config::<PlannerConfig>(
         "planner",
         "HIGH-LEVEL planner: Lyapunov docking (dock_pose, dock_robot), undocking (undock_robot), waypoint \
-         following by the goal approach after a route pre-check (waypoints, follow_waypoints, \
-         planner/check_route); cmd_vel out",
+         following by the goal approach after a route pre-check or by VFO round the obstacles in scan \
+         (waypoint_method; waypoints, follow_waypoints, planner/check_route); cmd_vel out",
     )
 }
 
