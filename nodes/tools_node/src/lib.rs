@@ -1,7 +1,9 @@
 //! What the demo's executables share: [`plot`], the SVG figures (map panel with the world's
 //! obstacles, time-series panels), and [`plan`], the third act's route, record, summary and
-//! figure. ROS-free, so it is tested on recorded data; the binaries in `src/bin` are the shells.
+//! figure, and [`vfo`], the VFO act's record, summary and figure. ROS-free, so it is tested on
+//! recorded data; the binaries in `src/bin` are the shells.
 #![warn(missing_docs)]
 
 pub mod plan;
 pub mod plot;
+pub mod vfo;
