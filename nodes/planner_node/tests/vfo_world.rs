@@ -14,7 +14,7 @@ use mobil_sim::lidar::{Lidar, LidarConfig};
 use mobil_sim::world::World;
 use nalgebra::Point2;
 
-const ROUTE: [(f64, f64); 4] = [(2.0, 2.6), (3.6, 0.3), (1.0, -0.3), (0.0, 2.2)];
+const ROUTE: [(f64, f64); 4] = [(2.0, 2.6), (3.2, 0.3), (1.0, -0.3), (0.0, 2.2)];
 const ROBOT_RADIUS: f64 = 0.25;
 const DT: f64 = 0.02;
 

@@ -9,7 +9,7 @@ use mobil_sim::world::World;
 
 /// The demo's route: past the pillar at (1, 1.5) (the first leg runs through it), beside the
 /// box, back west and north past the pillar again (tests/test_planner_vfo.py drives it too).
-pub const DEMO_ROUTE: [(f64, f64); 4] = [(2.0, 2.6), (3.6, 0.3), (1.0, -0.3), (0.0, 2.2)];
+pub const DEMO_ROUTE: [(f64, f64); 4] = [(2.0, 2.6), (3.2, 0.3), (1.0, -0.3), (0.0, 2.2)];
 
 /// An obstacle as the planner saw it: centre, r, R (m).
 #[derive(Debug, Clone, Copy, PartialEq)]
