@@ -330,6 +330,27 @@ impl Svg {
         );
     }
 
+    /// A circle of `radius` (m) round the world point (`x`, `y`): outlined in `stroke`, filled
+    /// with `fill` (an SVG colour or `none`) at `opacity`.
+    pub fn circle(
+        &mut self,
+        view: &MapView,
+        (x, y): (f64, f64),
+        radius: f64,
+        stroke: Stroke,
+        fill: &str,
+        opacity: f64,
+    ) {
+        let _ = writeln!(
+            self.body,
+            r#"<circle cx="{:.1}" cy="{:.1}" r="{:.1}" fill="{fill}" fill-opacity="{opacity}" {}/>"#,
+            view.x(x),
+            view.y(y),
+            radius * view.scale(),
+            stroke.attributes()
+        );
+    }
+
     /// A polyline through the world points `points` (non-finite ones skipped).
     pub fn path(&mut self, view: &MapView, points: &[(f64, f64)], stroke: Stroke) {
         let px: Vec<(f64, f64)> = points
