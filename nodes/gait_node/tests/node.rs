@@ -484,6 +484,7 @@ fn the_params_file_sets_every_parameter_and_invalid_sets_are_refused() {
         (0.15, 0.5)
     );
     assert_eq!(cfg.node.max_expansions_limit, 1_000_000);
+    assert_eq!((cfg.node.max_generated_states, cfg.node.max_plan_states), (2_000_000, 400));
 
     let refused = |name: &str, value: ros2_client::ParameterValue| {
         let mut values = initial.values.clone();
