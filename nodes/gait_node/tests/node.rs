@@ -5,9 +5,9 @@
 
 use mobil_gait::{BodyPose, Chunk, Evaluation, GaitState, Plan, PlanFailure, PlanStep, Rule, RuleSet};
 use mobil_gait_node::{
-    body_outline, body_pose, goal_from_pose, ground_from_assessment, header, markers, plan_reason, query_from_request,
-    refused_plan, reply_plan, run_query, support_triangle, GaitNodeConfig, GoalRefusal, Ground, RequestRefusal,
-    StopCause, WalkNext, Walker, PREEMPTED,
+    body_outline, body_pose, chunk_reason, goal_from_pose, ground_from_assessment, header, markers, plan_reason,
+    query_from_request, refused_plan, reply_plan, run_query, support_triangle, GaitNodeConfig, GoalRefusal, Ground,
+    RequestRefusal, StopCause, WalkNext, Walker, PREEMPTED,
 };
 use mobil_msgs::builtin_interfaces::msg::Time;
 use mobil_msgs::geometry_msgs::msg::PoseStamped;
@@ -484,7 +484,10 @@ fn the_params_file_sets_every_parameter_and_invalid_sets_are_refused() {
         (0.15, 0.5)
     );
     assert_eq!(cfg.node.max_expansions_limit, 1_000_000);
-    assert_eq!((cfg.node.max_generated_states, cfg.node.max_plan_states), (2_000_000, 400));
+    assert_eq!(
+        (cfg.node.max_generated_states, cfg.node.max_plan_states),
+        (2_000_000, 400)
+    );
 
     let refused = |name: &str, value: ros2_client::ParameterValue| {
         let mut values = initial.values.clone();
@@ -706,4 +709,31 @@ fn a_stopped_walk_draws_neither_its_old_plan_nor_its_last_move() {
     // DELETEALL, body outline, feet: no support triangle (2), no path (3), no goal (4).
     let ids: Vec<(i32, i32)> = m.markers.iter().map(|m| (m.id, m.action)).collect();
     assert_eq!(ids, vec![(0, Marker::DELETEALL), (0, Marker::ADD), (1, Marker::ADD)]);
+}
+
+#[test]
+fn a_walks_plan_stopped_by_the_time_limit_says_time_limit() {
+    let stopped = Plan {
+        steps: vec![],
+        success: false,
+        failure: Some(PlanFailure::Stopped),
+        expanded: 256,
+        generated: 900,
+    };
+    assert_eq!(
+        chunk_reason(&stopped, StopCause::TimeLimit, 2.0),
+        "TIME_LIMIT: no goal within the time limit of 2 s (256 states expanded); the plan is the best partial one"
+    );
+    assert!(chunk_reason(&stopped, StopCause::Preempted, 2.0).starts_with("STOPPED"));
+    let limit = Plan {
+        failure: Some(PlanFailure::ExpansionLimit(2000)),
+        ..stopped.clone()
+    };
+    assert!(chunk_reason(&limit, StopCause::None, 2.0).starts_with("EXPANSION_LIMIT: no goal within 2000"));
+    let reached = Plan {
+        success: true,
+        failure: None,
+        ..stopped
+    };
+    assert_eq!(chunk_reason(&reached, StopCause::TimeLimit, 2.0), "");
 }
