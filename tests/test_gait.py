@@ -22,6 +22,8 @@ import math
 import time
 
 from geometry_msgs.msg import PoseStamped
+from rclpy.serialization import serialize_message
+from visualization_msgs.msg import Marker, MarkerArray
 
 from harness import make_qos, param_set, qos_latched, subscribe, wait_until
 
@@ -126,7 +128,9 @@ def start_gait(start_node, ros_node, *args):
 
 
 def test_compute_plan_the_papers_experiment_refusals_preemption_and_uneven_ground(start_node, ros_node):
-    gait, client = start_gait(start_node, ros_node, "-p", "time_limit_s:=5.0")
+    # max_generated_states raised so that a long search (below) is bounded by time, not memory.
+    gait, client = start_gait(start_node, ros_node, "-p", "time_limit_s:=5.0",
+                              "-p", "max_generated_states:=100000000")
     start, goal = (0.0, 0.0, math.pi / 4), (-10.0, 10.0)
 
     # The paper's experiment A,(1).
@@ -134,17 +138,31 @@ def test_compute_plan_the_papers_experiment_refusals_preemption_and_uneven_groun
     check_plan(even, start, goal, 11)
     assert (even.rule_set, even.evaluation) == ("A", 1)
 
+    # A far goal: B,(3) to (−900, 900), 1270 [j] away, reaches it in thousands of states; the
+    # reply holds the first max_plan_states (400) of them, says so, and stays far under the
+    # ~100 KB that a default Fast DDS receiver still gets from RustDDS.
+    far_start = (0.0, 0.0, 1.5 * math.pi)
+    long = call(client, request(far_start, (-900.0, 900.0), "B", 3)).plan
+    assert not long.success and len(long.steps) == 400, (long.success, len(long.steps))
+    assert long.reason.startswith("TRUNCATED: the plan has ") and long.reason.endswith(
+        "only the first 400 are sent (max_plan_states); the whole plan reaches the goal"), long.reason
+    assert len(serialize_message(long)) < 80_000
+    check_path_start(long, far_start)
+
     # Refusals, answered at once with the reason.
     for bad, words in ((request(rule_set="C"), "rule_set"), (request(evaluation=4), "evaluation"),
                        (request(goal=(math.nan, 10.0)), "goal.x"),
-                       (request(start=(0.0, 1e5, 0.0)), "start.y")):
+                       (request(start=(0.0, 1e5, 0.0)), "start.y"),
+                       (request(goal=(-1000.5, 10.0)), "goal.x")):
         reply = call(client, bad).plan
         assert not reply.success and words in reply.reason and not reply.steps, reply.reason
 
-    # Pre-emption: a search that cannot end soon (B,(3) toward a goal 12 700 [j] away, about
-    # 800 000 expansions, beyond the 5 s time limit) is pre-empted by the next request; its
-    # caller gets "pre-empted", the newer one its plan.
-    far = request((0.0, 0.0, 1.5 * math.pi), (-9000.0, 9000.0), "B", 3, 1_000_000)
+    # Pre-emption: a search that cannot end soon (under Tab. 1's rearward reading A,(3) finds
+    # no plan within 200 000 expansions, README; here 1 000 000 are allowed, beyond the 5 s
+    # time limit) is pre-empted by the next request; its caller gets "pre-empted", the newer
+    # one its plan.
+    assert param_set(ros_node, "gait", "reading", "rearward").successful
+    far = request(start, goal, "A", 3, 1_000_000)
     searching = gait.log_text().count("searching")
     slow = client.call_async(far)
     assert wait_until(lambda: gait.log_text().count("searching") > searching, REPLY_TIMEOUT)
@@ -167,7 +185,8 @@ def test_compute_plan_the_papers_experiment_refusals_preemption_and_uneven_groun
     assert time.monotonic() - began < 3.0
     assert not limited.success and limited.reason.startswith("TIME_LIMIT"), limited.reason
     assert limited.states_expanded > 0
-    check_path_start(limited, (0.0, 0.0, 1.5 * math.pi))
+    check_path_start(limited, start)
+    assert param_set(ros_node, "gait", "reading", "forward").successful
 
     # UNEVEN ground: the next plans keep the larger margin and take the shorter step.
     even_margins = leg_move_margins(even)
@@ -188,7 +207,7 @@ def test_goal_pose_walk_publishes_latched_plans_and_ends_at_the_goal(start_node,
     start_node("gait_node", "-p", "walk_move_period_s:=0.01", params_file=PARAMS)
     goal = (2.0, 4.0)
     pub = ros_node.create_publisher(PoseStamped, "goal_pose", make_qos("reliable", "volatile", 10))
-    wait_until(lambda: pub.get_subscription_count() > 0, timeout=10)
+    assert wait_until(lambda: pub.get_subscription_count() > 0, timeout=10)
     msg = PoseStamped()
     msg.header.frame_id = "odom"
     msg.pose.position.x, msg.pose.position.y = goal
@@ -205,10 +224,62 @@ def test_goal_pose_walk_publishes_latched_plans_and_ends_at_the_goal(start_node,
         # The plan is latched: a reader that joins now still gets the latest.
         with subscribe(ros_node, GaitPlan, "gait/plan", qos=qos_latched()) as plans:
             first = plans.wait_for(None, REPLY_TIMEOUT)
-            assert first.header.frame_id == "odom" and first.rule_set == "A" and len(first.steps) >= 2
+            # The plan is in [j]: its header names no frame.
+            assert first.header.frame_id == "" and first.rule_set == "A" and len(first.steps) >= 2
 
         def arrived(b):
             return math.hypot(b.pose.position.x - goal[0], b.pose.position.y - goal[1]) <= GOAL_TOLERANCE + 1e-9
 
         end = body.wait_for(arrived, 20.0)
         assert end.header.frame_id == "odom"
+
+
+def test_walk_markers_and_a_goal_in_another_frame_stops_the_walk(start_node, ros_node):
+    period = 0.1
+    gait = start_node("gait_node", "-p", f"walk_move_period_s:={period}", params_file=PARAMS)
+    pub = ros_node.create_publisher(PoseStamped, "goal_pose", make_qos("reliable", "volatile", 10))
+    assert wait_until(lambda: pub.get_subscription_count() > 0, timeout=10)
+    msg = PoseStamped()
+    msg.header.frame_id = "odom"
+    msg.pose.position.x, msg.pose.position.y = 0.0, 40.0
+    volatile = make_qos("reliable", "volatile", 1000)
+    with subscribe(ros_node, PoseStamped, "gait/body", qos=volatile) as body, \
+            subscribe(ros_node, MarkerArray, "gait/markers", qos=volatile) as markers:
+        for _ in range(20):
+            pub.publish(msg)
+            try:
+                body.wait_for(lambda b: b.pose.position.y != 0.0, timeout=0.5)
+                break
+            except TimeoutError:
+                continue
+        # While walking: a DELETEALL first, then the body outline (0), the feet (1), the path (3)
+        # and the goal (4) at (0, 40) m; the support triangle (2) after a leg move.
+        walking = markers.wait_for(lambda m: any(k.id == 3 for k in m.markers), REPLY_TIMEOUT)
+        assert walking.markers[0].action == Marker.DELETEALL
+        ids = [k.id for k in walking.markers[1:]]
+        assert ids in ([0, 1, 3, 4], [0, 1, 2, 3, 4]), ids
+        goal_marker = walking.markers[-1]
+        assert (goal_marker.pose.position.x, goal_marker.pose.position.y) == (0.0, 40.0)
+        # A goal in frame `map` (the node has no transforms) stops the walk where it is.
+        wrong = PoseStamped()
+        wrong.header.frame_id = "map"
+        wrong.pose.position.x = 5.0
+        pub.publish(wrong)
+        gait.wait_for_log(r"goal_pose in frame `map`", timeout=REPLY_TIMEOUT)
+        stopped = markers.wait_for(lambda m: [k.id for k in m.markers[1:]] == [0, 1], REPLY_TIMEOUT)
+        assert stopped.markers[0].action == Marker.DELETEALL
+        here = body.latest
+        seen = len(body)
+        time.sleep(2 * period + 0.05)  # two move periods: a walk still going would move
+        after = body.snapshot()[seen:]
+        assert all((b.pose.position.x, b.pose.position.y) == (here.pose.position.x, here.pose.position.y)
+                   for b in after), after
+        # The next walk's plan starts where the body stands (1 m per [j]).
+        with subscribe(ros_node, GaitPlan, "gait/plan", qos=qos_latched()) as plans:
+            msg.pose.position.x, msg.pose.position.y = here.pose.position.x + 3.0, here.pose.position.y
+            pub.publish(msg)
+            gait.wait_for_log(r"walking there.*\n(.*\n)*.*walking there", timeout=REPLY_TIMEOUT)
+            plan = plans.wait_for(lambda p: p.steps and abs(p.steps[0].body.y - here.pose.position.y) < 1e-9,
+                                  REPLY_TIMEOUT)
+            first = plan.steps[0].body
+            assert math.hypot(first.x - here.pose.position.x, first.y - here.pose.position.y) < 1e-9

@@ -15,10 +15,13 @@
 //! - a `gait/compute_plan` request with a rule set other than "A"/"B", an evaluation other than
 //!   1/2/3, a non-finite number or a coordinate beyond ±[`MAX_COORDINATE`] \[j\] is answered at
 //!   once with `success` false and the reason ([`query_from_request`]); `max_expansions` above
-//!   `max_expansions_limit` is capped to it (the reason says so if the limit is hit);
-//! - a `goal_pose` in another frame, with NaN or beyond ±[`MAX_COORDINATE`] \[j\] is refused and
-//!   logged; the walk under way, if any, stops where it is (a quadruped standing on four feet
-//!   is safe);
+//!   `max_expansions_limit`, or above what `max_generated_states` allows, is capped to it (the
+//!   reason says so if the limit is hit);
+//! - a plan longer than `max_plan_states` is sent truncated, with `success` false and the
+//!   reason ([`reply_plan`]), so that no reply or `gait/plan` grows past what DDS carries;
+//! - a `goal_pose` in another frame, with NaN, beyond ±[`MAX_COORDINATE`] \[j\] or undecodable
+//!   is refused and logged; the walk under way, if any, stops where it is (a quadruped
+//!   standing on four feet is safe);
 //! - a `terrain/assessment` with an unknown class is ignored (logged); the last known class
 //!   stays.
 
@@ -40,9 +43,21 @@ use nalgebra::Point2;
 use std::collections::VecDeque;
 use thiserror::Error;
 
-/// Largest coordinate of a start or goal accepted, \[j\] (the paper's experiments span 15 \[j\];
-/// a goal this far is 10⁴ body lengths away and far beyond any expansion limit).
-pub const MAX_COORDINATE: f64 = 1e4;
+/// Largest coordinate of a start or goal accepted, \[j\]: 333 body lengths, about 30 times the
+/// paper's experiment (15 \[j\]). A search toward a goal this far ends at its expansion,
+/// memory or time limit with a partial plan, truncated to `max_plan_states`; a walk gets there
+/// plan by plan.
+pub const MAX_COORDINATE: f64 = 1000.0;
+
+/// Most successors one expansion can generate with a rule set: each rule gives at most two
+/// (a leg rule may place the foot at either of two points).
+pub fn max_successors(set: RuleSet) -> u32 {
+    let rules = match set {
+        RuleSet::A => 11,
+        RuleSet::B => 27,
+    };
+    2 * rules
+}
 
 /// The reason a pre-empted `gait/compute_plan` caller gets.
 pub const PREEMPTED: &str = "pre-empted";
@@ -53,6 +68,11 @@ pub const PREEMPTED: &str = "pre-empted";
 pub struct NodeParams {
     /// Most expansions one `gait/compute_plan` request may ask for; larger requests are capped.
     pub max_expansions_limit: u32,
+    /// Most states one search may generate (its memory): a search's expansions are capped to
+    /// this over [`max_successors`] of its rule set.
+    pub max_generated_states: u32,
+    /// Most states of a plan sent (a reply or `gait/plan`); a longer plan is truncated.
+    pub max_plan_states: u32,
     /// Wall time one search may take before it is stopped with its best partial plan \[s\].
     pub time_limit_s: f64,
     /// Metres per \[j\]: `goal_pose`, the markers and `gait/body` are in metres.
@@ -85,6 +105,8 @@ impl Default for NodeParams {
     fn default() -> Self {
         NodeParams {
             max_expansions_limit: 1_000_000,
+            max_generated_states: 2_000_000,
+            max_plan_states: 400,
             time_limit_s: 2.0,
             unit_length: 1.0,
             frame: "odom".into(),
@@ -197,6 +219,20 @@ fn declare_node(d: &mut Decl<NodeParams>) {
         |c, v| c.max_expansions_limit = count(v),
     )
     .within(1.0, f64::from(u32::MAX));
+    d.integer(
+        "max_generated_states",
+        i64::from(c.max_generated_states),
+        "most states one search may generate, its memory: expansions are capped to this over 2 × the rule count",
+        |c, v| c.max_generated_states = count(v),
+    )
+    .within(100.0, f64::from(u32::MAX));
+    d.integer(
+        "max_plan_states",
+        i64::from(c.max_plan_states),
+        "most states of a plan sent in a reply or on gait/plan; a longer plan is truncated (success false)",
+        |c, v| c.max_plan_states = count(v),
+    )
+    .within(2.0, 100_000.0);
     d.double(
         "time_limit_s",
         c.time_limit_s,
@@ -415,13 +451,38 @@ pub struct GaitQuery {
     pub evaluation: Evaluation,
     /// The expansion limit of the search.
     pub max_expansions: u32,
-    /// The request's own limit when it was capped to `max_expansions_limit`.
+    /// The request's own limit when it was capped (to `max_expansions_limit` or by
+    /// `max_generated_states`).
     pub capped_from: Option<u32>,
+    /// What capped it.
+    pub capped_by: Cap,
 }
 
-/// Checks a request and makes it a query: `max_expansions` 0 becomes `cfg.gait.max_expansions`,
-/// anything above `max_expansions_limit` is capped to it.
-pub fn query_from_request(req: &PlanGaitRequest, cfg: &GaitNodeConfig) -> Result<GaitQuery, RequestRefusal> {
+/// Which node limit capped a request's expansions.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Cap {
+    /// Not capped.
+    None,
+    /// `max_expansions_limit`.
+    ExpansionsLimit,
+    /// `max_generated_states` over the rule set's [`max_successors`].
+    GeneratedStates {
+        /// The parameter's value.
+        max_generated: u32,
+        /// Successors per expansion at most.
+        per_expansion: u32,
+    },
+}
+
+/// Checks a request and makes it a query for a search on `ground`: `max_expansions` 0 becomes
+/// `cfg.gait.max_expansions`, anything above `max_expansions_limit` is capped to it, and
+/// anything above `max_generated_states` / [`max_successors`] to that (so the search never
+/// holds more states). The start is checked under the configuration the search will run with.
+pub fn query_from_request(
+    req: &PlanGaitRequest,
+    cfg: &GaitNodeConfig,
+    ground: Ground,
+) -> Result<GaitQuery, RequestRefusal> {
     let set: RuleSet = req
         .rule_set
         .parse()
@@ -450,20 +511,35 @@ pub fn query_from_request(req: &PlanGaitRequest, cfg: &GaitNodeConfig) -> Result
             phi: req.start.theta,
         },
     );
-    mobil_gait::planner::check_start(&model, &cfg.gait, &start).map_err(RequestRefusal::Start)?;
+    mobil_gait::planner::check_start(&model, &cfg.gait_for(ground), &start).map_err(RequestRefusal::Start)?;
     let asked = if req.max_expansions == 0 {
         cfg.gait.max_expansions
     } else {
         req.max_expansions
     };
-    let limit = cfg.node.max_expansions_limit;
+    let per_expansion = max_successors(set);
+    let by_memory = (cfg.node.max_generated_states / per_expansion).max(1);
+    let (max_expansions, capped_by) = if asked <= cfg.node.max_expansions_limit.min(by_memory) {
+        (asked, Cap::None)
+    } else if cfg.node.max_expansions_limit <= by_memory {
+        (cfg.node.max_expansions_limit, Cap::ExpansionsLimit)
+    } else {
+        (
+            by_memory,
+            Cap::GeneratedStates {
+                max_generated: cfg.node.max_generated_states,
+                per_expansion,
+            },
+        )
+    };
     Ok(GaitQuery {
         start,
         goal: Point2::new(req.goal.x, req.goal.y),
         set,
         evaluation,
-        max_expansions: asked.min(limit),
-        capped_from: (asked > limit).then_some(asked),
+        max_expansions,
+        capped_from: (capped_by != Cap::None).then_some(asked),
+        capped_by,
     })
 }
 
@@ -530,13 +606,68 @@ pub fn plan_reason(plan: &Plan, cause: StopCause, query: &GaitQuery, time_limit_
         }
         StopCause::None => {}
     }
-    match (&plan.failure, query.capped_from) {
-        (None, _) => String::new(),
-        (Some(f @ PlanFailure::ExpansionLimit(_)), Some(asked)) => {
+    match (&plan.failure, query.capped_from, query.capped_by) {
+        (None, _, _) => String::new(),
+        (
+            Some(f @ PlanFailure::ExpansionLimit(_)),
+            Some(asked),
+            Cap::GeneratedStates {
+                max_generated,
+                per_expansion,
+            },
+        ) => format!(
+            "{f} (the request's {asked} was capped so that the search generates at most max_generated_states \
+             {max_generated} states, {per_expansion} per expansion at most)"
+        ),
+        (Some(f @ PlanFailure::ExpansionLimit(_)), Some(asked), _) => {
             format!("{f} (the request's {asked} was capped to max_expansions_limit)")
         }
-        (Some(f), _) => f.to_string(),
+        (Some(f), _, _) => f.to_string(),
     }
+}
+
+/// The reason of a walk's short-time plan: empty when it reaches the goal, `TIME_LIMIT` when
+/// the node's time limit stopped it, else the plan's failure.
+pub fn chunk_reason(plan: &Plan, cause: StopCause, time_limit_s: f64) -> String {
+    match (cause, &plan.failure) {
+        (_, None) => String::new(),
+        (StopCause::TimeLimit, Some(PlanFailure::Stopped)) => format!(
+            "TIME_LIMIT: no goal within the time limit of {time_limit_s} s ({} states expanded); the plan is the best partial one",
+            plan.expanded
+        ),
+        (_, Some(f)) => f.to_string(),
+    }
+}
+
+/// A plan as the message sent (a reply or `gait/plan`, header left default for the caller to
+/// stamp): at most `max_plan_states` states. A longer plan is truncated to its first
+/// `max_plan_states` states, `success` false, and the reason says so and what the whole plan
+/// was (the prefix is a valid walk, and a new request from its end continues it).
+pub fn reply_plan(plan: &Plan, set: RuleSet, evaluation: Evaluation, reason: String, max_plan_states: u32) -> GaitPlan {
+    let keep = usize::try_from(max_plan_states.max(1)).unwrap_or(usize::MAX);
+    let mut msg = GaitPlan {
+        header: Header::default(),
+        rule_set: set.to_string(),
+        evaluation: evaluation.number(),
+        success: plan.success,
+        reason,
+        states_expanded: plan.expanded,
+        states_generated: plan.generated,
+        steps: plan.steps.iter().take(keep).map(step_message).collect(),
+    };
+    if plan.steps.len() > keep {
+        let whole = if plan.success {
+            "the whole plan reaches the goal".to_owned()
+        } else {
+            msg.reason.clone()
+        };
+        msg.success = false;
+        msg.reason = format!(
+            "TRUNCATED: the plan has {} states, only the first {keep} are sent (max_plan_states); {whole}",
+            plan.steps.len()
+        );
+    }
+    msg
 }
 
 /// A plan state as a message step (\[j\]): rule 0 and "start" for the start, `moving_leg` −1
@@ -558,20 +689,6 @@ pub fn step_message(step: &PlanStep) -> GaitStep {
             .and_then(|l| i8::try_from(l).ok())
             .unwrap_or(-1),
         evaluation: step.evaluation,
-    }
-}
-
-/// A plan as the `GaitPlan` message (\[j\]).
-pub fn plan_message(plan: &Plan, set: RuleSet, evaluation: Evaluation, header: Header, reason: String) -> GaitPlan {
-    GaitPlan {
-        header,
-        rule_set: set.to_string(),
-        evaluation: evaluation.number(),
-        success: plan.success,
-        reason,
-        states_expanded: plan.expanded,
-        states_generated: plan.generated,
-        steps: plan.steps.iter().map(step_message).collect(),
     }
 }
 
@@ -650,6 +767,7 @@ pub struct Walker {
     plan: Vec<PlanStep>,
     current: Option<PlanStep>,
     chunks: u32,
+    epoch: u64,
 }
 
 impl Walker {
@@ -662,6 +780,7 @@ impl Walker {
             plan: Vec::new(),
             current: None,
             chunks: 0,
+            epoch: 0,
         }
     }
 
@@ -697,16 +816,43 @@ impl Walker {
         self.queue.clear();
         self.current = None;
         self.chunks = 0;
+        self.epoch += 1;
     }
 
-    /// Stops the walk where it is.
+    /// Stops the walk where it is: no goal, no moves queued, no plan or last move to draw.
     pub fn stop(&mut self) {
         self.goal = None;
         self.queue.clear();
+        self.plan.clear();
+        self.current = None;
+        self.epoch += 1;
     }
 
-    /// Takes a short-time plan made from [`Walker::state`]: its executed moves are queued.
-    pub fn take_chunk(&mut self, chunk: Chunk, tolerance: f64, max_chunks: u32) -> WalkNext {
+    /// The plans made so far no longer hold (the ground or the configuration changed): the
+    /// moves queued are dropped, and a plan asked for before now is refused by
+    /// [`Walker::take_chunk`]; the next plan starts from where the quadruped stands.
+    pub fn replan(&mut self) {
+        self.queue.clear();
+        self.epoch += 1;
+    }
+
+    /// The walk's plan counter: bumped by every new goal, stop and [`Walker::replan`]. A plan
+    /// is asked for with the counter of the moment and taken only while it is unchanged.
+    pub fn epoch(&self) -> u64 {
+        self.epoch
+    }
+
+    /// Takes a short-time plan made from [`Walker::state`] when the counter was `epoch`: its
+    /// executed moves are queued. A plan from an older counter (made for another goal, ground
+    /// or configuration) is dropped: `None`, nothing changes.
+    pub fn take_chunk(&mut self, epoch: u64, chunk: Chunk, tolerance: f64, max_chunks: u32) -> Option<WalkNext> {
+        if epoch != self.epoch || self.goal.is_none() {
+            return None;
+        }
+        Some(self.take_current_chunk(chunk, tolerance, max_chunks))
+    }
+
+    fn take_current_chunk(&mut self, chunk: Chunk, tolerance: f64, max_chunks: u32) -> WalkNext {
         self.chunks += 1;
         self.plan = chunk.plan.steps.clone();
         self.queue = chunk.executed.into_iter().collect();

@@ -8,16 +8,17 @@
 //!   `walk_move_period_s`, replan); each plan goes out on `gait/plan` (latched) as it is
 //!   executed, the walk on `gait/markers` and the body on `gait/body` after every move.
 //! - `terrain/assessment` (latched, from terrain_node): while its class is UNEVEN, plans use the
-//!   larger `uneven_stability_margin` and the shorter `uneven_translation_step`.
+//!   larger `uneven_stability_margin` and the shorter `uneven_translation_step`. A change of
+//!   ground or of the parameters during a walk drops the moves queued and the plan being made,
+//!   and the walk replans at once from where it stands.
 //!
 //! The rules for bad input are in the crate docs.
 
 use futures::StreamExt;
-use mobil_gait::Chunk;
-use mobil_gait::Plan;
+use mobil_gait::{Chunk, Evaluation, RuleSet};
 use mobil_gait_node::{
-    body_pose, goal_from_pose, ground_from_assessment, header, markers, plan_message, plan_reason, query_from_request,
-    refused_plan, run_query, GaitNodeConfig, GaitQuery, Ground, StopCause, WalkNext, Walker, PREEMPTED,
+    body_pose, chunk_reason, goal_from_pose, ground_from_assessment, header, markers, plan_reason, query_from_request,
+    refused_plan, reply_plan, run_query, GaitNodeConfig, Ground, StopCause, WalkNext, Walker, PREEMPTED,
 };
 use mobil_msgs::geometry_msgs::msg::PoseStamped;
 use mobil_msgs::mobil_msgs::msg::{GaitPlan, TerrainAssessment};
@@ -49,19 +50,24 @@ struct Outputs {
     body: Publisher<PoseStamped>,
 }
 
-/// A finished `gait/compute_plan` search.
+/// A finished `gait/compute_plan` search, its reply built off the loop (a long plan is
+/// truncated there), the header left to stamp.
 struct Answered {
     id: RmwRequestId,
-    query: GaitQuery,
-    plan: Plan,
-    cause: StopCause,
+    reply: GaitPlan,
+    /// States in the whole plan (the reply may hold fewer).
+    states: usize,
     took: Duration,
 }
 
-/// A finished short-time plan of the walk, for the goal it was made for.
+/// A finished short-time plan of the walk: the walker's plan counter when it was asked for,
+/// and the set and evaluation it was made with.
 struct Chunked {
-    goal_seq: u64,
+    epoch: u64,
     chunk: Chunk,
+    set: RuleSet,
+    evaluation: Evaluation,
+    cause: StopCause,
     took: Duration,
 }
 
@@ -75,7 +81,6 @@ struct Shell {
     config: GaitNodeConfig,
     ground: Ground,
     walker: Walker,
-    goal_seq: u64,
     /// When the next move may be executed (steady clock).
     next_move: Option<Instant>,
     running: Option<Running>,
@@ -88,6 +93,8 @@ enum Event {
     Request(RmwRequestId, PlanGaitRequest),
     Answered(Answered),
     Goal(PoseStamped),
+    /// An undecodable `goal_pose` (already logged): refused like a bad one.
+    BadGoal,
     Assessment(TerrainAssessment),
     Chunked(Chunked),
     Move,
@@ -108,7 +115,6 @@ async fn serve(node: &mut RosNode) -> anyhow::Result<()> {
         walker: Walker::new(config.walk_start_state()),
         config,
         ground: Ground::Even,
-        goal_seq: 0,
         next_move: None,
         running: None,
         throttle: LogThrottle::new(Duration::from_secs(2)),
@@ -152,7 +158,7 @@ async fn serve(node: &mut RosNode) -> anyhow::Result<()> {
             done = walk.result() => Event::Chunked(done),
             m = goals.next() => match m {
                 Some(Input::Message(m)) => Event::Goal(m),
-                Some(Input::Undecodable) => Event::Nothing,
+                Some(Input::Undecodable) => Event::BadGoal,
                 None => anyhow::bail!("the goal_pose subscription ended"),
             },
             m = terrain.next() => match m {
@@ -166,27 +172,35 @@ async fn serve(node: &mut RosNode) -> anyhow::Result<()> {
             Event::Shutdown => break,
             Event::Nothing => {}
             Event::Config(Ok(c)) => {
-                info!("parameters changed: they apply from the next plan");
+                info!("parameters changed: the walk, if any, replans with them now; requests get them from the next");
                 shell.config = c;
+                shell.replan(node, &out, &mut walk);
             }
             Event::Config(Err(e)) => warn!("parameters not applied: {e}"),
             Event::Request(id, req) => shell.request(node, &service, &mut searches, id, req),
             Event::Answered(done) => shell.answered(node, &service, done),
             Event::Goal(m) => shell.goal(node, &out, &mut walk, &m),
+            Event::BadGoal => shell.stop_walk(node, &out, &mut walk),
             Event::Assessment(a) => match ground_from_assessment(&a) {
                 Ok(ground) => {
                     if ground != shell.ground {
-                        info!(
-                            "terrain: {} ground from now on (stability margin {}, translation step {} [j])",
-                            match ground {
-                                Ground::Uneven => "UNEVEN",
-                                Ground::Even => "even",
-                            },
-                            shell.config.gait_for(ground).stability_margin,
-                            shell.config.gait_for(ground).translation_step
-                        );
+                        // Terrain can flip at touchdown rate: one line per throttle period.
+                        if let Some(suppressed) = shell.throttle.allow("ground", Instant::now()) {
+                            info!(
+                                "terrain: {} ground from now on (stability margin {}, translation step {} [j]; {} \
+                                 changes not logged before this)",
+                                match ground {
+                                    Ground::Uneven => "UNEVEN",
+                                    Ground::Even => "even",
+                                },
+                                shell.config.gait_for(ground).stability_margin,
+                                shell.config.gait_for(ground).translation_step,
+                                suppressed
+                            );
+                        }
+                        shell.ground = ground;
+                        shell.replan(node, &out, &mut walk);
                     }
-                    shell.ground = ground;
                 }
                 Err(why) => warn_throttled!(shell.throttle, "terrain", "{why}"),
             },
@@ -237,7 +251,7 @@ impl Shell {
         id: RmwRequestId,
         req: PlanGaitRequest,
     ) {
-        let query = match query_from_request(&req, &self.config) {
+        let query = match query_from_request(&req, &self.config, self.ground) {
             Ok(q) => q,
             Err(why) => {
                 warn_throttled!(self.throttle, "refused", "gait/compute_plan refused: {why}");
@@ -267,6 +281,7 @@ impl Shell {
         }
         let cfg = self.config.gait_for(self.ground);
         let time_limit = self.config.node.time_limit_s;
+        let max_plan_states = self.config.node.max_plan_states;
         info!(
             "gait/compute_plan: searching {},({}) from ({}, {}, φ {}) to ({}, {}) [j] within {} expansions and {} s",
             query.set,
@@ -283,11 +298,11 @@ impl Shell {
         searches.start(move |cancel| {
             let began = Instant::now();
             let (plan, cause) = run_query(&query, &cfg, &|| cancel.is_cancelled(), &mut deadline(time_limit));
+            let reason = plan_reason(&plan, cause, &query, time_limit);
             Answered {
                 id,
-                query,
-                plan,
-                cause,
+                reply: reply_plan(&plan, query.set, query.evaluation, reason, max_plan_states),
+                states: plan.steps.len(),
                 took: began.elapsed(),
             }
         });
@@ -297,29 +312,24 @@ impl Shell {
         if self.running.as_ref().map(|r| r.id) == Some(done.id) {
             self.running = None;
         }
-        let reason = plan_reason(&done.plan, done.cause, &done.query, self.config.node.time_limit_s);
+        let mut msg = done.reply;
         info!(
-            "gait/compute_plan: {} {},({}): {} states in the plan, {} expanded, {} generated, {:.1} ms{}",
-            if done.plan.success { "plan found" } else { "no plan" },
-            done.query.set,
-            done.query.evaluation.number(),
-            done.plan.steps.len(),
-            done.plan.expanded,
-            done.plan.generated,
+            "gait/compute_plan: {} {},({}): {} states in the plan ({} sent), {} expanded, {} generated, {:.1} ms{}",
+            if msg.success { "plan found" } else { "no plan" },
+            msg.rule_set,
+            msg.evaluation,
+            done.states,
+            msg.steps.len(),
+            msg.states_expanded,
+            msg.states_generated,
             done.took.as_secs_f64() * 1e3,
-            if reason.is_empty() {
+            if msg.reason.is_empty() {
                 String::new()
             } else {
-                format!("; {reason}")
+                format!("; {}", msg.reason)
             }
         );
-        let msg = plan_message(
-            &done.plan,
-            done.query.set,
-            done.query.evaluation,
-            header(node.stamp(), ""),
-            reason,
-        );
+        msg.header = header(node.stamp(), "");
         respond(service, done.id, msg, &mut self.throttle);
     }
 
@@ -328,7 +338,6 @@ impl Shell {
         match goal_from_pose(m, &n.frame, n.unit_length) {
             Ok(goal) => {
                 info!("goal_pose ({:.3}, {:.3}) [j]: walking there", goal.x, goal.y);
-                self.goal_seq += 1;
                 self.walker.set_goal(goal);
                 self.next_move = None;
                 walk.cancel();
@@ -336,12 +345,30 @@ impl Shell {
             }
             Err(why) => {
                 warn_throttled!(self.throttle, "goal", "{why}; the walk stops where it is");
-                walk.cancel();
-                self.walker.stop();
-                self.next_move = None;
-                self.publish_walk(node, out);
+                self.stop_walk(node, out, walk);
             }
         }
+    }
+
+    /// A refused `goal_pose`: the walk stops where it is (a quadruped standing on four feet is
+    /// safe).
+    fn stop_walk(&mut self, node: &RosNode, out: &Outputs, walk: &mut OffLoop<Chunked>) {
+        walk.cancel();
+        self.walker.stop();
+        self.next_move = None;
+        self.publish_walk(node, out);
+    }
+
+    /// The ground or the parameters changed: the moves queued and the plan being made were
+    /// made under the old ones; a walk under way replans from where it stands.
+    fn replan(&mut self, node: &RosNode, out: &Outputs, walk: &mut OffLoop<Chunked>) {
+        if self.walker.goal().is_none() {
+            return;
+        }
+        walk.cancel();
+        self.walker.replan();
+        self.next_move = None;
+        self.advance(node, out, walk);
     }
 
     /// Asks the walk what comes next and does it.
@@ -368,17 +395,32 @@ impl Shell {
                         return;
                     }
                 };
-                let (start, seq, time_limit) = (*self.walker.state(), self.goal_seq, self.config.node.time_limit_s);
+                let (start, epoch, time_limit) =
+                    (*self.walker.state(), self.walker.epoch(), self.config.node.time_limit_s);
                 let Some(goal) = self.walker.goal() else {
                     return;
                 };
                 walk.start(move |cancel| {
                     let began = Instant::now();
                     let mut timed_out = deadline(time_limit);
-                    let chunk = horizon.next_chunk(&start, goal, &mut || cancel.is_cancelled() || timed_out());
+                    let mut cause = StopCause::None;
+                    let chunk = horizon.next_chunk(&start, goal, &mut || {
+                        if cancel.is_cancelled() {
+                            cause = StopCause::Preempted;
+                            true
+                        } else if timed_out() {
+                            cause = StopCause::TimeLimit;
+                            true
+                        } else {
+                            false
+                        }
+                    });
                     Chunked {
-                        goal_seq: seq,
+                        epoch,
                         chunk,
+                        set: horizon.set,
+                        evaluation: horizon.eval,
+                        cause,
                         took: began.elapsed(),
                     }
                 });
@@ -404,33 +446,38 @@ impl Shell {
     }
 
     fn chunked(&mut self, node: &RosNode, out: &Outputs, walk: &mut OffLoop<Chunked>, done: Chunked) {
-        if done.goal_seq != self.goal_seq || self.walker.goal().is_none() {
+        // A plan made for another goal, ground or configuration is dropped.
+        if done.epoch != self.walker.epoch() || self.walker.goal().is_none() {
             return;
         }
         let n = &self.config.node;
-        let (set, eval) = (n.walk_rule_set, self.config.walk_evaluation());
         let plan = &done.chunk.plan;
+        let reason = chunk_reason(plan, done.cause, n.time_limit_s);
         info!(
-            "walk: short-time plan {} of {} states ({} expanded, {:.1} ms), executing {} moves",
+            "walk: short-time plan {} of {} states, {},({}) ({} expanded, {:.1} ms), executing {} moves{}",
             self.walker.chunks() + 1,
             plan.steps.len(),
+            done.set,
+            done.evaluation.number(),
             plan.expanded,
             done.took.as_secs_f64() * 1e3,
-            done.chunk.executed.len()
-        );
-        if let Ok(eval) = eval {
-            let reason = plan.failure.as_ref().map(|f| f.to_string()).unwrap_or_default();
-            let msg = plan_message(plan, set, eval, header(node.stamp(), &n.frame), reason);
-            if let Err(e) = out.plan.publish(msg) {
-                warn_throttled!(self.throttle, "plan", "cannot publish gait/plan: {e:?}");
+            done.chunk.executed.len(),
+            if reason.is_empty() {
+                String::new()
+            } else {
+                format!("; {reason}")
             }
-        }
-        let next = self.walker.take_chunk(
-            done.chunk,
-            self.config.gait.goal_tolerance,
-            self.config.node.walk_max_chunks,
         );
-        self.follow(node, out, walk, next);
+        // Coordinates in [j], not metres of `frame`: the header names no frame.
+        let mut msg = reply_plan(plan, done.set, done.evaluation, reason, n.max_plan_states);
+        msg.header = header(node.stamp(), "");
+        if let Err(e) = out.plan.publish(msg) {
+            warn_throttled!(self.throttle, "plan", "cannot publish gait/plan: {e:?}");
+        }
+        let (tolerance, max_chunks) = (self.config.gait.goal_tolerance, self.config.node.walk_max_chunks);
+        if let Some(next) = self.walker.take_chunk(done.epoch, done.chunk, tolerance, max_chunks) {
+            self.follow(node, out, walk, next);
+        }
     }
 
     fn step(&mut self, node: &RosNode, out: &Outputs, walk: &mut OffLoop<Chunked>) {

@@ -28,6 +28,14 @@ pub struct WalkState {
     pub rule: String,
 }
 
+impl WalkState {
+    /// The leg this state's rule moved, if it is a leg 0..=3 (a reply's other values, −1 for a
+    /// body move or anything out of range, are no leg).
+    pub fn leg(&self) -> Option<usize> {
+        usize::try_from(self.moving_leg).ok().filter(|&l| l < 4)
+    }
+}
+
 /// The plan as answered, and what the act asked.
 #[derive(Debug, Clone, PartialEq)]
 pub struct GaitWalk {
@@ -56,7 +64,7 @@ pub struct GaitWalk {
 impl GaitWalk {
     /// Leg moves in the plan.
     pub fn leg_moves(&self) -> usize {
-        self.steps.iter().filter(|s| s.moving_leg >= 0).count()
+        self.steps.iter().filter(|s| s.leg().is_some()).count()
     }
 
     /// The last body centre's distance to the goal \[j\].
@@ -68,7 +76,7 @@ impl GaitWalk {
 
     /// Body moves in the plan (the start not counted).
     pub fn body_moves(&self) -> usize {
-        self.steps.len().saturating_sub(1) - self.leg_moves()
+        self.steps.len().saturating_sub(1).saturating_sub(self.leg_moves())
     }
 }
 
@@ -133,11 +141,11 @@ pub fn figure(walk: &GaitWalk, title: &str) -> String {
         .chain(std::iter::once(walk.goal));
     let top = 34.0;
     let map = MapView::fit(&none, shown, 34.0, 1.0).at(0.0, top);
-    let frames: Vec<(usize, &WalkState)> = walk
+    let frames: Vec<(usize, usize, &WalkState)> = walk
         .steps
         .iter()
         .enumerate()
-        .filter(|(_, s)| s.moving_leg >= 0)
+        .filter_map(|(i, s)| s.leg().map(|leg| (i, leg, s)))
         .collect();
     let rows = frames.len().div_ceil(FRAMES_PER_ROW);
     let strip_top = top + map.height() + 40.0;
@@ -145,10 +153,10 @@ pub fn figure(walk: &GaitWalk, title: &str) -> String {
     let height = strip_top + rows as f64 * (FRAME + 24.0) + 60.0;
     let mut svg = Svg::new(width, height);
     svg.text(10.0, 22.0, 16.0, title);
-    svg.metre_axes(&map);
+    svg.axes(&map, "j");
 
     // Every state's body outline, the leg moves' support triangles, the body's path.
-    for s in walk.steps.iter().filter(|s| s.moving_leg >= 0) {
+    for s in walk.steps.iter().filter(|s| s.leg().is_some()) {
         svg.polygon(&map, &support(s), TRIANGLE, 0.18, Some(Stroke::solid(TRIANGLE, 1.0)));
     }
     for s in &walk.steps {
@@ -186,7 +194,7 @@ pub fn figure(walk: &GaitWalk, title: &str) -> String {
         13.0,
         "each leg move: body, the supporting feet and their triangle, the moving foot (lifted ○ → set ●)",
     );
-    for (k, &(i, s)) in frames.iter().enumerate() {
+    for (k, &(i, leg, s)) in frames.iter().enumerate() {
         let (col, row) = (k % FRAMES_PER_ROW, k / FRAMES_PER_ROW);
         let (fx, fy) = (10.0 + col as f64 * FRAME, strip_top + row as f64 * (FRAME + 24.0));
         let before = i.checked_sub(1).map(|j| &walk.steps[j]);
@@ -196,7 +204,6 @@ pub fn figure(walk: &GaitWalk, title: &str) -> String {
         let mut o = outline(s.body, walk.body_size).to_vec();
         o.push(o[0]);
         svg.path(&view, &o, Stroke::solid(BODY, 1.5));
-        let leg = usize::try_from(s.moving_leg).unwrap_or(0);
         for (k, f) in s.feet.iter().enumerate() {
             if k != leg {
                 svg.dot(view.x(f.0), view.y(f.1), 4.0, FOOT, None);
@@ -232,12 +239,9 @@ fn summary_caption(walk: &GaitWalk) -> String {
     )
 }
 
-/// The support triangle of a leg move: the other three feet.
+/// The support triangle of a leg move: the other three feet (all four when no leg moved).
 pub fn support(s: &WalkState) -> Vec<(f64, f64)> {
-    (0..4)
-        .filter(|&k| i64::from(s.moving_leg) != k as i64)
-        .map(|k| s.feet[k])
-        .collect()
+    (0..4).filter(|&k| s.leg() != Some(k)).map(|k| s.feet[k]).collect()
 }
 
 /// A frame centred on the body, FRAME / FRAME_SCALE = 10 \[j\] across: the feet lie within

@@ -291,6 +291,12 @@ impl Svg {
     /// A frame round the map panel with a tick and its label at every whole metre (x along the
     /// bottom, y along the left edge, inside the panel) and the axis names.
     pub fn metre_axes(&mut self, view: &MapView) {
+        self.axes(view, "m");
+    }
+
+    /// [`Svg::metre_axes`] for a map in another unit: ticks at every whole `unit`, the axes
+    /// named "x [`unit`]" and "y [`unit`]" (e.g. "j", the quadruped's unit).
+    pub fn axes(&mut self, view: &MapView, unit: &str) {
         let ((x0, x1), (y0, y1)) = view.range();
         let (left, top) = (view.x(x0), view.y(y1));
         let (right, bottom) = (view.x(x1), view.y(y0));
@@ -324,7 +330,7 @@ impl Svg {
         }
         let _ = writeln!(
             self.body,
-            r##"<text x="{:.1}" y="{:.1}" font-size="11" text-anchor="end" fill="#505050">x [m] →, y [m] ↑</text>"##,
+            r##"<text x="{:.1}" y="{:.1}" font-size="11" text-anchor="end" fill="#505050">x [{unit}] →, y [{unit}] ↑</text>"##,
             right - 4.0,
             top + 13.0
         );

@@ -90,3 +90,31 @@ fn the_figure_draws_every_outline_and_a_triangle_and_frame_per_leg_move() {
     assert!(svg.contains("1: leg0_max_length") && svg.contains("2: leg3_nominal"));
     assert!(svg.contains("goal (0, 1.2)"));
 }
+
+#[test]
+fn a_reply_with_out_of_range_legs_is_drawn_without_them() {
+    // moving_leg is an int8 from the reply: 4..=127 and −2 are no leg of the quadruped.
+    let mut w = walk();
+    w.steps[1].moving_leg = 9;
+    w.steps[2].moving_leg = 127;
+    w.steps[3].moving_leg = -2;
+    assert_eq!((w.leg_moves(), w.body_moves()), (0, 3));
+    let svg = figure(&w, "title");
+    // No leg move left: no triangle, no frame; the 4 outlines and the path.
+    assert_eq!(svg.matches("<polygon").count(), 0);
+    assert_eq!(svg.matches("<polyline").count(), 4 + 1);
+    // A reply whose every state, the start too, claims a leg move: 4 leg moves, 0 body moves
+    // (not an underflow).
+    let mut all = walk();
+    for (k, s) in all.steps.iter_mut().enumerate() {
+        s.moving_leg = k as i8;
+    }
+    assert_eq!((all.leg_moves(), all.body_moves()), (4, 0));
+}
+
+#[test]
+fn the_map_axes_are_in_the_plans_unit() {
+    let svg = figure(&walk(), "title");
+    assert!(svg.contains("x [j] →, y [j] ↑"));
+    assert!(!svg.contains("[m]"));
+}

@@ -53,7 +53,7 @@ fn main() -> ExitCode {
 }
 
 /// Calls `gait/compute_plan`, re-sending each 3 s (a request sent before discovery matched is
-/// lost) until `deadline`.
+/// lost) until `deadline`: the last attempt gets only the time left.
 async fn call(node: &mut RosNode, request: PlanGaitRequest, deadline: Instant) -> anyhow::Result<PlanGaitResponse> {
     let name = node.names().resolve("gait/compute_plan")?;
     let name = Name::parse(&name).map_err(|e| anyhow::anyhow!("bad service name {name}: {e:?}"))?;
@@ -81,16 +81,18 @@ async fn call(node: &mut RosNode, request: PlanGaitRequest, deadline: Instant) -
         }
     }
     loop {
-        if Instant::now() > deadline {
+        let left = deadline.saturating_duration_since(Instant::now());
+        if left.is_zero() {
             anyhow::bail!("gait/compute_plan did not answer (is gait_node running on this ROS_DOMAIN_ID?)");
         }
+        let attempt = Duration::from_secs(3).min(left);
         tokio::select! {
             _ = &mut shutdown => anyhow::bail!("interrupted"),
-            answer = tokio::time::timeout(Duration::from_secs(3), client.async_call_service(request.clone())) => {
+            answer = tokio::time::timeout(attempt, client.async_call_service(request.clone())) => {
                 match answer {
                     Ok(Ok(reply)) => return Ok(reply),
                     Ok(Err(e)) => info!("gait/compute_plan call failed ({e:?}); asking again"),
-                    Err(_) => info!("no answer within 3 s; asking again"),
+                    Err(_) => info!("no answer within {:.1} s; asking again", attempt.as_secs_f64()),
                 }
             }
         }
