@@ -107,6 +107,21 @@ impl StaticFrames {
         skipped
     }
 
+    /// Takes every `tf_static` message waiting on `sub` (non-blocking) and [`add`s](Self::add)
+    /// it; returns how many transforms were skipped as invalid (an undecodable sample counts as
+    /// one).
+    pub fn take_all(&mut self, sub: &Subscription<TFMessage>) -> usize {
+        let mut skipped = 0;
+        loop {
+            match sub.take() {
+                Ok(Some((msg, _))) => skipped += self.add(&msg),
+                Ok(None) => break,
+                Err(_) => skipped += 1,
+            }
+        }
+        skipped
+    }
+
     /// The chain from `frame` up to its root: (root, root_from_frame); `None` when the chain
     /// loops (a → b → a), which no tree has.
     fn to_root(&self, frame: &str) -> Option<(String, Pose2)> {

@@ -457,7 +457,7 @@ async fn event_loop(
             Event::Config(Err(e)) => warn!("parameters not applied: {e}"),
             Event::Odom(m) => shell.odom_in(node, out, servers, jobs, &m),
             Event::Scan(m) => {
-                let skipped = poll_tf_static(&mut shell.laser, tf_sub);
+                let skipped = shell.laser.take_all(tf_sub);
                 if skipped > 0 {
                     warn_throttled!(
                         shell.throttle,
@@ -547,19 +547,6 @@ async fn event_loop(
             Event::Tick => shell.tick(node, out, servers).await,
         }
     }
-}
-
-/// Takes every `tf_static` message waiting; returns how many transforms were invalid.
-fn poll_tf_static(frames: &mut StaticFrames, sub: &Subscription<TFMessage>) -> usize {
-    let mut skipped = 0;
-    loop {
-        match sub.take() {
-            Ok(Some((msg, _))) => skipped += frames.add(&msg),
-            Ok(None) => break,
-            Err(_) => skipped += 1,
-        }
-    }
-    skipped
 }
 
 fn respond(
