@@ -198,15 +198,7 @@ impl LaserPose {
     /// Takes every message waiting on `sub` (non-blocking); returns how many transforms were
     /// skipped as invalid. A sample that cannot be decoded is skipped too (counted as one).
     pub fn poll(&mut self, sub: &Subscription<TFMessage>) -> usize {
-        let mut skipped = 0;
-        loop {
-            match sub.take() {
-                Ok(Some((msg, _))) => skipped += self.add(&msg),
-                Ok(None) => break,
-                Err(_) => skipped += 1,
-            }
-        }
-        skipped
+        self.frames.take_all(sub)
     }
 
     /// The laser pose in the base frame and where it comes from; `None` while neither
