@@ -24,6 +24,8 @@ case " $SUPPORTED " in
   *" $want_ver "*) ;;
   *) echo "setup_env: Python $want_ver ($PY) is not supported: ROS 2 Jazzy's rclpy wheels exist for Python $SUPPORTED only (set PYTHON=...)" >&2; exit 1 ;;
 esac
+# --which-python: print the interpreter the venv has or will be made with, and stop.
+if [ "${1:-}" = --which-python ]; then echo "$PY"; exit 0; fi
 # The type support is compiled against one Python, so each version has its own build.
 BUILD="$ROOT/target/msgs-build-py$want_ver"
 INSTALL="$ROOT/target/msgs-install-py$want_ver"
