@@ -76,6 +76,21 @@ pub struct SimOutcome {
     pub steps: u64,
 }
 
+/// The torso frame's state at one instant of a simulation.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct TorsoState {
+    /// Time from the start (s).
+    pub t: f64,
+    /// Position (m), x forward, y left, z up.
+    pub x: f64,
+    /// See `x`.
+    pub y: f64,
+    /// See `x`.
+    pub z: f64,
+    /// Tilt of its vertical axis from the vertical (rad).
+    pub tilt: f64,
+}
+
 /// The physics evaluator: a fresh simulation per individual.
 #[derive(Debug, Clone)]
 pub struct PhysicsEvaluator {
@@ -140,6 +155,17 @@ impl PhysicsEvaluator {
 
     /// Like [`simulate`](Self::simulate) for `duration` seconds of simulated time.
     pub fn simulate_for(&self, individual: &Individual, duration: f64) -> SimOutcome {
+        self.simulate_observed(individual, duration, &mut |_| {})
+    }
+
+    /// Like [`simulate_for`](Self::simulate_for), calling `observe` with the torso's state after
+    /// every step (to trace or plot a motion).
+    pub fn simulate_observed(
+        &self,
+        individual: &Individual,
+        duration: f64,
+        observe: &mut dyn FnMut(&TorsoState),
+    ) -> SimOutcome {
         let mut robot = Robot::build(&self.body, &self.model.standing_pose);
         let dt = self.body.dt;
         let steps = (duration / dt).round().max(0.0) as u64;
@@ -166,6 +192,13 @@ impl PhysicsEvaluator {
             robot.command(&command);
             robot.world.step();
             let pose = robot.torso_pose();
+            observe(&TorsoState {
+                t,
+                x: pose.x,
+                y: pose.y,
+                z: pose.z,
+                tilt: pose.tilt,
+            });
             out.steps = n;
             if !pose.is_finite() {
                 out.fell = true;

@@ -175,3 +175,37 @@ fn bad_body_figures_are_refused() {
         Err(SimError::BadBody { name: "friction", .. })
     ));
 }
+
+#[test]
+fn servos_weaker_than_the_standing_load_let_the_robot_collapse() {
+    // The knees carry the body above them: each about half of the torso and both hips and
+    // thighs, (2.750 + 2·(0.135 + 0.394))/2 = 1.90 kg, about 0.039 m behind the knee
+    // (thigh 0.1 m · sin 0.4, the torso's mass above the hips): 1.90·9.81·0.039 = 0.73 N·m.
+    // A pitch torque limit 30 % below that cannot hold the pose; 35 % above it can.
+    let model = NaoModel::default();
+    let with = |tau: f64| {
+        let body = BodyParams {
+            pitch_max_torque: tau,
+            ..BodyParams::default()
+        };
+        PhysicsEvaluator::with_body(model.clone(), FitnessConfig::default(), body)
+            .unwrap()
+            .simulate(&model.standing())
+    };
+    let weak = with(0.5);
+    assert!(weak.fell && weak.t_end < 1.5, "{weak:?}");
+    let strong = with(1.0);
+    assert!(!strong.fell, "{strong:?}");
+}
+
+#[test]
+fn an_observer_sees_every_step_and_the_same_end() {
+    let ev = evaluator();
+    let model = NaoModel::default();
+    let mut seen = Vec::new();
+    let o = ev.simulate_observed(&model.standing(), 0.5, &mut |s| seen.push(*s));
+    // 0.5 s at 5 ms: 100 steps, the last at 0.5 s where the outcome ends.
+    assert_eq!(seen.len(), 100);
+    assert!((seen[99].t - 0.5).abs() < 1e-12);
+    assert_eq!(seen[99].z, o.end_height);
+}
