@@ -47,14 +47,17 @@ pub fn fitness_svg(history: &[GenerationStats], title: &str) -> String {
         history.iter().map(|s| (s.generation as f64, f(s))).collect()
     };
     let (max, mean, min) = (series(|s| s.max), series(|s| s.mean), series(|s| s.min));
-    let panel = SeriesPanel::fit(60.0, 40.0, 640.0, 300.0, &[&max, &mean, &min]);
+    // 8 % headroom above the best, so its line stays clear of the frame and the axis name.
+    let top = max.iter().map(|p| p.1).filter(|v| v.is_finite()).fold(0.0, f64::max);
+    let headroom = [(0.0, 1.08 * top)];
+    let panel = SeriesPanel::fit(60.0, 40.0, 640.0, 300.0, &[&max, &mean, &min, &headroom]);
     let mut svg = Svg::new(730.0, 400.0);
     svg.text(60.0, 24.0, 14.0, title);
     svg.series_axes(&panel, "generation", "fitness");
     svg.series(&panel, &min, Stroke::dashed("#8c8c8c", 1.5));
     svg.series(&panel, &mean, Stroke::solid("#1f5fbf", 1.8));
     svg.series(&panel, &max, Stroke::solid("#141414", 2.2));
-    svg.text(560.0, 390.0, 11.0, "max — black, mean — blue, min — grey dashed");
+    svg.text(60.0, 392.0, 11.0, "max — black, mean — blue, min — grey dashed");
     svg.finish()
 }
 
@@ -111,9 +114,10 @@ mod tests {
         let svg = fitness_svg(&h, "t");
         assert!(svg.starts_with("<svg"));
         assert_eq!(svg.matches("<polyline").count(), 3);
-        // The max series' last point is the panel's top right corner: x = 60 + 640, and the
-        // value axis runs 0 … 1.1, so 1.1 sits at y = 40.
-        assert!(svg.contains("700.0,40.0"), "{svg}");
+        // The max series' last point is at the panel's right edge, x = 60 + 640; the value axis
+        // runs 0 … 1.08·1.1 = 1.188 over 300 px from y = 40, so 1.1 sits at
+        // 40 + (1.188 − 1.1)/1.188·300 = 62.2.
+        assert!(svg.contains("700.0,62.2"), "{svg}");
     }
 
     #[test]
