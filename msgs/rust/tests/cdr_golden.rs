@@ -6,6 +6,7 @@
 use byteorder::LittleEndian;
 use mobil_msgs::geometry_msgs::msg::Twist;
 use mobil_msgs::mobil_msgs::msg::{FootTouchdown, GaitPlan, TerrainAssessment};
+use mobil_msgs::mobil_msgs::srv::{PlanGaitRequest, PlanGaitResponse};
 use mobil_msgs::nav_msgs::msg::Odometry;
 use mobil_msgs::sensor_msgs::msg::{JointState, LaserScan};
 use mobil_msgs::visualization_msgs::msg::Marker;
@@ -162,6 +163,38 @@ fn gait_plan_with_sequence_of_messages_from_rclpy() {
     assert_eq!(g.steps[0].rule, 3);
     assert_eq!(g.steps[0].rule_name, "r");
     assert_eq!(g.steps[0].moving_leg, -1);
+}
+
+#[test]
+fn plan_gait_request_and_response_from_rclpy() {
+    // Request: start (0, 0, 3π/2), goal (−10, 10, 0), "B", evaluation 3, 100 000 expansions.
+    let q: PlanGaitRequest = decode(concat!(
+        "00000000000000000000000000000000d221337f7cd9124000000000000024c000000000000024400000000000000000",
+        "0200000042000354a0860100"
+    ));
+    assert_eq!((q.start.x, q.start.y, q.start.theta), (0.0, 0.0, 4.71238898038469));
+    assert_eq!((q.goal.x, q.goal.y, q.goal.z), (-10.0, 10.0, 0.0));
+    assert_eq!((q.rule_set.as_str(), q.evaluation, q.max_expansions), ("B", 3, 100_000));
+    // Response: a refused plan with one step (rule 8 moving leg 0, body x 1, leg 3's foot y −1.5).
+    let r: PlanGaitResponse = decode(concat!(
+        "0000000000000000010000000000000002000000410001000b0000007072652d656d7074656400000700000009000000",
+        "01000000080000000d0000006c656730206e6f6d696e616c0000000000000000000000000000f03f0000000000000000",
+        "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+        "00000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000f8bf",
+        "000000000000000000000000000000000000000000000440"
+    ));
+    let p = &r.plan;
+    assert_eq!(
+        (p.rule_set.as_str(), p.evaluation, p.success, p.reason.as_str()),
+        ("A", 1, false, "pre-empted")
+    );
+    assert_eq!((p.states_expanded, p.states_generated, p.steps.len()), (7, 9, 1));
+    let s = &p.steps[0];
+    assert_eq!(
+        (s.rule, s.rule_name.as_str(), s.moving_leg, s.evaluation),
+        (8, "leg0 nominal", 0, 2.5)
+    );
+    assert_eq!((s.body.x, s.feet[3].y), (1.0, -1.5));
 }
 
 #[test]

@@ -107,7 +107,15 @@ pub struct GaitConfig {
     /// to 0.04 every row of the paper's table (forward reading) plans within 5 000 expansions
     /// with the paper's trends, and 0.03, the middle, gives the fewest (B,(3): 1 208 expanded,
     /// 103 states against the paper's 100). Margin 0 reproduces the SPEC's check figures
-    /// (52 / 37 / 96 states).
+    /// (52 / 37 / 96 states). The price of any positive margin: A,(1) returns the same 37-state
+    /// plan as A,(3) (the paper has 45 against 40). At margin 0, (1), blind to leg moves, takes
+    /// the lowest-h state, reached by full √1.75 shifts that need each leg set nominal and then
+    /// to max (40 leg moves, 9 of them lifted with the centre on the triangle's edge): the
+    /// paper's redundant leg moves. A positive margin forbids those 9 lifts, and (1) falls into
+    /// the cycle (3) chooses (21 leg moves, shifts of 1, 0.51 and 1.32). Neither is the fewest:
+    /// a 20-leg plan exists (32 states, found by (1) at 0.05 and valid at 0.03), but (3)'s h
+    /// (1 per \[j\]) outweighs its cost (0.4 per leg move, about 0.6 per \[j\]), so algorithm A
+    /// is not bound to find it. The key quantum (1e-6..1e-2) changes none of this.
     pub stability_margin: f64,
     /// ΔY of rule 2 \[j\]. Default b/3 = 1 (the paper's, SPEC §7).
     pub translation_step: f64,

@@ -114,7 +114,7 @@ impl RecedingHorizon {
                 return walk;
             }
             if walk.chunks >= max_chunks {
-                walk.failure = Some(PlanFailure::ExpansionLimit(self.chunk_expansions));
+                walk.failure = Some(PlanFailure::ChunkLimit(max_chunks));
                 return walk;
             }
             let chunk = self.next_chunk(&current, goal, stop);

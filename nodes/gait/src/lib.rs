@@ -32,10 +32,16 @@
 //!   goal's side of y_r, capped at its projection. Rules 12–27 keep the other polar coordinate as
 //!   measured. A move shorter than 1e-9 is "unchanged": no successor.
 //! - **Duplicates**: the key is the body pose and the feet, each rounded to `key_quantum` (φ
-//!   modulo 2π). The first state found under a key represents it; a later duplicate is
-//!   evaluated as that state, and re-parenting changes its parent, rule and f, not the stored
-//!   state. So under (1), where f does not depend on the path, no state is re-parented, and a
-//!   plan's consecutive states are one rule apart up to the key quantum.
+//!   modulo 2π). A later duplicate is judged on the state stored under its key, so under (1),
+//!   where f does not depend on the path, no state is re-parented. **Plans are exact**: every
+//!   step's state is the one its rule makes from the previous step's state, so an executed
+//!   plan never moves a planted foot. Re-parenting stores the state the rule makes
+//!   from the new parent (and re-opens it), and a link made from a parent's older state is made
+//!   again when the plan is taken ([`search`]'s documentation). Chosen over replaying the rules
+//!   from the start at the end: a replay can fail on any step (ΔY no longer fits by 1e-4, a
+//!   lift on the margin's edge) and returns states the search never ranked. The paper's six
+//!   rows (forward reading) plan as before, with the same counts; under (3) with a coarse key (0.1) the first
+//!   state stored under a key was up to 0.025 off the rule's.
 //! - **f is compared on a 1e-7 grid** ([`search::VALUE_QUANTUM`]): (2) and (3) accumulate f
 //!   along the path, and rounding noise (1e-15..1e-12) must not break the exact ties (1) has,
 //!   so (2) expands the same states in the same order as (1) (tested).

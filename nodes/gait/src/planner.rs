@@ -34,6 +34,9 @@ pub enum PlanFailure {
     InvalidConfig(String),
     /// The goal is not a finite point.
     InvalidGoal,
+    /// A receding-horizon walk made its most short-time plans (the number) without reaching
+    /// the goal.
+    ChunkLimit(u32),
 }
 
 impl std::fmt::Display for PlanFailure {
@@ -54,6 +57,7 @@ impl std::fmt::Display for PlanFailure {
             PlanFailure::InvalidStart(why) => write!(f, "INVALID_START: {why}"),
             PlanFailure::InvalidConfig(why) => write!(f, "INVALID_CONFIG: {why}"),
             PlanFailure::InvalidGoal => f.write_str("INVALID_GOAL: the goal is not a finite point"),
+            PlanFailure::ChunkLimit(n) => write!(f, "CHUNK_LIMIT: {n} short-time plans made without reaching the goal"),
         }
     }
 }

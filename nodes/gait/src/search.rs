@@ -12,11 +12,27 @@
 //! 7. Go to 2.
 //!
 //! OPEN is a binary heap with lazy deletion: a state's entry is stale once the state is closed
-//! or re-entered under a newer generation number; both lists are one hash map on the key. The
-//! first state generated under a key represents it: a later duplicate is evaluated as that
-//! state (with its own parent and step), and re-parenting changes the parent, step and f, not
-//! the stored state. A path's consecutive states are therefore one step apart up to the key's
-//! resolution (exactly, for a problem whose key is the state itself).
+//! or re-entered under a newer generation number; both lists are one hash map on the key.
+//!
+//! **Paths are exact**: each state of a returned path is its step applied to the state before
+//! it, as [`Problem::successors`] made it, not merely a state under the same key. Two states
+//! under one key may differ (by up to the key's quantum), so:
+//! - whether a duplicate's new path is better (step 6) is judged on the state stored under the
+//!   key, so a state whose f does not depend on its path, as under (1), is never re-parented
+//!   for the difference between two copies; only a cheaper path re-parents;
+//! - re-parenting stores the successor just made (and its f) in place of the old state and
+//!   re-opens it, so the link to the new parent is exact;
+//! - the node's children made from its old state keep their parent, so each link records the
+//!   parent's state version it was made from. When the path is taken (at a goal, or the best
+//!   partial path), a link from an older version is made again: the parent's state is expanded
+//!   and the successor under the same key taken. In practice the node is re-expanded before,
+//!   and its children re-parented with the better f, so this is rare (the paper's six rows
+//!   never need it). A goal whose path cannot be made again (no successor falls under its key
+//!   any more) is no solution and the search goes on; a partial path ends at its exact prefix.
+//!
+//! Replaying every rule from the start when the path is taken would be the other way; it can
+//! fail on any link (a translation of exactly ΔY, a leg lifted on a margin's edge) and would
+//! leave the states the search stored and ranked different from those returned.
 //!
 //! ```
 //! use mobil_gait::search::{search, Problem, SearchEnd};
@@ -53,8 +69,8 @@ pub const STOP_CHECK_EVERY: u32 = 256;
 
 /// A search problem: states, their keys, successors in order, the goal test and f.
 pub trait Problem {
-    /// A state.
-    type State: Clone;
+    /// A state (compared to tell whether re-parenting changed it).
+    type State: Clone + PartialEq;
     /// The key duplicates are found by (e.g. a quantised state).
     type Key: Hash + Eq;
     /// The operator that made a successor (e.g. a rule).
@@ -102,11 +118,14 @@ pub struct PathNode<S, St> {
 #[derive(Debug, Clone)]
 pub struct SearchResult<S, St> {
     /// Start to goal, or, when no goal was found, start to the state with least
-    /// [`Problem::remaining`] among those generated (ties: the first generated).
+    /// [`Problem::remaining`] among those generated (ties: the first generated), cut after its
+    /// last exact link if a later one cannot be made again. Each state is exactly its step
+    /// applied to the one before.
     pub path: Vec<PathNode<S, St>>,
     /// Why it ended.
     pub end: SearchEnd,
-    /// States moved to CLOSED (re-expansions of reopened states included).
+    /// States expanded: moved to CLOSED and their successors generated (re-expansions of
+    /// reopened states included; the goal, closed at step 4 and never expanded, is not).
     pub expanded: u32,
     /// Successors produced by the problem (duplicates of known states included).
     pub generated: u32,
@@ -122,6 +141,10 @@ struct Node<S, St> {
     generation: u64,
     goal: bool,
     closed: bool,
+    /// Bumped each time re-parenting replaces the state.
+    version: u32,
+    /// The parent's `version` when `state` was made from it: the link is exact while they agree.
+    parent_version: u32,
 }
 
 /// An OPEN entry: least f (on the [`VALUE_QUANTUM`] grid) first, then a goal, then the oldest
@@ -198,6 +221,10 @@ pub fn rank(f: f64) -> i64 {
 /// Best-first search from `start` until a goal is taken from OPEN, OPEN is empty,
 /// `max_expansions` states have been expanded, or `stop()` returns true (asked every
 /// [`STOP_CHECK_EVERY`] expansions).
+///
+/// The returned path is exact: each state is its step applied to the state before it, as
+/// [`Problem::successors`] made it (see the module's documentation for how re-parenting keeps
+/// this, and [`SearchResult::path`] for the rare goal whose path cannot be rebuilt).
 pub fn search<P: Problem>(
     problem: &P,
     start: P::State,
@@ -223,6 +250,8 @@ pub fn search<P: Problem>(
         generation,
         goal: goal0,
         closed: false,
+        version: 0,
+        parent_version: 0,
     });
     open.push(Entry {
         value: rank(f0),
@@ -231,6 +260,7 @@ pub fn search<P: Problem>(
         node: 0,
     });
 
+    let mut goal_path = None;
     let end = loop {
         // Step 2.
         let Some(e) = open.pop() else {
@@ -243,8 +273,14 @@ pub fn search<P: Problem>(
         // Steps 3–5.
         nodes[i].closed = true;
         if nodes[i].goal {
-            best = (0.0, e.node);
-            break SearchEnd::Goal;
+            match exact_path(problem, &nodes, e.node, &mut succ) {
+                Ok(path) if path.last().is_some_and(|n| problem.is_goal(&n.state)) => {
+                    goal_path = Some(path);
+                    break SearchEnd::Goal;
+                }
+                // The goal's path cannot be rebuilt exactly: it is no solution; go on.
+                _ => continue,
+            }
         }
         if expanded >= max_expansions {
             nodes[i].closed = false;
@@ -258,7 +294,7 @@ pub fn search<P: Problem>(
         // Step 6.
         succ.clear();
         problem.successors(&nodes[i].state, &mut succ);
-        let parent_f = nodes[i].value;
+        let (parent_f, parent_version) = (nodes[i].value, nodes[i].version);
         for (step, child) in succ.drain(..) {
             generated += 1;
             let key = problem.key(&child);
@@ -281,6 +317,8 @@ pub fn search<P: Problem>(
                         generation,
                         goal,
                         closed: false,
+                        version: 0,
+                        parent_version,
                     });
                     open.push(Entry {
                         value: rank(f),
@@ -289,16 +327,28 @@ pub fn search<P: Problem>(
                         node: id,
                     });
                 }
-                Some(&id) => {
-                    // The state first found under a key represents it: f is that state's, so a
-                    // state whose f does not depend on its path, as under (1), is never
-                    // re-parented by the quantum's difference between two of its copies.
-                    let f = problem.value(&nodes[i].state, parent_f, step, &nodes[id as usize].state);
-                    let n = &mut nodes[id as usize];
-                    if rank(f) < rank(n.value) {
+                Some(&id) if id as usize != i => {
+                    // Whether the new path is better is judged on the state already stored
+                    // under the key, so a state whose f does not depend on its path, as under
+                    // (1), is never re-parented for the quantum's difference between two of its
+                    // copies; only a cheaper path re-parents.
+                    let stored = &nodes[id as usize].state;
+                    let f_path = problem.value(&nodes[i].state, parent_f, step, stored);
+                    if rank(f_path) < rank(nodes[id as usize].value) {
+                        // Re-parented, the node takes the state this step makes from its new
+                        // parent, so the link is exact; its f is that state's.
+                        let f = problem.value(&nodes[i].state, parent_f, step, &child);
                         generation += 1;
+                        let n = &mut nodes[id as usize];
+                        if n.state != child {
+                            // The copy may lie on the other side of the goal's boundary.
+                            n.goal = problem.is_goal(&child);
+                            n.state = child;
+                            n.version = n.version.wrapping_add(1);
+                        }
                         n.value = f;
                         n.parent = i as u32;
+                        n.parent_version = parent_version;
                         n.step = Some(step);
                         n.generation = generation;
                         n.closed = false;
@@ -310,24 +360,20 @@ pub fn search<P: Problem>(
                         });
                     }
                 }
+                Some(_) => {} // a state is never its own better parent
             }
         }
     };
 
-    let mut path = Vec::new();
-    let mut at = best.1;
-    // A parent chain is at most as long as the node list (a guard against a value function
-    // under which re-parenting could close a cycle).
-    while at != u32::MAX && path.len() <= nodes.len() {
-        let n = &nodes[at as usize];
-        path.push(PathNode {
-            state: n.state.clone(),
-            step: n.step,
-            value: n.value,
-        });
-        at = n.parent;
-    }
-    path.reverse();
+    let path = match goal_path {
+        Some(path) => path,
+        None => {
+            // The best partial path: exact up to the first link that cannot be rebuilt.
+            match exact_path(problem, &nodes, best.1, &mut succ) {
+                Ok(path) | Err(path) => path,
+            }
+        }
+    };
     SearchResult {
         path,
         end,
@@ -335,4 +381,60 @@ pub fn search<P: Problem>(
         generated,
         distinct: nodes.len() as u32,
     }
+}
+
+/// The path from the start to node `at`, every state exactly its step applied to the state
+/// before it. A link made from a state its parent no longer holds (the parent was re-parented
+/// to a copy within the key afterwards) is made again: the parent's current state is expanded
+/// and its successor under the same key taken (the first generated). `Err` holds the exact
+/// prefix when some successor under the key is no longer generated.
+#[allow(clippy::type_complexity)]
+fn exact_path<P: Problem>(
+    problem: &P,
+    nodes: &[Node<P::State, P::Step>],
+    at: u32,
+    succ: &mut Vec<(P::Step, P::State)>,
+) -> Result<Vec<PathNode<P::State, P::Step>>, Vec<PathNode<P::State, P::Step>>> {
+    let mut chain = Vec::new();
+    let mut n = at;
+    // A parent chain is at most as long as the node list (a guard against a value function
+    // under which re-parenting could close a cycle).
+    while n != u32::MAX && chain.len() <= nodes.len() {
+        chain.push(n);
+        n = nodes[n as usize].parent;
+    }
+    chain.reverse();
+    let mut path: Vec<PathNode<P::State, P::Step>> = Vec::with_capacity(chain.len());
+    // Whether the path's last state differs from the one its node stores (it was made again).
+    let mut rebuilt = false;
+    for (k, &id) in chain.iter().enumerate() {
+        let node = &nodes[id as usize];
+        let exact = k == 0 || (!rebuilt && node.parent_version == nodes[chain[k - 1] as usize].version);
+        if exact {
+            path.push(PathNode {
+                state: node.state.clone(),
+                step: node.step,
+                value: node.value,
+            });
+            continue;
+        }
+        let Some(prev) = path.last() else {
+            return Err(path);
+        };
+        succ.clear();
+        problem.successors(&prev.state, succ);
+        let key = problem.key(&node.state);
+        let Some(pos) = succ.iter().position(|(_, s)| problem.key(s) == key) else {
+            return Err(path);
+        };
+        let (step, state) = succ.swap_remove(pos);
+        let value = problem.value(&prev.state, prev.value, step, &state);
+        rebuilt = state != node.state;
+        path.push(PathNode {
+            state,
+            step: Some(step),
+            value,
+        });
+    }
+    Ok(path)
 }

@@ -821,6 +821,13 @@ pub fn status_message(view: &StatusView, stamp: Time, frame: &str) -> NavStatus 
         alpha: 0.0,
         theta: 0.0,
         lyapunov: 0.0,
+        psi_z: f64::NAN,
+        chi_length: f64::NAN,
+        chi_danger: f64::NAN,
+        chi_control: f64::NAN,
+        chi_smoothness: f64::NAN,
+        virtual_robots: 0,
+        candidates: 0,
     }
 }
 

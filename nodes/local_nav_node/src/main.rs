@@ -279,7 +279,7 @@ async fn event_loop(
             Event::Config(Err(e)) => warn!("parameters not applied: {e}"),
             Event::Odom(m) => shell.odom_in(out, &m),
             Event::Scan(m) => {
-                let skipped = poll_tf_static(laser, tf_sub);
+                let skipped = laser.take_all(tf_sub);
                 if skipped > 0 {
                     warn_throttled!(
                         shell.throttle,
@@ -302,20 +302,6 @@ async fn event_loop(
 }
 
 type TFMessageAlias = mobil_msgs::tf2_msgs::msg::TFMessage;
-
-/// Takes every `tf_static` message waiting (non-blocking); returns how many transforms were
-/// skipped as invalid (an undecodable sample counts as one).
-fn poll_tf_static(frames: &mut StaticFrames, sub: &Subscription<TFMessageAlias>) -> usize {
-    let mut skipped = 0;
-    loop {
-        match sub.take() {
-            Ok(Some((msg, _))) => skipped += frames.add(&msg),
-            Ok(None) => break,
-            Err(_) => skipped += 1,
-        }
-    }
-    skipped
-}
 
 impl Shell {
     fn reconfigure(&mut self, c: LocalNavConfig) {

@@ -107,6 +107,21 @@ impl StaticFrames {
         skipped
     }
 
+    /// Takes every `tf_static` message waiting on `sub` (non-blocking) and [`add`s](Self::add)
+    /// it; returns how many transforms were skipped as invalid (an undecodable sample counts as
+    /// one).
+    pub fn take_all(&mut self, sub: &Subscription<TFMessage>) -> usize {
+        let mut skipped = 0;
+        loop {
+            match sub.take() {
+                Ok(Some((msg, _))) => skipped += self.add(&msg),
+                Ok(None) => break,
+                Err(_) => skipped += 1,
+            }
+        }
+        skipped
+    }
+
     /// The chain from `frame` up to its root: (root, root_from_frame); `None` when the chain
     /// loops (a → b → a), which no tree has.
     fn to_root(&self, frame: &str) -> Option<(String, Pose2)> {
@@ -183,15 +198,7 @@ impl LaserPose {
     /// Takes every message waiting on `sub` (non-blocking); returns how many transforms were
     /// skipped as invalid. A sample that cannot be decoded is skipped too (counted as one).
     pub fn poll(&mut self, sub: &Subscription<TFMessage>) -> usize {
-        let mut skipped = 0;
-        loop {
-            match sub.take() {
-                Ok(Some((msg, _))) => skipped += self.add(&msg),
-                Ok(None) => break,
-                Err(_) => skipped += 1,
-            }
-        }
-        skipped
+        self.frames.take_all(sub)
     }
 
     /// The laser pose in the base frame and where it comes from; `None` while neither

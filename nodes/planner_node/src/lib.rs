@@ -35,6 +35,10 @@ use thiserror::Error;
 
 pub use mobil_local_nav_node::{duration_msg, odom_pose, seconds, CommandGate, OdomError};
 
+pub mod vfo;
+
+pub use vfo::{VfoSettings, WaypointMethod};
+
 /// Everything the node is configured with, each field filled by one declared parameter.
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct PlannerConfig {
@@ -74,6 +78,10 @@ pub struct PlannerConfig {
     pub odom_frame: String,
     /// The robot frame (reference point).
     pub base_frame: String,
+    /// How `waypoints` and `follow_waypoints` are followed.
+    pub waypoint_method: WaypointMethod,
+    /// VFO waypoint following's settings.
+    pub vfo: VfoSettings,
 }
 
 /// The largest `odom_timeout_s` (s).
@@ -273,6 +281,7 @@ impl Config for PlannerConfig {
             c.base_frame = v
         })
         .read_only();
+        vfo::declare_vfo(d);
     }
 
     fn validate(&self) -> Result<(), ConfigError> {
@@ -281,6 +290,19 @@ impl Config for PlannerConfig {
         self.docking.validate().map_err(ConfigError::inconsistent)?;
         self.follow.validate().map_err(ConfigError::inconsistent)?;
         self.route_check().validate().map_err(ConfigError::inconsistent)?;
+        self.vfo.gains.validate().map_err(ConfigError::inconsistent)?;
+        mobil_planner::vfo::VfoWaypoint::new(0.0, 0.0, 0.0, self.vfo.guiding).map_err(ConfigError::inconsistent)?;
+        self.vfo.optimise.validate().map_err(ConfigError::inconsistent)?;
+        self.vfo
+            .scan_config(self.robot_radius)
+            .validate()
+            .map_err(ConfigError::inconsistent)?;
+        if !matches!(self.vfo.laser_pose.len(), 0 | 3) {
+            return Err(ConfigError::inconsistent(format!(
+                "vfo.laser_pose has {} values: give x, y, yaw (3) or none",
+                self.vfo.laser_pose.len()
+            )));
+        }
         Ok(())
     }
 }
@@ -435,13 +457,7 @@ impl Route {
         self.poses
             .iter()
             .enumerate()
-            .find(|(_, p)| {
-                let q = &p.pose.orientation;
-                let unset = q.x == 0.0 && q.y == 0.0 && q.z == 0.0 && q.w == 0.0;
-                let identity =
-                    q.x.abs() < 1e-6 && q.y.abs() < 1e-6 && q.z.abs() < 1e-6 && (q.w.abs() - 1.0).abs() < 1e-6;
-                !(unset || identity)
-            })
+            .find(|(_, p)| vfo::oriented(&p.pose.orientation))
             .map(|(i, _)| i)
     }
 }
@@ -576,6 +592,8 @@ pub enum Mode {
     Rotate,
     /// Following waypoints by the goal approach.
     Approach,
+    /// Following waypoints by VFO (SPEC §5).
+    Vfo,
     /// Backing out of the dock.
     Undock,
 }
@@ -589,6 +607,7 @@ impl Mode {
             Mode::Dock => "dock",
             Mode::Rotate => "rotate",
             Mode::Approach => "approach",
+            Mode::Vfo => "vfo",
             Mode::Undock => "undock",
         }
     }
@@ -620,10 +639,13 @@ impl Missed {
         match (self.pre_check, self.kind) {
             (true, ProblemKind::Unreachable(UnreachableCause::Blocked { .. })) => 206,
             (true, _) => 208,
-            (false, _) => 105,
+            (false, _) => MISSED_BY_THE_RUN,
         }
     }
 }
+
+/// The MissedWaypoint code of a waypoint the run gave up: FollowPath's FAILED_TO_MAKE_PROGRESS.
+pub const MISSED_BY_THE_RUN: u16 = 105;
 
 /// How a goal ended.
 #[derive(Debug, Clone, PartialEq)]
@@ -668,6 +690,29 @@ pub enum Outcome {
     },
     /// No valid odometry for `odom_timeout_s`.
     Stale,
+    /// No valid scan for `vfo.scan_timeout_s` (a VFO route).
+    ScanStale,
+    /// VFO: no left/right decisions take the robot to waypoint `index` without a collision
+    /// (none found within the caps): the robot stopped where the segment began.
+    NoSafePath {
+        /// The waypoint (request index).
+        index: usize,
+        /// Virtual robots simulated by the optimisation that found none.
+        virtual_robots: usize,
+        /// The waypoints not reached (request indices).
+        unreached: Vec<usize>,
+    },
+    /// VFO: the robot is inside the forbidden zone (d ≤ r) of an obstacle seen on the way.
+    Collision {
+        /// The obstacle's centre (odom).
+        centre: Point2<f64>,
+        /// Its forbidden radius r (m).
+        radius: f64,
+        /// The robot's distance to the centre (m).
+        distance: f64,
+        /// The waypoints not reached (request indices).
+        unreached: Vec<usize>,
+    },
     /// The client canceled.
     Canceled,
     /// A newer goal took over.
@@ -691,7 +736,9 @@ impl Outcome {
             Outcome::Stalled { .. } => "STALLED",
             Outcome::RouteInfeasible(_) => "ROUTE_INFEASIBLE",
             Outcome::UndockTimeout { .. } => "TIME_LIMIT",
-            Outcome::Stale => "STALE_INPUT",
+            Outcome::Stale | Outcome::ScanStale => "STALE_INPUT",
+            Outcome::NoSafePath { .. } => "NO_SAFE_PATH",
+            Outcome::Collision { .. } => "COLLISION",
             Outcome::Canceled => "CANCELED",
             Outcome::Preempted(_) => "PREEMPTED",
             Outcome::Invalid(_) => "INVALID_GOAL",
@@ -747,6 +794,23 @@ impl Outcome {
                 format!("not undocked within max_undocking_time {limit:.1} s (backed out {distance:.3} m)")
             }
             Outcome::Stale => "odom stale: robot stopped".to_owned(),
+            Outcome::ScanStale => "scan stale: the obstacles are unknown, robot stopped".to_owned(),
+            Outcome::NoSafePath {
+                index, virtual_robots, ..
+            } => format!(
+                "no left/right decisions round the obstacles take the robot to waypoint {index} without a \
+                 collision ({virtual_robots} virtual robots simulated): robot stopped"
+            ),
+            Outcome::Collision {
+                centre,
+                radius,
+                distance,
+                ..
+            } => format!(
+                "the robot is {distance:.2} m from the centre of the obstacle at ({:.2}, {:.2}), inside its \
+                 forbidden radius r = {radius:.2} m (an obstacle seen too late or moving): robot stopped",
+                centre.x, centre.y
+            ),
             Outcome::Canceled => "canceled by the client".to_owned(),
             Outcome::Preempted(by) => format!("preempted by a newer goal ({by})"),
             Outcome::Invalid(e) => e.to_string(),
@@ -774,9 +838,11 @@ impl Outcome {
     /// DOCK_NOT_VALID for a bad pose; UNKNOWN at shutdown; NONE otherwise.
     pub fn dock_result(&self) -> DockRobotResult {
         let error_code = match self {
-            Outcome::DockingFailed(..) | Outcome::ResidualStall(_) | Outcome::Stale | Outcome::Refused(_) => {
-                DockRobotResult::FAILED_TO_CONTROL
-            }
+            Outcome::DockingFailed(..)
+            | Outcome::ResidualStall(_)
+            | Outcome::Stale
+            | Outcome::ScanStale
+            | Outcome::Refused(_) => DockRobotResult::FAILED_TO_CONTROL,
             Outcome::Invalid(GoalError::NoDockDatabase) => DockRobotResult::DOCK_NOT_IN_DB,
             Outcome::Invalid(_) => DockRobotResult::DOCK_NOT_VALID,
             Outcome::ShuttingDown => DockRobotResult::UNKNOWN,
@@ -794,7 +860,7 @@ impl Outcome {
     /// UNKNOWN at shutdown; NONE otherwise.
     pub fn undock_result(&self) -> UndockRobotResult {
         let error_code = match self {
-            Outcome::UndockTimeout { .. } | Outcome::Stale | Outcome::Refused(_) => {
+            Outcome::UndockTimeout { .. } | Outcome::Stale | Outcome::ScanStale | Outcome::Refused(_) => {
                 UndockRobotResult::FAILED_TO_CONTROL
             }
             Outcome::ShuttingDown => UndockRobotResult::UNKNOWN,
@@ -821,19 +887,31 @@ impl Outcome {
         };
         let error_code = match self {
             Outcome::RouteDone { .. } | Outcome::Canceled | Outcome::Preempted(_) => FollowWaypointsResult::NONE,
-            Outcome::RouteInfeasible(_) | Outcome::Stalled { .. } | Outcome::Stale | Outcome::Refused(_) => {
-                FollowWaypointsResult::TASK_EXECUTOR_FAILED
-            }
+            Outcome::RouteInfeasible(_)
+            | Outcome::Stalled { .. }
+            | Outcome::Stale
+            | Outcome::ScanStale
+            | Outcome::Refused(_)
+            | Outcome::NoSafePath { .. }
+            | Outcome::Collision { .. } => FollowWaypointsResult::TASK_EXECUTOR_FAILED,
             _ => FollowWaypointsResult::UNKNOWN,
+        };
+        // A VFO route that ended early: the waypoints it did not reach, as FollowPath's
+        // FAILED_TO_MAKE_PROGRESS (the run gave them up).
+        let unreached: &[usize] = match self {
+            Outcome::NoSafePath { unreached, .. } | Outcome::Collision { unreached, .. } => unreached,
+            _ => &[],
         };
         FollowWaypointsResult {
             missed_waypoints: missed
                 .iter()
+                .map(|m| (m.index, m.error_code()))
+                .chain(unreached.iter().map(|&i| (i, MISSED_BY_THE_RUN)))
                 .take(MAX_RESULT_MISSED)
-                .map(|m| MissedWaypoint {
-                    index: u32::try_from(m.index).unwrap_or(u32::MAX),
-                    goal: poses.get(m.index).cloned().unwrap_or_default(),
-                    error_code: m.error_code(),
+                .map(|(index, error_code)| MissedWaypoint {
+                    index: u32::try_from(index).unwrap_or(u32::MAX),
+                    goal: poses.get(index).cloned().unwrap_or_default(),
+                    error_code,
                 })
                 .collect(),
             error_code,
@@ -979,6 +1057,8 @@ pub struct StatusView {
     /// The docking's e, α, Θ and V: `None` when not docking (sent as zeros); NaN while docking
     /// before the first pose is known.
     pub docking: Option<[f64; 4]>,
+    /// A VFO route's current segment: `None` otherwise (Ψ_z and the χ's sent as NaN, counts 0).
+    pub vfo: Option<vfo::SegmentReport>,
 }
 
 /// The NavStatus message of a view, stamped `stamp`, in `frame`.
@@ -992,6 +1072,8 @@ pub fn status_message(view: &StatusView, stamp: Time, frame: &str) -> NavStatus 
         |g| pose_msg(&g),
     );
     let [e, alpha, theta, lyapunov] = view.docking.unwrap_or_default();
+    let segment = view.vfo.unwrap_or_default();
+    let [chi_length, chi_danger, chi_control, chi_smoothness] = segment.indices;
     NavStatus {
         header: Header {
             stamp,
@@ -1011,6 +1093,13 @@ pub fn status_message(view: &StatusView, stamp: Time, frame: &str) -> NavStatus 
         alpha,
         theta,
         lyapunov,
+        psi_z: segment.psi_z,
+        chi_length,
+        chi_danger,
+        chi_control,
+        chi_smoothness,
+        virtual_robots: u32::try_from(segment.virtual_robots).unwrap_or(u32::MAX),
+        candidates: u32::try_from(segment.candidates).unwrap_or(u32::MAX),
     }
 }
 
@@ -1051,6 +1140,10 @@ pub struct MarkerView<'a> {
     pub problems: &'a [Missed],
     /// The dock pose.
     pub dock: Option<Pose2>,
+    /// A VFO route's last optimisation.
+    pub vfo: Option<&'a vfo::VfoDrawing>,
+    /// The robot's position: the obstacles nearest to it are drawn first.
+    pub robot: Option<Point2<f64>>,
 }
 
 /// The marker array: a DELETEALL first (so nothing stale stays), the route as a LINE_STRIP and
@@ -1111,7 +1204,79 @@ pub fn markers(view: &MarkerView<'_>, stamp: Time, frame: &str) -> MarkerArray {
         };
         out.push(arrow);
     }
+    if let Some(drawing) = view.vfo {
+        vfo_markers(&header, drawing, view.robot, &mut out);
+    }
     MarkerArray { markers: out }
+}
+
+/// A VFO optimisation's markers: each virtual robot's path a thin LINE_STRIP (`vfo_robots`,
+/// grey; orange where the path was dropped on a collision or the time cap), the chosen path a
+/// thick green one (`vfo_chosen`), each obstacle (at most [`vfo::MAX_DRAWN_OBSTACLES`], the
+/// nearest to `robot` first) a red CYLINDER of radius r (`vfo_forbidden`) inside a pale yellow
+/// one of radius R (`vfo_influence`).
+fn vfo_markers(header: &Header, drawing: &vfo::VfoDrawing, robot: Option<Point2<f64>>, out: &mut Vec<Marker>) {
+    for (i, r) in drawing.robots.iter().enumerate() {
+        let id = i32::try_from(i).unwrap_or(i32::MAX);
+        let c = if r.dropped {
+            color(1.0, 0.5, 0.0)
+        } else {
+            color(0.6, 0.6, 0.6)
+        };
+        let mut line = marker(header, "vfo_robots", id, Marker::LINE_STRIP, 0.01, c);
+        line.points = r.points.iter().map(|p| point(*p)).collect();
+        out.push(line);
+    }
+    if !drawing.chosen.is_empty() {
+        let mut line = marker(header, "vfo_chosen", 0, Marker::LINE_STRIP, 0.04, color(0.0, 0.9, 0.2));
+        line.points = drawing.chosen.iter().map(|p| point(*p)).collect();
+        out.push(line);
+    }
+    let mut order: Vec<usize> = (0..drawing.obstacles.len()).collect();
+    if let Some(at) = robot {
+        order.sort_by(|&a, &b| {
+            drawing.obstacles[a]
+                .distance(&at)
+                .total_cmp(&drawing.obstacles[b].distance(&at))
+        });
+    }
+    for (k, &i) in order.iter().take(vfo::MAX_DRAWN_OBSTACLES).enumerate() {
+        let o = &drawing.obstacles[i];
+        let id = i32::try_from(k).unwrap_or(i32::MAX);
+        for (ns, radius, height, c) in [
+            (
+                "vfo_influence",
+                o.influence_radius(),
+                0.02,
+                ColorRGBA {
+                    r: 1.0,
+                    g: 0.9,
+                    b: 0.2,
+                    a: 0.25,
+                },
+            ),
+            (
+                "vfo_forbidden",
+                o.forbidden_radius(),
+                0.05,
+                ColorRGBA {
+                    r: 0.9,
+                    g: 0.1,
+                    b: 0.1,
+                    a: 0.6,
+                },
+            ),
+        ] {
+            let mut disc = marker(header, ns, id, Marker::CYLINDER, 0.0, c);
+            disc.pose.position = point(o.centre());
+            disc.scale = Vector3 {
+                x: 2.0 * radius,
+                y: 2.0 * radius,
+                z: height,
+            };
+            out.push(disc);
+        }
+    }
 }
 
 fn clear_marker(header: &Header) -> Marker {
@@ -1522,6 +1687,7 @@ mod tests {
             predicted: &predicted,
             problems: &problems,
             dock: Some(Pose2::new(1.0, 2.0, 0.5)),
+            ..MarkerView::default()
         };
         let a = markers(&view, Time::default(), "odom");
         // DELETEALL, route line and dots, predicted path, 50 problems × 2, the dock arrow.
@@ -1567,6 +1733,7 @@ mod tests {
             reason: String::new(),
             waypoint_index: -1,
             docking: Some([1.0, 0.5, -0.25, 0.7]),
+            vfo: None,
         };
         let m = status_message(&view, Time::default(), "odom");
         assert_eq!(m.mode, "dock");
@@ -1578,6 +1745,7 @@ mod tests {
             goal: None,
             waypoint_index: 3,
             docking: None,
+            vfo: None,
             ..view
         };
         let m = status_message(&idle, Time::default(), "odom");

@@ -1,8 +1,11 @@
 //! `planner_node`: MOBIL-II's HIGH-LEVEL, the shell of [`mobil_planner`]. Lyapunov docking onto
 //! a pose (`dock_pose`, Nav2's `dock_robot`), backing out of a dock (`undock_robot`), and
-//! waypoint following by the goal approach (`waypoints`, Nav2's `follow_waypoints`), each route
+//! waypoint following (`waypoints`, Nav2's `follow_waypoints`) by the goal approach, each route
 //! first driven by a virtual robot against the known map (the pre-check, also served as
-//! `planner/check_route`). Every source feeds one session: a new goal from any of them
+//! `planner/check_route`), or with `waypoint_method: vfo` by VFO round the obstacles the LIDAR
+//! sees (`scan`), each segment's left/right decisions optimised by virtual robots
+//! ([`mobil_planner_node::vfo`]: the ticks run off the event loop and the robot stops while a
+//! segment is optimised). Every source feeds one session: a new goal from any of them
 //! pre-empts the running one.
 //!
 //! **One step per odometry message**: each valid `odom` (50 Hz from chassis_node) is one
@@ -20,6 +23,7 @@
 use futures::StreamExt;
 use mobil_chassis::{BodyTwist, ChassisParams};
 use mobil_geom::Pose2;
+use mobil_local_nav_node::scan_laser_pose;
 use mobil_msgs::geometry_msgs::msg::{PoseStamped, Twist};
 use mobil_msgs::mobil_msgs::msg::NavStatus;
 use mobil_msgs::mobil_msgs::srv::{CheckRoute, CheckRouteRequest, CheckRouteResponse};
@@ -28,10 +32,17 @@ use mobil_msgs::nav2_msgs::action::{
     UndockRobot, UndockRobotFeedback, UndockRobotGoal,
 };
 use mobil_msgs::nav_msgs::msg::{Odometry, Path};
+use mobil_msgs::sensor_msgs::msg::LaserScan;
+use mobil_msgs::tf2_msgs::msg::TFMessage;
 use mobil_msgs::visualization_msgs::msg::MarkerArray;
+use mobil_planner::vfo::{ObstacleMap, OptimiseWarning, VfoEnd, VfoEvent, VfoFollower, VfoOutput};
 use mobil_planner::{
     check_route_until, polar_error, DockingController, DockingOutput, DockingPhase, Finish, FollowEnd, FollowEvent,
-    ProblemKind, RouteReport, VelocityLimits, WaypointFollower,
+    PlannerError, ProblemKind, RouteReport, VelocityLimits, WaypointFollower,
+};
+use mobil_planner_node::vfo::{
+    segment_report, vfo_command, vfo_drawing, vfo_gains, vfo_waypoints, Handback, SegmentReport, VfoDrawing, VfoSlot,
+    WaypointMethod,
 };
 use mobil_planner_node::{
     backed_out, check_reply, clamp_twist, dock_goal, docking_offset, docking_outcome, duration_msg, load_world,
@@ -41,6 +52,7 @@ use mobil_planner_node::{
 use mobil_ros::action::{ActionEvent, GoalEnd, GoalRequest, GoalServer, GoalServerConfig};
 use mobil_ros::input::{decoded, Input};
 use mobil_ros::latest::Latest;
+use mobil_ros::scan::{scan_from_msg, tf_static_subscription, StaticFrames};
 use mobil_ros::stop::{final_stop, FINAL_STOP_WAIT};
 use mobil_ros::ticker::Ticker;
 use mobil_ros::time::{DtClock, DtError};
@@ -48,7 +60,7 @@ use mobil_ros::OffLoop;
 use mobil_ros::{qos, run_node, shutdown_signal, warn_throttled, ConfigError, LogThrottle, NodeDecl, RosNode};
 use mobil_sim::world::World;
 use nalgebra::Point2;
-use ros2_client::{Publisher, RmwRequestId, Server};
+use ros2_client::{Publisher, RmwRequestId, Server, Subscription};
 use std::process::ExitCode;
 use std::sync::Arc;
 use std::time::{Duration, Instant};
@@ -76,8 +88,8 @@ fn decl() -> NodeDecl {
     NodeDecl::for_config::<PlannerConfig>(
         "planner",
         "HIGH-LEVEL planner: Lyapunov docking (dock_pose, dock_robot), undocking (undock_robot), waypoint \
-         following by the goal approach after a route pre-check (waypoints, follow_waypoints, \
-         planner/check_route); cmd_vel out",
+         following by the goal approach after a route pre-check or by VFO round the obstacles in scan \
+         (waypoint_method; waypoints, follow_waypoints, planner/check_route); cmd_vel out",
     )
 }
 
@@ -130,6 +142,22 @@ enum Task {
         limit_s: f64,
         backed: f64,
     },
+    /// VFO waypoint following: the follower at home or out on a tick ([`VfoSlot`]).
+    Vfo {
+        slot: VfoSlot,
+        route: Route,
+        /// The goal's number: a tick's result for another goal is dropped.
+        seq: u64,
+        /// The steered point's offset behind the reference point ([`docking_offset`]).
+        offset: f64,
+        /// The waypoint pursued (route index) and ‖e*‖ to it.
+        index: usize,
+        distance: f64,
+        report: SegmentReport,
+        /// The obstacle map changed since the follower last saw it (`Some(true)`: with new
+        /// obstacles, which re-optimise the segment).
+        obstacles_changed: Option<bool>,
+    },
 }
 
 struct Active {
@@ -157,6 +185,7 @@ impl Active {
             Task::PreCheck { .. } => Mode::PreCheck,
             Task::Follow { .. } => Mode::Approach,
             Task::Undock { .. } => Mode::Undock,
+            Task::Vfo { .. } => Mode::Vfo,
         }
     }
 }
@@ -185,10 +214,20 @@ struct PreCheckDone {
 /// stopped); service requests beyond the rest are answered BUSY at once.
 const MAX_CHECKS: usize = 4;
 
+/// One VFO tick done on the blocking pool: the follower back, its output, and when the tick
+/// optimised, what the status and markers show of it.
+struct VfoTickDone {
+    seq: u64,
+    follower: Box<VfoFollower>,
+    output: Result<VfoOutput, PlannerError>,
+    optimised: Option<(SegmentReport, VfoDrawing)>,
+}
+
 /// The pre-checks off the event loop: the goal's (a newer goal stops the older one's) and
-/// the service's (each request answered, in any order).
+/// the service's (each request answered, in any order); the VFO ticks.
 struct Jobs {
     goal: OffLoop<PreCheckDone>,
+    vfo: OffLoop<VfoTickDone>,
     seq: u64,
     replies_tx: mpsc::UnboundedSender<(RmwRequestId, CheckRouteResponse)>,
     replies: mpsc::UnboundedReceiver<(RmwRequestId, CheckRouteResponse)>,
@@ -202,6 +241,7 @@ struct Drawing {
     predicted: Vec<Pose2>,
     problems: Vec<Missed>,
     dock: Option<Pose2>,
+    vfo: Option<VfoDrawing>,
 }
 
 /// Everything the loop holds between events.
@@ -217,6 +257,12 @@ struct Shell {
     drawing: Drawing,
     gate: CommandGate,
     throttle: LogThrottle,
+    /// Obstacles seen by the LIDAR, in odom (VFO); kept between goals.
+    map: ObstacleMap,
+    /// When the last valid scan arrived.
+    scan_seen: Latest<()>,
+    /// The laser's pose from `tf_static`.
+    laser: StaticFrames,
 }
 
 #[allow(clippy::large_enum_variant)]
@@ -224,6 +270,8 @@ enum Event {
     Shutdown,
     Config(Result<PlannerConfig, ConfigError>),
     Odom(Odometry),
+    Scan(LaserScan),
+    VfoTicked(VfoTickDone),
     DockPose(PoseStamped),
     Waypoints(Path),
     Dock(ActionEvent<DockRobotGoal>),
@@ -258,6 +306,10 @@ async fn start(node: &mut RosNode, out: &Outputs, config: PlannerConfig) -> anyh
     let odom_sub = node.subscription::<Odometry>("odom", &qos::default_qos())?;
     let dock_sub = node.subscription::<PoseStamped>("dock_pose", &qos::default_qos())?;
     let route_sub = node.subscription::<Path>("waypoints", &qos::default_qos())?;
+    let scan_sub = node.subscription::<LaserScan>("scan", &qos::sensor_data())?;
+    let tf_sub = tf_static_subscription(node)?;
+    let map = ObstacleMap::new(config.vfo.scan_config(config.robot_radius))
+        .map_err(|e| anyhow::anyhow!("vfo obstacle extraction: {e}"))?;
     let check = node.service::<CheckRoute>("planner/check_route")?;
     let server_config = GoalServerConfig {
         result_timeout: config.result_timeout(),
@@ -291,11 +343,15 @@ async fn start(node: &mut RosNode, out: &Outputs, config: PlannerConfig) -> anyh
         drawing: Drawing::default(),
         gate: CommandGate::default(),
         throttle: LogThrottle::new(Duration::from_secs(2)),
+        map,
+        scan_seen: Latest::new(),
+        laser: StaticFrames::default(),
     };
     shell.send_idle_status(node, out);
     let (replies_tx, replies) = mpsc::unbounded_channel();
     let mut jobs = Jobs {
         goal: OffLoop::new(),
+        vfo: OffLoop::new(),
         seq: 0,
         replies_tx,
         replies,
@@ -308,9 +364,11 @@ async fn start(node: &mut RosNode, out: &Outputs, config: PlannerConfig) -> anyh
         &mut servers,
         &mut jobs,
         (&odom_sub, &dock_sub, &route_sub),
+        (&scan_sub, &tf_sub),
         &check,
     )
     .await;
+    jobs.vfo.cancel();
     // A goal under way (a pre-check included: a command may be in flight from a goal it
     // pre-empted) ends, and its zero command, waited for, goes out before anything that may
     // take time; then the three servers close at once (each waits up to 2 s for its results).
@@ -341,14 +399,16 @@ async fn event_loop(
         &ros2_client::Subscription<PoseStamped>,
         &ros2_client::Subscription<Path>,
     ),
+    (scan_sub, tf_sub): (&Subscription<LaserScan>, &Subscription<TFMessage>),
     check: &Server<CheckRouteRequest, CheckRouteResponse>,
 ) -> anyhow::Result<()> {
     let odoms = decoded(odom_sub.async_stream(), "odom", "odom-read", "sample ignored");
     let docks = decoded(dock_sub.async_stream(), "dock_pose", "dock-read", "goal ignored");
     let routes = decoded(route_sub.async_stream(), "waypoints", "route-read", "route ignored");
+    let scans = decoded(scan_sub.async_stream(), "scan", "scan-read", "scan ignored");
     let requests = check.receive_request_stream();
     let shutdown = shutdown_signal();
-    tokio::pin!(odoms, docks, routes, requests, shutdown);
+    tokio::pin!(odoms, docks, routes, scans, requests, shutdown);
     let mut ticker = Ticker::new(WATCHDOG_RATE_HZ)?;
     loop {
         let event = tokio::select! {
@@ -358,6 +418,11 @@ async fn event_loop(
                 Some(Input::Message(m)) => Event::Odom(m),
                 Some(Input::Undecodable) => Event::Nothing,
                 None => anyhow::bail!("the odom subscription ended"),
+            },
+            m = scans.next() => match m {
+                Some(Input::Message(m)) => Event::Scan(m),
+                Some(Input::Undecodable) => Event::Nothing,
+                None => anyhow::bail!("the scan subscription ended"),
             },
             m = docks.next() => match m {
                 Some(Input::Message(m)) => Event::DockPose(m),
@@ -378,6 +443,7 @@ async fn event_loop(
                 None => anyhow::bail!("the planner/check_route service ended"),
             },
             done = jobs.goal.result() => Event::PreChecked(done),
+            done = jobs.vfo.result() => Event::VfoTicked(done),
             Some((id, reply)) = jobs.replies.recv() => Event::Checked(id, reply),
             e = servers.dock.next_event() => Event::Dock(e),
             e = servers.undock.next_event() => Event::Undock(e),
@@ -389,7 +455,19 @@ async fn event_loop(
             Event::Nothing => {}
             Event::Config(Ok(c)) => shell.reconfigure(c),
             Event::Config(Err(e)) => warn!("parameters not applied: {e}"),
-            Event::Odom(m) => shell.odom_in(node, out, servers, &m),
+            Event::Odom(m) => shell.odom_in(node, out, servers, jobs, &m),
+            Event::Scan(m) => {
+                let skipped = shell.laser.take_all(tf_sub);
+                if skipped > 0 {
+                    warn_throttled!(
+                        shell.throttle,
+                        "tf-static",
+                        "{skipped} invalid tf_static transform(s) skipped"
+                    );
+                }
+                shell.scan_in(&m);
+            }
+            Event::VfoTicked(done) => shell.vfo_ticked(node, out, servers, done),
             Event::DockPose(m) => {
                 let target = dock_goal(&m, &shell.config.odom_frame);
                 shell.new_goal(node, out, servers, Source::DockPose).await;
@@ -498,6 +576,16 @@ fn goal_end(outcome: &Outcome) -> GoalEnd {
 
 impl Shell {
     fn reconfigure(&mut self, c: PlannerConfig) {
+        let scan = c.vfo.scan_config(c.robot_radius);
+        if scan != self.config.vfo.scan_config(self.config.robot_radius) {
+            match ObstacleMap::new(scan) {
+                Ok(map) => {
+                    info!("vfo obstacle extraction changed: the obstacle map starts afresh");
+                    self.map = map;
+                }
+                Err(e) => return warn!("parameters not applied: {e}"),
+            }
+        }
         match c.chassis_params() {
             Ok(chassis) => {
                 self.chassis = chassis;
@@ -555,6 +643,7 @@ impl Shell {
             reason: String::new(),
             waypoint_index: -1,
             docking: None,
+            vfo: None,
         };
         self.send_status(node, out, &view);
     }
@@ -570,6 +659,7 @@ impl Shell {
                 reason,
                 waypoint_index: -1,
                 docking: None,
+                vfo: None,
             };
         };
         let (goal, distance, index, docking) = match &active.task {
@@ -608,6 +698,18 @@ impl Shell {
                 )
             }
             Task::Undock { distance, backed, .. } => (None, distance - backed, -1, None),
+            Task::Vfo {
+                route, index, distance, ..
+            } => {
+                let i = (*index).min(route.points.len().saturating_sub(1));
+                let request = route.request_index.get(i).copied().unwrap_or(0);
+                (
+                    route.points.get(i).map(|p| Pose2::new(p.x, p.y, 0.0)),
+                    *distance,
+                    i32::try_from(request).unwrap_or(i32::MAX),
+                    None,
+                )
+            }
             Task::PreCheck { route, .. } => (
                 route.points.first().map(|p| Pose2::new(p.x, p.y, 0.0)),
                 f64::NAN,
@@ -618,6 +720,10 @@ impl Shell {
                 None,
             ),
         };
+        let vfo = match &active.task {
+            Task::Vfo { report, .. } => Some(*report),
+            _ => None,
+        };
         StatusView {
             state,
             mode: active.mode(),
@@ -626,6 +732,7 @@ impl Shell {
             reason,
             waypoint_index: index,
             docking,
+            vfo,
         }
     }
 
@@ -644,6 +751,7 @@ impl Shell {
             reason: outcome.reason(),
             waypoint_index: -1,
             docking: None,
+            vfo: None,
         };
         self.send_status(node, out, &view);
     }
@@ -654,6 +762,8 @@ impl Shell {
             predicted: &self.drawing.predicted,
             problems: &self.drawing.problems,
             dock: self.drawing.dock,
+            vfo: self.drawing.vfo.as_ref(),
+            robot: self.odom.value().map(|p| p.position()),
         };
         let array = markers(&view, node.stamp(), &self.config.odom_frame);
         if let Err(e) = out.markers.publish(array) {
@@ -686,7 +796,7 @@ impl Shell {
             (Source::FollowAction, Task::Follow { route, missed, .. }) => {
                 servers.follow.finish(end, outcome.follow_result(&route.poses, missed));
             }
-            (Source::FollowAction, Task::PreCheck { route, .. }) => {
+            (Source::FollowAction, Task::PreCheck { route, .. } | Task::Vfo { route, .. }) => {
                 servers.follow.finish(end, outcome.follow_result(&route.poses, &[]));
             }
             (Source::FollowAction, _) => {
@@ -841,6 +951,10 @@ impl Shell {
             Ok(r) => r,
             Err(e) => return self.refuse(node, out, servers, source, Outcome::Invalid(e)),
         };
+        if self.config.waypoint_method == WaypointMethod::Vfo {
+            jobs.seq += 1;
+            return self.start_vfo(node, out, servers, route, start, source, jobs.seq);
+        }
         if let Some(i) = route.first_oriented() {
             info!(
                 "goal ({}): waypoint {i} (and any other) carries an orientation: ignored, the goal approach \
@@ -871,6 +985,76 @@ impl Shell {
         );
         self.activate(Task::PreCheck { route, start, seq }, source);
         self.publish_status(node, out, NavStatus::ACTIVE, String::new());
+    }
+
+    /// Starts VFO waypoint following of `route` from `start` (or refuses it).
+    #[allow(clippy::too_many_arguments)]
+    fn start_vfo(
+        &mut self,
+        node: &RosNode,
+        out: &Outputs,
+        servers: &mut Servers,
+        route: Route,
+        start: Option<Pose2>,
+        source: Source,
+        seq: u64,
+    ) {
+        let Some(start) = start else {
+            return self.refuse(node, out, servers, source, Outcome::Stale);
+        };
+        let offset = docking_offset(&self.chassis);
+        let settings = &self.config.vfo;
+        let gains = vfo_gains(&settings.gains, &self.chassis);
+        let built = vfo_waypoints(&route, &start.ahead(-offset), settings.guiding)
+            .map_err(Outcome::Invalid)
+            .and_then(|waypoints| {
+                VfoFollower::new(gains, settings.optimise, waypoints, self.map.obstacles())
+                    .map_err(|e| Outcome::Refused(e.to_string()))
+            });
+        let follower = match built {
+            Ok(f) => f,
+            Err(outcome) => return self.refuse(node, out, servers, source, outcome),
+        };
+        info!(
+            "goal ({}): {} waypoints by VFO ({} obstacles known; U_2 {:.2} m/s, |ω| ≤ {:.2} rad/s, T_p {:.3} s)",
+            source.name(),
+            route.points.len(),
+            follower.obstacles().len(),
+            gains.speed,
+            gains.omega_max,
+            settings.optimise.time_step
+        );
+        if self.chassis.model().is_nonholonomic() {
+            warn!(
+                "goal ({}): the VFO law is a unicycle's: on this {} chassis the virtual robots turn no \
+                 tighter than at U_2 over R_min, but slower commands are held to R_min too, so the robot may \
+                 turn wider than they did (waypoint_method approach is this chassis' default)",
+                source.name(),
+                self.chassis.model().as_str()
+            );
+        }
+        // A tick's command older than one control period is dropped (the robot stops).
+        let max_delay = Duration::from_secs_f64(settings.optimise.time_step.max(0.005));
+        let distance = (route.points[0] - start.position()).norm();
+        self.drawing = Drawing {
+            route: route.points.clone(),
+            ..Drawing::default()
+        };
+        self.activate(
+            Task::Vfo {
+                slot: VfoSlot::new(follower, max_delay),
+                route,
+                seq,
+                offset,
+                index: 0,
+                distance,
+                report: SegmentReport::default(),
+                obstacles_changed: None,
+            },
+            source,
+        );
+        self.publish_status(node, out, NavStatus::ACTIVE, String::new());
+        self.publish_markers(node, out);
     }
 
     /// A pre-check is done: the route it was for (if still the active goal) starts or is
@@ -914,6 +1098,7 @@ impl Shell {
             predicted: report.path.clone(),
             problems: problems.clone(),
             dock: None,
+            vfo: None,
         };
         if !problems.is_empty() {
             let outcome = Outcome::RouteInfeasible(problems.clone());
@@ -1050,6 +1235,11 @@ impl Shell {
                 source: Source::FollowAction,
                 ..
             }) => Outcome::Preempted("follow_waypoints").follow_result(&route.poses, missed),
+            Some(Active {
+                task: Task::Vfo { route, .. },
+                source: Source::FollowAction,
+                ..
+            }) => Outcome::Preempted("follow_waypoints").follow_result(&route.poses, &[]),
             _ => Outcome::Preempted("follow_waypoints").follow_result(&[], &[]),
         };
         self.new_goal(node, out, servers, Source::FollowAction).await;
@@ -1085,13 +1275,13 @@ impl Shell {
         Ok((start, route))
     }
 
-    fn odom_in(&mut self, node: &RosNode, out: &Outputs, servers: &mut Servers, m: &Odometry) {
+    fn odom_in(&mut self, node: &RosNode, out: &Outputs, servers: &mut Servers, jobs: &mut Jobs, m: &Odometry) {
         match odom_pose(m, &self.config.odom_frame, &self.config.base_frame) {
             Ok(pose) => {
                 self.odom_refused = false;
                 self.odom.set(pose, m.header.stamp.clone());
                 if self.active.is_some() {
-                    self.step(node, out, servers, pose);
+                    self.step(node, out, servers, jobs, pose);
                 }
             }
             Err(e) => {
@@ -1103,7 +1293,7 @@ impl Shell {
     }
 
     /// One control step at `pose`.
-    fn step(&mut self, node: &RosNode, out: &Outputs, servers: &mut Servers, pose: Pose2) {
+    fn step(&mut self, node: &RosNode, out: &Outputs, servers: &mut Servers, jobs: &mut Jobs, pose: Pose2) {
         let now = node.now_nanos();
         let Some(active) = self.active.as_mut() else { return };
         let dt = match active.clock.step(now) {
@@ -1123,10 +1313,15 @@ impl Shell {
         let chassis = active.chassis;
         let undock_speed = active.config.undock_speed;
         let finish = Finish::for_chassis(&chassis);
+        if matches!(active.task, Task::Vfo { .. }) {
+            return self.vfo_step(out, jobs, pose, t);
+        }
         let mut ended: Option<Outcome> = None;
         let mut changed = false;
         let command: Result<BodyTwist, String> = match &mut active.task {
             Task::PreCheck { .. } => return,
+            // Handled above.
+            Task::Vfo { .. } => return,
             Task::Dock {
                 controller,
                 last,
@@ -1244,12 +1439,238 @@ impl Shell {
         }
     }
 
+    /// A VFO tick at `pose`, time `t`: the follower goes to the blocking pool with the map's
+    /// latest obstacles, or, while it is still out (optimising), the robot stops.
+    fn vfo_step(&mut self, out: &Outputs, jobs: &mut Jobs, pose: Pose2, t: f64) {
+        let obstacles = self.map.obstacles();
+        let Some(Active {
+            task:
+                Task::Vfo {
+                    slot,
+                    seq,
+                    offset,
+                    obstacles_changed,
+                    ..
+                },
+            ..
+        }) = self.active.as_mut()
+        else {
+            return;
+        };
+        let Some(mut follower) = slot.lend(Instant::now()) else {
+            return self.zero(out);
+        };
+        if let Some(new) = obstacles_changed.take() {
+            follower.set_obstacles(obstacles, new);
+        }
+        let (seq, guide) = (*seq, pose.ahead(-*offset));
+        jobs.vfo.start(move |_| {
+            let output = follower.update(&guide, t);
+            let optimised = output
+                .as_ref()
+                .is_ok_and(|o| o.events.iter().any(|e| matches!(e, VfoEvent::Optimised { .. })))
+                .then(|| follower.last_optimisation())
+                .flatten()
+                .map(|o| (segment_report(o), vfo_drawing(o, follower.obstacles())));
+            VfoTickDone {
+                seq,
+                follower,
+                output,
+                optimised,
+            }
+        });
+    }
+
+    /// A VFO tick came back: its command goes out (zero when it came back late), its events
+    /// are logged, the route may end.
+    fn vfo_ticked(&mut self, node: &RosNode, out: &Outputs, servers: &mut Servers, done: VfoTickDone) {
+        let Some(active) = self.active.as_mut() else { return };
+        let chassis = active.chassis;
+        let Task::Vfo {
+            slot,
+            route,
+            seq,
+            index,
+            distance,
+            report,
+            ..
+        } = &mut active.task
+        else {
+            return;
+        };
+        if *seq != done.seq {
+            return;
+        }
+        let handback = slot.give_back(done.follower, Instant::now());
+        if let Some((r, drawing)) = done.optimised {
+            *report = r;
+            self.drawing.vfo = Some(drawing);
+        }
+        let o = match done.output {
+            Ok(o) => o,
+            Err(e) => {
+                active.refused += 1;
+                let e = e.to_string();
+                warn_throttled!(
+                    self.throttle,
+                    "step",
+                    "the planner refused its input: {e}; robot stopped"
+                );
+                if active.refused >= MAX_REFUSED_STEPS {
+                    return self.end_goal(node, out, servers, Outcome::Refused(e));
+                }
+                return self.refused(out);
+            }
+        };
+        active.refused = 0;
+        let request = |i: usize| route.request_index.get(i).copied().unwrap_or(i);
+        let mut changed = false;
+        for event in &o.events {
+            changed = true;
+            match event {
+                VfoEvent::Reached { index, vortex } => info!(
+                    "waypoint {} reached{}",
+                    request(*index),
+                    if *vortex {
+                        " (early: the robot was caught between obstacles, Algorithm 3)"
+                    } else {
+                        ""
+                    }
+                ),
+                VfoEvent::Optimised {
+                    index,
+                    reason,
+                    score,
+                    warnings,
+                } => {
+                    info!(
+                        "segment to waypoint {} optimised ({reason:?}): Ψ_z {}, {} virtual robots, {} candidates",
+                        request(*index),
+                        score.map_or("none".to_owned(), |s| format!("{s:.3}")),
+                        report.virtual_robots,
+                        report.candidates
+                    );
+                    for w in warnings.iter().filter(|w| !matches!(w, OptimiseWarning::NoSafeSigma)) {
+                        warn_throttled!(self.throttle, "vfo-caps", "segment optimisation: {w:?}");
+                    }
+                }
+            }
+        }
+        *index = o.index;
+        *distance = o.distance;
+        let unreached = |from: usize| (from..route.points.len()).map(request).collect::<Vec<_>>();
+        let ended = match o.end {
+            None => None,
+            Some(VfoEnd::Done) => Some(Outcome::RouteDone {
+                count: route.points.len(),
+                missed: Vec::new(),
+            }),
+            Some(VfoEnd::NoSafePath { index }) => Some(Outcome::NoSafePath {
+                index: request(index),
+                virtual_robots: report.virtual_robots,
+                unreached: unreached(index),
+            }),
+            Some(VfoEnd::Collision { obstacle }) => {
+                let o = slot.follower().and_then(|f| f.obstacles().get(obstacle).copied());
+                let at = self.odom.value().map(|p| p.position());
+                Some(Outcome::Collision {
+                    centre: o.map_or_else(Point2::origin, |o| o.centre()),
+                    radius: o.map_or(f64::NAN, |o| o.forbidden_radius()),
+                    distance: match (o, at) {
+                        (Some(o), Some(at)) => o.distance(&at),
+                        _ => f64::NAN,
+                    },
+                    unreached: unreached(*index),
+                })
+            }
+        };
+        if let Some(outcome) = ended {
+            return self.end_goal(node, out, servers, outcome);
+        }
+        if handback == Handback::Late {
+            warn_throttled!(
+                self.throttle,
+                "vfo-late",
+                "a tick took longer than {:.0} ms (an optimisation): its command is dropped, the robot stops \
+                 meanwhile",
+                slot.max_delay().as_secs_f64() * 1e3
+            );
+        }
+        let cmd = clamp_twist(vfo_command(&o, handback), &chassis);
+        self.publish_cmd(out, cmd);
+        if changed {
+            self.publish_status(node, out, NavStatus::ACTIVE, String::new());
+        }
+    }
+
+    /// A scan: its obstacles go into the map (in odom, at the latest fresh odometry pose);
+    /// a VFO route's follower gets them at its next tick.
+    fn scan_in(&mut self, m: &LaserScan) {
+        if self.config.waypoint_method != WaypointMethod::Vfo
+            && !self.active.as_ref().is_some_and(|a| matches!(a.task, Task::Vfo { .. }))
+        {
+            return;
+        }
+        let checked = scan_laser_pose(
+            &self.laser,
+            &self.config.base_frame,
+            &m.header.frame_id,
+            &self.config.vfo.laser_frame,
+            self.config.vfo.laser_pose(),
+        )
+        .map_err(|e| e.to_string())
+        .and_then(|(base_from_laser, _)| {
+            // Echoes beyond scan_range are no obstacles: the limit becomes the scan's range_max.
+            let mut limited = m.clone();
+            limited.range_max = limited.range_max.min(self.config.vfo.scan_range as f32);
+            scan_from_msg(&limited, base_from_laser).map_err(|e| e.to_string())
+        });
+        let scan = match checked {
+            Ok(s) => s,
+            Err(e) => {
+                return warn_throttled!(self.throttle, "scan-bad", "{e}; scan ignored");
+            }
+        };
+        let Some(odom_from_base) = self.fresh_odom() else {
+            return warn_throttled!(
+                self.throttle,
+                "scan-odom",
+                "scan ignored: odom stale or refused (obstacles are placed by it)"
+            );
+        };
+        let update = match self.map.update(&scan, &odom_from_base) {
+            Ok(u) => u,
+            Err(e) => return warn_throttled!(self.throttle, "scan-bad", "scan refused: {e}; scan ignored"),
+        };
+        if self.scan_seen.value().is_none() {
+            info!(
+                "first scan: {} beams, {} obstacles in the map (odom)",
+                scan.len(),
+                self.map.obstacles().len()
+            );
+        }
+        self.scan_seen.set((), m.header.stamp.clone());
+        if let Some(Active {
+            task: Task::Vfo { obstacles_changed, .. },
+            ..
+        }) = self.active.as_mut()
+        {
+            let new = !update.new.is_empty() || obstacles_changed.unwrap_or(false);
+            *obstacles_changed = Some(new);
+        }
+    }
+
     async fn tick(&mut self, node: &RosNode, out: &Outputs, servers: &mut Servers) {
         let Some(active) = &self.active else { return };
         let now = Instant::now();
         let goal_age = now.saturating_duration_since(active.started);
         if odom_stale(self.odom.age_at(now), goal_age, active.config.odom_timeout()) {
             return self.end_goal(node, out, servers, Outcome::Stale);
+        }
+        if matches!(active.task, Task::Vfo { .. })
+            && odom_stale(self.scan_seen.age_at(now), goal_age, active.config.vfo.scan_timeout())
+        {
+            return self.end_goal(node, out, servers, Outcome::ScanStale);
         }
         let status_period = Duration::from_secs_f64(1.0 / self.config.status_rate_hz);
         if self
@@ -1287,6 +1708,16 @@ impl Shell {
             }
             (Task::Follow { follower, route, .. }, Source::FollowAction) => {
                 let i = follower.index().min(route.points.len().saturating_sub(1));
+                let index = route.request_index.get(i).copied().unwrap_or(0);
+                servers
+                    .follow
+                    .feedback(FollowWaypointsFeedback {
+                        current_waypoint: u32::try_from(index).unwrap_or(u32::MAX),
+                    })
+                    .await
+            }
+            (Task::Vfo { route, index, .. }, Source::FollowAction) => {
+                let i = (*index).min(route.points.len().saturating_sub(1));
                 let index = route.request_index.get(i).copied().unwrap_or(0);
                 servers
                     .follow

@@ -291,6 +291,12 @@ impl Svg {
     /// A frame round the map panel with a tick and its label at every whole metre (x along the
     /// bottom, y along the left edge, inside the panel) and the axis names.
     pub fn metre_axes(&mut self, view: &MapView) {
+        self.axes(view, "m");
+    }
+
+    /// [`Svg::metre_axes`] for a map in another unit: ticks at every whole `unit`, the axes
+    /// named "x [`unit`]" and "y [`unit`]" (e.g. "j", the quadruped's unit).
+    pub fn axes(&mut self, view: &MapView, unit: &str) {
         let ((x0, x1), (y0, y1)) = view.range();
         let (left, top) = (view.x(x0), view.y(y1));
         let (right, bottom) = (view.x(x1), view.y(y0));
@@ -324,9 +330,30 @@ impl Svg {
         }
         let _ = writeln!(
             self.body,
-            r##"<text x="{:.1}" y="{:.1}" font-size="11" text-anchor="end" fill="#505050">x [m] →, y [m] ↑</text>"##,
+            r##"<text x="{:.1}" y="{:.1}" font-size="11" text-anchor="end" fill="#505050">x [{unit}] →, y [{unit}] ↑</text>"##,
             right - 4.0,
             top + 13.0
+        );
+    }
+
+    /// A circle of `radius` (m) round the world point (`x`, `y`): outlined in `stroke`, filled
+    /// with `fill` (an SVG colour or `none`) at `opacity`.
+    pub fn circle(
+        &mut self,
+        view: &MapView,
+        (x, y): (f64, f64),
+        radius: f64,
+        stroke: Stroke,
+        fill: &str,
+        opacity: f64,
+    ) {
+        let _ = writeln!(
+            self.body,
+            r#"<circle cx="{:.1}" cy="{:.1}" r="{:.1}" fill="{fill}" fill-opacity="{opacity}" {}/>"#,
+            view.x(x),
+            view.y(y),
+            radius * view.scale(),
+            stroke.attributes()
         );
     }
 
@@ -362,6 +389,25 @@ impl Svg {
             let _ = write!(self.body, "<title>{}</title>", escape(t));
         }
         let _ = writeln!(self.body, "</circle>");
+    }
+
+    /// A closed polygon through the world points `points`, filled with `fill` at `opacity`,
+    /// outlined by `stroke` if given (non-finite points skipped).
+    pub fn polygon(&mut self, view: &MapView, points: &[(f64, f64)], fill: &str, opacity: f64, stroke: Option<Stroke>) {
+        let pts: Vec<String> = points
+            .iter()
+            .filter(|(x, y)| x.is_finite() && y.is_finite())
+            .map(|&(x, y)| format!("{:.1},{:.1}", view.x(x), view.y(y)))
+            .collect();
+        let outline = stroke.map_or_else(
+            || r#"stroke="none""#.to_owned(),
+            |s| s.attributes().replace(r#"fill="none" "#, ""),
+        );
+        let _ = writeln!(
+            self.body,
+            r#"<polygon points="{}" fill="{fill}" fill-opacity="{opacity}" {outline}/>"#,
+            pts.join(" ")
+        );
     }
 
     /// A diagonal cross (✕) of half-size `half` px at the pixel (`x`, `y`).
