@@ -179,6 +179,20 @@ fn resume_state(cli: &Cli, setup: &GaSetup) -> anyhow::Result<GaState> {
             state.setup.ga.crossover, setup.ga.crossover
         ));
     }
+    if state.setup.fitness.distance_on_fall != setup.fitness.distance_on_fall {
+        let shape = |on: bool| {
+            if on {
+                "distance counted on a fall"
+            } else {
+                "distance counted only without a fall"
+            }
+        };
+        differences.push(format!(
+            "fitness {} (asked {})",
+            shape(state.setup.fitness.distance_on_fall),
+            shape(setup.fitness.distance_on_fall)
+        ));
+    }
     if differences.is_empty() && state.setup != *setup {
         differences.push("other parameters of the robot, the algorithm or the fitness".to_owned());
     }

@@ -279,6 +279,19 @@ fn a_missing_foreign_or_other_runs_checkpoint_is_refused_and_left_alone() {
     one_line_error(&o, 1, "seed 1 (asked 2)");
     let o = run(&dir, 6, 2, 1, &["--resume"]);
     one_line_error(&o, 1, "population 4 (asked 6)");
+    // The same run evolved under the other fitness shape (a fall's distance counted).
+    let mut v: serde_json::Value = serde_json::from_str(&before).unwrap();
+    v["setup"]["fitness"]["distance_on_fall"] = serde_json::json!(true);
+    let other_shape = v.to_string();
+    std::fs::write(dir.join("checkpoint.json"), &other_shape).unwrap();
+    let o = run(&dir, 4, 2, 1, &["--resume"]);
+    one_line_error(
+        &o,
+        1,
+        "fitness distance counted on a fall (asked distance counted only without a fall)",
+    );
+    assert_eq!(read(&dir.join("checkpoint.json")), other_shape);
+    std::fs::write(dir.join("checkpoint.json"), &before).unwrap();
     // A new run over an existing one.
     let o = run(&dir, 4, 2, 1, &[]);
     one_line_error(&o, 1, "already holds a run");
