@@ -57,7 +57,8 @@ pub enum EvaluatorArg {
     about = "Evolves a Nao humanoid's forward step by a genetic algorithm (SPEC §8).",
     long_about = "Evolves a Nao humanoid's forward step by a genetic algorithm (SPEC §8): ten leg servos as \
 piecewise-linear functions over 20 intervals of the step time, evaluated in a physics simulation \
-(or an external simulator over ROS 2), scored by the time until a fall and the forward distance.\n\n\
+(or an external simulator over ROS 2), scored by the time until a fall and, for a step that does \
+not fall, the forward distance.\n\n\
 Writes into DIR: fitness.csv, fitness.svg, best.motion (Webots), best_gen_NNNN.motion every 10 \
 generations, best_trajectory.yaml (trajectory_msgs/JointTrajectory) and checkpoint.json after every \
 generation. Stops at the first non-falling forward step, when the mean fitness levels off, or after \

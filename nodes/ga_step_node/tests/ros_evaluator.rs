@@ -79,11 +79,12 @@ fn a_candidate_goes_out_as_a_joint_trajectory_and_its_answer_is_scored() {
     ind.knots[Servo::RKneePitch.index()][10] = 1.5;
     let e = evaluator.evaluate(&ind);
     assert_eq!(evaluator.failure(), None);
-    // Fell at 1.25 s of T_sim = 3 s, 1.5/10 = 0.15 m forward: f = 1.25/3 + 2·0.15 = 0.716667.
+    // Fell at 1.25 s of T_sim = 3 s, 1.5/10 = 0.15 m forward: a fall scores its time alone,
+    // f = 1.25/3 = 0.416667 (the distance is reported but does not count).
     assert!(e.fell);
     assert_eq!(e.t_fall, 1.25);
     assert!((e.forward_distance - 0.15).abs() < 1e-12);
-    assert!((e.fitness - (1.25 / 3.0 + 0.3)).abs() < 1e-12, "{e:?}");
+    assert!((e.fitness - 1.25 / 3.0).abs() < 1e-12, "{e:?}");
     let m = rx.recv_timeout(Duration::from_secs(5)).unwrap();
     assert_eq!(m.header.frame_id, "candidate 1");
     assert_eq!(m.joint_names[0], "RHipPitch");

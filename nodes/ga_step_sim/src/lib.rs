@@ -1,7 +1,7 @@
 //! The built-in physics evaluator of `mobil_ga_step` (SPEC §8): a Nao-sized biped simulated on
 //! [rapier3d](https://rapier.rs) whose ten leg servos follow an individual's piecewise-linear
 //! trajectories for the step time T and then hold the standing pose to T_sim = T + 1 s, scored
-//! by the time until it falls and the torso's forward distance
+//! by the time until it falls and, without a fall, the torso's forward distance
 //! ([`Evaluation::from_outcome`]). ROS-free, and a crate of its own beside the GA library so
 //! that the library's tests and its ROS-free check do not compile a physics engine.
 //!
