@@ -3,7 +3,7 @@
 //! JSON (serde_json, with its exact float parsing): readable with any tool, and every f64 is
 //! written in its shortest round-trip form and read back to the same bits, so a resumed run
 //! equals the uninterrupted one. The document starts with a format tag and a version:
-//! `{"format": "mobil_ga_step checkpoint", "version": 1, …}`; the generator is stored as its seed
+//! `{"format": "mobil_ga_step checkpoint", "version": 2, …}`; the generator is stored as its seed
 //! and its position in the stream (ChaCha8, 32-bit words). A file that is not JSON or has
 //! another tag is [`CheckpointError::Foreign`], another version
 //! [`CheckpointError::UnsupportedVersion`], a damaged or inconsistent one
@@ -21,8 +21,11 @@ use std::path::{Path, PathBuf};
 
 /// The format tag of a checkpoint.
 pub const CHECKPOINT_FORMAT: &str = "mobil_ga_step checkpoint";
-/// The format version this library writes and reads.
-pub const CHECKPOINT_VERSION: u64 = 1;
+/// The format version this library writes and reads. Version 2: the setup's fitness carries
+/// `distance_on_fall`; a version-1 checkpoint was evolved under the SPEC's example shape
+/// (distance counted on a fall) and names no shape, so it is refused rather than resumed under
+/// another fitness.
+pub const CHECKPOINT_VERSION: u64 = 2;
 
 #[derive(Serialize, Deserialize)]
 struct Header {

@@ -207,9 +207,13 @@ impl GaConfig {
     }
 }
 
-/// The fitness formula of the SPEC's Decision, f = t_fall / T_sim + w·max(0, Δx), and the fall
-/// test an evaluator applies. T_sim = T + `settle_time`; t_fall = T_sim when the robot does not
-/// fall.
+/// The fitness of an evaluation and the fall test an evaluator applies (SPEC §8 Decision, read
+/// so that a fall never pays): f = t_fall / T_sim for a step that falls (< 1), and
+/// f = 1 + w·max(0, Δx) for one that does not (≥ 1). T_sim = T + `settle_time`. No fall can
+/// outscore standing still, so the best individual is a non-falling one whenever the population
+/// has one. The SPEC's example shape, f = t_fall / T_sim + w·max(0, Δx) for every step, is kept
+/// as the option [`FitnessConfig::distance_on_fall`]: under it a forward lunge that falls at 1–2 s
+/// scores above standing and above any short upright step, and selection breeds lunges.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(default)]
 pub struct FitnessConfig {
@@ -234,6 +238,13 @@ pub struct FitnessConfig {
     /// Forward distance (m) that makes a non-falling step "a forward step" (the stop rule).
     /// Default 0.04 m, the default maximum step length of Nao's own walk (ALMotion's MaxStepX).
     pub step_min_forward: f64,
+    /// Whether a fall's forward distance counts too: `true` is the SPEC's example shape
+    /// f = t_fall / T_sim + w·max(0, Δx) for every step, `false` (default) counts distance only
+    /// for a step that does not fall. Default `false`: with distance on a fall, four runs of
+    /// population 100 bred forward lunges (0.5–1 m, falling at 1–2 s, f = 1.5–2.6) that beat
+    /// standing (1.0) and every upright step shorter than 25–80 cm; only one of the four reached
+    /// a non-falling forward step (README, "Humanoid step by a genetic algorithm").
+    pub distance_on_fall: bool,
 }
 
 impl Default for FitnessConfig {
@@ -244,6 +255,7 @@ impl Default for FitnessConfig {
             fall_height: 0.20,
             fall_tilt: 0.5,
             step_min_forward: 0.04,
+            distance_on_fall: false,
         }
     }
 }
@@ -278,12 +290,19 @@ impl FitnessConfig {
         step_time + self.settle_time
     }
 
-    /// The fitness f = t_fall / T_sim + w·max(0, Δx) (SPEC §8 Decision), t_fall clamped into
-    /// [0, T_sim] (pass T_sim when the robot did not fall). Never negative; a non-finite input
-    /// gives 0.
-    pub fn fitness(&self, step_time: f64, t_fall: f64, forward_distance: f64) -> f64 {
+    /// The fitness of a step (see [`FitnessConfig`]): `t_fall` is the time of the fall, `None`
+    /// without one. A fall scores t_fall / T_sim, t_fall clamped into [0, T_sim] (plus
+    /// w·max(0, Δx) with [`FitnessConfig::distance_on_fall`]); no fall scores 1 + w·max(0, Δx).
+    /// Never negative; a non-finite input gives 0.
+    pub fn fitness(&self, step_time: f64, t_fall: Option<f64>, forward_distance: f64) -> f64 {
         let t_sim = self.sim_time(step_time);
-        let f = t_fall.clamp(0.0, t_sim) / t_sim + self.forward_weight * forward_distance.max(0.0);
+        let distance = self.forward_weight * forward_distance.max(0.0);
+        let f = match t_fall {
+            None => 1.0 + distance,
+            Some(t) if self.distance_on_fall => t.clamp(0.0, t_sim) / t_sim + distance,
+            // A NaN distance still makes the fitness 0 below, as under the other shape.
+            Some(t) => t.clamp(0.0, t_sim) / t_sim + 0.0 * forward_distance,
+        };
         if f.is_finite() {
             f
         } else {
@@ -359,14 +378,47 @@ mod tests {
     fn the_fitness_formula() {
         let f = FitnessConfig::default();
         // T = 2 s, T_sim = 3 s, w = 2 /m.
-        // No fall, 5 cm forward: 3/3 + 2·0.05 = 1.1.
-        assert!((f.fitness(2.0, 3.0, 0.05) - 1.1).abs() < 1e-12);
-        // A fall at 1.5 s, 10 cm forward: 0.5 + 0.2 = 0.7.
-        assert!((f.fitness(2.0, 1.5, 0.10) - 0.7).abs() < 1e-12);
-        // Backwards counts as 0; t_fall beyond T_sim counts as T_sim.
-        assert!((f.fitness(2.0, 9.0, -0.3) - 1.0).abs() < 1e-12);
+        // No fall, 5 cm forward: 1 + 2·0.05 = 1.1.
+        assert!((f.fitness(2.0, None, 0.05) - 1.1).abs() < 1e-12);
+        // A fall at 1.5 s, 10 cm forward: 1.5/3 = 0.5, the distance does not count.
+        assert!((f.fitness(2.0, Some(1.5), 0.10) - 0.5).abs() < 1e-12);
+        // Backwards counts as 0; t_fall beyond T_sim counts as T_sim, below 0 as 0.
+        assert!((f.fitness(2.0, None, -0.3) - 1.0).abs() < 1e-12);
+        assert!((f.fitness(2.0, Some(9.0), 0.2) - 1.0).abs() < 1e-12);
+        assert_eq!(f.fitness(2.0, Some(-1.0), 0.2), 0.0);
         // Non-finite inputs score 0.
-        assert_eq!(f.fitness(2.0, f64::NAN, 0.1), 0.0);
-        assert_eq!(f.fitness(2.0, 1.0, f64::INFINITY), 0.0);
+        assert_eq!(f.fitness(2.0, Some(f64::NAN), 0.1), 0.0);
+        assert_eq!(f.fitness(2.0, None, f64::INFINITY), 0.0);
+        assert_eq!(f.fitness(2.0, Some(1.0), f64::NAN), 0.0);
+    }
+
+    #[test]
+    fn a_lunge_that_falls_scores_below_standing_and_below_an_upright_step() {
+        let f = FitnessConfig::default();
+        assert!(!f.distance_on_fall);
+        // The lunge: falls at 1.5 s of T_sim = 3 s, 0.8 m forward: 1.5/3 = 0.5.
+        let lunge = f.fitness(2.0, Some(1.5), 0.8);
+        // Standing still for all of T_sim: 1. An upright 10 cm step: 1 + 2·0.1 = 1.2.
+        let standing = f.fitness(2.0, None, 0.0);
+        let step = f.fitness(2.0, None, 0.1);
+        assert!((lunge - 0.5).abs() < 1e-12, "{lunge}");
+        assert_eq!(standing, 1.0);
+        assert!((step - 1.2).abs() < 1e-12, "{step}");
+        // A fall at the very end still scores at most standing still's 1.
+        assert!(f.fitness(2.0, Some(3.0), 5.0) <= standing);
+    }
+
+    #[test]
+    fn the_spec_example_shape_counts_a_falls_distance() {
+        let f = FitnessConfig {
+            distance_on_fall: true,
+            ..FitnessConfig::default()
+        };
+        // The same lunge: 0.5 + 2·0.8 = 2.1, above standing (1.0) and the 10 cm step (1.2).
+        assert!((f.fitness(2.0, Some(1.5), 0.8) - 2.1).abs() < 1e-12);
+        assert!((f.fitness(2.0, None, 0.1) - 1.2).abs() < 1e-12);
+        assert_eq!(f.fitness(2.0, None, 0.0), 1.0);
+        // A fall at 80 % of T_sim (2.4 s) with 10 cm: 0.8 + 0.2 = 1.0, as standing still.
+        assert!((f.fitness(2.0, Some(2.4), 0.1) - 1.0).abs() < 1e-12);
     }
 }

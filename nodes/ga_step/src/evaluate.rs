@@ -38,9 +38,10 @@ impl Evaluation {
         t_fall: f64,
         forward_distance: f64,
     ) -> Evaluation {
+        let fitness = config.fitness(step_time, fell.then_some(t_fall), forward_distance);
         let t_fall = if fell { t_fall } else { config.sim_time(step_time) };
         Evaluation {
-            fitness: config.fitness(step_time, t_fall, forward_distance),
+            fitness,
             fell,
             t_fall,
             forward_distance,
@@ -128,8 +129,8 @@ pub fn evaluate_all<E: Evaluator + ?Sized>(
 /// benchmarks of the genetic algorithm. It measures the normalised RMS distance d ∈ [0, 1] of an
 /// individual's inner knots from a fixed target trajectory (each knot's difference divided by
 /// its servo's range), and reports a fall when d > 0.25 at t_fall = T_sim·(1 − d), and a forward
-/// distance 0.1·(1 − 4d) m; the fitness is the SPEC formula's. So the optimum (d = 0) scores
-/// 1 + 0.1·w, a non-falling forward step of 4 cm needs d ≤ 0.15, standing still (d ≈ 0.21)
+/// distance 0.1·(1 − 4d) m; the fitness is the [`FitnessConfig`]'s. So the optimum (d = 0)
+/// scores 1 + 0.1·w, a non-falling forward step of 4 cm needs d ≤ 0.15, standing still (d ≈ 0.21)
 /// does not fall but steps only 1.5 cm, and a random individual (d ≈ 0.38: its RMS expectation
 /// with uniform knots) falls.
 #[derive(Debug, Clone)]

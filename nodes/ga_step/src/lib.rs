@@ -41,9 +41,14 @@
 //!   source's `(0.5 − u)/3`.
 //! - **One-point cut**: over the 190 inner knots (the pinned ends are equal in both parents),
 //!   uniform in 1 … 189, so each child has knots of both parents.
-//! - **Fitness constants** (SPEC: e.g. f = t_fall/T_sim + w·max(0, Δx)): T_sim = T + 1 s,
-//!   w = 2 /m, a fall is the torso below 0.20 m or tilted beyond 0.5 rad; a "forward step" is no
-//!   fall and Δx ≥ 0.04 m. See [`FitnessConfig`].
+//! - **Fitness** (SPEC: e.g. f = t_fall/T_sim + w·max(0, Δx); a better reading of that
+//!   Decision): distance counts only for a step that does not fall, f = t_fall/T_sim for a fall
+//!   (< 1) and f = 1 + w·max(0, Δx) without one (≥ 1), so no fall outscores standing and the
+//!   best individual is a non-falling one whenever one exists. The SPEC's example shape, under
+//!   which forward lunges that fall outscore short upright steps and take over the population,
+//!   is the option `distance_on_fall`. T_sim = T + 1 s, w = 2 /m, a fall is the torso below
+//!   0.20 m or tilted beyond 0.5 rad; a "forward step" is no fall and Δx ≥ 0.04 m. See
+//!   [`FitnessConfig`].
 //! - **Stop rules**, tested after every generation in this order: the best individual makes a
 //!   forward step (`stop_at_step`, default on); the mean fitness rose by less than 0.1 % over
 //!   the last 20 generations (under best-N replacement it cannot fall); the requested number of
@@ -56,7 +61,7 @@
 //! - **Parallelism**: `std::thread::scope` with an atomic work counter, not rayon (see
 //!   [`evaluate`]).
 //! - **Checkpoint**: one JSON document (readable, and with serde_json's exact float parsing
-//!   every f64 comes back to the same bits), tagged `mobil_ga_step checkpoint`, version 1,
+//!   every f64 comes back to the same bits), tagged `mobil_ga_step checkpoint`, version 2,
 //!   written to `<file>.tmp`, synced and renamed. See [`checkpoint`].
 //! - **Motion files** list only the ten evolved joints (Webots leaves the others where they are)
 //!   and write `-0.0000` as `0.0000`. The JointTrajectory YAML gives the 21 knots, exact for a

@@ -159,10 +159,17 @@ fn foreign_and_corrupt_files_are_refused() {
     }
     let other_tag = good.replacen("mobil_ga_step checkpoint", "something else", 1);
     assert!(matches!(from_json(&other_tag), Err(CheckpointError::Foreign(_))));
-    let v2 = good.replacen("\"version\":1", "\"version\":2", 1);
+    let v3 = good.replacen("\"version\":2", "\"version\":3", 1);
     assert!(matches!(
-        from_json(&v2),
-        Err(CheckpointError::UnsupportedVersion { found: 2, expected: 1 })
+        from_json(&v3),
+        Err(CheckpointError::UnsupportedVersion { found: 3, expected: 2 })
+    ));
+    // Version 1 (distance counted on a fall, no shape recorded) is refused, not resumed under
+    // the other shape.
+    let v1 = good.replacen("\"version\":2", "\"version\":1", 1);
+    assert!(matches!(
+        from_json(&v1),
+        Err(CheckpointError::UnsupportedVersion { found: 1, expected: 2 })
     ));
 
     let truncated = &good[..good.len() / 2];
@@ -190,4 +197,22 @@ fn foreign_and_corrupt_files_are_refused() {
     std::fs::write(&path, [0xff, 0xfe, 0x00, 0x12]).unwrap();
     assert!(matches!(read_checkpoint(&path), Err(CheckpointError::Foreign(_))));
     std::fs::remove_dir_all(&d).unwrap();
+}
+
+/// The fitness shape is part of the recorded setup: a checkpoint of a run that counts a fall's
+/// distance reads back with that shape and differs from the default setup, so a caller comparing
+/// setups (the `ga_step` executable) refuses to resume it under the other shape.
+#[test]
+fn the_fitness_shape_is_recorded() {
+    let mut with_fall = setup(Crossover::Arithmetic);
+    with_fall.fitness.distance_on_fall = true;
+    let e = TestLandscape::new(NaoModel::default(), with_fall.fitness.clone());
+    let s = GaState::start(with_fall.clone(), 3, &e, 1).unwrap();
+    let text = to_json(&s);
+    let v: serde_json::Value = serde_json::from_str(&text).unwrap();
+    assert_eq!(v["setup"]["fitness"]["distance_on_fall"], serde_json::json!(true));
+    let back = from_json(&text).unwrap();
+    assert!(back.setup.fitness.distance_on_fall);
+    assert_eq!(back.setup, with_fall);
+    assert_ne!(back.setup, setup(Crossover::Arithmetic));
 }

@@ -41,6 +41,7 @@ fn the_file_holds_the_documented_defaults() {
         "fall_height",
         "fall_tilt",
         "step_min_forward",
+        "distance_on_fall",
         "offspring",
         "blx_alpha",
         "blx_variant",
@@ -109,10 +110,13 @@ fn statement_4_staying_up_comes_before_distance() {
     let t = model.step_time;
     let t_sim = 3.0; // T + settle time = 2 + 1
     assert_eq!(fitness.sim_time(t), t_sim);
-    let standing = fitness.fitness(t, t_sim, 0.0);
+    let standing = fitness.fitness(t, None, 0.0);
     assert_eq!(standing, 1.0);
     // 10 cm without a fall: 1 + 2 · 0.1 = 1.2.
-    assert!((fitness.fitness(t, t_sim, 0.10) - 1.2).abs() < 1e-12);
-    // A fall at 80 % of T_sim (2.4 s) with 10 cm: 0.8 + 0.2 = 1.0, as standing still.
-    assert!((fitness.fitness(t, 0.8 * t_sim, 0.10) - standing).abs() < 1e-12);
+    assert!((fitness.fitness(t, None, 0.10) - 1.2).abs() < 1e-12);
+    // A fall scores its time alone: at 80 % of T_sim (2.4 s) with 10 cm, 0.8; a lunge of 1 m
+    // falling 0.1 s before the end, 2.9/3 < 1.
+    assert!((fitness.fitness(t, Some(0.8 * t_sim), 0.10) - 0.8).abs() < 1e-12);
+    assert!((fitness.fitness(t, Some(2.9), 1.0) - 2.9 / 3.0).abs() < 1e-12);
+    assert!(fitness.fitness(t, Some(2.9), 1.0) < standing);
 }

@@ -1,0 +1,63 @@
+//! `ga_step`: evolves a Nao humanoid's forward step (see `ga_step --help`). Exit status 0 when
+//! the run stops by itself, 130 after Ctrl-C (the run can be resumed), 1 on an error and 2 on a
+//! bad command line; every error is one line on stderr.
+
+use clap::Parser as _;
+use mobil_ga_step::StopReason;
+use mobil_ga_step_node::run::{run, Cli};
+use std::process::ExitCode;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Arc;
+
+fn main() -> ExitCode {
+    let cli = match Cli::try_parse() {
+        Ok(cli) => cli,
+        Err(e) => {
+            use clap::error::ErrorKind;
+            if matches!(e.kind(), ErrorKind::DisplayHelp | ErrorKind::DisplayVersion) {
+                let _ = e.print();
+                return ExitCode::SUCCESS;
+            }
+            // clap's message is several lines (the error, its details, usage, hints): keep the
+            // error and its details, on one line.
+            let text = e.to_string();
+            let message = text
+                .lines()
+                .take_while(|l| !l.trim().is_empty())
+                .map(str::trim)
+                .collect::<Vec<_>>()
+                .join(" ");
+            let message = message.trim_start_matches("error: ");
+            eprintln!("ga_step: {message} (see ga_step --help)");
+            return ExitCode::from(2);
+        }
+    };
+    let interrupt = Arc::new(AtomicBool::new(false));
+    let flag = interrupt.clone();
+    let handler = ctrlc::set_handler(move || {
+        if flag.swap(true, Ordering::SeqCst) {
+            // A second interrupt: stop now; the last checkpoint on disk is whole.
+            std::process::exit(130);
+        }
+        eprintln!("ga_step: interrupted; stopping after the generation in flight (Ctrl-C again to stop at once)");
+    });
+    if let Err(e) = handler {
+        eprintln!("ga_step: cannot handle Ctrl-C: {e}");
+        return ExitCode::FAILURE;
+    }
+    match run(&cli, &interrupt) {
+        Ok(summary) => {
+            println!("{}", summary.line(&cli.out));
+            if summary.reason == StopReason::Interrupted {
+                ExitCode::from(130)
+            } else {
+                ExitCode::SUCCESS
+            }
+        }
+        Err(e) => {
+            let text = format!("{e:#}").replace('\n', " ");
+            eprintln!("ga_step: {text}");
+            ExitCode::FAILURE
+        }
+    }
+}

@@ -1,0 +1,319 @@
+//! The `ga_step` executable as a user runs it: small populations for a few generations on the
+//! physics evaluator (each run a few seconds), resume, Ctrl-C, and refused input.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output, Stdio};
+use std::time::{Duration, Instant};
+
+const BIN: &str = env!("CARGO_BIN_EXE_ga_step");
+
+fn scratch(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("ga_step_cli_{}_{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    dir
+}
+
+fn ga_step(args: &[&str]) -> Output {
+    Command::new(BIN).args(args).output().unwrap()
+}
+
+fn run(out: &Path, population: u32, generations: u32, seed: u64, extra: &[&str]) -> Output {
+    let (p, g, s) = (population.to_string(), generations.to_string(), seed.to_string());
+    let mut args = vec![
+        "--population",
+        &p,
+        "--generations",
+        &g,
+        "--seed",
+        &s,
+        "--crossover",
+        "blx",
+    ];
+    let o = out.to_str().unwrap();
+    args.extend(["--out", o]);
+    args.extend(extra);
+    ga_step(&args)
+}
+
+fn read(path: &Path) -> String {
+    std::fs::read_to_string(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()))
+}
+
+/// The generation number written in a checkpoint (0 while none is readable).
+fn checkpoint_generation(dir: &Path) -> u64 {
+    let Ok(text) = std::fs::read_to_string(dir.join("checkpoint.json")) else {
+        return 0;
+    };
+    let Ok(v) = serde_json::from_str::<serde_json::Value>(&text) else {
+        return 0;
+    };
+    v["generation"].as_u64().unwrap_or(0)
+}
+
+fn no_temporaries(dir: &Path) {
+    for e in std::fs::read_dir(dir).unwrap() {
+        let name = e.unwrap().file_name().to_string_lossy().into_owned();
+        assert!(!name.ends_with(".tmp"), "{name} left in {}", dir.display());
+    }
+}
+
+fn one_line_error(o: &Output, code: i32, contains: &str) {
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(code), "stderr: {err}");
+    assert_eq!(err.lines().count(), 1, "stderr: {err}");
+    assert!(err.starts_with("ga_step: "), "stderr: {err}");
+    assert!(err.contains(contains), "stderr: {err}");
+    assert!(!err.contains("panicked"), "stderr: {err}");
+}
+
+#[test]
+fn a_run_writes_every_output_and_a_resumed_run_equals_an_uninterrupted_one() {
+    let (whole, split) = (scratch("whole"), scratch("split"));
+    let o = run(&whole, 4, 4, 11, &[]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let line = String::from_utf8_lossy(&o.stdout);
+    assert!(
+        line.starts_with("ga_step: stopped at generation 4 by the requested generations"),
+        "{line}"
+    );
+    let csv = read(&whole.join("fitness.csv"));
+    // Header and generations 0 … 4.
+    assert_eq!(csv.lines().count(), 6, "{csv}");
+    assert_eq!(csv.lines().next(), Some("generation,max,mean,min"));
+    for name in [
+        "fitness.svg",
+        "best.motion",
+        "best_gen_0000.motion",
+        "best_trajectory.yaml",
+        "checkpoint.json",
+    ] {
+        assert!(whole.join(name).is_file(), "{name}");
+    }
+    // T = 2 s at 40 ms: a header and 51 rows.
+    assert_eq!(read(&whole.join("best.motion")).lines().count(), 52);
+    no_temporaries(&whole);
+
+    let o = run(&split, 4, 2, 11, &[]);
+    assert!(o.status.success());
+    assert_eq!(checkpoint_generation(&split), 2);
+    let o = run(&split, 4, 4, 11, &["--resume"]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    for name in [
+        "checkpoint.json",
+        "fitness.csv",
+        "best.motion",
+        "best_trajectory.yaml",
+        "fitness.svg",
+    ] {
+        assert_eq!(read(&whole.join(name)), read(&split.join(name)), "{name}");
+    }
+    // Resuming a finished run changes nothing.
+    let o = run(&split, 4, 4, 11, &["--resume"]);
+    assert!(o.status.success());
+    assert_eq!(
+        read(&whole.join("checkpoint.json")),
+        read(&split.join("checkpoint.json"))
+    );
+    let _ = std::fs::remove_dir_all(&whole);
+    let _ = std::fs::remove_dir_all(&split);
+}
+
+#[test]
+fn ctrl_c_loses_at_most_the_generation_in_flight_and_the_run_resumes_to_the_same_end() {
+    let (reference, stopped) = (scratch("reference"), scratch("stopped"));
+    let o = run(&reference, 4, 12, 23, &["--threads", "1"]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+
+    let child = Command::new(BIN)
+        .args([
+            "--population",
+            "4",
+            "--generations",
+            "12",
+            "--seed",
+            "23",
+            "--crossover",
+            "blx",
+        ])
+        .args(["--threads", "1", "--out", stopped.to_str().unwrap()])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let deadline = Instant::now() + Duration::from_secs(60);
+    while checkpoint_generation(&stopped) < 2 {
+        assert!(Instant::now() < deadline, "no checkpoint of generation 2 within 60 s");
+        std::thread::sleep(Duration::from_millis(10));
+    }
+    let seen = checkpoint_generation(&stopped);
+    let kill = Command::new("kill")
+        .args(["-INT", &child.id().to_string()])
+        .status()
+        .unwrap();
+    assert!(kill.success());
+    let o = child.wait_with_output().unwrap();
+    // Interrupted: exit status 130, the checkpoint whole and at or after the generation seen
+    // (the generation in flight is finished and kept, so none is lost).
+    assert_eq!(o.status.code(), Some(130), "{}", String::from_utf8_lossy(&o.stderr));
+    let at_stop = checkpoint_generation(&stopped);
+    assert!(at_stop >= seen && at_stop < 12, "{seen} {at_stop}");
+    assert!(String::from_utf8_lossy(&o.stdout).contains("by an interrupt"));
+    no_temporaries(&stopped);
+
+    let o = run(&stopped, 4, 12, 23, &["--threads", "1", "--resume"]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    for name in ["checkpoint.json", "fitness.csv", "best.motion"] {
+        assert_eq!(read(&reference.join(name)), read(&stopped.join(name)), "{name}");
+    }
+    let _ = std::fs::remove_dir_all(&reference);
+    let _ = std::fs::remove_dir_all(&stopped);
+}
+
+#[test]
+fn bad_options_are_one_line_errors() {
+    let dir = scratch("options");
+    let d = dir.to_str().unwrap();
+    let o = ga_step(&[
+        "--population",
+        "4",
+        "--generations",
+        "1",
+        "--seed",
+        "1",
+        "--crossover",
+        "uniform",
+        "--out",
+        d,
+    ]);
+    one_line_error(&o, 2, "--crossover");
+    let o = ga_step(&[
+        "--population",
+        "many",
+        "--generations",
+        "1",
+        "--seed",
+        "1",
+        "--crossover",
+        "blx",
+        "--out",
+        d,
+    ]);
+    one_line_error(&o, 2, "--population");
+    let o = ga_step(&[
+        "--population",
+        "4",
+        "--generations",
+        "1",
+        "--seed",
+        "1",
+        "--crossover",
+        "blx",
+    ]);
+    one_line_error(&o, 2, "--out");
+    let o = ga_step(&[
+        "--population",
+        "1",
+        "--generations",
+        "1",
+        "--seed",
+        "1",
+        "--crossover",
+        "blx",
+        "--out",
+        d,
+    ]);
+    one_line_error(&o, 2, "--population");
+    let o = ga_step(&[
+        "--population",
+        "4",
+        "--generations",
+        "1",
+        "--seed",
+        "-3",
+        "--crossover",
+        "blx",
+        "--out",
+        d,
+    ]);
+    one_line_error(&o, 2, "");
+    assert!(!dir.exists(), "a refused command line created {d}");
+    // --help documents every option.
+    let o = ga_step(&["--help"]);
+    assert!(o.status.success());
+    let help = String::from_utf8_lossy(&o.stdout);
+    for opt in [
+        "--population <N>",
+        "--generations <G>",
+        "--seed <S>",
+        "--crossover",
+        "--out <DIR>",
+        "--resume",
+    ] {
+        assert!(help.contains(opt), "{opt} missing from --help");
+    }
+    for c in ["blx", "arithmetic", "one-point", "geometric", "linear"] {
+        assert!(help.contains(c), "{c} missing from --help");
+    }
+}
+
+#[test]
+fn a_missing_foreign_or_other_runs_checkpoint_is_refused_and_left_alone() {
+    let dir = scratch("checkpoints");
+    // Nothing to resume.
+    let o = run(&dir, 4, 2, 1, &["--resume"]);
+    one_line_error(&o, 1, "cannot resume");
+    // A foreign file.
+    std::fs::write(dir.join("checkpoint.json"), "{\"hello\": 1}").unwrap();
+    let o = run(&dir, 4, 2, 1, &["--resume"]);
+    one_line_error(&o, 1, "not a ga_step checkpoint");
+    assert_eq!(read(&dir.join("checkpoint.json")), "{\"hello\": 1}");
+    // Not JSON at all.
+    std::fs::write(dir.join("checkpoint.json"), [0xff, 0xfe, 0x00]).unwrap();
+    let o = run(&dir, 4, 2, 1, &["--resume"]);
+    one_line_error(&o, 1, "cannot resume");
+    // Another run's checkpoint.
+    std::fs::remove_file(dir.join("checkpoint.json")).unwrap();
+    assert!(run(&dir, 4, 1, 1, &[]).status.success());
+    let before = read(&dir.join("checkpoint.json"));
+    let o = run(&dir, 4, 2, 2, &["--resume"]);
+    one_line_error(&o, 1, "seed 1 (asked 2)");
+    let o = run(&dir, 6, 2, 1, &["--resume"]);
+    one_line_error(&o, 1, "population 4 (asked 6)");
+    // The same run evolved under the other fitness shape (a fall's distance counted).
+    let mut v: serde_json::Value = serde_json::from_str(&before).unwrap();
+    v["setup"]["fitness"]["distance_on_fall"] = serde_json::json!(true);
+    let other_shape = v.to_string();
+    std::fs::write(dir.join("checkpoint.json"), &other_shape).unwrap();
+    let o = run(&dir, 4, 2, 1, &["--resume"]);
+    one_line_error(
+        &o,
+        1,
+        "fitness distance counted on a fall (asked distance counted only without a fall)",
+    );
+    assert_eq!(read(&dir.join("checkpoint.json")), other_shape);
+    std::fs::write(dir.join("checkpoint.json"), &before).unwrap();
+    // A new run over an existing one.
+    let o = run(&dir, 4, 2, 1, &[]);
+    one_line_error(&o, 1, "already holds a run");
+    assert_eq!(read(&dir.join("checkpoint.json")), before);
+    no_temporaries(&dir);
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn an_unwritable_output_directory_is_refused_before_any_work() {
+    let dir = scratch("unwritable");
+    std::fs::create_dir_all(&dir).unwrap();
+    // A regular file where the directory should be (root may write anywhere, so permissions
+    // would not stop this test's user).
+    let file = dir.join("a_file");
+    std::fs::write(&file, "x").unwrap();
+    let t = Instant::now();
+    let o = run(&file.join("out"), 4, 2, 1, &[]);
+    one_line_error(&o, 1, "cannot create output directory");
+    assert!(t.elapsed() < Duration::from_secs(5));
+    let o = run(&file, 4, 2, 1, &[]);
+    one_line_error(&o, 1, "output directory");
+    assert_eq!(read(&file), "x");
+    let _ = std::fs::remove_dir_all(&dir);
+}

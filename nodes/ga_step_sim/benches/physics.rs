@@ -1,0 +1,53 @@
+//! Speed of the physics evaluator (a bench binary: `cargo bench -p mobil_ga_step_sim`):
+//! simulated seconds per wall second for one evaluation of a standing robot (3 s simulated),
+//! individuals per second over every core on a random initial population, and the wall time of
+//! one generation of 100 (offspring of an evaluated random population, BLX-α).
+
+use mobil_ga_step::{evaluate_all, resolve_threads, FitnessConfig, GaSetup, GaState, NaoModel};
+use mobil_ga_step_sim::PhysicsEvaluator;
+use rand::SeedableRng;
+use std::time::Instant;
+
+fn main() {
+    let model = NaoModel::default();
+    let ev = PhysicsEvaluator::new(model.clone(), FitnessConfig::default()).expect("default figures are valid");
+    let standing = model.standing();
+    let runs = 5;
+    let t = Instant::now();
+    let mut simulated = 0.0;
+    for _ in 0..runs {
+        simulated += ev.simulate(&standing).t_end;
+    }
+    let wall = t.elapsed().as_secs_f64();
+    println!(
+        "one evaluation (standing, 3 s simulated): {:.1} ms, {:.1} simulated s per wall s",
+        1e3 * wall / runs as f64,
+        simulated / wall
+    );
+
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(1);
+    let batch: Vec<_> = (0..100).map(|_| model.random_individual(&mut rng)).collect();
+    let threads = resolve_threads(0);
+    let t = Instant::now();
+    let evals = evaluate_all(&ev, &batch, 0);
+    let wall = t.elapsed().as_secs_f64();
+    let mean_t = evals.iter().map(|e| e.t_fall).sum::<f64>() / evals.len() as f64;
+    println!(
+        "random individuals on {threads} threads: {:.0} per s (they fall after {mean_t:.2} s on average)",
+        batch.len() as f64 / wall
+    );
+
+    let setup = GaSetup::default();
+    let mut state = GaState::start(setup, 1, &ev, 0).expect("default setup is valid");
+    for g in 1..=3 {
+        let t = Instant::now();
+        state.next_generation(&ev, 0);
+        let s = &state.history[state.generation as usize];
+        println!(
+            "generation {g} of 100 on {threads} threads: {:.2} s wall (best {:.3}, mean {:.3})",
+            t.elapsed().as_secs_f64(),
+            s.max,
+            s.mean
+        );
+    }
+}

@@ -1,0 +1,443 @@
+//! The built-in physics evaluator of `mobil_ga_step` (SPEC §8): a Nao-sized biped simulated on
+//! [rapier3d](https://rapier.rs) whose ten leg servos follow an individual's piecewise-linear
+//! trajectories for the step time T and then hold the standing pose to T_sim = T + 1 s, scored
+//! by the time until it falls and, without a fall, the torso's forward distance
+//! ([`Evaluation::from_outcome`]). ROS-free, and a crate of its own beside the GA library so
+//! that the library's tests and its ROS-free check do not compile a physics engine.
+//!
+//! **The body** ([`BodyParams`], every figure with its source): a lumped torso (the whole
+//! robot's 4.996 kg less both legs: head, arms and pelvis links held rigid, as the hip yaw-pitch,
+//! the arms and the head are not evolved) and two legs of Nao's chain torso → hip roll → hip
+//! pitch → knee → ankle pitch → ankle roll, with Nao's link lengths (hips 50 mm either side of
+//! and 85 mm below the torso frame, thigh 100 mm, tibia 102.9 mm, foot height 45.19 mm) and link
+//! masses. Thighs and tibias are capsules, hip and ankle links small balls, the feet 160 × 90 mm
+//! boxes in Coulomb contact (μ = 0.8) with a flat floor; the legs collide with each other, not
+//! with the links they are jointed to.
+//!
+//! **The servos**: revolute joints of a rapier multibody (reduced coordinates: the chain cannot
+//! drift apart), each a position motor (stiffness 156 N·m/rad, damping 3 N·m·s/rad) whose force
+//! is capped as a DC motor's: Nao's stall torque (7.78 N·m pitch, 11.97 N·m roll) at rest,
+//! falling linearly to 0 at the no-load speed (6.40 rad/s pitch, 4.16 rad/s roll) while the motor
+//! drives the joint the way it turns, the stall torque while it brakes; Table 1's limits; the
+//! commanded angle moves towards the trajectory no faster than the no-load speed. (With the
+//! stall torque at every speed, evolution found lunges that carried the torso 0.7 m forward in
+//! 1.4 s, several times Nao's walking speed.)
+//!
+//! **A fall**: the torso frame below `fall_height` (0.20 m; it starts about 0.31 m up) or its
+//! vertical axis tilted more than `fall_tilt` (0.5 rad) from the vertical, tested after every
+//! 5 ms step; the simulation ends there. A non-finite state counts as a fall at that time.
+//! Δx is the torso frame's displacement along x (forward) from the start to the end or the fall.
+//!
+//! **Determinism**: each evaluation builds its own world and steps it on the calling thread;
+//! rapier is built with `enhanced-determinism`, so the same individual gives the same
+//! evaluation, bit for bit, on any thread and in any order.
+
+#![warn(missing_docs)]
+
+pub mod body;
+
+pub use body::{BodyParams, LegMasses};
+
+use body::{is_roll, leg_chain};
+use mobil_ga_step::{Evaluation, Evaluator, FitnessConfig, GaError, Individual, NaoModel, Servo, SERVO_COUNT};
+use rapier3d::prelude::*;
+
+/// Why an evaluator could not be built.
+#[derive(Debug, thiserror::Error, PartialEq)]
+pub enum SimError {
+    /// The robot or fitness configuration is invalid.
+    #[error(transparent)]
+    Config(#[from] GaError),
+    /// A body figure is not positive and finite.
+    #[error("body parameter {name} = {value} must be positive and finite")]
+    BadBody {
+        /// The parameter.
+        name: &'static str,
+        /// Its value.
+        value: f64,
+    },
+}
+
+/// What one simulated step did, in more detail than an [`Evaluation`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SimOutcome {
+    /// Whether the robot fell.
+    pub fell: bool,
+    /// Time of the fall (s), or the simulated time T_sim without one.
+    pub t_end: f64,
+    /// Torso frame's displacement along x (forward, m) at the end or the fall.
+    pub forward_distance: f64,
+    /// Torso frame's displacement along y (left, m) at the end or the fall.
+    pub lateral_distance: f64,
+    /// Torso frame's height at the start (m).
+    pub start_height: f64,
+    /// Torso frame's height at the end or the fall (m).
+    pub end_height: f64,
+    /// Largest tilt of the torso's vertical axis seen (rad).
+    pub max_tilt: f64,
+    /// Simulation steps made.
+    pub steps: u64,
+}
+
+/// The torso frame's state at one instant of a simulation.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct TorsoState {
+    /// Time from the start (s).
+    pub t: f64,
+    /// Position (m), x forward, y left, z up.
+    pub x: f64,
+    /// See `x`.
+    pub y: f64,
+    /// See `x`.
+    pub z: f64,
+    /// Tilt of its vertical axis from the vertical (rad).
+    pub tilt: f64,
+}
+
+/// The physics evaluator: a fresh simulation per individual.
+#[derive(Debug, Clone)]
+pub struct PhysicsEvaluator {
+    model: NaoModel,
+    fitness: FitnessConfig,
+    body: BodyParams,
+}
+
+impl PhysicsEvaluator {
+    /// An evaluator of `model`'s step scored by `fitness`, with the default body.
+    pub fn new(model: NaoModel, fitness: FitnessConfig) -> Result<PhysicsEvaluator, SimError> {
+        PhysicsEvaluator::with_body(model, fitness, BodyParams::default())
+    }
+
+    /// An evaluator with a body of one's own.
+    pub fn with_body(model: NaoModel, fitness: FitnessConfig, body: BodyParams) -> Result<PhysicsEvaluator, SimError> {
+        model.validate()?;
+        fitness.validate()?;
+        let b = &body;
+        for (name, value) in [
+            ("hip_offset_y", b.hip_offset_y),
+            ("hip_offset_z", b.hip_offset_z),
+            ("thigh_length", b.thigh_length),
+            ("tibia_length", b.tibia_length),
+            ("foot_height", b.foot_height),
+            ("foot_length", b.foot_length),
+            ("foot_width", b.foot_width),
+            ("sole_thickness", b.sole_thickness),
+            ("torso_mass", b.torso_mass),
+            ("limb_radius", b.limb_radius),
+            ("pitch_max_torque", b.pitch_max_torque),
+            ("roll_max_torque", b.roll_max_torque),
+            ("pitch_max_speed", b.pitch_max_speed),
+            ("roll_max_speed", b.roll_max_speed),
+            ("servo_stiffness", b.servo_stiffness),
+            ("servo_damping", b.servo_damping),
+            ("friction", b.friction),
+            ("dt", b.dt),
+        ] {
+            if !(value.is_finite() && value > 0.0) {
+                return Err(SimError::BadBody { name, value });
+            }
+        }
+        Ok(PhysicsEvaluator { model, fitness, body })
+    }
+
+    /// The robot model (standing pose, T).
+    pub fn model(&self) -> &NaoModel {
+        &self.model
+    }
+
+    /// The body's figures.
+    pub fn body(&self) -> &BodyParams {
+        &self.body
+    }
+
+    /// Simulates the individual's step for T, then the standing pose held to T_sim, or until a
+    /// fall.
+    pub fn simulate(&self, individual: &Individual) -> SimOutcome {
+        self.simulate_for(individual, self.fitness.sim_time(self.model.step_time))
+    }
+
+    /// Like [`simulate`](Self::simulate) for `duration` seconds of simulated time.
+    pub fn simulate_for(&self, individual: &Individual, duration: f64) -> SimOutcome {
+        self.simulate_observed(individual, duration, &mut |_| {})
+    }
+
+    /// Like [`simulate_for`](Self::simulate_for), calling `observe` with the torso's state after
+    /// every step (to trace or plot a motion).
+    pub fn simulate_observed(
+        &self,
+        individual: &Individual,
+        duration: f64,
+        observe: &mut dyn FnMut(&TorsoState),
+    ) -> SimOutcome {
+        let mut robot = Robot::build(&self.body, &self.model.standing_pose);
+        let dt = self.body.dt;
+        let steps = (duration / dt).round().max(0.0) as u64;
+        let start = robot.torso_pose();
+        let mut out = SimOutcome {
+            fell: false,
+            t_end: duration,
+            forward_distance: 0.0,
+            lateral_distance: 0.0,
+            start_height: start.z,
+            end_height: start.z,
+            max_tilt: start.tilt,
+            steps: 0,
+        };
+        let mut command = self.model.standing_pose;
+        for n in 1..=steps {
+            let t = n as f64 * dt;
+            let wanted = individual.angles_at(t, self.model.step_time);
+            for s in Servo::ALL {
+                let i = s.index();
+                let max_move = self.body.max_speed(s) * dt;
+                command[i] = s.clamp(command[i] + (wanted[i] - command[i]).clamp(-max_move, max_move));
+            }
+            robot.command(&command, &self.body);
+            robot.world.step();
+            let pose = robot.torso_pose();
+            observe(&TorsoState {
+                t,
+                x: pose.x,
+                y: pose.y,
+                z: pose.z,
+                tilt: pose.tilt,
+            });
+            out.steps = n;
+            if !pose.is_finite() {
+                out.fell = true;
+                out.t_end = t;
+                break;
+            }
+            out.forward_distance = pose.x - start.x;
+            out.lateral_distance = pose.y - start.y;
+            out.end_height = pose.z;
+            out.max_tilt = out.max_tilt.max(pose.tilt);
+            if pose.z < self.fitness.fall_height || pose.tilt > self.fitness.fall_tilt {
+                out.fell = true;
+                out.t_end = t;
+                break;
+            }
+        }
+        out
+    }
+}
+
+impl Evaluator for PhysicsEvaluator {
+    fn evaluate(&self, individual: &Individual) -> Evaluation {
+        let o = self.simulate(individual);
+        Evaluation::from_outcome(&self.fitness, self.model.step_time, o.fell, o.t_end, o.forward_distance)
+    }
+}
+
+/// The torso frame's position and tilt.
+#[derive(Debug, Clone, Copy)]
+struct TorsoPose {
+    x: f64,
+    y: f64,
+    z: f64,
+    tilt: f64,
+}
+
+impl TorsoPose {
+    fn is_finite(&self) -> bool {
+        self.x.is_finite() && self.y.is_finite() && self.z.is_finite() && self.tilt.is_finite()
+    }
+}
+
+/// A built world: the floor, the body and its ten motors.
+struct Robot {
+    world: PhysicsWorld,
+    torso: RigidBodyHandle,
+    /// Per servo (genome order): its joint, its standing angle, stiffness, damping, torque.
+    motors: Vec<(MultibodyJointHandle, Servo, f64)>,
+    stiffness: Real,
+    damping: Real,
+}
+
+fn v(x: f64, y: f64, z: f64) -> Vector {
+    Vector::new(x as Real, y as Real, z as Real)
+}
+
+impl Robot {
+    /// The robot in the standing pose `stand`, its lowest sole corner on the floor (z = 0),
+    /// torso frame above the origin. Every body frame is parallel to the world's in the standing
+    /// pose, so a joint's coordinate is its angle less the standing angle.
+    fn build(b: &BodyParams, stand: &[f64; SERVO_COUNT]) -> Robot {
+        let mut world = PhysicsWorld::new();
+        world.gravity = v(0.0, 0.0, -9.81);
+        world.integration_parameters.dt = b.dt as Real;
+        world.integration_parameters.num_solver_iterations = b.solver_iterations.max(1);
+
+        // Forward kinematics of both legs in the standing pose, relative to the torso frame.
+        struct LegGeom {
+            origins: [Vector; 5],     // hip, thigh (= hip), tibia (knee), ankle, foot (= ankle)
+            axes: [Vector; 5],        // joint axes in the world (= in both bodies' frames)
+            rotations: [Rotation; 5], // each child link's rotation in the standing pose
+            sole_corners_z: f64,
+        }
+        let leg = |left: bool| -> LegGeom {
+            let side = if left { 1.0 } else { -1.0 };
+            let chain = leg_chain(left);
+            let hip = v(0.0, side * b.hip_offset_y, -b.hip_offset_z);
+            let mut rot = Rotation::IDENTITY;
+            let mut axes = [Vector::ZERO; 5];
+            let mut rotations = [Rotation::IDENTITY; 5];
+            for (k, s) in chain.iter().enumerate() {
+                let local = if is_roll(*s) { Vector::X } else { Vector::Y };
+                axes[k] = rot * local;
+                rot *= Rotation::from_axis_angle(local, stand[s.index()] as Real);
+                rotations[k] = rot;
+            }
+            let knee = hip + rotations[1] * v(0.0, 0.0, -b.thigh_length);
+            let ankle = knee + rotations[2] * v(0.0, 0.0, -b.tibia_length);
+            let foot_rot = rotations[4];
+            let mut lowest = f64::INFINITY;
+            for (sx, sy) in [(1.0, 1.0), (1.0, -1.0), (-1.0, 1.0), (-1.0, -1.0)] {
+                let c = ankle
+                    + foot_rot
+                        * v(
+                            b.foot_forward + sx * b.foot_length / 2.0,
+                            sy * b.foot_width / 2.0,
+                            -b.foot_height,
+                        );
+                lowest = lowest.min(c.z as f64);
+            }
+            LegGeom {
+                origins: [hip, hip, knee, ankle, ankle],
+                axes,
+                rotations,
+                sole_corners_z: lowest,
+            }
+        };
+        let legs = [leg(false), leg(true)];
+        let height = -legs[0].sole_corners_z.min(legs[1].sole_corners_z);
+        let base = v(0.0, 0.0, height);
+
+        world.insert_collider(
+            ColliderBuilder::cuboid(50.0, 50.0, 0.5)
+                .translation(v(0.0, 0.0, -0.5))
+                .friction(b.friction as Real),
+            None,
+        );
+
+        let dynamic = |at: Vector| RigidBodyBuilder::dynamic().translation(at).can_sleep(false);
+        let torso = world.insert_body(dynamic(base));
+        let [dx, dy, dz] = b.torso_box;
+        let box_inertia = |m: f64, a: f64, bb: f64, c: f64| {
+            v(
+                m * (bb * bb + c * c) / 12.0,
+                m * (a * a + c * c) / 12.0,
+                m * (a * a + bb * bb) / 12.0,
+            )
+        };
+        // The collision box sits above the thighs (its bottom 40 mm below the torso frame,
+        // 45 mm above the hips); the mass acts at the lumped centre of mass.
+        world.insert_collider(
+            ColliderBuilder::cuboid((dx / 2.0) as Real, (dy / 2.0) as Real, (dz / 2.0) as Real)
+                .translation(v(0.0, 0.0, dz / 2.0 - 0.04))
+                .mass_properties(MassProperties::new(
+                    v(0.0, 0.0, b.torso_com_z - (dz / 2.0 - 0.04)),
+                    b.torso_mass as Real,
+                    box_inertia(b.torso_mass, dx, dy, dz),
+                )),
+            Some(torso),
+        );
+
+        let mut motors = Vec::with_capacity(SERVO_COUNT);
+        for (g, left) in legs.iter().zip([false, true]) {
+            let chain = leg_chain(left);
+            let masses = [b.leg.hip, b.leg.thigh, b.leg.tibia, b.leg.ankle, b.leg.foot];
+            let mut parent = torso;
+            let mut parent_origin = Vector::ZERO;
+            for k in 0..5 {
+                let origin = g.origins[k];
+                let link = world.insert_body(dynamic(base + origin));
+                let r = b.limb_radius as Real;
+                let collider = match k {
+                    1 | 2 => {
+                        let length = if k == 1 { b.thigh_length } else { b.tibia_length };
+                        let rot = g.rotations[k];
+                        ColliderBuilder::capsule_z((length / 2.0) as Real - r, r)
+                            .position(Pose::from_parts(rot * v(0.0, 0.0, -length / 2.0), rot))
+                    }
+                    4 => {
+                        let rot = g.rotations[4];
+                        let centre = rot * v(b.foot_forward, 0.0, -b.foot_height + b.sole_thickness / 2.0);
+                        ColliderBuilder::cuboid(
+                            (b.foot_length / 2.0) as Real,
+                            (b.foot_width / 2.0) as Real,
+                            (b.sole_thickness / 2.0) as Real,
+                        )
+                        .position(Pose::from_parts(centre, rot))
+                        .friction(b.friction as Real)
+                    }
+                    _ => ColliderBuilder::ball(0.02),
+                };
+                world.insert_collider(collider.mass(masses[k] as Real), Some(link));
+                let s = chain[k];
+                let (lo, hi) = s.limits();
+                let q0 = stand[s.index()];
+                let joint = RevoluteJointBuilder::new(g.axes[k])
+                    .local_anchor1(origin - parent_origin)
+                    .local_anchor2(Vector::ZERO)
+                    .contacts_enabled(false)
+                    .limits([(lo - q0) as Real, (hi - q0) as Real])
+                    .motor_model(MotorModel::ForceBased)
+                    .motor_position(0.0, b.servo_stiffness as Real, b.servo_damping as Real)
+                    .motor_max_force(b.max_torque(s) as Real);
+                // The chain is a tree hanging from the torso: insertion cannot fail.
+                if let Some(h) = world.insert_multibody_joint(parent, link, joint) {
+                    motors.push((h, s, q0));
+                }
+                parent = link;
+                parent_origin = origin;
+            }
+        }
+        Robot {
+            world,
+            torso,
+            motors,
+            stiffness: b.servo_stiffness as Real,
+            damping: b.servo_damping as Real,
+        }
+    }
+
+    /// Sets every servo's target angle (rad, Nao's convention) and its torque limit for this
+    /// step: a DC motor's line, the stall torque at rest falling to 0 at the no-load speed while
+    /// the motor drives the joint the way it turns; the full stall torque while it brakes.
+    fn command(&mut self, angles: &[f64; SERVO_COUNT], body: &BodyParams) {
+        for &(h, s, q0) in &self.motors {
+            if let Some((mb, id)) = self.world.multibody_joints.get_mut(h) {
+                let Some(link) = mb.link(id) else { continue };
+                let omega = mb.joint_velocity(link).get(0).copied().unwrap_or(0.0) as f64;
+                let q = link.joint.coords()[3] as f64;
+                let target = angles[s.index()] - q0;
+                let stall = body.max_torque(s);
+                let driving = (target - q) * omega > 0.0;
+                let limit = if driving {
+                    stall * (1.0 - omega.abs() / body.max_speed(s)).clamp(0.0, 1.0)
+                } else {
+                    stall
+                };
+                if let Some(link) = mb.link_mut(id) {
+                    link.joint
+                        .data
+                        .set_motor_position(JointAxis::AngX, target as Real, self.stiffness, self.damping)
+                        .set_motor_max_force(JointAxis::AngX, limit as Real);
+                }
+            }
+        }
+    }
+
+    fn torso_pose(&self) -> TorsoPose {
+        let rb = &self.world.bodies[self.torso];
+        let p = rb.translation();
+        let up = *rb.rotation() * Vector::Z;
+        TorsoPose {
+            x: p.x as f64,
+            y: p.y as f64,
+            z: p.z as f64,
+            tilt: (up.z as f64).clamp(-1.0, 1.0).acos(),
+        }
+    }
+}
