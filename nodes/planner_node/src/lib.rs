@@ -1189,7 +1189,7 @@ pub const MAX_MARKER_POINTS: usize = 1000;
 /// a SPHERE_LIST of its waypoints, the predicted path as a LINE_STRIP (at most
 /// [`MAX_DRAWN_PATH`] points), each problem (at most [`MAX_LISTED_PROBLEMS`]) as a red SPHERE
 /// and a TEXT_VIEW_FACING at its place, the dock pose as an ARROW, and a VFO optimisation
-/// ([`vfo_markers`]). The points share one budget, [`MAX_MARKER_POINTS`]: the route takes up to
+/// (below). The points share one budget, [`MAX_MARKER_POINTS`]: the route takes up to
 /// half of it (its line and dots, a quarter each, downsampled beyond), the predicted path up to
 /// a quarter of the rest, the VFO paths what remains.
 pub fn markers(view: &MarkerView<'_>, stamp: Time, frame: &str) -> MarkerArray {

@@ -6,7 +6,7 @@
 //! reports a new obstacle ([`VfoFollower::set_obstacles`] with `new_obstacles`,
 //! [`VfoFollower::add_obstacle`]) or when the robot enters an influence zone whose σ the last
 //! optimisation left undecided (it did not foresee that zone), the segment is re-optimised from
-//! the real state ([`find_sigmas`]) before the command is worked out. The tick then applies the
+//! the real state ([`find_sigmas`](super::find_sigmas)) before the command is worked out. The tick then applies the
 //! law with the segment's Σ: Algorithm 3, Algorithm 1 (the next waypoint in the same tick) or
 //! the end test, u = [ω, v].
 //!
