@@ -1039,4 +1039,33 @@ mod tests {
         assert_eq!(of("vfo_forbidden"), MAX_DRAWN_OBSTACLES);
         println!("{} bytes, {} markers, {points} points", bytes.len(), a.markers.len());
     }
+
+    #[test]
+    fn the_late_command_bound_is_two_measured_odometry_periods() {
+        let t0 = Instant::now();
+        let ms = Duration::from_millis;
+        let mut p = ArrivalPeriod::default();
+        assert_eq!(p.period(), None);
+        // Before a period is measured: the control step (20 ms), floored at 10 ms.
+        assert_eq!(vfo_max_delay(p.period(), 0.02), ms(20));
+        assert_eq!(vfo_max_delay(p.period(), 0.001), MIN_MAX_DELAY);
+        // Odometry every 20 ms: the mean is 20 ms, the bound 40 ms.
+        for k in 0..10 {
+            p.arrived(t0 + ms(20 * k));
+        }
+        let period = p.period().expect("measured");
+        assert!((period.as_secs_f64() - 0.020).abs() < 1e-9, "{period:?}");
+        assert_eq!(vfo_max_delay(p.period(), 0.5), 2 * period);
+        // A 3 s pause is not a period; one 30 ms interval moves the mean by a tenth: 21 ms.
+        p.arrived(t0 + ms(180 + 3000));
+        assert!((p.period().expect("kept").as_secs_f64() - 0.020).abs() < 1e-9);
+        p.arrived(t0 + ms(180 + 3000 + 30));
+        assert!((p.period().expect("kept").as_secs_f64() - 0.021).abs() < 1e-9);
+        // At 5× simulated time odometry comes every 4 ms of wall time: the floor, 10 ms.
+        let mut fast = ArrivalPeriod::default();
+        for k in 0..10 {
+            fast.arrived(t0 + ms(4 * k));
+        }
+        assert_eq!(vfo_max_delay(fast.period(), 0.02), MIN_MAX_DELAY);
+    }
 }
