@@ -5,10 +5,12 @@ under the simulated clock at 5× real time (≥ 4× asserted).
 An rclpy FollowWaypoints ActionClient sends four waypoints through the world's clutter: past the
 pillar at (1, 1.5) (the first leg runs straight through it), toward the box at x ≥ 4.5, back
 west, and north past the pillar again (the last leg passes 0.67 m from its centre, inside its
-influence zone). Every waypoint lies outside the influence zones (R = r + 0.4 m), where
-Algorithm 3 could pass it early: an earlier route with a waypoint 0.9 m from the box's face,
-inside the zone of the circles that cover it, was passed early now and then and the next
-segment, begun at the box, found no safe Σ once in a few runs. planner_node knows no map: the obstacles come from the LIDAR.
+influence zone). The second waypoint, (3.6, 0.3), lies 0.9 m from the box's face, inside the
+influence zones of the circles that cover it (R = r + 0.4 m), where Algorithm 3 may pass it
+early (SPEC §5): the robot then stands still before the next segment is optimised, so the
+virtual robots start where the real one really is (nodes/planner_node/tests/vfo_world.rs
+reproduces the run that once ended there, without DDS). planner_node knows no map: the
+obstacles come from the LIDAR.
 Checked from ``ground_truth`` (sim_node's plant, not the odometry the node follows) and from the
 action and topics:
 
@@ -53,7 +55,7 @@ PLANNER_ARGS = ("-p", "use_sim_time:=true", "-p", "odom_timeout_s:=2.0", "-p", "
                 "-p", "status_rate_hz:=20.0", "-p", "markers_rate_hz:=2.0")
 SIM_COLLISION_RADIUS = 0.05
 # Through the clutter of the built-in world from (0, 0) facing east (see the module docstring).
-WAYPOINTS = [(2.0, 2.6), (3.2, 0.3), (1.0, -0.3), (0.0, 2.2)]
+WAYPOINTS = [(2.0, 2.6), (3.6, 0.3), (1.0, -0.3), (0.0, 2.2)]
 FINAL_EPSILON = 0.05
 ODOM_DRIFT_PER_M = 0.01
 SIM_BUDGET_S = 90.0
@@ -188,3 +190,86 @@ def test_omr3_follows_waypoints_through_clutter_by_vfo(start_scenario, start_nod
             assert big.scale.x - r_disc.scale.x == pytest.approx(0.8, abs=1e-9)
             # r = the fitted radius + the robot's 0.25 m: at least 0.25 m.
             assert r_disc.scale.x / 2 >= radius
+
+
+@pytest.mark.timeout(120)
+def test_vfo_goal_needs_a_fresh_scan_and_ends_stale_when_scans_stop(start_scenario, start_node, sim_clock,
+                                                                    ros_node):
+    """The scans reach planner_node only through a relay in this test (``scan`` remapped to
+    ``scan_relay``). A goal sent before any scan arrived is refused STALE_INPUT; with the relay
+    on the goal starts; when the relay stops
+    mid-route, the goal ends STALE_INPUT within vfo.scan_timeout_s (0.5 s, steady clock) plus
+    the 20 Hz watchdog, the robot is sent the zero command, and the waypoints not reached are
+    listed (code 105)."""
+    from geometry_msgs.msg import Twist
+    from mobil_msgs.msg import NavStatus
+    from nav2_msgs.action import FollowWaypoints
+    from rclpy.qos import qos_profile_sensor_data
+    from sensor_msgs.msg import LaserScan
+
+    start_scenario(PARAMS, real_time_factor=REAL_TIME_FACTOR, lidar=True,
+                   sim_args=("-p", f"robot_radius:={SIM_COLLISION_RADIUS}"), node_args=CHASSIS_ARGS)
+    planner = start_node("planner_node", "-p", "use_sim_time:=true", "-p", "odom_timeout_s:=2.0",
+                         "-p", "vfo.scan_timeout_s:=0.5", "-r", "scan:=scan_relay", params_file=PARAMS)
+    relay_on = [False]
+    relay_pub = ros_node.create_publisher(LaserScan, "scan_relay", qos_profile_sensor_data)
+    relay_sub = ros_node.create_subscription(
+        LaserScan, "scan", lambda m: relay_pub.publish(m) if relay_on[0] else None, qos_profile_sensor_data)
+    client = ActionClient(ros_node, FollowWaypoints, "follow_waypoints")
+    goal = FollowWaypoints.Goal()
+    goal.poses = [stamped(x, y) for x, y in WAYPOINTS]
+
+    def run_goal():
+        handle = None
+        for _ in range(4):
+            future = client.send_goal_async(goal)
+            if wait_until(future.done, 3.0):
+                handle = future.result()
+                break
+        assert handle is not None and handle.accepted, "goal not accepted"
+        return handle
+
+    def result_of(handle, timeout: float):
+        future = handle.get_result_async()
+        assert wait_until(future.done, timeout), "no result in time"
+        return future.result()
+
+    try:
+        with subscribe(ros_node, NavStatus, "planner/status", qos=make_qos("reliable", "transient_local", 5000)) \
+                as status, subscribe(ros_node, Twist, "cmd_vel", qos=make_qos("reliable", "volatile", 5000)) as cmd:
+            sim_clock.wait_started(timeout=10)
+            planner.wait_for_log(r"chassis, pre-check world", timeout=20)
+            assert client.wait_for_server(timeout_sec=10)
+            # No scan yet: refused at once (the robot never moved).
+            r = result_of(run_goal(), 10.0)
+            assert r.status == GoalStatus.STATUS_ABORTED, r
+            assert r.result.error_msg.startswith("STALE_INPUT: scan stale"), r.result.error_msg
+            assert not cmd.snapshot() or all(m.linear.x == 0.0 for m in cmd.snapshot())
+            # Scans flow: the goal starts and the robot drives.
+            relay_on[0] = True
+            planner.wait_for_log(r"first scan: \d+ beams", timeout=20)
+            handle = run_goal()
+            status.wait_for(lambda s: s.mode == "vfo" and s.state == NavStatus.ACTIVE and s.virtual_robots > 0,
+                            timeout=15)
+            cmd.wait_for(lambda m: abs(m.linear.x) > 0.05, timeout=15)
+            # The scans stop mid-route.
+            seen = len(status)
+            relay_on[0] = False
+            t_stop = time.monotonic()
+            r = result_of(handle, 10.0)
+            waited = time.monotonic() - t_stop
+            assert r.status == GoalStatus.STATUS_ABORTED, r
+            assert r.result.error_msg.startswith("STALE_INPUT: scan stale"), r.result.error_msg
+            missed = [m.index for m in r.result.missed_waypoints]
+            assert missed and missed == list(range(missed[0], 4)), missed
+            assert {m.error_code for m in r.result.missed_waypoints} == {105}
+            # 0.5 s of timeout, the 50 ms watchdog tick, the result's round trip.
+            assert waited < 0.5 + 1.5, f"{waited:.2f} s"
+            end = status.wait_for(lambda s: s.state == NavStatus.FAILED, timeout=5, start=seen)
+            assert "STALE_INPUT" in end.reason, end.reason
+            time.sleep(0.3)
+            last = cmd.snapshot()[-1]
+            assert (last.linear.x, last.linear.y, last.angular.z) == (0.0, 0.0, 0.0), last
+    finally:
+        ros_node.destroy_subscription(relay_sub)
+        ros_node.destroy_publisher(relay_pub)

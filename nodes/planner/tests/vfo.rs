@@ -9,9 +9,9 @@ use std::f64::consts::{FRAC_PI_2, PI};
 use approx::assert_relative_eq;
 use mobil_geom::{wrap, Pose2};
 use mobil_planner::vfo::{
-    convergence_field, field_rate, find_sigmas, path_time_limit, potential, potential_derivative,
+    convergence_field, field_rate, find_sigmas, integrate_unicycle, path_time_limit, potential, potential_derivative,
     simulate_uninterrupted, Obstacle, OptimiseConfig, OptimiseWarning, PathFate, PathIndices, QualityWeights, RobotEnd,
-    Segment, Sigma, VfoController, VfoEnd, VfoEvent, VfoFollower, VfoGains, VfoWaypoint,
+    Segment, Sigma, VfoController, VfoEnd, VfoEvent, VfoFollower, VfoGains, VfoWaypoint, MAX_SETTLE_S, REST_SPEED,
 };
 use mobil_planner::PlannerError;
 use nalgebra::{Point2, Vector2};
@@ -622,4 +622,188 @@ fn entering_a_zone_the_optimisation_did_not_foresee_reoptimises() {
     );
     assert_ne!(f.sigmas()[0], Sigma::Undecided);
     assert!(pushed.end.is_none() && pushed.v != 0.0);
+}
+
+#[test]
+fn a_segment_begun_inside_a_zone_is_optimised_from_where_the_robot_comes_to_rest() {
+    // The layout of the vortex test: Algorithm 3 passes waypoint 0 early, 0.5 m from p1's centre,
+    // deep in its zone. The robot here answers its commands with a lag (first order, τ = 0.2 s,
+    // as drives do), so at the switch it still moves at about U_2 toward p1. The follower then
+    // commands zero and optimises the next segment only once the robot stands (it moved less
+    // than REST_SPEED·Δt in a tick), from the pose it stands at: the first virtual robot starts
+    // there. The route still ends within ϵ, outside every r.
+    let obstacles = vec![
+        ob(3.0, 0.5, 0.4, 1.0),
+        ob(1.5, -0.9, 0.3, 0.8),
+        ob(4.4, -0.6, 0.3, 0.8),
+        ob(4.0, 1.9, 0.35, 0.9),
+        ob(5.6, 0.9, 0.3, 0.8),
+    ];
+    let route = vec![wp(3.0, 0.0, 0.0), wp(6.5, 0.0, 0.0)];
+    let mut f =
+        VfoFollower::new(VfoGains::default(), OptimiseConfig::default(), route, obstacles.clone()).expect("valid");
+    let (dt, tau) = (0.01, 0.2);
+    let (mut pose, mut v, mut omega) = (Pose2::identity(), 0.0, 0.0);
+    let mut poses = vec![pose];
+    let mut switch: Option<(f64, f64)> = None; // time and speed at the switch
+    let mut optimised_at: Option<(f64, Pose2, f64)> = None; // time, pose and speed
+    let mut end = None;
+    let mut t = 0.0;
+    while t < 200.0 {
+        let out = f.update(&pose, t).expect("valid tick");
+        for e in &out.events {
+            match e {
+                VfoEvent::Reached { index: 0, vortex } => {
+                    assert!(*vortex);
+                    switch = Some((t, v));
+                    // The switch's tick: zero, no optimisation yet.
+                    assert_eq!((out.v, out.omega), (0.0, 0.0));
+                    assert!(f.is_settling());
+                }
+                VfoEvent::Optimised { index: 1, .. } if optimised_at.is_none() => {
+                    let start = f
+                        .last_optimisation()
+                        .and_then(|o| o.robots.first())
+                        .and_then(|r| r.path.first().copied());
+                    assert_eq!(
+                        start,
+                        Some(pose.position()),
+                        "the virtual robots start where the robot stands"
+                    );
+                    optimised_at = Some((t, pose, v));
+                }
+                _ => {}
+            }
+        }
+        if out.end.is_some() {
+            end = out.end;
+            break;
+        }
+        let a = dt / (tau + dt);
+        v += a * (out.v - v);
+        omega += a * (out.omega - omega);
+        pose = integrate_unicycle(&pose, v, omega, dt);
+        poses.push(pose);
+        t += dt;
+    }
+    let (t_switch, v_switch) = switch.expect("Algorithm 3 passed waypoint 0");
+    assert!(v_switch > 0.2, "moving at the switch: {v_switch}");
+    let (t_opt, _, v_opt) = optimised_at.expect("segment 1 optimised");
+    // Coming to rest takes a few τ: from 0.3 m/s to below 0.01 m/s is ln(30)·τ ≈ 0.68 s.
+    assert!(
+        t_opt - t_switch > 0.4 && t_opt - t_switch < MAX_SETTLE_S,
+        "{t_switch} → {t_opt}"
+    );
+    assert!(v_opt.abs() < REST_SPEED, "{v_opt}");
+    assert_eq!(end, Some(VfoEnd::Done));
+    for o in &obstacles {
+        assert!(clearance(&poses, o) > o.forbidden_radius(), "{o:?}");
+    }
+}
+
+#[test]
+fn decisions_follow_their_obstacles_when_the_map_drops_one() {
+    // A far obstacle (index 0) and one on the way to (4, 0) (index 1): the optimisation decides
+    // σ_1 only. The map then forgets the far one and adds one elsewhere: the one on the way is
+    // now index 0 and keeps its σ; the new one is undecided; without new obstacles reported, no
+    // re-optimisation.
+    let far = ob(10.0, 10.0, 0.3, 0.8);
+    let on_way = ob(2.0, 0.0, 0.5, 1.0);
+    let mut f = VfoFollower::new(
+        VfoGains::default(),
+        OptimiseConfig::default(),
+        vec![wp(4.0, 0.0, 0.0)],
+        vec![far, on_way],
+    )
+    .expect("valid");
+    f.update(&Pose2::identity(), 0.0).expect("valid");
+    let decided = f.sigmas()[1];
+    assert_eq!(f.sigmas()[0], Sigma::Undecided);
+    assert_ne!(decided, Sigma::Undecided);
+    let elsewhere = ob(-5.0, 5.0, 0.3, 0.8);
+    f.set_obstacles_mapped(vec![on_way, elsewhere], &[Some(1), None], false);
+    assert_eq!(f.sigmas(), &[decided, Sigma::Undecided]);
+    let out = f.update(&Pose2::identity(), 0.01).expect("valid");
+    assert!(out.events.is_empty(), "{:?}", out.events);
+    assert_eq!(f.obstacles()[0], on_way);
+}
+
+/// A dense layout for the interrupt tests: 24 obstacles in a staggered grid across the way from
+/// (0, 0) to (12, 0), each zone overlapping its neighbours', so Algorithm 2 simulates hundreds
+/// of virtual robots.
+fn dense() -> Vec<Obstacle> {
+    (0..8)
+        .flat_map(|i| (0..3).map(move |j| (i, j)))
+        .map(|(i, j)| {
+            let x = 1.5 + 1.3 * f64::from(i);
+            let y = -1.3 + 1.3 * f64::from(j) + if i % 2 == 0 { 0.0 } else { 0.65 };
+            ob(x, y, 0.3, 0.8)
+        })
+        .collect()
+}
+
+#[test]
+fn a_cancelled_optimisation_returns_promptly_and_a_spent_budget_keeps_the_best_so_far() {
+    use mobil_planner::vfo::{find_sigmas_until, Interrupt, INTERRUPT_CHECK_STEPS};
+    use std::sync::atomic::{AtomicUsize, Ordering};
+    let obstacles = dense();
+    let segment = Segment {
+        waypoint: wp(12.0, 0.0, 0.0),
+        last: true,
+        obstacles: &obstacles,
+    };
+    let config = OptimiseConfig {
+        threads: 1,
+        ..OptimiseConfig::default()
+    };
+    let full = find_sigmas(&Pose2::identity(), &controller(), &segment, &config).expect("valid");
+    assert!(full.robots.len() > 50, "{} virtual robots", full.robots.len());
+    let steps_full = (full.simulated_time / config.time_step).round() as usize;
+    // Cancel after 20 questions: at most 20 checks of 32 steps (plus one batch start each) are
+    // simulated, a small part of the full run's steps.
+    let asked = AtomicUsize::new(0);
+    let cancel = || (asked.fetch_add(1, Ordering::Relaxed) >= 20).then_some(Interrupt::Cancel);
+    let r = find_sigmas_until(&Pose2::identity(), &controller(), &segment, &config, &cancel);
+    assert_eq!(r, Err(mobil_planner::PlannerError::Stopped));
+    let questions = asked.load(Ordering::Relaxed);
+    assert!(questions <= 22, "{questions} questions after the cancel");
+    assert!(
+        21 * INTERRUPT_CHECK_STEPS < steps_full / 10,
+        "{steps_full} steps in the full run"
+    );
+    // A budget spent after 200 questions: the best so far, fewer virtual robots, a warning.
+    let asked = AtomicUsize::new(0);
+    let budget = || (asked.fetch_add(1, Ordering::Relaxed) >= 200).then_some(Interrupt::Budget);
+    let r = find_sigmas_until(&Pose2::identity(), &controller(), &segment, &config, &budget).expect("best so far");
+    assert!(r.robots.len() < full.robots.len());
+    assert!(
+        r.warnings
+            .iter()
+            .any(|w| matches!(w, OptimiseWarning::WallTimeBudget { pending } if *pending > 0)),
+        "{:?}",
+        r.warnings
+    );
+    assert!(r.robots.iter().all(|v| v.end != RobotEnd::Interrupted));
+    // Spent before the start: nothing simulated, no safe Σ found.
+    let r = find_sigmas_until(&Pose2::identity(), &controller(), &segment, &config, &|| {
+        Some(Interrupt::Budget)
+    })
+    .expect("valid");
+    assert_eq!(r.robots.len(), 0);
+    assert_eq!(
+        r.warnings,
+        vec![
+            OptimiseWarning::WallTimeBudget { pending: 1 },
+            OptimiseWarning::NoSafeSigma
+        ]
+    );
+    // The follower: a cancel leaves the segment due for optimisation at the next tick.
+    let mut f =
+        VfoFollower::new(VfoGains::default(), config, vec![wp(12.0, 0.0, 0.0)], obstacles.clone()).expect("valid");
+    let r = f.update_until(&Pose2::identity(), 0.0, &|| Some(Interrupt::Cancel));
+    assert_eq!(r, Err(mobil_planner::PlannerError::Stopped));
+    assert!(f.last_optimisation().is_none());
+    let out = f.update(&Pose2::identity(), 0.01).expect("valid");
+    assert!(matches!(out.events.first(), Some(VfoEvent::Optimised { .. })));
+    assert_eq!(f.last_optimisation().map(|o| o.robots.len()), Some(full.robots.len()));
 }

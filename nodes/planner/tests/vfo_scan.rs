@@ -1,12 +1,13 @@
 //! Obstacles from a laser scan (SPEC §5: detected online): circles recovered from a synthetic
-//! scan whose ranges are worked out here by ray–circle intersection, merged over time, and
+//! scan whose ranges are worked out here by ray–circle intersection, merged over time, placed
+//! with the odometry pose at the scan's stamp, forgotten (seen through, decayed, capped), and
 //! malformed scans refused.
 
-use std::f64::consts::PI;
+use std::f64::consts::{FRAC_PI_2, PI};
 
 use approx::assert_relative_eq;
 use mobil_geom::Pose2;
-use mobil_planner::vfo::{ObstacleMap, ScanObstacleConfig};
+use mobil_planner::vfo::{Circle, ObstacleMap, PoseHistory, ScanObstacleConfig};
 use nalgebra::{Point2, Vector2};
 
 /// Ranges of a scan from `odom_from_laser` with `beams` beams over `fov` (centred), seeing
@@ -49,7 +50,7 @@ fn obstacles_from_a_scan_recover_known_circles_and_merge_over_time() {
     ranges[0] = f32::NAN; // REP-117 no-measurements are not echoes
     ranges[1] = f32::NEG_INFINITY;
     let update = map
-        .update_from_ranges(&ranges, -fov / 2.0, inc, 0.06, 10.0, &laser)
+        .update_from_ranges(&ranges, -fov / 2.0, inc, 0.06, 10.0, &laser, 0.0)
         .expect("valid scan");
     assert_eq!(update.new, vec![0, 1]);
     let found = map.circles();
@@ -75,7 +76,7 @@ fn obstacles_from_a_scan_recover_known_circles_and_merge_over_time() {
     let laser2 = Pose2::new(2.5, -0.5, 1.0);
     let ranges2 = synthetic_scan(&laser2, beams, fov, &circles);
     let update = map
-        .update_from_ranges(&ranges2, -fov / 2.0, inc, 0.06, 10.0, &laser2)
+        .update_from_ranges(&ranges2, -fov / 2.0, inc, 0.06, 10.0, &laser2, 1.0)
         .expect("valid scan");
     assert_eq!((update.new.len(), update.seen), (0, 2));
     assert!((map.circles()[0].centre - circles[0].0).norm() < 1e-3);
@@ -83,23 +84,25 @@ fn obstacles_from_a_scan_recover_known_circles_and_merge_over_time() {
     let more = [circles[0], circles[1], (Point2::new(3.0, -2.0), 0.25)];
     let ranges3 = synthetic_scan(&laser2, beams, fov, &more);
     let update = map
-        .update_from_ranges(&ranges3, -fov / 2.0, inc, 0.06, 10.0, &laser2)
+        .update_from_ranges(&ranges3, -fov / 2.0, inc, 0.06, 10.0, &laser2, 1.0)
         .expect("valid scan");
     assert_eq!(update.new, vec![2]);
     assert!((map.circles()[2].centre - Point2::new(3.0, -2.0)).norm() < 1e-3);
     // Malformed scans change nothing.
-    assert!(map.update_from_ranges(&[], 0.0, 0.01, 0.06, 10.0, &laser).is_err());
+    assert!(map.update_from_ranges(&[], 0.0, 0.01, 0.06, 10.0, &laser, 0.0).is_err());
     assert!(map
-        .update_from_ranges(&ranges, 0.0, f64::NAN, 0.06, 10.0, &laser)
+        .update_from_ranges(&ranges, 0.0, f64::NAN, 0.06, 10.0, &laser, 0.0)
         .is_err());
-    assert!(map.update_from_ranges(&ranges, 0.0, inc, 1.0, 0.5, &laser).is_err());
     assert!(map
-        .update_from_ranges(&ranges, 0.0, inc, 0.06, 10.0, &Pose2::new(f64::NAN, 0.0, 0.0))
+        .update_from_ranges(&ranges, 0.0, inc, 1.0, 0.5, &laser, 0.0)
+        .is_err());
+    assert!(map
+        .update_from_ranges(&ranges, 0.0, inc, 0.06, 10.0, &Pose2::new(f64::NAN, 0.0, 0.0), 0.0)
         .is_err());
     // Only NaN and inf: no obstacle.
     let nothing = vec![f32::NAN, f32::INFINITY, f32::NEG_INFINITY, f32::INFINITY];
     let update = map
-        .update_from_ranges(&nothing, 0.0, 0.1, 0.06, 10.0, &laser)
+        .update_from_ranges(&nothing, 0.0, 0.1, 0.06, 10.0, &laser, 0.0)
         .expect("valid");
     assert_eq!((update.new.len(), update.seen), (0, 0));
     assert_eq!(map.circles().len(), 3);
@@ -127,7 +130,7 @@ fn a_wall_is_covered_by_a_chain_of_circles_holding_every_echo() {
     let mut map = ObstacleMap::new(ScanObstacleConfig::default()).expect("valid");
     let laser = Pose2::identity();
     let update = map
-        .update_from_ranges(&ranges, -fov / 2.0, inc, 0.06, 10.0, &laser)
+        .update_from_ranges(&ranges, -fov / 2.0, inc, 0.06, 10.0, &laser, 0.0)
         .expect("valid scan");
     let circles = map.circles();
     assert!(circles.len() >= 3, "{circles:?}");
@@ -146,4 +149,199 @@ fn a_wall_is_covered_by_a_chain_of_circles_holding_every_echo() {
         // The centroid of a piece at most 1 m long lies on the wall, within 1 m of its ends.
         assert!(c.radius <= 1.0 && (c.centre.x - 2.0).abs() < 1e-6, "{c:?}");
     }
+}
+
+fn circle_map(decay_s: f64, max_obstacles: usize) -> ObstacleMap {
+    ObstacleMap::new(ScanObstacleConfig {
+        decay_s,
+        max_obstacles,
+        ..ScanObstacleConfig::default()
+    })
+    .expect("valid")
+}
+
+fn circle(x: f64, y: f64, radius: f64) -> Circle {
+    Circle {
+        centre: Point2::new(x, y),
+        radius,
+    }
+}
+
+#[test]
+fn the_pose_history_interpolates_and_refuses_a_time_without_odometry_near_it() {
+    let mut h = PoseHistory::new(50);
+    assert!(h.at(0.0, 0.1).is_none());
+    h.push(0.0, Pose2::new(0.0, 0.0, 0.0));
+    h.push(0.1, Pose2::new(0.1, 0.02, 0.3));
+    // A quarter of the way: (0.025, 0.005, 0.075).
+    let p = h.at(0.025, 0.05).expect("between two poses");
+    assert_relative_eq!(p.x, 0.025, epsilon = 1e-12);
+    assert_relative_eq!(p.y, 0.005, epsilon = 1e-12);
+    assert_relative_eq!(p.yaw, 0.075, epsilon = 1e-12);
+    // After the last pose: the last one while within the bound, none beyond (no extrapolation).
+    assert_eq!(h.at(0.14, 0.05), Some(Pose2::new(0.1, 0.02, 0.3)));
+    assert!(h.at(0.16, 0.05).is_none());
+    assert!(h.at(-0.06, 0.05).is_none());
+    assert!(h.at(f64::NAN, 0.05).is_none());
+    // Across ±π the heading goes the short way: from 3.1 to −3.1 is +0.083 rad, so the
+    // midpoint lies at 3.1 + 0.0416 = 3.1416.
+    h.push(0.2, Pose2::new(0.0, 0.0, 3.1));
+    h.push(0.3, Pose2::new(0.0, 0.0, -3.1));
+    let p = h.at(0.25, 0.1).expect("between");
+    assert_relative_eq!(p.yaw, 3.1 + 0.5 * (2.0 * PI - 6.2), epsilon = 1e-12);
+    // A gap of one second in the odometry: a scan in its middle is refused.
+    h.push(1.3, Pose2::new(1.0, 0.0, 0.0));
+    assert!(h.at(0.8, 0.1).is_none());
+    // Time going backwards (a clock reset) starts the history afresh; the capacity holds.
+    h.push(0.05, Pose2::new(5.0, 5.0, 0.0));
+    assert_eq!(h.len(), 1);
+    for k in 0..60 {
+        h.push(1.0 + f64::from(k) * 0.02, Pose2::identity());
+    }
+    assert_eq!(h.len(), 50);
+}
+
+#[test]
+fn a_scan_placed_with_the_pose_at_its_stamp_finds_the_obstacle_where_it_is() {
+    // The robot turns on the spot at 1.5 rad/s: odometry at 50 Hz; a scan taken at t = 0.05 s
+    // (heading 0.075 rad) of a pillar at (3, 0.5), r 0.3. Placed with the pose at its stamp
+    // (interpolated between 0.04 and 0.06) the circle is found within 1 mm; placed with the
+    // pose 0.1 s later (heading 0.225 rad, what a late scan met) it lands 0.15 rad round, about
+    // 3.04 · 0.15 = 0.46 m off.
+    let pillar = (Point2::new(3.0, 0.5), 0.3);
+    let mut h = PoseHistory::new(50);
+    for k in 0..10 {
+        let t = f64::from(k) * 0.02;
+        h.push(t, Pose2::new(0.0, 0.0, 1.5 * t));
+    }
+    let taken = Pose2::new(0.0, 0.0, 0.075);
+    let fov = 1.5 * PI;
+    let beams = 1081;
+    let inc = fov / (beams - 1) as f64;
+    let ranges = synthetic_scan(&taken, beams, fov, &[pillar]);
+    let at_stamp = h.at(0.05, 0.05).expect("odometry near the stamp");
+    assert_relative_eq!(at_stamp.yaw, 0.075, epsilon = 1e-12);
+    let mut map = ObstacleMap::new(ScanObstacleConfig::default()).expect("valid");
+    map.update_from_ranges(&ranges, -fov / 2.0, inc, 0.06, 10.0, &at_stamp, 0.05)
+        .expect("valid");
+    assert!(
+        (map.circles()[0].centre - pillar.0).norm() < 1e-3,
+        "{:?}",
+        map.circles()
+    );
+    let mut late = ObstacleMap::new(ScanObstacleConfig::default()).expect("valid");
+    late.update_from_ranges(&ranges, -fov / 2.0, inc, 0.06, 10.0, &Pose2::new(0.0, 0.0, 0.225), 0.05)
+        .expect("valid");
+    let off = (late.circles()[0].centre - pillar.0).norm();
+    assert!((off - 0.46).abs() < 0.02, "{off}");
+}
+
+#[test]
+fn a_circle_seen_through_is_removed_and_one_hidden_or_out_of_view_is_kept() {
+    // From the origin facing +x (270°, 10 m): a pillar at (3, 0) r 0.3 is seen at t = 0.
+    let fov = 1.5 * PI;
+    let beams = 1081;
+    let inc = fov / (beams - 1) as f64;
+    let laser = Pose2::identity();
+    let pillar = (Point2::new(3.0, 0.0), 0.3);
+    let mut map = circle_map(30.0, 200);
+    let ranges = synthetic_scan(&laser, beams, fov, &[pillar]);
+    map.update_from_ranges(&ranges, -fov / 2.0, inc, 0.06, 10.0, &laser, 0.0)
+        .expect("valid");
+    assert_eq!(map.ids(), vec![0]);
+    // A box at (−2, −0.1), behind the laser's back (outside its 270°), is known too.
+    map.merge_at(&[circle(-2.0, -0.1, 0.3)], 0.0);
+    // Now a small pillar at (1.5, 0), r 0.2, hides it: kept (the echoes at 1.3 m stop short of
+    // it); the small one is new (id 2).
+    let occluder = (Point2::new(1.5, 0.0), 0.2);
+    let hidden = synthetic_scan(&laser, beams, fov, &[occluder]);
+    let u = map
+        .update_from_ranges(&hidden, -fov / 2.0, inc, 0.06, 10.0, &laser, 1.0)
+        .expect("valid");
+    assert!(u.seen_through.is_empty(), "{u:?}");
+    assert_eq!(map.ids(), vec![0, 1, 2]);
+    // Nothing at all along the beams (both moved away): both are removed, by id; the box behind
+    // the laser is not in view and stays, now at index 0.
+    let empty = vec![f32::INFINITY; beams];
+    let u = map
+        .update_from_ranges(&empty, -fov / 2.0, inc, 0.06, 10.0, &laser, 2.0)
+        .expect("valid");
+    assert_eq!(u.seen_through, vec![0, 2]);
+    assert!(u.removed_any());
+    assert_eq!(map.ids(), vec![1]);
+    assert_eq!(map.circles()[0].centre, Point2::new(-2.0, -0.1));
+    // A circle beyond range_max (here 2.5 m) is not judged: kept.
+    let mut map = circle_map(30.0, 200);
+    map.merge_at(&[circle(3.0, 0.0, 0.3)], 0.0);
+    let u = map
+        .update_from_ranges(&empty, -fov / 2.0, inc, 0.06, 2.5, &laser, 1.0)
+        .expect("valid");
+    assert!(u.seen_through.is_empty());
+    assert_eq!(map.len(), 1);
+}
+
+#[test]
+fn a_circle_not_seen_for_the_decay_time_is_forgotten() {
+    // decay 5 s; the laser looks along −x with a 0.2 rad field of view: it never sees the
+    // circle at (3, 0), nor through it.
+    let mut map = circle_map(5.0, 200);
+    map.merge_at(&[circle(3.0, 0.0, 0.3)], 0.0);
+    map.merge_at(&[circle(0.0, 3.0, 0.3)], 2.0);
+    let away = Pose2::new(0.0, 0.0, PI);
+    let ranges = vec![f32::INFINITY; 21];
+    let u = map
+        .update_from_ranges(&ranges, -0.1, 0.01, 0.06, 10.0, &away, 5.0)
+        .expect("valid");
+    assert!(u.decayed.is_empty());
+    assert_eq!(map.len(), 2);
+    // At 5.1 s the first (seen at 0) is 5.1 s old: forgotten; the second (seen at 2) stays.
+    let u = map
+        .update_from_ranges(&ranges, -0.1, 0.01, 0.06, 10.0, &away, 5.1)
+        .expect("valid");
+    assert_eq!(u.decayed, vec![0]);
+    assert_eq!(map.ids(), vec![1]);
+    // Seen again, a circle's clock restarts.
+    map.merge_at(&[circle(0.0, 3.0, 0.3)], 6.0);
+    let u = map
+        .update_from_ranges(&ranges, -0.1, 0.01, 0.06, 10.0, &away, 10.5)
+        .expect("valid");
+    assert!(u.decayed.is_empty());
+    assert_eq!(map.ids(), vec![1]);
+}
+
+#[test]
+fn beyond_the_cap_the_least_recently_seen_circles_are_dropped() {
+    // Cap 2; A seen at 0, B at 1, C at 2, then A again at 3: B is the least recently seen.
+    let mut map = circle_map(30.0, 2);
+    map.merge_at(&[circle(3.0, 0.0, 0.3)], 0.0);
+    map.merge_at(&[circle(0.0, 3.0, 0.3)], 1.0);
+    map.merge_at(&[circle(-3.0, 0.0, 0.3)], 2.0);
+    map.merge_at(&[circle(3.0, 0.0, 0.3)], 3.0);
+    assert_eq!(map.ids(), vec![0, 1, 2]);
+    let away = Pose2::new(0.0, 0.0, -FRAC_PI_2);
+    let ranges = vec![f32::INFINITY; 21];
+    let u = map
+        .update_from_ranges(&ranges, -0.1, 0.01, 0.06, 10.0, &away, 3.5)
+        .expect("valid");
+    assert_eq!(u.capped, vec![1]);
+    assert_eq!(map.ids(), vec![0, 2]);
+    assert_eq!(map.circles()[1].centre, Point2::new(-3.0, 0.0));
+    // Equal ages: the oldest (smallest id) goes first.
+    let mut map = circle_map(30.0, 1);
+    map.merge_at(&[circle(3.0, 0.0, 0.3), circle(0.0, 3.0, 0.3)], 0.0);
+    let u = map
+        .update_from_ranges(&ranges, -0.1, 0.01, 0.06, 10.0, &away, 0.5)
+        .expect("valid");
+    assert_eq!((u.capped, map.ids()), (vec![0], vec![1]));
+    // Refused settings.
+    assert!(ObstacleMap::new(ScanObstacleConfig {
+        max_obstacles: 0,
+        ..ScanObstacleConfig::default()
+    })
+    .is_err());
+    assert!(ObstacleMap::new(ScanObstacleConfig {
+        decay_s: f64::NAN,
+        ..ScanObstacleConfig::default()
+    })
+    .is_err());
 }

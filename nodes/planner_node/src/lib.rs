@@ -460,6 +460,14 @@ impl Route {
             .find(|(_, p)| vfo::oriented(&p.pose.orientation))
             .map(|(i, _)| i)
     }
+
+    /// The request indices of the waypoints from route index `from` on (those not reached
+    /// when the run stops while pursuing `from`).
+    pub fn unreached_from(&self, from: usize) -> Vec<usize> {
+        (from..self.points.len())
+            .map(|i| self.request_index.get(i).copied().unwrap_or(i))
+            .collect()
+    }
 }
 
 /// A route from `poses` (each in `odom_frame`; an empty frame takes `default_frame`, the path's
@@ -920,6 +928,29 @@ impl Outcome {
     }
 }
 
+impl Outcome {
+    /// FollowWaypoints' result for a VFO route: as [`Outcome::follow_result`], and every early
+    /// end (stale input, a refusal, a cancel, a pre-emption, shutdown, as well as NO_SAFE_PATH
+    /// and COLLISION, which carry their own) lists the waypoints not reached, `unreached`
+    /// (request indices, from the one pursued on), as given up by the run.
+    pub fn vfo_follow_result(&self, poses: &[PoseStamped], unreached: &[usize]) -> FollowWaypointsResult {
+        let mut r = self.follow_result(poses, &[]);
+        let own = matches!(self, Outcome::NoSafePath { .. } | Outcome::Collision { .. });
+        if !self.succeeded() && !own {
+            r.missed_waypoints = unreached
+                .iter()
+                .take(MAX_RESULT_MISSED)
+                .map(|&index| MissedWaypoint {
+                    index: u32::try_from(index).unwrap_or(u32::MAX),
+                    goal: poses.get(index).cloned().unwrap_or_default(),
+                    error_code: MISSED_BY_THE_RUN,
+                })
+                .collect();
+        }
+        r
+    }
+}
+
 /// How a failed docking is reported. On a chassis that cannot turn in place
 /// ([`Finish::ReportResidual`]) V stops falling for one reason: the law asks for a turn tighter
 /// than the minimum radius (near the goal v = γ·e·cos α → 0 while ω does not; elsewhere a
@@ -1146,20 +1177,33 @@ pub struct MarkerView<'a> {
     pub robot: Option<Point2<f64>>,
 }
 
+/// Most points over the whole marker array — the route's line and dots, the predicted path,
+/// the virtual robots' paths and the chosen one — shared among them by [`markers`]: 24 bytes
+/// each in CDR, 24 KB. With the markers' own bytes (about 250 each, at most
+/// 2 + 1 + 2·[`MAX_LISTED_PROBLEMS`] + 1 + [`vfo::MAX_DRAWN_ROBOTS`] + 1 +
+/// 2·[`vfo::MAX_DRAWN_OBSTACLES`] of them) the array stays below the 80 KB a message to rclpy
+/// should stay below (tested on the worst case).
+pub const MAX_MARKER_POINTS: usize = 1000;
+
 /// The marker array: a DELETEALL first (so nothing stale stays), the route as a LINE_STRIP and
 /// a SPHERE_LIST of its waypoints, the predicted path as a LINE_STRIP (at most
 /// [`MAX_DRAWN_PATH`] points), each problem (at most [`MAX_LISTED_PROBLEMS`]) as a red SPHERE
-/// and a TEXT_VIEW_FACING at its place, the dock pose as an ARROW. With 200 waypoints and 50
-/// problems about 30 KB.
+/// and a TEXT_VIEW_FACING at its place, the dock pose as an ARROW, and a VFO optimisation
+/// (below). The points share one budget, [`MAX_MARKER_POINTS`]: the route takes up to
+/// half of it (its line and dots, a quarter each, downsampled beyond), the predicted path up to
+/// a quarter of the rest, the VFO paths what remains.
 pub fn markers(view: &MarkerView<'_>, stamp: Time, frame: &str) -> MarkerArray {
     let header = Header {
         stamp,
         frame_id: frame.to_owned(),
     };
     let mut out = vec![clear_marker(&header)];
+    let mut budget = MAX_MARKER_POINTS;
     if !view.route.is_empty() {
+        let route = downsample(view.route, MAX_MARKER_POINTS / 4);
+        budget -= 2 * route.len();
         let mut line = marker(&header, "route", 0, Marker::LINE_STRIP, 0.02, color(0.2, 0.6, 1.0));
-        line.points = view.route.iter().map(|p| point(*p)).collect();
+        line.points = route.iter().map(|p| point(*p)).collect();
         let mut dots = marker(&header, "route", 1, Marker::SPHERE_LIST, 0.12, color(0.2, 0.6, 1.0));
         dots.points = line.points.clone();
         out.push(line);
@@ -1167,10 +1211,11 @@ pub fn markers(view: &MarkerView<'_>, stamp: Time, frame: &str) -> MarkerArray {
     }
     if !view.predicted.is_empty() {
         let mut path = marker(&header, "predicted", 0, Marker::LINE_STRIP, 0.015, color(0.0, 0.8, 0.0));
-        path.points = downsample(view.predicted, MAX_DRAWN_PATH)
+        path.points = downsample(view.predicted, MAX_DRAWN_PATH.min(budget / 4))
             .iter()
             .map(|p| point(p.position()))
             .collect();
+        budget -= path.points.len();
         out.push(path);
     }
     for (i, m) in view.problems.iter().take(MAX_LISTED_PROBLEMS).enumerate() {
@@ -1205,7 +1250,7 @@ pub fn markers(view: &MarkerView<'_>, stamp: Time, frame: &str) -> MarkerArray {
         out.push(arrow);
     }
     if let Some(drawing) = view.vfo {
-        vfo_markers(&header, drawing, view.robot, &mut out);
+        vfo_markers(&header, drawing, view.robot, budget, &mut out);
     }
     MarkerArray { markers: out }
 }
@@ -1214,9 +1259,21 @@ pub fn markers(view: &MarkerView<'_>, stamp: Time, frame: &str) -> MarkerArray {
 /// grey; orange where the path was dropped on a collision or the time cap), the chosen path a
 /// thick green one (`vfo_chosen`), each obstacle (at most [`vfo::MAX_DRAWN_OBSTACLES`], the
 /// nearest to `robot` first) a red CYLINDER of radius r (`vfo_forbidden`) inside a pale yellow
-/// one of radius R (`vfo_influence`).
-fn vfo_markers(header: &Header, drawing: &vfo::VfoDrawing, robot: Option<Point2<f64>>, out: &mut Vec<Marker>) {
-    for (i, r) in drawing.robots.iter().enumerate() {
+/// one of radius R (`vfo_influence`). The paths share `budget` points: the chosen one up to a
+/// third, the virtual robots the rest, evenly (at least two points each, so the first
+/// `budget / 2` robots at most).
+fn vfo_markers(
+    header: &Header,
+    drawing: &vfo::VfoDrawing,
+    robot: Option<Point2<f64>>,
+    budget: usize,
+    out: &mut Vec<Marker>,
+) {
+    let chosen = downsample(&drawing.chosen, budget / 3);
+    let rest = budget - chosen.len();
+    let robots = &drawing.robots[..drawing.robots.len().min(rest / 2).min(vfo::MAX_DRAWN_ROBOTS)];
+    let per_robot = (rest / robots.len().max(1)).max(2);
+    for (i, r) in robots.iter().enumerate() {
         let id = i32::try_from(i).unwrap_or(i32::MAX);
         let c = if r.dropped {
             color(1.0, 0.5, 0.0)
@@ -1224,12 +1281,12 @@ fn vfo_markers(header: &Header, drawing: &vfo::VfoDrawing, robot: Option<Point2<
             color(0.6, 0.6, 0.6)
         };
         let mut line = marker(header, "vfo_robots", id, Marker::LINE_STRIP, 0.01, c);
-        line.points = r.points.iter().map(|p| point(*p)).collect();
+        line.points = downsample(&r.points, per_robot).iter().map(|p| point(*p)).collect();
         out.push(line);
     }
-    if !drawing.chosen.is_empty() {
+    if !chosen.is_empty() {
         let mut line = marker(header, "vfo_chosen", 0, Marker::LINE_STRIP, 0.04, color(0.0, 0.9, 0.2));
-        line.points = drawing.chosen.iter().map(|p| point(*p)).collect();
+        line.points = chosen.iter().map(|p| point(*p)).collect();
         out.push(line);
     }
     let mut order: Vec<usize> = (0..drawing.obstacles.len()).collect();
@@ -1694,7 +1751,10 @@ mod tests {
         assert_eq!(a.markers.len(), 1 + 2 + 1 + 2 * MAX_LISTED_PROBLEMS + 1);
         assert_eq!(a.markers[0].action, Marker::DELETEALL);
         let points: usize = a.markers.iter().map(|m| m.points.len()).sum();
-        assert_eq!(points, 2 * MAX_WAYPOINTS + MAX_DRAWN_PATH);
+        // The route whole (200 ≤ a quarter of the budget each), the predicted path within a
+        // quarter of the rest: (1000 − 400) / 4 = 150 points.
+        assert_eq!(points, 2 * MAX_WAYPOINTS + (MAX_MARKER_POINTS - 2 * MAX_WAYPOINTS) / 4);
+        assert_eq!(points, 550);
         let arrow = a.markers.last().expect("arrow");
         assert_eq!(arrow.r#type, Marker::ARROW);
         assert_relative_eq!(yaw_of(&arrow.pose.orientation), 0.5, epsilon = 1e-12);

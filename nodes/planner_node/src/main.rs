@@ -35,14 +35,16 @@ use mobil_msgs::nav_msgs::msg::{Odometry, Path};
 use mobil_msgs::sensor_msgs::msg::LaserScan;
 use mobil_msgs::tf2_msgs::msg::TFMessage;
 use mobil_msgs::visualization_msgs::msg::MarkerArray;
-use mobil_planner::vfo::{ObstacleMap, OptimiseWarning, VfoEnd, VfoEvent, VfoFollower, VfoOutput};
+use mobil_planner::vfo::{
+    Interrupt, ObstacleMap, OptimiseWarning, PoseHistory, VfoEnd, VfoEvent, VfoFollower, VfoOutput,
+};
 use mobil_planner::{
     check_route_until, polar_error, DockingController, DockingOutput, DockingPhase, Finish, FollowEnd, FollowEvent,
     PlannerError, ProblemKind, RouteReport, VelocityLimits, WaypointFollower,
 };
 use mobil_planner_node::vfo::{
-    segment_report, vfo_command, vfo_drawing, vfo_gains, vfo_waypoints, Handback, SegmentReport, VfoDrawing, VfoSlot,
-    WaypointMethod,
+    segment_report, vfo_command, vfo_drawing, vfo_gains, vfo_max_delay, vfo_waypoints, ArrivalPeriod, Handback,
+    SegmentReport, VfoDrawing, VfoSlot, WaypointMethod,
 };
 use mobil_planner_node::{
     backed_out, check_reply, clamp_twist, dock_goal, docking_offset, docking_outcome, duration_msg, load_world,
@@ -52,10 +54,11 @@ use mobil_planner_node::{
 use mobil_ros::action::{ActionEvent, GoalEnd, GoalRequest, GoalServer, GoalServerConfig};
 use mobil_ros::input::{decoded, Input};
 use mobil_ros::latest::Latest;
+use mobil_ros::offloop::CancelToken;
 use mobil_ros::scan::{scan_from_msg, tf_static_subscription, StaticFrames};
 use mobil_ros::stop::{final_stop, FINAL_STOP_WAIT};
 use mobil_ros::ticker::Ticker;
-use mobil_ros::time::{DtClock, DtError};
+use mobil_ros::time::{secs_from_stamp, DtClock, DtError};
 use mobil_ros::OffLoop;
 use mobil_ros::{qos, run_node, shutdown_signal, warn_throttled, ConfigError, LogThrottle, NodeDecl, RosNode};
 use mobil_sim::world::World;
@@ -157,6 +160,11 @@ enum Task {
         /// The obstacle map changed since the follower last saw it (`Some(true)`: with new
         /// obstacles, which re-optimise the segment).
         obstacles_changed: Option<bool>,
+        /// The map's ids of the obstacles the follower holds, by its index: its σ follow them
+        /// over removals from the map.
+        ids: Vec<u64>,
+        /// Cancelled when the goal ends: a tick's optimisation under way stops at once.
+        stop: CancelToken,
     },
 }
 
@@ -214,6 +222,10 @@ struct PreCheckDone {
 /// stopped); service requests beyond the rest are answered BUSY at once.
 const MAX_CHECKS: usize = 4;
 
+/// Odometry poses kept to place scans by their stamps: 2 s at 50 Hz, far beyond
+/// `vfo.scan_odom_max_gap_s`'s range.
+const ODOM_HISTORY: usize = 100;
+
 /// One VFO tick done on the blocking pool: the follower back, its output, and when the tick
 /// optimised, what the status and markers show of it.
 struct VfoTickDone {
@@ -259,8 +271,16 @@ struct Shell {
     throttle: LogThrottle,
     /// Obstacles seen by the LIDAR, in odom (VFO); kept between goals.
     map: ObstacleMap,
+    /// A parameter change asked for a new map while a goal ran: built once none runs.
+    map_rebuild: bool,
+    /// The odometry poses of the last seconds by stamp: a scan is placed with the pose at its
+    /// own stamp.
+    odom_history: PoseHistory,
     /// When the last valid scan arrived.
     scan_seen: Latest<()>,
+    /// The odometry's measured period (steady clock): a VFO tick's command later than two of
+    /// them is dropped.
+    odom_period: ArrivalPeriod,
     /// The laser's pose from `tf_static`.
     laser: StaticFrames,
 }
@@ -344,7 +364,10 @@ async fn start(node: &mut RosNode, out: &Outputs, config: PlannerConfig) -> anyh
         gate: CommandGate::default(),
         throttle: LogThrottle::new(Duration::from_secs(2)),
         map,
+        map_rebuild: false,
+        odom_history: PoseHistory::new(ODOM_HISTORY),
         scan_seen: Latest::new(),
+        odom_period: ArrivalPeriod::default(),
         laser: StaticFrames::default(),
     };
     shell.send_idle_status(node, out);
@@ -578,12 +601,19 @@ impl Shell {
     fn reconfigure(&mut self, c: PlannerConfig) {
         let scan = c.vfo.scan_config(c.robot_radius);
         if scan != self.config.vfo.scan_config(self.config.robot_radius) {
-            match ObstacleMap::new(scan) {
-                Ok(map) => {
-                    info!("vfo obstacle extraction changed: the obstacle map starts afresh");
+            if let Err(e) = ObstacleMap::new(scan) {
+                return warn!("parameters not applied: {e}");
+            }
+            if self.active.is_some() {
+                // The goal keeps the map its parameters built (its obstacles and σ stay valid).
+                info!("vfo obstacle extraction changed: the obstacle map starts afresh once the goal ends");
+                self.map_rebuild = true;
+            } else {
+                info!("vfo obstacle extraction changed: the obstacle map starts afresh");
+                self.map_rebuild = false;
+                if let Ok(map) = ObstacleMap::new(scan) {
                     self.map = map;
                 }
-                Err(e) => return warn!("parameters not applied: {e}"),
             }
         }
         match c.chassis_params() {
@@ -784,6 +814,9 @@ impl Shell {
     /// [`Shell::end_goal`] but for the zero command, which the caller sends.
     fn end_goal_without_zero(&mut self, node: &RosNode, out: &Outputs, servers: &mut Servers, outcome: Outcome) {
         let Some(active) = self.active.as_ref() else { return };
+        if let Task::Vfo { stop, .. } = &active.task {
+            stop.cancel();
+        }
         let source = active.source;
         let end = goal_end(&outcome);
         match (source, &active.task) {
@@ -796,7 +829,13 @@ impl Shell {
             (Source::FollowAction, Task::Follow { route, missed, .. }) => {
                 servers.follow.finish(end, outcome.follow_result(&route.poses, missed));
             }
-            (Source::FollowAction, Task::PreCheck { route, .. } | Task::Vfo { route, .. }) => {
+            (Source::FollowAction, Task::Vfo { route, index, .. }) => {
+                servers.follow.finish(
+                    end,
+                    outcome.vfo_follow_result(&route.poses, &route.unreached_from(*index)),
+                );
+            }
+            (Source::FollowAction, Task::PreCheck { route, .. }) => {
                 servers.follow.finish(end, outcome.follow_result(&route.poses, &[]));
             }
             (Source::FollowAction, _) => {
@@ -814,6 +853,15 @@ impl Shell {
         }
         self.publish_status(node, out, outcome.state(), outcome.reason());
         self.active = None;
+        if std::mem::take(&mut self.map_rebuild) {
+            match ObstacleMap::new(self.config.vfo.scan_config(self.config.robot_radius)) {
+                Ok(map) => {
+                    info!("the obstacle map starts afresh with the new extraction parameters");
+                    self.map = map;
+                }
+                Err(e) => warn!("the obstacle map keeps its old parameters: {e}"),
+            }
+        }
         self.publish_markers(node, out);
     }
 
@@ -1002,6 +1050,11 @@ impl Shell {
         let Some(start) = start else {
             return self.refuse(node, out, servers, source, Outcome::Stale);
         };
+        // Without a fresh scan the obstacles are unknown: the first tick would optimise the
+        // segment through a map with nothing in it.
+        if self.scan_seen.get(self.config.vfo.scan_timeout()).is_none() {
+            return self.refuse(node, out, servers, source, Outcome::ScanStale);
+        }
         let offset = docking_offset(&self.chassis);
         let settings = &self.config.vfo;
         let gains = vfo_gains(&settings.gains, &self.chassis);
@@ -1033,9 +1086,10 @@ impl Shell {
                 self.chassis.model().as_str()
             );
         }
-        // A tick's command older than one control period is dropped (the robot stops).
-        let max_delay = Duration::from_secs_f64(settings.optimise.time_step.max(0.005));
-        let distance = (route.points[0] - start.position()).norm();
+        // A tick's command later than the next odometry or two is dropped (the robot stops).
+        let max_delay = vfo_max_delay(self.odom_period.period(), settings.optimise.time_step);
+        // Progress is the follower's: from the point the law steers (the guide point).
+        let distance = (route.points[0] - start.ahead(-offset).position()).norm();
         self.drawing = Drawing {
             route: route.points.clone(),
             ..Drawing::default()
@@ -1050,6 +1104,8 @@ impl Shell {
                 distance,
                 report: SegmentReport::default(),
                 obstacles_changed: None,
+                ids: self.map.ids(),
+                stop: CancelToken::new(),
             },
             source,
         );
@@ -1236,10 +1292,10 @@ impl Shell {
                 ..
             }) => Outcome::Preempted("follow_waypoints").follow_result(&route.poses, missed),
             Some(Active {
-                task: Task::Vfo { route, .. },
+                task: Task::Vfo { route, index, .. },
                 source: Source::FollowAction,
                 ..
-            }) => Outcome::Preempted("follow_waypoints").follow_result(&route.poses, &[]),
+            }) => Outcome::Preempted("follow_waypoints").vfo_follow_result(&route.poses, &route.unreached_from(*index)),
             _ => Outcome::Preempted("follow_waypoints").follow_result(&[], &[]),
         };
         self.new_goal(node, out, servers, Source::FollowAction).await;
@@ -1279,6 +1335,10 @@ impl Shell {
         match odom_pose(m, &self.config.odom_frame, &self.config.base_frame) {
             Ok(pose) => {
                 self.odom_refused = false;
+                if let Some(t) = secs_from_stamp(&m.header.stamp) {
+                    self.odom_history.push(t, pose);
+                }
+                self.odom_period.arrived(Instant::now());
                 self.odom.set(pose, m.header.stamp.clone());
                 if self.active.is_some() {
                     self.step(node, out, servers, jobs, pose);
@@ -1287,6 +1347,7 @@ impl Shell {
             Err(e) => {
                 warn_throttled!(self.throttle, "odom-bad", "odom sample dropped: {e}; robot stopped");
                 self.odom_refused = true;
+                self.odom_history.clear();
                 self.refused(out);
             }
         }
@@ -1442,7 +1503,6 @@ impl Shell {
     /// A VFO tick at `pose`, time `t`: the follower goes to the blocking pool with the map's
     /// latest obstacles, or, while it is still out (optimising), the robot stops.
     fn vfo_step(&mut self, out: &Outputs, jobs: &mut Jobs, pose: Pose2, t: f64) {
-        let obstacles = self.map.obstacles();
         let Some(Active {
             task:
                 Task::Vfo {
@@ -1450,8 +1510,11 @@ impl Shell {
                     seq,
                     offset,
                     obstacles_changed,
+                    ids,
+                    stop,
                     ..
                 },
+            config,
             ..
         }) = self.active.as_mut()
         else {
@@ -1461,11 +1524,28 @@ impl Shell {
             return self.zero(out);
         };
         if let Some(new) = obstacles_changed.take() {
-            follower.set_obstacles(obstacles, new);
+            let now_ids = self.map.ids();
+            let previous: Vec<Option<usize>> = now_ids
+                .iter()
+                .map(|id| ids.iter().position(|held| held == id))
+                .collect();
+            follower.set_obstacles_mapped(self.map.obstacles(), &previous, new);
+            *ids = now_ids;
         }
-        let (seq, guide) = (*seq, pose.ahead(-*offset));
-        jobs.vfo.start(move |_| {
-            let output = follower.update(&guide, t);
+        let (seq, guide, stop) = (*seq, pose.ahead(-*offset), stop.clone());
+        let budget = config.vfo.optimise_budget();
+        jobs.vfo.start(move |cancel| {
+            let started = Instant::now();
+            let interrupt = || {
+                if cancel.is_cancelled() || stop.is_cancelled() {
+                    Some(Interrupt::Cancel)
+                } else if started.elapsed() > budget {
+                    Some(Interrupt::Budget)
+                } else {
+                    None
+                }
+            };
+            let output = follower.update_until(&guide, t, &interrupt);
             let optimised = output
                 .as_ref()
                 .is_ok_and(|o| o.events.iter().any(|e| matches!(e, VfoEvent::Optimised { .. })))
@@ -1493,6 +1573,7 @@ impl Shell {
             index,
             distance,
             report,
+            offset,
             ..
         } = &mut active.task
         else {
@@ -1558,7 +1639,7 @@ impl Shell {
         }
         *index = o.index;
         *distance = o.distance;
-        let unreached = |from: usize| (from..route.points.len()).map(request).collect::<Vec<_>>();
+        let unreached = |from: usize| route.unreached_from(from);
         let ended = match o.end {
             None => None,
             Some(VfoEnd::Done) => Some(Outcome::RouteDone {
@@ -1572,7 +1653,8 @@ impl Shell {
             }),
             Some(VfoEnd::Collision { obstacle }) => {
                 let o = slot.follower().and_then(|f| f.obstacles().get(obstacle).copied());
-                let at = self.odom.value().map(|p| p.position());
+                // The guide point's distance, as the follower measured the collision.
+                let at = self.odom.value().map(|p| p.ahead(-*offset).position());
                 Some(Outcome::Collision {
                     centre: o.map_or_else(Point2::origin, |o| o.centre()),
                     radius: o.map_or(f64::NAN, |o| o.forbidden_radius()),
@@ -1603,26 +1685,32 @@ impl Shell {
         }
     }
 
-    /// A scan: its obstacles go into the map (in odom, at the latest fresh odometry pose);
-    /// a VFO route's follower gets them at its next tick.
+    /// A scan: its obstacles go into the map (in odom, with the odometry pose at the scan's
+    /// stamp); a VFO route's follower gets them at its next tick. A goal's scans are read with
+    /// the parameters it began with.
     fn scan_in(&mut self, m: &LaserScan) {
-        if self.config.waypoint_method != WaypointMethod::Vfo
-            && !self.active.as_ref().is_some_and(|a| matches!(a.task, Task::Vfo { .. }))
-        {
-            return;
-        }
+        let config = match &self.active {
+            Some(a) if matches!(a.task, Task::Vfo { .. }) => &a.config,
+            _ if self.config.waypoint_method == WaypointMethod::Vfo => &self.config,
+            _ => return,
+        };
+        let (max_gap, scan_range) = (config.vfo.scan_odom_max_gap_s, config.vfo.scan_range);
         let checked = scan_laser_pose(
             &self.laser,
-            &self.config.base_frame,
+            &config.base_frame,
             &m.header.frame_id,
-            &self.config.vfo.laser_frame,
-            self.config.vfo.laser_pose(),
+            &config.vfo.laser_frame,
+            config.vfo.laser_pose(),
         )
         .map_err(|e| e.to_string())
         .and_then(|(base_from_laser, _)| {
+            // (f32::min would take scan_range in place of a NaN range_max.)
+            if !m.range_max.is_finite() {
+                return Err(format!("scan refused: range_max {} is not finite", m.range_max));
+            }
             // Echoes beyond scan_range are no obstacles: the limit becomes the scan's range_max.
             let mut limited = m.clone();
-            limited.range_max = limited.range_max.min(self.config.vfo.scan_range as f32);
+            limited.range_max = limited.range_max.min(scan_range as f32);
             scan_from_msg(&limited, base_from_laser).map_err(|e| e.to_string())
         });
         let scan = match checked {
@@ -1631,22 +1719,40 @@ impl Shell {
                 return warn_throttled!(self.throttle, "scan-bad", "{e}; scan ignored");
             }
         };
-        let Some(odom_from_base) = self.fresh_odom() else {
+        let Some(stamp) = secs_from_stamp(&m.header.stamp) else {
+            return warn_throttled!(
+                self.throttle,
+                "scan-bad",
+                "scan stamp invalid (nanosec ≥ 1e9); scan ignored"
+            );
+        };
+        let placed = self.fresh_odom().and_then(|_| self.odom_history.at(stamp, max_gap));
+        let Some(odom_from_base) = placed else {
             return warn_throttled!(
                 self.throttle,
                 "scan-odom",
-                "scan ignored: odom stale or refused (obstacles are placed by it)"
+                "scan at {stamp:.3} s ignored: no fresh odometry within {max_gap} s of its stamp (obstacles are \
+                 placed by the pose at the scan's time)"
             );
         };
-        let update = match self.map.update(&scan, &odom_from_base) {
+        let update = match self.map.update(&scan, &odom_from_base, stamp) {
             Ok(u) => u,
             Err(e) => return warn_throttled!(self.throttle, "scan-bad", "scan refused: {e}; scan ignored"),
         };
+        if !update.capped.is_empty() {
+            warn_throttled!(
+                self.throttle,
+                "map-cap",
+                "obstacle map full (vfo.max_obstacles {}): the {} least recently seen dropped",
+                self.map.config().max_obstacles,
+                update.capped.len()
+            );
+        }
         if self.scan_seen.value().is_none() {
             info!(
                 "first scan: {} beams, {} obstacles in the map (odom)",
                 scan.len(),
-                self.map.obstacles().len()
+                self.map.len()
             );
         }
         self.scan_seen.set((), m.header.stamp.clone());

@@ -73,6 +73,12 @@ pub struct VfoSettings {
     pub scan_range: f64,
     /// A VFO goal fails STALE_INPUT when no valid scan arrived for this long (steady clock), s.
     pub scan_timeout_s: f64,
+    /// The wall-clock budget of one segment's optimisation (s): when spent, the best Σ found
+    /// so far is taken, with a warning (the robot stands meanwhile).
+    pub optimise_budget_s: f64,
+    /// A scan is placed with the odometry pose at its stamp, interpolated; one with no
+    /// odometry pose within this (s) of its stamp is refused.
+    pub scan_odom_max_gap_s: f64,
     /// The scan's frame when its header has none.
     pub laser_frame: String,
     /// The laser's pose in the base frame (x, y, yaw) for a frame `tf_static` does not give;
@@ -89,13 +95,34 @@ impl Default for VfoSettings {
             guiding: DEFAULT_GUIDING,
             scan_range: 4.0,
             scan_timeout_s: 0.5,
+            scan_odom_max_gap_s: DEFAULT_SCAN_ODOM_MAX_GAP_S,
+            optimise_budget_s: DEFAULT_OPTIMISE_BUDGET_S,
             laser_frame: "laser".to_owned(),
             laser_pose: vec![0.0; 3],
         }
     }
 }
 
+/// The default `vfo.scan_odom_max_gap_s` (s): five periods of 50 Hz odometry. Between two
+/// odometry poses a scan's pose is interpolated; beyond the last one it is held for at most
+/// this, where a robot turning at 1.5 rad/s turns 0.15 rad (0.45 m at 3 m) — the worst
+/// misplacement accepted.
+pub const DEFAULT_SCAN_ODOM_MAX_GAP_S: f64 = 0.1;
+
+/// The largest `vfo.optimise_budget_s` (s).
+pub const MAX_OPTIMISE_BUDGET_S: f64 = 30.0;
+
+/// The default `vfo.optimise_budget_s` (s): twice the second Algorithm 2 takes at 30 obstacles
+/// (the bench), so on a loaded machine an optimisation still finishes, while a robot standing
+/// for it never stands longer than this.
+pub const DEFAULT_OPTIMISE_BUDGET_S: f64 = 2.0;
+
 impl VfoSettings {
+    /// The optimisation's wall-clock budget.
+    pub fn optimise_budget(&self) -> Duration {
+        crate::seconds(self.optimise_budget_s, MAX_OPTIMISE_BUDGET_S)
+    }
+
     /// The laser's pose from `laser_pose` (`None` when empty or malformed).
     pub fn laser_pose(&self) -> Option<Pose2> {
         match self.laser_pose.as_slice() {
@@ -288,6 +315,36 @@ pub fn declare_vfo(d: &mut Decl<PlannerConfig>) {
     )
     .min(1.0);
     d.double(
+        "vfo.optimise_budget_s",
+        v.optimise_budget_s,
+        "wall-clock budget of one optimisation: then the best Σ so far, with a warning (the robot stands meanwhile) [s]",
+        |c, x| c.vfo.optimise_budget_s = x,
+    )
+    .above(0.0)
+    .max(MAX_OPTIMISE_BUDGET_S);
+    d.double(
+        "vfo.decay_s",
+        s.decay_s,
+        "an obstacle not seen again for this long is forgotten [s]",
+        |c, x| c.vfo.scan.decay_s = x,
+    )
+    .above(0.0);
+    d.integer(
+        "vfo.max_obstacles",
+        s.max_obstacles as i64,
+        "most obstacles in the map; beyond, the least recently seen are dropped (with a warning)",
+        |c, x| c.vfo.scan.max_obstacles = usize::try_from(x).unwrap_or(0),
+    )
+    .min(1.0);
+    d.double(
+        "vfo.scan_odom_max_gap_s",
+        v.scan_odom_max_gap_s,
+        "a scan is placed with the odometry pose at its stamp; refused when no odometry lies within this of it [s]",
+        |c, x| c.vfo.scan_odom_max_gap_s = x,
+    )
+    .above(0.0)
+    .max(1.0);
+    d.double(
         "vfo.scan_range",
         v.scan_range,
         "echoes farther than this are not turned into obstacles [m]",
@@ -343,19 +400,29 @@ pub(crate) fn oriented(q: &mobil_msgs::geometry_msgs::msg::Quaternion) -> bool {
     !(unset || identity)
 }
 
-/// The route as VFO waypoints from `start`: θ_r is the pose's heading when it carries an
-/// orientation (an identity or unset quaternion counts as none), else the direction from the
-/// waypoint before (the start for the first) — the robot arrives moving along its leg. A
-/// waypoint on the point before keeps the heading before it. μ = `guiding` for every one.
+/// The route as VFO waypoints from `start`, μ = `guiding` for every one. θ_r, by one rule for
+/// the whole route (a ROS pose's orientation defaults to the identity, so a single identity
+/// cannot tell "heading 0" from "no heading"):
+/// - a route in which some pose carries an orientation other than the identity is an
+///   **oriented route**: every waypoint's θ_r is its pose's yaw, the identity's 0 rad included
+///   (only an all-zero quaternion, never set, counts as none there);
+/// - in any other route (every orientation the identity or unset) no waypoint carries one.
+///
+/// A waypoint without a heading takes the direction from the waypoint before (the start for
+/// the first): the robot arrives moving along its leg; one on the point before keeps the
+/// heading before it.
 pub fn vfo_waypoints(route: &Route, start: &Pose2, guiding: f64) -> Result<Vec<VfoWaypoint>, GoalError> {
+    let oriented_route = route.first_oriented().is_some();
     let mut previous = start.position();
     let mut heading = start.yaw;
     let mut out = Vec::with_capacity(route.points.len());
     for (k, p) in route.points.iter().enumerate() {
         let pose = route.request_index.get(k).and_then(|&i| route.poses.get(i));
         let leg = p - previous;
-        heading = match pose.filter(|s| oriented(&s.pose.orientation)) {
-            Some(s) => mobil_ros::geometry::yaw_of(&s.pose.orientation),
+        let q = pose.map(|s| &s.pose.orientation);
+        let given = q.filter(|q| oriented_route && !(q.x == 0.0 && q.y == 0.0 && q.z == 0.0 && q.w == 0.0));
+        heading = match given {
+            Some(q) => mobil_ros::geometry::yaw_of(q),
             None if leg.norm() > 1e-9 => leg.y.atan2(leg.x),
             None => heading,
         };
@@ -376,6 +443,50 @@ pub struct VfoSlot {
     lent: Option<Instant>,
     max_delay: Duration,
 }
+
+/// The mean period of a stream's arrivals (steady clock): an exponential mean giving each new
+/// interval a weight of 0.1; an interval over [`ArrivalPeriod::PAUSE`] (the stream paused)
+/// is not counted.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct ArrivalPeriod {
+    last: Option<Instant>,
+    mean: Option<f64>,
+}
+
+impl ArrivalPeriod {
+    /// Intervals longer than this are a pause, not the period.
+    pub const PAUSE: Duration = Duration::from_secs(1);
+
+    /// One arrival at `at`.
+    pub fn arrived(&mut self, at: Instant) {
+        if let Some(last) = self.last {
+            let gap = at.saturating_duration_since(last);
+            if gap <= Self::PAUSE && !gap.is_zero() {
+                let gap = gap.as_secs_f64();
+                self.mean = Some(self.mean.map_or(gap, |m| m + 0.1 * (gap - m)));
+            }
+        }
+        self.last = Some(at);
+    }
+
+    /// The mean period, once two arrivals were seen.
+    pub fn period(&self) -> Option<Duration> {
+        self.mean.map(Duration::from_secs_f64)
+    }
+}
+
+/// The longest delay of a VFO tick's command after its pose: two odometry periods (by then a
+/// newer pose has come, and the command was worked out for a place the robot has left), at
+/// least [`MIN_MAX_DELAY`] (a scheduler's jitter); the control step `time_step` (s) until a
+/// period was measured. Under a simulated clock the period is the wall-clock one, as the delay.
+pub fn vfo_max_delay(period: Option<Duration>, time_step: f64) -> Duration {
+    period
+        .map_or_else(|| Duration::from_secs_f64(time_step.max(0.0)), |p| 2 * p)
+        .max(MIN_MAX_DELAY)
+}
+
+/// The shortest [`vfo_max_delay`].
+pub const MIN_MAX_DELAY: Duration = Duration::from_millis(10);
 
 /// What to do with a tick's output that came back.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -477,12 +588,13 @@ pub fn segment_report(o: &Optimisation) -> SegmentReport {
 }
 
 /// Most virtual robots drawn (the first ones simulated; the count is in the status).
-pub const MAX_DRAWN_ROBOTS: usize = 80;
-/// Most points over all virtual robots drawn, and of the chosen path (each 24 bytes: 48 KB in
-/// all, so the marker array stays below the 80 KB a message to rclpy should stay below).
+pub const MAX_DRAWN_ROBOTS: usize = 40;
+/// Most points over all virtual robots drawn, and of the chosen path, in a [`VfoDrawing`] (the
+/// demo's SVG); the markers draw fewer, within [`crate::MAX_MARKER_POINTS`] shared with the
+/// route.
 pub const MAX_DRAWN_POINTS: usize = 1600;
 /// Most obstacles drawn (the nearest to the robot first), two markers each.
-pub const MAX_DRAWN_OBSTACLES: usize = 40;
+pub const MAX_DRAWN_OBSTACLES: usize = 25;
 
 /// One virtual robot's path as drawn.
 #[derive(Debug, Clone, PartialEq)]
@@ -628,24 +740,41 @@ mod tests {
     }
 
     #[test]
-    fn waypoint_headings_follow_the_legs_unless_the_pose_carries_one() {
-        // From (0, 0) facing 0.3 rad: (1, 0) along +x (0); (1, 0) again keeps 0; (1, 2) carries
-        // 0.5 rad; (0, 2) along −x (π).
-        let poses = vec![
+    fn waypoint_headings_follow_the_legs_unless_the_route_carries_orientations() {
+        // No orientation in the route (all identity): from (0, 0) facing 0.3 rad, (1, 0) along
+        // +x (0); (1, 0) again keeps 0; (1, 2) along +y (π/2); (0, 2) along −x (π).
+        let plain = vec![
             pose(1.0, 0.0, None),
             pose(1.0, 0.0, None),
-            pose(1.0, 2.0, Some(0.5)),
+            pose(1.0, 2.0, None),
             pose(0.0, 2.0, None),
         ];
-        let route = route_from_poses(&poses, "odom", "odom", 0, 0, None, 0.01).expect("valid");
+        let route = route_from_poses(&plain, "odom", "odom", 0, 0, None, 0.01).expect("valid");
         let w = vfo_waypoints(&route, &Pose2::new(0.0, 0.0, 0.3), 0.4).expect("valid");
         let headings: Vec<f64> = w.iter().map(|w| w.heading).collect();
         assert_relative_eq!(headings[0], 0.0, epsilon = 1e-12);
         assert_relative_eq!(headings[1], 0.0, epsilon = 1e-12);
-        assert_relative_eq!(headings[2], 0.5, epsilon = 1e-9);
+        assert_relative_eq!(headings[2], PI / 2.0, epsilon = 1e-12);
         assert_relative_eq!(headings[3], PI, epsilon = 1e-12);
         assert!(w.iter().all(|w| w.guiding == 0.4));
         assert_eq!(w[2].position, Point2::new(1.0, 2.0));
+        // An oriented route: (1, 2) carries 0.5 rad, so the identity of (0, 2) is a real
+        // heading of 0 rad (not the leg's π), and an unset (all-zero) one is none: the leg's.
+        let mut unset = pose(0.0, 3.0, None);
+        unset.pose.orientation.w = 0.0;
+        let oriented = vec![
+            pose(1.0, 0.0, None),
+            pose(1.0, 2.0, Some(0.5)),
+            pose(0.0, 2.0, None),
+            unset,
+        ];
+        let route = route_from_poses(&oriented, "odom", "odom", 0, 0, None, 0.01).expect("valid");
+        let w = vfo_waypoints(&route, &Pose2::new(0.0, 0.0, 0.3), 0.4).expect("valid");
+        let headings: Vec<f64> = w.iter().map(|w| w.heading).collect();
+        assert_relative_eq!(headings[0], 0.0, epsilon = 1e-12);
+        assert_relative_eq!(headings[1], 0.5, epsilon = 1e-9);
+        assert_relative_eq!(headings[2], 0.0, epsilon = 1e-12);
+        assert_relative_eq!(headings[3], PI / 2.0, epsilon = 1e-12);
         // A waypoint on the start keeps the start's heading.
         let route = route_from_poses(
             &[pose(0.0, 0.0, None), pose(1.0, 1.0, None)],
@@ -853,5 +982,90 @@ mod tests {
             .error_msg
             .starts_with("COLLISION: the robot is 0.55 m from the centre of the obstacle at (2.00, -1.00)"));
         assert_eq!(Outcome::ScanStale.code(), "STALE_INPUT");
+    }
+
+    #[test]
+    fn the_worst_marker_array_stays_below_80_kb_in_cdr() {
+        // Everything at once, each at its cap: a route of 1000 waypoints, a predicted path of
+        // 5000 poses, 60 problems with their texts, a dock, 200 virtual robots of 500 points,
+        // a chosen path of 5000 points, 300 obstacles.
+        let route: Vec<Point2<f64>> = (0..1000).map(|i| Point2::new(f64::from(i) * 0.1, 1.0)).collect();
+        let predicted: Vec<Pose2> = (0..5000).map(|i| Pose2::new(f64::from(i) * 0.01, 0.0, 0.1)).collect();
+        let problems: Vec<crate::Missed> = (0..60)
+            .map(|i| crate::Missed {
+                index: i,
+                position: Point2::new(i as f64, 2.0),
+                kind: mobil_planner::ProblemKind::TurnRadius {
+                    required: 0.123456,
+                    minimum: 0.734567,
+                },
+                pre_check: true,
+            })
+            .collect();
+        let path: Vec<Point2<f64>> = (0..500).map(|i| Point2::new(f64::from(i) * 0.01, 0.5)).collect();
+        let drawing = VfoDrawing {
+            robots: (0..200)
+                .map(|i| DrawnRobot {
+                    points: path.clone(),
+                    dropped: i % 2 == 0,
+                })
+                .collect(),
+            chosen: (0..5000).map(|i| Point2::new(f64::from(i) * 0.01, 0.0)).collect(),
+            obstacles: (0..300)
+                .map(|i| Obstacle::new(Point2::new(f64::from(i), 3.0), 0.4, 0.8).expect("valid"))
+                .collect(),
+        };
+        let view = MarkerView {
+            route: &route,
+            predicted: &predicted,
+            problems: &problems,
+            dock: Some(Pose2::new(1.0, 2.0, 0.5)),
+            vfo: Some(&drawing),
+            robot: Some(Point2::new(0.0, 0.0)),
+        };
+        let a = markers(&view, Time::default(), "odom");
+        let bytes = cdr_encoding::to_vec::<_, byteorder::LittleEndian>(&a).expect("serialisable");
+        let points: usize = a.markers.iter().map(|m| m.points.len()).sum();
+        assert!(points <= crate::MAX_MARKER_POINTS, "{points} points");
+        assert!(
+            bytes.len() < 80_000,
+            "{} bytes, {} markers, {points} points",
+            bytes.len(),
+            a.markers.len()
+        );
+        // Each part is still drawn.
+        let of = |ns: &str| a.markers.iter().filter(|m| m.ns == ns).count();
+        assert!(of("vfo_robots") >= 20 && of("vfo_chosen") == 1 && of("route") == 2);
+        assert_eq!(of("vfo_forbidden"), MAX_DRAWN_OBSTACLES);
+        println!("{} bytes, {} markers, {points} points", bytes.len(), a.markers.len());
+    }
+
+    #[test]
+    fn the_late_command_bound_is_two_measured_odometry_periods() {
+        let t0 = Instant::now();
+        let ms = Duration::from_millis;
+        let mut p = ArrivalPeriod::default();
+        assert_eq!(p.period(), None);
+        // Before a period is measured: the control step (20 ms), floored at 10 ms.
+        assert_eq!(vfo_max_delay(p.period(), 0.02), ms(20));
+        assert_eq!(vfo_max_delay(p.period(), 0.001), MIN_MAX_DELAY);
+        // Odometry every 20 ms: the mean is 20 ms, the bound 40 ms.
+        for k in 0..10 {
+            p.arrived(t0 + ms(20 * k));
+        }
+        let period = p.period().expect("measured");
+        assert!((period.as_secs_f64() - 0.020).abs() < 1e-9, "{period:?}");
+        assert_eq!(vfo_max_delay(p.period(), 0.5), 2 * period);
+        // A 3 s pause is not a period; one 30 ms interval moves the mean by a tenth: 21 ms.
+        p.arrived(t0 + ms(180 + 3000));
+        assert!((p.period().expect("kept").as_secs_f64() - 0.020).abs() < 1e-9);
+        p.arrived(t0 + ms(180 + 3000 + 30));
+        assert!((p.period().expect("kept").as_secs_f64() - 0.021).abs() < 1e-9);
+        // At 5× simulated time odometry comes every 4 ms of wall time: the floor, 10 ms.
+        let mut fast = ArrivalPeriod::default();
+        for k in 0..10 {
+            fast.arrived(t0 + ms(4 * k));
+        }
+        assert_eq!(vfo_max_delay(fast.period(), 0.02), MIN_MAX_DELAY);
     }
 }

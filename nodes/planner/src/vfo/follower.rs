@@ -6,9 +6,23 @@
 //! reports a new obstacle ([`VfoFollower::set_obstacles`] with `new_obstacles`,
 //! [`VfoFollower::add_obstacle`]) or when the robot enters an influence zone whose σ the last
 //! optimisation left undecided (it did not foresee that zone), the segment is re-optimised from
-//! the real state ([`find_sigmas`]) before the command is worked out. The tick then applies the
+//! the real state ([`find_sigmas`](super::find_sigmas)) before the command is worked out. The tick then applies the
 //! law with the segment's Σ: Algorithm 3, Algorithm 1 (the next waypoint in the same tick) or
 //! the end test, u = [ω, v].
+//!
+//! **A segment that starts inside an influence zone starts from rest.** At a waypoint switch
+//! the law's command jumps (the new waypoint may lie behind the robot), and the virtual robots
+//! take the new command at once, while the real robot answers with its drives' lag and coasts
+//! on. Outside every zone that costs a few centimetres of path; inside one — after Algorithm 3
+//! passed a waypoint early, deep in a zone, where V grows steeply toward r — the real robot
+//! coasts toward the obstacle from where the virtual robots turned away, and leaves their
+//! paths: the next re-optimisation starts a few centimetres from r, where every Σ collides (no
+//! safe Σ), or the robot collides on the old Σ. So when a segment starts with the robot inside
+//! a zone, the follower commands zero until the robot is at rest (it moved less than
+//! [`REST_SPEED`]·Δt and turned less than [`REST_TURN_RATE`]·Δt between two ticks, or
+//! [`MAX_SETTLE_S`] passed), and only then optimises the segment, from the pose where the robot
+//! stands: a state the real robot is really in, from which it can start as the virtual robots
+//! do.
 //!
 //! Safety: on a collision (d ≤ r), or when no safe Σ exists for the segment, the command is
 //! zero and the route ends ([`VfoEnd`]); the caller reports it. Bad input (a non-finite pose,
@@ -19,8 +33,16 @@ use mobil_geom::Pose2;
 
 use super::controller::{ControlStep, StepOutcome, VfoController, VfoGains, VfoWaypoint};
 use super::obstacles::{Obstacle, Sigma};
-use super::optimise::{find_sigmas, Optimisation, OptimiseConfig, OptimiseWarning, Segment};
+use super::optimise::{find_sigmas_until, Interrupt, Optimisation, OptimiseConfig, OptimiseWarning, Segment};
 use crate::error::PlannerError;
+
+/// Below this speed (m/s) between two ticks the robot is at rest (module docs).
+pub const REST_SPEED: f64 = 0.01;
+/// Below this turn rate (rad/s) between two ticks the robot is at rest (module docs).
+pub const REST_TURN_RATE: f64 = 0.05;
+/// The longest wait for the robot to come to rest before a segment started inside a zone is
+/// optimised anyway (s): a robot that never reads still (odometry noise) must not wait forever.
+pub const MAX_SETTLE_S: f64 = 2.0;
 
 /// Something that happened during a tick.
 #[derive(Debug, Clone, PartialEq)]
@@ -106,6 +128,14 @@ pub struct VfoFollower {
     last: Option<Optimisation>,
     last_t: Option<f64>,
     end: Option<VfoEnd>,
+    /// Waiting for rest before optimising: since when, and the last tick's pose and time.
+    settling: Option<Settling>,
+}
+
+#[derive(Debug, Clone, Copy)]
+struct Settling {
+    since: f64,
+    last: Option<(Pose2, f64)>,
 }
 
 impl VfoFollower {
@@ -144,6 +174,7 @@ impl VfoFollower {
             last: None,
             last_t: None,
             end: None,
+            settling: None,
         })
     }
 
@@ -173,6 +204,12 @@ impl VfoFollower {
         self.last.as_ref()
     }
 
+    /// Whether the follower is bringing the robot to rest before it optimises a segment that
+    /// started inside an influence zone (module docs).
+    pub fn is_settling(&self) -> bool {
+        self.settling.is_some()
+    }
+
     /// How the route ended, once it has.
     pub fn end(&self) -> Option<VfoEnd> {
         self.end
@@ -196,7 +233,35 @@ impl VfoFollower {
         }
     }
 
-    fn optimise(&mut self, pose: &Pose2, reason: Reoptimised, events: &mut Vec<VfoEvent>) -> Result<(), PlannerError> {
+    /// Replaces the obstacles by a map in which some were removed or reordered: `previous[k]`
+    /// is the index, among the obstacles before, of obstacle `k` (`None`: a new one). Each kept
+    /// obstacle keeps its σ; new ones are undecided. With `new_obstacles` the segment is
+    /// re-optimised at the next tick. Removing an obstacle never re-optimises by itself: the
+    /// decisions left stay those of a path that was safe with more obstacles.
+    pub fn set_obstacles_mapped(&mut self, obstacles: Vec<Obstacle>, previous: &[Option<usize>], new_obstacles: bool) {
+        self.sigmas = (0..obstacles.len())
+            .map(|k| {
+                previous
+                    .get(k)
+                    .copied()
+                    .flatten()
+                    .and_then(|i| self.sigmas.get(i).copied())
+                    .unwrap_or(Sigma::Undecided)
+            })
+            .collect();
+        self.obstacles = obstacles;
+        if new_obstacles {
+            self.optimise.get_or_insert(Reoptimised::NewObstacle);
+        }
+    }
+
+    fn optimise(
+        &mut self,
+        pose: &Pose2,
+        reason: Reoptimised,
+        events: &mut Vec<VfoEvent>,
+        interrupt: &(dyn Fn() -> Option<Interrupt> + Sync),
+    ) -> Result<(), PlannerError> {
         let Some(waypoint) = self.waypoints.get(self.index).copied() else {
             return Ok(());
         };
@@ -205,7 +270,7 @@ impl VfoFollower {
             last: self.index + 1 == self.waypoints.len(),
             obstacles: &self.obstacles,
         };
-        let result = find_sigmas(pose, &self.controller, &segment, &self.config)?;
+        let result = find_sigmas_until(pose, &self.controller, &segment, &self.config, interrupt)?;
         self.sigmas = result.sigmas.clone();
         events.push(VfoEvent::Optimised {
             index: self.index,
@@ -223,6 +288,20 @@ impl VfoFollower {
     /// One control tick at `pose` (θ, x, y of the robot's guide point) at time `t` (s,
     /// non-decreasing). Refuses a non-finite or out-of-range pose or time.
     pub fn update(&mut self, pose: &Pose2, t: f64) -> Result<VfoOutput, PlannerError> {
+        self.update_until(pose, t, &|| None)
+    }
+
+    /// [`VfoFollower::update`] whose optimisation asks `interrupt` whether to stop
+    /// ([`find_sigmas_until`]): on [`Interrupt::Cancel`] the tick returns
+    /// [`PlannerError::Stopped`] and the segment stays due for optimisation; on
+    /// [`Interrupt::Budget`] the best Σ found so far is taken, with the warning in the
+    /// [`VfoEvent::Optimised`] event.
+    pub fn update_until(
+        &mut self,
+        pose: &Pose2,
+        t: f64,
+        interrupt: &(dyn Fn() -> Option<Interrupt> + Sync),
+    ) -> Result<VfoOutput, PlannerError> {
         crate::docking::check_pose("pose", pose)?;
         if !t.is_finite() || self.last_t.is_some_and(|last| t < last) {
             return Err(PlannerError::InvalidConfig {
@@ -241,8 +320,33 @@ impl VfoFollower {
                 self.end = Some(VfoEnd::Done);
                 continue;
             };
+            if let Some(settling) = self.settling.as_mut() {
+                let rest = settling.last.is_some_and(|(p, t0)| {
+                    let dt = t - t0;
+                    dt > 0.0
+                        && (p.position() - pose.position()).norm() < REST_SPEED * dt
+                        && mobil_geom::wrap(pose.yaw - p.yaw).abs() < REST_TURN_RATE * dt
+                });
+                if rest || t - settling.since >= MAX_SETTLE_S {
+                    self.settling = None;
+                } else {
+                    settling.last = Some((*pose, t));
+                    return Ok(VfoOutput {
+                        omega: 0.0,
+                        v: 0.0,
+                        index: self.index,
+                        distance: (waypoint.position - pose.position()).norm(),
+                        step: None,
+                        events,
+                        end: None,
+                    });
+                }
+            }
             if let Some(reason) = self.optimise.take() {
-                self.optimise(pose, reason, &mut events)?;
+                if let Err(e) = self.optimise(pose, reason, &mut events, interrupt) {
+                    self.optimise = Some(reason);
+                    return Err(e);
+                }
                 continue;
             }
             // A zone the optimisation did not foresee: decide it now.
@@ -281,6 +385,14 @@ impl VfoFollower {
                     self.controller.start_segment();
                     if self.index < self.waypoints.len() {
                         self.optimise = Some(Reoptimised::SegmentStart);
+                        let position = pose.position();
+                        if self
+                            .obstacles
+                            .iter()
+                            .any(|o| o.distance(&position) <= o.influence_radius())
+                        {
+                            self.settling = Some(Settling { since: t, last: None });
+                        }
                     }
                 }
                 StepOutcome::Collision { obstacle } => {

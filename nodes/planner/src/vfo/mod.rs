@@ -8,7 +8,10 @@
 //! - [`optimise`]: Algorithm 2 (findSigmas) with cycle detection, caps and parallel batches.
 //! - [`follower`]: [`VfoFollower`], the online follower: one control tick at a time, Σ per
 //!   segment, re-optimised on new obstacles; the last optimisation for display.
-//! - [`scan`]: obstacles from a laser scan (clusters → circles) merged over time in odom.
+//! - [`scan`]: obstacles from a laser scan (clusters → circles) merged over time in odom,
+//!   forgotten when seen through, when not seen for a while, and beyond a cap.
+//! - [`history`]: a short history of odometry poses, to place each scan with the pose at its
+//!   stamp.
 //!
 //! ```
 //! use mobil_geom::Pose2;
@@ -26,6 +29,7 @@
 
 pub mod controller;
 pub mod follower;
+pub mod history;
 pub mod obstacles;
 pub mod optimise;
 pub mod quality;
@@ -35,11 +39,13 @@ pub use controller::{
     convergence_field, field_rate, integrate_unicycle, ControlStep, Field, StepOutcome, VfoController, VfoGains,
     VfoWaypoint, DEFAULT_GUIDING,
 };
-pub use follower::{Reoptimised, VfoEnd, VfoEvent, VfoFollower, VfoOutput};
+pub use follower::{Reoptimised, VfoEnd, VfoEvent, VfoFollower, VfoOutput, MAX_SETTLE_S, REST_SPEED, REST_TURN_RATE};
+pub use history::PoseHistory;
 pub use obstacles::{potential, potential_derivative, Obstacle, Sigma};
 pub use optimise::{
-    find_sigmas, path_time_limit, simulate_uninterrupted, DecisionEdge, ExploredPath, Optimisation, OptimiseConfig,
-    OptimiseWarning, PathFate, RobotEnd, Segment, VirtualRobot, PARALLEL_MIN_BATCH,
+    find_sigmas, find_sigmas_until, path_time_limit, simulate_uninterrupted, DecisionEdge, ExploredPath, Interrupt,
+    Optimisation, OptimiseConfig, OptimiseWarning, PathFate, RobotEnd, Segment, VirtualRobot, INTERRUPT_CHECK_STEPS,
+    PARALLEL_MIN_BATCH,
 };
 pub use quality::{normalise, normalised, path_score, PathIndices, QualityWeights};
 pub use scan::{extract_circles, fit_circle, Circle, MapUpdate, ObstacleMap, ScanObstacleConfig};

@@ -17,6 +17,13 @@
 //! - Caps: at most `max_virtual_robots` virtual robots and `max_total_time_s` of simulated time
 //!   per optimisation; when one is hit the pending branches are abandoned and the best
 //!   candidate so far is returned with a warning.
+//! - **Interrupts** ([`find_sigmas_until`]): the caller's closure is asked before every batch
+//!   and every [`INTERRUPT_CHECK_STEPS`] steps of each virtual robot. [`Interrupt::Cancel`]
+//!   (the result is no longer wanted: a cancel, a new goal, shutdown) ends the optimisation at
+//!   once with [`PlannerError::Stopped`]; [`Interrupt::Budget`] (the caller's wall-clock budget
+//!   is spent) abandons the virtual robots under way and the pending branches and returns the
+//!   best candidate so far with [`OptimiseWarning::WallTimeBudget`], as the caps do. The clock
+//!   is the caller's: the library reads none.
 //!
 //! **Parallel branches.** The pending branches are a stack (LIFO, depth first). The optimiser
 //! pops up to `batch` branches at a time (the top of the stack first), simulates them — one
@@ -144,7 +151,22 @@ pub enum RobotEnd {
     },
     /// Its path's simulated time exceeded [`path_time_limit`].
     TimeCap,
+    /// The caller interrupted it ([`Interrupt`]); its path is abandoned.
+    Interrupted,
 }
+
+/// Why the caller stops an optimisation before its end ([`find_sigmas_until`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Interrupt {
+    /// The result is no longer wanted: [`PlannerError::Stopped`] at once.
+    Cancel,
+    /// The wall-clock budget is spent: the best candidate so far, with a warning.
+    Budget,
+}
+
+/// A virtual robot asks the caller's interrupt closure every this many steps (at T_p = 0.02 s,
+/// every 0.64 s of simulated time, some tens of microseconds of computation).
+pub const INTERRUPT_CHECK_STEPS: usize = 32;
 
 /// One virtual robot: the simulation from one stop to the next.
 #[derive(Debug, Clone, PartialEq)]
@@ -221,6 +243,12 @@ pub enum OptimiseWarning {
     VirtualRobotCap {
         /// The cap.
         limit: usize,
+        /// Branches left unexplored.
+        pending: usize,
+    },
+    /// The caller's wall-clock budget was spent ([`Interrupt::Budget`]); `pending` branches
+    /// (the virtual robots under way among them) were abandoned.
+    WallTimeBudget {
         /// Branches left unexplored.
         pending: usize,
     },
@@ -338,13 +366,19 @@ fn simulate(
     mut state: RobotState,
     sigmas: &[Sigma],
     stop_at_entries: bool,
+    interrupt: &(dyn Fn() -> Option<Interrupt> + Sync),
 ) -> Piece {
     let dt = config.time_step;
     let mut indices = PathIndices::default();
     let mut path = vec![state.pose.position()];
     let mut travelled_since_point = 0.0;
     let start_time = state.time;
+    let mut steps = 0usize;
     let end = loop {
+        steps += 1;
+        if steps.is_multiple_of(INTERRUPT_CHECK_STEPS) && interrupt().is_some() {
+            break RobotEnd::Interrupted;
+        }
         if let Some(obstacle) = entry(segment.obstacles, &state.pose.position(), &mut state.inside)
             && stop_at_entries
         {
@@ -412,6 +446,20 @@ pub fn find_sigmas(
     segment: &Segment<'_>,
     config: &OptimiseConfig,
 ) -> Result<Optimisation, PlannerError> {
+    find_sigmas_until(start, controller, segment, config, &|| None)
+}
+
+/// [`find_sigmas`] that asks `interrupt` between batches and every [`INTERRUPT_CHECK_STEPS`]
+/// steps of a virtual robot whether to stop (module docs): [`Interrupt::Cancel`] returns
+/// [`PlannerError::Stopped`], [`Interrupt::Budget`] the best candidate so far with
+/// [`OptimiseWarning::WallTimeBudget`].
+pub fn find_sigmas_until(
+    start: &Pose2,
+    controller: &VfoController,
+    segment: &Segment<'_>,
+    config: &OptimiseConfig,
+    interrupt: &(dyn Fn() -> Option<Interrupt> + Sync),
+) -> Result<Optimisation, PlannerError> {
     config.validate()?;
     crate::docking::check_pose("virtual robot start", start)?;
     let n = segment.obstacles.len();
@@ -439,6 +487,16 @@ pub fn find_sigmas(
         simulated_time: 0.0,
     };
     while !stack.is_empty() {
+        match interrupt() {
+            Some(Interrupt::Cancel) => return Err(PlannerError::Stopped),
+            Some(Interrupt::Budget) => {
+                result
+                    .warnings
+                    .push(OptimiseWarning::WallTimeBudget { pending: stack.len() });
+                break;
+            }
+            None => {}
+        }
         if result.robots.len() >= config.max_virtual_robots {
             result.warnings.push(OptimiseWarning::VirtualRobotCap {
                 limit: config.max_virtual_robots,
@@ -458,8 +516,17 @@ pub fn find_sigmas(
             .min(stack.len())
             .min(config.max_virtual_robots - result.robots.len());
         let batch: Vec<Branch> = (0..take).filter_map(|_| stack.pop()).collect();
-        let pieces = simulate_batch(segment, config, time_limit, &batch, threads);
+        let pieces = simulate_batch(segment, config, time_limit, &batch, threads, interrupt);
+        let cut = pieces.iter().filter(|p| p.end == RobotEnd::Interrupted).count();
+        // A cancel ends it here; on the budget the batch's finished pieces still count, the
+        // interrupted ones and the stack are abandoned below.
+        if cut > 0 && interrupt() == Some(Interrupt::Cancel) {
+            return Err(PlannerError::Stopped);
+        }
         for (mut branch, piece) in batch.into_iter().zip(pieces) {
+            if piece.end == RobotEnd::Interrupted {
+                continue;
+            }
             let id = result.robots.len();
             result.simulated_time += piece.time;
             result.robots.push(VirtualRobot {
@@ -510,6 +577,8 @@ pub fn find_sigmas(
                     });
                     Some(PathFate::TimeCap)
                 }
+                // Skipped above.
+                RobotEnd::Interrupted => None,
             };
             if let Some(fate) = fate {
                 result.paths.push(ExploredPath {
@@ -522,6 +591,12 @@ pub fn find_sigmas(
                     score: None,
                 });
             }
+        }
+        if cut > 0 {
+            result.warnings.push(OptimiseWarning::WallTimeBudget {
+                pending: stack.len() + cut,
+            });
+            break;
         }
     }
     choose(&mut result, &config.weights);
@@ -553,8 +628,9 @@ fn simulate_batch(
     time_limit: f64,
     batch: &[Branch],
     threads: usize,
+    interrupt: &(dyn Fn() -> Option<Interrupt> + Sync),
 ) -> Vec<Piece> {
-    let run = |b: &Branch| simulate(segment, config, time_limit, b.state.clone(), &b.sigmas, true);
+    let run = |b: &Branch| simulate(segment, config, time_limit, b.state.clone(), &b.sigmas, true, interrupt);
     let workers = threads.min(batch.len());
     if workers <= 1 || batch.len() < PARALLEL_MIN_BATCH {
         return batch.iter().map(run).collect();
@@ -633,6 +709,6 @@ pub fn simulate_uninterrupted(
         time: 0.0,
     };
     let limit = path_time_limit(start, segment, controller, config);
-    let piece = simulate(segment, config, limit, state, sigmas, false);
+    let piece = simulate(segment, config, limit, state, sigmas, false, &|| None);
     Ok((piece.indices, piece.path, piece.end))
 }

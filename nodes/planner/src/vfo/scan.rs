@@ -18,10 +18,21 @@
 //!   obstacle's centre, or that overlaps it by more than half the smaller radius, is the same
 //!   obstacle: centre and radius become the running mean over its detections (at most the
 //!   last `memory` detections weigh in). Any other circle is a new obstacle, appended (indices
-//!   never change) and reported, so the caller re-optimises.
+//!   never change but for the removals below) and reported, so the caller re-optimises.
+//! - **Forgetting** (each scan, after the merge; the removed obstacles' ids reported):
+//!   1. *seen through*: a known circle this scan did not detect, whose centre lies inside the
+//!      scan's field of view and range, is removed when the beam nearest its bearing and both
+//!      its neighbours see free space beyond its far side (an echo farther than d + ρ, or none
+//!      within range_max): the obstacle moved away, or was a phantom;
+//!   2. *decay*: a circle not detected for `decay_s` is removed (out of view, it may be gone);
+//!   3. *cap*: beyond `max_obstacles` circles, the least recently detected (then the oldest)
+//!      are dropped, and the update says how many.
+//!
+//!   Every obstacle keeps an id ([`ObstacleMap::ids`]) for its whole life, so a caller holding
+//!   decisions by index can carry them over a removal.
 //! - **Obstacle model**: r = r_p + `robot_radius`, R = r + `influence_margin`.
 
-use mobil_geom::{Pose2, Scan};
+use mobil_geom::{Beam, Pose2, Scan};
 use nalgebra::{Matrix3, Point2, Vector3};
 
 use super::obstacles::Obstacle;
@@ -46,6 +57,14 @@ pub struct ScanObstacleConfig {
     pub association_distance: f64,
     /// Detections the running mean remembers. Default 20 (half a second of a 40 Hz scanner).
     pub memory: usize,
+    /// A circle not detected for this long (s) is forgotten. Default 30: 9 m of driving at
+    /// 0.3 m/s, long enough to keep what the 270° scanner loses behind the robot while it goes
+    /// round it, short enough that a long run does not carry a map of everything it passed.
+    pub decay_s: f64,
+    /// Most circles kept; beyond, the least recently detected are dropped. Default 200: a
+    /// room's clutter and walls at 1 m per circle, and about a second of Algorithm 2 even if
+    /// every one lay on the segment.
+    pub max_obstacles: usize,
 }
 
 impl Default for ScanObstacleConfig {
@@ -58,6 +77,8 @@ impl Default for ScanObstacleConfig {
             max_radius: 0.5,
             association_distance: 0.2,
             memory: 20,
+            decay_s: 30.0,
+            max_obstacles: 200,
         }
     }
 }
@@ -70,6 +91,14 @@ impl ScanObstacleConfig {
         positive_finite("cluster_gap", self.cluster_gap)?;
         positive_finite("max_radius", self.max_radius)?;
         positive_finite("association_distance", self.association_distance)?;
+        positive_finite("decay_s", self.decay_s)?;
+        if self.max_obstacles == 0 {
+            return Err(PlannerError::InvalidConfig {
+                name: "max_obstacles",
+                value: 0.0,
+                reason: "must be at least 1",
+            });
+        }
         if self.min_points < 3 || self.memory == 0 {
             return Err(PlannerError::InvalidConfig {
                 name: "min_points/memory",
@@ -229,15 +258,32 @@ pub fn fit_circle(points: &[Point2<f64>]) -> Option<Circle> {
 struct Tracked {
     circle: Circle,
     detections: usize,
+    id: u64,
+    /// When it was last detected (s).
+    seen_at: f64,
 }
 
 /// What a scan changed.
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct MapUpdate {
-    /// Indices of the obstacles this scan added (the caller re-optimises when not empty).
+    /// Indices (after the update) of the obstacles this scan added (the caller re-optimises
+    /// when not empty).
     pub new: Vec<usize>,
     /// How many known obstacles it saw again.
     pub seen: usize,
+    /// Ids of the obstacles the scan saw through (removed).
+    pub seen_through: Vec<u64>,
+    /// Ids of the obstacles forgotten for not being detected for `decay_s`.
+    pub decayed: Vec<u64>,
+    /// Ids of the obstacles dropped by the `max_obstacles` cap (the caller warns).
+    pub capped: Vec<u64>,
+}
+
+impl MapUpdate {
+    /// Whether any obstacle was removed (the indices after it changed).
+    pub fn removed_any(&self) -> bool {
+        !(self.seen_through.is_empty() && self.decayed.is_empty() && self.capped.is_empty())
+    }
 }
 
 /// The obstacles seen so far, in the odom frame, merged over time (module docs).
@@ -245,6 +291,7 @@ pub struct MapUpdate {
 pub struct ObstacleMap {
     config: ScanObstacleConfig,
     tracked: Vec<Tracked>,
+    next_id: u64,
 }
 
 impl ObstacleMap {
@@ -254,7 +301,28 @@ impl ObstacleMap {
         Ok(ObstacleMap {
             config,
             tracked: Vec::new(),
+            next_id: 0,
         })
+    }
+
+    /// The settings.
+    pub fn config(&self) -> &ScanObstacleConfig {
+        &self.config
+    }
+
+    /// Each obstacle's id, by index: an id names one obstacle for its whole life.
+    pub fn ids(&self) -> Vec<u64> {
+        self.tracked.iter().map(|t| t.id).collect()
+    }
+
+    /// The number of obstacles.
+    pub fn len(&self) -> usize {
+        self.tracked.len()
+    }
+
+    /// Whether the map is empty.
+    pub fn is_empty(&self) -> bool {
+        self.tracked.is_empty()
     }
 
     /// The circles as detected (r_p, without the robot's radius), by index.
@@ -272,17 +340,70 @@ impl ObstacleMap {
         Obstacle::new(c.centre, r, r + self.config.influence_margin).ok()
     }
 
-    /// Adds the circles of a checked scan taken at `odom_from_base`.
-    pub fn update(&mut self, scan: &Scan, odom_from_base: &Pose2) -> Result<MapUpdate, PlannerError> {
+    /// Adds the circles of a checked scan taken at `odom_from_base` at time `t` (s), then
+    /// forgets what the scan saw through, what decayed and what exceeds the cap (module docs).
+    pub fn update(&mut self, scan: &Scan, odom_from_base: &Pose2, t: f64) -> Result<MapUpdate, PlannerError> {
         crate::docking::check_pose("odom_from_base", odom_from_base)?;
+        if !t.is_finite() {
+            return Err(PlannerError::InvalidConfig {
+                name: "t",
+                value: t,
+                reason: "a scan's time must be finite",
+            });
+        }
         let circles = extract_circles(scan, odom_from_base, &self.config);
-        Ok(self.merge(&circles))
+        let mut update = self.merge_at(&circles, t);
+        let frame_from_laser = *odom_from_base * scan.base_from_laser();
+        let new_ids: Vec<u64> = update
+            .new
+            .iter()
+            .filter_map(|&i| self.tracked.get(i))
+            .map(|t| t.id)
+            .collect();
+        let config = self.config;
+        let mut kept = Vec::with_capacity(self.tracked.len());
+        for tr in self.tracked.drain(..) {
+            if tr.seen_at < t && sees_through(scan, &frame_from_laser, &tr.circle) {
+                update.seen_through.push(tr.id);
+            } else if t - tr.seen_at > config.decay_s {
+                update.decayed.push(tr.id);
+            } else {
+                kept.push(tr);
+            }
+        }
+        if kept.len() > config.max_obstacles {
+            // Least recently detected first, then the oldest (smallest id).
+            let mut order: Vec<usize> = (0..kept.len()).collect();
+            order.sort_by(|&a, &b| {
+                kept[a]
+                    .seen_at
+                    .total_cmp(&kept[b].seen_at)
+                    .then(kept[a].id.cmp(&kept[b].id))
+            });
+            let drop: Vec<u64> = order[..kept.len() - config.max_obstacles]
+                .iter()
+                .map(|&i| kept[i].id)
+                .collect();
+            kept.retain(|tr| !drop.contains(&tr.id));
+            update.capped = drop;
+        }
+        self.tracked = kept;
+        update.new = self
+            .tracked
+            .iter()
+            .enumerate()
+            .filter(|(_, tr)| new_ids.contains(&tr.id))
+            .map(|(i, _)| i)
+            .collect();
+        Ok(update)
     }
 
     /// Adds the circles of a scan given as plain LaserScan fields: `ranges` from `angle_min`
     /// every `angle_increment`, valid within [`range_min`, `range_max`], the laser at
-    /// `odom_from_laser`. A malformed scan (empty, bad angles or limits, non-finite pose) is
+    /// `odom_from_laser`, at time `t` (s; see [`Self::update`]). A malformed scan (empty, bad
+    /// angles or limits, non-finite pose) is
     /// refused and changes nothing; NaN and ±inf ranges are no echoes (REP-117).
+    #[allow(clippy::too_many_arguments)]
     pub fn update_from_ranges(
         &mut self,
         ranges: &[f32],
@@ -291,6 +412,7 @@ impl ObstacleMap {
         range_min: f64,
         range_max: f64,
         odom_from_laser: &Pose2,
+        t: f64,
     ) -> Result<MapUpdate, PlannerError> {
         let angle_max = angle_min + ranges.len().saturating_sub(1) as f64 * angle_increment;
         let scan = Scan::new(
@@ -303,11 +425,12 @@ impl ObstacleMap {
             Vec::new(),
             Pose2::identity(),
         )?;
-        self.update(&scan, odom_from_laser)
+        self.update(&scan, odom_from_laser, t)
     }
 
-    /// Merges detected circles (odom frame) into the map.
-    pub fn merge(&mut self, circles: &[Circle]) -> MapUpdate {
+    /// Merges detected circles (odom frame) into the map, detected at time `now` (s); nothing is
+    /// forgotten here.
+    pub fn merge_at(&mut self, circles: &[Circle], now: f64) -> MapUpdate {
         let mut update = MapUpdate::default();
         // Only obstacles known before this scan: the circles of one scan are distinct (a
         // wall's chain overlaps by design).
@@ -327,6 +450,7 @@ impl ObstacleMap {
                     let w = 1.0 / t.detections as f64;
                     t.circle.centre += (c.centre - t.circle.centre) * w;
                     t.circle.radius += (c.radius - t.circle.radius) * w;
+                    t.seen_at = t.seen_at.max(now);
                     update.seen += 1;
                 }
                 // A circle the law cannot take (beyond the coordinate limit) is not kept, so
@@ -337,10 +461,42 @@ impl ObstacleMap {
                     self.tracked.push(Tracked {
                         circle: *c,
                         detections: 1,
+                        id: self.next_id,
+                        seen_at: now,
                     });
+                    self.next_id += 1;
                 }
             }
         }
         update
     }
+}
+
+/// Whether `scan` (its laser at `frame_from_laser`) sees free space through `circle`: its centre
+/// lies inside the field of view and within (range_min, range_max), and the beam nearest its
+/// bearing and both neighbours reach beyond d + ρ (an echo farther, or none within range_max).
+fn sees_through(scan: &Scan, frame_from_laser: &Pose2, circle: &Circle) -> bool {
+    let centre = frame_from_laser.inverse().transform_point(circle.centre);
+    let d = centre.coords.norm();
+    let (range_min, range_max) = scan.range_limits();
+    if !(d > range_min && d < range_max) || scan.len() < 3 {
+        return false;
+    }
+    let increment = scan_increment(scan);
+    if increment <= 0.0 {
+        return false;
+    }
+    let bearing = centre.y.atan2(centre.x);
+    let k = ((bearing - scan.angle(0)) / increment).round();
+    if !(k >= 1.0 && k <= (scan.len() - 2) as f64) {
+        return false;
+    }
+    let k = k as usize;
+    let beyond = d + circle.radius;
+    (k - 1..=k + 1).all(|i| match scan.beam(i) {
+        Some(Beam::Hit(r)) => r > beyond,
+        Some(Beam::NoEcho) => true,
+        Some(Beam::OutOfLimits(r)) => r > range_max,
+        _ => false,
+    })
 }
