@@ -185,7 +185,7 @@ impl PhysicsEvaluator {
         duration: f64,
         observe: &mut dyn FnMut(&TorsoState),
     ) -> SimOutcome {
-        self.simulate_with_feet(individual, duration, &mut |s, _| observe(s))
+        self.run(individual, duration, false, &mut |s, _| observe(s))
     }
 
     /// Like [`simulate_observed`](Self::simulate_observed), also passing each foot's contact
@@ -194,6 +194,18 @@ impl PhysicsEvaluator {
         &self,
         individual: &Individual,
         duration: f64,
+        observe: &mut dyn FnMut(&TorsoState, &[FootContact; 2]),
+    ) -> SimOutcome {
+        self.run(individual, duration, true, observe)
+    }
+
+    /// The simulation loop; the feet's contacts are worked out only `with_feet` (the
+    /// evaluation's hot path does without them) and are all zero otherwise.
+    fn run(
+        &self,
+        individual: &Individual,
+        duration: f64,
+        with_feet: bool,
         observe: &mut dyn FnMut(&TorsoState, &[FootContact; 2]),
     ) -> SimOutcome {
         let mut robot = Robot::build(&self.body, &self.model.standing_pose);
@@ -222,7 +234,11 @@ impl PhysicsEvaluator {
             robot.command(&command, &self.body);
             robot.world.step();
             let pose = robot.torso_pose();
-            let feet = robot.feet(&self.body);
+            let feet = if with_feet {
+                robot.feet(&self.body)
+            } else {
+                [FootContact::default(); 2]
+            };
             observe(
                 &TorsoState {
                     t,
