@@ -228,7 +228,7 @@ pub struct FitnessConfig {
     /// pendulum's time constant √(h/g) is 0.17 s).
     pub settle_time: f64,
     /// w (1/m): fitness per metre of forward distance. Default 2.0: not falling for the whole
-    /// time scores 1, and a 10 cm step adds 0.2, so a fall before 80 % of T_sim loses more than
+    /// time scores at least 1 (standing still 1 + w·b = 3), and a 10 cm step adds 0.2, so a fall before 80 % of T_sim loses more than
     /// a 10 cm gain buys back (staying up matters most, as in the source: its robots first
     /// learned not to fall), while among non-falling individuals distance decides.
     pub forward_weight: f64,

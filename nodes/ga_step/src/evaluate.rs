@@ -130,8 +130,8 @@ pub fn evaluate_all<E: Evaluator + ?Sized>(
 /// individual's inner knots from a fixed target trajectory (each knot's difference divided by
 /// its servo's range), and reports a fall when d > 0.25 at t_fall = T_sim·(1 − d), and a forward
 /// distance 0.1·(1 − 4d) m; the fitness is the [`FitnessConfig`]'s. So the optimum (d = 0)
-/// scores 1 + w·(0.1 + b), a non-falling forward step of 4 cm needs d ≤ 0.15, standing still (d ≈ 0.21)
-/// does not fall but steps only 1.5 cm, and a random individual (d ≈ 0.38: its RMS expectation
+/// scores 1 + w·(0.1 + b), a non-falling forward step of 4 cm needs d ≤ 0.15, standing still
+/// (d ≈ 0.21) does not fall but steps only 1.5 cm, and a random individual (d ≈ 0.38: its RMS expectation
 /// with uniform knots) falls.
 #[derive(Debug, Clone)]
 pub struct TestLandscape {
