@@ -3,7 +3,7 @@
 //! JSON (serde_json, with its exact float parsing): readable with any tool, and every f64 is
 //! written in its shortest round-trip form and read back to the same bits, so a resumed run
 //! equals the uninterrupted one. The document starts with a format tag and a version:
-//! `{"format": "mobil_ga_step checkpoint", "version": 2, …}`; the generator is stored as its seed
+//! `{"format": "mobil_ga_step checkpoint", "version": 3, …}`; the generator is stored as its seed
 //! and its position in the stream (ChaCha8, 32-bit words). A file that is not JSON or has
 //! another tag is [`CheckpointError::Foreign`], another version
 //! [`CheckpointError::UnsupportedVersion`], a damaged or inconsistent one
@@ -21,11 +21,15 @@ use std::path::{Path, PathBuf};
 
 /// The format tag of a checkpoint.
 pub const CHECKPOINT_FORMAT: &str = "mobil_ga_step checkpoint";
-/// The format version this library writes and reads. Version 2: the setup's fitness carries
-/// `distance_on_fall`; a version-1 checkpoint was evolved under the SPEC's example shape
-/// (distance counted on a fall) and names no shape, so it is refused rather than resumed under
-/// another fitness.
-pub const CHECKPOINT_VERSION: u64 = 2;
+/// The format version this library writes. Version 3: the setup's fitness carries
+/// `backward_allowance` besides `distance_on_fall`. A version-2 checkpoint is read as the shape
+/// it was evolved under, a backward allowance of 0 (the field did not exist); a version-1
+/// checkpoint was evolved under the SPEC's example shape and names no shape, so it is refused
+/// rather than resumed under another fitness.
+pub const CHECKPOINT_VERSION: u64 = 3;
+
+/// The oldest version read: 2, whose fitness had no backward allowance (b = 0).
+pub const CHECKPOINT_OLDEST_READ: u64 = 2;
 
 #[derive(Serialize, Deserialize)]
 struct Header {
@@ -81,8 +85,8 @@ pub fn from_json(text: &str) -> Result<GaState, CheckpointError> {
         Some(other) => return Err(CheckpointError::Foreign(format!("format tag `{other}`"))),
         None => return Err(CheckpointError::Foreign("no format tag".into())),
     }
-    match header.version {
-        Some(CHECKPOINT_VERSION) => {}
+    let version = match header.version {
+        Some(v @ CHECKPOINT_OLDEST_READ..=CHECKPOINT_VERSION) => v,
         Some(found) => {
             return Err(CheckpointError::UnsupportedVersion {
                 found,
@@ -90,8 +94,12 @@ pub fn from_json(text: &str) -> Result<GaState, CheckpointError> {
             })
         }
         None => return Err(CheckpointError::Corrupt("no version".into())),
+    };
+    let mut doc: Document = serde_json::from_str(text).map_err(|e| CheckpointError::Corrupt(e.to_string()))?;
+    if version == 2 {
+        // Evolved before the allowance existed, under f = 1 + w·max(0, Δx) without a fall.
+        doc.setup.fitness.backward_allowance = 0.0;
     }
-    let doc: Document = serde_json::from_str(text).map_err(|e| CheckpointError::Corrupt(e.to_string()))?;
     let word_pos: u128 = doc
         .rng_word_pos
         .parse()

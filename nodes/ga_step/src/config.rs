@@ -105,7 +105,9 @@ pub struct GaConfig {
     /// Generations over which the mean fitness must rise for the run to go on. Default 20: the
     /// source stopped when the mean "practically stopped changing"; 20 generations is a seventh
     /// of the source's slower (arithmetic) run, long enough that a plateau between two of the
-    /// best individual's jumps does not end a run that still improves.
+    /// best individual's jumps does not end a run that still improves. 0 turns the rule off (the
+    /// source stopped its runs by hand at the first step; a population that is all upright and
+    /// equally fit sits on a plateau that only the operators can leave).
     pub level_window: usize,
     /// Relative rise of the mean fitness over `level_window` generations below which it has
     /// levelled off. Default 0.001 (0.1 %): the mean can only rise under best-N replacement,
@@ -196,8 +198,6 @@ impl GaConfig {
             self.mutation_step > 0.0,
             "must be > 0",
         )?;
-        let w = self.level_window as f64;
-        check("level_window", w, self.level_window >= 1, "must be ≥ 1")?;
         check(
             "level_tolerance",
             self.level_tolerance,
@@ -208,12 +208,17 @@ impl GaConfig {
 }
 
 /// The fitness of an evaluation and the fall test an evaluator applies (SPEC §8 Decision, read
-/// so that a fall never pays): f = t_fall / T_sim for a step that falls (< 1), and
-/// f = 1 + w·max(0, Δx) for one that does not (≥ 1). T_sim = T + `settle_time`. No fall can
-/// outscore standing still, so the best individual is a non-falling one whenever the population
-/// has one. The SPEC's example shape, f = t_fall / T_sim + w·max(0, Δx) for every step, is kept
-/// as the option [`FitnessConfig::distance_on_fall`]: under it a forward lunge that falls at 1–2 s
-/// scores above standing and above any short upright step, and selection breeds lunges.
+/// so that a fall never pays and an upright step is ranked by how far it goes): f = t_fall / T_sim
+/// for a step that falls (< 1), and f = 1 + w·max(0, Δx + b) for one that does not (≥ 1), b the
+/// [`backward_allowance`](FitnessConfig::backward_allowance). T_sim = T + `settle_time`. So a fall
+/// < any upright individual ≤ standing still (1 + w·b) < a forward step: no fall can outscore an
+/// upright individual, and among upright ones a shuffle backward scores less than standing, a
+/// forward step more, by its signed distance. Two earlier shapes stay selectable: b = 0 gives
+/// f = 1 + w·max(0, Δx), under which every upright individual that does not gain ground scores
+/// exactly 1 (runs bred backward shufflers and levelled off there); and
+/// [`distance_on_fall`](FitnessConfig::distance_on_fall) with b = 0 is the SPEC's example,
+/// f = t_fall / T_sim + w·max(0, Δx) for every step, under which a forward lunge that falls at
+/// 1–2 s scores above standing and above any short upright step, and selection breeds lunges.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(default)]
 pub struct FitnessConfig {
@@ -223,7 +228,7 @@ pub struct FitnessConfig {
     /// pendulum's time constant √(h/g) is 0.17 s).
     pub settle_time: f64,
     /// w (1/m): fitness per metre of forward distance. Default 2.0: not falling for the whole
-    /// time scores 1, and a 10 cm step adds 0.2, so a fall before 80 % of T_sim loses more than
+    /// time scores at least 1 (standing still 1 + w·b = 3), and a 10 cm step adds 0.2, so a fall before 80 % of T_sim loses more than
     /// a 10 cm gain buys back (staying up matters most, as in the source: its robots first
     /// learned not to fall), while among non-falling individuals distance decides.
     pub forward_weight: f64,
@@ -245,6 +250,12 @@ pub struct FitnessConfig {
     /// standing (1.0) and every upright step shorter than 25–80 cm; only one of the four reached
     /// a non-falling forward step (README, "Humanoid step by a genetic algorithm").
     pub distance_on_fall: bool,
+    /// b (m): the backward distance an upright individual may move before its fitness bottoms
+    /// out at 1, f = 1 + w·max(0, Δx + b). Default 1.0 m: the runs with b = 0 bred individuals
+    /// that stay up while moving 0.2–0.7 m backward in 3 s, all scored 1 like standing still, so
+    /// selection had no gradient towards moving forward; 1 m covers every such shuffle seen with
+    /// room to spare, and standing scores 1 + 2·1 = 3. 0 gives the previous shape.
+    pub backward_allowance: f64,
 }
 
 impl Default for FitnessConfig {
@@ -256,12 +267,14 @@ impl Default for FitnessConfig {
             fall_tilt: 0.5,
             step_min_forward: 0.04,
             distance_on_fall: false,
+            backward_allowance: 1.0,
         }
     }
 }
 
 impl FitnessConfig {
-    /// Checks settle time ≥ 0, w ≥ 0, h₀ > 0, 0 < θ₀ < π/2 and a step distance ≥ 0.
+    /// Checks settle time ≥ 0, w ≥ 0, h₀ > 0, 0 < θ₀ < π/2, a step distance ≥ 0 and a backward
+    /// allowance ≥ 0.
     pub fn validate(&self) -> Result<(), GaError> {
         check("settle_time", self.settle_time, self.settle_time >= 0.0, "must be ≥ 0")?;
         check(
@@ -282,7 +295,23 @@ impl FitnessConfig {
             self.step_min_forward,
             self.step_min_forward >= 0.0,
             "must be ≥ 0",
+        )?;
+        check(
+            "backward_allowance",
+            self.backward_allowance,
+            self.backward_allowance >= 0.0,
+            "must be ≥ 0",
         )
+    }
+
+    /// The shape's description for messages: which distance counts, and the allowance.
+    pub fn shape(&self) -> String {
+        let fall = if self.distance_on_fall {
+            "distance counted on a fall"
+        } else {
+            "distance counted only without a fall"
+        };
+        format!("{fall}, backward allowance {} m", self.backward_allowance)
     }
 
     /// T_sim (s): the simulated duration of one evaluation, the step time plus the settle time.
@@ -292,13 +321,13 @@ impl FitnessConfig {
 
     /// The fitness of a step (see [`FitnessConfig`]): `t_fall` is the time of the fall, `None`
     /// without one. A fall scores t_fall / T_sim, t_fall clamped into [0, T_sim] (plus
-    /// w·max(0, Δx) with [`FitnessConfig::distance_on_fall`]); no fall scores 1 + w·max(0, Δx).
+    /// w·max(0, Δx) with [`FitnessConfig::distance_on_fall`]); no fall scores 1 + w·max(0, Δx + b).
     /// Never negative; a non-finite input gives 0.
     pub fn fitness(&self, step_time: f64, t_fall: Option<f64>, forward_distance: f64) -> f64 {
         let t_sim = self.sim_time(step_time);
         let distance = self.forward_weight * forward_distance.max(0.0);
         let f = match t_fall {
-            None => 1.0 + distance,
+            None => 1.0 + self.forward_weight * (forward_distance + self.backward_allowance).max(0.0),
             Some(t) if self.distance_on_fall => t.clamp(0.0, t_sim) / t_sim + distance,
             // A NaN distance still makes the fitness 0 below, as under the other shape.
             Some(t) => t.clamp(0.0, t_sim) / t_sim + 0.0 * forward_distance,
@@ -372,11 +401,47 @@ mod tests {
             f.validate(),
             Err(GaError::InvalidConfig { name: "fall_tilt", .. })
         ));
+        for b in [-0.1, f64::NAN] {
+            let f = FitnessConfig {
+                backward_allowance: b,
+                ..FitnessConfig::default()
+            };
+            assert!(matches!(
+                f.validate(),
+                Err(GaError::InvalidConfig {
+                    name: "backward_allowance",
+                    ..
+                })
+            ));
+        }
     }
 
     #[test]
-    fn the_fitness_formula() {
+    fn an_upright_individual_is_ranked_by_its_signed_distance() {
         let f = FitnessConfig::default();
+        // T = 2 s, T_sim = 3 s, w = 2 /m, b = 1 m.
+        assert_eq!((f.forward_weight, f.backward_allowance), (2.0, 1.0));
+        let eq = |a: f64, b: f64| (a - b).abs() < 1e-12;
+        // A fall at 1.5 s: 1.5/3 = 0.5, whatever its distance.
+        assert!(eq(f.fitness(2.0, Some(1.5), 0.3), 0.5));
+        assert!(eq(f.fitness(2.0, Some(1.5), -0.5), 0.5));
+        // Upright, 0.5 m backward: 1 + 2·(−0.5 + 1) = 2.0.
+        assert!(eq(f.fitness(2.0, None, -0.5), 2.0));
+        // Standing still: 1 + 2·1 = 3.0.
+        assert!(eq(f.fitness(2.0, None, 0.0), 3.0));
+        // Upright, 0.1 m forward: 1 + 2·1.1 = 3.2.
+        assert!(eq(f.fitness(2.0, None, 0.1), 3.2));
+        // Upright, 1.2 m backward: 1 + 2·max(0, −0.2) = 1.0, still above every fall.
+        assert!(eq(f.fitness(2.0, None, -1.2), 1.0));
+        assert!(f.fitness(2.0, Some(3.0), 5.0) <= f.fitness(2.0, None, -5.0));
+    }
+
+    #[test]
+    fn a_zero_allowance_is_the_previous_shape() {
+        let f = FitnessConfig {
+            backward_allowance: 0.0,
+            ..FitnessConfig::default()
+        };
         // T = 2 s, T_sim = 3 s, w = 2 /m.
         // No fall, 5 cm forward: 1 + 2·0.05 = 1.1.
         assert!((f.fitness(2.0, None, 0.05) - 1.1).abs() < 1e-12);
@@ -394,7 +459,10 @@ mod tests {
 
     #[test]
     fn a_lunge_that_falls_scores_below_standing_and_below_an_upright_step() {
-        let f = FitnessConfig::default();
+        let f = FitnessConfig {
+            backward_allowance: 0.0,
+            ..FitnessConfig::default()
+        };
         assert!(!f.distance_on_fall);
         // The lunge: falls at 1.5 s of T_sim = 3 s, 0.8 m forward: 1.5/3 = 0.5.
         let lunge = f.fitness(2.0, Some(1.5), 0.8);
@@ -412,6 +480,7 @@ mod tests {
     fn the_spec_example_shape_counts_a_falls_distance() {
         let f = FitnessConfig {
             distance_on_fall: true,
+            backward_allowance: 0.0,
             ..FitnessConfig::default()
         };
         // The same lunge: 0.5 + 2·0.8 = 2.1, above standing (1.0) and the 10 cm step (1.2).

@@ -130,8 +130,8 @@ pub fn evaluate_all<E: Evaluator + ?Sized>(
 /// individual's inner knots from a fixed target trajectory (each knot's difference divided by
 /// its servo's range), and reports a fall when d > 0.25 at t_fall = T_sim·(1 − d), and a forward
 /// distance 0.1·(1 − 4d) m; the fitness is the [`FitnessConfig`]'s. So the optimum (d = 0)
-/// scores 1 + 0.1·w, a non-falling forward step of 4 cm needs d ≤ 0.15, standing still (d ≈ 0.21)
-/// does not fall but steps only 1.5 cm, and a random individual (d ≈ 0.38: its RMS expectation
+/// scores 1 + w·(0.1 + b), a non-falling forward step of 4 cm needs d ≤ 0.15, standing still
+/// (d ≈ 0.21) does not fall but steps only 1.5 cm, and a random individual (d ≈ 0.38: its RMS expectation
 /// with uniform knots) falls.
 #[derive(Debug, Clone)]
 pub struct TestLandscape {
@@ -198,10 +198,10 @@ mod tests {
     fn the_target_scores_the_landscape_maximum() {
         let l = TestLandscape::new(NaoModel::default(), FitnessConfig::default());
         let e = l.evaluate(l.target());
-        // d = 0: no fall, 0.1 m forward, f = 1 + 2·0.1 = 1.2.
+        // d = 0: no fall, 0.1 m forward, f = 1 + 2·(0.1 + 1) = 3.2.
         assert_eq!(l.distance(l.target()), 0.0);
         assert!(!e.fell);
-        assert!((e.fitness - 1.2).abs() < 1e-12);
+        assert!((e.fitness - 3.2).abs() < 1e-12);
     }
 
     #[test]
@@ -217,9 +217,9 @@ mod tests {
         assert!((d - d_expected).abs() < 1e-12, "{d} vs {d_expected}");
         assert!((0.20..0.22).contains(&d));
         let e = l.evaluate(&m.standing());
-        // No fall (d ≤ 0.25): f = 1 + 2·0.1·(1 − 4d).
+        // No fall (d ≤ 0.25): f = 1 + 2·(0.1·(1 − 4d) + 1).
         assert!(!e.fell);
-        assert!((e.fitness - (1.0 + 0.2 * (1.0 - 4.0 * d_expected))).abs() < 1e-12);
+        assert!((e.fitness - (1.0 + 2.0 * (0.1 * (1.0 - 4.0 * d_expected) + 1.0))).abs() < 1e-12);
         assert!(!e.is_forward_step(&FitnessConfig::default()));
     }
 

@@ -69,7 +69,7 @@ pub enum StopReason {
     /// The best individual makes a non-falling forward step (only with `stop_at_step`).
     ForwardStep,
     /// The mean fitness rose by less than `level_tolerance` (relative) over `level_window`
-    /// generations.
+    /// generations (never with a window of 0).
     Levelled,
     /// The requested number of generations is done.
     MaxGenerations,
@@ -334,7 +334,7 @@ impl GaState {
             return Some(StopReason::ForwardStep);
         }
         let g = self.generation as usize;
-        if g >= ga.level_window {
+        if ga.level_window > 0 && g >= ga.level_window {
             let (then, now) = (self.history[g - ga.level_window].mean, self.history[g].mean);
             if now - then <= ga.level_tolerance * then.abs() {
                 return Some(StopReason::Levelled);

@@ -42,11 +42,13 @@
 //! - **One-point cut**: over the 190 inner knots (the pinned ends are equal in both parents),
 //!   uniform in 1 … 189, so each child has knots of both parents.
 //! - **Fitness** (SPEC: e.g. f = t_fall/T_sim + w·max(0, Δx); a better reading of that
-//!   Decision): distance counts only for a step that does not fall, f = t_fall/T_sim for a fall
-//!   (< 1) and f = 1 + w·max(0, Δx) without one (≥ 1), so no fall outscores standing and the
-//!   best individual is a non-falling one whenever one exists. The SPEC's example shape, under
+//!   Decision): a fall scores its time alone, f = t_fall/T_sim (< 1), an upright individual its
+//!   signed distance, f = 1 + w·max(0, Δx + b) (≥ 1, b = 1 m), so a fall < any upright
+//!   individual ≤ standing still (3) < a forward step, and the best individual is a non-falling
+//!   one whenever one exists. With b = 0 every upright individual that does not gain ground
+//!   scores 1 (runs bred backward shufflers and stalled there); the SPEC's example shape, under
 //!   which forward lunges that fall outscore short upright steps and take over the population,
-//!   is the option `distance_on_fall`. T_sim = T + 1 s, w = 2 /m, a fall is the torso below
+//!   is the option `distance_on_fall` with b = 0. T_sim = T + 1 s, w = 2 /m, a fall is the torso below
 //!   0.20 m or tilted beyond 0.5 rad; a "forward step" is no fall and Δx ≥ 0.04 m. See
 //!   [`FitnessConfig`].
 //! - **Stop rules**, tested after every generation in this order: the best individual makes a

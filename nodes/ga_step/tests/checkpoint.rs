@@ -159,17 +159,17 @@ fn foreign_and_corrupt_files_are_refused() {
     }
     let other_tag = good.replacen("mobil_ga_step checkpoint", "something else", 1);
     assert!(matches!(from_json(&other_tag), Err(CheckpointError::Foreign(_))));
-    let v3 = good.replacen("\"version\":2", "\"version\":3", 1);
+    let v4 = good.replacen("\"version\":3", "\"version\":4", 1);
     assert!(matches!(
-        from_json(&v3),
-        Err(CheckpointError::UnsupportedVersion { found: 3, expected: 2 })
+        from_json(&v4),
+        Err(CheckpointError::UnsupportedVersion { found: 4, expected: 3 })
     ));
     // Version 1 (distance counted on a fall, no shape recorded) is refused, not resumed under
     // the other shape.
-    let v1 = good.replacen("\"version\":2", "\"version\":1", 1);
+    let v1 = good.replacen("\"version\":3", "\"version\":1", 1);
     assert!(matches!(
         from_json(&v1),
-        Err(CheckpointError::UnsupportedVersion { found: 1, expected: 2 })
+        Err(CheckpointError::UnsupportedVersion { found: 1, expected: 3 })
     ));
 
     let truncated = &good[..good.len() / 2];
@@ -215,4 +215,28 @@ fn the_fitness_shape_is_recorded() {
     assert!(back.setup.fitness.distance_on_fall);
     assert_eq!(back.setup, with_fall);
     assert_ne!(back.setup, setup(Crossover::Arithmetic));
+
+    // The backward allowance too: a run under b = 0.25 m reads back with it.
+    let mut allowance = setup(Crossover::Arithmetic);
+    allowance.fitness.backward_allowance = 0.25;
+    let e = TestLandscape::new(NaoModel::default(), allowance.fitness.clone());
+    let text = to_json(&GaState::start(allowance.clone(), 3, &e, 1).unwrap());
+    let v: serde_json::Value = serde_json::from_str(&text).unwrap();
+    assert_eq!(v["version"], serde_json::json!(3));
+    assert_eq!(v["setup"]["fitness"]["backward_allowance"], serde_json::json!(0.25));
+    let back = from_json(&text).unwrap();
+    assert_eq!(back.setup, allowance);
+    assert_ne!(back.setup, setup(Crossover::Arithmetic));
+
+    // A version-2 checkpoint (no allowance field) was evolved under b = 0: it reads back so,
+    // not under the default b = 1 m.
+    let mut v: serde_json::Value = serde_json::from_str(&text).unwrap();
+    v["version"] = serde_json::json!(2);
+    v["setup"]["fitness"]
+        .as_object_mut()
+        .unwrap()
+        .remove("backward_allowance");
+    let back = from_json(&v.to_string()).unwrap();
+    assert_eq!(back.setup.fitness.backward_allowance, 0.0);
+    assert_eq!(FitnessConfig::default().backward_allowance, 1.0);
 }

@@ -113,6 +113,16 @@ fn a_flat_landscape_levels_off_after_the_window() {
         StopReason::Levelled
     );
     assert_eq!(s.generation, 20);
+
+    // A window of 0 turns the rule off: the same flat run goes on to the requested 30.
+    let mut off = setup(Crossover::Arithmetic);
+    off.ga.level_window = 0;
+    let mut s = GaState::start(off, 3, &Flat, 1).unwrap();
+    assert_eq!(
+        s.run(&Flat, 1, 30, |_| ControlFlow::Continue(())),
+        StopReason::MaxGenerations
+    );
+    assert_eq!(s.generation, 30);
 }
 
 /// Records every evaluated individual in order (one thread, so the order is the batch's).

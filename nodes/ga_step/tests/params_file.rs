@@ -42,6 +42,7 @@ fn the_file_holds_the_documented_defaults() {
         "fall_tilt",
         "step_min_forward",
         "distance_on_fall",
+        "backward_allowance",
         "offspring",
         "blx_alpha",
         "blx_variant",
@@ -111,9 +112,13 @@ fn statement_4_staying_up_comes_before_distance() {
     let t_sim = 3.0; // T + settle time = 2 + 1
     assert_eq!(fitness.sim_time(t), t_sim);
     let standing = fitness.fitness(t, None, 0.0);
-    assert_eq!(standing, 1.0);
-    // 10 cm without a fall: 1 + 2 · 0.1 = 1.2.
-    assert!((fitness.fitness(t, None, 0.10) - 1.2).abs() < 1e-12);
+    // Standing still, upright: 1 + 2 · (0 + 1) = 3.
+    assert_eq!(standing, 3.0);
+    // 10 cm without a fall: 1 + 2 · 1.1 = 3.2; 0.5 m backward without one: 1 + 2 · 0.5 = 2.
+    assert!((fitness.fitness(t, None, 0.10) - 3.2).abs() < 1e-12);
+    assert!((fitness.fitness(t, None, -0.5) - 2.0).abs() < 1e-12);
+    // Any upright individual, however far back, scores at least 1, above every fall.
+    assert_eq!(fitness.fitness(t, None, -3.0), 1.0);
     // A fall scores its time alone: at 80 % of T_sim (2.4 s) with 10 cm, 0.8; a lunge of 1 m
     // falling 0.1 s before the end, 2.9/3 < 1.
     assert!((fitness.fitness(t, Some(0.8 * t_sim), 0.10) - 0.8).abs() < 1e-12);

@@ -61,8 +61,8 @@ piecewise-linear functions over 20 intervals of the step time, evaluated in a ph
 not fall, the forward distance.\n\n\
 Writes into DIR: fitness.csv, fitness.svg, best.motion (Webots), best_gen_NNNN.motion every 10 \
 generations, best_trajectory.yaml (trajectory_msgs/JointTrajectory) and checkpoint.json after every \
-generation. Stops at the first non-falling forward step, when the mean fitness levels off, or after \
-G generations. Ctrl-C stops after the generation in flight (a second Ctrl-C at once); --resume \
+generation. Stops at the first non-falling forward step, when the mean fitness levels off \
+(--level-window), or after G generations. Ctrl-C stops after the generation in flight (a second Ctrl-C at once); --resume \
 continues to G exactly as an uninterrupted run would.",
     version
 )]
@@ -95,6 +95,10 @@ pub struct Cli {
     /// Seconds to wait for an external simulator's answer to one candidate (--evaluator ros).
     #[arg(long, value_name = "SECONDS", default_value_t = 30.0)]
     pub eval_timeout: f64,
+    /// Stop when the mean fitness rose by less than 0.1 % over this many generations; 0 turns
+    /// the rule off (default 20, params/nao_step.yaml). A resume must repeat it.
+    #[arg(long, value_name = "N")]
+    pub level_window: Option<usize>,
 }
 
 /// How a run ended.
@@ -147,6 +151,9 @@ pub fn setup_of(cli: &Cli) -> GaSetup {
     setup.ga.population = cli.population as usize;
     setup.ga.offspring = cli.population as usize;
     setup.ga.crossover = cli.crossover.into();
+    if let Some(w) = cli.level_window {
+        setup.ga.level_window = w;
+    }
     setup
 }
 
@@ -192,6 +199,18 @@ fn resume_state(cli: &Cli, setup: &GaSetup) -> anyhow::Result<GaState> {
             "fitness {} (asked {})",
             shape(state.setup.fitness.distance_on_fall),
             shape(setup.fitness.distance_on_fall)
+        ));
+    }
+    if state.setup.ga.level_window != setup.ga.level_window {
+        differences.push(format!(
+            "level window {} (asked {})",
+            state.setup.ga.level_window, setup.ga.level_window
+        ));
+    }
+    if state.setup.fitness.backward_allowance != setup.fitness.backward_allowance {
+        differences.push(format!(
+            "fitness backward allowance {} m (asked {} m)",
+            state.setup.fitness.backward_allowance, setup.fitness.backward_allowance
         ));
     }
     if differences.is_empty() && state.setup != *setup {

@@ -248,6 +248,7 @@ fn bad_options_are_one_line_errors() {
         "--crossover",
         "--out <DIR>",
         "--resume",
+        "--level-window <N>",
     ] {
         assert!(help.contains(opt), "{opt} missing from --help");
     }
@@ -291,7 +292,19 @@ fn a_missing_foreign_or_other_runs_checkpoint_is_refused_and_left_alone() {
         "fitness distance counted on a fall (asked distance counted only without a fall)",
     );
     assert_eq!(read(&dir.join("checkpoint.json")), other_shape);
+    // The same run evolved under the previous upright shape (no backward allowance).
+    let mut v: serde_json::Value = serde_json::from_str(&before).unwrap();
+    v["setup"]["fitness"]["backward_allowance"] = serde_json::json!(0.0);
+    let other_shape = v.to_string();
+    std::fs::write(dir.join("checkpoint.json"), &other_shape).unwrap();
+    let o = run(&dir, 4, 2, 1, &["--resume"]);
+    one_line_error(&o, 1, "fitness backward allowance 0 m (asked 1 m)");
+    assert_eq!(read(&dir.join("checkpoint.json")), other_shape);
     std::fs::write(dir.join("checkpoint.json"), &before).unwrap();
+    // The levelling rule is part of the run: a resume with another window is refused.
+    let o = run(&dir, 4, 2, 1, &["--resume", "--level-window", "0"]);
+    one_line_error(&o, 1, "level window 20 (asked 0)");
+    assert_eq!(read(&dir.join("checkpoint.json")), before);
     // A new run over an existing one.
     let o = run(&dir, 4, 2, 1, &[]);
     one_line_error(&o, 1, "already holds a run");

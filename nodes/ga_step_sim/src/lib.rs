@@ -94,6 +94,22 @@ pub struct TorsoState {
     pub tilt: f64,
 }
 
+/// One foot's contact with the floor after a simulation step.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct FootContact {
+    /// Normal force (N) the floor pushed the sole with during the step (its contact impulse
+    /// over the time step); 0 off the floor.
+    pub normal_force: f64,
+    /// Friction force (N) the floor pushed the sole with during the step: the length of the sum
+    /// of the contact points' friction impulses over the time step. Coulomb's law bounds it by
+    /// μ times the normal force; a sole slides only where it reaches that bound.
+    pub friction_force: f64,
+    /// Horizontal speed (m/s) of the slowest of nine points of the sole's bottom face (its
+    /// corners, edge midpoints and centre). A sole resting or rolling over an edge has a point
+    /// at rest, so this is the sliding speed of a loaded foot (a lower bound of it).
+    pub slip_speed: f64,
+}
+
 /// The physics evaluator: a fresh simulation per individual.
 #[derive(Debug, Clone)]
 pub struct PhysicsEvaluator {
@@ -169,6 +185,29 @@ impl PhysicsEvaluator {
         duration: f64,
         observe: &mut dyn FnMut(&TorsoState),
     ) -> SimOutcome {
+        self.run(individual, duration, false, &mut |s, _| observe(s))
+    }
+
+    /// Like [`simulate_observed`](Self::simulate_observed), also passing each foot's contact
+    /// with the floor (right, left) after every step: to check that a loaded sole grips.
+    pub fn simulate_with_feet(
+        &self,
+        individual: &Individual,
+        duration: f64,
+        observe: &mut dyn FnMut(&TorsoState, &[FootContact; 2]),
+    ) -> SimOutcome {
+        self.run(individual, duration, true, observe)
+    }
+
+    /// The simulation loop; the feet's contacts are worked out only `with_feet` (the
+    /// evaluation's hot path does without them) and are all zero otherwise.
+    fn run(
+        &self,
+        individual: &Individual,
+        duration: f64,
+        with_feet: bool,
+        observe: &mut dyn FnMut(&TorsoState, &[FootContact; 2]),
+    ) -> SimOutcome {
         let mut robot = Robot::build(&self.body, &self.model.standing_pose);
         let dt = self.body.dt;
         let steps = (duration / dt).round().max(0.0) as u64;
@@ -195,13 +234,21 @@ impl PhysicsEvaluator {
             robot.command(&command, &self.body);
             robot.world.step();
             let pose = robot.torso_pose();
-            observe(&TorsoState {
-                t,
-                x: pose.x,
-                y: pose.y,
-                z: pose.z,
-                tilt: pose.tilt,
-            });
+            let feet = if with_feet {
+                robot.feet(&self.body)
+            } else {
+                [FootContact::default(); 2]
+            };
+            observe(
+                &TorsoState {
+                    t,
+                    x: pose.x,
+                    y: pose.y,
+                    z: pose.z,
+                    tilt: pose.tilt,
+                },
+                &feet,
+            );
             out.steps = n;
             if !pose.is_finite() {
                 out.fell = true;
@@ -250,6 +297,10 @@ struct Robot {
     torso: RigidBodyHandle,
     /// Per servo (genome order): its joint, its standing angle, stiffness, damping, torque.
     motors: Vec<(MultibodyJointHandle, Servo, f64)>,
+    /// The floor's collider.
+    floor: ColliderHandle,
+    /// Each foot's body and sole collider (right, left).
+    feet: Vec<(RigidBodyHandle, ColliderHandle)>,
     stiffness: Real,
     damping: Real,
 }
@@ -313,7 +364,7 @@ impl Robot {
         let height = -legs[0].sole_corners_z.min(legs[1].sole_corners_z);
         let base = v(0.0, 0.0, height);
 
-        world.insert_collider(
+        let floor = world.insert_collider(
             ColliderBuilder::cuboid(50.0, 50.0, 0.5)
                 .translation(v(0.0, 0.0, -0.5))
                 .friction(b.friction as Real),
@@ -344,6 +395,7 @@ impl Robot {
         );
 
         let mut motors = Vec::with_capacity(SERVO_COUNT);
+        let mut feet = Vec::with_capacity(2);
         for (g, left) in legs.iter().zip([false, true]) {
             let chain = leg_chain(left);
             let masses = [b.leg.hip, b.leg.thigh, b.leg.tibia, b.leg.ankle, b.leg.foot];
@@ -373,7 +425,10 @@ impl Robot {
                     }
                     _ => ColliderBuilder::ball(0.02),
                 };
-                world.insert_collider(collider.mass(masses[k] as Real), Some(link));
+                let handle = world.insert_collider(collider.mass(masses[k] as Real), Some(link));
+                if k == 4 {
+                    feet.push((link, handle));
+                }
                 let s = chain[k];
                 let (lo, hi) = s.limits();
                 let q0 = stand[s.index()];
@@ -397,6 +452,8 @@ impl Robot {
             world,
             torso,
             motors,
+            floor,
+            feet,
             stiffness: b.servo_stiffness as Real,
             damping: b.servo_damping as Real,
         }
@@ -429,6 +486,38 @@ impl Robot {
         }
     }
 
+    /// Each foot's contact with the floor (right, left) after the last step.
+    fn feet(&self, b: &BodyParams) -> [FootContact; 2] {
+        let mut out = [FootContact::default(); 2];
+        for (c, &(body, sole)) in out.iter_mut().zip(&self.feet) {
+            if let Some(PairContacts::Rigid(r)) = self.world.contact_pair(self.floor, sole).map(|p| &p.contacts) {
+                let (mut normal, mut friction) = (0.0, 0.0);
+                for m in r.solver_manifolds() {
+                    for p in &m.points {
+                        normal += p.data.impulse as f64;
+                        friction += p.data.tangent_impulse.norm() as f64;
+                    }
+                }
+                c.normal_force = normal / b.dt;
+                c.friction_force = friction / b.dt;
+            }
+            let (Some(rb), Some(co)) = (self.world.bodies.get(body), self.world.colliders.get(sole)) else {
+                continue;
+            };
+            let (hl, hw, ht) = (b.foot_length / 2.0, b.foot_width / 2.0, b.sole_thickness / 2.0);
+            let mut slowest = f64::INFINITY;
+            for sx in [-1.0, 0.0, 1.0] {
+                for sy in [-1.0, 0.0, 1.0] {
+                    let p = co.position().transform_point(v(sx * hl, sy * hw, -ht));
+                    let vel = rb.velocity_at_point(p);
+                    slowest = slowest.min((vel.x as f64).hypot(vel.y as f64));
+                }
+            }
+            c.slip_speed = slowest;
+        }
+        out
+    }
+
     fn torso_pose(&self) -> TorsoPose {
         let rb = &self.world.bodies[self.torso];
         let p = rb.translation();
@@ -439,5 +528,54 @@ impl Robot {
             z: p.z as f64,
             tilt: (up.z as f64).clamp(-1.0, 1.0).acos(),
         }
+    }
+}
+
+#[cfg(test)]
+mod contact_tests {
+    use super::*;
+
+    /// Stands the robot for 0.5 s, then pushes the right foot's body horizontally (along x) with
+    /// `force` newtons for 1 s; returns the right foot's normal force before the push and how far
+    /// its sole's centre moved along x during the push.
+    fn push_right_foot(body: &BodyParams, force: f64) -> (f64, f64) {
+        let model = NaoModel::default();
+        let mut robot = Robot::build(body, &model.standing_pose);
+        let stand = model.standing_pose;
+        let settle = (0.5 / body.dt).round() as usize;
+        let mut load = 0.0;
+        for _ in 0..settle {
+            robot.command(&stand, body);
+            robot.world.step();
+            load = robot.feet(body)[0].normal_force;
+        }
+        let (foot, _) = robot.feet[0];
+        let x0 = robot.world.bodies[foot].translation().x as f64;
+        let push = (1.0 / body.dt).round() as usize;
+        for _ in 0..push {
+            robot.command(&stand, body);
+            let rb = &mut robot.world.bodies[foot];
+            rb.reset_forces(true);
+            rb.add_force(v(force, 0.0, 0.0), true);
+            robot.world.step();
+        }
+        let x1 = robot.world.bodies[foot].translation().x as f64;
+        (load, x1 - x0)
+    }
+
+    #[test]
+    fn a_loaded_sole_grips_below_coulombs_bound_and_slides_above_it() {
+        let b = BodyParams::default();
+        // The whole robot weighs 4.996 kg · 9.81 = 49.0 N, half of it on each foot: 24.5 N.
+        // Both soles hold the robot against a push until μ·W = 0.8 · 49.0 = 39.2 N.
+        let (load, held) = push_right_foot(&b, 25.0);
+        assert!((load - 24.5).abs() < 2.5, "the right sole carries {load} N");
+        // 25 N < 39.2 N: the sole stays within 5 mm over the second (the servos' sag under the
+        // push and the standing creep are millimetres).
+        assert!(held.abs() < 0.005, "a 25 N push moved the sole {held} m");
+        // 50 N > 39.2 N: the robot slides; with the 10.8 N excess on 5 kg it would move
+        // ½ · 2.2 m/s² · (1 s)² = 1.1 m; anything beyond 0.2 m is sliding, not sag.
+        let (_, slid) = push_right_foot(&b, 50.0);
+        assert!(slid > 0.2, "a 50 N push moved the sole only {slid} m");
     }
 }
