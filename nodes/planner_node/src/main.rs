@@ -1726,8 +1726,10 @@ impl Shell {
                 "scan stamp invalid (nanosec ≥ 1e9); scan ignored"
             );
         };
-        let placed = self.fresh_odom().and_then(|_| self.odom_history.at(stamp, max_gap));
-        let Some(odom_from_base) = placed else {
+        let placed = self
+            .fresh_odom()
+            .and_then(|_| self.odom_history.placed_at(stamp, max_gap));
+        let Some((odom_from_base, placement)) = placed else {
             return warn_throttled!(
                 self.throttle,
                 "scan-odom",
@@ -1735,10 +1737,18 @@ impl Shell {
                  placed by the pose at the scan's time)"
             );
         };
-        let update = match self.map.update(&scan, &odom_from_base, stamp) {
+        let update = match self.map.update_placed(&scan, &odom_from_base, placement, stamp) {
             Ok(u) => u,
             Err(e) => return warn_throttled!(self.throttle, "scan-bad", "scan refused: {e}; scan ignored"),
         };
+        if !update.cleared.is_empty() {
+            warn_throttled!(
+                self.throttle,
+                "map-reset",
+                "scan at {stamp:.3} s is older than obstacles already seen (clock reset?): the {} obstacles forgotten",
+                update.cleared.len()
+            );
+        }
         if !update.capped.is_empty() {
             warn_throttled!(
                 self.throttle,

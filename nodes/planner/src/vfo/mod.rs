@@ -40,7 +40,7 @@ pub use controller::{
     VfoWaypoint, DEFAULT_GUIDING,
 };
 pub use follower::{Reoptimised, VfoEnd, VfoEvent, VfoFollower, VfoOutput, MAX_SETTLE_S, REST_SPEED, REST_TURN_RATE};
-pub use history::PoseHistory;
+pub use history::{Placement, PoseHistory};
 pub use obstacles::{potential, potential_derivative, Obstacle, Sigma};
 pub use optimise::{
     find_sigmas, find_sigmas_until, path_time_limit, simulate_uninterrupted, DecisionEdge, ExploredPath, Interrupt,
