@@ -586,10 +586,7 @@ fn bad_input_is_refused() {
     .expect("valid");
     let out = f.update(&Pose2::identity(), 0.0).expect("valid");
     assert_eq!((out.v, out.omega), (0.0, 0.0));
-    assert!(matches!(
-        out.end,
-        Some(VfoEnd::NoSafePath { index: 0 }) | Some(VfoEnd::Collision { obstacle: 0 })
-    ));
+    assert_eq!(out.end, Some(VfoEnd::Collision { obstacle: 0 }));
 }
 
 #[test]
@@ -771,11 +768,24 @@ fn a_cancelled_optimisation_returns_promptly_and_a_spent_budget_keeps_the_best_s
         21 * INTERRUPT_CHECK_STEPS < steps_full / 10,
         "{steps_full} steps in the full run"
     );
-    // A budget spent after 200 questions: the best so far, fewer virtual robots, a warning.
+    // How many questions the full run asks; a budget spent half-way: the best so far (the
+    // first candidates end early), fewer virtual robots, a warning.
     let asked = AtomicUsize::new(0);
-    let budget = || (asked.fetch_add(1, Ordering::Relaxed) >= 200).then_some(Interrupt::Budget);
+    let count = || {
+        asked.fetch_add(1, Ordering::Relaxed);
+        None
+    };
+    find_sigmas_until(&Pose2::identity(), &controller(), &segment, &config, &count).expect("valid");
+    let half = asked.load(Ordering::Relaxed) / 2;
+    let asked = AtomicUsize::new(0);
+    let budget = || (asked.fetch_add(1, Ordering::Relaxed) >= half).then_some(Interrupt::Budget);
     let r = find_sigmas_until(&Pose2::identity(), &controller(), &segment, &config, &budget).expect("best so far");
     assert!(r.robots.len() < full.robots.len());
+    assert!(
+        r.best.is_some(),
+        "a candidate found before the budget ran out is returned"
+    );
+    assert!(!r.warnings.contains(&OptimiseWarning::NoSafeSigma), "{:?}", r.warnings);
     assert!(
         r.warnings
             .iter()
@@ -784,19 +794,42 @@ fn a_cancelled_optimisation_returns_promptly_and_a_spent_budget_keeps_the_best_s
         r.warnings
     );
     assert!(r.robots.iter().all(|v| v.end != RobotEnd::Interrupted));
-    // Spent before the start: nothing simulated, no safe Σ found.
+    // Spent before the start: nothing simulated, no candidate, and nothing proven unsafe (no
+    // NoSafeSigma).
     let r = find_sigmas_until(&Pose2::identity(), &controller(), &segment, &config, &|| {
         Some(Interrupt::Budget)
     })
     .expect("valid");
     assert_eq!(r.robots.len(), 0);
-    assert_eq!(
-        r.warnings,
-        vec![
-            OptimiseWarning::WallTimeBudget { pending: 1 },
-            OptimiseWarning::NoSafeSigma
-        ]
-    );
+    assert!(r.best.is_none());
+    assert_eq!(r.warnings, vec![OptimiseWarning::WallTimeBudget { pending: 1 }]);
+    // The follower starved by the budget holds zero and retries: not NoSafePath; the third
+    // starved optimisation in a row ends the route as BudgetExhausted.
+    let spent = || Some(Interrupt::Budget);
+    let mut f =
+        VfoFollower::new(VfoGains::default(), config, vec![wp(12.0, 0.0, 0.0)], obstacles.clone()).expect("valid");
+    for k in 0..3 {
+        let out = f
+            .update_until(&Pose2::identity(), f64::from(k) * 0.05, &spent)
+            .expect("valid");
+        assert_eq!((out.v, out.omega), (0.0, 0.0));
+        assert!(matches!(
+            out.events.as_slice(),
+            [VfoEvent::Optimised { score: None, .. }]
+        ));
+        let expected = (k == 2).then_some(VfoEnd::BudgetExhausted { index: 0 });
+        assert_eq!(out.end, expected, "tick {k}");
+    }
+    // Starved twice, then given time: the third optimisation runs in full and the robot drives.
+    let mut f =
+        VfoFollower::new(VfoGains::default(), config, vec![wp(12.0, 0.0, 0.0)], obstacles.clone()).expect("valid");
+    for k in 0..2 {
+        f.update_until(&Pose2::identity(), f64::from(k) * 0.05, &spent)
+            .expect("valid");
+    }
+    let out = f.update(&Pose2::identity(), 0.1).expect("valid");
+    assert!(out.end.is_none() && out.v > 0.0, "{out:?}");
+    assert_eq!(f.last_optimisation().map(|o| o.robots.len()), Some(full.robots.len()));
     // The follower: a cancel leaves the segment due for optimisation at the next tick.
     let mut f =
         VfoFollower::new(VfoGains::default(), config, vec![wp(12.0, 0.0, 0.0)], obstacles.clone()).expect("valid");
@@ -806,4 +839,27 @@ fn a_cancelled_optimisation_returns_promptly_and_a_spent_budget_keeps_the_best_s
     let out = f.update(&Pose2::identity(), 0.01).expect("valid");
     assert!(matches!(out.events.first(), Some(VfoEvent::Optimised { .. })));
     assert_eq!(f.last_optimisation().map(|o| o.robots.len()), Some(full.robots.len()));
+}
+
+#[test]
+fn a_collision_ends_the_route_while_the_follower_holds() {
+    // Waypoint 0 at the start pose is reached on the first tick, inside the zone of the obstacle
+    // at (0, 0.8) (d = 0.8 < R = 1): the follower holds zero until rest. The robot still slides
+    // toward it: at (0, 0.45) it is 0.35 m from the centre, outside r = 0.3, still held; at
+    // (0, 0.55) it is 0.25 m away, inside r: COLLISION, though holding.
+    let mut f = VfoFollower::new(
+        VfoGains::default(),
+        OptimiseConfig::default(),
+        vec![wp(0.0, 0.0, 0.0), wp(3.0, 0.0, 0.0)],
+        vec![ob(0.0, 0.8, 0.3, 1.0)],
+    )
+    .expect("valid");
+    let out = f.update(&Pose2::identity(), 0.0).expect("valid");
+    assert!(matches!(out.events.last(), Some(VfoEvent::Reached { index: 0, .. })));
+    assert!(f.is_settling() && out.end.is_none());
+    let out = f.update(&Pose2::new(0.0, 0.45, 0.0), 0.05).expect("valid");
+    assert!(f.is_settling() && out.end.is_none());
+    let out = f.update(&Pose2::new(0.0, 0.55, 0.0), 0.1).expect("valid");
+    assert_eq!((out.v, out.omega), (0.0, 0.0));
+    assert_eq!(out.end, Some(VfoEnd::Collision { obstacle: 0 }));
 }

@@ -36,7 +36,7 @@ use mobil_msgs::sensor_msgs::msg::LaserScan;
 use mobil_msgs::tf2_msgs::msg::TFMessage;
 use mobil_msgs::visualization_msgs::msg::MarkerArray;
 use mobil_planner::vfo::{
-    Interrupt, ObstacleMap, OptimiseWarning, PoseHistory, VfoEnd, VfoEvent, VfoFollower, VfoOutput,
+    Interrupt, ObstacleMap, OptimiseWarning, PoseHistory, VfoEnd, VfoEvent, VfoFollower, VfoOutput, MAX_BUDGET_RETRIES,
 };
 use mobil_planner::{
     check_route_until, polar_error, DockingController, DockingOutput, DockingPhase, Finish, FollowEnd, FollowEvent,
@@ -1649,6 +1649,11 @@ impl Shell {
             Some(VfoEnd::NoSafePath { index }) => Some(Outcome::NoSafePath {
                 index: request(index),
                 virtual_robots: report.virtual_robots,
+                unreached: unreached(index),
+            }),
+            Some(VfoEnd::BudgetExhausted { index }) => Some(Outcome::OptimisationBudget {
+                index: request(index),
+                tries: MAX_BUDGET_RETRIES,
                 unreached: unreached(index),
             }),
             Some(VfoEnd::Collision { obstacle }) => {

@@ -24,8 +24,12 @@
 //! stands: a state the real robot is really in, from which it can start as the virtual robots
 //! do.
 //!
-//! Safety: on a collision (d ≤ r), or when no safe Σ exists for the segment, the command is
-//! zero and the route ends ([`VfoEnd`]); the caller reports it. Bad input (a non-finite pose,
+//! Safety: on a collision (d ≤ r, checked on every tick, holding or not), or when no safe Σ
+//! exists for the segment, the command is zero and the route ends ([`VfoEnd`]); the caller
+//! reports it. An optimisation whose wall-clock budget ran out before any candidate proved
+//! nothing unsafe: the follower holds zero and retries on the next ticks, and only after
+//! [`MAX_BUDGET_RETRIES`] such optimisations in a row ends the route with
+//! [`VfoEnd::BudgetExhausted`]. Bad input (a non-finite pose,
 //! time going backwards) is refused with a [`PlannerError`] and changes nothing; the caller
 //! commands zero.
 
@@ -43,6 +47,10 @@ pub const REST_TURN_RATE: f64 = 0.05;
 /// The longest wait for the robot to come to rest before a segment started inside a zone is
 /// optimised anyway (s): a robot that never reads still (odometry noise) must not wait forever.
 pub const MAX_SETTLE_S: f64 = 2.0;
+/// Optimisations in a row whose budget ran out before any candidate, after which the route
+/// ends ([`VfoEnd::BudgetExhausted`]): three ticks of held zero (0.15 s at 20 Hz) ride out a
+/// passing load on the machine, more means the budget is too small for the scene.
+pub const MAX_BUDGET_RETRIES: u32 = 3;
 
 /// Something that happened during a tick.
 #[derive(Debug, Clone, PartialEq)]
@@ -94,6 +102,13 @@ pub enum VfoEnd {
         /// The waypoint index.
         index: usize,
     },
+    /// The wall-clock budget ran out before any candidate for segment `index`, on
+    /// [`MAX_BUDGET_RETRIES`] optimisations in a row: nothing was proven unsafe, but no Σ
+    /// was found in time.
+    BudgetExhausted {
+        /// The waypoint index.
+        index: usize,
+    },
 }
 
 /// One tick's result.
@@ -130,6 +145,8 @@ pub struct VfoFollower {
     end: Option<VfoEnd>,
     /// Waiting for rest before optimising: since when, and the last tick's pose and time.
     settling: Option<Settling>,
+    /// Optimisations in a row whose budget ran out before any candidate.
+    budget_misses: u32,
 }
 
 #[derive(Debug, Clone, Copy)]
@@ -175,6 +192,7 @@ impl VfoFollower {
             last_t: None,
             end: None,
             settling: None,
+            budget_misses: 0,
         })
     }
 
@@ -261,9 +279,9 @@ impl VfoFollower {
         reason: Reoptimised,
         events: &mut Vec<VfoEvent>,
         interrupt: &(dyn Fn() -> Option<Interrupt> + Sync),
-    ) -> Result<(), PlannerError> {
+    ) -> Result<bool, PlannerError> {
         let Some(waypoint) = self.waypoints.get(self.index).copied() else {
-            return Ok(());
+            return Ok(true);
         };
         let segment = Segment {
             waypoint,
@@ -271,18 +289,55 @@ impl VfoFollower {
             obstacles: &self.obstacles,
         };
         let result = find_sigmas_until(pose, &self.controller, &segment, &self.config, interrupt)?;
-        self.sigmas = result.sigmas.clone();
         events.push(VfoEvent::Optimised {
             index: self.index,
             reason,
             score: result.score(),
             warnings: result.warnings.clone(),
         });
-        if result.best.is_none() {
-            self.end = Some(VfoEnd::NoSafePath { index: self.index });
+        let starved = result.best.is_none()
+            && result
+                .warnings
+                .iter()
+                .any(|w| matches!(w, OptimiseWarning::WallTimeBudget { .. }));
+        if starved {
+            // Nothing proven unsafe: keep the old Σ, hold, retry (module docs).
+            self.budget_misses += 1;
+            if self.budget_misses >= MAX_BUDGET_RETRIES {
+                self.end = Some(VfoEnd::BudgetExhausted { index: self.index });
+            }
+        } else {
+            self.budget_misses = 0;
+            self.sigmas = result.sigmas.clone();
+            if result.best.is_none() {
+                self.end = Some(VfoEnd::NoSafePath { index: self.index });
+            }
         }
         self.last = Some(result);
-        Ok(())
+        Ok(!starved)
+    }
+
+    /// The obstacle whose forbidden zone (d ≤ r) holds `pose`, if any.
+    fn collision(&self, pose: &Pose2) -> Option<usize> {
+        let position = pose.position();
+        self.obstacles
+            .iter()
+            .position(|o| o.distance(&position) <= o.forbidden_radius())
+    }
+
+    fn hold(&self, pose: &Pose2, events: Vec<VfoEvent>) -> VfoOutput {
+        VfoOutput {
+            omega: 0.0,
+            v: 0.0,
+            index: self.index,
+            distance: self
+                .waypoints
+                .get(self.index)
+                .map_or(0.0, |w| (w.position - pose.position()).norm()),
+            step: None,
+            events,
+            end: None,
+        }
     }
 
     /// One control tick at `pose` (θ, x, y of the robot's guide point) at time `t` (s,
@@ -312,6 +367,11 @@ impl VfoFollower {
         }
         self.last_t = Some(t);
         let mut events = Vec::new();
+        if self.end.is_none()
+            && let Some(obstacle) = self.collision(pose)
+        {
+            self.end = Some(VfoEnd::Collision { obstacle });
+        }
         loop {
             if self.end.is_some() {
                 return Ok(self.stopped(events));
@@ -331,21 +391,23 @@ impl VfoFollower {
                     self.settling = None;
                 } else {
                     settling.last = Some((*pose, t));
-                    return Ok(VfoOutput {
-                        omega: 0.0,
-                        v: 0.0,
-                        index: self.index,
-                        distance: (waypoint.position - pose.position()).norm(),
-                        step: None,
-                        events,
-                        end: None,
-                    });
+                    return Ok(self.hold(pose, events));
                 }
             }
             if let Some(reason) = self.optimise.take() {
-                if let Err(e) = self.optimise(pose, reason, &mut events, interrupt) {
-                    self.optimise = Some(reason);
-                    return Err(e);
+                match self.optimise(pose, reason, &mut events, interrupt) {
+                    Ok(true) => {}
+                    Ok(false) => {
+                        // Starved by the budget: due again on the next tick, zero meanwhile.
+                        if self.end.is_none() {
+                            self.optimise = Some(reason);
+                            return Ok(self.hold(pose, events));
+                        }
+                    }
+                    Err(e) => {
+                        self.optimise = Some(reason);
+                        return Err(e);
+                    }
                 }
                 continue;
             }
