@@ -11,7 +11,8 @@ use mobil_geom::{wrap, Pose2};
 use mobil_planner::vfo::{
     convergence_field, field_rate, find_sigmas, integrate_unicycle, path_time_limit, potential, potential_derivative,
     simulate_uninterrupted, Obstacle, OptimiseConfig, OptimiseWarning, PathFate, PathIndices, QualityWeights, RobotEnd,
-    Segment, Sigma, VfoController, VfoEnd, VfoEvent, VfoFollower, VfoGains, VfoWaypoint, MAX_SETTLE_S, REST_SPEED,
+    Segment, Sigma, VfoController, VfoEnd, VfoEvent, VfoFollower, VfoGains, VfoOutput, VfoWaypoint, MAX_SETTLE_S,
+    REST_INTERVALS, REST_SPEED,
 };
 use mobil_planner::PlannerError;
 use nalgebra::{Point2, Vector2};
@@ -605,7 +606,16 @@ fn entering_a_zone_the_optimisation_did_not_foresee_reoptimises() {
     let first = f.update(&Pose2::identity(), 0.0).expect("valid");
     assert_eq!(f.sigmas(), &[Sigma::Undecided]);
     assert_eq!(first.events.len(), 1);
-    let pushed = f.update(&Pose2::new(2.5, 1.2, 0.0), 0.01).expect("valid");
+    // Inside the zone the robot is first brought to rest: zero, settling, no optimisation.
+    let at = Pose2::new(2.5, 1.2, 0.0);
+    let held = f.update(&at, 0.01).expect("valid");
+    assert!(held.events.is_empty() && f.is_settling() && (held.v, held.omega) == (0.0, 0.0));
+    // Standing still: REST_INTERVALS intervals later it optimises from there.
+    let mut pushed = held;
+    for k in 1..=REST_INTERVALS {
+        pushed = f.update(&at, 0.01 + f64::from(k) * 0.02).expect("valid");
+        assert_eq!(pushed.events.is_empty(), k < REST_INTERVALS, "tick {k}");
+    }
     assert!(
         pushed.events.iter().any(|e| matches!(
             e,
@@ -862,4 +872,50 @@ fn a_collision_ends_the_route_while_the_follower_holds() {
     let out = f.update(&Pose2::new(0.0, 0.55, 0.0), 0.1).expect("valid");
     assert_eq!((out.v, out.omega), (0.0, 0.0));
     assert_eq!(out.end, Some(VfoEnd::Collision { obstacle: 0 }));
+}
+
+#[test]
+fn a_republished_pose_is_no_rest_and_rest_needs_consecutive_still_intervals() {
+    // As the zone test above: at (2.5, 1.2) inside the zone of (2.5, 2) with σ undecided, the
+    // follower holds until rest, timed by the poses' stamps.
+    let mut f = VfoFollower::new(
+        VfoGains::default(),
+        OptimiseConfig::default(),
+        vec![wp(5.0, 0.0, 0.0)],
+        vec![ob(2.5, 2.0, 0.5, 1.0)],
+    )
+    .expect("valid");
+    f.update(&Pose2::identity(), 0.0).expect("valid");
+    let optimised = |o: &VfoOutput| o.events.iter().any(|e| matches!(e, VfoEvent::Optimised { .. }));
+    // Moving at 0.2 m/s along x, odometry stamped every 0.02 s.
+    let moving = |k: u32| Pose2::new(2.5 + 0.004 * f64::from(k), 1.2, 0.0);
+    let out = f.update_stamped(&moving(0), 0.02, 0.02, &|| None).expect("valid");
+    assert!(f.is_settling() && !optimised(&out));
+    // The same sample arrives again and again, later (arrival 0.04 … 0.12 s), stamp unchanged: no
+    // interval, no rest, however long it took to arrive.
+    for k in 0..5 {
+        let out = f
+            .update_stamped(&moving(0), 0.04 + f64::from(k) * 0.02, 0.02, &|| None)
+            .expect("valid");
+        assert!(f.is_settling() && !optimised(&out), "repeat {k}");
+    }
+    // Two still intervals (each under REST_SPEED), then a moving one: the run restarts.
+    let out = f.update_stamped(&moving(0), 0.14, 0.04, &|| None).expect("valid");
+    assert!(!optimised(&out));
+    let out = f.update_stamped(&moving(0), 0.16, 0.06, &|| None).expect("valid");
+    assert!(!optimised(&out));
+    let out = f.update_stamped(&moving(1), 0.18, 0.08, &|| None).expect("valid");
+    assert!(
+        f.is_settling() && !optimised(&out),
+        "0.004 m in 0.02 s is 0.2 m/s: moving"
+    );
+    // Three still intervals in a row: rest, the zone is optimised.
+    for (k, stamp) in [0.10, 0.12].into_iter().enumerate() {
+        let out = f
+            .update_stamped(&moving(1), 0.2 + k as f64 * 0.02, stamp, &|| None)
+            .expect("valid");
+        assert!(!optimised(&out), "still interval {}", k + 1);
+    }
+    let out = f.update_stamped(&moving(1), 0.24, 0.14, &|| None).expect("valid");
+    assert!(optimised(&out) && !f.is_settling());
 }

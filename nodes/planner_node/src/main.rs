@@ -37,6 +37,7 @@ use mobil_msgs::tf2_msgs::msg::TFMessage;
 use mobil_msgs::visualization_msgs::msg::MarkerArray;
 use mobil_planner::vfo::{
     Interrupt, ObstacleMap, OptimiseWarning, PoseHistory, VfoEnd, VfoEvent, VfoFollower, VfoOutput, MAX_BUDGET_RETRIES,
+    MAX_SETTLE_S,
 };
 use mobil_planner::{
     check_route_until, polar_error, DockingController, DockingOutput, DockingPhase, Finish, FollowEnd, FollowEvent,
@@ -276,6 +277,8 @@ struct Shell {
     /// The odometry poses of the last seconds by stamp: a scan is placed with the pose at its
     /// own stamp.
     odom_history: PoseHistory,
+    /// The stamp (s) of the last odometry sample taken, the VFO rest test's clock.
+    odom_stamp: f64,
     /// When the last valid scan arrived.
     scan_seen: Latest<()>,
     /// The odometry's measured period (steady clock): a VFO tick's command later than two of
@@ -366,6 +369,7 @@ async fn start(node: &mut RosNode, out: &Outputs, config: PlannerConfig) -> anyh
         map,
         map_rebuild: false,
         odom_history: PoseHistory::new(ODOM_HISTORY),
+        odom_stamp: f64::NAN,
         scan_seen: Latest::new(),
         odom_period: ArrivalPeriod::default(),
         laser: StaticFrames::default(),
@@ -1335,8 +1339,9 @@ impl Shell {
         match odom_pose(m, &self.config.odom_frame, &self.config.base_frame) {
             Ok(pose) => {
                 self.odom_refused = false;
-                if let Some(t) = secs_from_stamp(&m.header.stamp) {
-                    self.odom_history.push(t, pose);
+                self.odom_stamp = secs_from_stamp(&m.header.stamp).unwrap_or(f64::NAN);
+                if self.odom_stamp.is_finite() {
+                    self.odom_history.push(self.odom_stamp, pose);
                 }
                 self.odom_period.arrived(Instant::now());
                 self.odom.set(pose, m.header.stamp.clone());
@@ -1532,7 +1537,7 @@ impl Shell {
             follower.set_obstacles_mapped(self.map.obstacles(), &previous, new);
             *ids = now_ids;
         }
-        let (seq, guide, stop) = (*seq, pose.ahead(-*offset), stop.clone());
+        let (seq, guide, stop, stamp) = (*seq, pose.ahead(-*offset), stop.clone(), self.odom_stamp);
         let budget = config.vfo.optimise_budget();
         jobs.vfo.start(move |cancel| {
             let started = Instant::now();
@@ -1545,7 +1550,7 @@ impl Shell {
                     None
                 }
             };
-            let output = follower.update_until(&guide, t, &interrupt);
+            let output = follower.update_stamped(&guide, t, stamp, &interrupt);
             let optimised = output
                 .as_ref()
                 .is_ok_and(|o| o.events.iter().any(|e| matches!(e, VfoEvent::Optimised { .. })))
@@ -1636,6 +1641,15 @@ impl Shell {
                     }
                 }
             }
+        }
+        if o.end.is_none() && slot.follower().is_some_and(|f| f.is_settling()) {
+            warn_throttled!(
+                self.throttle,
+                "vfo-settle",
+                "robot held at zero inside an influence zone until it stands (at most {MAX_SETTLE_S} s), then the \
+                 segment to waypoint {} is optimised from there",
+                request(o.index)
+            );
         }
         *index = o.index;
         *distance = o.distance;

@@ -19,10 +19,14 @@
 //! paths: the next re-optimisation starts a few centimetres from r, where every Σ collides (no
 //! safe Σ), or the robot collides on the old Σ. So when a segment starts with the robot inside
 //! a zone, the follower commands zero until the robot is at rest (it moved less than
-//! [`REST_SPEED`]·Δt and turned less than [`REST_TURN_RATE`]·Δt between two ticks, or
-//! [`MAX_SETTLE_S`] passed), and only then optimises the segment, from the pose where the robot
+//! [`REST_SPEED`]·Δt and turned less than [`REST_TURN_RATE`]·Δt over each of
+//! [`REST_INTERVALS`] consecutive intervals between poses, Δt timed by the poses' own stamps
+//! — a pose republished with its old stamp is no interval, and one timed by its arrival would
+//! read still — or [`MAX_SETTLE_S`] passed), and only then optimises the segment, from the pose where the robot
 //! stands: a state the real robot is really in, from which it can start as the virtual robots
-//! do.
+//! do. The same holds for a re-optimisation inside a zone (a new obstacle, an undecided zone
+//! entered): the robot is brought to rest first. [`VfoFollower::is_settling`] tells the caller
+//! why the robot stands.
 //!
 //! Safety: on a collision (d ≤ r, checked on every tick, holding or not), or when no safe Σ
 //! exists for the segment, the command is zero and the route ends ([`VfoEnd`]); the caller
@@ -44,6 +48,9 @@ use crate::error::PlannerError;
 pub const REST_SPEED: f64 = 0.01;
 /// Below this turn rate (rad/s) between two ticks the robot is at rest (module docs).
 pub const REST_TURN_RATE: f64 = 0.05;
+/// Consecutive still intervals between poses that make rest (module docs): one still interval
+/// may be a repeated sample; three (60 ms of 50 Hz odometry) are not.
+pub const REST_INTERVALS: u32 = 3;
 /// The longest wait for the robot to come to rest before a segment started inside a zone is
 /// optimised anyway (s): a robot that never reads still (odometry noise) must not wait forever.
 pub const MAX_SETTLE_S: f64 = 2.0;
@@ -152,7 +159,10 @@ pub struct VfoFollower {
 #[derive(Debug, Clone, Copy)]
 struct Settling {
     since: f64,
+    /// The last pose and its stamp.
     last: Option<(Pose2, f64)>,
+    /// Still intervals in a row.
+    still: u32,
 }
 
 impl VfoFollower {
@@ -317,6 +327,14 @@ impl VfoFollower {
         Ok(!starved)
     }
 
+    /// Whether `pose` lies inside some obstacle's influence zone.
+    fn in_zone(&self, pose: &Pose2) -> bool {
+        let position = pose.position();
+        self.obstacles
+            .iter()
+            .any(|o| o.distance(&position) <= o.influence_radius())
+    }
+
     /// The obstacle whose forbidden zone (d ≤ r) holds `pose`, if any.
     fn collision(&self, pose: &Pose2) -> Option<usize> {
         let position = pose.position();
@@ -357,6 +375,19 @@ impl VfoFollower {
         t: f64,
         interrupt: &(dyn Fn() -> Option<Interrupt> + Sync),
     ) -> Result<VfoOutput, PlannerError> {
+        self.update_stamped(pose, t, t, interrupt)
+    }
+
+    /// [`VfoFollower::update_until`] with `pose_stamp` (s), the time the pose was measured
+    /// (the odometry's stamp, on its own clock): the rest test times the pose changes by it
+    /// (module docs). A non-finite stamp is no interval.
+    pub fn update_stamped(
+        &mut self,
+        pose: &Pose2,
+        t: f64,
+        pose_stamp: f64,
+        interrupt: &(dyn Fn() -> Option<Interrupt> + Sync),
+    ) -> Result<VfoOutput, PlannerError> {
         crate::docking::check_pose("pose", pose)?;
         if !t.is_finite() || self.last_t.is_some_and(|last| t < last) {
             return Err(PlannerError::InvalidConfig {
@@ -367,6 +398,8 @@ impl VfoFollower {
         }
         self.last_t = Some(t);
         let mut events = Vec::new();
+        // Whether the robot came to rest in this tick (it then optimises without a new wait).
+        let mut settled = false;
         if self.end.is_none()
             && let Some(obstacle) = self.collision(pose)
         {
@@ -381,16 +414,38 @@ impl VfoFollower {
                 continue;
             };
             if let Some(settling) = self.settling.as_mut() {
-                let rest = settling.last.is_some_and(|(p, t0)| {
-                    let dt = t - t0;
-                    dt > 0.0
-                        && (p.position() - pose.position()).norm() < REST_SPEED * dt
-                        && mobil_geom::wrap(pose.yaw - p.yaw).abs() < REST_TURN_RATE * dt
-                });
-                if rest || t - settling.since >= MAX_SETTLE_S {
+                match settling.last {
+                    // The same sample again (or no usable stamp): no interval.
+                    Some((_, s0)) if !(pose_stamp.is_finite() && pose_stamp != s0) => {}
+                    Some((p, s0)) => {
+                        let dt = pose_stamp - s0;
+                        let still = dt > 0.0
+                            && (p.position() - pose.position()).norm() < REST_SPEED * dt
+                            && mobil_geom::wrap(pose.yaw - p.yaw).abs() < REST_TURN_RATE * dt;
+                        settling.still = if still { settling.still + 1 } else { 0 };
+                        settling.last = Some((*pose, pose_stamp));
+                    }
+                    None => {
+                        if pose_stamp.is_finite() {
+                            settling.last = Some((*pose, pose_stamp));
+                        }
+                    }
+                }
+                if settling.still >= REST_INTERVALS || t - settling.since >= MAX_SETTLE_S {
                     self.settling = None;
+                    settled = true;
                 } else {
-                    settling.last = Some((*pose, t));
+                    return Ok(self.hold(pose, events));
+                }
+            }
+            if let Some(reason) = self.optimise {
+                // A re-optimisation inside a zone starts from rest too (module docs).
+                if reason != Reoptimised::SegmentStart && !settled && self.in_zone(pose) {
+                    self.settling = Some(Settling {
+                        since: t,
+                        last: Some((*pose, pose_stamp)).filter(|_| pose_stamp.is_finite()),
+                        still: 0,
+                    });
                     return Ok(self.hold(pose, events));
                 }
             }
@@ -447,13 +502,12 @@ impl VfoFollower {
                     self.controller.start_segment();
                     if self.index < self.waypoints.len() {
                         self.optimise = Some(Reoptimised::SegmentStart);
-                        let position = pose.position();
-                        if self
-                            .obstacles
-                            .iter()
-                            .any(|o| o.distance(&position) <= o.influence_radius())
-                        {
-                            self.settling = Some(Settling { since: t, last: None });
+                        if self.in_zone(pose) {
+                            self.settling = Some(Settling {
+                                since: t,
+                                last: Some((*pose, pose_stamp)).filter(|_| pose_stamp.is_finite()),
+                                still: 0,
+                            });
                         }
                     }
                 }

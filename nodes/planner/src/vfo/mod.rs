@@ -40,7 +40,8 @@ pub use controller::{
     VfoWaypoint, DEFAULT_GUIDING,
 };
 pub use follower::{
-    Reoptimised, VfoEnd, VfoEvent, VfoFollower, VfoOutput, MAX_BUDGET_RETRIES, MAX_SETTLE_S, REST_SPEED, REST_TURN_RATE,
+    Reoptimised, VfoEnd, VfoEvent, VfoFollower, VfoOutput, MAX_BUDGET_RETRIES, MAX_SETTLE_S, REST_INTERVALS,
+    REST_SPEED, REST_TURN_RATE,
 };
 pub use history::{Placement, PoseHistory};
 pub use obstacles::{potential, potential_derivative, Obstacle, Sigma};
