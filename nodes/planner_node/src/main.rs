@@ -1529,13 +1529,7 @@ impl Shell {
             return self.zero(out);
         };
         if let Some(new) = obstacles_changed.take() {
-            let now_ids = self.map.ids();
-            let previous: Vec<Option<usize>> = now_ids
-                .iter()
-                .map(|id| ids.iter().position(|held| held == id))
-                .collect();
-            follower.set_obstacles_mapped(self.map.obstacles(), &previous, new);
-            *ids = now_ids;
+            follower.follow_map(&self.map, ids, new);
         }
         let (seq, guide, stop, stamp) = (*seq, pose.ahead(-*offset), stop.clone(), self.odom_stamp);
         let budget = config.vfo.optimise_budget();

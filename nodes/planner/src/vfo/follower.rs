@@ -42,6 +42,7 @@ use mobil_geom::Pose2;
 use super::controller::{ControlStep, StepOutcome, VfoController, VfoGains, VfoWaypoint};
 use super::obstacles::{Obstacle, Sigma};
 use super::optimise::{find_sigmas_until, Interrupt, Optimisation, OptimiseConfig, OptimiseWarning, Segment};
+use super::scan::ObstacleMap;
 use crate::error::PlannerError;
 
 /// Below this speed (m/s) between two ticks the robot is at rest (module docs).
@@ -250,8 +251,9 @@ impl VfoFollower {
         self.optimise.get_or_insert(Reoptimised::NewObstacle);
     }
 
-    /// Replaces the obstacles (an updated map: the same indices for the same obstacles, new
-    /// ones appended). With `new_obstacles` the segment is re-optimised at the next tick;
+    /// Replaces the obstacles by a list that only grew: the same indices for the same
+    /// obstacles, new ones appended (an [`ObstacleMap`] removes and re-indexes: follow one with
+    /// [`Self::follow_map`]). With `new_obstacles` the segment is re-optimised at the next tick;
     /// without, Σ is kept (new entries undecided).
     pub fn set_obstacles(&mut self, obstacles: Vec<Obstacle>, new_obstacles: bool) {
         self.sigmas.resize(obstacles.len(), Sigma::Undecided);
@@ -281,6 +283,20 @@ impl VfoFollower {
         if new_obstacles {
             self.optimise.get_or_insert(Reoptimised::NewObstacle);
         }
+    }
+
+    /// Takes the obstacles of `map`, carrying each decision over by the obstacle's id:
+    /// `held_ids` are the ids of the obstacles the follower holds (by index), updated here.
+    /// With `new_obstacles` the segment is re-optimised at the next tick
+    /// ([`Self::set_obstacles_mapped`]).
+    pub fn follow_map(&mut self, map: &ObstacleMap, held_ids: &mut Vec<u64>, new_obstacles: bool) {
+        let now = map.ids();
+        let previous: Vec<Option<usize>> = now
+            .iter()
+            .map(|id| held_ids.iter().position(|held| held == id))
+            .collect();
+        self.set_obstacles_mapped(map.obstacles(), &previous, new_obstacles);
+        *held_ids = now;
     }
 
     fn optimise(
