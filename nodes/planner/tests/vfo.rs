@@ -11,7 +11,8 @@ use mobil_geom::{wrap, Pose2};
 use mobil_planner::vfo::{
     convergence_field, field_rate, find_sigmas, integrate_unicycle, path_time_limit, potential, potential_derivative,
     simulate_uninterrupted, Obstacle, OptimiseConfig, OptimiseWarning, PathFate, PathIndices, QualityWeights, RobotEnd,
-    Segment, Sigma, VfoController, VfoEnd, VfoEvent, VfoFollower, VfoGains, VfoWaypoint, MAX_SETTLE_S, REST_SPEED,
+    Segment, Sigma, VfoController, VfoEnd, VfoEvent, VfoFollower, VfoGains, VfoOutput, VfoWaypoint, MAX_SETTLE_S,
+    REST_INTERVALS, REST_SPEED,
 };
 use mobil_planner::PlannerError;
 use nalgebra::{Point2, Vector2};
@@ -586,10 +587,7 @@ fn bad_input_is_refused() {
     .expect("valid");
     let out = f.update(&Pose2::identity(), 0.0).expect("valid");
     assert_eq!((out.v, out.omega), (0.0, 0.0));
-    assert!(matches!(
-        out.end,
-        Some(VfoEnd::NoSafePath { index: 0 }) | Some(VfoEnd::Collision { obstacle: 0 })
-    ));
+    assert_eq!(out.end, Some(VfoEnd::Collision { obstacle: 0 }));
 }
 
 #[test]
@@ -608,7 +606,16 @@ fn entering_a_zone_the_optimisation_did_not_foresee_reoptimises() {
     let first = f.update(&Pose2::identity(), 0.0).expect("valid");
     assert_eq!(f.sigmas(), &[Sigma::Undecided]);
     assert_eq!(first.events.len(), 1);
-    let pushed = f.update(&Pose2::new(2.5, 1.2, 0.0), 0.01).expect("valid");
+    // Inside the zone the robot is first brought to rest: zero, settling, no optimisation.
+    let at = Pose2::new(2.5, 1.2, 0.0);
+    let held = f.update(&at, 0.01).expect("valid");
+    assert!(held.events.is_empty() && f.is_settling() && (held.v, held.omega) == (0.0, 0.0));
+    // Standing still: REST_INTERVALS intervals later it optimises from there.
+    let mut pushed = held;
+    for k in 1..=REST_INTERVALS {
+        pushed = f.update(&at, 0.01 + f64::from(k) * 0.02).expect("valid");
+        assert_eq!(pushed.events.is_empty(), k < REST_INTERVALS, "tick {k}");
+    }
     assert!(
         pushed.events.iter().any(|e| matches!(
             e,
@@ -771,11 +778,24 @@ fn a_cancelled_optimisation_returns_promptly_and_a_spent_budget_keeps_the_best_s
         21 * INTERRUPT_CHECK_STEPS < steps_full / 10,
         "{steps_full} steps in the full run"
     );
-    // A budget spent after 200 questions: the best so far, fewer virtual robots, a warning.
+    // How many questions the full run asks; a budget spent half-way: the best so far (the
+    // first candidates end early), fewer virtual robots, a warning.
     let asked = AtomicUsize::new(0);
-    let budget = || (asked.fetch_add(1, Ordering::Relaxed) >= 200).then_some(Interrupt::Budget);
+    let count = || {
+        asked.fetch_add(1, Ordering::Relaxed);
+        None
+    };
+    find_sigmas_until(&Pose2::identity(), &controller(), &segment, &config, &count).expect("valid");
+    let half = asked.load(Ordering::Relaxed) / 2;
+    let asked = AtomicUsize::new(0);
+    let budget = || (asked.fetch_add(1, Ordering::Relaxed) >= half).then_some(Interrupt::Budget);
     let r = find_sigmas_until(&Pose2::identity(), &controller(), &segment, &config, &budget).expect("best so far");
     assert!(r.robots.len() < full.robots.len());
+    assert!(
+        r.best.is_some(),
+        "a candidate found before the budget ran out is returned"
+    );
+    assert!(!r.warnings.contains(&OptimiseWarning::NoSafeSigma), "{:?}", r.warnings);
     assert!(
         r.warnings
             .iter()
@@ -784,19 +804,42 @@ fn a_cancelled_optimisation_returns_promptly_and_a_spent_budget_keeps_the_best_s
         r.warnings
     );
     assert!(r.robots.iter().all(|v| v.end != RobotEnd::Interrupted));
-    // Spent before the start: nothing simulated, no safe Σ found.
+    // Spent before the start: nothing simulated, no candidate, and nothing proven unsafe (no
+    // NoSafeSigma).
     let r = find_sigmas_until(&Pose2::identity(), &controller(), &segment, &config, &|| {
         Some(Interrupt::Budget)
     })
     .expect("valid");
     assert_eq!(r.robots.len(), 0);
-    assert_eq!(
-        r.warnings,
-        vec![
-            OptimiseWarning::WallTimeBudget { pending: 1 },
-            OptimiseWarning::NoSafeSigma
-        ]
-    );
+    assert!(r.best.is_none());
+    assert_eq!(r.warnings, vec![OptimiseWarning::WallTimeBudget { pending: 1 }]);
+    // The follower starved by the budget holds zero and retries: not NoSafePath; the third
+    // starved optimisation in a row ends the route as BudgetExhausted.
+    let spent = || Some(Interrupt::Budget);
+    let mut f =
+        VfoFollower::new(VfoGains::default(), config, vec![wp(12.0, 0.0, 0.0)], obstacles.clone()).expect("valid");
+    for k in 0..3 {
+        let out = f
+            .update_until(&Pose2::identity(), f64::from(k) * 0.05, &spent)
+            .expect("valid");
+        assert_eq!((out.v, out.omega), (0.0, 0.0));
+        assert!(matches!(
+            out.events.as_slice(),
+            [VfoEvent::Optimised { score: None, .. }]
+        ));
+        let expected = (k == 2).then_some(VfoEnd::BudgetExhausted { index: 0 });
+        assert_eq!(out.end, expected, "tick {k}");
+    }
+    // Starved twice, then given time: the third optimisation runs in full and the robot drives.
+    let mut f =
+        VfoFollower::new(VfoGains::default(), config, vec![wp(12.0, 0.0, 0.0)], obstacles.clone()).expect("valid");
+    for k in 0..2 {
+        f.update_until(&Pose2::identity(), f64::from(k) * 0.05, &spent)
+            .expect("valid");
+    }
+    let out = f.update(&Pose2::identity(), 0.1).expect("valid");
+    assert!(out.end.is_none() && out.v > 0.0, "{out:?}");
+    assert_eq!(f.last_optimisation().map(|o| o.robots.len()), Some(full.robots.len()));
     // The follower: a cancel leaves the segment due for optimisation at the next tick.
     let mut f =
         VfoFollower::new(VfoGains::default(), config, vec![wp(12.0, 0.0, 0.0)], obstacles.clone()).expect("valid");
@@ -806,4 +849,73 @@ fn a_cancelled_optimisation_returns_promptly_and_a_spent_budget_keeps_the_best_s
     let out = f.update(&Pose2::identity(), 0.01).expect("valid");
     assert!(matches!(out.events.first(), Some(VfoEvent::Optimised { .. })));
     assert_eq!(f.last_optimisation().map(|o| o.robots.len()), Some(full.robots.len()));
+}
+
+#[test]
+fn a_collision_ends_the_route_while_the_follower_holds() {
+    // Waypoint 0 at the start pose is reached on the first tick, inside the zone of the obstacle
+    // at (0, 0.8) (d = 0.8 < R = 1): the follower holds zero until rest. The robot still slides
+    // toward it: at (0, 0.45) it is 0.35 m from the centre, outside r = 0.3, still held; at
+    // (0, 0.55) it is 0.25 m away, inside r: COLLISION, though holding.
+    let mut f = VfoFollower::new(
+        VfoGains::default(),
+        OptimiseConfig::default(),
+        vec![wp(0.0, 0.0, 0.0), wp(3.0, 0.0, 0.0)],
+        vec![ob(0.0, 0.8, 0.3, 1.0)],
+    )
+    .expect("valid");
+    let out = f.update(&Pose2::identity(), 0.0).expect("valid");
+    assert!(matches!(out.events.last(), Some(VfoEvent::Reached { index: 0, .. })));
+    assert!(f.is_settling() && out.end.is_none());
+    let out = f.update(&Pose2::new(0.0, 0.45, 0.0), 0.05).expect("valid");
+    assert!(f.is_settling() && out.end.is_none());
+    let out = f.update(&Pose2::new(0.0, 0.55, 0.0), 0.1).expect("valid");
+    assert_eq!((out.v, out.omega), (0.0, 0.0));
+    assert_eq!(out.end, Some(VfoEnd::Collision { obstacle: 0 }));
+}
+
+#[test]
+fn a_republished_pose_is_no_rest_and_rest_needs_consecutive_still_intervals() {
+    // As the zone test above: at (2.5, 1.2) inside the zone of (2.5, 2) with σ undecided, the
+    // follower holds until rest, timed by the poses' stamps.
+    let mut f = VfoFollower::new(
+        VfoGains::default(),
+        OptimiseConfig::default(),
+        vec![wp(5.0, 0.0, 0.0)],
+        vec![ob(2.5, 2.0, 0.5, 1.0)],
+    )
+    .expect("valid");
+    f.update(&Pose2::identity(), 0.0).expect("valid");
+    let optimised = |o: &VfoOutput| o.events.iter().any(|e| matches!(e, VfoEvent::Optimised { .. }));
+    // Moving at 0.2 m/s along x, odometry stamped every 0.02 s.
+    let moving = |k: u32| Pose2::new(2.5 + 0.004 * f64::from(k), 1.2, 0.0);
+    let out = f.update_stamped(&moving(0), 0.02, 0.02, &|| None).expect("valid");
+    assert!(f.is_settling() && !optimised(&out));
+    // The same sample arrives again and again, later (arrival 0.04 … 0.12 s), stamp unchanged: no
+    // interval, no rest, however long it took to arrive.
+    for k in 0..5 {
+        let out = f
+            .update_stamped(&moving(0), 0.04 + f64::from(k) * 0.02, 0.02, &|| None)
+            .expect("valid");
+        assert!(f.is_settling() && !optimised(&out), "repeat {k}");
+    }
+    // Two still intervals (each under REST_SPEED), then a moving one: the run restarts.
+    let out = f.update_stamped(&moving(0), 0.14, 0.04, &|| None).expect("valid");
+    assert!(!optimised(&out));
+    let out = f.update_stamped(&moving(0), 0.16, 0.06, &|| None).expect("valid");
+    assert!(!optimised(&out));
+    let out = f.update_stamped(&moving(1), 0.18, 0.08, &|| None).expect("valid");
+    assert!(
+        f.is_settling() && !optimised(&out),
+        "0.004 m in 0.02 s is 0.2 m/s: moving"
+    );
+    // Three still intervals in a row: rest, the zone is optimised.
+    for (k, stamp) in [0.10, 0.12].into_iter().enumerate() {
+        let out = f
+            .update_stamped(&moving(1), 0.2 + k as f64 * 0.02, stamp, &|| None)
+            .expect("valid");
+        assert!(!optimised(&out), "still interval {}", k + 1);
+    }
+    let out = f.update_stamped(&moving(1), 0.24, 0.14, &|| None).expect("valid");
+    assert!(optimised(&out) && !f.is_settling());
 }

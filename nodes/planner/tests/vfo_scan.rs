@@ -6,8 +6,8 @@
 use std::f64::consts::{FRAC_PI_2, PI};
 
 use approx::assert_relative_eq;
-use mobil_geom::Pose2;
-use mobil_planner::vfo::{Circle, ObstacleMap, PoseHistory, ScanObstacleConfig};
+use mobil_geom::{Pose2, Scan};
+use mobil_planner::vfo::{Circle, ObstacleMap, Placement, PoseHistory, ScanObstacleConfig};
 use nalgebra::{Point2, Vector2};
 
 /// Ranges of a scan from `odom_from_laser` with `beams` beams over `fov` (centred), seeing
@@ -102,7 +102,7 @@ fn obstacles_from_a_scan_recover_known_circles_and_merge_over_time() {
     // Only NaN and inf: no obstacle.
     let nothing = vec![f32::NAN, f32::INFINITY, f32::NEG_INFINITY, f32::INFINITY];
     let update = map
-        .update_from_ranges(&nothing, 0.0, 0.1, 0.06, 10.0, &laser, 0.0)
+        .update_from_ranges(&nothing, 0.0, 0.1, 0.06, 10.0, &laser, 1.0)
         .expect("valid");
     assert_eq!((update.new.len(), update.seen), (0, 0));
     assert_eq!(map.circles().len(), 3);
@@ -181,6 +181,10 @@ fn the_pose_history_interpolates_and_refuses_a_time_without_odometry_near_it() {
     // After the last pose: the last one while within the bound, none beyond (no extrapolation).
     assert_eq!(h.at(0.14, 0.05), Some(Pose2::new(0.1, 0.02, 0.3)));
     assert!(h.at(0.16, 0.05).is_none());
+    // Between two poses or at one's stamp the pose is interpolated; after the last, held.
+    assert_eq!(h.placed_at(0.025, 0.05).map(|(_, p)| p), Some(Placement::Interpolated));
+    assert_eq!(h.placed_at(0.1, 0.05).map(|(_, p)| p), Some(Placement::Interpolated));
+    assert_eq!(h.placed_at(0.14, 0.05).map(|(_, p)| p), Some(Placement::Held));
     assert!(h.at(-0.06, 0.05).is_none());
     assert!(h.at(f64::NAN, 0.05).is_none());
     // Across ±π the heading goes the short way: from 3.1 to −3.1 is +0.083 rad, so the
@@ -260,11 +264,16 @@ fn a_circle_seen_through_is_removed_and_one_hidden_or_out_of_view_is_kept() {
         .expect("valid");
     assert!(u.seen_through.is_empty(), "{u:?}");
     assert_eq!(map.ids(), vec![0, 1, 2]);
-    // Nothing at all along the beams (both moved away): both are removed, by id; the box behind
-    // the laser is not in view and stays, now at index 0.
+    // Nothing at all along the beams (both moved away): one scan is not enough, the second in a
+    // row removes both, by id; the box behind the laser is not in view and stays, now at index 0.
     let empty = vec![f32::INFINITY; beams];
     let u = map
         .update_from_ranges(&empty, -fov / 2.0, inc, 0.06, 10.0, &laser, 2.0)
+        .expect("valid");
+    assert!(u.seen_through.is_empty(), "{u:?}");
+    assert_eq!(map.ids(), vec![0, 1, 2]);
+    let u = map
+        .update_from_ranges(&empty, -fov / 2.0, inc, 0.06, 10.0, &laser, 2.025)
         .expect("valid");
     assert_eq!(u.seen_through, vec![0, 2]);
     assert!(u.removed_any());
@@ -273,10 +282,134 @@ fn a_circle_seen_through_is_removed_and_one_hidden_or_out_of_view_is_kept() {
     // A circle beyond range_max (here 2.5 m) is not judged: kept.
     let mut map = circle_map(30.0, 200);
     map.merge_at(&[circle(3.0, 0.0, 0.3)], 0.0);
+    for t in [1.0, 1.025] {
+        let u = map
+            .update_from_ranges(&empty, -fov / 2.0, inc, 0.06, 2.5, &laser, t)
+            .expect("valid");
+        assert!(u.seen_through.is_empty());
+    }
+    assert_eq!(map.len(), 1);
+}
+
+#[test]
+fn a_run_of_seen_through_scans_is_broken_by_a_detection() {
+    // The pillar at (3, 0) r 0.3: seen, seen through, seen again, seen through: never two in a
+    // row, kept; the next scan through it completes a run of two and removes it.
+    let fov = 1.5 * PI;
+    let beams = 1081;
+    let inc = fov / (beams - 1) as f64;
+    let laser = Pose2::identity();
+    let seen = synthetic_scan(&laser, beams, fov, &[(Point2::new(3.0, 0.0), 0.3)]);
+    let empty = vec![f32::INFINITY; beams];
+    let mut map = circle_map(30.0, 200);
+    for (k, ranges) in [&seen, &empty, &seen, &empty].into_iter().enumerate() {
+        let u = map
+            .update_from_ranges(ranges, -fov / 2.0, inc, 0.06, 10.0, &laser, k as f64 * 0.025)
+            .expect("valid");
+        assert!(u.seen_through.is_empty(), "scan {k}: {u:?}");
+    }
     let u = map
-        .update_from_ranges(&empty, -fov / 2.0, inc, 0.06, 2.5, &laser, 1.0)
+        .update_from_ranges(&empty, -fov / 2.0, inc, 0.06, 10.0, &laser, 0.1)
         .expect("valid");
-    assert!(u.seen_through.is_empty());
+    assert_eq!(u.seen_through, vec![0]);
+}
+
+#[test]
+fn a_scan_placed_with_a_held_pose_does_not_remove_the_pillar_it_misplaces() {
+    // The robot turns on the spot at 1.5 rad/s; odometry up to 0.06 s (heading 0.09 rad). A
+    // pillar at (3.5, 0), r 0.1, is known from a scan at 0.06 s. A scan stamped 0.1 s (true
+    // heading 0.15 rad) is placed with the held pose at 0.06 s: 0.06 rad off, so the pillar
+    // lands 3.5 · 0.06 = 0.21 m aside — beyond the 0.2 m association distance, and
+    // 0.1 + 0.1 − 0.21 < 0 overlap: a new circle — and the beams at the known circle's bearing
+    // (0.06 rad from the pillar, which spans ±0.1 / 3.5 = ±0.029 rad) see nothing.
+    let pillar = (Point2::new(3.5, 0.0), 0.1);
+    let mut h = PoseHistory::new(50);
+    for k in 0..4 {
+        let t = f64::from(k) * 0.02;
+        h.push(t, Pose2::new(0.0, 0.0, 1.5 * t));
+    }
+    let fov = 1.5 * PI;
+    let beams = 1081;
+    let inc = fov / (beams - 1) as f64;
+    let scan_at = |yaw: f64| {
+        let ranges = synthetic_scan(&Pose2::new(0.0, 0.0, yaw), beams, fov, &[pillar]);
+        Scan::new(
+            -fov / 2.0,
+            fov / 2.0,
+            inc,
+            0.06,
+            10.0,
+            ranges,
+            Vec::new(),
+            Pose2::identity(),
+        )
+        .expect("valid")
+    };
+    let mut map = ObstacleMap::new(ScanObstacleConfig::default()).expect("valid");
+    let (first, how) = h.placed_at(0.06, 0.1).expect("odometry at the stamp");
+    assert_eq!(how, Placement::Interpolated);
+    map.update_placed(&scan_at(0.09), &first, how, 0.06).expect("valid");
+    assert_eq!(map.ids(), vec![0]);
+    assert!((map.circles()[0].centre - pillar.0).norm() < 1e-3);
+    let (held, how) = h.placed_at(0.1, 0.1).expect("within max_gap of the newest odometry");
+    assert_eq!(how, Placement::Held);
+    assert_relative_eq!(held.yaw, 0.09, epsilon = 1e-12);
+    // Twice (a second scan at the same true heading, as if the odometry stalled).
+    for t in [0.1, 0.125] {
+        let u = map.update_placed(&scan_at(0.15), &held, how, t).expect("valid");
+        assert!(u.seen_through.is_empty(), "{u:?}");
+    }
+    // The misplaced pillar was added; the true one is kept.
+    assert_eq!(map.ids(), vec![0, 1]);
+    let off = (map.circles()[1].centre - pillar.0).norm();
+    assert!((off - 0.21).abs() < 0.02, "{off}");
+    assert!((map.circles()[0].centre - pillar.0).norm() < 1e-3);
+}
+
+#[test]
+fn a_full_turn_scanner_judges_an_obstacle_at_a_negative_bearing() {
+    // Beams from 0 every 0.5° over the full turn; a circle at bearing −0.5 rad, 3 m away: beam
+    // (2π − 0.5) / 0.5° ≈ 658 looks at it. Two empty scans remove it.
+    let beams = 720;
+    let inc = 2.0 * PI / beams as f64;
+    let empty = vec![f32::INFINITY; beams];
+    let mut map = circle_map(30.0, 200);
+    map.merge_at(&[circle(3.0 * (-0.5f64).cos(), 3.0 * (-0.5f64).sin(), 0.3)], 0.0);
+    let laser = Pose2::identity();
+    map.update_from_ranges(&empty, 0.0, inc, 0.06, 10.0, &laser, 0.5)
+        .expect("valid");
+    let u = map
+        .update_from_ranges(&empty, 0.0, inc, 0.06, 10.0, &laser, 0.525)
+        .expect("valid");
+    assert_eq!(u.seen_through, vec![0]);
+}
+
+#[test]
+fn a_scan_older_than_the_map_empties_it() {
+    // Circles seen at 100 s; the clock restarts and a scan stamped 1 s arrives (looking away
+    // from both, so nothing is seen through): the map is emptied and says which ids went; a
+    // circle then seen at 1 s decays 30 s later, on the new clock.
+    let mut map = circle_map(30.0, 200);
+    map.merge_at(&[circle(3.0, 0.0, 0.3), circle(0.0, 3.0, 0.3)], 100.0);
+    let away = Pose2::new(0.0, 0.0, -FRAC_PI_2);
+    let ranges = vec![f32::INFINITY; 21];
+    let u = map
+        .update_from_ranges(&ranges, -0.1, 0.01, 0.06, 10.0, &away, 99.0)
+        .expect("valid");
+    assert_eq!(u.cleared, vec![0, 1]);
+    assert!(u.removed_any());
+    assert!(map.is_empty());
+    map.merge_at(&[circle(3.0, 0.0, 0.3)], 99.5);
+    let u = map
+        .update_from_ranges(&ranges, -0.1, 0.01, 0.06, 10.0, &away, 129.6)
+        .expect("valid");
+    assert_eq!(u.decayed, vec![2]);
+    // A scan at the same time as the last detection is no reset.
+    map.merge_at(&[circle(3.0, 0.0, 0.3)], 130.0);
+    let u = map
+        .update_from_ranges(&ranges, -0.1, 0.01, 0.06, 10.0, &away, 130.0)
+        .expect("valid");
+    assert!(u.cleared.is_empty());
     assert_eq!(map.len(), 1);
 }
 

@@ -710,6 +710,17 @@ pub enum Outcome {
         /// The waypoints not reached (request indices).
         unreached: Vec<usize>,
     },
+    /// VFO: the optimisation's wall-clock budget (`vfo.optimise_budget_s`) ran out before any
+    /// candidate path to waypoint `index`, `tries` times in a row: no path was proven unsafe,
+    /// none was found in time.
+    OptimisationBudget {
+        /// The waypoint (request index).
+        index: usize,
+        /// Optimisations in a row that ran out.
+        tries: u32,
+        /// The waypoints not reached (request indices).
+        unreached: Vec<usize>,
+    },
     /// VFO: the robot is inside the forbidden zone (d ≤ r) of an obstacle seen on the way.
     Collision {
         /// The obstacle's centre (odom).
@@ -746,6 +757,7 @@ impl Outcome {
             Outcome::UndockTimeout { .. } => "TIME_LIMIT",
             Outcome::Stale | Outcome::ScanStale => "STALE_INPUT",
             Outcome::NoSafePath { .. } => "NO_SAFE_PATH",
+            Outcome::OptimisationBudget { .. } => "OPTIMISATION_BUDGET",
             Outcome::Collision { .. } => "COLLISION",
             Outcome::Canceled => "CANCELED",
             Outcome::Preempted(_) => "PREEMPTED",
@@ -808,6 +820,9 @@ impl Outcome {
             } => format!(
                 "no left/right decisions round the obstacles take the robot to waypoint {index} without a \
                  collision ({virtual_robots} virtual robots simulated): robot stopped"
+            ),
+            Outcome::OptimisationBudget { index, tries, .. } => format!(
+                "optimisation budget exhausted: {tries} optimisations in a row ran out of vfo.optimise_budget_s                  before finding any path to waypoint {index} (none was proven unsafe; the scene needs a larger                  budget or a faster machine): robot stopped"
             ),
             Outcome::Collision {
                 centre,
@@ -901,13 +916,16 @@ impl Outcome {
             | Outcome::ScanStale
             | Outcome::Refused(_)
             | Outcome::NoSafePath { .. }
+            | Outcome::OptimisationBudget { .. }
             | Outcome::Collision { .. } => FollowWaypointsResult::TASK_EXECUTOR_FAILED,
             _ => FollowWaypointsResult::UNKNOWN,
         };
         // A VFO route that ended early: the waypoints it did not reach, as FollowPath's
         // FAILED_TO_MAKE_PROGRESS (the run gave them up).
         let unreached: &[usize] = match self {
-            Outcome::NoSafePath { unreached, .. } | Outcome::Collision { unreached, .. } => unreached,
+            Outcome::NoSafePath { unreached, .. }
+            | Outcome::OptimisationBudget { unreached, .. }
+            | Outcome::Collision { unreached, .. } => unreached,
             _ => &[],
         };
         FollowWaypointsResult {
@@ -935,7 +953,10 @@ impl Outcome {
     /// (request indices, from the one pursued on), as given up by the run.
     pub fn vfo_follow_result(&self, poses: &[PoseStamped], unreached: &[usize]) -> FollowWaypointsResult {
         let mut r = self.follow_result(poses, &[]);
-        let own = matches!(self, Outcome::NoSafePath { .. } | Outcome::Collision { .. });
+        let own = matches!(
+            self,
+            Outcome::NoSafePath { .. } | Outcome::OptimisationBudget { .. } | Outcome::Collision { .. }
+        );
         if !self.succeeded() && !own {
             r.missed_waypoints = unreached
                 .iter()

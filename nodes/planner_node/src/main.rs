@@ -36,7 +36,8 @@ use mobil_msgs::sensor_msgs::msg::LaserScan;
 use mobil_msgs::tf2_msgs::msg::TFMessage;
 use mobil_msgs::visualization_msgs::msg::MarkerArray;
 use mobil_planner::vfo::{
-    Interrupt, ObstacleMap, OptimiseWarning, PoseHistory, VfoEnd, VfoEvent, VfoFollower, VfoOutput,
+    Interrupt, ObstacleMap, OptimiseWarning, PoseHistory, VfoEnd, VfoEvent, VfoFollower, VfoOutput, MAX_BUDGET_RETRIES,
+    MAX_SETTLE_S,
 };
 use mobil_planner::{
     check_route_until, polar_error, DockingController, DockingOutput, DockingPhase, Finish, FollowEnd, FollowEvent,
@@ -276,6 +277,8 @@ struct Shell {
     /// The odometry poses of the last seconds by stamp: a scan is placed with the pose at its
     /// own stamp.
     odom_history: PoseHistory,
+    /// The stamp (s) of the last odometry sample taken, the VFO rest test's clock.
+    odom_stamp: f64,
     /// When the last valid scan arrived.
     scan_seen: Latest<()>,
     /// The odometry's measured period (steady clock): a VFO tick's command later than two of
@@ -366,6 +369,7 @@ async fn start(node: &mut RosNode, out: &Outputs, config: PlannerConfig) -> anyh
         map,
         map_rebuild: false,
         odom_history: PoseHistory::new(ODOM_HISTORY),
+        odom_stamp: f64::NAN,
         scan_seen: Latest::new(),
         odom_period: ArrivalPeriod::default(),
         laser: StaticFrames::default(),
@@ -1335,8 +1339,9 @@ impl Shell {
         match odom_pose(m, &self.config.odom_frame, &self.config.base_frame) {
             Ok(pose) => {
                 self.odom_refused = false;
-                if let Some(t) = secs_from_stamp(&m.header.stamp) {
-                    self.odom_history.push(t, pose);
+                self.odom_stamp = secs_from_stamp(&m.header.stamp).unwrap_or(f64::NAN);
+                if self.odom_stamp.is_finite() {
+                    self.odom_history.push(self.odom_stamp, pose);
                 }
                 self.odom_period.arrived(Instant::now());
                 self.odom.set(pose, m.header.stamp.clone());
@@ -1524,15 +1529,9 @@ impl Shell {
             return self.zero(out);
         };
         if let Some(new) = obstacles_changed.take() {
-            let now_ids = self.map.ids();
-            let previous: Vec<Option<usize>> = now_ids
-                .iter()
-                .map(|id| ids.iter().position(|held| held == id))
-                .collect();
-            follower.set_obstacles_mapped(self.map.obstacles(), &previous, new);
-            *ids = now_ids;
+            follower.follow_map(&self.map, ids, new);
         }
-        let (seq, guide, stop) = (*seq, pose.ahead(-*offset), stop.clone());
+        let (seq, guide, stop, stamp) = (*seq, pose.ahead(-*offset), stop.clone(), self.odom_stamp);
         let budget = config.vfo.optimise_budget();
         jobs.vfo.start(move |cancel| {
             let started = Instant::now();
@@ -1545,7 +1544,7 @@ impl Shell {
                     None
                 }
             };
-            let output = follower.update_until(&guide, t, &interrupt);
+            let output = follower.update_stamped(&guide, t, stamp, &interrupt);
             let optimised = output
                 .as_ref()
                 .is_ok_and(|o| o.events.iter().any(|e| matches!(e, VfoEvent::Optimised { .. })))
@@ -1637,6 +1636,15 @@ impl Shell {
                 }
             }
         }
+        if o.end.is_none() && slot.follower().is_some_and(|f| f.is_settling()) {
+            warn_throttled!(
+                self.throttle,
+                "vfo-settle",
+                "robot held at zero inside an influence zone until it stands (at most {MAX_SETTLE_S} s), then the \
+                 segment to waypoint {} is optimised from there",
+                request(o.index)
+            );
+        }
         *index = o.index;
         *distance = o.distance;
         let unreached = |from: usize| route.unreached_from(from);
@@ -1649,6 +1657,11 @@ impl Shell {
             Some(VfoEnd::NoSafePath { index }) => Some(Outcome::NoSafePath {
                 index: request(index),
                 virtual_robots: report.virtual_robots,
+                unreached: unreached(index),
+            }),
+            Some(VfoEnd::BudgetExhausted { index }) => Some(Outcome::OptimisationBudget {
+                index: request(index),
+                tries: MAX_BUDGET_RETRIES,
                 unreached: unreached(index),
             }),
             Some(VfoEnd::Collision { obstacle }) => {
@@ -1726,8 +1739,10 @@ impl Shell {
                 "scan stamp invalid (nanosec ≥ 1e9); scan ignored"
             );
         };
-        let placed = self.fresh_odom().and_then(|_| self.odom_history.at(stamp, max_gap));
-        let Some(odom_from_base) = placed else {
+        let placed = self
+            .fresh_odom()
+            .and_then(|_| self.odom_history.placed_at(stamp, max_gap));
+        let Some((odom_from_base, placement)) = placed else {
             return warn_throttled!(
                 self.throttle,
                 "scan-odom",
@@ -1735,10 +1750,18 @@ impl Shell {
                  placed by the pose at the scan's time)"
             );
         };
-        let update = match self.map.update(&scan, &odom_from_base, stamp) {
+        let update = match self.map.update_placed(&scan, &odom_from_base, placement, stamp) {
             Ok(u) => u,
             Err(e) => return warn_throttled!(self.throttle, "scan-bad", "scan refused: {e}; scan ignored"),
         };
+        if !update.cleared.is_empty() {
+            warn_throttled!(
+                self.throttle,
+                "map-reset",
+                "scan at {stamp:.3} s is older than obstacles already seen (clock reset?): the {} obstacles forgotten",
+                update.cleared.len()
+            );
+        }
         if !update.capped.is_empty() {
             warn_throttled!(
                 self.throttle,

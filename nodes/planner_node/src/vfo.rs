@@ -982,6 +982,24 @@ mod tests {
             .error_msg
             .starts_with("COLLISION: the robot is 0.55 m from the centre of the obstacle at (2.00, -1.00)"));
         assert_eq!(Outcome::ScanStale.code(), "STALE_INPUT");
+        // A starved optimisation is its own failure, never NO_SAFE_PATH.
+        let outcome = Outcome::OptimisationBudget {
+            index: 1,
+            tries: 3,
+            unreached: vec![1, 2, 3],
+        };
+        assert_eq!(outcome.state(), NavStatus::FAILED);
+        let r = outcome.vfo_follow_result(&poses, &[0, 1, 2, 3]);
+        assert_eq!(r.error_code, FollowWaypointsResult::TASK_EXECUTOR_FAILED);
+        let listed: Vec<u32> = r.missed_waypoints.iter().map(|m| m.index).collect();
+        assert_eq!(listed, vec![1, 2, 3]);
+        assert!(
+            r.error_msg
+                .starts_with("OPTIMISATION_BUDGET: optimisation budget exhausted: 3 optimisations in a row"),
+            "{}",
+            r.error_msg
+        );
+        assert!(r.error_msg.contains("waypoint 1") && !r.error_msg.contains("NO_SAFE_PATH"));
     }
 
     #[test]

@@ -8,7 +8,9 @@
 use mobil_chassis::ChassisParams;
 use mobil_geom::Pose2;
 use mobil_msgs::geometry_msgs::msg::PoseStamped;
-use mobil_planner::vfo::{integrate_unicycle, ObstacleMap, OptimiseConfig, VfoEnd, VfoEvent, VfoFollower, VfoGains};
+use mobil_planner::vfo::{
+    integrate_unicycle, ObstacleMap, OptimiseConfig, PoseHistory, VfoEnd, VfoEvent, VfoFollower, VfoGains,
+};
 use mobil_planner_node::route_from_poses;
 use mobil_planner_node::vfo::{vfo_gains, vfo_waypoints, VfoSettings};
 use mobil_sim::lidar::{Lidar, LidarConfig};
@@ -31,7 +33,8 @@ struct Run {
 }
 
 /// Drives `route` from `start`; the first scan at step `scan_phase` (0 or 1), then every other
-/// step, taken `lag` steps before the pose it is placed with; after each optimisation the
+/// step, taken `lag` steps before it is processed and placed, as the node does, with the pose
+/// the odometry history gives at its stamp; the follower takes the map by ids, as the node; after each optimisation the
 /// command is zero for `hold` steps (the node stops while one runs); the robot answers the
 /// commands through a first-order lag of time constant `tau` (s; 0: at once).
 fn drive(route: &[(f64, f64)], start: Pose2, scan_phase: usize, hold: usize, lag: usize, tau: f64) -> Run {
@@ -78,24 +81,33 @@ fn drive(route: &[(f64, f64)], start: Pose2, scan_phase: usize, hold: usize, lag
     let mut pose = start;
     let mut held = 0;
     let mut past = vec![start];
+    let mut history = PoseHistory::new(50);
+    let mut ids = Vec::new();
     let (mut v, mut w) = (0.0, 0.0);
     for k in 0..(120.0 / DT) as usize {
         past.push(pose);
+        history.push(k as f64 * DT, pose);
         if k % 2 == scan_phase {
-            let seen = past[past.len().saturating_sub(1 + lag)];
+            let taken = k.saturating_sub(lag);
+            let seen = past[taken + 1];
             let s = lidar.scan(&world, (seen.x, seen.y, seen.yaw));
-            let update = map
-                .update_from_ranges(
-                    &s.ranges,
-                    s.angle_min,
-                    s.angle_increment,
-                    s.range_min,
-                    s.range_max,
-                    &pose,
-                    k as f64 * DT,
-                )
-                .expect("valid scan");
-            follower.set_obstacles(map.obstacles(), !update.new.is_empty());
+            let stamp = taken as f64 * DT;
+            let (placed, how) = history
+                .placed_at(stamp, settings.scan_odom_max_gap_s)
+                .expect("odometry at the scan's stamp");
+            let scan = mobil_geom::Scan::new(
+                s.angle_min,
+                s.angle_min + (s.ranges.len() - 1) as f64 * s.angle_increment,
+                s.angle_increment,
+                s.range_min,
+                s.range_max,
+                s.ranges.clone(),
+                Vec::new(),
+                Pose2::identity(),
+            )
+            .expect("valid scan");
+            let update = map.update_placed(&scan, &placed, how, stamp).expect("valid scan");
+            follower.follow_map(&map, &mut ids, !update.new.is_empty());
         }
         let o = follower.update(&pose, k as f64 * DT).expect("valid pose");
         for e in &o.events {
@@ -189,6 +201,7 @@ fn an_obstacle_appearing_mid_segment_re_optimises_the_segment_round_it() {
     };
     let mut follower = VfoFollower::new(gains, config, waypoints, Vec::new()).expect("valid");
     let mut map = ObstacleMap::new(settings.scan_config(ROBOT_RADIUS)).expect("valid");
+    let mut ids = Vec::new();
     let mut lidar = Lidar::new(
         LidarConfig {
             range_max: settings.scan_range,
@@ -224,7 +237,7 @@ fn an_obstacle_appearing_mid_segment_re_optimises_the_segment_round_it() {
                     t,
                 )
                 .expect("valid scan");
-            follower.set_obstacles(map.obstacles(), !update.new.is_empty());
+            follower.follow_map(&map, &mut ids, !update.new.is_empty());
         }
         let o = follower.update(&pose, t).expect("valid pose");
         for e in &o.events {

@@ -19,13 +19,21 @@
 //! paths: the next re-optimisation starts a few centimetres from r, where every Σ collides (no
 //! safe Σ), or the robot collides on the old Σ. So when a segment starts with the robot inside
 //! a zone, the follower commands zero until the robot is at rest (it moved less than
-//! [`REST_SPEED`]·Δt and turned less than [`REST_TURN_RATE`]·Δt between two ticks, or
-//! [`MAX_SETTLE_S`] passed), and only then optimises the segment, from the pose where the robot
+//! [`REST_SPEED`]·Δt and turned less than [`REST_TURN_RATE`]·Δt over each of
+//! [`REST_INTERVALS`] consecutive intervals between poses, Δt timed by the poses' own stamps
+//! — a pose republished with its old stamp is no interval, and one timed by its arrival would
+//! read still — or [`MAX_SETTLE_S`] passed), and only then optimises the segment, from the pose where the robot
 //! stands: a state the real robot is really in, from which it can start as the virtual robots
-//! do.
+//! do. The same holds for a re-optimisation inside a zone (a new obstacle, an undecided zone
+//! entered): the robot is brought to rest first. [`VfoFollower::is_settling`] tells the caller
+//! why the robot stands.
 //!
-//! Safety: on a collision (d ≤ r), or when no safe Σ exists for the segment, the command is
-//! zero and the route ends ([`VfoEnd`]); the caller reports it. Bad input (a non-finite pose,
+//! Safety: on a collision (d ≤ r, checked on every tick, holding or not), or when no safe Σ
+//! exists for the segment, the command is zero and the route ends ([`VfoEnd`]); the caller
+//! reports it. An optimisation whose wall-clock budget ran out before any candidate proved
+//! nothing unsafe: the follower holds zero and retries on the next ticks, and only after
+//! [`MAX_BUDGET_RETRIES`] such optimisations in a row ends the route with
+//! [`VfoEnd::BudgetExhausted`]. Bad input (a non-finite pose,
 //! time going backwards) is refused with a [`PlannerError`] and changes nothing; the caller
 //! commands zero.
 
@@ -34,15 +42,23 @@ use mobil_geom::Pose2;
 use super::controller::{ControlStep, StepOutcome, VfoController, VfoGains, VfoWaypoint};
 use super::obstacles::{Obstacle, Sigma};
 use super::optimise::{find_sigmas_until, Interrupt, Optimisation, OptimiseConfig, OptimiseWarning, Segment};
+use super::scan::ObstacleMap;
 use crate::error::PlannerError;
 
 /// Below this speed (m/s) between two ticks the robot is at rest (module docs).
 pub const REST_SPEED: f64 = 0.01;
 /// Below this turn rate (rad/s) between two ticks the robot is at rest (module docs).
 pub const REST_TURN_RATE: f64 = 0.05;
+/// Consecutive still intervals between poses that make rest (module docs): one still interval
+/// may be a repeated sample; three (60 ms of 50 Hz odometry) are not.
+pub const REST_INTERVALS: u32 = 3;
 /// The longest wait for the robot to come to rest before a segment started inside a zone is
 /// optimised anyway (s): a robot that never reads still (odometry noise) must not wait forever.
 pub const MAX_SETTLE_S: f64 = 2.0;
+/// Optimisations in a row whose budget ran out before any candidate, after which the route
+/// ends ([`VfoEnd::BudgetExhausted`]): three ticks of held zero (0.15 s at 20 Hz) ride out a
+/// passing load on the machine, more means the budget is too small for the scene.
+pub const MAX_BUDGET_RETRIES: u32 = 3;
 
 /// Something that happened during a tick.
 #[derive(Debug, Clone, PartialEq)]
@@ -94,6 +110,13 @@ pub enum VfoEnd {
         /// The waypoint index.
         index: usize,
     },
+    /// The wall-clock budget ran out before any candidate for segment `index`, on
+    /// [`MAX_BUDGET_RETRIES`] optimisations in a row: nothing was proven unsafe, but no Σ
+    /// was found in time.
+    BudgetExhausted {
+        /// The waypoint index.
+        index: usize,
+    },
 }
 
 /// One tick's result.
@@ -130,12 +153,17 @@ pub struct VfoFollower {
     end: Option<VfoEnd>,
     /// Waiting for rest before optimising: since when, and the last tick's pose and time.
     settling: Option<Settling>,
+    /// Optimisations in a row whose budget ran out before any candidate.
+    budget_misses: u32,
 }
 
 #[derive(Debug, Clone, Copy)]
 struct Settling {
     since: f64,
+    /// The last pose and its stamp.
     last: Option<(Pose2, f64)>,
+    /// Still intervals in a row.
+    still: u32,
 }
 
 impl VfoFollower {
@@ -175,6 +203,7 @@ impl VfoFollower {
             last_t: None,
             end: None,
             settling: None,
+            budget_misses: 0,
         })
     }
 
@@ -222,8 +251,9 @@ impl VfoFollower {
         self.optimise.get_or_insert(Reoptimised::NewObstacle);
     }
 
-    /// Replaces the obstacles (an updated map: the same indices for the same obstacles, new
-    /// ones appended). With `new_obstacles` the segment is re-optimised at the next tick;
+    /// Replaces the obstacles by a list that only grew: the same indices for the same
+    /// obstacles, new ones appended (an [`ObstacleMap`] removes and re-indexes: follow one with
+    /// [`Self::follow_map`]). With `new_obstacles` the segment is re-optimised at the next tick;
     /// without, Σ is kept (new entries undecided).
     pub fn set_obstacles(&mut self, obstacles: Vec<Obstacle>, new_obstacles: bool) {
         self.sigmas.resize(obstacles.len(), Sigma::Undecided);
@@ -255,15 +285,29 @@ impl VfoFollower {
         }
     }
 
+    /// Takes the obstacles of `map`, carrying each decision over by the obstacle's id:
+    /// `held_ids` are the ids of the obstacles the follower holds (by index), updated here.
+    /// With `new_obstacles` the segment is re-optimised at the next tick
+    /// ([`Self::set_obstacles_mapped`]).
+    pub fn follow_map(&mut self, map: &ObstacleMap, held_ids: &mut Vec<u64>, new_obstacles: bool) {
+        let now = map.ids();
+        let previous: Vec<Option<usize>> = now
+            .iter()
+            .map(|id| held_ids.iter().position(|held| held == id))
+            .collect();
+        self.set_obstacles_mapped(map.obstacles(), &previous, new_obstacles);
+        *held_ids = now;
+    }
+
     fn optimise(
         &mut self,
         pose: &Pose2,
         reason: Reoptimised,
         events: &mut Vec<VfoEvent>,
         interrupt: &(dyn Fn() -> Option<Interrupt> + Sync),
-    ) -> Result<(), PlannerError> {
+    ) -> Result<bool, PlannerError> {
         let Some(waypoint) = self.waypoints.get(self.index).copied() else {
-            return Ok(());
+            return Ok(true);
         };
         let segment = Segment {
             waypoint,
@@ -271,18 +315,63 @@ impl VfoFollower {
             obstacles: &self.obstacles,
         };
         let result = find_sigmas_until(pose, &self.controller, &segment, &self.config, interrupt)?;
-        self.sigmas = result.sigmas.clone();
         events.push(VfoEvent::Optimised {
             index: self.index,
             reason,
             score: result.score(),
             warnings: result.warnings.clone(),
         });
-        if result.best.is_none() {
-            self.end = Some(VfoEnd::NoSafePath { index: self.index });
+        let starved = result.best.is_none()
+            && result
+                .warnings
+                .iter()
+                .any(|w| matches!(w, OptimiseWarning::WallTimeBudget { .. }));
+        if starved {
+            // Nothing proven unsafe: keep the old Σ, hold, retry (module docs).
+            self.budget_misses += 1;
+            if self.budget_misses >= MAX_BUDGET_RETRIES {
+                self.end = Some(VfoEnd::BudgetExhausted { index: self.index });
+            }
+        } else {
+            self.budget_misses = 0;
+            self.sigmas = result.sigmas.clone();
+            if result.best.is_none() {
+                self.end = Some(VfoEnd::NoSafePath { index: self.index });
+            }
         }
         self.last = Some(result);
-        Ok(())
+        Ok(!starved)
+    }
+
+    /// Whether `pose` lies inside some obstacle's influence zone.
+    fn in_zone(&self, pose: &Pose2) -> bool {
+        let position = pose.position();
+        self.obstacles
+            .iter()
+            .any(|o| o.distance(&position) <= o.influence_radius())
+    }
+
+    /// The obstacle whose forbidden zone (d ≤ r) holds `pose`, if any.
+    fn collision(&self, pose: &Pose2) -> Option<usize> {
+        let position = pose.position();
+        self.obstacles
+            .iter()
+            .position(|o| o.distance(&position) <= o.forbidden_radius())
+    }
+
+    fn hold(&self, pose: &Pose2, events: Vec<VfoEvent>) -> VfoOutput {
+        VfoOutput {
+            omega: 0.0,
+            v: 0.0,
+            index: self.index,
+            distance: self
+                .waypoints
+                .get(self.index)
+                .map_or(0.0, |w| (w.position - pose.position()).norm()),
+            step: None,
+            events,
+            end: None,
+        }
     }
 
     /// One control tick at `pose` (θ, x, y of the robot's guide point) at time `t` (s,
@@ -302,6 +391,19 @@ impl VfoFollower {
         t: f64,
         interrupt: &(dyn Fn() -> Option<Interrupt> + Sync),
     ) -> Result<VfoOutput, PlannerError> {
+        self.update_stamped(pose, t, t, interrupt)
+    }
+
+    /// [`VfoFollower::update_until`] with `pose_stamp` (s), the time the pose was measured
+    /// (the odometry's stamp, on its own clock): the rest test times the pose changes by it
+    /// (module docs). A non-finite stamp is no interval.
+    pub fn update_stamped(
+        &mut self,
+        pose: &Pose2,
+        t: f64,
+        pose_stamp: f64,
+        interrupt: &(dyn Fn() -> Option<Interrupt> + Sync),
+    ) -> Result<VfoOutput, PlannerError> {
         crate::docking::check_pose("pose", pose)?;
         if !t.is_finite() || self.last_t.is_some_and(|last| t < last) {
             return Err(PlannerError::InvalidConfig {
@@ -312,6 +414,13 @@ impl VfoFollower {
         }
         self.last_t = Some(t);
         let mut events = Vec::new();
+        // Whether the robot came to rest in this tick (it then optimises without a new wait).
+        let mut settled = false;
+        if self.end.is_none()
+            && let Some(obstacle) = self.collision(pose)
+        {
+            self.end = Some(VfoEnd::Collision { obstacle });
+        }
         loop {
             if self.end.is_some() {
                 return Ok(self.stopped(events));
@@ -321,31 +430,55 @@ impl VfoFollower {
                 continue;
             };
             if let Some(settling) = self.settling.as_mut() {
-                let rest = settling.last.is_some_and(|(p, t0)| {
-                    let dt = t - t0;
-                    dt > 0.0
-                        && (p.position() - pose.position()).norm() < REST_SPEED * dt
-                        && mobil_geom::wrap(pose.yaw - p.yaw).abs() < REST_TURN_RATE * dt
-                });
-                if rest || t - settling.since >= MAX_SETTLE_S {
+                match settling.last {
+                    // The same sample again (or no usable stamp): no interval.
+                    Some((_, s0)) if !(pose_stamp.is_finite() && pose_stamp != s0) => {}
+                    Some((p, s0)) => {
+                        let dt = pose_stamp - s0;
+                        let still = dt > 0.0
+                            && (p.position() - pose.position()).norm() < REST_SPEED * dt
+                            && mobil_geom::wrap(pose.yaw - p.yaw).abs() < REST_TURN_RATE * dt;
+                        settling.still = if still { settling.still + 1 } else { 0 };
+                        settling.last = Some((*pose, pose_stamp));
+                    }
+                    None => {
+                        if pose_stamp.is_finite() {
+                            settling.last = Some((*pose, pose_stamp));
+                        }
+                    }
+                }
+                if settling.still >= REST_INTERVALS || t - settling.since >= MAX_SETTLE_S {
                     self.settling = None;
+                    settled = true;
                 } else {
-                    settling.last = Some((*pose, t));
-                    return Ok(VfoOutput {
-                        omega: 0.0,
-                        v: 0.0,
-                        index: self.index,
-                        distance: (waypoint.position - pose.position()).norm(),
-                        step: None,
-                        events,
-                        end: None,
+                    return Ok(self.hold(pose, events));
+                }
+            }
+            if let Some(reason) = self.optimise {
+                // A re-optimisation inside a zone starts from rest too (module docs).
+                if reason != Reoptimised::SegmentStart && !settled && self.in_zone(pose) {
+                    self.settling = Some(Settling {
+                        since: t,
+                        last: Some((*pose, pose_stamp)).filter(|_| pose_stamp.is_finite()),
+                        still: 0,
                     });
+                    return Ok(self.hold(pose, events));
                 }
             }
             if let Some(reason) = self.optimise.take() {
-                if let Err(e) = self.optimise(pose, reason, &mut events, interrupt) {
-                    self.optimise = Some(reason);
-                    return Err(e);
+                match self.optimise(pose, reason, &mut events, interrupt) {
+                    Ok(true) => {}
+                    Ok(false) => {
+                        // Starved by the budget: due again on the next tick, zero meanwhile.
+                        if self.end.is_none() {
+                            self.optimise = Some(reason);
+                            return Ok(self.hold(pose, events));
+                        }
+                    }
+                    Err(e) => {
+                        self.optimise = Some(reason);
+                        return Err(e);
+                    }
                 }
                 continue;
             }
@@ -385,13 +518,12 @@ impl VfoFollower {
                     self.controller.start_segment();
                     if self.index < self.waypoints.len() {
                         self.optimise = Some(Reoptimised::SegmentStart);
-                        let position = pose.position();
-                        if self
-                            .obstacles
-                            .iter()
-                            .any(|o| o.distance(&position) <= o.influence_radius())
-                        {
-                            self.settling = Some(Settling { since: t, last: None });
+                        if self.in_zone(pose) {
+                            self.settling = Some(Settling {
+                                since: t,
+                                last: Some((*pose, pose_stamp)).filter(|_| pose_stamp.is_finite()),
+                                still: 0,
+                            });
                         }
                     }
                 }

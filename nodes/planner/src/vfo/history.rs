@@ -8,10 +8,25 @@
 //!   the shorter way round) between the two poses around it when they lie at most `2·max_gap`
 //!   apart, else the nearest pose when it lies within `max_gap`; otherwise none (the caller
 //!   refuses the scan). It never extrapolates beyond `max_gap`.
+//! - [`PoseHistory::placed_at`] says which of the two it was ([`Placement`]): only a pose
+//!   between two odometry poses (or at one's own stamp) is exact enough to judge what a scan
+//!   sees through; a held pose (the scan's stamp beyond the newest odometry, up to `max_gap`)
+//!   may be a turn's worth off.
 
 use std::collections::VecDeque;
 
 use mobil_geom::{wrap, Pose2};
+
+/// How a pose was found for a time.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Placement {
+    /// Interpolated between the two odometry poses around the time, or an odometry pose at
+    /// exactly that time.
+    Interpolated,
+    /// The nearest odometry pose, held (up to `max_gap` away in time): the robot may have
+    /// moved since.
+    Held,
+}
 
 /// Poses by time, oldest first (module docs).
 #[derive(Debug, Clone, PartialEq)]
@@ -65,6 +80,11 @@ impl PoseHistory {
 
     /// The pose at time `t` (module docs), or `None` when no pose lies within `max_gap` (s).
     pub fn at(&self, t: f64, max_gap: f64) -> Option<Pose2> {
+        self.placed_at(t, max_gap).map(|(p, _)| p)
+    }
+
+    /// The pose at time `t` as [`Self::at`] gives it, and how it was found.
+    pub fn placed_at(&self, t: f64, max_gap: f64) -> Option<(Pose2, Placement)> {
         if !t.is_finite() {
             return None;
         }
@@ -75,11 +95,12 @@ impl PoseHistory {
             && t1 - t0 <= 2.0 * max_gap
         {
             let f = if t1 > t0 { (t - t0) / (t1 - t0) } else { 0.0 };
-            return Some(Pose2::new(
+            let pose = Pose2::new(
                 p0.x + f * (p1.x - p0.x),
                 p0.y + f * (p1.y - p0.y),
                 p0.yaw + f * wrap(p1.yaw - p0.yaw),
-            ));
+            );
+            return Some((pose, Placement::Interpolated));
         }
         [before, next]
             .into_iter()
@@ -87,6 +108,13 @@ impl PoseHistory {
             .map(|&(s, p)| ((s - t).abs(), p))
             .filter(|&(gap, _)| gap <= max_gap)
             .min_by(|a, b| a.0.total_cmp(&b.0))
-            .map(|(_, p)| p)
+            .map(|(gap, p)| {
+                let placement = if gap == 0.0 {
+                    Placement::Interpolated
+                } else {
+                    Placement::Held
+                };
+                (p, placement)
+            })
     }
 }

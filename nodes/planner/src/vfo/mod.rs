@@ -39,8 +39,11 @@ pub use controller::{
     convergence_field, field_rate, integrate_unicycle, ControlStep, Field, StepOutcome, VfoController, VfoGains,
     VfoWaypoint, DEFAULT_GUIDING,
 };
-pub use follower::{Reoptimised, VfoEnd, VfoEvent, VfoFollower, VfoOutput, MAX_SETTLE_S, REST_SPEED, REST_TURN_RATE};
-pub use history::PoseHistory;
+pub use follower::{
+    Reoptimised, VfoEnd, VfoEvent, VfoFollower, VfoOutput, MAX_BUDGET_RETRIES, MAX_SETTLE_S, REST_INTERVALS,
+    REST_SPEED, REST_TURN_RATE,
+};
+pub use history::{Placement, PoseHistory};
 pub use obstacles::{potential, potential_derivative, Obstacle, Sigma};
 pub use optimise::{
     find_sigmas, find_sigmas_until, path_time_limit, simulate_uninterrupted, DecisionEdge, ExploredPath, Interrupt,

@@ -265,7 +265,8 @@ pub enum OptimiseWarning {
         path: usize,
     },
     /// No path reached the waypoint without collision: no safe Σ exists (or none was found
-    /// within the caps).
+    /// within the caps). Not given when the wall-clock budget cut the search short before any
+    /// candidate ([`OptimiseWarning::WallTimeBudget`] alone says so).
     NoSafeSigma,
 }
 
@@ -672,6 +673,11 @@ fn choose(result: &mut Optimisation, weights: &QualityWeights) {
     result.best = best;
     match best {
         Some(b) => result.sigmas = result.paths[b].sigmas.clone(),
+        // Cut short by the caller's budget before any candidate, nothing was proven unsafe.
+        None if result
+            .warnings
+            .iter()
+            .any(|w| matches!(w, OptimiseWarning::WallTimeBudget { .. })) => {}
         None => result.warnings.push(OptimiseWarning::NoSafeSigma),
     }
 }

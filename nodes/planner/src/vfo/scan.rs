@@ -20,13 +20,22 @@
 //!   last `memory` detections weigh in). Any other circle is a new obstacle, appended (indices
 //!   never change but for the removals below) and reported, so the caller re-optimises.
 //! - **Forgetting** (each scan, after the merge; the removed obstacles' ids reported):
-//!   1. *seen through*: a known circle this scan did not detect, whose centre lies inside the
-//!      scan's field of view and range, is removed when the beam nearest its bearing and both
-//!      its neighbours see free space beyond its far side (an echo farther than d + ρ, or none
-//!      within range_max): the obstacle moved away, or was a phantom;
+//!   1. *seen through*: a known circle a scan did not detect, whose centre lies inside the
+//!      scan's field of view and range, is seen through when the beam nearest its bearing and
+//!      both its neighbours see free space beyond its far side (an echo farther than d + ρ, or
+//!      none within range_max); seen through on [`SEEN_THROUGH_SCANS`] consecutive scans it is
+//!      removed: the obstacle moved away, or was a phantom. Only a scan placed by a pose
+//!      between two odometry poses ([`Placement::Interpolated`]) judges this: a held pose
+//!      may be a turn's worth off (0.06 rad at 1.5 rad/s over 0.04 s puts a pillar 3.5 m away
+//!      0.21 m aside), and the real pillar would look seen through. A held scan neither counts
+//!      nor breaks the run;
 //!   2. *decay*: a circle not detected for `decay_s` is removed (out of view, it may be gone);
 //!   3. *cap*: beyond `max_obstacles` circles, the least recently detected (then the oldest)
 //!      are dropped, and the update says how many.
+//!
+//!   4. *clock reset*: a scan stamped before the last detection of any circle (time went
+//!      backwards: a simulation restarted) empties the map first, its ids in
+//!      [`MapUpdate::cleared`]; the circles' ages would mean nothing.
 //!
 //!   Every obstacle keeps an id ([`ObstacleMap::ids`]) for its whole life, so a caller holding
 //!   decisions by index can carry them over a removal.
@@ -35,8 +44,14 @@
 use mobil_geom::{Beam, Pose2, Scan};
 use nalgebra::{Matrix3, Point2, Vector3};
 
+use super::history::Placement;
 use super::obstacles::Obstacle;
 use crate::error::{positive_finite, PlannerError};
+
+/// How many consecutive scans (placed by interpolation) must see through a circle before it is
+/// removed: one scan may be off (a pose error, a beam through a gap), two in a row (25 ms apart
+/// on a 40 Hz scanner) agree on free space.
+pub const SEEN_THROUGH_SCANS: u8 = 2;
 
 /// Settings of the extraction and the merge; every default justified.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -261,6 +276,8 @@ struct Tracked {
     id: u64,
     /// When it was last detected (s).
     seen_at: f64,
+    /// Consecutive interpolated scans that saw through it.
+    through: u8,
 }
 
 /// What a scan changed.
@@ -277,12 +294,15 @@ pub struct MapUpdate {
     pub decayed: Vec<u64>,
     /// Ids of the obstacles dropped by the `max_obstacles` cap (the caller warns).
     pub capped: Vec<u64>,
+    /// Ids of the obstacles dropped because the scan's time lay before their last detection
+    /// (a clock reset: the caller warns).
+    pub cleared: Vec<u64>,
 }
 
 impl MapUpdate {
     /// Whether any obstacle was removed (the indices after it changed).
     pub fn removed_any(&self) -> bool {
-        !(self.seen_through.is_empty() && self.decayed.is_empty() && self.capped.is_empty())
+        !(self.seen_through.is_empty() && self.decayed.is_empty() && self.capped.is_empty() && self.cleared.is_empty())
     }
 }
 
@@ -340,9 +360,22 @@ impl ObstacleMap {
         Obstacle::new(c.centre, r, r + self.config.influence_margin).ok()
     }
 
-    /// Adds the circles of a checked scan taken at `odom_from_base` at time `t` (s), then
-    /// forgets what the scan saw through, what decayed and what exceeds the cap (module docs).
+    /// Adds the circles of a checked scan taken at `odom_from_base` at time `t` (s), the pose
+    /// interpolated at the scan's time, then forgets what was seen through, what decayed and
+    /// what exceeds the cap (module docs).
     pub fn update(&mut self, scan: &Scan, odom_from_base: &Pose2, t: f64) -> Result<MapUpdate, PlannerError> {
+        self.update_placed(scan, odom_from_base, Placement::Interpolated, t)
+    }
+
+    /// As [`Self::update`], the pose found as `placement` says: a [`Placement::Held`] scan
+    /// adds and confirms circles but judges none seen through.
+    pub fn update_placed(
+        &mut self,
+        scan: &Scan,
+        odom_from_base: &Pose2,
+        placement: Placement,
+        t: f64,
+    ) -> Result<MapUpdate, PlannerError> {
         crate::docking::check_pose("odom_from_base", odom_from_base)?;
         if !t.is_finite() {
             return Err(PlannerError::InvalidConfig {
@@ -351,8 +384,14 @@ impl ObstacleMap {
                 reason: "a scan's time must be finite",
             });
         }
+        let cleared: Vec<u64> = if self.tracked.iter().any(|tr| tr.seen_at > t) {
+            self.tracked.drain(..).map(|tr| tr.id).collect()
+        } else {
+            Vec::new()
+        };
         let circles = extract_circles(scan, odom_from_base, &self.config);
         let mut update = self.merge_at(&circles, t);
+        update.cleared = cleared;
         let frame_from_laser = *odom_from_base * scan.base_from_laser();
         let new_ids: Vec<u64> = update
             .new
@@ -362,8 +401,12 @@ impl ObstacleMap {
             .collect();
         let config = self.config;
         let mut kept = Vec::with_capacity(self.tracked.len());
-        for tr in self.tracked.drain(..) {
-            if tr.seen_at < t && sees_through(scan, &frame_from_laser, &tr.circle) {
+        for mut tr in self.tracked.drain(..) {
+            if placement == Placement::Interpolated {
+                let through = tr.seen_at < t && sees_through(scan, &frame_from_laser, &tr.circle);
+                tr.through = if through { tr.through.saturating_add(1) } else { 0 };
+            }
+            if tr.through >= SEEN_THROUGH_SCANS {
                 update.seen_through.push(tr.id);
             } else if t - tr.seen_at > config.decay_s {
                 update.decayed.push(tr.id);
@@ -451,6 +494,7 @@ impl ObstacleMap {
                     t.circle.centre += (c.centre - t.circle.centre) * w;
                     t.circle.radius += (c.radius - t.circle.radius) * w;
                     t.seen_at = t.seen_at.max(now);
+                    t.through = 0;
                     update.seen += 1;
                 }
                 // A circle the law cannot take (beyond the coordinate limit) is not kept, so
@@ -463,6 +507,7 @@ impl ObstacleMap {
                         detections: 1,
                         id: self.next_id,
                         seen_at: now,
+                        through: 0,
                     });
                     self.next_id += 1;
                 }
@@ -486,8 +531,10 @@ fn sees_through(scan: &Scan, frame_from_laser: &Pose2, circle: &Circle) -> bool 
     if increment <= 0.0 {
         return false;
     }
-    let bearing = centre.y.atan2(centre.x);
-    let k = ((bearing - scan.angle(0)) / increment).round();
+    // Relative to the first beam, in [0, 2π): a scanner sweeping 0…2π sees obstacles at
+    // negative bearings too.
+    let from_first = (centre.y.atan2(centre.x) - scan.angle(0)).rem_euclid(std::f64::consts::TAU);
+    let k = (from_first / increment).round();
     if !(k >= 1.0 && k <= (scan.len() - 2) as f64) {
         return false;
     }
