@@ -40,8 +40,14 @@ impl Stroke {
         }
     }
 
+    /// The stroke for an open shape (no fill).
     fn attributes(&self) -> String {
-        let mut a = format!(r#"fill="none" stroke="{}" stroke-width="{}""#, self.color, self.width);
+        format!(r#"fill="none" {}"#, self.outline())
+    }
+
+    /// The stroke alone, for a shape that sets its own fill.
+    fn outline(&self) -> String {
+        let mut a = format!(r#"stroke="{}" stroke-width="{}""#, self.color, self.width);
         if let Some(d) = self.dash {
             let _ = write!(a, r#" stroke-dasharray="{d}""#);
         }
@@ -353,7 +359,7 @@ impl Svg {
             view.x(x),
             view.y(y),
             radius * view.scale(),
-            stroke.attributes()
+            stroke.outline()
         );
     }
 
@@ -399,10 +405,7 @@ impl Svg {
             .filter(|(x, y)| x.is_finite() && y.is_finite())
             .map(|&(x, y)| format!("{:.1},{:.1}", view.x(x), view.y(y)))
             .collect();
-        let outline = stroke.map_or_else(
-            || r#"stroke="none""#.to_owned(),
-            |s| s.attributes().replace(r#"fill="none" "#, ""),
-        );
+        let outline = stroke.map_or_else(|| r#"stroke="none""#.to_owned(), |s| s.outline());
         let _ = writeln!(
             self.body,
             r#"<polygon points="{}" fill="{fill}" fill-opacity="{opacity}" {outline}/>"#,
@@ -616,5 +619,31 @@ mod tests {
             dy
         );
         assert!(text.contains(&expect), "{expect}\n{text}");
+    }
+
+    #[test]
+    fn filled_shapes_with_a_stroke_name_their_fill_once() {
+        // An attribute given twice makes the whole SVG invalid XML (viewers refuse it).
+        let world = World { obstacles: vec![] };
+        let v = MapView::fit(&world, [(-1.0, -1.0), (1.0, 1.0)], 100.0, 0.0);
+        let mut svg = Svg::new(200.0, 200.0);
+        svg.circle(&v, (0.0, 0.0), 0.5, Stroke::dashed("#c01818", 1.0), "#e04040", 0.35);
+        svg.polygon(
+            &v,
+            &[(0.0, 0.0), (0.5, 0.0), (0.0, 0.5)],
+            "#e04040",
+            0.35,
+            Some(Stroke::solid("#000", 1.0)),
+        );
+        let text = svg.finish();
+        let shapes: Vec<&str> = text
+            .lines()
+            .filter(|l| l.starts_with("<circle") || l.starts_with("<polygon"))
+            .collect();
+        assert_eq!(shapes.len(), 2, "{text}");
+        for shape in shapes {
+            assert_eq!(shape.matches(" fill=").count(), 1, "{shape}");
+            assert_eq!(shape.matches(" stroke=").count(), 1, "{shape}");
+        }
     }
 }
