@@ -68,7 +68,8 @@ if left="$(grep -rl --include='*.cmake' '/opt/python/' "$VENV/share" 2>/dev/null
   exit 1
 fi
 
-# mobil_msgs Python type support, from the same CMakeLists.txt colcon uses.
+# mobil_msgs Python type support, from the same CMakeLists.txt colcon uses, with its C type
+# supports only (MOBIL_MSGS_C_ONLY: rclpy loads no C++ type support; that halves the build).
 # The hash of an interface package's inputs (msgs/rust and the nested nav2_msgs are not part of
 # mobil_msgs).
 package_hash() {
@@ -77,12 +78,12 @@ package_hash() {
 want_msgs="$want_ver $(package_hash "$ROOT/msgs")"
 stamp_msgs="$INSTALL/.mobil-msgs-stamp"
 if [ "$(cat "$stamp_msgs" 2>/dev/null)" != "$want_msgs" ]; then
-  echo "setup_env: building mobil_msgs Python type support (about 15 s)" >&2
+  echo "setup_env: building mobil_msgs Python type support (about 1 CPU-minute)" >&2
   rm -rf "$BUILD" "$INSTALL"
   mkdir -p "$ROOT/target"
   PATH="$VENV/bin:$PATH" AMENT_PREFIX_PATH="$VENV" CMAKE_PREFIX_PATH="$VENV" \
     "$VENV/bin/cmake" -S "$ROOT/msgs" -B "$BUILD" -DPython3_EXECUTABLE="$VENV/bin/python" \
-      -DBUILD_TESTING=OFF -DCMAKE_INSTALL_PREFIX="$INSTALL" >"$ROOT/target/msgs-cmake.log" 2>&1 \
+      -DBUILD_TESTING=OFF -DMOBIL_MSGS_C_ONLY=ON -DCMAKE_INSTALL_PREFIX="$INSTALL" >"$ROOT/target/msgs-cmake.log" 2>&1 \
     && PATH="$VENV/bin:$PATH" "$VENV/bin/cmake" --build "$BUILD" -j2 >>"$ROOT/target/msgs-cmake.log" 2>&1 \
     && "$VENV/bin/cmake" --install "$BUILD" >>"$ROOT/target/msgs-cmake.log" 2>&1 \
     || { echo "setup_env: mobil_msgs build failed, see target/msgs-cmake.log" >&2; tail -30 "$ROOT/target/msgs-cmake.log" >&2; exit 1; }
@@ -96,11 +97,11 @@ NAV2_BUILD="$ROOT/target/nav2-msgs-build-py$want_ver"
 want_nav2="$want_ver $(package_hash "$ROOT/msgs/nav2_msgs")"
 stamp_nav2="$INSTALL/.mobil-nav2-msgs-stamp"
 if [ "$(cat "$stamp_nav2" 2>/dev/null)" != "$want_nav2" ]; then
-  echo "setup_env: building nav2_msgs Python type support (about 15 s)" >&2
+  echo "setup_env: building nav2_msgs Python type support (about 1 CPU-minute)" >&2
   rm -rf "$NAV2_BUILD"
   PATH="$VENV/bin:$PATH" AMENT_PREFIX_PATH="$VENV" CMAKE_PREFIX_PATH="$VENV" \
     "$VENV/bin/cmake" -S "$ROOT/msgs/nav2_msgs" -B "$NAV2_BUILD" -DPython3_EXECUTABLE="$VENV/bin/python" \
-      -DBUILD_TESTING=OFF -DCMAKE_INSTALL_PREFIX="$INSTALL" >"$ROOT/target/nav2-msgs-cmake.log" 2>&1 \
+      -DBUILD_TESTING=OFF -DMOBIL_MSGS_C_ONLY=ON -DCMAKE_INSTALL_PREFIX="$INSTALL" >"$ROOT/target/nav2-msgs-cmake.log" 2>&1 \
     && PATH="$VENV/bin:$PATH" "$VENV/bin/cmake" --build "$NAV2_BUILD" -j2 >>"$ROOT/target/nav2-msgs-cmake.log" 2>&1 \
     && "$VENV/bin/cmake" --install "$NAV2_BUILD" >>"$ROOT/target/nav2-msgs-cmake.log" 2>&1 \
     || { echo "setup_env: nav2_msgs build failed, see target/nav2-msgs-cmake.log" >&2; tail -30 "$ROOT/target/nav2-msgs-cmake.log" >&2; exit 1; }
