@@ -5,7 +5,7 @@
 rclpy publishes 1081-beam, 270° LaserScans at 40 Hz, the send time in the header stamp, to two
 Rust nodes in the same run, each in its own namespace:
 
-* ``scan_echo`` (nodes/tools_node): answers every scan with one cmd_vel at once (the floor: the
+* ``scan_echo`` (nodes/local_nav_node): answers every scan with one cmd_vel at once (the floor: the
   same DDS path, the same message types and QoS, no work);
 * ``local_nav_node`` (params/omr3.yaml): fed an odometry that advances at 0.5 m/s along x (so its
   progress checker is satisfied) and a goal 1 km ahead, in a 4 m wide corridor (the walls are in
