@@ -224,20 +224,32 @@ impl RosEvaluator {
         link.as_ref().and_then(|l| l.failed.clone())
     }
 
-    fn simulator_present(link: &mut Link) -> bool {
+    /// Whether a simulator is matched on both topics now. (ros2-client's match futures, polled
+    /// briefly: its match counts log an error for an entity that was never matched.)
+    fn simulator_present(&self, link: &mut Link) -> bool {
         let Link {
             node,
             candidates,
             outcome,
             ..
         } = link;
-        candidates.get_subscription_count(node.inner()) > 0 && outcome.get_publisher_count(node.inner()) > 0
+        let node = &*node.inner();
+        let reader = candidates.wait_for_subscription(node);
+        let writer = outcome.wait_for_publisher(node);
+        self.runtime.block_on(async {
+            tokio::time::timeout(Duration::from_millis(2), async {
+                reader.await;
+                writer.await;
+            })
+            .await
+            .is_ok()
+        })
     }
 
     /// Waits until a simulator is matched on both topics, up to the timeout.
     fn await_simulator(&self, link: &mut Link, n: u64) -> Result<(), RosEvalError> {
         let deadline = Instant::now() + self.timeout;
-        while !Self::simulator_present(link) {
+        while !self.simulator_present(link) {
             if self.interrupt.load(Ordering::SeqCst) {
                 return Err(RosEvalError::Interrupted(n));
             }
@@ -307,7 +319,7 @@ impl RosEvaluator {
                 return Ok(None);
             }
             // A simulator that restarted never heard this candidate: send it again once it is back.
-            let now_present = Self::simulator_present(link);
+            let now_present = self.simulator_present(link);
             if now_present && !present {
                 link.candidates
                     .publish(message.clone())

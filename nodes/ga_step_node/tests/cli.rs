@@ -170,6 +170,52 @@ fn ctrl_c_loses_at_most_the_generation_in_flight_and_the_run_resumes_to_the_same
     let _ = std::fs::remove_dir_all(&stopped);
 }
 
+/// With `--evaluator ros` and no simulator, Ctrl-C stops the wait for one at once (not after
+/// the 30 s timeout): status 130, nothing written.
+#[test]
+fn ctrl_c_reaches_the_ros_evaluator() {
+    let dir = scratch("ctrl_c_ros");
+    let domain = (200 + std::process::id() % 30).to_string();
+    let child = Command::new(BIN)
+        .args([
+            "--population",
+            "4",
+            "--generations",
+            "2",
+            "--seed",
+            "1",
+            "--crossover",
+            "blx",
+        ])
+        .args([
+            "--out",
+            dir.to_str().unwrap(),
+            "--evaluator",
+            "ros",
+            "--eval-timeout",
+            "30",
+        ])
+        .env("ROS_DOMAIN_ID", &domain)
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    std::thread::sleep(Duration::from_millis(1500));
+    let t = Instant::now();
+    interrupt(&child);
+    let o = child.wait_with_output().unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(t.elapsed() < Duration::from_secs(5), "{:?} {err}", t.elapsed());
+    assert_eq!(o.status.code(), Some(130), "{err}");
+    assert!(
+        err.contains("interrupted during generation 0; nothing written"),
+        "{err}"
+    );
+    assert!(!dir.join("checkpoint.json").exists());
+    assert!(!dir.join("fitness.csv").exists());
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
 /// Sends SIGINT to a child process.
 fn interrupt(child: &std::process::Child) {
     let kill = Command::new("kill")

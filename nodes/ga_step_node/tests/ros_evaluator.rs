@@ -155,6 +155,21 @@ fn candidates_are_answered_by_their_own_outcome_only() {
         rx.recv_timeout(Duration::from_secs(5)).unwrap().header.frame_id,
         "candidate 2"
     );
+    stop.store(true, Ordering::SeqCst);
+    sim.join().unwrap();
+
+    // The simulator restarts: the evaluator waits for the new one and is answered by it.
+    let stop = Arc::new(AtomicBool::new(false));
+    let (tx, rx) = mpsc::channel();
+    let sim = fake_simulator(domain, false, tx, stop.clone());
+    ind.knots[Servo::RKneePitch.index()][10] = 1.0;
+    let e3 = evaluator.evaluate(&ind);
+    assert_eq!(evaluator.failure(), None);
+    assert!((e3.forward_distance - 0.1).abs() < 1e-12, "{e3:?}");
+    assert_eq!(
+        rx.recv_timeout(Duration::from_secs(5)).unwrap().header.frame_id,
+        "candidate 3"
+    );
     drop(evaluator);
     stop.store(true, Ordering::SeqCst);
     sim.join().unwrap();

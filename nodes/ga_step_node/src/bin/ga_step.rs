@@ -42,6 +42,12 @@ fn main() -> ExitCode {
             return ExitCode::from(2);
         }
     };
+    // Warnings and errors only, unless --ros-args --log-level asks for more: the progress bar
+    // and the last line are the run's output.
+    let mut ros_args = ros_args;
+    if ros_args.log_level.is_none() {
+        ros_args.log_level = Some("warn".to_owned());
+    }
     mobil_ros::node::init_process(&ros_args);
     let interrupt = Arc::new(AtomicBool::new(false));
     let flag = interrupt.clone();
