@@ -3,11 +3,14 @@
 //! JSON (serde_json, with its exact float parsing): readable with any tool, and every f64 is
 //! written in its shortest round-trip form and read back to the same bits, so a resumed run
 //! equals the uninterrupted one. The document starts with a format tag and a version:
-//! `{"format": "mobil_ga_step checkpoint", "version": 3, …}`; the generator is stored as its seed
-//! and its position in the stream (ChaCha8, 32-bit words). A file that is not JSON or has
+//! `{"format": "mobil_ga_step checkpoint", "version": 4, …}`; the generator is stored as its seed
+//! and its position in the stream (ChaCha8, 32-bit words), and the evaluator that scored the
+//! population as an [`EvaluatorTag`] (a resume under another evaluator, or another version of the
+//! physics, would mix fitness values of two different measures). A file that is not JSON or has
 //! another tag is [`CheckpointError::Foreign`], another version
 //! [`CheckpointError::UnsupportedVersion`], a damaged or inconsistent one
-//! [`CheckpointError::Corrupt`].
+//! [`CheckpointError::Corrupt`], a file above [`MAX_CHECKPOINT_BYTES`]
+//! [`CheckpointError::TooLarge`] (read no further than that).
 //!
 //! Writing goes to `<file>.tmp` in the same directory, is flushed to disk, then renamed over the
 //! file: a reader sees the old checkpoint or the new one, never half of one.
@@ -16,20 +19,50 @@ use crate::error::CheckpointError;
 use crate::ga::{GaSetup, GaState, GenerationStats};
 use crate::selection::Scored;
 use serde::{Deserialize, Serialize};
-use std::io::Write;
+use std::io::{Read, Write};
 use std::path::{Path, PathBuf};
 
 /// The format tag of a checkpoint.
 pub const CHECKPOINT_FORMAT: &str = "mobil_ga_step checkpoint";
-/// The format version this library writes. Version 3: the setup's fitness carries
-/// `backward_allowance` besides `distance_on_fall`. A version-2 checkpoint is read as the shape
-/// it was evolved under, a backward allowance of 0 (the field did not exist); a version-1
-/// checkpoint was evolved under the SPEC's example shape and names no shape, so it is refused
-/// rather than resumed under another fitness.
-pub const CHECKPOINT_VERSION: u64 = 3;
+/// The format version this library writes. Version 4: the document records the evaluator
+/// ([`EvaluatorTag`]). Earlier versions do not say which evaluator (or which version of the
+/// physics) scored their population, so they are refused rather than resumed under a measure
+/// they may not have been scored by.
+pub const CHECKPOINT_VERSION: u64 = 4;
 
-/// The oldest version read: 2, whose fitness had no backward allowance (b = 0).
-pub const CHECKPOINT_OLDEST_READ: u64 = 2;
+/// The oldest version read: 4, the first that records its evaluator.
+pub const CHECKPOINT_OLDEST_READ: u64 = 4;
+
+/// The largest checkpoint read (128 MiB); a larger file (or a device such as `/dev/zero`) is
+/// refused after reading this much. An individual takes about 4.2 KB of JSON (210 knots in
+/// shortest round-trip form and its evaluation), so the largest population the executable
+/// accepts (10 000) is about 42 MB, leaving room for a history of more than 400 000 generations
+/// (about 200 bytes each).
+pub const MAX_CHECKPOINT_BYTES: u64 = 128 * 1024 * 1024;
+
+/// Who scored a run's individuals, as its checkpoint records it.
+#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(tag = "kind", rename_all = "kebab-case")]
+pub enum EvaluatorTag {
+    /// The built-in physics simulation, at the version of its model (`mobil_ga_step_sim`'s
+    /// `PHYSICS_VERSION`): another version scores the same individual differently.
+    Physics {
+        /// The physics model's version.
+        physics_version: u32,
+    },
+    /// An external simulator over ROS 2 (its model is the user's; ga_step cannot know its
+    /// version).
+    Ros,
+}
+
+impl std::fmt::Display for EvaluatorTag {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            EvaluatorTag::Physics { physics_version } => write!(f, "physics (model version {physics_version})"),
+            EvaluatorTag::Ros => f.write_str("ros (an external simulator)"),
+        }
+    }
+}
 
 #[derive(Serialize, Deserialize)]
 struct Header {
@@ -41,6 +74,7 @@ struct Header {
 struct Document {
     format: String,
     version: u64,
+    evaluator: EvaluatorTag,
     seed: u64,
     /// The generator's position (32-bit words), as a decimal string (beyond JSON's safe integers).
     rng_word_pos: String,
@@ -51,11 +85,12 @@ struct Document {
     history: Vec<GenerationStats>,
 }
 
-/// The checkpoint's text.
-pub fn to_json(state: &GaState) -> String {
+/// The checkpoint's text: `state` as scored by `evaluator`.
+pub fn to_json(state: &GaState, evaluator: &EvaluatorTag) -> String {
     let doc = Document {
         format: CHECKPOINT_FORMAT.to_owned(),
         version: CHECKPOINT_VERSION,
+        evaluator: evaluator.clone(),
         seed: state.seed,
         rng_word_pos: state.rng_word_pos().to_string(),
         generation: state.generation,
@@ -69,8 +104,13 @@ pub fn to_json(state: &GaState) -> String {
     serde_json::to_string(&doc).unwrap_or_default()
 }
 
-/// A state from a checkpoint's text.
+/// A state from a checkpoint's text (the evaluator's record dropped: see [`from_json_tagged`]).
 pub fn from_json(text: &str) -> Result<GaState, CheckpointError> {
+    from_json_tagged(text).map(|(state, _)| state)
+}
+
+/// A state from a checkpoint's text, with the evaluator that scored it.
+pub fn from_json_tagged(text: &str) -> Result<(GaState, EvaluatorTag), CheckpointError> {
     let header: Header = serde_json::from_str(text).map_err(|e| {
         // Our tag at the start of a file that does not parse: a damaged (e.g. truncated) checkpoint.
         let tag = format!("{{\"format\":\"{CHECKPOINT_FORMAT}\"");
@@ -85,7 +125,7 @@ pub fn from_json(text: &str) -> Result<GaState, CheckpointError> {
         Some(other) => return Err(CheckpointError::Foreign(format!("format tag `{other}`"))),
         None => return Err(CheckpointError::Foreign("no format tag".into())),
     }
-    let version = match header.version {
+    match header.version {
         Some(v @ CHECKPOINT_OLDEST_READ..=CHECKPOINT_VERSION) => v,
         Some(found) => {
             return Err(CheckpointError::UnsupportedVersion {
@@ -95,16 +135,12 @@ pub fn from_json(text: &str) -> Result<GaState, CheckpointError> {
         }
         None => return Err(CheckpointError::Corrupt("no version".into())),
     };
-    let mut doc: Document = serde_json::from_str(text).map_err(|e| CheckpointError::Corrupt(e.to_string()))?;
-    if version == 2 {
-        // Evolved before the allowance existed, under f = 1 + w·max(0, Δx) without a fall.
-        doc.setup.fitness.backward_allowance = 0.0;
-    }
+    let doc: Document = serde_json::from_str(text).map_err(|e| CheckpointError::Corrupt(e.to_string()))?;
     let word_pos: u128 = doc
         .rng_word_pos
         .parse()
         .map_err(|_| CheckpointError::Corrupt(format!("generator position `{}`", doc.rng_word_pos)))?;
-    GaState::from_parts(
+    let state = GaState::from_parts(
         doc.setup,
         doc.seed,
         doc.generation,
@@ -113,7 +149,8 @@ pub fn from_json(text: &str) -> Result<GaState, CheckpointError> {
         doc.first_step_generation,
         word_pos,
     )
-    .map_err(|e| CheckpointError::Corrupt(e.to_string()))
+    .map_err(|e| CheckpointError::Corrupt(e.to_string()))?;
+    Ok((state, doc.evaluator))
 }
 
 fn io_error(path: &Path) -> impl FnOnce(std::io::Error) -> CheckpointError + '_ {
@@ -130,15 +167,18 @@ pub fn temp_path(path: &Path) -> PathBuf {
     path.with_file_name(name)
 }
 
-/// Writes the checkpoint atomically: to [`temp_path`], flushed to disk, renamed over `path`.
-/// On failure the temporary file is removed and `path` is untouched.
-pub fn write_checkpoint(state: &GaState, path: &Path) -> Result<(), CheckpointError> {
+/// Writes the checkpoint atomically: to [`temp_path`], flushed to disk, renamed over `path`,
+/// and the directory flushed so the rename itself survives a power loss. On failure the
+/// temporary file is removed and `path` is untouched.
+pub fn write_checkpoint(state: &GaState, evaluator: &EvaluatorTag, path: &Path) -> Result<(), CheckpointError> {
     let tmp = temp_path(path);
     let result = (|| {
         let mut f = std::fs::File::create(&tmp).map_err(io_error(&tmp))?;
-        f.write_all(to_json(state).as_bytes()).map_err(io_error(&tmp))?;
+        f.write_all(to_json(state, evaluator).as_bytes())
+            .map_err(io_error(&tmp))?;
         f.sync_all().map_err(io_error(&tmp))?;
-        std::fs::rename(&tmp, path).map_err(io_error(path))
+        std::fs::rename(&tmp, path).map_err(io_error(path))?;
+        sync_parent(path).map_err(io_error(path))
     })();
     if result.is_err() {
         // Best effort: the temporary file may not exist.
@@ -147,9 +187,43 @@ pub fn write_checkpoint(state: &GaState, path: &Path) -> Result<(), CheckpointEr
     result
 }
 
-/// Reads a checkpoint written by [`write_checkpoint`].
+/// Flushes the directory holding `path` to disk (on Unix; elsewhere a no-op), so that a rename
+/// into it is durable.
+pub fn sync_parent(path: &Path) -> std::io::Result<()> {
+    #[cfg(unix)]
+    {
+        let dir = match path.parent() {
+            Some(d) if !d.as_os_str().is_empty() => d,
+            _ => Path::new("."),
+        };
+        std::fs::File::open(dir)?.sync_all()
+    }
+    #[cfg(not(unix))]
+    {
+        let _ = path;
+        Ok(())
+    }
+}
+
+/// Reads a checkpoint written by [`write_checkpoint`] (the evaluator's record dropped).
 pub fn read_checkpoint(path: &Path) -> Result<GaState, CheckpointError> {
-    let bytes = std::fs::read(path).map_err(io_error(path))?;
+    read_checkpoint_tagged(path).map(|(state, _)| state)
+}
+
+/// Reads a checkpoint written by [`write_checkpoint`], with the evaluator that scored it. Reads
+/// at most [`MAX_CHECKPOINT_BYTES`] (+1 to tell a larger file).
+pub fn read_checkpoint_tagged(path: &Path) -> Result<(GaState, EvaluatorTag), CheckpointError> {
+    let file = std::fs::File::open(path).map_err(io_error(path))?;
+    let mut bytes = Vec::new();
+    file.take(MAX_CHECKPOINT_BYTES + 1)
+        .read_to_end(&mut bytes)
+        .map_err(io_error(path))?;
+    if bytes.len() as u64 > MAX_CHECKPOINT_BYTES {
+        return Err(CheckpointError::TooLarge {
+            path: path.display().to_string(),
+            limit: MAX_CHECKPOINT_BYTES,
+        });
+    }
     let text = String::from_utf8(bytes).map_err(|_| CheckpointError::Foreign("not UTF-8 text".into()))?;
-    from_json(&text)
+    from_json_tagged(&text)
 }

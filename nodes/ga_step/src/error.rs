@@ -63,6 +63,14 @@ pub enum CheckpointError {
     /// A checkpoint whose content is damaged or inconsistent.
     #[error("corrupt checkpoint: {0}")]
     Corrupt(String),
+    /// A file larger than any checkpoint this program writes (or a device without an end).
+    #[error("{path}: larger than {limit} bytes, not a ga_step checkpoint")]
+    TooLarge {
+        /// The file.
+        path: String,
+        /// The largest size read (bytes).
+        limit: u64,
+    },
 }
 
 /// Why a motion file could not be read.

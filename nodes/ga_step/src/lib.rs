@@ -96,8 +96,11 @@ pub mod operators;
 pub mod output;
 pub mod selection;
 
-pub use checkpoint::{read_checkpoint, write_checkpoint, CHECKPOINT_FORMAT, CHECKPOINT_VERSION};
-pub use config::{BlxVariant, Crossover, FitnessConfig, GaConfig};
+pub use checkpoint::{
+    read_checkpoint, read_checkpoint_tagged, write_checkpoint, EvaluatorTag, CHECKPOINT_FORMAT, CHECKPOINT_VERSION,
+    MAX_CHECKPOINT_BYTES,
+};
+pub use config::{BlxVariant, Crossover, FitnessConfig, GaConfig, MAX_POPULATION};
 pub use error::{CheckpointError, GaError, MotionError};
 pub use evaluate::{evaluate_all, resolve_threads, Evaluation, Evaluator, TestLandscape};
 pub use ga::{GaRng, GaSetup, GaState, GenerationStats, StopReason};

@@ -1,12 +1,16 @@
 //! Checkpoints: a resumed run equals the uninterrupted one; the file is written atomically and a
 //! foreign, other-version or damaged file is a typed error.
 
+use mobil_ga_step::checkpoint::from_json_tagged;
 use mobil_ga_step::checkpoint::{from_json, temp_path, to_json};
 use mobil_ga_step::{
     read_checkpoint, write_checkpoint, CheckpointError, Crossover, FitnessConfig, GaConfig, GaSetup, GaState, NaoModel,
     StopReason, TestLandscape,
 };
+use mobil_ga_step::{read_checkpoint_tagged, EvaluatorTag, MAX_CHECKPOINT_BYTES};
 use std::ops::ControlFlow;
+
+const TAG: EvaluatorTag = EvaluatorTag::Physics { physics_version: 7 };
 use std::path::PathBuf;
 
 fn dir(name: &str) -> PathBuf {
@@ -41,9 +45,9 @@ fn resume_equals_uninterrupted() {
     for c in [Crossover::Blx, Crossover::Linear] {
         let path = d.join("checkpoint.json");
         let mut full = GaState::start(setup(c), 99, &e, 1).unwrap();
-        let mut saved = vec![to_json(&full)];
+        let mut saved = vec![to_json(&full, &TAG)];
         full.run(&e, 1, 12, |s| {
-            write_checkpoint(s, &path).unwrap();
+            write_checkpoint(s, &TAG, &path).unwrap();
             saved.push(std::fs::read_to_string(&path).unwrap());
             ControlFlow::Continue(())
         });
@@ -73,7 +77,7 @@ fn an_interrupted_run_resumes_to_the_same_end() {
     full.run(&e, 2, 10, |_| ControlFlow::Continue(()));
     let mut cut = GaState::start(setup(Crossover::Arithmetic), 4, &e, 2).unwrap();
     let reason = cut.run(&e, 2, 10, |s| {
-        write_checkpoint(s, &path).unwrap();
+        write_checkpoint(s, &TAG, &path).unwrap();
         if s.generation == 4 {
             ControlFlow::Break(())
         } else {
@@ -98,7 +102,7 @@ fn a_checkpoint_round_trips_exactly() {
     let e = landscape();
     let mut s = GaState::start(setup(Crossover::Geometric), 5, &e, 2).unwrap();
     s.run(&e, 2, 3, |_| ControlFlow::Continue(()));
-    let back = from_json(&to_json(&s)).unwrap();
+    let back = from_json(&to_json(&s, &TAG)).unwrap();
     for (a, b) in s.population.iter().zip(&back.population) {
         for (x, y) in a
             .individual
@@ -123,12 +127,12 @@ fn the_write_is_atomic_and_failures_are_typed() {
     let e = landscape();
     let s = GaState::start(setup(Crossover::Blx), 1, &e, 1).unwrap();
     let path = d.join("state.json");
-    write_checkpoint(&s, &path).unwrap();
+    write_checkpoint(&s, &TAG, &path).unwrap();
     assert_eq!(temp_path(&path), d.join("state.json.tmp"));
     assert!(!temp_path(&path).exists());
     let missing = d.join("no_such_dir").join("state.json");
     assert!(matches!(
-        write_checkpoint(&s, &missing),
+        write_checkpoint(&s, &TAG, &missing),
         Err(CheckpointError::Io { .. })
     ));
     assert!(!missing.exists());
@@ -147,7 +151,7 @@ fn foreign_and_corrupt_files_are_refused() {
     let e = landscape();
     let mut s = GaState::start(setup(Crossover::Blx), 1, &e, 1).unwrap();
     s.run(&e, 1, 2, |_| ControlFlow::Continue(()));
-    let good = to_json(&s);
+    let good = to_json(&s, &TAG);
 
     for text in [
         "generation,max,mean,min\n0,1,1,1\n",
@@ -159,18 +163,20 @@ fn foreign_and_corrupt_files_are_refused() {
     }
     let other_tag = good.replacen("mobil_ga_step checkpoint", "something else", 1);
     assert!(matches!(from_json(&other_tag), Err(CheckpointError::Foreign(_))));
-    let v4 = good.replacen("\"version\":3", "\"version\":4", 1);
+    let v5 = good.replacen("\"version\":4", "\"version\":5", 1);
     assert!(matches!(
-        from_json(&v4),
-        Err(CheckpointError::UnsupportedVersion { found: 4, expected: 3 })
+        from_json(&v5),
+        Err(CheckpointError::UnsupportedVersion { found: 5, expected: 4 })
     ));
-    // Version 1 (distance counted on a fall, no shape recorded) is refused, not resumed under
-    // the other shape.
-    let v1 = good.replacen("\"version\":3", "\"version\":1", 1);
-    assert!(matches!(
-        from_json(&v1),
-        Err(CheckpointError::UnsupportedVersion { found: 1, expected: 3 })
-    ));
+    // Versions 1–3 record no evaluator: refused, not resumed under a measure they may not have
+    // been scored by.
+    for old in [1, 2, 3] {
+        let text = good.replacen("\"version\":4", &format!("\"version\":{old}"), 1);
+        assert!(matches!(
+            from_json(&text),
+            Err(CheckpointError::UnsupportedVersion { found, expected: 4 }) if found == old
+        ));
+    }
 
     let truncated = &good[..good.len() / 2];
     assert!(matches!(from_json(truncated), Err(CheckpointError::Corrupt(_))));
@@ -208,7 +214,7 @@ fn the_fitness_shape_is_recorded() {
     with_fall.fitness.distance_on_fall = true;
     let e = TestLandscape::new(NaoModel::default(), with_fall.fitness.clone());
     let s = GaState::start(with_fall.clone(), 3, &e, 1).unwrap();
-    let text = to_json(&s);
+    let text = to_json(&s, &TAG);
     let v: serde_json::Value = serde_json::from_str(&text).unwrap();
     assert_eq!(v["setup"]["fitness"]["distance_on_fall"], serde_json::json!(true));
     let back = from_json(&text).unwrap();
@@ -220,23 +226,49 @@ fn the_fitness_shape_is_recorded() {
     let mut allowance = setup(Crossover::Arithmetic);
     allowance.fitness.backward_allowance = 0.25;
     let e = TestLandscape::new(NaoModel::default(), allowance.fitness.clone());
-    let text = to_json(&GaState::start(allowance.clone(), 3, &e, 1).unwrap());
+    let text = to_json(&GaState::start(allowance.clone(), 3, &e, 1).unwrap(), &TAG);
     let v: serde_json::Value = serde_json::from_str(&text).unwrap();
-    assert_eq!(v["version"], serde_json::json!(3));
+    assert_eq!(v["version"], serde_json::json!(4));
     assert_eq!(v["setup"]["fitness"]["backward_allowance"], serde_json::json!(0.25));
     let back = from_json(&text).unwrap();
     assert_eq!(back.setup, allowance);
     assert_ne!(back.setup, setup(Crossover::Arithmetic));
+}
 
-    // A version-2 checkpoint (no allowance field) was evolved under b = 0: it reads back so,
-    // not under the default b = 1 m.
-    let mut v: serde_json::Value = serde_json::from_str(&text).unwrap();
-    v["version"] = serde_json::json!(2);
-    v["setup"]["fitness"]
-        .as_object_mut()
-        .unwrap()
-        .remove("backward_allowance");
-    let back = from_json(&v.to_string()).unwrap();
-    assert_eq!(back.setup.fitness.backward_allowance, 0.0);
-    assert_eq!(FitnessConfig::default().backward_allowance, 1.0);
+/// The evaluator is recorded and read back; a document without it is corrupt.
+#[test]
+fn the_evaluator_is_recorded() {
+    let e = landscape();
+    let s = GaState::start(setup(Crossover::Blx), 5, &e, 1).unwrap();
+    for tag in [EvaluatorTag::Ros, EvaluatorTag::Physics { physics_version: 3 }] {
+        let text = to_json(&s, &tag);
+        let v: serde_json::Value = serde_json::from_str(&text).unwrap();
+        match tag {
+            EvaluatorTag::Ros => assert_eq!(v["evaluator"], serde_json::json!({"kind": "ros"})),
+            EvaluatorTag::Physics { .. } => assert_eq!(
+                v["evaluator"],
+                serde_json::json!({"kind": "physics", "physics_version": 3})
+            ),
+        }
+        let (back, back_tag) = from_json_tagged(&text).unwrap();
+        assert_eq!(back, s);
+        assert_eq!(back_tag, tag);
+    }
+    let mut v: serde_json::Value = serde_json::from_str(&to_json(&s, &TAG)).unwrap();
+    v.as_object_mut().unwrap().remove("evaluator");
+    assert!(matches!(from_json(&v.to_string()), Err(CheckpointError::Corrupt(m)) if m.contains("evaluator")));
+}
+
+/// A file beyond the size cap is refused after reading the cap, not read whole: `/dev/zero`
+/// has no end.
+#[test]
+fn an_endless_file_is_refused_by_its_size() {
+    let t = std::time::Instant::now();
+    let r = read_checkpoint_tagged(std::path::Path::new("/dev/zero"));
+    assert!(
+        matches!(&r, Err(CheckpointError::TooLarge { limit, .. }) if *limit == MAX_CHECKPOINT_BYTES),
+        "{r:?}"
+    );
+    assert!(t.elapsed() < std::time::Duration::from_secs(20));
+    assert_eq!(MAX_CHECKPOINT_BYTES, 128 * 1024 * 1024);
 }

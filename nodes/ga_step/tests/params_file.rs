@@ -1,8 +1,9 @@
 //! `params/nao_step.yaml` loads into the library's model and configurations, equals their
 //! documented defaults, and makes the statements its comments mark: (1) T is a whole number of
 //! 40 ms rows; (2) hip + knee + ankle pitch = 0 on each leg; (3) the standing pose lies within
-//! Table 1's limits; (4) with its fitness constants a 10 cm non-falling step adds 0.2 and a fall
-//! at 80 % of T_sim with a 10 cm step scores what standing still does.
+//! Table 1's limits; (4) with its fitness constants standing still scores 1 + w·b = 3 (b = 1.0 m),
+//! a 10 cm non-falling step adds 0.2, and a fall scores its time alone (0.8 at 80 % of T_sim,
+//! whatever its distance), below any upright individual.
 
 // Table 1's values as printed (4 decimals): 0.7854 is the table's, not π/4.
 #![allow(clippy::approx_constant)]

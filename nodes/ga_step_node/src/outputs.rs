@@ -1,5 +1,7 @@
 //! What a run leaves in its output directory, every file written atomically (to `<name>.tmp`,
-//! synced, renamed), so an interrupted run never leaves a half-written file:
+//! synced, renamed, the directory synced), so an interrupted run never leaves a half-written
+//! file; the writes hold [`WRITING`], which a second Ctrl-C takes before it exits, and a run
+//! starts by removing the `.tmp` files a killed run may have left:
 //! - `fitness.csv`: `generation,max,mean,min`, one row per generation;
 //! - `fitness.svg`: max, mean and min fitness per generation (the source's Fig. 2–3);
 //! - `best.motion`: the best individual as a Webots motion file, and `best_gen_NNNN.motion`, the
@@ -7,18 +9,25 @@
 //! - `best_trajectory.yaml`: the best individual as a `trajectory_msgs/JointTrajectory` (YAML);
 //! - `checkpoint.json`: the run's state (see `mobil_ga_step::checkpoint`).
 
-use mobil_ga_step::{write_fitness_csv, write_joint_trajectory_yaml, write_motion, GaState, GenerationStats};
+use mobil_ga_step::{
+    write_fitness_csv, write_joint_trajectory_yaml, write_motion, EvaluatorTag, GaState, GenerationStats,
+};
 use mobil_tools_node::plot::{SeriesPanel, Stroke, Svg};
 use std::io::Write;
 use std::path::{Path, PathBuf};
+use std::sync::{Mutex, PoisonError};
+
+/// Held while a generation's outputs are written: whoever must end the process at once (a
+/// second Ctrl-C) takes it first, so the process ends between two files' writes, never in one.
+pub static WRITING: Mutex<()> = Mutex::new(());
 
 /// The checkpoint's file name.
 pub const CHECKPOINT: &str = "checkpoint.json";
 /// Generations between two `best_gen_NNNN.motion` files.
 pub const MOTION_EVERY: u32 = 10;
 
-/// Writes `bytes` to `path` atomically: to `<path>.tmp`, synced, renamed over `path`. On
-/// failure the temporary file is removed and `path` is untouched.
+/// Writes `bytes` to `path` atomically: to `<path>.tmp`, synced, renamed over `path`, the
+/// directory synced. On failure the temporary file is removed and `path` is untouched.
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
     let mut tmp = path.as_os_str().to_owned();
     tmp.push(".tmp");
@@ -27,7 +36,8 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
         let mut f = std::fs::File::create(&tmp)?;
         f.write_all(bytes)?;
         f.sync_all()?;
-        std::fs::rename(&tmp, path)
+        std::fs::rename(&tmp, path)?;
+        mobil_ga_step::checkpoint::sync_parent(path)
     })();
     if result.is_err() {
         let _ = std::fs::remove_file(&tmp);
@@ -61,9 +71,22 @@ pub fn fitness_svg(history: &[GenerationStats], title: &str) -> String {
     svg.finish()
 }
 
-/// Writes every output of `state` into `dir` (the checkpoint last, so that a checkpoint on
-/// disk always has its outputs beside it).
-pub fn write_all(dir: &Path, state: &GaState) -> anyhow::Result<()> {
+/// Removes the `*.tmp` files in `dir` (left by a process killed while writing). Best effort.
+pub fn remove_temporaries(dir: &Path) {
+    let Ok(entries) = std::fs::read_dir(dir) else {
+        return;
+    };
+    for e in entries.flatten() {
+        if e.file_name().to_string_lossy().ends_with(".tmp") {
+            let _ = std::fs::remove_file(e.path());
+        }
+    }
+}
+
+/// Writes every output of `state` (scored by `evaluator`) into `dir` (the checkpoint last, so
+/// that a checkpoint on disk always has its outputs beside it), holding [`WRITING`].
+pub fn write_all(dir: &Path, state: &GaState, evaluator: &EvaluatorTag) -> anyhow::Result<()> {
+    let _writing = WRITING.lock().unwrap_or_else(PoisonError::into_inner);
     let write = |name: &str, bytes: &[u8]| -> anyhow::Result<()> {
         let path = dir.join(name);
         write_atomic(&path, bytes).map_err(|e| anyhow::anyhow!("cannot write {}: {e}", path.display()))
@@ -87,7 +110,8 @@ pub fn write_all(dir: &Path, state: &GaState) -> anyhow::Result<()> {
     write_joint_trajectory_yaml(&mut yaml, &state.setup.model, best)?;
     write("best_trajectory.yaml", &yaml)?;
     let path = dir.join(CHECKPOINT);
-    mobil_ga_step::write_checkpoint(state, &path).map_err(|e| anyhow::anyhow!("cannot write the checkpoint: {e}"))?;
+    mobil_ga_step::write_checkpoint(state, evaluator, &path)
+        .map_err(|e| anyhow::anyhow!("cannot write the checkpoint: {e}"))?;
     Ok(())
 }
 

@@ -2,16 +2,22 @@
 //! with its outputs and progress bar, and the way it ends.
 
 use crate::outputs::{self, CHECKPOINT};
-use crate::ros_eval::RosEvaluator;
+use crate::ros_eval::{RosEvalError, RosEvaluator};
 use anyhow::{anyhow, bail, Context as _};
 use clap::{Parser, ValueEnum};
 use indicatif::{ProgressBar, ProgressStyle};
-use mobil_ga_step::{Crossover, Evaluator, GaSetup, GaState, StopReason};
-use mobil_ga_step_sim::PhysicsEvaluator;
+use mobil_ga_step::{Crossover, Evaluator, EvaluatorTag, GaSetup, GaState, StopReason, MAX_POPULATION};
+use mobil_ga_step_sim::{PhysicsEvaluator, PHYSICS_VERSION};
+use mobil_ros::args::RosArgs;
 use std::ops::ControlFlow;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Arc;
 use std::time::{Duration, Instant};
+
+/// The longest `--eval-timeout` (s): one day. Longer is no timeout at all, and past about
+/// 10¹¹ s a deadline no longer fits the clock.
+pub const MAX_EVAL_TIMEOUT_S: f64 = 86_400.0;
 
 /// The crossover operator, as the option spells it.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
@@ -45,8 +51,8 @@ impl From<CrossoverArg> for Crossover {
 pub enum EvaluatorArg {
     /// The built-in rigid-body simulation (rapier3d), on every core.
     Physics,
-    /// An external simulator over ROS 2 (topics ga_step/candidate, ga_step/fell,
-    /// ga_step/forward_distance, ga_step/fall_time), one individual at a time.
+    /// An external simulator over ROS 2 (topics ga_step/candidate and ga_step/outcome; node
+    /// name, namespace and topics remapped by --ros-args -r …), one individual at a time.
     Ros,
 }
 
@@ -62,13 +68,16 @@ not fall, the forward distance.\n\n\
 Writes into DIR: fitness.csv, fitness.svg, best.motion (Webots), best_gen_NNNN.motion every 10 \
 generations, best_trajectory.yaml (trajectory_msgs/JointTrajectory) and checkpoint.json after every \
 generation. Stops at the first non-falling forward step, when the mean fitness levels off \
-(--level-window), or after G generations. Ctrl-C stops after the generation in flight (a second Ctrl-C at once); --resume \
-continues to G exactly as an uninterrupted run would.",
+(--level-window), or after G generations. Ctrl-C stops after the generation in flight (with \
+--evaluator ros at once, the generation in flight lost); a second Ctrl-C stops at once, after the \
+file being written if any; --resume continues to G exactly as an uninterrupted run would.\n\n\
+With --evaluator ros, ROS arguments follow --ros-args (e.g. --ros-args -r __ns:=/sim1 \
+-r ga_step/candidate:=/webots/candidate).",
     version
 )]
 pub struct Cli {
     /// Individuals per generation (and children made per generation).
-    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(2..=100_000))]
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(2..=MAX_POPULATION as i64))]
     pub population: u32,
     /// Generations to run at most (generation 0 is the initial population).
     #[arg(long, value_name = "G")]
@@ -92,9 +101,15 @@ pub struct Cli {
     /// Threads evaluating the physics (0: one per core).
     #[arg(long, value_name = "K", default_value_t = 0)]
     pub threads: usize,
-    /// Seconds to wait for an external simulator's answer to one candidate (--evaluator ros).
+    /// Seconds to wait for an external simulator's answer to one candidate, and for a simulator
+    /// to appear (--evaluator ros); at most 86400.
     #[arg(long, value_name = "SECONDS", default_value_t = 30.0)]
     pub eval_timeout: f64,
+    /// Parameter file of the robot, the fitness and the algorithm (params/nao_step.yaml's
+    /// form); without it the built-in defaults, which are that file's values. A resume must
+    /// repeat it.
+    #[arg(long, value_name = "FILE")]
+    pub params: Option<PathBuf>,
     /// Stop when the mean fitness rose by less than 0.1 % over this many generations; 0 turns
     /// the rule off (default 20, params/nao_step.yaml). A resume must repeat it.
     #[arg(long, value_name = "N")]
@@ -145,16 +160,20 @@ impl Summary {
     }
 }
 
-/// The setup the command line asks for.
-pub fn setup_of(cli: &Cli) -> GaSetup {
-    let mut setup = GaSetup::default();
+/// The setup the command line asks for: the parameter file's (or the defaults) with the
+/// options' population, crossover and level window.
+pub fn setup_of(cli: &Cli) -> anyhow::Result<GaSetup> {
+    let mut setup = match &cli.params {
+        Some(path) => crate::params::read_setup(path)?,
+        None => GaSetup::default(),
+    };
     setup.ga.population = cli.population as usize;
     setup.ga.offspring = cli.population as usize;
     setup.ga.crossover = cli.crossover.into();
     if let Some(w) = cli.level_window {
         setup.ga.level_window = w;
     }
-    setup
+    Ok(setup)
 }
 
 /// Checks that `dir` can be written: creates it, writes and removes a probe file.
@@ -166,56 +185,66 @@ fn check_writable(dir: &Path) -> anyhow::Result<()> {
     Ok(())
 }
 
-/// Reads the checkpoint in `dir` and checks that it is the run the command line names.
-fn resume_state(cli: &Cli, setup: &GaSetup) -> anyhow::Result<GaState> {
-    let path = cli.out.join(CHECKPOINT);
-    let state =
-        mobil_ga_step::read_checkpoint(&path).map_err(|e| anyhow!("cannot resume from {}: {e}", path.display()))?;
+/// What differs between a checkpoint's run and the one the command line asks for, one phrase
+/// each (empty: the same run).
+fn run_differences(
+    state: &GaState,
+    recorded: &EvaluatorTag,
+    cli: &Cli,
+    setup: &GaSetup,
+    asked: &EvaluatorTag,
+) -> Vec<String> {
     let mut differences = Vec::new();
-    if state.seed != cli.seed {
-        differences.push(format!("seed {} (asked {})", state.seed, cli.seed));
-    }
-    if state.setup.ga.population != setup.ga.population || state.setup.ga.offspring != setup.ga.offspring {
-        differences.push(format!(
-            "population {} (asked {})",
-            state.setup.ga.population, setup.ga.population
-        ));
-    }
-    if state.setup.ga.crossover != setup.ga.crossover {
-        differences.push(format!(
-            "crossover {} (asked {})",
-            state.setup.ga.crossover, setup.ga.crossover
-        ));
-    }
-    if state.setup.fitness.distance_on_fall != setup.fitness.distance_on_fall {
-        let shape = |on: bool| {
-            if on {
-                "distance counted on a fall"
-            } else {
-                "distance counted only without a fall"
-            }
-        };
-        differences.push(format!(
-            "fitness {} (asked {})",
-            shape(state.setup.fitness.distance_on_fall),
-            shape(setup.fitness.distance_on_fall)
-        ));
-    }
-    if state.setup.ga.level_window != setup.ga.level_window {
-        differences.push(format!(
-            "level window {} (asked {})",
-            state.setup.ga.level_window, setup.ga.level_window
-        ));
-    }
-    if state.setup.fitness.backward_allowance != setup.fitness.backward_allowance {
-        differences.push(format!(
-            "fitness backward allowance {} m (asked {} m)",
-            state.setup.fitness.backward_allowance, setup.fitness.backward_allowance
-        ));
-    }
+    let mut differ = |same: bool, what: &str, theirs: String, ours: String| {
+        if !same {
+            differences.push(format!("{what} {theirs} (asked {ours})"));
+        }
+    };
+    differ(recorded == asked, "evaluator", recorded.to_string(), asked.to_string());
+    differ(
+        state.seed == cli.seed,
+        "seed",
+        state.seed.to_string(),
+        cli.seed.to_string(),
+    );
+    let (was, now) = (&state.setup.ga, &setup.ga);
+    differ(
+        was.population == now.population && was.offspring == now.offspring,
+        "population",
+        was.population.to_string(),
+        now.population.to_string(),
+    );
+    differ(
+        was.crossover == now.crossover,
+        "crossover",
+        was.crossover.to_string(),
+        now.crossover.to_string(),
+    );
+    differ(
+        was.level_window == now.level_window,
+        "level window",
+        was.level_window.to_string(),
+        now.level_window.to_string(),
+    );
+    let (was_f, now_f) = (&state.setup.fitness, &setup.fitness);
+    differ(
+        was_f.distance_on_fall == now_f.distance_on_fall && was_f.backward_allowance == now_f.backward_allowance,
+        "fitness",
+        was_f.shape(),
+        now_f.shape(),
+    );
     if differences.is_empty() && state.setup != *setup {
-        differences.push("other parameters of the robot, the algorithm or the fitness".to_owned());
+        differences.push("other parameters of the robot, the algorithm or the fitness (--params)".to_owned());
     }
+    differences
+}
+
+/// Reads the checkpoint in `dir` and checks that it is the run the command line names.
+fn resume_state(cli: &Cli, setup: &GaSetup, asked: &EvaluatorTag) -> anyhow::Result<GaState> {
+    let path = cli.out.join(CHECKPOINT);
+    let (state, recorded) = mobil_ga_step::read_checkpoint_tagged(&path)
+        .map_err(|e| anyhow!("cannot resume from {}: {e}", path.display()))?;
+    let differences = run_differences(&state, &recorded, cli, setup, asked);
     if !differences.is_empty() {
         bail!(
             "the checkpoint in {} is of another run: {}",
@@ -241,29 +270,46 @@ impl Chosen {
     }
 
     /// The error that stopped an external evaluator (its evaluations since are void).
-    fn failure(&self) -> Option<String> {
+    fn failure(&self) -> Option<RosEvalError> {
         match self {
             Chosen::Physics(_) => None,
-            Chosen::Ros(r) => r.failure().map(|e| e.to_string()),
+            Chosen::Ros(r) => r.failure(),
         }
     }
 }
 
-/// Runs the command line to its end. `interrupt` is polled between generations.
-pub fn run(cli: &Cli, interrupt: &AtomicBool) -> anyhow::Result<Summary> {
+/// The evaluator `arg` names, as a checkpoint records it.
+pub fn evaluator_tag(arg: EvaluatorArg) -> EvaluatorTag {
+    match arg {
+        EvaluatorArg::Physics => EvaluatorTag::Physics {
+            physics_version: PHYSICS_VERSION,
+        },
+        EvaluatorArg::Ros => EvaluatorTag::Ros,
+    }
+}
+
+/// An interrupt that came before generation 0 was whole: nothing was written.
+#[derive(Debug, thiserror::Error)]
+#[error("interrupted during generation 0; nothing written")]
+pub struct InterruptedBeforeStart;
+
+/// Runs the command line to its end. `interrupt` is polled between generations, and by the ROS
+/// evaluator while it waits; `ros_args` name, place and remap the ROS evaluator's node.
+pub fn run(cli: &Cli, ros_args: &RosArgs, interrupt: &Arc<AtomicBool>) -> anyhow::Result<Summary> {
     let started = Instant::now();
-    let setup = setup_of(cli);
+    let setup = setup_of(cli)?;
     setup.validate().map_err(|e| anyhow!("{e}"))?;
-    if !(cli.eval_timeout.is_finite() && cli.eval_timeout > 0.0) {
+    if !(cli.eval_timeout.is_finite() && cli.eval_timeout > 0.0 && cli.eval_timeout <= MAX_EVAL_TIMEOUT_S) {
         bail!(
-            "--eval-timeout must be a positive number of seconds, not {}",
+            "--eval-timeout must be a number of seconds within (0, {MAX_EVAL_TIMEOUT_S}], not {}",
             cli.eval_timeout
         );
     }
-    check_writable(&cli.out)?;
+    let tag = evaluator_tag(cli.evaluator);
+    // The checkpoint is judged before anything is created in DIR.
     let checkpoint = cli.out.join(CHECKPOINT);
     let resumed = if cli.resume {
-        Some(resume_state(cli, &setup)?)
+        Some(resume_state(cli, &setup, &tag)?)
     } else {
         if checkpoint.exists() {
             bail!(
@@ -273,6 +319,8 @@ pub fn run(cli: &Cli, interrupt: &AtomicBool) -> anyhow::Result<Summary> {
         }
         None
     };
+    check_writable(&cli.out)?;
+    outputs::remove_temporaries(&cli.out);
     let (chosen, threads) = match cli.evaluator {
         EvaluatorArg::Physics => (
             Chosen::Physics(Box::new(
@@ -286,6 +334,8 @@ pub fn run(cli: &Cli, interrupt: &AtomicBool) -> anyhow::Result<Summary> {
                     setup.model.clone(),
                     setup.fitness.clone(),
                     Duration::from_secs_f64(cli.eval_timeout),
+                    ros_args,
+                    interrupt.clone(),
                 )
                 .context("cannot start the ROS 2 evaluator")?,
             )),
@@ -314,31 +364,42 @@ pub fn run(cli: &Cli, interrupt: &AtomicBool) -> anyhow::Result<Summary> {
         Some(state) => state,
         None => {
             let state = GaState::start(setup, cli.seed, evaluator, threads).map_err(|e| anyhow!("{e}"))?;
-            if let Some(e) = chosen.failure() {
-                bail!("{e}");
+            match chosen.failure() {
+                Some(RosEvalError::Interrupted(_)) => return Err(InterruptedBeforeStart.into()),
+                Some(e) => bail!("{e}"),
+                None => {}
             }
-            outputs::write_all(&cli.out, &state)?;
+            outputs::write_all(&cli.out, &state, &tag)?;
             state
         }
     };
     // A resumed run rewrites its outputs from the checkpoint (they may be older than it).
     if cli.resume {
-        outputs::write_all(&cli.out, &state)?;
+        outputs::write_all(&cli.out, &state, &tag)?;
     }
     bar.reset_eta();
     show(&bar, &state);
 
     let mut failure: Option<anyhow::Error> = None;
+    // Set when the generation just made is void (an interrupted external evaluation).
+    let mut lost = false;
     let reason = if interrupt.load(Ordering::SeqCst) {
         StopReason::Interrupted
     } else {
         state.run(evaluator, threads, cli.generations, |s| {
-            if let Some(e) = chosen.failure() {
+            match chosen.failure() {
                 // The generation just made holds void evaluations: keep the last checkpoint.
-                failure = Some(anyhow!("{e}"));
-                return ControlFlow::Break(());
+                Some(RosEvalError::Interrupted(_)) => {
+                    lost = true;
+                    return ControlFlow::Break(());
+                }
+                Some(e) => {
+                    failure = Some(anyhow!("{e}"));
+                    return ControlFlow::Break(());
+                }
+                None => {}
             }
-            if let Err(e) = outputs::write_all(&cli.out, s) {
+            if let Err(e) = outputs::write_all(&cli.out, s, &tag) {
                 failure = Some(e);
                 return ControlFlow::Break(());
             }
@@ -354,14 +415,19 @@ pub fn run(cli: &Cli, interrupt: &AtomicBool) -> anyhow::Result<Summary> {
     if let Some(e) = failure {
         return Err(e);
     }
-    let best = state.best();
+    // The generation the outputs hold: the one before a lost one.
+    let generation = if lost { state.generation - 1 } else { state.generation };
+    let row = state
+        .history
+        .get(generation as usize)
+        .ok_or_else(|| anyhow!("no statistics of generation {generation}"))?;
     Ok(Summary {
         reason,
-        generation: state.generation,
-        best_fitness: best.fitness(),
-        best_fell: best.evaluation.fell,
-        best_forward: best.evaluation.forward_distance,
-        first_step_generation: state.first_step_generation,
+        generation,
+        best_fitness: row.max,
+        best_fell: row.best_fell,
+        best_forward: row.best_forward,
+        first_step_generation: state.first_step_generation.filter(|g| *g <= generation),
         wall: started.elapsed(),
     })
 }

@@ -6,6 +6,7 @@ use std::process::{Command, Output, Stdio};
 use std::time::{Duration, Instant};
 
 const BIN: &str = env!("CARGO_BIN_EXE_ga_step");
+const PARAMS: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../../params/nao_step.yaml");
 
 fn scratch(name: &str) -> PathBuf {
     let dir = std::env::temp_dir().join(format!("ga_step_cli_{}_{name}", std::process::id()));
@@ -169,6 +170,117 @@ fn ctrl_c_loses_at_most_the_generation_in_flight_and_the_run_resumes_to_the_same
     let _ = std::fs::remove_dir_all(&stopped);
 }
 
+/// With `--evaluator ros` and no simulator, Ctrl-C stops the wait for one at once (not after
+/// the 30 s timeout): status 130, nothing written.
+#[test]
+fn ctrl_c_reaches_the_ros_evaluator() {
+    let dir = scratch("ctrl_c_ros");
+    let domain = (200 + std::process::id() % 30).to_string();
+    let child = Command::new(BIN)
+        .args([
+            "--population",
+            "4",
+            "--generations",
+            "2",
+            "--seed",
+            "1",
+            "--crossover",
+            "blx",
+        ])
+        .args([
+            "--out",
+            dir.to_str().unwrap(),
+            "--evaluator",
+            "ros",
+            "--eval-timeout",
+            "30",
+        ])
+        .env("ROS_DOMAIN_ID", &domain)
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    std::thread::sleep(Duration::from_millis(1500));
+    let t = Instant::now();
+    interrupt(&child);
+    let o = child.wait_with_output().unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(t.elapsed() < Duration::from_secs(5), "{:?} {err}", t.elapsed());
+    assert_eq!(o.status.code(), Some(130), "{err}");
+    assert!(
+        err.contains("interrupted during generation 0; nothing written"),
+        "{err}"
+    );
+    assert!(!dir.join("checkpoint.json").exists());
+    assert!(!dir.join("fitness.csv").exists());
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// Sends SIGINT to a child process.
+fn interrupt(child: &std::process::Child) {
+    let kill = Command::new("kill")
+        .args(["-INT", &child.id().to_string()])
+        .status()
+        .unwrap();
+    assert!(kill.success());
+}
+
+/// Ctrl-C during generation 0 (a population of 200 takes the physics seconds): the generation
+/// is finished and written whole. Ctrl-C twice: the process ends at once (well before the 40
+/// generations), with status 130, and every file in DIR is whole: no `.tmp`, and the
+/// checkpoint, if one was written, reads back.
+#[test]
+fn ctrl_c_during_generation_0_and_a_second_ctrl_c_leave_whole_files() {
+    let spawn = |dir: &Path, generations: &str| {
+        Command::new(BIN)
+            .args(["--population", "200", "--generations", generations, "--seed", "3"])
+            .args(["--crossover", "blx", "--threads", "1", "--out", dir.to_str().unwrap()])
+            .stdout(Stdio::piped())
+            .stderr(Stdio::piped())
+            .spawn()
+            .unwrap()
+    };
+    // Once, during generation 0: generation 0 is kept.
+    let once = scratch("ctrl_c_once");
+    let child = spawn(&once, "40");
+    std::thread::sleep(Duration::from_millis(300));
+    assert_eq!(checkpoint_generation(&once), 0);
+    assert!(
+        !once.join("checkpoint.json").exists(),
+        "generation 0 done too soon for this test"
+    );
+    interrupt(&child);
+    let o = child.wait_with_output().unwrap();
+    assert_eq!(o.status.code(), Some(130), "{}", String::from_utf8_lossy(&o.stderr));
+    let v: serde_json::Value = serde_json::from_str(&read(&once.join("checkpoint.json"))).unwrap();
+    assert_eq!(v["generation"], serde_json::json!(0));
+    assert_eq!(read(&once.join("fitness.csv")).lines().count(), 2);
+    no_temporaries(&once);
+
+    // Twice, during the writes of the later generations: ends at once, files whole.
+    let twice = scratch("ctrl_c_twice");
+    let child = spawn(&twice, "40");
+    let deadline = Instant::now() + Duration::from_secs(120);
+    while checkpoint_generation(&twice) < 1 {
+        assert!(Instant::now() < deadline, "no checkpoint of generation 1 within 120 s");
+        std::thread::sleep(Duration::from_millis(5));
+    }
+    interrupt(&child);
+    std::thread::sleep(Duration::from_millis(20));
+    interrupt(&child);
+    let t = Instant::now();
+    let o = child.wait_with_output().unwrap();
+    assert!(t.elapsed() < Duration::from_secs(5), "{:?}", t.elapsed());
+    assert_eq!(o.status.code(), Some(130), "{}", String::from_utf8_lossy(&o.stderr));
+    assert!(checkpoint_generation(&twice) < 40);
+    no_temporaries(&twice);
+    let state = mobil_ga_step::read_checkpoint(&twice.join("checkpoint.json")).unwrap();
+    let csv = read(&twice.join("fitness.csv"));
+    assert!(csv.lines().count() as u32 >= state.generation + 2, "{csv}");
+    let _ = std::fs::remove_dir_all(&once);
+    let _ = std::fs::remove_dir_all(&twice);
+}
+
 #[test]
 fn bad_options_are_one_line_errors() {
     let dir = scratch("options");
@@ -236,6 +348,100 @@ fn bad_options_are_one_line_errors() {
         d,
     ]);
     one_line_error(&o, 2, "");
+    // Beyond the population cap (10 000).
+    let o = ga_step(&[
+        "--population",
+        "10001",
+        "--generations",
+        "1",
+        "--seed",
+        "1",
+        "--crossover",
+        "blx",
+        "--out",
+        d,
+    ]);
+    one_line_error(&o, 2, "--population");
+    // A timeout beyond a day (1e20 s once overflowed the clock), or not a positive number.
+    for t in ["1e20", "86401", "0", "NaN", "inf"] {
+        let o = ga_step(&[
+            "--population",
+            "4",
+            "--generations",
+            "1",
+            "--seed",
+            "1",
+            "--crossover",
+            "blx",
+            "--out",
+            d,
+            "--evaluator",
+            "ros",
+            "--eval-timeout",
+            t,
+        ]);
+        one_line_error(&o, 1, "--eval-timeout must be a number of seconds within (0, 86400]");
+    }
+    // A parameter file with an unknown key, a bad value, or none at all.
+    std::fs::create_dir_all(std::env::temp_dir()).unwrap();
+    let bad = std::env::temp_dir().join(format!("ga_step_cli_{}_bad.yaml", std::process::id()));
+    let shipped = read(Path::new(PARAMS));
+    for (text, want) in [
+        (
+            shipped.replace("blx_alpha:", "blx_alfa:"),
+            "unknown parameter `blx_alfa`",
+        ),
+        (shipped.replace("fall_height: 0.20", "fall_height: -1"), "fall_height"),
+    ] {
+        std::fs::write(&bad, text).unwrap();
+        let o = ga_step(&[
+            "--population",
+            "4",
+            "--generations",
+            "1",
+            "--seed",
+            "1",
+            "--crossover",
+            "blx",
+            "--out",
+            d,
+            "--params",
+            bad.to_str().unwrap(),
+        ]);
+        one_line_error(&o, 1, want);
+    }
+    std::fs::remove_file(&bad).unwrap();
+    let o = ga_step(&[
+        "--population",
+        "4",
+        "--generations",
+        "1",
+        "--seed",
+        "1",
+        "--crossover",
+        "blx",
+        "--out",
+        d,
+        "--params",
+        "/nonexistent/nao.yaml",
+    ]);
+    one_line_error(&o, 1, "cannot read /nonexistent/nao.yaml");
+    // A malformed ROS argument.
+    let o = ga_step(&[
+        "--population",
+        "4",
+        "--generations",
+        "1",
+        "--seed",
+        "1",
+        "--crossover",
+        "blx",
+        "--out",
+        d,
+        "--ros-args",
+        "-r",
+    ]);
+    one_line_error(&o, 2, "`-r` needs a value");
     assert!(!dir.exists(), "a refused command line created {d}");
     // --help documents every option.
     let o = ga_step(&["--help"]);
@@ -260,9 +466,11 @@ fn bad_options_are_one_line_errors() {
 #[test]
 fn a_missing_foreign_or_other_runs_checkpoint_is_refused_and_left_alone() {
     let dir = scratch("checkpoints");
-    // Nothing to resume.
+    // Nothing to resume: refused before anything is created.
     let o = run(&dir, 4, 2, 1, &["--resume"]);
     one_line_error(&o, 1, "cannot resume");
+    assert!(!dir.exists(), "a refused resume created {}", dir.display());
+    std::fs::create_dir_all(&dir).unwrap();
     // A foreign file.
     std::fs::write(dir.join("checkpoint.json"), "{\"hello\": 1}").unwrap();
     let o = run(&dir, 4, 2, 1, &["--resume"]);
@@ -289,7 +497,7 @@ fn a_missing_foreign_or_other_runs_checkpoint_is_refused_and_left_alone() {
     one_line_error(
         &o,
         1,
-        "fitness distance counted on a fall (asked distance counted only without a fall)",
+        "fitness distance counted on a fall, backward allowance 1 m (asked distance counted only without a fall, backward allowance 1 m)",
     );
     assert_eq!(read(&dir.join("checkpoint.json")), other_shape);
     // The same run evolved under the previous upright shape (no backward allowance).
@@ -298,13 +506,53 @@ fn a_missing_foreign_or_other_runs_checkpoint_is_refused_and_left_alone() {
     let other_shape = v.to_string();
     std::fs::write(dir.join("checkpoint.json"), &other_shape).unwrap();
     let o = run(&dir, 4, 2, 1, &["--resume"]);
-    one_line_error(&o, 1, "fitness backward allowance 0 m (asked 1 m)");
+    one_line_error(
+        &o,
+        1,
+        "backward allowance 0 m (asked distance counted only without a fall, backward allowance 1 m)",
+    );
     assert_eq!(read(&dir.join("checkpoint.json")), other_shape);
     std::fs::write(dir.join("checkpoint.json"), &before).unwrap();
     // The levelling rule is part of the run: a resume with another window is refused.
     let o = run(&dir, 4, 2, 1, &["--resume", "--level-window", "0"]);
     one_line_error(&o, 1, "level window 20 (asked 0)");
     assert_eq!(read(&dir.join("checkpoint.json")), before);
+    // Another evaluator: the checkpoint records the physics at its version, this asks for ros.
+    let v: serde_json::Value = serde_json::from_str(&before).unwrap();
+    let version = mobil_ga_step_sim::PHYSICS_VERSION;
+    assert_eq!(
+        v["evaluator"],
+        serde_json::json!({"kind": "physics", "physics_version": version})
+    );
+    let o = run(&dir, 4, 2, 1, &["--resume", "--evaluator", "ros"]);
+    one_line_error(
+        &o,
+        1,
+        &format!("evaluator physics (model version {version}) (asked ros (an external simulator))"),
+    );
+    // Another version of the physics model.
+    let mut v: serde_json::Value = serde_json::from_str(&before).unwrap();
+    v["evaluator"]["physics_version"] = serde_json::json!(version + 1);
+    let other_physics = v.to_string();
+    std::fs::write(dir.join("checkpoint.json"), &other_physics).unwrap();
+    let o = run(&dir, 4, 2, 1, &["--resume"]);
+    one_line_error(
+        &o,
+        1,
+        &format!(
+            "evaluator physics (model version {}) (asked physics (model version {version}))",
+            version + 1
+        ),
+    );
+    assert_eq!(read(&dir.join("checkpoint.json")), other_physics);
+    // Another parameter file: refused as other parameters.
+    std::fs::write(dir.join("checkpoint.json"), &before).unwrap();
+    let params = dir.join("slow.yaml");
+    let shipped = read(Path::new(PARAMS));
+    std::fs::write(&params, shipped.replace("step_time: 2.0", "step_time: 2.4")).unwrap();
+    let o = run(&dir, 4, 2, 1, &["--resume", "--params", params.to_str().unwrap()]);
+    one_line_error(&o, 1, "other parameters");
+    std::fs::remove_file(&params).unwrap();
     // A new run over an existing one.
     let o = run(&dir, 4, 2, 1, &[]);
     one_line_error(&o, 1, "already holds a run");

@@ -38,6 +38,11 @@ pub mod body;
 
 pub use body::{BodyParams, LegMasses};
 
+/// The version of the physics model (body, solver, fall test, motors): a checkpoint records it,
+/// and a run scored under another version is not resumed, as the same individual scores
+/// differently. Raise it with every change that moves a score.
+pub const PHYSICS_VERSION: u32 = 1;
+
 use body::{is_roll, leg_chain};
 use mobil_ga_step::{Evaluation, Evaluator, FitnessConfig, GaError, Individual, NaoModel, Servo, SERVO_COUNT};
 use rapier3d::prelude::*;
