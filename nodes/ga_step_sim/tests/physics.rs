@@ -345,7 +345,7 @@ fn finer(k: usize) -> PhysicsEvaluator {
 fn bobbing_in_place_on_both_feet_goes_nowhere() {
     // Both legs bob ±0.15 rad of hip and ankle pitch (±0.3 rad of knee) at 1.25 Hz, 2.5
     // cycles in the 2 s step: hip + knee + ankle pitch stays 0, the torso upright over flat
-    // feet, rising and sinking some 2 cm. The fastest knee knot slope, 0.3·sin(π/4)/0.1 s
+    // feet, rising and sinking. The fastest knee knot slope, 0.3·sin(π/4)/0.1 s
     // = 2.1 rad/s, is within the 6.4 rad/s slew limit. Nothing in the motion pushes along x or y,
     // so the torso must end where it started: within 1 cm (a quarter of a 4 cm step), with
     // neither foot slipping.
@@ -368,8 +368,8 @@ fn bobbing_in_place_on_both_feet_goes_nowhere() {
         assert!(!o.fell, "{o:?}");
         assert!(o.forward_distance.abs() < 0.01, "{o:?}");
         assert!(o.lateral_distance.abs() < 0.01, "{o:?}");
-        // It did bob: the torso sank by at least 1 cm (the knees' 0.3 rad bend lowers it
-        // about 0.2029·(cos 0.4 − cos 0.55) = 1.6 cm).
+        // It did bob: the torso sank by at least 1 cm (thigh and shank at 0.55 rad from the
+        // vertical instead of 0.4 lower it by 0.2029·(cos 0.4 − cos 0.55) = 1.4 cm).
         assert!(lowest < o.start_height - 0.01, "lowest {lowest} {o:?}");
         // Both feet stayed loaded, and no sole slid faster than 1 cm/s.
         assert!(unloaded < 0.05, "a foot carried under 5 N for {unloaded} s");
