@@ -75,19 +75,27 @@ pub struct BodyParams {
     pub leg: LegMasses,
     /// Radius of the thigh and tibia capsules (m) for their inertia and collisions.
     pub limb_radius: f64,
-    /// Stall torque of the pitch joints (hip, knee, ankle pitch; N·m): Nao's leg motor (RE-Max
-    /// 24, stall 59.5 mN·m) through the type B reduction 130.85 gives 7.78 N·m (Aldebaran,
-    /// "Motors", without the gearbox's efficiency).
+    /// Continuous torque of the pitch joints (hip, knee, ankle pitch; N·m): Nao's leg motor
+    /// (RE-Max 24, nominal torque 12.3 mN·m) through the type B reduction 130.85 gives 1.61 N·m
+    /// (Aldebaran, "Motors", without the gearbox's efficiency). The motor delivers it
+    /// continuously; the stall torque is a momentary figure that would burn the winding.
     pub pitch_max_torque: f64,
-    /// Stall torque of the roll joints (hip, ankle roll; N·m): the same motor through the type A
-    /// reduction 201.3, 11.97 N·m.
+    /// Continuous torque of the roll joints (hip, ankle roll; N·m): the same motor through the
+    /// type A reduction 201.3, 2.47 N·m.
     pub roll_max_torque: f64,
+    /// Stall torque of the pitch joints (N·m): 59.5 mN·m × 130.85 = 7.78 N·m. It only fixes the
+    /// slope of the DC motor's torque–speed line, τ_stall·(1 − ω/ω₀), which caps the torque
+    /// above the nominal speed (290.25 °/s, where the line passes 1.62 N·m, the nominal torque).
+    pub pitch_stall_torque: f64,
+    /// Stall torque of the roll joints (N·m): 59.5 mN·m × 201.3 = 11.97 N·m.
+    pub roll_stall_torque: f64,
     /// No-load speed of the pitch joints (rad/s): 366.83 °/s = 6.40 rad/s (same page). The
     /// servo's target moves no faster.
     pub pitch_max_speed: f64,
     /// No-load speed of the roll joints (rad/s): 238.45 °/s = 4.16 rad/s.
     pub roll_max_speed: f64,
-    /// Servo stiffness (N·m/rad): the full stall torque at 0.05 rad of error (pitch).
+    /// Servo stiffness (N·m/rad): the stall torque at 0.05 rad of error (pitch); the continuous
+    /// torque is reached at 0.01 rad.
     pub servo_stiffness: f64,
     /// Servo damping (N·m·s/rad), about critical for a leg's inertia about the hip.
     pub servo_damping: f64,
@@ -95,8 +103,12 @@ pub struct BodyParams {
     pub friction: f64,
     /// Simulation step (s).
     pub dt: f64,
-    /// Solver iterations per step (rapier's `num_solver_iterations`).
+    /// Solver iterations per step (rapier's `num_solver_iterations`: substeps of the
+    /// soft-constraint solver).
     pub solver_iterations: usize,
+    /// Projected Gauss–Seidel passes within each solver iteration (rapier's
+    /// `num_internal_pgs_iterations`).
+    pub pgs_iterations: usize,
 }
 
 impl Default for BodyParams {
@@ -123,8 +135,10 @@ impl Default for BodyParams {
             torso_box: [0.10, 0.20, 0.30],
             leg,
             limb_radius: 0.030,
-            pitch_max_torque: 7.78,
-            roll_max_torque: 11.97,
+            pitch_max_torque: 1.61,
+            roll_max_torque: 2.47,
+            pitch_stall_torque: 7.78,
+            roll_stall_torque: 11.97,
             pitch_max_speed: 366.83_f64.to_radians(),
             roll_max_speed: 238.45_f64.to_radians(),
             servo_stiffness: 7.78 / 0.05,
@@ -132,17 +146,40 @@ impl Default for BodyParams {
             friction: 0.8,
             dt: 0.005,
             solver_iterations: 4,
+            pgs_iterations: 2,
         }
     }
 }
 
 impl BodyParams {
-    /// The joint's torque limit (N·m).
+    /// The joint's continuous torque limit (N·m).
     pub fn max_torque(&self, servo: Servo) -> f64 {
         if is_roll(servo) {
             self.roll_max_torque
         } else {
             self.pitch_max_torque
+        }
+    }
+
+    /// The joint's stall torque (N·m), the torque–speed line's value at rest.
+    pub fn stall_torque(&self, servo: Servo) -> f64 {
+        if is_roll(servo) {
+            self.roll_stall_torque
+        } else {
+            self.pitch_stall_torque
+        }
+    }
+
+    /// The torque the joint's motor can give at joint speed `omega` (rad/s): the continuous
+    /// torque, cut by the DC motor's line τ_stall·(1 − |ω|/ω₀) while it drives the joint the
+    /// way it turns (`driving`), to 0 at the no-load speed ω₀. While it brakes, the continuous
+    /// torque.
+    pub fn torque_limit(&self, servo: Servo, omega: f64, driving: bool) -> f64 {
+        let max = self.max_torque(servo);
+        if driving {
+            max.min(self.stall_torque(servo) * (1.0 - omega.abs() / self.max_speed(servo)).max(0.0))
+        } else {
+            max
         }
     }
 

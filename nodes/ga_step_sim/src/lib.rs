@@ -15,18 +15,28 @@
 //! with the links they are jointed to.
 //!
 //! **The servos**: revolute joints of a rapier multibody (reduced coordinates: the chain cannot
-//! drift apart), each a position motor (stiffness 156 N·m/rad, damping 3 N·m·s/rad) whose force
-//! is capped as a DC motor's: Nao's stall torque (7.78 N·m pitch, 11.97 N·m roll) at rest,
-//! falling linearly to 0 at the no-load speed (6.40 rad/s pitch, 4.16 rad/s roll) while the motor
-//! drives the joint the way it turns, the stall torque while it brakes; Table 1's limits; the
-//! commanded angle moves towards the trajectory no faster than the no-load speed. (With the
-//! stall torque at every speed, evolution found lunges that carried the torso 0.7 m forward in
-//! 1.4 s, several times Nao's walking speed.)
+//! drift apart), each a position motor (stiffness 156 N·m/rad, damping 3 N·m·s/rad) whose torque
+//! is what Nao's motor gives continuously: the nominal torque (1.61 N·m pitch, 2.47 N·m roll),
+//! cut above the nominal speed by the DC motor's torque–speed line (stall torque 7.78 / 11.97
+//! N·m at rest, 0 at the no-load speed 6.40 / 4.16 rad/s) while the motor drives the joint the
+//! way it turns; Table 1's limits; the commanded angle moves towards the trajectory no faster
+//! than the no-load speed ([`BodyParams::torque_limit`]). Joint signs are Nao's (Aldebaran,
+//! "H25 – Joints": every joint frame is the torso's at the zero pose, roll turns about x, pitch
+//! about y, right-handed): a negative hip pitch swings the leg forward, a positive knee bends it
+//! back, a positive ankle roll lifts the foot's left edge ([`PhysicsEvaluator::reach`]).
 //!
-//! **A fall**: the torso frame below `fall_height` (0.20 m; it starts about 0.31 m up) or its
-//! vertical axis tilted more than `fall_tilt` (0.5 rad) from the vertical, tested after every
-//! 5 ms step; the simulation ends there. A non-finite state counts as a fall at that time.
-//! Δx is the torso frame's displacement along x (forward) from the start to the end or the fall.
+//! **A fall**, tested after every step; the simulation ends there: the torso frame below
+//! `fall_height` (0.20 m; it starts about 0.32 m up), its vertical axis tilted more than
+//! `fall_tilt` (0.5 rad) from the vertical, or any body but the two feet touching the floor (a
+//! knee, a shank, a thigh, the torso). A non-finite state counts as a fall at that time. Δx is
+//! the torso frame's displacement along x (forward) from the start to the end or the fall.
+//!
+//! **The solver**: 5 ms steps, 4 solver iterations (substeps) of 2 projected Gauss–Seidel
+//! passes each. With 1 pass (rapier's default) the friction does not converge: a standing robot
+//! crept 11 mm in 3 s and evolved motions travelled 0.3–0.6 m by hopping and sliding, motions
+//! that fall at any finer setting; with 2 passes the outcomes of standing, bobbing in place and
+//! those motions match those at a quarter of the step with four times the iterations (the
+//! README's table), at the same cost.
 //!
 //! **Determinism**: each evaluation builds its own world and steps it on the calling thread;
 //! rapier is built with `enhanced-determinism`, so the same individual gives the same
@@ -35,6 +45,16 @@
 #![warn(missing_docs)]
 
 pub mod body;
+pub mod motions;
+
+/// The version of the simulated physics. A checkpoint records it, and a run made under another
+/// is not resumed: the same individual scores differently.
+///
+/// 2: Nao's continuous (nominal) motor torque instead of its stall torque; two Gauss–Seidel
+/// passes per solver iteration, so that friction converges (the standing robot no longer
+/// creeps, motions no longer travel by sliding); a floor contact of any body but the feet is a
+/// fall. 1 was the first evaluator.
+pub const PHYSICS_VERSION: u32 = 2;
 
 pub use body::{BodyParams, LegMasses};
 
@@ -63,11 +83,27 @@ pub enum SimError {
     },
 }
 
+/// What ended a simulation early.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum FallCause {
+    /// The torso frame sank below `fall_height`.
+    Height,
+    /// The torso's vertical axis tilted beyond `fall_tilt`.
+    Tilt,
+    /// A body other than a foot touched the floor (a knee, a shin, a thigh, the torso, a hip or
+    /// ankle link).
+    Contact,
+    /// The state stopped being finite.
+    NonFinite,
+}
+
 /// What one simulated step did, in more detail than an [`Evaluation`].
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct SimOutcome {
     /// Whether the robot fell.
     pub fell: bool,
+    /// Why it fell, if it did.
+    pub cause: Option<FallCause>,
     /// Time of the fall (s), or the simulated time T_sim without one.
     pub t_end: f64,
     /// Torso frame's displacement along x (forward, m) at the end or the fall.
@@ -147,6 +183,8 @@ impl PhysicsEvaluator {
             ("limb_radius", b.limb_radius),
             ("pitch_max_torque", b.pitch_max_torque),
             ("roll_max_torque", b.roll_max_torque),
+            ("pitch_stall_torque", b.pitch_stall_torque),
+            ("roll_stall_torque", b.roll_stall_torque),
             ("pitch_max_speed", b.pitch_max_speed),
             ("roll_max_speed", b.roll_max_speed),
             ("servo_stiffness", b.servo_stiffness),
@@ -219,6 +257,7 @@ impl PhysicsEvaluator {
         let start = robot.torso_pose();
         let mut out = SimOutcome {
             fell: false,
+            cause: None,
             t_end: duration,
             forward_distance: 0.0,
             lateral_distance: 0.0,
@@ -257,6 +296,7 @@ impl PhysicsEvaluator {
             out.steps = n;
             if !pose.is_finite() {
                 out.fell = true;
+                out.cause = Some(FallCause::NonFinite);
                 out.t_end = t;
                 break;
             }
@@ -264,11 +304,87 @@ impl PhysicsEvaluator {
             out.lateral_distance = pose.y - start.y;
             out.end_height = pose.z;
             out.max_tilt = out.max_tilt.max(pose.tilt);
-            if pose.z < self.fitness.fall_height || pose.tilt > self.fitness.fall_tilt {
+            let cause = if pose.z < self.fitness.fall_height {
+                Some(FallCause::Height)
+            } else if pose.tilt > self.fitness.fall_tilt {
+                Some(FallCause::Tilt)
+            } else if robot.touches_floor_off_the_feet() {
+                Some(FallCause::Contact)
+            } else {
+                None
+            };
+            if cause.is_some() {
                 out.fell = true;
+                out.cause = cause;
                 out.t_end = t;
                 break;
             }
+        }
+        out
+    }
+}
+
+/// Where a held leg's points end up, relative to the torso frame (m; x forward, y left, z up),
+/// right leg first.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct LegPoints {
+    /// The knee joints (the tibias' origins).
+    pub knees: [[f64; 3]; 2],
+    /// The ankle joints (the feet's origins).
+    pub ankles: [[f64; 3]; 2],
+    /// The centres of the soles' bottom faces.
+    pub soles: [[f64; 3]; 2],
+    /// Each sole's normal (the foot's −z axis turned into the torso's frame): (0, 0, −1) for a
+    /// flat foot.
+    pub sole_normals: [[f64; 3]; 2],
+}
+
+impl PhysicsEvaluator {
+    /// Builds the robot standing, holds its torso still in the air without gravity and drives
+    /// its servos to `pose` for `seconds` through the same motors as a step: the kinematics and
+    /// the joints' signs as the simulation has them, to check against Nao's convention.
+    pub fn reach(&self, pose: &[f64; SERVO_COUNT], seconds: f64) -> LegPoints {
+        let b = &self.body;
+        let mut robot = Robot::build(b, &self.model.standing_pose);
+        robot.world.gravity = v(0.0, 0.0, 0.0);
+        // Out of the floor's reach: the floor is moved 1 m down, the torso fixed.
+        if let Some(co) = robot.world.colliders.get_mut(robot.floor) {
+            co.set_translation(v(0.0, 0.0, -1.5));
+        }
+        if let Some(rb) = robot.world.bodies.get_mut(robot.torso) {
+            rb.set_body_type(RigidBodyType::Fixed, true);
+        }
+        let steps = (seconds / b.dt).round().max(1.0) as u64;
+        let mut command = self.model.standing_pose;
+        for _ in 0..steps {
+            for s in Servo::ALL {
+                let i = s.index();
+                let max_move = b.max_speed(s) * b.dt;
+                command[i] = s.clamp(command[i] + (pose[i] - command[i]).clamp(-max_move, max_move));
+            }
+            robot.command(&command, b);
+            robot.world.step();
+        }
+        let torso = *robot.world.bodies[robot.torso].position();
+        let local = |p: Vector| -> [f64; 3] {
+            let q = torso.inverse_transform_point(p);
+            [q.x as f64, q.y as f64, q.z as f64]
+        };
+        let mut out = LegPoints {
+            knees: [[0.0; 3]; 2],
+            ankles: [[0.0; 3]; 2],
+            soles: [[0.0; 3]; 2],
+            sole_normals: [[0.0; 3]; 2],
+        };
+        for (k, &(foot, sole)) in robot.feet.iter().enumerate() {
+            out.ankles[k] = local(robot.world.bodies[foot].translation());
+            let co = &robot.world.colliders[sole];
+            out.soles[k] = local(co.position().transform_point(v(0.0, 0.0, -b.sole_thickness / 2.0)));
+            let n = torso.rotation.inverse() * (co.position().rotation * v(0.0, 0.0, -1.0));
+            out.sole_normals[k] = [n.x as f64, n.y as f64, n.z as f64];
+        }
+        for (k, &tibia) in robot.tibias.iter().enumerate() {
+            out.knees[k] = local(robot.world.bodies[tibia].translation());
         }
         out
     }
@@ -306,6 +422,8 @@ struct Robot {
     floor: ColliderHandle,
     /// Each foot's body and sole collider (right, left).
     feet: Vec<(RigidBodyHandle, ColliderHandle)>,
+    /// Each tibia's body (right, left), its origin at the knee.
+    tibias: Vec<RigidBodyHandle>,
     stiffness: Real,
     damping: Real,
 }
@@ -315,21 +433,23 @@ fn v(x: f64, y: f64, z: f64) -> Vector {
 }
 
 impl Robot {
-    /// The robot in the standing pose `stand`, its lowest sole corner on the floor (z = 0),
-    /// torso frame above the origin. Every body frame is parallel to the world's in the standing
+    /// The robot in the standing pose `stand`, its lowest point on the floor (z = 0): a sole
+    /// corner, or a thigh's or shank's capsule in a pose that kneels; the torso frame above the
+    /// origin. Every body frame is parallel to the world's in the standing
     /// pose, so a joint's coordinate is its angle less the standing angle.
     fn build(b: &BodyParams, stand: &[f64; SERVO_COUNT]) -> Robot {
         let mut world = PhysicsWorld::new();
         world.gravity = v(0.0, 0.0, -9.81);
         world.integration_parameters.dt = b.dt as Real;
         world.integration_parameters.num_solver_iterations = b.solver_iterations.max(1);
+        world.integration_parameters.num_internal_pgs_iterations = b.pgs_iterations.max(1);
 
         // Forward kinematics of both legs in the standing pose, relative to the torso frame.
         struct LegGeom {
             origins: [Vector; 5],     // hip, thigh (= hip), tibia (knee), ankle, foot (= ankle)
             axes: [Vector; 5],        // joint axes in the world (= in both bodies' frames)
             rotations: [Rotation; 5], // each child link's rotation in the standing pose
-            sole_corners_z: f64,
+            lowest_z: f64,
         }
         let leg = |left: bool| -> LegGeom {
             let side = if left { 1.0 } else { -1.0 };
@@ -347,7 +467,18 @@ impl Robot {
             let knee = hip + rotations[1] * v(0.0, 0.0, -b.thigh_length);
             let ankle = knee + rotations[2] * v(0.0, 0.0, -b.tibia_length);
             let foot_rot = rotations[4];
+            // The capsules' lowest points: each ends in a ball of the limb radius whose centre
+            // lies one radius inside the link's ends.
+            let r = b.limb_radius;
             let mut lowest = f64::INFINITY;
+            for (start, rot, length) in [
+                (hip, rotations[1], b.thigh_length),
+                (knee, rotations[2], b.tibia_length),
+            ] {
+                for along in [r, length - r] {
+                    lowest = lowest.min((start + rot * v(0.0, 0.0, -along)).z as f64 - r);
+                }
+            }
             for (sx, sy) in [(1.0, 1.0), (1.0, -1.0), (-1.0, 1.0), (-1.0, -1.0)] {
                 let c = ankle
                     + foot_rot
@@ -362,11 +493,11 @@ impl Robot {
                 origins: [hip, hip, knee, ankle, ankle],
                 axes,
                 rotations,
-                sole_corners_z: lowest,
+                lowest_z: lowest,
             }
         };
         let legs = [leg(false), leg(true)];
-        let height = -legs[0].sole_corners_z.min(legs[1].sole_corners_z);
+        let height = -legs[0].lowest_z.min(legs[1].lowest_z);
         let base = v(0.0, 0.0, height);
 
         let floor = world.insert_collider(
@@ -401,6 +532,7 @@ impl Robot {
 
         let mut motors = Vec::with_capacity(SERVO_COUNT);
         let mut feet = Vec::with_capacity(2);
+        let mut tibias = Vec::with_capacity(2);
         for (g, left) in legs.iter().zip([false, true]) {
             let chain = leg_chain(left);
             let masses = [b.leg.hip, b.leg.thigh, b.leg.tibia, b.leg.ankle, b.leg.foot];
@@ -434,6 +566,9 @@ impl Robot {
                 if k == 4 {
                     feet.push((link, handle));
                 }
+                if k == 2 {
+                    tibias.push(link);
+                }
                 let s = chain[k];
                 let (lo, hi) = s.limits();
                 let q0 = stand[s.index()];
@@ -459,14 +594,14 @@ impl Robot {
             motors,
             floor,
             feet,
+            tibias,
             stiffness: b.servo_stiffness as Real,
             damping: b.servo_damping as Real,
         }
     }
 
     /// Sets every servo's target angle (rad, Nao's convention) and its torque limit for this
-    /// step: a DC motor's line, the stall torque at rest falling to 0 at the no-load speed while
-    /// the motor drives the joint the way it turns; the full stall torque while it brakes.
+    /// step ([`BodyParams::torque_limit`]).
     fn command(&mut self, angles: &[f64; SERVO_COUNT], body: &BodyParams) {
         for &(h, s, q0) in &self.motors {
             if let Some((mb, id)) = self.world.multibody_joints.get_mut(h) {
@@ -474,13 +609,7 @@ impl Robot {
                 let omega = mb.joint_velocity(link).get(0).copied().unwrap_or(0.0) as f64;
                 let q = link.joint.coords()[3] as f64;
                 let target = angles[s.index()] - q0;
-                let stall = body.max_torque(s);
-                let driving = (target - q) * omega > 0.0;
-                let limit = if driving {
-                    stall * (1.0 - omega.abs() / body.max_speed(s)).clamp(0.0, 1.0)
-                } else {
-                    stall
-                };
+                let limit = body.torque_limit(s, omega, (target - q) * omega > 0.0);
                 if let Some(link) = mb.link_mut(id) {
                     link.joint
                         .data
@@ -489,6 +618,24 @@ impl Robot {
                 }
             }
         }
+    }
+
+    /// Whether the floor touches any collider but the two feet after the last step: a contact
+    /// point closer than 1 mm or one the floor pushed. Speculative contacts (rapier keeps points
+    /// up to 2 cm apart, to catch fast bodies) are not touches.
+    fn touches_floor_off_the_feet(&self) -> bool {
+        self.world.contact_pairs_with(self.floor).any(|pair| {
+            let other = if pair.collider1 == self.floor {
+                pair.collider2
+            } else {
+                pair.collider1
+            };
+            !self.feet.iter().any(|&(_, sole)| sole == other)
+                && pair
+                    .solver_manifolds()
+                    .iter()
+                    .any(|m| m.points.iter().any(|p| p.dist < 1.0e-3 || p.data.impulse > 0.0))
+        })
     }
 
     /// Each foot's contact with the floor (right, left) after the last step.
