@@ -47,8 +47,9 @@
 pub mod body;
 pub mod motions;
 
-/// The version of the simulated physics. A checkpoint records it, and a run made under another
-/// is not resumed: the same individual scores differently.
+/// The version of the physics model (body, solver, fall test, motors). A checkpoint records it,
+/// and a run made under another is not resumed: the same individual scores differently. Raise it
+/// with every change that moves a score.
 ///
 /// 2: Nao's continuous (nominal) motor torque instead of its stall torque; two Gauss–Seidel
 /// passes per solver iteration, so that friction converges (the standing robot no longer
@@ -57,11 +58,6 @@ pub mod motions;
 pub const PHYSICS_VERSION: u32 = 2;
 
 pub use body::{BodyParams, LegMasses};
-
-/// The version of the physics model (body, solver, fall test, motors): a checkpoint records it,
-/// and a run scored under another version is not resumed, as the same individual scores
-/// differently. Raise it with every change that moves a score.
-pub const PHYSICS_VERSION: u32 = 1;
 
 use body::{is_roll, leg_chain};
 use mobil_ga_step::{Evaluation, Evaluator, FitnessConfig, GaError, Individual, NaoModel, Servo, SERVO_COUNT};
