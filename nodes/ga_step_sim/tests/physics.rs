@@ -1,7 +1,9 @@
 //! The physics evaluator against what a body of Nao's figures must do. Each test simulates at
 //! most T_sim = 3 s.
 
-use mobil_ga_step::{evaluate_all, Evaluator, FitnessConfig, Individual, NaoModel, Servo, KNOTS};
+use mobil_ga_step::{
+    evaluate_all, Evaluation, Evaluator, FitnessConfig, Individual, NaoModel, Servo, KNOTS, SERVO_COUNT,
+};
 use mobil_ga_step_sim::{motions, BodyParams, FallCause, PhysicsEvaluator, SimError};
 use rand::{Rng, SeedableRng};
 use std::f64::consts::{FRAC_PI_2, FRAC_PI_4};
@@ -177,6 +179,148 @@ fn bad_body_figures_are_refused() {
         PhysicsEvaluator::with_body(NaoModel::default(), FitnessConfig::default(), body),
         Err(SimError::BadBody { name: "friction", .. })
     ));
+    // Solver counts within 1 … 256 (usize::MAX would never finish a step).
+    for (it, pgs, name, value) in [
+        (0, 2, "solver_iterations", 0),
+        (usize::MAX, 2, "solver_iterations", usize::MAX),
+        (4, 257, "pgs_iterations", 257),
+        (4, 0, "pgs_iterations", 0),
+    ] {
+        let body = BodyParams {
+            solver_iterations: it,
+            pgs_iterations: pgs,
+            ..BodyParams::default()
+        };
+        let r = PhysicsEvaluator::with_body(NaoModel::default(), FitnessConfig::default(), body);
+        assert_eq!(r.err(), Some(SimError::BadSolverCount { name, value }));
+    }
+    let body = BodyParams {
+        solver_iterations: 256,
+        pgs_iterations: 1,
+        ..BodyParams::default()
+    };
+    assert!(PhysicsEvaluator::with_body(NaoModel::default(), FitnessConfig::default(), body).is_ok());
+    // A stall torque below the continuous one would cut the torque at rest.
+    let body = BodyParams {
+        roll_stall_torque: 2.0,
+        ..BodyParams::default()
+    };
+    assert_eq!(
+        PhysicsEvaluator::with_body(NaoModel::default(), FitnessConfig::default(), body).err(),
+        Some(SimError::StallBelowContinuous {
+            joints: "roll",
+            stall: 2.0,
+            continuous: 2.47
+        })
+    );
+}
+
+/// The individuals of `fixtures/blx1_gen56.txt` with the evaluation a `ga_step` run stored for
+/// each, every figure as the bits of its double.
+fn stored_individuals() -> Vec<(Individual, Evaluation)> {
+    let text = include_str!("fixtures/blx1_gen56.txt");
+    let bits = |t: &str| f64::from_bits(u64::from_str_radix(t, 16).expect("fixture: hexadecimal bits"));
+    text.lines()
+        .filter(|l| !l.starts_with('#') && !l.trim().is_empty())
+        .map(|l| {
+            let t: Vec<&str> = l.split_whitespace().collect();
+            assert_eq!(t.len(), 4 + SERVO_COUNT * KNOTS, "fixture line");
+            let mut ind = NaoModel::default().standing();
+            for s in 0..SERVO_COUNT {
+                for k in 0..KNOTS {
+                    ind.knots[s][k] = bits(t[4 + s * KNOTS + k]);
+                }
+            }
+            let e = Evaluation {
+                fell: t[0] == "1",
+                fitness: bits(t[1]),
+                t_fall: bits(t[2]),
+                forward_distance: bits(t[3]),
+            };
+            (ind, e)
+        })
+        .collect()
+}
+
+#[test]
+fn individuals_of_a_physics_2_run_score_exactly_what_the_run_stored() {
+    // Physics version 2 must score every individual as the runs made under it did, to the bit:
+    // five of a BLX-α run's population (generation 56; ranks 0, 7, 28, 63 and 99), their
+    // fitness, fall time and Δx as its checkpoint holds them.
+    let ev = evaluator();
+    let model = NaoModel::default();
+    let stored = stored_individuals();
+    assert_eq!(stored.len(), 5);
+    for (i, (ind, want)) in stored.iter().enumerate() {
+        assert_eq!(ind.validate(&model), Ok(()), "individual {i}");
+        let got = ev.evaluate(ind);
+        assert_eq!(got.fell, want.fell, "individual {i}");
+        assert_eq!(
+            got.fitness.to_bits(),
+            want.fitness.to_bits(),
+            "individual {i}: {got:?} {want:?}"
+        );
+        assert_eq!(
+            got.t_fall.to_bits(),
+            want.t_fall.to_bits(),
+            "individual {i}: {got:?} {want:?}"
+        );
+        assert_eq!(
+            got.forward_distance.to_bits(),
+            want.forward_distance.to_bits(),
+            "individual {i}: {got:?} {want:?}"
+        );
+        // The feet's report watches the same simulation: the same outcome, bit for bit.
+        let (o, _) = ev.simulate_feet_report(ind, 3.0);
+        assert_eq!(o, ev.simulate(ind), "individual {i}");
+    }
+}
+
+#[test]
+fn an_invalid_individual_is_a_fall_at_once_without_a_simulation() {
+    let ev = evaluator();
+    let model = NaoModel::default();
+    // A NaN knot would become a NaN motor target.
+    let mut nan = model.standing();
+    nan.knots[Servo::LKneePitch.index()][7] = f64::NAN;
+    // RHipRoll's limits are [−0.7854, 0.4363] (Table 1): 0.5 is outside.
+    let mut wide = model.standing();
+    wide.knots[Servo::RHipRoll.index()][3] = 0.5;
+    // The last knot must be the standing pose (−0.4 for the ankle pitch).
+    let mut end = model.standing();
+    end.knots[Servo::RAnklePitch.index()][KNOTS - 1] = -0.3;
+    for (ind, servo, knot) in [
+        (&nan, Servo::LKneePitch, 7),
+        (&wide, Servo::RHipRoll, 3),
+        (&end, Servo::RAnklePitch, KNOTS - 1),
+    ] {
+        assert!(ind.validate(&model).is_err());
+        let o = ev.simulate(ind);
+        assert!(o.fell && o.t_end == 0.0 && o.steps == 0, "{o:?}");
+        assert_eq!(o.cause, Some(FallCause::Invalid { servo, knot }));
+        // A fall at 0 s scores 0/3 s = 0.
+        let e = ev.evaluate(ind);
+        assert!(e.fell && e.t_fall == 0.0 && e.fitness == 0.0, "{e:?}");
+    }
+}
+
+#[test]
+fn standing_lifts_no_foot_and_never_flies() {
+    // Standing still, both soles stay flat on the floor (lowest corner at 0 m; the servos'
+    // sag tips them by milliradians, a corner by well under a millimetre), each carries half
+    // the weight (24.5 N > 5 N) throughout, and neither moves.
+    let ev = evaluator();
+    let model = NaoModel::default();
+    let (o, r) = ev.simulate_feet_report(&model.standing(), 3.0);
+    assert!(!o.fell, "{o:?}");
+    assert_eq!(r.longest_flight, 0.0, "{r:?}");
+    assert_eq!(r.flight_time, 0.0, "{r:?}");
+    for f in r.feet {
+        assert!(f.peak_height.abs() < 0.001, "{r:?}");
+        assert!(f.forward.abs() < 0.002, "{r:?}");
+        assert!(f.slip_loaded < 0.001, "{r:?}");
+        assert!(f.loaded_time > 2.95, "{r:?}");
+    }
 }
 
 #[test]
