@@ -241,8 +241,12 @@ pub struct FitnessConfig {
     /// learned not to fall), while among non-falling individuals distance decides.
     pub forward_weight: f64,
     /// h₀ (m): the torso frame below this height is a fall. Default 0.20: the standing pose puts
-    /// it about 0.32 m up (foot 0.045 + legs 0.203·cos 0.4 + hip offset 0.085); 0.20 m is
-    /// below any upright walking posture, reached only sitting or lying.
+    /// it about 0.32 m up (foot 0.045 + legs 0.203·cos 0.4 + hip offset 0.085). The lowest
+    /// upright, flat-footed posture within the limits, a full squat (ankle pitch at its limit
+    /// −1.309, knee at 2.2689, so the shank 1.309 rad and the thigh 0.960 rad from the
+    /// vertical), puts it at 0.045 + 0.1·cos 0.960 + 0.1029·cos 1.309 + 0.085 ≈ 0.214 m: only
+    /// 14 mm above h₀. Tipped feet, a leaning torso or kneeling go lower, so this rule is a
+    /// backstop: the physics evaluator's tilt and floor-contact rules decide most falls.
     pub fall_height: f64,
     /// θ₀ (rad): a torso tilted more than this from upright (pitch or roll) is a fall. Default
     /// 0.5 rad (29°): a Nao standing with its torso leaning that far has its centre of mass

@@ -29,7 +29,12 @@
 //! `fall_height` (0.20 m; it starts about 0.32 m up), its vertical axis tilted more than
 //! `fall_tilt` (0.5 rad) from the vertical, or any body but the two feet touching the floor (a
 //! knee, a shank, a thigh, the torso). A non-finite state counts as a fall at that time. Δx is
-//! the torso frame's displacement along x (forward) from the start to the end or the fall.
+//! the torso frame's displacement along x (forward) from the start to the end or the fall. The
+//! contact rule lags the others by one step: rapier finds contacts (its narrow phase) at the
+//! start of a step, before it integrates, so after the step at t the torso's height and tilt
+//! are those at t, the contacts those at t − 5 ms. An individual that is not valid for the
+//! model (a knot not finite, outside its servo's limits, or an end off the standing pose) is
+//! not simulated: a fall at t = 0 ([`FallCause::Invalid`]), fitness 0.
 //!
 //! **The solver**: 5 ms steps, 4 solver iterations (substeps) of 2 projected Gauss–Seidel
 //! passes each. With 1 pass (rapier's default) the friction does not converge: a standing robot
@@ -60,7 +65,7 @@ pub const PHYSICS_VERSION: u32 = 2;
 pub use body::{BodyParams, LegMasses};
 
 use body::{is_roll, leg_chain};
-use mobil_ga_step::{Evaluation, Evaluator, FitnessConfig, GaError, Individual, NaoModel, Servo, SERVO_COUNT};
+use mobil_ga_step::{Evaluation, Evaluator, FitnessConfig, GaError, Individual, NaoModel, Servo, KNOTS, SERVO_COUNT};
 use rapier3d::prelude::*;
 
 /// Why an evaluator could not be built.
@@ -77,7 +82,31 @@ pub enum SimError {
         /// Its value.
         value: f64,
     },
+    /// A solver count is outside 1 … [`MAX_SOLVER_COUNT`].
+    #[error("body parameter {name} = {value} must be within 1 … {MAX_SOLVER_COUNT}")]
+    BadSolverCount {
+        /// The parameter.
+        name: &'static str,
+        /// Its value.
+        value: usize,
+    },
+    /// A joint's stall torque is below its continuous torque: the torque–speed line would cut
+    /// the continuous torque at rest.
+    #[error("{joints} stall torque {stall} N·m must be at least the continuous torque {continuous} N·m")]
+    StallBelowContinuous {
+        /// `pitch` or `roll`.
+        joints: &'static str,
+        /// The stall torque (N·m).
+        stall: f64,
+        /// The continuous torque (N·m).
+        continuous: f64,
+    },
 }
+
+/// The largest solver iteration or Gauss–Seidel pass count accepted: 64 times the default, far
+/// beyond any setting that changes an outcome (the README's convergence table), and small
+/// enough that a step cannot take unbounded time.
+pub const MAX_SOLVER_COUNT: usize = 256;
 
 /// What ended a simulation early.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -91,6 +120,15 @@ pub enum FallCause {
     Contact,
     /// The state stopped being finite.
     NonFinite,
+    /// The individual is not one of the model's, so it was not simulated: the knot `knot` of
+    /// `servo` is not finite, lies outside the servo's limits, or (first or last) is not the
+    /// standing pose ([`Individual::validate`] says which). The outcome is a fall at t = 0.
+    Invalid {
+        /// The servo with the bad knot.
+        servo: Servo,
+        /// The knot's index (0 … 20).
+        knot: usize,
+    },
 }
 
 /// What one simulated step did, in more detail than an [`Evaluation`].
@@ -145,6 +183,101 @@ pub struct FootContact {
     /// corners, edge midpoints and centre). A sole resting or rolling over an edge has a point
     /// at rest, so this is the sliding speed of a loaded foot (a lower bound of it).
     pub slip_speed: f64,
+    /// Height (m) above the floor of the lowest corner of the sole's bottom face: about 0 for a
+    /// foot on the floor (flat or tipped over an edge), its clearance for a lifted one.
+    pub sole_height: f64,
+    /// Position along x (forward, m) of the centre of the sole's bottom face.
+    pub sole_x: f64,
+}
+
+/// The normal force (N) above which a foot counts as loaded (carrying weight): a tenth of the
+/// robot's weight (4.996 kg · 9.81 = 49 N).
+pub const LOADED_FORCE: f64 = 5.0;
+
+/// What one foot did over a simulation ([`FeetReport`]).
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct FootReport {
+    /// The highest [`sole_height`](FootContact::sole_height) seen (m): how far the foot was
+    /// lifted off the floor.
+    pub peak_height: f64,
+    /// The sole centre's displacement along x (m) from the start to the end or the fall: a
+    /// foot put down ahead has a positive one.
+    pub forward: f64,
+    /// Time (s) the foot was loaded (normal force above [`LOADED_FORCE`]).
+    pub loaded_time: f64,
+    /// Distance (m) the sole slid while loaded: its [`slip_speed`](FootContact::slip_speed)
+    /// integrated over the loaded steps.
+    pub slip_loaded: f64,
+}
+
+/// What the feet did over a simulation: whether a step was a step (a foot lifted and put down
+/// ahead) or the torso got there by sliding or hopping. Worked out from the [`FootContact`]s
+/// after every step by a [`FeetTracker`].
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct FeetReport {
+    /// Right foot, left foot.
+    pub feet: [FootReport; 2],
+    /// The longest time (s) both feet were unloaded at once (flight: the robot hopped).
+    pub longest_flight: f64,
+    /// The total time (s) both feet were unloaded.
+    pub flight_time: f64,
+}
+
+/// Sums the feet's contacts, step by step, into a [`FeetReport`].
+#[derive(Debug, Clone)]
+pub struct FeetTracker {
+    dt: f64,
+    start_x: [f64; 2],
+    last_x: [f64; 2],
+    flight_run: f64,
+    report: FeetReport,
+}
+
+impl FeetTracker {
+    /// A tracker for steps of `dt` seconds, the feet's contacts at the start being `start`
+    /// (their soles' positions).
+    pub fn new(dt: f64, start: &[FootContact; 2]) -> FeetTracker {
+        let start_x = [start[0].sole_x, start[1].sole_x];
+        let mut report = FeetReport::default();
+        for (r, c) in report.feet.iter_mut().zip(start) {
+            r.peak_height = c.sole_height;
+        }
+        FeetTracker {
+            dt,
+            start_x,
+            last_x: start_x,
+            flight_run: 0.0,
+            report,
+        }
+    }
+
+    /// Adds the feet's contacts after one step.
+    pub fn observe(&mut self, feet: &[FootContact; 2]) {
+        for (k, (r, c)) in self.report.feet.iter_mut().zip(feet).enumerate() {
+            r.peak_height = r.peak_height.max(c.sole_height);
+            if c.normal_force > LOADED_FORCE {
+                r.loaded_time += self.dt;
+                r.slip_loaded += c.slip_speed * self.dt;
+            }
+            self.last_x[k] = c.sole_x;
+        }
+        if feet.iter().all(|c| c.normal_force <= LOADED_FORCE) {
+            self.flight_run += self.dt;
+            self.report.flight_time += self.dt;
+            self.report.longest_flight = self.report.longest_flight.max(self.flight_run);
+        } else {
+            self.flight_run = 0.0;
+        }
+    }
+
+    /// The report so far.
+    pub fn report(&self) -> FeetReport {
+        let mut r = self.report;
+        for (k, f) in r.feet.iter_mut().enumerate() {
+            f.forward = self.last_x[k] - self.start_x[k];
+        }
+        r
+    }
 }
 
 /// The physics evaluator: a fresh simulation per individual.
@@ -192,6 +325,26 @@ impl PhysicsEvaluator {
                 return Err(SimError::BadBody { name, value });
             }
         }
+        for (name, value) in [
+            ("solver_iterations", b.solver_iterations),
+            ("pgs_iterations", b.pgs_iterations),
+        ] {
+            if !(1..=MAX_SOLVER_COUNT).contains(&value) {
+                return Err(SimError::BadSolverCount { name, value });
+            }
+        }
+        for (joints, stall, continuous) in [
+            ("pitch", b.pitch_stall_torque, b.pitch_max_torque),
+            ("roll", b.roll_stall_torque, b.roll_max_torque),
+        ] {
+            if stall < continuous {
+                return Err(SimError::StallBelowContinuous {
+                    joints,
+                    stall,
+                    continuous,
+                });
+            }
+        }
         Ok(PhysicsEvaluator { model, fitness, body })
     }
 
@@ -224,7 +377,7 @@ impl PhysicsEvaluator {
         duration: f64,
         observe: &mut dyn FnMut(&TorsoState),
     ) -> SimOutcome {
-        self.run(individual, duration, false, &mut |s, _| observe(s))
+        self.run(individual, duration, false, &mut |_| {}, &mut |s, _| observe(s))
     }
 
     /// Like [`simulate_observed`](Self::simulate_observed), also passing each foot's contact
@@ -235,18 +388,69 @@ impl PhysicsEvaluator {
         duration: f64,
         observe: &mut dyn FnMut(&TorsoState, &[FootContact; 2]),
     ) -> SimOutcome {
-        self.run(individual, duration, true, observe)
+        self.run(individual, duration, true, &mut |_| {}, observe)
+    }
+
+    /// Like [`simulate_for`](Self::simulate_for), also reporting what the feet did: each one's
+    /// peak height, forward displacement and slip while loaded, and the robot's flight. The
+    /// outcome is the same, bit for bit, as without the report.
+    pub fn simulate_feet_report(&self, individual: &Individual, duration: f64) -> (SimOutcome, FeetReport) {
+        let tracker = std::cell::RefCell::new(None);
+        let o = self.run(
+            individual,
+            duration,
+            true,
+            &mut |start| *tracker.borrow_mut() = Some(FeetTracker::new(self.body.dt, start)),
+            &mut |_, feet| {
+                if let Some(t) = tracker.borrow_mut().as_mut() {
+                    t.observe(feet);
+                }
+            },
+        );
+        let report = tracker.borrow().as_ref().map(FeetTracker::report).unwrap_or_default();
+        (o, report)
+    }
+
+    /// The first knot that makes `individual` invalid for the model (not finite, outside its
+    /// servo's limits, or an end off the standing pose), as [`Individual::validate`] judges.
+    pub fn first_bad_knot(&self, individual: &Individual) -> Option<(Servo, usize)> {
+        let last = KNOTS - 1;
+        Servo::ALL.into_iter().find_map(|s| {
+            let (lo, hi) = s.limits();
+            let stand = self.model.standing_pose[s.index()];
+            individual.knots[s.index()]
+                .iter()
+                .enumerate()
+                .find(|&(k, &q)| !(q.is_finite() && (lo..=hi).contains(&q)) || ((k == 0 || k == last) && q != stand))
+                .map(|(k, _)| (s, k))
+        })
     }
 
     /// The simulation loop; the feet's contacts are worked out only `with_feet` (the
-    /// evaluation's hot path does without them) and are all zero otherwise.
+    /// evaluation's hot path does without them) and are all zero otherwise; `start` receives
+    /// them before the first step. An invalid individual is not simulated: a fall at t = 0
+    /// ([`FallCause::Invalid`]; heights and tilt 0).
     fn run(
         &self,
         individual: &Individual,
         duration: f64,
         with_feet: bool,
+        start_feet: &mut dyn FnMut(&[FootContact; 2]),
         observe: &mut dyn FnMut(&TorsoState, &[FootContact; 2]),
     ) -> SimOutcome {
+        if let Some((servo, knot)) = self.first_bad_knot(individual) {
+            return SimOutcome {
+                fell: true,
+                cause: Some(FallCause::Invalid { servo, knot }),
+                t_end: 0.0,
+                forward_distance: 0.0,
+                lateral_distance: 0.0,
+                start_height: 0.0,
+                end_height: 0.0,
+                max_tilt: 0.0,
+                steps: 0,
+            };
+        }
         let mut robot = Robot::build(&self.body, &self.model.standing_pose);
         let dt = self.body.dt;
         let steps = (duration / dt).round().max(0.0) as u64;
@@ -262,6 +466,9 @@ impl PhysicsEvaluator {
             max_tilt: start.tilt,
             steps: 0,
         };
+        if with_feet {
+            start_feet(&robot.feet(&self.body));
+        }
         let mut command = self.model.standing_pose;
         for n in 1..=steps {
             let t = n as f64 * dt;
@@ -618,7 +825,9 @@ impl Robot {
 
     /// Whether the floor touches any collider but the two feet after the last step: a contact
     /// point closer than 1 mm or one the floor pushed. Speculative contacts (rapier keeps points
-    /// up to 2 cm apart, to catch fast bodies) are not touches.
+    /// up to 2 cm apart, to catch fast bodies) are not touches. The manifolds are the narrow
+    /// phase's of the last step, which runs before the step integrates: they describe the
+    /// bodies one step (`dt`) before the torso pose the other fall rules read.
     fn touches_floor_off_the_feet(&self) -> bool {
         self.world.contact_pairs_with(self.floor).any(|pair| {
             let other = if pair.collider1 == self.floor {
@@ -654,14 +863,21 @@ impl Robot {
             };
             let (hl, hw, ht) = (b.foot_length / 2.0, b.foot_width / 2.0, b.sole_thickness / 2.0);
             let mut slowest = f64::INFINITY;
+            let mut lowest = f64::INFINITY;
             for sx in [-1.0, 0.0, 1.0] {
                 for sy in [-1.0, 0.0, 1.0] {
                     let p = co.position().transform_point(v(sx * hl, sy * hw, -ht));
                     let vel = rb.velocity_at_point(p);
                     slowest = slowest.min((vel.x as f64).hypot(vel.y as f64));
+                    // The floor's top face is z = 0; a flat face's lowest point is a corner.
+                    lowest = lowest.min(p.z as f64);
+                    if sx == 0.0 && sy == 0.0 {
+                        c.sole_x = p.x as f64;
+                    }
                 }
             }
             c.slip_speed = slowest;
+            c.sole_height = lowest;
         }
         out
     }
@@ -709,6 +925,103 @@ mod contact_tests {
         }
         let x1 = robot.world.bodies[foot].translation().x as f64;
         (load, x1 - x0)
+    }
+
+    #[test]
+    fn a_foot_lifted_by_a_known_pose_peaks_at_the_height_worked_out_by_hand() {
+        // The torso held at its standing height (a fixed body; gravity on), the right leg is
+        // driven from standing (hip −0.4, knee 0.8, ankle −0.4) to hip −0.7, knee 1.4, ankle
+        // −0.7: hip + knee + ankle stays 0, so the foot stays flat and parallel to the floor,
+        // and the thigh and the shank both end 0.7 rad from the vertical instead of 0.4. The
+        // ankle, and with it the whole sole, rises by (0.1 + 0.1029)·(cos 0.4 − cos 0.7)
+        // = 0.2029·(0.921061 − 0.764842) = 0.031697 m. Along x the ankle goes from
+        // 0.1·sin 0.4 − 0.1029·sin 0.4 = −0.001129 m to 0.1·sin 0.7 − 0.1029·sin 0.7
+        // = −0.001868 m: −0.74 mm. The left foot stays on the floor: no lift.
+        let b = BodyParams::default();
+        let model = NaoModel::default();
+        let mut robot = Robot::build(&b, &model.standing_pose);
+        if let Some(rb) = robot.world.bodies.get_mut(robot.torso) {
+            rb.set_body_type(RigidBodyType::Fixed, true);
+        }
+        let mut tracker = FeetTracker::new(b.dt, &robot.feet(&b));
+        let mut pose = model.standing_pose;
+        pose[Servo::RHipPitch.index()] = -0.7;
+        pose[Servo::RKneePitch.index()] = 1.4;
+        pose[Servo::RAnklePitch.index()] = -0.7;
+        let mut command = model.standing_pose;
+        for _ in 0..(1.0 / b.dt).round() as usize {
+            for s in Servo::ALL {
+                let i = s.index();
+                let max_move = b.max_speed(s) * b.dt;
+                command[i] += (pose[i] - command[i]).clamp(-max_move, max_move);
+            }
+            robot.command(&command, &b);
+            robot.world.step();
+            tracker.observe(&robot.feet(&b));
+        }
+        let r = tracker.report();
+        // The servos sag under the lower leg's weight by a few milliradians: within 2 mm.
+        assert!((r.feet[0].peak_height - 0.031697).abs() < 0.002, "{r:?}");
+        assert!((r.feet[0].forward - -0.00074).abs() < 0.001, "{r:?}");
+        // A lifted foot carries nothing.
+        assert_eq!(r.feet[0].loaded_time, 0.0, "{r:?}");
+        assert!(r.feet[1].peak_height.abs() < 0.001, "{r:?}");
+        assert!(r.feet[1].forward.abs() < 0.001, "{r:?}");
+    }
+
+    #[test]
+    fn the_feet_tracker_sums_loaded_slip_and_the_longest_flight() {
+        // Made-up contacts at 10 ms steps: right loaded, sliding at 0.1 m/s, for 2 steps; then
+        // both unloaded for 3 steps (30 ms flight); then left loaded for 1 step; then both
+        // unloaded for 2 steps (20 ms). Right slid 2 · 0.1 · 0.01 = 2 mm while loaded; the
+        // 4 N contact does not count (below 5 N). Flights 30 and 20 ms: longest 30, total 50.
+        let foot = |n: f64, slip: f64, h: f64, x: f64| FootContact {
+            normal_force: n,
+            friction_force: 0.0,
+            slip_speed: slip,
+            sole_height: h,
+            sole_x: x,
+        };
+        let off = foot(0.0, 0.3, 0.02, 0.0);
+        let mut t = FeetTracker::new(0.01, &[foot(0.0, 0.0, 0.0, 0.10), foot(0.0, 0.0, 0.0, -0.05)]);
+        for _ in 0..2 {
+            t.observe(&[foot(20.0, 0.1, 0.0, 0.11), foot(4.0, 1.0, 0.005, -0.05)]);
+        }
+        for h in [0.01, 0.04, 0.03] {
+            t.observe(&[foot(0.0, 0.5, h, 0.12), off]);
+        }
+        t.observe(&[off, foot(30.0, 0.0, 0.0, 0.0)]);
+        t.observe(&[off, off]);
+        t.observe(&[foot(0.0, 0.0, 0.0, 0.16), foot(0.0, 0.0, 0.0, 0.02)]);
+        let r = t.report();
+        assert!((r.feet[0].slip_loaded - 0.002).abs() < 1e-12, "{r:?}");
+        assert!((r.feet[0].loaded_time - 0.02).abs() < 1e-12, "{r:?}");
+        assert_eq!(r.feet[1].slip_loaded, 0.0, "{r:?}");
+        assert!((r.feet[1].loaded_time - 0.01).abs() < 1e-12, "{r:?}");
+        assert_eq!(r.feet[0].peak_height, 0.04, "{r:?}");
+        assert_eq!(r.feet[1].peak_height, 0.02, "{r:?}");
+        assert!((r.feet[0].forward - 0.06).abs() < 1e-12, "{r:?}");
+        assert!((r.feet[1].forward - 0.07).abs() < 1e-12, "{r:?}");
+        assert!((r.longest_flight - 0.03).abs() < 1e-12, "{r:?}");
+        assert!((r.flight_time - 0.05).abs() < 1e-12, "{r:?}");
+    }
+
+    #[test]
+    fn the_built_robot_weighs_the_sum_of_naos_h25_masses() {
+        // By hand from "H25 – Masses": one leg below the pelvis 0.13530 + 0.39421 + 0.29159 +
+        // 0.13892 + 0.16304 = 1.12306 kg; the lump above is the rest of 4.996 kg, 2.74988 kg.
+        // The rapier world as built holds 11 bodies (the torso and five links a leg) whose
+        // masses (f32) add up to 4.996 kg, the torso alone to 2.74988 kg.
+        let b = BodyParams::default();
+        let robot = Robot::build(&b, &NaoModel::default().standing_pose);
+        assert_eq!(robot.world.bodies.len(), 11);
+        let total: f64 = robot.world.bodies.iter().map(|(_, rb)| rb.mass() as f64).sum();
+        assert!((total - 4.996).abs() < 1e-5, "{total}");
+        let torso = robot.world.bodies[robot.torso].mass() as f64;
+        assert!((torso - 2.74988).abs() < 1e-5, "{torso}");
+        for &(foot, _) in &robot.feet {
+            assert!((robot.world.bodies[foot].mass() as f64 - 0.16304).abs() < 1e-6);
+        }
     }
 
     #[test]

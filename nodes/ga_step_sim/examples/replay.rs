@@ -1,0 +1,171 @@
+//! Replays a run's best individual at the default solver settings and at two finer ones, with
+//! what its feet did, to tell a found step from one that holds only at the evaluator's exact
+//! numbers (motions at the edge of a fall change their verdict with the setting):
+//! `cargo run --release -p mobil_ga_step_sim --example replay -- CHECKPOINT_OR_MOTION
+//! [DT_MS:ITERATIONS:PASSES...]`. The argument is a `ga_step` checkpoint (its best individual,
+//! its model and fitness) or a Webots motion file as `ga_step` writes it (40 ms rows, values to
+//! 4 decimals: the knots between rows are rebuilt from the two rows before them, within about
+//! 1e-4 rad). Prints per setting: the verdict and why, the fall time or T_sim, Δx and Δy of the
+//! torso, and per foot its peak sole height, its sole's Δx, the time it was loaded and how far
+//! it slid while loaded, and the longest and total time both feet were unloaded (flight).
+//!
+//! `replay --check CHECKPOINT` instead re-scores the checkpoint's whole population at the
+//! default settings and compares each evaluation with the stored one bit for bit (a physics
+//! change that keeps `PHYSICS_VERSION` must pass this); the exit status is 1 if any differs.
+use mobil_ga_step::Evaluator;
+use mobil_ga_step::{FitnessConfig, Individual, NaoModel, Servo, INTERVALS, KNOTS};
+use mobil_ga_step_sim::{BodyParams, PhysicsEvaluator};
+
+/// The settings replayed without any given: the default, then 2.5 ms/8/2 and 1.25 ms/16/4.
+const SETTINGS: [(f64, usize, usize); 3] = [(0.005, 4, 2), (0.0025, 8, 2), (0.00125, 16, 4)];
+
+fn from_motion(path: &str, model: &NaoModel) -> Result<Individual, Box<dyn std::error::Error>> {
+    let file = std::io::BufReader::new(std::fs::File::open(path)?);
+    let motion = mobil_ga_step::read_motion(file)?;
+    let knot_ms = model.step_time * 1000.0 / INTERVALS as f64;
+    // A row's value of one servo at `ms`, if there is a row there.
+    let at = |col: usize, ms: f64| {
+        motion
+            .rows
+            .iter()
+            .find(|r| (r.time_ms as f64 - ms).abs() < 0.5)
+            .and_then(|r| r.values.get(col).copied())
+    };
+    let mut ind = model.standing();
+    for s in Servo::ALL {
+        let col = motion
+            .joint_names
+            .iter()
+            .position(|n| n == s.name())
+            .ok_or_else(|| format!("{path}: no column {}", s.name()))?;
+        for k in 1..KNOTS - 1 {
+            let ms = k as f64 * knot_ms;
+            let v = match at(col, ms) {
+                Some(v) => v,
+                None => {
+                    // The last two rows of the interval that ends at this knot lie on its line.
+                    let b = (ms / 40.0).floor() * 40.0;
+                    let a = b - 40.0;
+                    let (va, vb) = (
+                        at(col, a).ok_or_else(|| format!("{path}: no row at {a} ms"))?,
+                        at(col, b).ok_or_else(|| format!("{path}: no row at {b} ms"))?,
+                    );
+                    vb + (vb - va) * (ms - b) / 40.0
+                }
+            };
+            ind.knots[s.index()][k] = s.clamp(v);
+        }
+    }
+    Ok(ind)
+}
+
+fn main() -> Result<(), Box<dyn std::error::Error>> {
+    let mut args = std::env::args().skip(1).peekable();
+    if args.peek().map(String::as_str) == Some("--check") {
+        args.next();
+        let path = args.next().ok_or("usage: replay --check CHECKPOINT")?;
+        return check(&path);
+    }
+    let path = args
+        .next()
+        .ok_or("usage: replay CHECKPOINT_OR_MOTION [DT_MS:ITERATIONS:PASSES...]")?;
+    let mut settings = Vec::new();
+    for a in args {
+        let p: Vec<&str> = a.split(':').collect();
+        if p.len() != 3 {
+            return Err(format!("{a}: expected DT_MS:ITERATIONS:PASSES").into());
+        }
+        settings.push((p[0].parse::<f64>()? / 1e3, p[1].parse()?, p[2].parse()?));
+    }
+    if settings.is_empty() {
+        settings = SETTINGS.to_vec();
+    }
+    let (model, fitness, ind, stored) = if path.ends_with(".motion") {
+        let model = NaoModel::default();
+        let ind = from_motion(&path, &model)?;
+        (model, FitnessConfig::default(), ind, None)
+    } else {
+        let state = mobil_ga_step::read_checkpoint(std::path::Path::new(&path))?;
+        let best = state.best();
+        (
+            state.setup.model.clone(),
+            state.setup.fitness.clone(),
+            best.individual.clone(),
+            Some((state.generation, best.evaluation)),
+        )
+    };
+    println!("{path}");
+    if let Some((generation, e)) = stored {
+        println!(
+            "  stored (generation {generation}): fitness {:.4}, {}, t {:.3} s, dx {:+.4} m",
+            e.fitness,
+            if e.fell { "falls" } else { "upright" },
+            e.t_fall,
+            e.forward_distance
+        );
+    }
+    let duration = fitness.sim_time(model.step_time);
+    for (dt, iterations, passes) in settings {
+        let body = BodyParams {
+            dt,
+            solver_iterations: iterations,
+            pgs_iterations: passes,
+            ..BodyParams::default()
+        };
+        let ev = PhysicsEvaluator::with_body(model.clone(), fitness.clone(), body)?;
+        let (o, r) = ev.simulate_feet_report(&ind, duration);
+        let verdict = match o.cause {
+            Some(c) => format!("falls ({c:?})"),
+            None => "upright".to_string(),
+        };
+        println!(
+            "  {:5.3} ms {:2} it {} passes: {verdict:<18} t {:.3} s  dx {:+.4} m  dy {:+.4} m  flight longest {:.3} s, total {:.3} s",
+            dt * 1e3,
+            iterations,
+            passes,
+            o.t_end,
+            o.forward_distance,
+            o.lateral_distance,
+            r.longest_flight,
+            r.flight_time
+        );
+        for (name, f) in ["right", "left"].iter().zip(r.feet) {
+            println!(
+                "      {name:<5} foot: peak {:5.1} mm  sole dx {:+.4} m  loaded {:.3} s  slid while loaded {:.4} m",
+                f.peak_height * 1e3,
+                f.forward,
+                f.loaded_time,
+                f.slip_loaded
+            );
+        }
+    }
+    Ok(())
+}
+
+/// Re-scores a checkpoint's population and compares with the stored evaluations, bit for bit.
+fn check(path: &str) -> Result<(), Box<dyn std::error::Error>> {
+    let state = mobil_ga_step::read_checkpoint(std::path::Path::new(path))?;
+    let ev = PhysicsEvaluator::new(state.setup.model.clone(), state.setup.fitness.clone())?;
+    let mut differ = 0;
+    for (i, scored) in state.population.iter().enumerate() {
+        let (got, want) = (ev.evaluate(&scored.individual), scored.evaluation);
+        let same = got.fell == want.fell
+            && got.fitness.to_bits() == want.fitness.to_bits()
+            && got.t_fall.to_bits() == want.t_fall.to_bits()
+            && got.forward_distance.to_bits() == want.forward_distance.to_bits();
+        if !same {
+            differ += 1;
+            println!("individual {i}: stored {want:?}, now {got:?}");
+        }
+    }
+    println!(
+        "{path}: generation {}, {} individuals, {} scored differently",
+        state.generation,
+        state.population.len(),
+        differ
+    );
+    if differ > 0 {
+        std::process::exit(1);
+    }
+    Ok(())
+}
