@@ -34,9 +34,9 @@ pub const CHECKPOINT_VERSION: u64 = 4;
 pub const CHECKPOINT_OLDEST_READ: u64 = 4;
 
 /// The largest checkpoint read (128 MiB); a larger file (or a device such as `/dev/zero`) is
-/// refused after reading this much and one byte more. An individual takes about 4.2 KB of JSON (210 knots in
+/// refused after reading this much and one byte more. An individual takes about 4.0 KB of JSON (210 knots in
 /// shortest round-trip form and its evaluation), so the largest population the executable
-/// accepts (10 000) is about 42 MB, leaving room for a history of more than 400 000 generations
+/// accepts (10 000) is about 40 MB, leaving room for a history of more than 400 000 generations
 /// (about 200 bytes each).
 pub const MAX_CHECKPOINT_BYTES: u64 = 128 * 1024 * 1024;
 
