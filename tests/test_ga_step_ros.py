@@ -102,4 +102,6 @@ def test_ga_step_evaluates_through_a_simulator_and_ignores_stale_answers(ros_nod
     # The stale answers (13) arrived and were never taken: every fitness is what the rule gives,
     # at most 3 + 2·0.0227 < 3.05.
     assert "discarded an outcome for `candidate" in proc.stderr, proc.stderr
+    # Every candidate was answered: no void score.
+    assert "; 0 unanswered candidates scored 0;" in proc.stdout, proc.stdout
     assert max(float(r["max"]) for r in rows) < 3.05

@@ -34,9 +34,9 @@ pub const CHECKPOINT_VERSION: u64 = 4;
 pub const CHECKPOINT_OLDEST_READ: u64 = 4;
 
 /// The largest checkpoint read (128 MiB); a larger file (or a device such as `/dev/zero`) is
-/// refused after reading this much. An individual takes about 4.2 KB of JSON (210 knots in
+/// refused after reading this much and one byte more. An individual takes about 4.0 KB of JSON (210 knots in
 /// shortest round-trip form and its evaluation), so the largest population the executable
-/// accepts (10 000) is about 42 MB, leaving room for a history of more than 400 000 generations
+/// accepts (10 000) is about 40 MB, leaving room for a history of more than 400 000 generations
 /// (about 200 bytes each).
 pub const MAX_CHECKPOINT_BYTES: u64 = 128 * 1024 * 1024;
 
@@ -188,7 +188,9 @@ pub fn write_checkpoint(state: &GaState, evaluator: &EvaluatorTag, path: &Path) 
 }
 
 /// Flushes the directory holding `path` to disk (on Unix; elsewhere a no-op), so that a rename
-/// into it is durable.
+/// into it is durable. A file system that cannot sync a directory (the call fails with EINVAL
+/// or ENOTSUP: some network and FUSE file systems) is not an error: the rename is done, and
+/// such a file system offers no stronger promise.
 pub fn sync_parent(path: &Path) -> std::io::Result<()> {
     #[cfg(unix)]
     {
@@ -196,12 +198,24 @@ pub fn sync_parent(path: &Path) -> std::io::Result<()> {
             Some(d) if !d.as_os_str().is_empty() => d,
             _ => Path::new("."),
         };
-        std::fs::File::open(dir)?.sync_all()
+        unsupported_is_done(std::fs::File::open(dir)?.sync_all())
     }
     #[cfg(not(unix))]
     {
         let _ = path;
         Ok(())
+    }
+}
+
+/// A directory sync's result, with EINVAL and ENOTSUP (the file system cannot sync a
+/// directory) taken as done.
+#[cfg(unix)]
+fn unsupported_is_done(result: std::io::Result<()>) -> std::io::Result<()> {
+    use std::io::ErrorKind;
+    // The standard library names EINVAL `InvalidInput` and ENOTSUP/EOPNOTSUPP `Unsupported`.
+    match result {
+        Err(e) if matches!(e.kind(), ErrorKind::InvalidInput | ErrorKind::Unsupported) => Ok(()),
+        other => other,
     }
 }
 
@@ -226,4 +240,21 @@ pub fn read_checkpoint_tagged(path: &Path) -> Result<(GaState, EvaluatorTag), Ch
     }
     let text = String::from_utf8(bytes).map_err(|_| CheckpointError::Foreign("not UTF-8 text".into()))?;
     from_json_tagged(&text)
+}
+
+#[cfg(all(test, unix))]
+mod tests {
+    use super::unsupported_is_done;
+    use std::io::Error;
+
+    #[test]
+    fn a_directory_sync_the_file_system_cannot_do_is_not_an_error() {
+        // Linux's errno values: EINVAL 22, EOPNOTSUPP (= ENOTSUP) 95; EIO 5, ENOSPC 28.
+        assert!(unsupported_is_done(Err(Error::from_raw_os_error(22))).is_ok());
+        assert!(unsupported_is_done(Err(Error::from_raw_os_error(95))).is_ok());
+        assert!(unsupported_is_done(Ok(())).is_ok());
+        let eio = unsupported_is_done(Err(Error::from_raw_os_error(5))).unwrap_err();
+        assert_eq!(eio.raw_os_error(), Some(5));
+        assert!(unsupported_is_done(Err(Error::from_raw_os_error(28))).is_err());
+    }
 }

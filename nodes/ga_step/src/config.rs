@@ -139,8 +139,8 @@ impl Default for GaConfig {
 }
 
 /// The largest population (and offspring count): 10 000, a hundred times the source's 100.
-/// Every generation's checkpoint holds the whole population at about 4.5 KB of JSON an
-/// individual, so 10 000 is about 42 MB written each generation (100 000 would be 420 MB); and
+/// Every generation's checkpoint holds the whole population at about 4.0 KB of JSON an
+/// individual, so 10 000 is about 40 MB written each generation (100 000 would be 400 MB); and
 /// a generation of 10 000 already takes the built-in physics minutes (about 3 on two cores at
 /// the README's 59 individuals a second).
 pub const MAX_POPULATION: usize = 10_000;

@@ -1,7 +1,7 @@
 //! What a run leaves in its output directory, every file written atomically (to `<name>.tmp`,
 //! synced, renamed, the directory synced), so an interrupted run never leaves a half-written
 //! file; the writes hold [`WRITING`], which a second Ctrl-C takes before it exits, and a run
-//! starts by removing the `.tmp` files a killed run may have left:
+//! starts by removing the `.tmp` files of these names a killed run may have left (no other):
 //! - `fitness.csv`: `generation,max,mean,min`, one row per generation;
 //! - `fitness.svg`: max, mean and min fitness per generation (the source's Fig. 2–3);
 //! - `best.motion`: the best individual as a Webots motion file, and `best_gen_NNNN.motion`, the
@@ -15,6 +15,7 @@ use mobil_ga_step::{
 use mobil_tools_node::plot::{SeriesPanel, Stroke, Svg};
 use std::io::Write;
 use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::{Mutex, PoisonError};
 
 /// Held while a generation's outputs are written: whoever must end the process at once (a
@@ -23,8 +24,21 @@ pub static WRITING: Mutex<()> = Mutex::new(());
 
 /// The checkpoint's file name.
 pub const CHECKPOINT: &str = "checkpoint.json";
+/// The outputs with a fixed name (besides `best_gen_NNNN.motion`).
+pub const OUTPUTS: [&str; 5] = [
+    "fitness.csv",
+    "fitness.svg",
+    "best.motion",
+    "best_trajectory.yaml",
+    CHECKPOINT,
+];
 /// Generations between two `best_gen_NNNN.motion` files.
 pub const MOTION_EVERY: u32 = 10;
+
+/// A pause (ms) between writing each output's temporary file and renaming it, 0 by default: a
+/// test's way to land a signal while a write holds [`WRITING`] (`ga_step`'s hidden
+/// `--write-delay-ms`).
+pub static WRITE_DELAY_MS: AtomicU64 = AtomicU64::new(0);
 
 /// Writes `bytes` to `path` atomically: to `<path>.tmp`, synced, renamed over `path`, the
 /// directory synced. On failure the temporary file is removed and `path` is untouched.
@@ -36,6 +50,10 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
         let mut f = std::fs::File::create(&tmp)?;
         f.write_all(bytes)?;
         f.sync_all()?;
+        let delay = WRITE_DELAY_MS.load(Ordering::Relaxed);
+        if delay > 0 {
+            std::thread::sleep(std::time::Duration::from_millis(delay));
+        }
         std::fs::rename(&tmp, path)?;
         mobil_ga_step::checkpoint::sync_parent(path)
     })();
@@ -71,13 +89,29 @@ pub fn fitness_svg(history: &[GenerationStats], title: &str) -> String {
     svg.finish()
 }
 
-/// Removes the `*.tmp` files in `dir` (left by a process killed while writing). Best effort.
+/// Whether `name` is a temporary file this program writes: one of its outputs' names (the
+/// fixed ones, or `best_gen_` with four or more digits `.motion`) followed by `.tmp`.
+pub fn is_own_temporary(name: &str) -> bool {
+    let Some(output) = name.strip_suffix(".tmp") else {
+        return false;
+    };
+    if OUTPUTS.contains(&output) {
+        return true;
+    }
+    output
+        .strip_prefix("best_gen_")
+        .and_then(|rest| rest.strip_suffix(".motion"))
+        .is_some_and(|digits| digits.len() >= 4 && digits.bytes().all(|b| b.is_ascii_digit()))
+}
+
+/// Removes the temporary files of this program's outputs from `dir` (left by a process killed
+/// while writing); any other file, `*.tmp` or not, is left alone. Best effort.
 pub fn remove_temporaries(dir: &Path) {
     let Ok(entries) = std::fs::read_dir(dir) else {
         return;
     };
     for e in entries.flatten() {
-        if e.file_name().to_string_lossy().ends_with(".tmp") {
+        if e.file_name().to_str().is_some_and(is_own_temporary) {
             let _ = std::fs::remove_file(e.path());
         }
     }
@@ -155,6 +189,43 @@ mod tests {
         assert!(!dir.join("a.txt.tmp").exists());
         // A directory that does not exist: an error, and nothing left behind.
         assert!(write_atomic(&dir.join("missing/b.txt"), b"x").is_err());
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
+    fn only_this_programs_temporaries_are_removed() {
+        let dir = std::env::temp_dir().join(format!("ga_step_temporaries_{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        std::fs::create_dir_all(&dir).unwrap();
+        let ours = [
+            "fitness.csv.tmp",
+            "fitness.svg.tmp",
+            "best.motion.tmp",
+            "best_trajectory.yaml.tmp",
+            "checkpoint.json.tmp",
+            "best_gen_0010.motion.tmp",
+            "best_gen_12340.motion.tmp",
+        ];
+        let theirs = [
+            "notes.tmp",
+            "fitness.csv",
+            "best_gen_12.motion.tmp",
+            "best_gen_00x0.motion.tmp",
+            "my_fitness.csv.tmp",
+            "checkpoint.json.tmp.tmp",
+        ];
+        for name in ours.iter().chain(&theirs) {
+            std::fs::write(dir.join(name), b"x").unwrap();
+        }
+        remove_temporaries(&dir);
+        let mut left: Vec<String> = std::fs::read_dir(&dir)
+            .unwrap()
+            .map(|e| e.unwrap().file_name().into_string().unwrap())
+            .collect();
+        left.sort();
+        let mut want: Vec<String> = theirs.iter().map(|s| s.to_string()).collect();
+        want.sort();
+        assert_eq!(left, want);
         std::fs::remove_dir_all(&dir).unwrap();
     }
 

@@ -1,13 +1,21 @@
 //! `--params FILE`: the robot, the fitness and the algorithm's parameters from a file of
 //! `params/nao_step.yaml`'s form (`ga_step: ros__parameters: {key: value, …}`), every key one of
 //! [`NaoModel`], [`FitnessConfig`] or [`GaConfig`]'s fields and a missing key its default. The
-//! population is `--population`'s, so the file may not set it; the offspring count, as without a
-//! file, is set to the population too.
+//! population (and with it the offspring count) and the crossover are options, so the file may
+//! not set them ([`OPTIONS`]): a file that does is refused, naming the option.
 
 use anyhow::{anyhow, bail};
 use mobil_ga_step::{FitnessConfig, GaConfig, GaSetup, NaoModel};
 use serde_norway::{Mapping, Value};
 use std::path::Path;
+
+/// The algorithm's settings that are command-line options, not parameters, with the option
+/// that sets them (the offspring count is the population).
+pub const OPTIONS: [(&str, &str); 3] = [
+    ("population", "--population"),
+    ("offspring", "--population"),
+    ("crossover", "--crossover"),
+];
 
 /// The largest parameter file read (64 KiB; params/nao_step.yaml is under 5 KiB).
 pub const MAX_PARAMS_BYTES: u64 = 64 * 1024;
@@ -24,7 +32,11 @@ fn keys_of<T: serde::Serialize + Default>() -> Vec<String> {
 pub fn known_keys() -> Vec<String> {
     let mut keys = keys_of::<NaoModel>();
     keys.extend(keys_of::<FitnessConfig>());
-    keys.extend(keys_of::<GaConfig>().into_iter().filter(|k| k != "population"));
+    keys.extend(
+        keys_of::<GaConfig>()
+            .into_iter()
+            .filter(|k| !OPTIONS.iter().any(|(key, _)| key == k)),
+    );
     keys
 }
 
@@ -41,7 +53,10 @@ pub fn setup_from_yaml(text: &str, name: &str) -> anyhow::Result<GaSetup> {
     let known = known_keys();
     for k in map.keys() {
         match k.as_str() {
-            Some("population") => bail!("{name}: `population` is the --population option, not a parameter"),
+            Some(k) if OPTIONS.iter().any(|(key, _)| *key == k) => {
+                let option = OPTIONS.iter().find(|(key, _)| *key == k).map_or("", |(_, o)| *o);
+                bail!("{name}: `{k}` is set by the {option} option, not a parameter")
+            }
             Some(k) if known.iter().any(|n| n == k) => {}
             _ => bail!(
                 "{name}: unknown parameter `{}` (known: {})",
@@ -113,8 +128,16 @@ mod tests {
             (text.replace("fall_tilt: 0.5", "fall_tilt: 2.0"), "fall_tilt"),
             (text.replace("mutation_picks: 10", "mutation_picks: ten"), "algorithm"),
             (
-                text.replace("offspring: 100", "offspring: 100\n    population: 5"),
-                "--population",
+                text.replace("blx_alpha: 0.7", "blx_alpha: 0.7\n    population: 5"),
+                "`population` is set by the --population option",
+            ),
+            (
+                text.replace("blx_alpha: 0.7", "blx_alpha: 0.7\n    offspring: 100"),
+                "`offspring` is set by the --population option",
+            ),
+            (
+                text.replace("blx_alpha: 0.7", "blx_alpha: 0.7\n    crossover: arithmetic"),
+                "`crossover` is set by the --crossover option",
             ),
             ("ga_step: 3".to_owned(), "no `ga_step: ros__parameters:`"),
         ];

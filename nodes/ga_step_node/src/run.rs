@@ -114,6 +114,10 @@ pub struct Cli {
     /// the rule off (default 20, params/nao_step.yaml). A resume must repeat it.
     #[arg(long, value_name = "N")]
     pub level_window: Option<usize>,
+    /// Testing only: pause this many ms inside each output's write (after its temporary file is
+    /// written, before the rename), holding the write lock.
+    #[arg(long, value_name = "MS", default_value_t = 0, hide = true)]
+    pub write_delay_ms: u64,
 }
 
 /// How a run ended.
@@ -133,6 +137,9 @@ pub struct Summary {
     pub first_step_generation: Option<u32>,
     /// Wall time of this invocation.
     pub wall: Duration,
+    /// With an external simulator: the candidates it left unanswered after every attempt,
+    /// scored 0 (void scores). `None` with the built-in physics.
+    pub void_scores: Option<u64>,
 }
 
 impl Summary {
@@ -148,8 +155,12 @@ impl Summary {
             Some(g) => format!("first forward step at generation {g}"),
             None => "no forward step yet".to_owned(),
         };
+        let void = match self.void_scores {
+            Some(v) => format!("; {v} unanswered candidates scored 0"),
+            None => String::new(),
+        };
         format!(
-            "ga_step: stopped at generation {} by {why}; best fitness {:.4} ({}, {:+.3} m forward); {step}; {:.1} s; wrote {}",
+            "ga_step: stopped at generation {} by {why}; best fitness {:.4} ({}, {:+.3} m forward); {step}{void}; {:.1} s; wrote {}",
             self.generation,
             self.best_fitness,
             if self.best_fell { "falls" } else { "stands" },
@@ -276,6 +287,14 @@ impl Chosen {
             Chosen::Ros(r) => r.failure(),
         }
     }
+
+    /// An external evaluator's void scores (candidates unanswered, scored 0).
+    fn void_scores(&self) -> Option<u64> {
+        match self {
+            Chosen::Physics(_) => None,
+            Chosen::Ros(r) => Some(r.void_scores()),
+        }
+    }
 }
 
 /// The evaluator `arg` names, as a checkpoint records it.
@@ -288,9 +307,10 @@ pub fn evaluator_tag(arg: EvaluatorArg) -> EvaluatorTag {
     }
 }
 
-/// An interrupt that came before generation 0 was whole: nothing was written.
+/// An interrupt that came before generation 0 was whole: no output was written (DIR itself
+/// may have been created).
 #[derive(Debug, thiserror::Error)]
-#[error("interrupted during generation 0; nothing written")]
+#[error("interrupted during generation 0; no output written")]
 pub struct InterruptedBeforeStart;
 
 /// Runs the command line to its end. `interrupt` is polled between generations, and by the ROS
@@ -299,7 +319,8 @@ pub fn run(cli: &Cli, ros_args: &RosArgs, interrupt: &Arc<AtomicBool>) -> anyhow
     let started = Instant::now();
     let setup = setup_of(cli)?;
     setup.validate().map_err(|e| anyhow!("{e}"))?;
-    if !(cli.eval_timeout.is_finite() && cli.eval_timeout > 0.0 && cli.eval_timeout <= MAX_EVAL_TIMEOUT_S) {
+    let timeout_ok = cli.eval_timeout.is_finite() && cli.eval_timeout > 0.0 && cli.eval_timeout <= MAX_EVAL_TIMEOUT_S;
+    if cli.evaluator == EvaluatorArg::Ros && !timeout_ok {
         bail!(
             "--eval-timeout must be a number of seconds within (0, {MAX_EVAL_TIMEOUT_S}], not {}",
             cli.eval_timeout
@@ -320,7 +341,7 @@ pub fn run(cli: &Cli, ros_args: &RosArgs, interrupt: &Arc<AtomicBool>) -> anyhow
         None
     };
     check_writable(&cli.out)?;
-    outputs::remove_temporaries(&cli.out);
+    outputs::WRITE_DELAY_MS.store(cli.write_delay_ms, Ordering::Relaxed);
     let (chosen, threads) = match cli.evaluator {
         EvaluatorArg::Physics => (
             Chosen::Physics(Box::new(
@@ -343,6 +364,9 @@ pub fn run(cli: &Cli, ros_args: &RosArgs, interrupt: &Arc<AtomicBool>) -> anyhow
         ),
     };
     let evaluator = chosen.evaluator();
+    // Once the evaluator is up, just before the first write: a run that could not start leaves
+    // DIR as it was.
+    outputs::remove_temporaries(&cli.out);
 
     let bar = ProgressBar::new(cli.generations as u64);
     bar.set_style(
@@ -356,7 +380,11 @@ pub fn run(cli: &Cli, ros_args: &RosArgs, interrupt: &Arc<AtomicBool>) -> anyhow
     let show = |bar: &ProgressBar, state: &GaState| {
         if let Some(s) = state.history.last() {
             bar.set_position(state.generation as u64);
-            bar.set_message(format!("best {:.4}  mean {:.4}", s.max, s.mean));
+            let void = match chosen.void_scores() {
+                Some(v) if v > 0 => format!("  unanswered {v}"),
+                _ => String::new(),
+            };
+            bar.set_message(format!("best {:.4}  mean {:.4}{void}", s.max, s.mean));
         }
     };
 
@@ -429,5 +457,6 @@ pub fn run(cli: &Cli, ros_args: &RosArgs, interrupt: &Arc<AtomicBool>) -> anyhow
         best_forward: row.best_forward,
         first_step_generation: state.first_step_generation.filter(|g| *g <= generation),
         wall: started.elapsed(),
+        void_scores: chosen.void_scores(),
     })
 }

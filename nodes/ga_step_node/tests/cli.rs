@@ -70,7 +70,12 @@ fn one_line_error(o: &Output, code: i32, contains: &str) {
 #[test]
 fn a_run_writes_every_output_and_a_resumed_run_equals_an_uninterrupted_one() {
     let (whole, split) = (scratch("whole"), scratch("split"));
-    let o = run(&whole, 4, 4, 11, &[]);
+    // A user's temporary file in DIR is left alone; one of ours from a killed run is removed.
+    std::fs::create_dir_all(&whole).unwrap();
+    std::fs::write(whole.join("notes.tmp"), b"mine").unwrap();
+    std::fs::write(whole.join("best_gen_0030.motion.tmp"), b"half").unwrap();
+    // --eval-timeout is the external evaluator's: with the physics, even 0 is not looked at.
+    let o = run(&whole, 4, 4, 11, &["--eval-timeout", "0"]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let line = String::from_utf8_lossy(&o.stdout);
     assert!(
@@ -92,6 +97,8 @@ fn a_run_writes_every_output_and_a_resumed_run_equals_an_uninterrupted_one() {
     }
     // T = 2 s at 40 ms: a header and 51 rows.
     assert_eq!(read(&whole.join("best.motion")).lines().count(), 52);
+    assert_eq!(read(&whole.join("notes.tmp")), "mine");
+    std::fs::remove_file(whole.join("notes.tmp")).unwrap();
     no_temporaries(&whole);
 
     let o = run(&split, 4, 2, 11, &[]);
@@ -208,7 +215,7 @@ fn ctrl_c_reaches_the_ros_evaluator() {
     assert!(t.elapsed() < Duration::from_secs(5), "{:?} {err}", t.elapsed());
     assert_eq!(o.status.code(), Some(130), "{err}");
     assert!(
-        err.contains("interrupted during generation 0; nothing written"),
+        err.contains("interrupted during generation 0; no output written"),
         "{err}"
     );
     assert!(!dir.join("checkpoint.json").exists());
@@ -226,15 +233,17 @@ fn interrupt(child: &std::process::Child) {
 }
 
 /// Ctrl-C during generation 0 (a population of 200 takes the physics seconds): the generation
-/// is finished and written whole. Ctrl-C twice: the process ends at once (well before the 40
-/// generations), with status 130, and every file in DIR is whole: no `.tmp`, and the
-/// checkpoint, if one was written, reads back.
+/// is finished and written whole. Ctrl-C twice while a write holds the write lock (the hidden
+/// `--write-delay-ms` pauses each output's write between its temporary file and the rename):
+/// the process ends at once after that write, with status 130, and every file in DIR is whole:
+/// no `.tmp`, and the checkpoint reads back with the fitness table of the same generation.
 #[test]
 fn ctrl_c_during_generation_0_and_a_second_ctrl_c_leave_whole_files() {
-    let spawn = |dir: &Path, generations: &str| {
+    let spawn = |dir: &Path, population: &str, extra: &[&str]| {
         Command::new(BIN)
-            .args(["--population", "200", "--generations", generations, "--seed", "3"])
+            .args(["--population", population, "--generations", "40", "--seed", "3"])
             .args(["--crossover", "blx", "--threads", "1", "--out", dir.to_str().unwrap()])
+            .args(extra)
             .stdout(Stdio::piped())
             .stderr(Stdio::piped())
             .spawn()
@@ -242,7 +251,7 @@ fn ctrl_c_during_generation_0_and_a_second_ctrl_c_leave_whole_files() {
     };
     // Once, during generation 0: generation 0 is kept.
     let once = scratch("ctrl_c_once");
-    let child = spawn(&once, "40");
+    let child = spawn(&once, "200", &[]);
     std::thread::sleep(Duration::from_millis(300));
     assert_eq!(checkpoint_generation(&once), 0);
     assert!(
@@ -257,26 +266,38 @@ fn ctrl_c_during_generation_0_and_a_second_ctrl_c_leave_whole_files() {
     assert_eq!(read(&once.join("fitness.csv")).lines().count(), 2);
     no_temporaries(&once);
 
-    // Twice, during the writes of the later generations: ends at once, files whole.
+    // Twice, while generation 1's fitness.csv.tmp is written and not yet renamed (fitness.csv,
+    // fitness.svg, best.motion and best_trajectory.yaml pause 400 ms each, the checkpoint
+    // none): the second Ctrl-C waits for the write lock, so the process ends after the
+    // checkpoint of generation 1, about 1.6 s later, with no `.tmp` left.
     let twice = scratch("ctrl_c_twice");
-    let child = spawn(&twice, "40");
-    let deadline = Instant::now() + Duration::from_secs(120);
-    while checkpoint_generation(&twice) < 1 {
-        assert!(Instant::now() < deadline, "no checkpoint of generation 1 within 120 s");
-        std::thread::sleep(Duration::from_millis(5));
+    let child = spawn(&twice, "4", &["--write-delay-ms", "400"]);
+    let deadline = Instant::now() + Duration::from_secs(60);
+    while !(checkpoint_generation(&twice) == 0
+        && twice.join("checkpoint.json").exists()
+        && twice.join("fitness.csv.tmp").exists())
+    {
+        assert!(Instant::now() < deadline, "no write of generation 1 seen within 60 s");
+        std::thread::sleep(Duration::from_millis(2));
     }
     interrupt(&child);
     std::thread::sleep(Duration::from_millis(20));
     interrupt(&child);
     let t = Instant::now();
     let o = child.wait_with_output().unwrap();
-    assert!(t.elapsed() < Duration::from_secs(5), "{:?}", t.elapsed());
-    assert_eq!(o.status.code(), Some(130), "{}", String::from_utf8_lossy(&o.stderr));
-    assert!(checkpoint_generation(&twice) < 40);
+    let waited = t.elapsed();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(130), "{err}");
+    // The rest of the write: at least the three pauses after fitness.csv's, 1.2 s.
+    assert!(
+        waited >= Duration::from_millis(1150) && waited < Duration::from_secs(10),
+        "{waited:?} {err}"
+    );
     no_temporaries(&twice);
     let state = mobil_ga_step::read_checkpoint(&twice.join("checkpoint.json")).unwrap();
+    assert_eq!(state.generation, 1);
     let csv = read(&twice.join("fitness.csv"));
-    assert!(csv.lines().count() as u32 >= state.generation + 2, "{csv}");
+    assert_eq!(csv.lines().count(), 3, "{csv}");
     let _ = std::fs::remove_dir_all(&once);
     let _ = std::fs::remove_dir_all(&twice);
 }
@@ -392,6 +413,14 @@ fn bad_options_are_one_line_errors() {
             "unknown parameter `blx_alfa`",
         ),
         (shipped.replace("fall_height: 0.20", "fall_height: -1"), "fall_height"),
+        (
+            shipped.replace("blx_alpha: 0.7", "blx_alpha: 0.7\n    offspring: 50"),
+            "`offspring` is set by the --population option",
+        ),
+        (
+            shipped.replace("blx_alpha: 0.7", "blx_alpha: 0.7\n    crossover: linear"),
+            "`crossover` is set by the --crossover option",
+        ),
     ] {
         std::fs::write(&bad, text).unwrap();
         let o = ga_step(&[

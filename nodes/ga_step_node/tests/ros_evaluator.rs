@@ -1,7 +1,7 @@
 //! The external evaluator against a fake simulator in the same process (two DDS participants),
 //! under a namespace given as a ROS argument: round trips whose answers are told apart from
-//! stale and foreign ones by the echoed header, a simulator that never answers, and an
-//! interrupt while waiting.
+//! stale and foreign ones by the echoed header, a simulator that restarts while a candidate
+//! waits, copies lost, a simulator that never answers, and an interrupt while waiting.
 
 use mobil_ga_step::{Evaluator, FitnessConfig, NaoModel, Servo};
 use mobil_ga_step_node::ros_eval::{RosEvalError, RosEvaluator, CANDIDATE_TOPIC, OUTCOME_TOPIC};
@@ -15,7 +15,11 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{mpsc, Arc};
 use std::time::{Duration, Instant};
 
-const NS: &str = "/sim7";
+/// The namespace of this process's topics: another copy of this test running at the same time
+/// (another checkout) on the same domain must not answer its candidates.
+fn ns() -> String {
+    format!("/sim{}", std::process::id())
+}
 
 fn outcome(header: Header, fell: bool, fall_time: f64, forward: f64) -> JointState {
     JointState {
@@ -26,14 +30,25 @@ fn outcome(header: Header, fell: bool, fall_time: f64, forward: f64) -> JointSta
     }
 }
 
-/// A simulator under [`NS`] that answers every candidate: a fall at 1.25 s, and as forward
-/// distance the candidate's RKneePitch at its middle point (t = T/2) divided by 10. Before each
-/// answer it sends two it must be ignored for: the previous candidate's header with an upright
-/// 9 m, and this candidate's frame_id with another stamp (another run) with an upright 7 m. It
-/// sends what it received to `seen`. With `silent` it answers nothing.
+/// How a fake simulator answers.
+#[derive(Clone, Copy, PartialEq)]
+enum Mode {
+    /// Every candidate it receives.
+    Answer,
+    /// Nothing (it hears, and stays up: a simulator that hung, or crashed within its lease).
+    Silent,
+    /// A candidate the second time it receives it (the first copy "lost").
+    SecondCopy,
+}
+
+/// A simulator under [`ns`] that answers candidates as `mode` says: a fall at 1.25 s, and as
+/// forward distance the candidate's RKneePitch at its middle point (t = T/2) divided by 10.
+/// Before each answer it sends two it must be ignored for: the header of the previous candidate
+/// it answered (unless this is a copy of it) with an upright 9 m, and this candidate's frame_id with another stamp (another run) with an
+/// upright 7 m. It sends what it received to `seen`.
 fn fake_simulator(
     domain: u16,
-    silent: bool,
+    mode: Mode,
     seen: mpsc::Sender<JointTrajectory>,
     stop: Arc<AtomicBool>,
 ) -> std::thread::JoinHandle<()> {
@@ -45,14 +60,14 @@ fn fake_simulator(
         let q = mobil_ros::qos::reliable(10);
         let candidate_topic = node
             .create_topic(
-                &Name::parse(&format!("{NS}/{CANDIDATE_TOPIC}")).unwrap(),
+                &Name::parse(&format!("{}/{CANDIDATE_TOPIC}", ns())).unwrap(),
                 JointTrajectory::type_name(),
                 &q,
             )
             .unwrap();
         let outcome_topic = node
             .create_topic(
-                &Name::parse(&format!("{NS}/{OUTCOME_TOPIC}")).unwrap(),
+                &Name::parse(&format!("{}/{OUTCOME_TOPIC}", ns())).unwrap(),
                 JointState::type_name(),
                 &q,
             )
@@ -64,6 +79,7 @@ fn fake_simulator(
             .create_publisher::<JointState>(&outcome_topic, Some(q.clone()))
             .unwrap();
         let mut previous: Option<Header> = None;
+        let mut received: Vec<Header> = Vec::new();
         while !stop.load(Ordering::SeqCst) {
             if let Ok(Some((m, _))) = candidates.take() {
                 let knee = m
@@ -74,8 +90,16 @@ fn fake_simulator(
                     .unwrap_or(f64::NAN);
                 let header = m.header.clone();
                 let _ = seen.send(m);
-                if !silent {
-                    if let Some(p) = previous.take() {
+                let first_copy = !received.contains(&header);
+                received.push(header.clone());
+                let answer = match mode {
+                    Mode::Answer => true,
+                    Mode::Silent => false,
+                    Mode::SecondCopy => !first_copy,
+                };
+                if answer {
+                    // The previous candidate answered (not a copy of this one).
+                    if let Some(p) = previous.take().filter(|p| *p != header) {
                         outcomes.publish(outcome(p, false, 0.0, 9.0)).unwrap();
                     }
                     let mut other_run = header.clone();
@@ -84,8 +108,8 @@ fn fake_simulator(
                     outcomes
                         .publish(outcome(header.clone(), true, 1.25, knee / 10.0))
                         .unwrap();
+                    previous = Some(header);
                 }
-                previous = Some(header);
             }
             std::thread::sleep(Duration::from_millis(2));
         }
@@ -94,7 +118,7 @@ fn fake_simulator(
 
 fn namespaced() -> RosArgs {
     RosArgs {
-        namespace: Some(NS.into()),
+        namespace: Some(ns()),
         ..RosArgs::default()
     }
 }
@@ -107,7 +131,7 @@ fn candidates_are_answered_by_their_own_outcome_only() {
     let model = NaoModel::default();
     let stop = Arc::new(AtomicBool::new(false));
     let (tx, rx) = mpsc::channel();
-    let sim = fake_simulator(domain, false, tx, stop.clone());
+    let sim = fake_simulator(domain, Mode::Answer, tx, stop.clone());
     let interrupt = Arc::new(AtomicBool::new(false));
     let evaluator = RosEvaluator::new(
         model.clone(),
@@ -161,7 +185,7 @@ fn candidates_are_answered_by_their_own_outcome_only() {
     // The simulator restarts: the evaluator waits for the new one and is answered by it.
     let stop = Arc::new(AtomicBool::new(false));
     let (tx, rx) = mpsc::channel();
-    let sim = fake_simulator(domain, false, tx, stop.clone());
+    let sim = fake_simulator(domain, Mode::Answer, tx, stop.clone());
     ind.knots[Servo::RKneePitch.index()][10] = 1.0;
     let e3 = evaluator.evaluate(&ind);
     assert_eq!(evaluator.failure(), None);
@@ -174,12 +198,15 @@ fn candidates_are_answered_by_their_own_outcome_only() {
     stop.store(true, Ordering::SeqCst);
     sim.join().unwrap();
 
-    // A simulator that hears the candidates but never answers: each candidate scores 0 after
-    // the timeout (1 s), the run goes on; the third in a row stops the evaluator, and every
-    // later evaluation returns at once.
+    restart_and_lost_copies(domain, &model);
+
+    // A simulator that hears the candidates but never answers: each attempt ends after the
+    // timeout (1 s); the first candidate's two attempts leave it a void score of 0 and the run
+    // goes on; the second candidate's first attempt is the third in a row, which stops the
+    // evaluator, and every later evaluation returns at once.
     let stop = Arc::new(AtomicBool::new(false));
     let (tx, rx) = mpsc::channel();
-    let sim = fake_simulator(domain, true, tx, stop.clone());
+    let sim = fake_simulator(domain, Mode::Silent, tx, stop.clone());
     let evaluator = RosEvaluator::new(
         model.clone(),
         FitnessConfig::default(),
@@ -191,21 +218,27 @@ fn candidates_are_answered_by_their_own_outcome_only() {
     // The first call may also wait up to 1 s for discovery.
     let t = Instant::now();
     let e = evaluator.evaluate(&ind);
-    assert!(t.elapsed() < Duration::from_secs(4), "{:?}", t.elapsed());
+    let took = t.elapsed();
+    assert!(
+        took >= Duration::from_secs(2) && took < Duration::from_secs(5),
+        "{took:?} {e:?} {:?}",
+        evaluator.failure()
+    );
     assert_eq!((e.fitness, e.fell), (0.0, true));
     assert_eq!(evaluator.failure(), None);
-    assert_eq!(
-        rx.recv_timeout(Duration::from_secs(2)).unwrap().header.frame_id,
-        "candidate 1"
-    );
-    evaluator.evaluate(&ind);
-    assert_eq!(evaluator.failure(), None);
+    assert_eq!(evaluator.void_scores(), 1);
+    // Sent once per attempt (no periodic re-send within 1 s), with the same header.
+    let first = rx.recv_timeout(Duration::from_secs(2)).unwrap();
+    let again = rx.recv_timeout(Duration::from_secs(2)).unwrap();
+    assert_eq!(first.header.frame_id, "candidate 1");
+    assert_eq!(again.header, first.header);
     evaluator.evaluate(&ind);
     assert!(
-        matches!(evaluator.failure(), Some(RosEvalError::Unanswered { candidate: 3, .. })),
+        matches!(evaluator.failure(), Some(RosEvalError::Unanswered { candidate: 2, .. })),
         "{:?}",
         evaluator.failure()
     );
+    assert_eq!(evaluator.void_scores(), 1);
     let t = Instant::now();
     evaluator.evaluate(&ind);
     assert!(t.elapsed() < Duration::from_millis(100));
@@ -240,6 +273,90 @@ fn candidates_are_answered_by_their_own_outcome_only() {
     );
     setter.join().unwrap();
     drop(evaluator);
+    stop.store(true, Ordering::SeqCst);
+    sim.join().unwrap();
+}
+
+/// A candidate in flight when its simulator restarts, or whose first copy is lost.
+fn restart_and_lost_copies(domain: u16, model: &NaoModel) {
+    let interrupt = Arc::new(AtomicBool::new(false));
+    let mut ind = model.standing();
+    ind.knots[Servo::RKneePitch.index()][10] = 0.7;
+
+    // The old simulator hears candidate 1 and hangs (its participant stays, as a crashed one's
+    // does until its lease ends); a new one starts while the candidate waits. The candidate is
+    // sent again once the new reader is matched, and answered long before the timeout (20 s)
+    // or the periodic re-send (60 s here).
+    let stop_old = Arc::new(AtomicBool::new(false));
+    let (tx_old, rx_old) = mpsc::channel();
+    let old = fake_simulator(domain, Mode::Silent, tx_old, stop_old.clone());
+    let evaluator = RosEvaluator::new(
+        model.clone(),
+        FitnessConfig::default(),
+        Duration::from_secs(20),
+        &namespaced(),
+        interrupt.clone(),
+    )
+    .unwrap()
+    .with_resend_every(Duration::from_secs(60));
+    let stop_new = Arc::new(AtomicBool::new(false));
+    let (tx_new, rx_new) = mpsc::channel();
+    let (e, took, new) = std::thread::scope(|s| {
+        let waiting = s.spawn(|| evaluator.evaluate(&ind));
+        let heard = rx_old.recv_timeout(Duration::from_secs(10)).unwrap();
+        assert_eq!(heard.header.frame_id, "candidate 1");
+        let t = Instant::now();
+        let new = fake_simulator(domain, Mode::Answer, tx_new, stop_new.clone());
+        let e = waiting.join().unwrap();
+        (e, t.elapsed(), new)
+    });
+    assert_eq!(evaluator.failure(), None);
+    assert!(took < Duration::from_secs(10), "{took:?}");
+    // 0.7/10 = 0.07 m, the fall at 1.25 s: f = 1.25/3.
+    assert!((e.forward_distance - 0.07).abs() < 1e-12, "{e:?}");
+    assert!((e.fitness - 1.25 / 3.0).abs() < 1e-12, "{e:?}");
+    assert_eq!(
+        rx_new.recv_timeout(Duration::from_secs(1)).unwrap().header.frame_id,
+        "candidate 1"
+    );
+    drop(evaluator);
+    for (stop, sim) in [(stop_old, old), (stop_new, new)] {
+        stop.store(true, Ordering::SeqCst);
+        sim.join().unwrap();
+    }
+
+    // A simulator that loses the first copy of each candidate. With a timeout of 20 s and a
+    // re-send every second, the second copy is answered after about a second; with a timeout
+    // of 1 s (no re-send within it), the second attempt's copy is.
+    let stop = Arc::new(AtomicBool::new(false));
+    let (tx, rx) = mpsc::channel();
+    let sim = fake_simulator(domain, Mode::SecondCopy, tx, stop.clone());
+    for (timeout, every) in [(20, 1), (1, 60)] {
+        let evaluator = RosEvaluator::new(
+            model.clone(),
+            FitnessConfig::default(),
+            Duration::from_secs(timeout),
+            &namespaced(),
+            interrupt.clone(),
+        )
+        .unwrap()
+        .with_resend_every(Duration::from_secs(every));
+        let t = Instant::now();
+        let e = evaluator.evaluate(&ind);
+        let took = t.elapsed();
+        assert_eq!(evaluator.failure(), None, "timeout {timeout} s");
+        assert_eq!(evaluator.void_scores(), 0);
+        assert!(
+            took >= Duration::from_millis(900) && took < Duration::from_secs(8),
+            "{took:?}"
+        );
+        assert!((e.forward_distance - 0.07).abs() < 1e-12, "timeout {timeout} s: {e:?}");
+        let first = rx.recv_timeout(Duration::from_secs(1)).unwrap();
+        let second = rx.recv_timeout(Duration::from_secs(1)).unwrap();
+        assert_eq!(first.header, second.header);
+        drop(evaluator);
+        while rx.try_recv().is_ok() {}
+    }
     stop.store(true, Ordering::SeqCst);
     sim.join().unwrap();
 }

@@ -859,11 +859,12 @@ impl Node {
   pub fn status_receiver(&self) -> Option<Receiver<NodeEvent>> {
     if self.have_spinner() {
       let (status_event_sender, status_event_receiver) = async_channel::bounded(8);
-      self
-        .status_event_senders
-        .lock()
-        .unwrap()
-        .push(status_event_sender);
+      let mut senders = self.status_event_senders.lock().unwrap();
+      // Senders whose receivers were dropped (e.g. by a finished or abandoned
+      // `wait_for_reader`/`wait_for_writer`) are otherwise pruned only when an
+      // event is sent, i.e. on a graph change: on a steady graph they pile up.
+      senders.retain(|s| !s.is_closed());
+      senders.push(status_event_sender);
       Some(status_event_receiver)
     } else {
       None
@@ -917,7 +918,8 @@ impl Node {
 
     match (already_present, status_receiver) {
       (true, _) => {
-        info!("wait_for_reader: Already have matched a reader.");
+        // Not `info!`: a caller that checks for a reader often would flood the log.
+        debug!("wait_for_reader: Already have matched a reader.");
         ReaderWait::Ready
       }
       (false, Some(status_receiver)) => ReaderWait::Wait {
@@ -1749,6 +1751,28 @@ mod tests {
 
     assert!(node.has_parameter("rate_hz"));
     assert!(node.spinner().is_ok());
+  }
+
+  #[test]
+  fn dropped_status_receivers_do_not_pile_up() {
+    let mut node = Node::new(
+      NodeName::new("/", "status_receivers").unwrap(),
+      NodeOptions::new().start_parameter_services(false),
+      Context::new().unwrap(),
+    )
+    .unwrap();
+    let _spinner = node.spinner().unwrap();
+    let kept = node.status_receiver().unwrap();
+    // A thousand receivers taken and dropped on a graph that does not change (nothing is
+    // spinning, so no event is sent): each new one prunes the closed ones.
+    for _ in 0..1000 {
+      drop(node.status_receiver().unwrap());
+    }
+    // The kept receiver and the last dropped one (closed after its own push).
+    assert_eq!(node.status_event_senders.lock().unwrap().len(), 2);
+    drop(kept);
+    drop(node.status_receiver().unwrap());
+    assert_eq!(node.status_event_senders.lock().unwrap().len(), 1);
   }
 
   #[test]
