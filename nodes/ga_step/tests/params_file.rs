@@ -44,6 +44,7 @@ fn the_file_holds_the_documented_defaults() {
         "step_min_forward",
         "distance_on_fall",
         "backward_allowance",
+        "robust_check",
         "blx_alpha",
         "blx_variant",
         "crossover_weight",

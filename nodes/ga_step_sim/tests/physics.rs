@@ -4,13 +4,31 @@
 use mobil_ga_step::{
     evaluate_all, Evaluation, Evaluator, FitnessConfig, Individual, NaoModel, Servo, KNOTS, SERVO_COUNT,
 };
-use mobil_ga_step_sim::{motions, BodyParams, FallCause, PhysicsEvaluator, SimError};
+use mobil_ga_step_sim::{
+    motions, BodyParams, FallCause, PhysicsEvaluator, SimError, SimOutcome, SolverSetting, CHECK_SETTING,
+};
 use rand::{Rng, SeedableRng};
 use std::f64::consts::{FRAC_PI_2, FRAC_PI_4};
 
 fn evaluator() -> PhysicsEvaluator {
     PhysicsEvaluator::new(NaoModel::default(), FitnessConfig::default()).unwrap()
 }
+
+/// An evaluator of one setting alone (no robust score): the default body at `setting`.
+fn single(setting: SolverSetting) -> PhysicsEvaluator {
+    let fitness = FitnessConfig {
+        robust_check: false,
+        ..FitnessConfig::default()
+    };
+    PhysicsEvaluator::with_body(NaoModel::default(), fitness, setting.apply(&BodyParams::default())).unwrap()
+}
+
+/// The default solver setting, 5 ms, 4 iterations of 2 passes.
+const DEFAULT: SolverSetting = SolverSetting {
+    dt: 0.005,
+    solver_iterations: 4,
+    pgs_iterations: 2,
+};
 
 /// Every inner knot of `servos` at `value`.
 fn hold(model: &NaoModel, servos: &[(Servo, f64)]) -> Individual {
@@ -111,7 +129,9 @@ fn a_mirrored_individual_moves_the_torso_the_mirrored_way() {
 
 #[test]
 fn the_same_individual_gives_the_same_evaluation_bit_for_bit_on_any_thread() {
+    // The robust score (the default and the check setting), as ga_step uses it.
     let ev = evaluator();
+    assert_eq!(ev.check_bodies().len(), 1);
     let model = NaoModel::default();
     let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(5);
     // Gentle random motions (a quarter of each range around the standing pose) that stay up
@@ -217,7 +237,11 @@ fn bad_body_figures_are_refused() {
 /// The individuals of `fixtures/blx1_gen56.txt` with the evaluation a `ga_step` run stored for
 /// each, every figure as the bits of its double.
 fn stored_individuals() -> Vec<(Individual, Evaluation)> {
-    let text = include_str!("fixtures/blx1_gen56.txt");
+    parse_fixture(include_str!("fixtures/blx1_gen56.txt"))
+}
+
+/// Individuals and stored evaluations from a fixture's text (see its header).
+fn parse_fixture(text: &str) -> Vec<(Individual, Evaluation)> {
     let bits = |t: &str| f64::from_bits(u64::from_str_radix(t, 16).expect("fixture: hexadecimal bits"));
     text.lines()
         .filter(|l| !l.starts_with('#') && !l.trim().is_empty())
@@ -242,11 +266,13 @@ fn stored_individuals() -> Vec<(Individual, Evaluation)> {
 }
 
 #[test]
-fn individuals_of_a_physics_2_run_score_exactly_what_the_run_stored() {
-    // Physics version 2 must score every individual as the runs made under it did, to the bit:
-    // five of a BLX-α run's population (generation 56; ranks 0, 7, 28, 63 and 99), their
-    // fitness, fall time and Δx as its checkpoint holds them.
-    let ev = evaluator();
+fn the_single_setting_scores_individuals_of_a_physics_2_run_exactly_as_the_run_did() {
+    // Without the robust score, the evaluator is physics version 2's and must score every
+    // individual as the runs made under it did, to the bit: five of a BLX-α run's population
+    // (generation 56; ranks 0, 7, 28, 63 and 99), their fitness, fall time and Δx as its
+    // checkpoint holds them.
+    let ev = single(DEFAULT);
+    assert!(ev.check_bodies().is_empty());
     let model = NaoModel::default();
     let stored = stored_individuals();
     assert_eq!(stored.len(), 5);
@@ -605,5 +631,155 @@ fn upright_motions_end_at_the_same_place_at_half_the_step_and_twice_the_iteratio
             (coarse.lateral_distance - fine.lateral_distance).abs() < 0.002,
             "{coarse:?} {fine:?}"
         );
+    }
+}
+
+/// The worse of two outcomes by the robust score's rule, written out here apart from the
+/// evaluator's: a fall is worse than none; of two falls the earlier; of two upright outcomes the
+/// smaller Δx; a tie keeps `first`.
+fn worse_of(first: SimOutcome, second: SimOutcome) -> SimOutcome {
+    let second_worse = match (first.fell, second.fell) {
+        (false, true) => true,
+        (true, false) => false,
+        (true, true) => second.t_end < first.t_end,
+        (false, false) => second.forward_distance < first.forward_distance,
+    };
+    if second_worse {
+        second
+    } else {
+        first
+    }
+}
+
+/// `fixtures/blx1_gen136_edge.txt`: evolved individuals upright at the default setting that
+/// fall at the check setting.
+fn edge_individuals() -> Vec<(Individual, Evaluation)> {
+    parse_fixture(include_str!("fixtures/blx1_gen136_edge.txt"))
+}
+
+#[test]
+fn an_evolved_motion_upright_only_at_the_default_setting_scores_as_a_fall() {
+    // Individuals a physics-2 run (BLX-α, seed 1) kept at generation 136 as upright: the
+    // fixture holds what the run stored (no fall, fitness 1 + 2·(Δx + 1)). At the check
+    // setting (4 ms/4/2) and at the reference 1.25 ms/16/4 they fall (the check_settings
+    // example's table). Under the robust score each is a fall, at the check setting's fall
+    // time, scoring t / 3 s < 1.
+    let ev = evaluator();
+    let default = single(DEFAULT);
+    let check = single(CHECK_SETTING);
+    let reference = single(SolverSetting {
+        dt: 0.00125,
+        solver_iterations: 16,
+        pgs_iterations: 4,
+    });
+    let edge = edge_individuals();
+    assert!(!edge.is_empty());
+    for (i, (ind, stored)) in edge.iter().enumerate() {
+        // What the run stored: upright, f = 1 + 2·(Δx + 1).
+        assert!(!stored.fell, "individual {i}");
+        assert!((stored.fitness - (1.0 + 2.0 * (stored.forward_distance + 1.0))).abs() < 1e-12);
+        let d = default.evaluate(ind);
+        assert_eq!(d.fitness.to_bits(), stored.fitness.to_bits(), "individual {i}: {d:?}");
+        let c = check.simulate(ind);
+        assert!(c.fell, "individual {i}: {c:?}");
+        assert!(reference.simulate(ind).fell, "individual {i}");
+        let got = ev.evaluate(ind);
+        assert!(got.fell, "individual {i}: {got:?}");
+        assert_eq!(got.t_fall, c.t_end, "individual {i}");
+        assert!((got.fitness - c.t_end / 3.0).abs() < 1e-12, "individual {i}: {got:?}");
+        assert!(got.fitness < 1.0);
+    }
+}
+
+#[test]
+fn standing_is_upright_under_every_setting() {
+    // Standing still for T_sim = 3 s: upright at both settings, the torso within 2 mm of where
+    // it began (the README's convergence table: −0.4 and −0.3 mm), so the robust fitness is
+    // 1 + 2·(Δx + 1) = 3 within 0.004, with Δx the smaller of the two settings'. The check
+    // setting is not the default one.
+    assert_ne!(CHECK_SETTING, DEFAULT);
+    let model = NaoModel::default();
+    let stand = model.standing();
+    let a = single(DEFAULT).simulate(&stand);
+    let b = single(CHECK_SETTING).simulate(&stand);
+    assert!(!a.fell && !b.fell, "{a:?} {b:?}");
+    let e = evaluator().evaluate(&stand);
+    assert!(!e.fell, "{e:?}");
+    assert_eq!(e.t_fall, 3.0);
+    assert_eq!(e.forward_distance, a.forward_distance.min(b.forward_distance));
+    assert!(e.forward_distance.abs() < 0.002, "{e:?}");
+    assert!((e.fitness - 3.0).abs() < 0.004, "{e:?}");
+}
+
+#[test]
+fn the_robust_score_is_the_worst_of_the_scores_under_each_setting() {
+    // Per individual, both settings simulated in full on their own, the worse outcome picked by
+    // `worse_of` and scored by the fitness formula by hand (a fall: t / 3 s; none:
+    // 1 + 2·(Δx + 1)), against the robust evaluator, bit for bit. The individuals: standing,
+    // the knee fold (falls at once under both), the run's individuals of generation 56 (fall
+    // under both, at different times) and of generation 136 (upright at the default only), and
+    // gentle random motions (some up, some falling). The evaluator cuts its check short at the
+    // default's fall time; this checks that the cut never changes the result.
+    let model = NaoModel::default();
+    let mut batch = vec![
+        model.standing(),
+        motions::ramp_to(&model, &[(Servo::RKneePitch, 2.2689), (Servo::LKneePitch, 2.2689)], 1),
+    ];
+    batch.extend(stored_individuals().into_iter().map(|(i, _)| i));
+    batch.extend(edge_individuals().into_iter().map(|(i, _)| i));
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(11);
+    for _ in 0..6 {
+        let mut ind = model.standing();
+        for s in Servo::ALL {
+            let (lo, hi) = s.limits();
+            for k in 1..KNOTS - 1 {
+                let v = model.standing_pose[s.index()] + 0.1 * (hi - lo) * (2.0 * rng.random::<f64>() - 1.0);
+                ind.knots[s.index()][k] = s.clamp(v);
+            }
+        }
+        batch.push(ind);
+    }
+    let (a, b, ev) = (single(DEFAULT), single(CHECK_SETTING), evaluator());
+    let (mut falls, mut upright, mut check_decided) = (0, 0, 0);
+    for (i, ind) in batch.iter().enumerate() {
+        let (oa, ob) = (a.simulate(ind), b.simulate(ind));
+        let w = worse_of(oa, ob);
+        let f = if w.fell {
+            w.t_end / 3.0
+        } else {
+            1.0 + 2.0 * (w.forward_distance + 1.0)
+        };
+        let got = ev.evaluate(ind);
+        assert_eq!(got.fell, w.fell, "individual {i}: {got:?} {oa:?} {ob:?}");
+        assert_eq!(got.t_fall.to_bits(), w.t_end.to_bits(), "individual {i}: {got:?} {w:?}");
+        assert_eq!(
+            got.forward_distance.to_bits(),
+            w.forward_distance.to_bits(),
+            "individual {i}"
+        );
+        assert!((got.fitness - f).abs() < 1e-12, "individual {i}: {got:?} vs {f}");
+        falls += usize::from(w.fell);
+        upright += usize::from(!w.fell);
+        check_decided += usize::from(w != oa);
+    }
+    // The batch covers both verdicts and results the check decided.
+    assert!(
+        falls >= 3 && upright >= 1 && check_decided >= 2,
+        "{falls} {upright} {check_decided}"
+    );
+}
+
+#[test]
+fn the_robust_score_can_be_switched_off() {
+    // robust_check false: the evaluator has no check and scores what the default setting alone
+    // does; the edge individuals then score their stored, upright, evaluation again.
+    let fitness = FitnessConfig {
+        robust_check: false,
+        ..FitnessConfig::default()
+    };
+    let ev = PhysicsEvaluator::new(NaoModel::default(), fitness).unwrap();
+    assert!(ev.check_bodies().is_empty());
+    for (ind, stored) in edge_individuals() {
+        assert_eq!(ev.evaluate(&ind), stored);
     }
 }
