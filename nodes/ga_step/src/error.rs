@@ -90,4 +90,8 @@ pub enum MotionError {
         /// What is wrong.
         reason: String,
     },
+    /// The motion is not one `write_motion` wrote for the model: a joint missing, another
+    /// length, or a knot no row pins down.
+    #[error("not a step of this model: {0}")]
+    NotAStep(String),
 }

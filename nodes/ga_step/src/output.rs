@@ -4,7 +4,7 @@
 
 use crate::error::MotionError;
 use crate::ga::GenerationStats;
-use crate::model::{joint_names, Individual, NaoModel, INTERVALS, KNOTS, SAMPLE_PERIOD_MS};
+use crate::model::{joint_names, Individual, NaoModel, Servo, INTERVALS, KNOTS, SAMPLE_PERIOD_MS};
 use std::io::{self, BufRead, Write};
 
 /// The header line of `fitness.csv`.
@@ -78,6 +78,57 @@ pub struct Motion {
     pub joint_names: Vec<String>,
     /// The rows, times strictly increasing.
     pub rows: Vec<MotionRow>,
+}
+
+impl Motion {
+    /// The individual [`write_motion`] wrote this motion from, for `model`: each servo's column
+    /// found by its Webots name, each inner knot read from the row at its time or, between rows,
+    /// extrapolated along the line through the interval's last two rows before it (the motion
+    /// is linear within an interval), clamped into the servo's limits; the first and last knots
+    /// are the standing pose. With the file's 4 decimals a knot comes back within 1e-4 rad
+    /// (a row's rounding, 5·10⁻⁵, at most doubled by the extrapolation). Refused: a servo's
+    /// column missing, a last row other than at T, a knot with fewer than two rows in its
+    /// interval before it (a step time under 80 ms an interval).
+    pub fn to_individual(&self, model: &NaoModel) -> Result<Individual, MotionError> {
+        let step_ms = model.step_time_ms();
+        let last = self.rows.last().map_or(0, |r| r.time_ms);
+        if last != step_ms {
+            return Err(MotionError::NotAStep(format!(
+                "the last row is at {last} ms, the step lasts {step_ms} ms"
+            )));
+        }
+        let knot_ms = step_ms as f64 / INTERVALS as f64;
+        let mut ind = model.standing();
+        for s in Servo::ALL {
+            let col = self
+                .joint_names
+                .iter()
+                .position(|n| n == s.name())
+                .ok_or_else(|| MotionError::NotAStep(format!("no column {}", s.name())))?;
+            for k in 1..KNOTS - 1 {
+                let (start, ms) = ((k - 1) as f64 * knot_ms, k as f64 * knot_ms);
+                let v = if let Some(r) = self.rows.iter().find(|r| (r.time_ms as f64 - ms).abs() < 1e-6) {
+                    r.values[col]
+                } else {
+                    let before: Vec<&MotionRow> = self
+                        .rows
+                        .iter()
+                        .filter(|r| (start..ms).contains(&(r.time_ms as f64)))
+                        .collect();
+                    let [.., a, b] = before[..] else {
+                        return Err(MotionError::NotAStep(format!(
+                            "knot {k} at {ms} ms has fewer than two rows between it and the knot before"
+                        )));
+                    };
+                    let (ta, tb) = (a.time_ms as f64, b.time_ms as f64);
+                    let (va, vb) = (a.values[col], b.values[col]);
+                    vb + (vb - va) * (ms - tb) / (tb - ta)
+                };
+                ind.knots[s.index()][k] = s.clamp(v);
+            }
+        }
+        Ok(ind)
+    }
 }
 
 fn parse_time(s: &str) -> Option<u64> {

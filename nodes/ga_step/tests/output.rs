@@ -109,6 +109,79 @@ fn the_motion_file_round_trips_through_the_reader() {
     }
 }
 
+#[test]
+fn a_motion_file_gives_back_its_individual_within_the_files_rounding() {
+    // 2 s steps: knots every 100 ms, rows every 40 ms, so the odd knots lie between rows and are
+    // extrapolated from the two rows before them (a knot at 100 ms from the rows at 40 and 80).
+    // A 1.2 s step: knots every 60 ms, one in three on a row. Each knot back within 1e-4 rad,
+    // the ends at the standing pose.
+    for (step_time, seeds) in [(2.0, 0..10), (1.2, 10..15)] {
+        let m = NaoModel {
+            step_time,
+            ..NaoModel::default()
+        };
+        for seed in seeds {
+            let ind = m.random_individual(&mut ChaCha8Rng::seed_from_u64(seed));
+            let back = read_motion(motion_text(&m, &ind).as_bytes())
+                .unwrap()
+                .to_individual(&m)
+                .unwrap();
+            for (s, (got, want)) in back.knots.iter().zip(&ind.knots).enumerate() {
+                for (k, (g, w)) in got.iter().zip(want).enumerate() {
+                    assert!(
+                        (g - w).abs() <= 1e-4 + 1e-12,
+                        "seed {seed} servo {s} knot {k}: {g} vs {w}"
+                    );
+                }
+                assert_eq!((got[0], got[got.len() - 1]), (want[0], want[want.len() - 1]));
+            }
+        }
+    }
+    // By hand: one interval's rows at 0.5 (40 ms) and 0.6 (80 ms) put the 100 ms knot at 0.65.
+    let m = NaoModel::default();
+    let (_, ind) = individual(3);
+    let mut motion = read_motion(motion_text(&m, &ind).as_bytes()).unwrap();
+    motion.rows[1].values[0] = -0.5;
+    motion.rows[2].values[0] = -0.6;
+    let back = motion.to_individual(&m).unwrap();
+    assert!((back.knots[0][1] - -0.65).abs() < 1e-12, "{}", back.knots[0][1]);
+}
+
+#[test]
+fn a_motion_of_another_length_or_without_a_servo_is_not_an_individual() {
+    let (m, ind) = individual(4);
+    let text = motion_text(&m, &ind);
+    let slower = NaoModel {
+        step_time: 2.4,
+        ..NaoModel::default()
+    };
+    let e = read_motion(text.as_bytes())
+        .unwrap()
+        .to_individual(&slower)
+        .unwrap_err();
+    assert_eq!(
+        e,
+        MotionError::NotAStep("the last row is at 2000 ms, the step lasts 2400 ms".into())
+    );
+    let renamed = text.replacen("LAnkleRoll", "LAnkleRoll2", 1);
+    let e = read_motion(renamed.as_bytes()).unwrap().to_individual(&m).unwrap_err();
+    assert_eq!(e, MotionError::NotAStep("no column LAnkleRoll".into()));
+    // A 0.4 s step: knots every 20 ms, the one at 20 ms between rows at 0 and 40 ms alone.
+    let short = NaoModel {
+        step_time: 0.4,
+        ..NaoModel::default()
+    };
+    let ind = short.random_individual(&mut ChaCha8Rng::seed_from_u64(5));
+    let e = read_motion(motion_text(&short, &ind).as_bytes())
+        .unwrap()
+        .to_individual(&short)
+        .unwrap_err();
+    assert!(
+        matches!(e, MotionError::NotAStep(ref r) if r.starts_with("knot 1 at 20 ms")),
+        "{e}"
+    );
+}
+
 /// The reader also takes the source's spaced form with its empty field after the version.
 #[test]
 fn the_reader_takes_the_sources_spaced_form() {

@@ -1,4 +1,5 @@
-//! Replays a run's best individual at the default solver settings and at two finer ones, with
+//! Replays a run's best individual under the robust score, then at the default solver setting,
+//! the check setting and two finer ones, with
 //! what its feet did, to tell a found step from one that holds only at the evaluator's exact
 //! numbers (motions at the edge of a fall change their verdict with the setting):
 //! `cargo run --release -p mobil_ga_step_sim --example replay -- CHECKPOINT_OR_MOTION
@@ -9,55 +10,26 @@
 //! torso, and per foot its peak sole height, its sole's Δx, the time it was loaded and how far
 //! it slid while loaded, and the longest and total time both feet were unloaded (flight).
 //!
-//! `replay --check CHECKPOINT` instead re-scores the checkpoint's whole population at the
-//! default settings and compares each evaluation with the stored one bit for bit (a physics
-//! change that keeps `PHYSICS_VERSION` must pass this); the exit status is 1 if any differs.
+//! `replay --check CHECKPOINT` instead re-scores the checkpoint's whole population with the
+//! evaluator it records (the built-in physics at this `PHYSICS_VERSION`, refused
+//! otherwise) and compares each evaluation with the stored one bit for bit (a physics change
+//! that keeps `PHYSICS_VERSION` must pass this); the exit status is 1 if any differs.
 use mobil_ga_step::Evaluator;
-use mobil_ga_step::{FitnessConfig, Individual, NaoModel, Servo, INTERVALS, KNOTS};
-use mobil_ga_step_sim::{BodyParams, PhysicsEvaluator};
+use mobil_ga_step::{EvaluatorTag, FitnessConfig, NaoModel};
+use mobil_ga_step_sim::{BodyParams, PhysicsEvaluator, CHECK_SETTING, PHYSICS_VERSION};
 
-/// The settings replayed without any given: the default, then 2.5 ms/8/2 and 1.25 ms/16/4.
-const SETTINGS: [(f64, usize, usize); 3] = [(0.005, 4, 2), (0.0025, 8, 2), (0.00125, 16, 4)];
-
-fn from_motion(path: &str, model: &NaoModel) -> Result<Individual, Box<dyn std::error::Error>> {
-    let file = std::io::BufReader::new(std::fs::File::open(path)?);
-    let motion = mobil_ga_step::read_motion(file)?;
-    let knot_ms = model.step_time * 1000.0 / INTERVALS as f64;
-    // A row's value of one servo at `ms`, if there is a row there.
-    let at = |col: usize, ms: f64| {
-        motion
-            .rows
-            .iter()
-            .find(|r| (r.time_ms as f64 - ms).abs() < 0.5)
-            .and_then(|r| r.values.get(col).copied())
-    };
-    let mut ind = model.standing();
-    for s in Servo::ALL {
-        let col = motion
-            .joint_names
-            .iter()
-            .position(|n| n == s.name())
-            .ok_or_else(|| format!("{path}: no column {}", s.name()))?;
-        for k in 1..KNOTS - 1 {
-            let ms = k as f64 * knot_ms;
-            let v = match at(col, ms) {
-                Some(v) => v,
-                None => {
-                    // The last two rows of the interval that ends at this knot lie on its line.
-                    let b = (ms / 40.0).floor() * 40.0;
-                    let a = b - 40.0;
-                    let (va, vb) = (
-                        at(col, a).ok_or_else(|| format!("{path}: no row at {a} ms"))?,
-                        at(col, b).ok_or_else(|| format!("{path}: no row at {b} ms"))?,
-                    );
-                    vb + (vb - va) * (ms - b) / 40.0
-                }
-            };
-            ind.knots[s.index()][k] = s.clamp(v);
-        }
-    }
-    Ok(ind)
-}
+/// The settings replayed without any given: the default, the robust score's check (4 ms/4/2),
+/// then 2.5 ms/8/2 and 1.25 ms/16/4.
+const SETTINGS: [(f64, usize, usize); 4] = [
+    (0.005, 4, 2),
+    (
+        CHECK_SETTING.dt,
+        CHECK_SETTING.solver_iterations,
+        CHECK_SETTING.pgs_iterations,
+    ),
+    (0.0025, 8, 2),
+    (0.00125, 16, 4),
+];
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mut args = std::env::args().skip(1).peekable();
@@ -82,7 +54,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     }
     let (model, fitness, ind, stored) = if path.ends_with(".motion") {
         let model = NaoModel::default();
-        let ind = from_motion(&path, &model)?;
+        let file = std::io::BufReader::new(std::fs::File::open(&path)?);
+        let ind = mobil_ga_step::read_motion(file)?
+            .to_individual(&model)
+            .map_err(|e| format!("{path}: {e}"))?;
         (model, FitnessConfig::default(), ind, None)
     } else {
         let state = mobil_ga_step::read_checkpoint(std::path::Path::new(&path))?;
@@ -105,6 +80,22 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         );
     }
     let duration = fitness.sim_time(model.step_time);
+    // The robust score's verdict when the fitness asks for it (the default and the check).
+    if fitness.robust_check && !fitness.distance_on_fall {
+        let e = PhysicsEvaluator::new(model.clone(), fitness.clone())?.evaluate(&ind);
+        println!(
+            "  robust score (5 ms/4/2 and 4 ms/4/2): fitness {:.4}, {}, t {:.3} s, dx {:+.4} m",
+            e.fitness,
+            if e.fell { "falls" } else { "upright" },
+            e.t_fall,
+            e.forward_distance
+        );
+    }
+    // One setting at a time: without the robust score.
+    let fitness = FitnessConfig {
+        robust_check: false,
+        ..fitness
+    };
     for (dt, iterations, passes) in settings {
         let body = BodyParams {
             dt,
@@ -144,7 +135,13 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
 
 /// Re-scores a checkpoint's population and compares with the stored evaluations, bit for bit.
 fn check(path: &str) -> Result<(), Box<dyn std::error::Error>> {
-    let state = mobil_ga_step::read_checkpoint(std::path::Path::new(path))?;
+    let (state, tag) = mobil_ga_step::read_checkpoint_tagged(std::path::Path::new(path))?;
+    let ours = EvaluatorTag::Physics {
+        physics_version: PHYSICS_VERSION,
+    };
+    if tag != ours {
+        return Err(format!("{path}: scored by {tag}, not by this {ours}").into());
+    }
     let ev = PhysicsEvaluator::new(state.setup.model.clone(), state.setup.fitness.clone())?;
     let mut differ = 0;
     for (i, scored) in state.population.iter().enumerate() {
