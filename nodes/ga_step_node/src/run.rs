@@ -244,6 +244,12 @@ fn run_differences(
         was_f.shape(),
         now_f.shape(),
     );
+    differ(
+        was_f.robust_check == now_f.robust_check,
+        "robust_check",
+        was_f.robust_check.to_string(),
+        now_f.robust_check.to_string(),
+    );
     if differences.is_empty() && state.setup != *setup {
         differences.push("other parameters of the robot, the algorithm or the fitness (--params)".to_owned());
     }

@@ -581,6 +581,21 @@ fn a_missing_foreign_or_other_runs_checkpoint_is_refused_and_left_alone() {
     std::fs::write(&params, shipped.replace("step_time: 2.0", "step_time: 2.4")).unwrap();
     let o = run(&dir, 4, 2, 1, &["--resume", "--params", params.to_str().unwrap()]);
     one_line_error(&o, 1, "other parameters");
+    // A parameter file that switches the robust score off: named.
+    std::fs::write(&params, shipped.replace("robust_check: true", "robust_check: false")).unwrap();
+    let o = run(&dir, 4, 2, 1, &["--resume", "--params", params.to_str().unwrap()]);
+    one_line_error(&o, 1, "robust_check true (asked false)");
+    // A fall's distance counted with the robust score on: refused before any work.
+    std::fs::write(
+        &params,
+        shipped.replace("distance_on_fall: false", "distance_on_fall: true"),
+    )
+    .unwrap();
+    let fresh = scratch("distance_on_fall_robust");
+    let o = run(&fresh, 4, 2, 1, &["--params", params.to_str().unwrap()]);
+    one_line_error(&o, 1, "robust_check needs distance_on_fall false");
+    assert!(!fresh.join("checkpoint.json").exists());
+    let _ = std::fs::remove_dir_all(&fresh);
     std::fs::remove_file(&params).unwrap();
     // A new run over an existing one.
     let o = run(&dir, 4, 2, 1, &[]);

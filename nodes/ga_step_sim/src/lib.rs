@@ -111,12 +111,28 @@ pub enum SimError {
         /// The continuous torque (N·m).
         continuous: f64,
     },
+    /// The time step is outside [`DT_RANGE`].
+    #[error("body parameter dt = {value} s must be within {} … {} s", DT_RANGE.0, DT_RANGE.1)]
+    BadTimeStep {
+        /// The time step (s).
+        value: f64,
+    },
+    /// Check settings asked for with [`FitnessConfig::distance_on_fall`]: a fall's distance can
+    /// score it above the upright outcome, so "the worse of the two" would not be the lower
+    /// score, and a check could raise an individual's fitness.
+    #[error("robust_check needs distance_on_fall false: with a fall's distance counted, the worse of two outcomes is not the lower score (set robust_check: false)")]
+    ChecksWithDistanceOnFall,
 }
 
 /// The largest solver iteration or Gauss–Seidel pass count accepted: 64 times the default, far
 /// beyond any setting that changes an outcome (the README's convergence table), and small
 /// enough that a step cannot take unbounded time.
 pub const MAX_SOLVER_COUNT: usize = 256;
+
+/// The time steps accepted (s): 10 µs, 1/500 of the default, takes 300 000 steps for one
+/// 3 s evaluation; 50 ms, ten times the default, is a quarter of the legs' swing time
+/// constant, beyond which a contact is resolved once per footfall. NaN or infinite is refused.
+pub const DT_RANGE: (f64, f64) = (1e-5, 0.05);
 
 /// A solver setting: the time step and the solver's iteration counts of a [`BodyParams`].
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -147,7 +163,7 @@ impl SolverSetting {
 /// 1.25 ms/16/4, on the 100 individuals of a physics-2 run upright at the default and 53 other
 /// motions: each of them turned all 100 into falls, as the reference does, and each called the
 /// same single motion a fall that the reference calls upright; 4 ms/4/2 costs the least of the
-/// solver settings, 1.25 times the default.
+/// solver settings: 5/4 of the default's steps, 1.34 times its time in the benchmark.
 pub const CHECK_SETTING: SolverSetting = SolverSetting {
     dt: 0.004,
     solver_iterations: 4,
@@ -356,7 +372,8 @@ impl PhysicsEvaluator {
 
     /// An evaluator that scores under `body` and under `body` at each of `checks` and keeps
     /// the worst score ([`robust_simulate`](Self::robust_simulate)), whatever
-    /// [`FitnessConfig::robust_check`] says; with no checks, under `body` alone.
+    /// [`FitnessConfig::robust_check`] says; with no checks, under `body` alone. Checks with
+    /// [`FitnessConfig::distance_on_fall`] are refused ([`SimError::ChecksWithDistanceOnFall`]).
     pub fn with_checks(
         model: NaoModel,
         fitness: FitnessConfig,
@@ -365,6 +382,9 @@ impl PhysicsEvaluator {
     ) -> Result<PhysicsEvaluator, SimError> {
         model.validate()?;
         fitness.validate()?;
+        if fitness.distance_on_fall && !checks.is_empty() {
+            return Err(SimError::ChecksWithDistanceOnFall);
+        }
         Self::validate_body(&body)?;
         let checks: Vec<BodyParams> = checks.iter().map(|c| c.apply(&body)).collect();
         for c in &checks {
@@ -406,6 +426,9 @@ impl PhysicsEvaluator {
                 return Err(SimError::BadBody { name, value });
             }
         }
+        if !(DT_RANGE.0..=DT_RANGE.1).contains(&b.dt) {
+            return Err(SimError::BadTimeStep { value: b.dt });
+        }
         for (name, value) in [
             ("solver_iterations", b.solver_iterations),
             ("pgs_iterations", b.pgs_iterations),
@@ -437,12 +460,13 @@ impl PhysicsEvaluator {
 
     /// The robust score's outcome: the individual simulated under the body's setting and each
     /// check setting, the worst outcome kept. A fall is worse than no fall; of two falls, the
-    /// one of lower fitness (without [`FitnessConfig::distance_on_fall`], the earlier; a tie
-    /// keeps the earlier setting's); of two upright outcomes, the smaller Δx (a tie keeps the
-    /// earlier setting's). Without checks, [`simulate`](Self::simulate).
+    /// earlier (a tie keeps the earlier setting's); of two upright outcomes, the smaller Δx (a
+    /// tie keeps the earlier setting's). That is the lower fitness, a fall's distance not
+    /// counting (checks are refused with [`FitnessConfig::distance_on_fall`]). Without checks,
+    /// [`simulate`](Self::simulate).
     ///
     /// A check is cut short where it cannot change the result, exactly: once the worst so far
-    /// is a fall at t (and a fall's distance does not count), a check only matters if it falls
+    /// is a fall at t, a check only matters if it falls
     /// before t, and a simulation's first steps do not depend on how long it runs, so the check
     /// is simulated to t alone (its steps up to t: `round(t / dt)` ≥ `floor(t / dt)` of them). A
     /// fall at t = 0 (an invalid individual) needs no check at all.
@@ -450,42 +474,36 @@ impl PhysicsEvaluator {
         let duration = self.fitness.sim_time(self.model.step_time);
         let mut worst = self.simulate_for(individual, duration);
         for body in &self.checks {
-            let cut = worst.fell && !self.fitness.distance_on_fall;
-            if cut && worst.t_end <= 0.0 {
+            let Some(d) = Self::check_duration(&worst, duration) else {
                 break;
-            }
-            let o = self.run(
-                body,
-                individual,
-                if cut { worst.t_end } else { duration },
-                false,
-                &mut |_| {},
-                &mut |_, _| {},
-            );
-            if self.worse(&o, &worst) {
+            };
+            let o = self.run(body, individual, d, false, &mut |_| {}, &mut |_, _| {});
+            if Self::worse(&o, &worst) {
                 worst = o;
             }
         }
         worst
     }
 
+    /// How long a check must be simulated when the worst outcome so far is `worst` and an
+    /// evaluation lasts `duration` (the cut of [`robust_simulate`](Self::robust_simulate)):
+    /// in full after an upright outcome, to the fall's time after a fall, not at all after a
+    /// fall at t = 0.
+    pub fn check_duration(worst: &SimOutcome, duration: f64) -> Option<f64> {
+        match (worst.fell, worst.t_end) {
+            (false, _) => Some(duration),
+            (true, t) if t <= 0.0 => None,
+            (true, t) => Some(t),
+        }
+    }
+
     /// Whether `a` scores strictly worse than `b` ([`robust_simulate`](Self::robust_simulate)).
-    fn worse(&self, a: &SimOutcome, b: &SimOutcome) -> bool {
+    fn worse(a: &SimOutcome, b: &SimOutcome) -> bool {
         match (a.fell, b.fell) {
             (true, false) => true,
             (false, true) => false,
             (false, false) => a.forward_distance < b.forward_distance,
-            (true, true) => {
-                let f = |o: &SimOutcome| {
-                    self.fitness
-                        .fitness(self.model.step_time, Some(o.t_end), o.forward_distance)
-                };
-                if self.fitness.distance_on_fall {
-                    f(a) < f(b)
-                } else {
-                    a.t_end < b.t_end
-                }
-            }
+            (true, true) => a.t_end < b.t_end,
         }
     }
 

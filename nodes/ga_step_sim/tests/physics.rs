@@ -6,6 +6,7 @@ use mobil_ga_step::{
 };
 use mobil_ga_step_sim::{
     motions, BodyParams, FallCause, PhysicsEvaluator, SimError, SimOutcome, SolverSetting, CHECK_SETTING,
+    PHYSICS_VERSION,
 };
 use rand::{Rng, SeedableRng};
 use std::f64::consts::{FRAC_PI_2, FRAC_PI_4};
@@ -190,6 +191,33 @@ fn bad_body_figures_are_refused() {
     };
     let r = PhysicsEvaluator::with_body(NaoModel::default(), FitnessConfig::default(), body);
     assert_eq!(r.err(), Some(SimError::BadBody { name: "dt", value: 0.0 }));
+    // The time step within 10 µs … 50 ms, both ends accepted.
+    for (dt, ok) in [
+        (1e-5, true),
+        (0.05, true),
+        (0.9e-5, false),
+        (0.051, false),
+        (1.0, false),
+    ] {
+        let body = BodyParams {
+            dt,
+            ..BodyParams::default()
+        };
+        let r = PhysicsEvaluator::with_body(NaoModel::default(), FitnessConfig::default(), body);
+        if ok {
+            assert!(r.is_ok(), "dt {dt}");
+        } else {
+            assert_eq!(r.err(), Some(SimError::BadTimeStep { value: dt }));
+        }
+    }
+    // A check setting's time step is checked too.
+    let fine = SolverSetting {
+        dt: 1e-6,
+        ..CHECK_SETTING
+    };
+    let fitness = FitnessConfig::default();
+    let r = PhysicsEvaluator::with_checks(NaoModel::default(), fitness, BodyParams::default(), &[fine]);
+    assert_eq!(r.err(), Some(SimError::BadTimeStep { value: 1e-6 }));
     let body = BodyParams {
         friction: f64::NAN,
         ..BodyParams::default()
@@ -705,7 +733,6 @@ fn standing_is_upright_under_every_setting() {
     assert!(!a.fell && !b.fell, "{a:?} {b:?}");
     let e = evaluator().evaluate(&stand);
     assert!(!e.fell, "{e:?}");
-    assert_eq!(e.t_fall, 3.0);
     assert_eq!(e.forward_distance, a.forward_distance.min(b.forward_distance));
     assert!(e.forward_distance.abs() < 0.002, "{e:?}");
     assert!((e.fitness - 3.0).abs() < 0.004, "{e:?}");
@@ -726,7 +753,8 @@ fn the_robust_score_is_the_worst_of_the_scores_under_each_setting() {
         motions::ramp_to(&model, &[(Servo::RKneePitch, 2.2689), (Servo::LKneePitch, 2.2689)], 1),
     ];
     batch.extend(stored_individuals().into_iter().map(|(i, _)| i));
-    batch.extend(edge_individuals().into_iter().map(|(i, _)| i));
+    let edge: Vec<Individual> = edge_individuals().into_iter().map(|(i, _)| i).collect();
+    batch.extend(edge.iter().cloned());
     let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(11);
     for _ in 0..6 {
         let mut ind = model.standing();
@@ -739,34 +767,148 @@ fn the_robust_score_is_the_worst_of_the_scores_under_each_setting() {
         }
         batch.push(ind);
     }
-    let (a, b, ev) = (single(DEFAULT), single(CHECK_SETTING), evaluator());
+    // The evaluator of ga_step (the default, checked at 4 ms/4/2) on the whole batch, and the
+    // pair the other way round (4 ms/4/2, checked at the default) on the edge individuals:
+    // there the first setting falls and the check would stay up, a case the evolved and random
+    // motions tried never give the default pair (its check is the finer setting).
+    let swapped = PhysicsEvaluator::with_checks(
+        model.clone(),
+        FitnessConfig::default(),
+        CHECK_SETTING.apply(&BodyParams::default()),
+        &[DEFAULT],
+    )
+    .unwrap();
+    let pairs = [
+        (single(DEFAULT), single(CHECK_SETTING), evaluator(), &batch[..]),
+        (single(CHECK_SETTING), single(DEFAULT), swapped, &edge[..]),
+    ];
     let (mut falls, mut upright, mut check_decided) = (0, 0, 0);
-    for (i, ind) in batch.iter().enumerate() {
-        let (oa, ob) = (a.simulate(ind), b.simulate(ind));
-        let w = worse_of(oa, ob);
-        let f = if w.fell {
-            w.t_end / 3.0
-        } else {
-            1.0 + 2.0 * (w.forward_distance + 1.0)
-        };
-        let got = ev.evaluate(ind);
-        assert_eq!(got.fell, w.fell, "individual {i}: {got:?} {oa:?} {ob:?}");
-        assert_eq!(got.t_fall.to_bits(), w.t_end.to_bits(), "individual {i}: {got:?} {w:?}");
-        assert_eq!(
-            got.forward_distance.to_bits(),
-            w.forward_distance.to_bits(),
-            "individual {i}"
-        );
-        assert!((got.fitness - f).abs() < 1e-12, "individual {i}: {got:?} vs {f}");
-        falls += usize::from(w.fell);
-        upright += usize::from(!w.fell);
-        check_decided += usize::from(w != oa);
+    // Where the cut is taken (the first setting falls) and the check, simulated in full,
+    // would fall later or not at all: the cases the cut must not change.
+    let (mut cut_check_later, mut cut_check_up) = (0, 0);
+    for (a, b, ev, batch) in &pairs {
+        for (i, ind) in batch.iter().enumerate() {
+            let (oa, ob) = (a.simulate(ind), b.simulate(ind));
+            let w = worse_of(oa, ob);
+            let f = if w.fell {
+                w.t_end / 3.0
+            } else {
+                1.0 + 2.0 * (w.forward_distance + 1.0)
+            };
+            let got = ev.evaluate(ind);
+            assert_eq!(got.fell, w.fell, "individual {i}: {got:?} {oa:?} {ob:?}");
+            assert_eq!(got.t_fall.to_bits(), w.t_end.to_bits(), "individual {i}: {got:?} {w:?}");
+            assert_eq!(
+                got.forward_distance.to_bits(),
+                w.forward_distance.to_bits(),
+                "individual {i}"
+            );
+            assert!((got.fitness - f).abs() < 1e-12, "individual {i}: {got:?} vs {f}");
+            falls += usize::from(w.fell);
+            upright += usize::from(!w.fell);
+            check_decided += usize::from(w != oa);
+            if oa.fell && oa.t_end > 0.0 {
+                assert_eq!(PhysicsEvaluator::check_duration(&oa, 3.0), Some(oa.t_end));
+                cut_check_later += usize::from(ob.fell && ob.t_end > oa.t_end);
+                cut_check_up += usize::from(!ob.fell);
+            }
+        }
     }
-    // The batch covers both verdicts and results the check decided.
+    // The batch covers both verdicts, results the check decided, and cut checks that would
+    // have fallen later or stayed up.
     assert!(
-        falls >= 3 && upright >= 1 && check_decided >= 2,
-        "{falls} {upright} {check_decided}"
+        falls >= 3 && upright >= 1 && check_decided >= 2 && cut_check_later >= 1 && cut_check_up >= 1,
+        "{falls} {upright} {check_decided} {cut_check_later} {cut_check_up}"
     );
+}
+
+#[test]
+fn a_check_is_cut_at_the_fall_so_far_and_skipped_after_a_fall_at_once() {
+    let o = |fell: bool, t_end: f64| SimOutcome {
+        fell,
+        cause: None,
+        t_end,
+        forward_distance: 0.0,
+        lateral_distance: 0.0,
+        start_height: 0.3,
+        end_height: 0.3,
+        max_tilt: 0.0,
+        steps: 0,
+    };
+    assert_eq!(PhysicsEvaluator::check_duration(&o(false, 3.0), 3.0), Some(3.0));
+    assert_eq!(PhysicsEvaluator::check_duration(&o(true, 1.25), 3.0), Some(1.25));
+    assert_eq!(PhysicsEvaluator::check_duration(&o(true, 0.0), 3.0), None);
+}
+
+#[test]
+fn the_check_setting_and_the_physics_version_are_pinned() {
+    // The robust score's check setting is part of physics version 3: changing either moves
+    // every score, and checkpoints of version 3 would resume under other numbers. The test's
+    // DEFAULT is the body's default setting.
+    assert_eq!(
+        (PHYSICS_VERSION, CHECK_SETTING),
+        (
+            3,
+            SolverSetting {
+                dt: 0.004,
+                solver_iterations: 4,
+                pgs_iterations: 2
+            }
+        )
+    );
+    assert_eq!(DEFAULT.apply(&BodyParams::default()), BodyParams::default());
+}
+
+#[test]
+fn the_robust_score_scores_individuals_of_a_physics_3_run_exactly_as_the_run_did() {
+    // Five of a BLX-α run's population under physics 3 (generation 55; ranks 0, 7, 28, 63 and
+    // 99), their fitness, fall time and Δx as its checkpoint holds them, to the bit. Some fall
+    // at a time only the check setting's 4 ms steps reach (1.984 s, 1.492 s, 1.408 s: not
+    // multiples of 5 ms), one at a time only the default's reach (1.365 s).
+    let ev = evaluator();
+    let stored = parse_fixture(include_str!("fixtures/blx1_p3_gen55.txt"));
+    assert_eq!(stored.len(), 5);
+    let (mut by_check, mut by_default) = (0, 0);
+    for (i, (ind, want)) in stored.iter().enumerate() {
+        let got = ev.evaluate(ind);
+        assert_eq!(got.fell, want.fell, "individual {i}");
+        for (g, w) in [
+            (got.fitness, want.fitness),
+            (got.t_fall, want.t_fall),
+            (got.forward_distance, want.forward_distance),
+        ] {
+            assert_eq!(g.to_bits(), w.to_bits(), "individual {i}: {got:?} {want:?}");
+        }
+        let steps = |dt: f64| (want.t_fall / dt).round() * dt;
+        by_check += usize::from((steps(0.005) - want.t_fall).abs() > 1e-9);
+        by_default += usize::from((steps(0.004) - want.t_fall).abs() > 1e-9);
+    }
+    assert_eq!((by_check, by_default), (3, 1));
+}
+
+#[test]
+fn checks_are_refused_when_a_falls_distance_counts() {
+    // With distance_on_fall a lunge that falls 0.8 m ahead at 1.5 s scores 0.5 + 1.6 = 2.1,
+    // above an upright step at −0.5 m (1 + 2·0.5 = 2): "the worse outcome" would then keep the
+    // higher score. The combination is refused; without checks it is accepted.
+    let fitness = FitnessConfig {
+        distance_on_fall: true,
+        ..FitnessConfig::default()
+    };
+    assert!(fitness.robust_check);
+    assert_eq!(
+        PhysicsEvaluator::new(NaoModel::default(), fitness.clone()).err(),
+        Some(SimError::ChecksWithDistanceOnFall)
+    );
+    assert_eq!(
+        PhysicsEvaluator::with_checks(NaoModel::default(), fitness.clone(), BodyParams::default(), &[DEFAULT]).err(),
+        Some(SimError::ChecksWithDistanceOnFall)
+    );
+    let alone = FitnessConfig {
+        robust_check: false,
+        ..fitness
+    };
+    assert!(PhysicsEvaluator::new(NaoModel::default(), alone).is_ok());
 }
 
 #[test]
