@@ -18,22 +18,20 @@ fn ga_step(args: &[&str]) -> Output {
     Command::new(BIN).args(args).output().unwrap()
 }
 
-fn run(out: &Path, population: u32, generations: u32, seed: u64, extra: &[&str]) -> Output {
-    let (p, g, s) = (population.to_string(), generations.to_string(), seed.to_string());
-    let mut args = vec![
-        "--population",
-        &p,
-        "--generations",
-        &g,
-        "--seed",
-        &s,
-        "--crossover",
-        "blx",
-    ];
-    let o = out.to_str().unwrap();
-    args.extend(["--out", o]);
+/// `ga_step` with `--population`, `--generations`, `--seed` and `--crossover` given as text
+/// (in that order), `--out` if given, then `extra`.
+fn ga_step_opts([p, g, s, x]: [&str; 4], out: Option<&str>, extra: &[&str]) -> Output {
+    let mut args = vec!["--population", p, "--generations", g, "--seed", s, "--crossover", x];
+    if let Some(o) = out {
+        args.extend(["--out", o]);
+    }
     args.extend(extra);
     ga_step(&args)
+}
+
+fn run(out: &Path, population: u32, generations: u32, seed: u64, extra: &[&str]) -> Output {
+    let (p, g, s) = (population.to_string(), generations.to_string(), seed.to_string());
+    ga_step_opts([&p, &g, &s, "blx"], Some(out.to_str().unwrap()), extra)
 }
 
 fn read(path: &Path) -> String {
@@ -306,101 +304,26 @@ fn ctrl_c_during_generation_0_and_a_second_ctrl_c_leave_whole_files() {
 fn bad_options_are_one_line_errors() {
     let dir = scratch("options");
     let d = dir.to_str().unwrap();
-    let o = ga_step(&[
-        "--population",
-        "4",
-        "--generations",
-        "1",
-        "--seed",
-        "1",
-        "--crossover",
-        "uniform",
-        "--out",
-        d,
-    ]);
+    let o = ga_step_opts(["4", "1", "1", "uniform"], Some(d), &[]);
     one_line_error(&o, 2, "--crossover");
-    let o = ga_step(&[
-        "--population",
-        "many",
-        "--generations",
-        "1",
-        "--seed",
-        "1",
-        "--crossover",
-        "blx",
-        "--out",
-        d,
-    ]);
+    let o = ga_step_opts(["many", "1", "1", "blx"], Some(d), &[]);
     one_line_error(&o, 2, "--population");
-    let o = ga_step(&[
-        "--population",
-        "4",
-        "--generations",
-        "1",
-        "--seed",
-        "1",
-        "--crossover",
-        "blx",
-    ]);
+    let o = ga_step_opts(["4", "1", "1", "blx"], None, &[]);
     one_line_error(&o, 2, "--out");
-    let o = ga_step(&[
-        "--population",
-        "1",
-        "--generations",
-        "1",
-        "--seed",
-        "1",
-        "--crossover",
-        "blx",
-        "--out",
-        d,
-    ]);
+    let o = ga_step_opts(["1", "1", "1", "blx"], Some(d), &[]);
     one_line_error(&o, 2, "--population");
-    let o = ga_step(&[
-        "--population",
-        "4",
-        "--generations",
-        "1",
-        "--seed",
-        "-3",
-        "--crossover",
-        "blx",
-        "--out",
-        d,
-    ]);
+    let o = ga_step_opts(["4", "1", "-3", "blx"], Some(d), &[]);
     one_line_error(&o, 2, "");
     // Beyond the population cap (10 000).
-    let o = ga_step(&[
-        "--population",
-        "10001",
-        "--generations",
-        "1",
-        "--seed",
-        "1",
-        "--crossover",
-        "blx",
-        "--out",
-        d,
-    ]);
+    let o = ga_step_opts(["10001", "1", "1", "blx"], Some(d), &[]);
     one_line_error(&o, 2, "--population");
     // A timeout beyond a day (1e20 s once overflowed the clock), or not a positive number.
     for t in ["1e20", "86401", "0", "NaN", "inf"] {
-        let o = ga_step(&[
-            "--population",
-            "4",
-            "--generations",
-            "1",
-            "--seed",
-            "1",
-            "--crossover",
-            "blx",
-            "--out",
-            d,
-            "--evaluator",
-            "ros",
-            "--eval-timeout",
-            t,
-        ]);
+        let o = ga_step_opts(
+            ["4", "1", "1", "blx"],
+            Some(d),
+            &["--evaluator", "ros", "--eval-timeout", t],
+        );
         one_line_error(&o, 1, "--eval-timeout must be a number of seconds within (0, 86400]");
     }
     // A parameter file with an unknown key, a bad value, or none at all.
@@ -423,53 +346,14 @@ fn bad_options_are_one_line_errors() {
         ),
     ] {
         std::fs::write(&bad, text).unwrap();
-        let o = ga_step(&[
-            "--population",
-            "4",
-            "--generations",
-            "1",
-            "--seed",
-            "1",
-            "--crossover",
-            "blx",
-            "--out",
-            d,
-            "--params",
-            bad.to_str().unwrap(),
-        ]);
+        let o = ga_step_opts(["4", "1", "1", "blx"], Some(d), &["--params", bad.to_str().unwrap()]);
         one_line_error(&o, 1, want);
     }
     std::fs::remove_file(&bad).unwrap();
-    let o = ga_step(&[
-        "--population",
-        "4",
-        "--generations",
-        "1",
-        "--seed",
-        "1",
-        "--crossover",
-        "blx",
-        "--out",
-        d,
-        "--params",
-        "/nonexistent/nao.yaml",
-    ]);
+    let o = ga_step_opts(["4", "1", "1", "blx"], Some(d), &["--params", "/nonexistent/nao.yaml"]);
     one_line_error(&o, 1, "cannot read /nonexistent/nao.yaml");
     // A malformed ROS argument.
-    let o = ga_step(&[
-        "--population",
-        "4",
-        "--generations",
-        "1",
-        "--seed",
-        "1",
-        "--crossover",
-        "blx",
-        "--out",
-        d,
-        "--ros-args",
-        "-r",
-    ]);
+    let o = ga_step_opts(["4", "1", "1", "blx"], Some(d), &["--ros-args", "-r"]);
     one_line_error(&o, 2, "`-r` needs a value");
     assert!(!dir.exists(), "a refused command line created {d}");
     // --help documents every option.

@@ -116,6 +116,44 @@ fn fake_simulator(
     })
 }
 
+/// A running [`fake_simulator`]: what it received, and the way to stop it.
+struct FakeSim {
+    seen: mpsc::Receiver<JointTrajectory>,
+    stop: Arc<AtomicBool>,
+    thread: std::thread::JoinHandle<()>,
+}
+
+impl FakeSim {
+    fn start(domain: u16, mode: Mode) -> FakeSim {
+        let stop = Arc::new(AtomicBool::new(false));
+        let (tx, seen) = mpsc::channel();
+        let thread = fake_simulator(domain, mode, tx, stop.clone());
+        FakeSim { seen, stop, thread }
+    }
+
+    /// The next candidate it received, within `secs`.
+    fn heard(&self, secs: u64) -> JointTrajectory {
+        self.seen.recv_timeout(Duration::from_secs(secs)).unwrap()
+    }
+
+    fn stop(self) {
+        self.stop.store(true, Ordering::SeqCst);
+        self.thread.join().unwrap();
+    }
+}
+
+/// An evaluator under [`ns`] with the default fitness and an attempt timeout of `timeout_s`.
+fn ros_evaluator(model: &NaoModel, timeout_s: u64, interrupt: &Arc<AtomicBool>) -> RosEvaluator {
+    RosEvaluator::new(
+        model.clone(),
+        FitnessConfig::default(),
+        Duration::from_secs(timeout_s),
+        &namespaced(),
+        interrupt.clone(),
+    )
+    .unwrap()
+}
+
 fn namespaced() -> RosArgs {
     RosArgs {
         namespace: Some(ns()),
@@ -129,18 +167,9 @@ fn candidates_are_answered_by_their_own_outcome_only() {
     // SAFETY: set before any thread of this test binary reads the environment (one test).
     unsafe { std::env::set_var("ROS_DOMAIN_ID", domain.to_string()) };
     let model = NaoModel::default();
-    let stop = Arc::new(AtomicBool::new(false));
-    let (tx, rx) = mpsc::channel();
-    let sim = fake_simulator(domain, Mode::Answer, tx, stop.clone());
+    let sim = FakeSim::start(domain, Mode::Answer);
     let interrupt = Arc::new(AtomicBool::new(false));
-    let evaluator = RosEvaluator::new(
-        model.clone(),
-        FitnessConfig::default(),
-        Duration::from_secs(20),
-        &namespaced(),
-        interrupt.clone(),
-    )
-    .unwrap();
+    let evaluator = ros_evaluator(&model, 20, &interrupt);
     let mut ind = model.standing();
     ind.knots[Servo::RKneePitch.index()][10] = 1.5;
     let e = evaluator.evaluate(&ind);
@@ -151,7 +180,7 @@ fn candidates_are_answered_by_their_own_outcome_only() {
     assert_eq!(e.t_fall, 1.25);
     assert!((e.forward_distance - 0.15).abs() < 1e-12);
     assert!((e.fitness - 1.25 / 3.0).abs() < 1e-12, "{e:?}");
-    let m = rx.recv_timeout(Duration::from_secs(5)).unwrap();
+    let m = sim.heard(5);
     assert_eq!(m.header.frame_id, "candidate 1");
     assert!(m.header.stamp.sec > 1_700_000_000, "{:?}", m.header.stamp);
     assert_eq!(m.joint_names[0], "RHipPitch");
@@ -175,28 +204,18 @@ fn candidates_are_answered_by_their_own_outcome_only() {
     assert!(e2.fell, "{e2:?}");
     assert!((e2.forward_distance - 0.05).abs() < 1e-12, "{e2:?}");
     assert!((e2.fitness - 1.25 / 3.0).abs() < 1e-12, "{e2:?}");
-    assert_eq!(
-        rx.recv_timeout(Duration::from_secs(5)).unwrap().header.frame_id,
-        "candidate 2"
-    );
-    stop.store(true, Ordering::SeqCst);
-    sim.join().unwrap();
+    assert_eq!(sim.heard(5).header.frame_id, "candidate 2");
+    sim.stop();
 
     // The simulator restarts: the evaluator waits for the new one and is answered by it.
-    let stop = Arc::new(AtomicBool::new(false));
-    let (tx, rx) = mpsc::channel();
-    let sim = fake_simulator(domain, Mode::Answer, tx, stop.clone());
+    let sim = FakeSim::start(domain, Mode::Answer);
     ind.knots[Servo::RKneePitch.index()][10] = 1.0;
     let e3 = evaluator.evaluate(&ind);
     assert_eq!(evaluator.failure(), None);
     assert!((e3.forward_distance - 0.1).abs() < 1e-12, "{e3:?}");
-    assert_eq!(
-        rx.recv_timeout(Duration::from_secs(5)).unwrap().header.frame_id,
-        "candidate 3"
-    );
+    assert_eq!(sim.heard(5).header.frame_id, "candidate 3");
     drop(evaluator);
-    stop.store(true, Ordering::SeqCst);
-    sim.join().unwrap();
+    sim.stop();
 
     restart_and_lost_copies(domain, &model);
 
@@ -204,17 +223,8 @@ fn candidates_are_answered_by_their_own_outcome_only() {
     // timeout (1 s); the first candidate's two attempts leave it a void score of 0 and the run
     // goes on; the second candidate's first attempt is the third in a row, which stops the
     // evaluator, and every later evaluation returns at once.
-    let stop = Arc::new(AtomicBool::new(false));
-    let (tx, rx) = mpsc::channel();
-    let sim = fake_simulator(domain, Mode::Silent, tx, stop.clone());
-    let evaluator = RosEvaluator::new(
-        model.clone(),
-        FitnessConfig::default(),
-        Duration::from_secs(1),
-        &namespaced(),
-        interrupt.clone(),
-    )
-    .unwrap();
+    let sim = FakeSim::start(domain, Mode::Silent);
+    let evaluator = ros_evaluator(&model, 1, &interrupt);
     // The first call may also wait up to 1 s for discovery.
     let t = Instant::now();
     let e = evaluator.evaluate(&ind);
@@ -228,8 +238,8 @@ fn candidates_are_answered_by_their_own_outcome_only() {
     assert_eq!(evaluator.failure(), None);
     assert_eq!(evaluator.void_scores(), 1);
     // Sent once per attempt (no periodic re-send within 1 s), with the same header.
-    let first = rx.recv_timeout(Duration::from_secs(2)).unwrap();
-    let again = rx.recv_timeout(Duration::from_secs(2)).unwrap();
+    let first = sim.heard(2);
+    let again = sim.heard(2);
     assert_eq!(first.header.frame_id, "candidate 1");
     assert_eq!(again.header, first.header);
     evaluator.evaluate(&ind);
@@ -245,14 +255,7 @@ fn candidates_are_answered_by_their_own_outcome_only() {
     drop(evaluator);
 
     // An interrupt while a candidate waits (timeout 20 s) stops the wait within a moment.
-    let evaluator = RosEvaluator::new(
-        model.clone(),
-        FitnessConfig::default(),
-        Duration::from_secs(20),
-        &namespaced(),
-        interrupt.clone(),
-    )
-    .unwrap();
+    let evaluator = ros_evaluator(&model, 20, &interrupt);
     let flag = interrupt.clone();
     let setter = std::thread::spawn(move || {
         std::thread::sleep(Duration::from_millis(2500));
@@ -273,8 +276,7 @@ fn candidates_are_answered_by_their_own_outcome_only() {
     );
     setter.join().unwrap();
     drop(evaluator);
-    stop.store(true, Ordering::SeqCst);
-    sim.join().unwrap();
+    sim.stop();
 }
 
 /// A candidate in flight when its simulator restarts, or whose first copy is lost.
@@ -287,26 +289,14 @@ fn restart_and_lost_copies(domain: u16, model: &NaoModel) {
     // does until its lease ends); a new one starts while the candidate waits. The candidate is
     // sent again once the new reader is matched, and answered long before the timeout (20 s)
     // or the periodic re-send (60 s here).
-    let stop_old = Arc::new(AtomicBool::new(false));
-    let (tx_old, rx_old) = mpsc::channel();
-    let old = fake_simulator(domain, Mode::Silent, tx_old, stop_old.clone());
-    let evaluator = RosEvaluator::new(
-        model.clone(),
-        FitnessConfig::default(),
-        Duration::from_secs(20),
-        &namespaced(),
-        interrupt.clone(),
-    )
-    .unwrap()
-    .with_resend_every(Duration::from_secs(60));
-    let stop_new = Arc::new(AtomicBool::new(false));
-    let (tx_new, rx_new) = mpsc::channel();
+    let old = FakeSim::start(domain, Mode::Silent);
+    let evaluator = ros_evaluator(model, 20, &interrupt).with_resend_every(Duration::from_secs(60));
     let (e, took, new) = std::thread::scope(|s| {
         let waiting = s.spawn(|| evaluator.evaluate(&ind));
-        let heard = rx_old.recv_timeout(Duration::from_secs(10)).unwrap();
+        let heard = old.heard(10);
         assert_eq!(heard.header.frame_id, "candidate 1");
         let t = Instant::now();
-        let new = fake_simulator(domain, Mode::Answer, tx_new, stop_new.clone());
+        let new = FakeSim::start(domain, Mode::Answer);
         let e = waiting.join().unwrap();
         (e, t.elapsed(), new)
     });
@@ -315,32 +305,17 @@ fn restart_and_lost_copies(domain: u16, model: &NaoModel) {
     // 0.7/10 = 0.07 m, the fall at 1.25 s: f = 1.25/3.
     assert!((e.forward_distance - 0.07).abs() < 1e-12, "{e:?}");
     assert!((e.fitness - 1.25 / 3.0).abs() < 1e-12, "{e:?}");
-    assert_eq!(
-        rx_new.recv_timeout(Duration::from_secs(1)).unwrap().header.frame_id,
-        "candidate 1"
-    );
+    assert_eq!(new.heard(1).header.frame_id, "candidate 1");
     drop(evaluator);
-    for (stop, sim) in [(stop_old, old), (stop_new, new)] {
-        stop.store(true, Ordering::SeqCst);
-        sim.join().unwrap();
-    }
+    old.stop();
+    new.stop();
 
     // A simulator that loses the first copy of each candidate. With a timeout of 20 s and a
     // re-send every second, the second copy is answered after about a second; with a timeout
     // of 1 s (no re-send within it), the second attempt's copy is.
-    let stop = Arc::new(AtomicBool::new(false));
-    let (tx, rx) = mpsc::channel();
-    let sim = fake_simulator(domain, Mode::SecondCopy, tx, stop.clone());
+    let sim = FakeSim::start(domain, Mode::SecondCopy);
     for (timeout, every) in [(20, 1), (1, 60)] {
-        let evaluator = RosEvaluator::new(
-            model.clone(),
-            FitnessConfig::default(),
-            Duration::from_secs(timeout),
-            &namespaced(),
-            interrupt.clone(),
-        )
-        .unwrap()
-        .with_resend_every(Duration::from_secs(every));
+        let evaluator = ros_evaluator(model, timeout, &interrupt).with_resend_every(Duration::from_secs(every));
         let t = Instant::now();
         let e = evaluator.evaluate(&ind);
         let took = t.elapsed();
@@ -351,12 +326,11 @@ fn restart_and_lost_copies(domain: u16, model: &NaoModel) {
             "{took:?}"
         );
         assert!((e.forward_distance - 0.07).abs() < 1e-12, "timeout {timeout} s: {e:?}");
-        let first = rx.recv_timeout(Duration::from_secs(1)).unwrap();
-        let second = rx.recv_timeout(Duration::from_secs(1)).unwrap();
+        let first = sim.heard(1);
+        let second = sim.heard(1);
         assert_eq!(first.header, second.header);
         drop(evaluator);
-        while rx.try_recv().is_ok() {}
+        while sim.seen.try_recv().is_ok() {}
     }
-    stop.store(true, Ordering::SeqCst);
-    sim.join().unwrap();
+    sim.stop();
 }
