@@ -878,6 +878,10 @@ impl Shell {
         if active.source == source && matches!(source, Source::DockAction | Source::UndockAction | Source::FollowAction)
         {
             let old = active.source;
+            // The old goal's optimisation under way stops too (its result would be dropped).
+            if let Task::Vfo { stop, .. } = &active.task {
+                stop.cancel();
+            }
             if active.commanded {
                 self.zero(out);
             }
@@ -1490,18 +1494,25 @@ impl Shell {
                     self.publish_status(node, out, NavStatus::ACTIVE, String::new());
                 }
             }
-            Err(e) => {
-                active.refused += 1;
-                warn_throttled!(
-                    self.throttle,
-                    "step",
-                    "the planner refused its input: {e}; robot stopped"
-                );
-                if active.refused >= MAX_REFUSED_STEPS {
-                    return self.end_goal(node, out, servers, Outcome::Refused(e));
-                }
-                self.refused(out);
-            }
+            Err(e) => self.refused_step(node, out, servers, e),
+        }
+    }
+
+    /// A step whose input the planner refused: the robot stops, and after
+    /// [`MAX_REFUSED_STEPS`] in a row the goal ends refused.
+    fn refused_step(&mut self, node: &RosNode, out: &Outputs, servers: &mut Servers, e: String) {
+        let Some(active) = self.active.as_mut() else { return };
+        active.refused += 1;
+        let refused = active.refused;
+        warn_throttled!(
+            self.throttle,
+            "step",
+            "the planner refused its input: {e}; robot stopped"
+        );
+        if refused >= MAX_REFUSED_STEPS {
+            self.end_goal(node, out, servers, Outcome::Refused(e));
+        } else {
+            self.refused(out);
         }
     }
 
@@ -1588,19 +1599,7 @@ impl Shell {
         }
         let o = match done.output {
             Ok(o) => o,
-            Err(e) => {
-                active.refused += 1;
-                let e = e.to_string();
-                warn_throttled!(
-                    self.throttle,
-                    "step",
-                    "the planner refused its input: {e}; robot stopped"
-                );
-                if active.refused >= MAX_REFUSED_STEPS {
-                    return self.end_goal(node, out, servers, Outcome::Refused(e));
-                }
-                return self.refused(out);
-            }
+            Err(e) => return self.refused_step(node, out, servers, e.to_string()),
         };
         active.refused = 0;
         let request = |i: usize| route.request_index.get(i).copied().unwrap_or(i);
