@@ -4,7 +4,7 @@
 
 use crate::error::MotionError;
 use crate::ga::GenerationStats;
-use crate::model::{joint_names, Individual, NaoModel, Servo, INTERVALS, KNOTS, SAMPLE_PERIOD_MS};
+use crate::model::{joint_names, Individual, NaoModel, Servo, INTERVALS, KNOTS, SAMPLE_PERIOD_MS, SERVO_COUNT};
 use std::io::{self, BufRead, Write};
 
 /// The header line of `fitness.csv`.
@@ -83,53 +83,107 @@ pub struct Motion {
 impl Motion {
     /// The individual [`write_motion`] wrote this motion from, for `model`: each servo's column
     /// found by its Webots name, each inner knot read from the row at its time or, between rows,
-    /// extrapolated along the line through the interval's last two rows before it (the motion
-    /// is linear within an interval), clamped into the servo's limits; the first and last knots
-    /// are the standing pose. With the file's 4 decimals a knot comes back within 1e-4 rad
-    /// (a row's rounding, 5·10⁻⁵, at most doubled by the extrapolation). Refused: a servo's
-    /// column missing, a last row other than at T, a knot with fewer than two rows in its
-    /// interval before it (a step time under 80 ms an interval).
+    /// extrapolated along the line through the first and last rows of its interval before it
+    /// (the motion is linear within an interval), clamped into the servo's limits; the first and
+    /// last knots are the standing pose. A row's value is within 5·10⁻⁵ of the motion (4
+    /// decimals), so an extrapolated knot r of the baseline past the last row is within
+    /// 5·10⁻⁵·(1 + 2r): r = ¼ and 7.5e-5 rad for the default 2 s step, under 1.5e-4 for any
+    /// step (r < 1: rows 40 ms apart, a knot less than 40 ms past the last). The result is
+    /// then sampled as `write_motion` would and must give the file's rows, times exactly and
+    /// values within [`MOTION_MATCH`], so a motion of another standing pose, another grid or no
+    /// such individual at all is refused, as are a missing servo column, a row without its
+    /// value, and a knot with fewer than two rows in its interval before it (intervals under
+    /// 80 ms).
     pub fn to_individual(&self, model: &NaoModel) -> Result<Individual, MotionError> {
+        let not = |reason: String| MotionError::NotAStep(reason);
+        model.validate().map_err(|e| not(e.to_string()))?;
         let step_ms = model.step_time_ms();
         let last = self.rows.last().map_or(0, |r| r.time_ms);
         if last != step_ms {
-            return Err(MotionError::NotAStep(format!(
+            return Err(not(format!(
                 "the last row is at {last} ms, the step lasts {step_ms} ms"
             )));
         }
-        let knot_ms = step_ms as f64 / INTERVALS as f64;
-        let mut ind = model.standing();
+        // Knot k at k·T/20: whole milliseconds, T being a whole number of 40 ms rows.
+        let knot_ms = |k: usize| k as u64 * step_ms / INTERVALS as u64;
+        let mut cols = [0; SERVO_COUNT];
         for s in Servo::ALL {
-            let col = self
+            cols[s.index()] = self
                 .joint_names
                 .iter()
                 .position(|n| n == s.name())
-                .ok_or_else(|| MotionError::NotAStep(format!("no column {}", s.name())))?;
+                .ok_or_else(|| not(format!("no column {}", s.name())))?;
+        }
+        let mut ind = model.standing();
+        for s in Servo::ALL {
+            let col = cols[s.index()];
+            let value = |r: &MotionRow| {
+                r.values
+                    .get(col)
+                    .copied()
+                    .ok_or_else(|| not(format!("the row at {} ms has no {}", r.time_ms, s.name())))
+            };
             for k in 1..KNOTS - 1 {
-                let (start, ms) = ((k - 1) as f64 * knot_ms, k as f64 * knot_ms);
-                let v = if let Some(r) = self.rows.iter().find(|r| (r.time_ms as f64 - ms).abs() < 1e-6) {
-                    r.values[col]
+                let (start, ms) = (knot_ms(k - 1), knot_ms(k));
+                let v = if let Some(r) = self.rows.iter().find(|r| r.time_ms == ms) {
+                    value(r)?
                 } else {
-                    let before: Vec<&MotionRow> = self
-                        .rows
-                        .iter()
-                        .filter(|r| (start..ms).contains(&(r.time_ms as f64)))
-                        .collect();
-                    let [.., a, b] = before[..] else {
-                        return Err(MotionError::NotAStep(format!(
-                            "knot {k} at {ms} ms has fewer than two rows between it and the knot before"
+                    let before: Vec<&MotionRow> =
+                        self.rows.iter().filter(|r| (start..ms).contains(&r.time_ms)).collect();
+                    let (Some(a), Some(b)) = (before.first(), before.last()) else {
+                        return Err(not(format!(
+                            "knot {k} at {ms} ms has no row between it and the knot before"
                         )));
                     };
+                    if b.time_ms <= a.time_ms {
+                        return Err(not(format!(
+                            "knot {k} at {ms} ms has fewer than two rows between it and the knot before"
+                        )));
+                    }
                     let (ta, tb) = (a.time_ms as f64, b.time_ms as f64);
-                    let (va, vb) = (a.values[col], b.values[col]);
-                    vb + (vb - va) * (ms - tb) / (tb - ta)
+                    let (va, vb) = (value(a)?, value(b)?);
+                    vb + (vb - va) * (ms as f64 - tb) / (tb - ta)
                 };
                 ind.knots[s.index()][k] = s.clamp(v);
+            }
+        }
+        // Written again, the individual must give this file's rows.
+        let rows = ind.sample(model);
+        if rows.len() != self.rows.len() {
+            return Err(not(format!(
+                "{} rows, a step of {step_ms} ms has {}",
+                self.rows.len(),
+                rows.len()
+            )));
+        }
+        for (row, (ms, angles)) in self.rows.iter().zip(rows) {
+            if row.time_ms != ms {
+                return Err(not(format!("a row at {} ms where one at {ms} ms was due", row.time_ms)));
+            }
+            for s in Servo::ALL {
+                let Some(&want) = row.values.get(cols[s.index()]) else {
+                    return Err(not(format!("the row at {ms} ms has no {}", s.name())));
+                };
+                let got = angles[s.index()];
+                // NaN (a hand-built row) is no match either.
+                let matches = (got - want).abs() <= MOTION_MATCH;
+                if !matches {
+                    return Err(not(format!(
+                        "{} at {ms} ms is {want}, and no individual of this model gives it ({got:.4} here)",
+                        s.name()
+                    )));
+                }
             }
         }
         Ok(ind)
     }
 }
+
+/// How far (rad) a motion file's value may be from the individual
+/// [`Motion::to_individual`] builds from it: 5·10⁻⁵ of the file's rounding plus 1.5·10⁻⁴ of
+/// the knots' (the rows are interpolated between knots, so within the knots' error), with
+/// room for rounding in the arithmetic.
+pub const MOTION_MATCH: f64 = 2.5e-4;
 
 fn parse_time(s: &str) -> Option<u64> {
     let mut parts = s.split(':');

@@ -235,6 +235,29 @@ fn the_fitness_shape_is_recorded() {
     assert_ne!(back.setup, setup(Crossover::Arithmetic));
 }
 
+/// The robust score's switch is recorded; a checkpoint written before it existed (no key) was
+/// scored without it and reads back with it off, though a missing key elsewhere takes its
+/// default (on, for this one).
+#[test]
+fn the_robust_score_switch_is_recorded_and_off_where_a_checkpoint_predates_it() {
+    let s = setup(Crossover::Blx);
+    assert!(s.fitness.robust_check);
+    let e = TestLandscape::new(NaoModel::default(), s.fitness.clone());
+    let text = to_json(&GaState::start(s.clone(), 3, &e, 1).unwrap(), &TAG);
+    let mut v: serde_json::Value = serde_json::from_str(&text).unwrap();
+    assert_eq!(v["setup"]["fitness"]["robust_check"], serde_json::json!(true));
+    assert!(from_json(&text).unwrap().setup.fitness.robust_check);
+    v["setup"]["fitness"]["robust_check"] = serde_json::json!(false);
+    assert!(!from_json(&v.to_string()).unwrap().setup.fitness.robust_check);
+    v["setup"]["fitness"].as_object_mut().unwrap().remove("robust_check");
+    let old = from_json(&v.to_string()).unwrap();
+    assert!(!old.setup.fitness.robust_check);
+    // Every other field as written.
+    let mut want = s;
+    want.fitness.robust_check = false;
+    assert_eq!(old.setup, want);
+}
+
 /// The evaluator is recorded and read back; a document without it is corrupt.
 #[test]
 fn the_evaluator_is_recorded() {

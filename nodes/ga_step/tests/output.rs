@@ -112,10 +112,15 @@ fn the_motion_file_round_trips_through_the_reader() {
 #[test]
 fn a_motion_file_gives_back_its_individual_within_the_files_rounding() {
     // 2 s steps: knots every 100 ms, rows every 40 ms, so the odd knots lie between rows and are
-    // extrapolated from the two rows before them (a knot at 100 ms from the rows at 40 and 80).
-    // A 1.2 s step: knots every 60 ms, one in three on a row. Each knot back within 1e-4 rad,
-    // the ends at the standing pose.
-    for (step_time, seeds) in [(2.0, 0..10), (1.2, 10..15)] {
+    // extrapolated from the first and last rows before them in their interval (a knot at 100 ms
+    // from the rows at 0 and 80: r = 20/80, within 5e-5·1.5 of the file's rounding; at 300 ms
+    // from 200 and 280). A 1.2 s step: knots every 60 ms, one in three on a row, the others
+    // from two rows 40 ms apart 20 ms before them (r = ½: 1e-4). A 2.08 s step: knots every
+    // 104 ms; knot 1 at 104 ms from the rows at 0 and 80 (r = 24/80), knot 2 at 208 from 120
+    // and 200 (r = 8/80), and the worst, knot 3 at 312 ms from the only two rows in its
+    // interval, 240 and 280 (r = 32/40 = 0.8: 5e-5·2.6 = 1.3e-4); every fifth knot on a row.
+    // The ends at the standing pose.
+    for (step_time, seeds, bound) in [(2.0, 0..10, 7.5e-5), (1.2, 10..15, 1e-4), (2.08, 15..20, 1.3e-4)] {
         let m = NaoModel {
             step_time,
             ..NaoModel::default()
@@ -129,7 +134,7 @@ fn a_motion_file_gives_back_its_individual_within_the_files_rounding() {
             for (s, (got, want)) in back.knots.iter().zip(&ind.knots).enumerate() {
                 for (k, (g, w)) in got.iter().zip(want).enumerate() {
                     assert!(
-                        (g - w).abs() <= 1e-4 + 1e-12,
+                        (g - w).abs() <= bound + 1e-12,
                         "seed {seed} servo {s} knot {k}: {g} vs {w}"
                     );
                 }
@@ -137,49 +142,67 @@ fn a_motion_file_gives_back_its_individual_within_the_files_rounding() {
             }
         }
     }
-    // By hand: one interval's rows at 0.5 (40 ms) and 0.6 (80 ms) put the 100 ms knot at 0.65.
+    // By hand: one interval's rows at 0 ms (the standing −0.4), 40 ms and 80 ms, set on a line
+    // through −0.4 and −0.6 at 80 ms, put the 100 ms knot at −0.65; the rows written from
+    // that individual are the same line, so the check passes.
     let m = NaoModel::default();
     let (_, ind) = individual(3);
     let mut motion = read_motion(motion_text(&m, &ind).as_bytes()).unwrap();
     motion.rows[1].values[0] = -0.5;
     motion.rows[2].values[0] = -0.6;
+    // Rows 3 and 4 (120, 160 ms) lie on the line from the 100 ms knot to the 200 ms one.
+    let k2 = motion.rows[5].values[0];
+    motion.rows[3].values[0] = -0.65 + (k2 + 0.65) * 0.2;
+    motion.rows[4].values[0] = -0.65 + (k2 + 0.65) * 0.6;
     let back = motion.to_individual(&m).unwrap();
     assert!((back.knots[0][1] - -0.65).abs() < 1e-12, "{}", back.knots[0][1]);
 }
 
 #[test]
-fn a_motion_of_another_length_or_without_a_servo_is_not_an_individual() {
+fn a_motion_no_individual_of_the_model_gives_is_refused() {
     let (m, ind) = individual(4);
     let text = motion_text(&m, &ind);
+    let not_a_step = |motion: &mobil_ga_step::Motion, model: &NaoModel| match motion.to_individual(model) {
+        Err(MotionError::NotAStep(r)) => r,
+        other => panic!("{other:?}"),
+    };
+    let motion = read_motion(text.as_bytes()).unwrap();
     let slower = NaoModel {
         step_time: 2.4,
         ..NaoModel::default()
     };
-    let e = read_motion(text.as_bytes())
-        .unwrap()
-        .to_individual(&slower)
-        .unwrap_err();
     assert_eq!(
-        e,
-        MotionError::NotAStep("the last row is at 2000 ms, the step lasts 2400 ms".into())
+        not_a_step(&motion, &slower),
+        "the last row is at 2000 ms, the step lasts 2400 ms"
     );
-    let renamed = text.replacen("LAnkleRoll", "LAnkleRoll2", 1);
-    let e = read_motion(renamed.as_bytes()).unwrap().to_individual(&m).unwrap_err();
-    assert_eq!(e, MotionError::NotAStep("no column LAnkleRoll".into()));
-    // A 0.4 s step: knots every 20 ms, the one at 20 ms between rows at 0 and 40 ms alone.
+    let renamed = read_motion(text.replacen("LAnkleRoll", "LAnkleRoll2", 1).as_bytes()).unwrap();
+    assert_eq!(not_a_step(&renamed, &m), "no column LAnkleRoll");
+    // A 0.4 s step: knots every 20 ms, the one at 20 ms with a single row (0 ms) before it.
     let short = NaoModel {
         step_time: 0.4,
         ..NaoModel::default()
     };
-    let ind = short.random_individual(&mut ChaCha8Rng::seed_from_u64(5));
-    let e = read_motion(motion_text(&short, &ind).as_bytes())
-        .unwrap()
-        .to_individual(&short)
-        .unwrap_err();
-    assert!(
-        matches!(e, MotionError::NotAStep(ref r) if r.starts_with("knot 1 at 20 ms")),
-        "{e}"
-    );
+    let s = short.random_individual(&mut ChaCha8Rng::seed_from_u64(5));
+    let r = not_a_step(&read_motion(motion_text(&short, &s).as_bytes()).unwrap(), &short);
+    assert!(r.starts_with("knot 1 at 20 ms has fewer than two rows"), "{r}");
+    // Another standing pose: the first row is not this model's.
+    let crouched = NaoModel {
+        standing_pose: m.standing_pose.map(|q| q * 1.1),
+        ..NaoModel::default()
+    };
+    let r = not_a_step(&motion, &crouched);
+    assert!(r.starts_with("RHipPitch at 0 ms is -0.4"), "{r}");
+    // A row off the motion by 1e-3 rad (a hand edit, or not piecewise linear on this grid):
+    // the one at 240 ms, between the rows (200 and 280 ms) that give the knot at 300 ms.
+    let mut edited = motion.clone();
+    edited.rows[6].values[2] += 1e-3;
+    let r = not_a_step(&edited, &m);
+    assert!(r.starts_with("RKneePitch at 240 ms"), "{r}");
+    // A row without the value (rows built by hand; the reader never gives one).
+    let mut short_row = motion.clone();
+    short_row.rows[3].values.truncate(4);
+    let r = not_a_step(&short_row, &m);
+    assert_eq!(r, "the row at 120 ms has no RAnkleRoll");
 }
 
 /// The reader also takes the source's spaced form with its empty field after the version.

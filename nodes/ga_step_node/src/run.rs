@@ -261,6 +261,13 @@ fn resume_state(cli: &Cli, setup: &GaSetup, asked: &EvaluatorTag) -> anyhow::Res
     let path = cli.out.join(CHECKPOINT);
     let (state, recorded) = mobil_ga_step::read_checkpoint_tagged(&path)
         .map_err(|e| anyhow!("cannot resume from {}: {e}", path.display()))?;
+    let f = &state.setup.fitness;
+    if matches!(recorded, EvaluatorTag::Physics { .. }) && f.robust_check && f.distance_on_fall {
+        bail!(
+            "cannot resume from {}: its run was scored by the robust score with a fall's distance counted, which is no longer offered (the worse of two outcomes is not the lower score there)",
+            path.display()
+        );
+    }
     let differences = run_differences(&state, &recorded, cli, setup, asked);
     if !differences.is_empty() {
         bail!(
@@ -333,6 +340,13 @@ pub fn run(cli: &Cli, ros_args: &RosArgs, interrupt: &Arc<AtomicBool>) -> anyhow
         );
     }
     let tag = evaluator_tag(cli.evaluator);
+    // The built-in physics refuses a setup it cannot score before anything is created in DIR.
+    let physics = match cli.evaluator {
+        EvaluatorArg::Physics => {
+            Some(PhysicsEvaluator::new(setup.model.clone(), setup.fitness.clone()).map_err(|e| anyhow!("{e}"))?)
+        }
+        EvaluatorArg::Ros => None,
+    };
     // The checkpoint is judged before anything is created in DIR.
     let checkpoint = cli.out.join(CHECKPOINT);
     let resumed = if cli.resume {
@@ -348,14 +362,9 @@ pub fn run(cli: &Cli, ros_args: &RosArgs, interrupt: &Arc<AtomicBool>) -> anyhow
     };
     check_writable(&cli.out)?;
     outputs::WRITE_DELAY_MS.store(cli.write_delay_ms, Ordering::Relaxed);
-    let (chosen, threads) = match cli.evaluator {
-        EvaluatorArg::Physics => (
-            Chosen::Physics(Box::new(
-                PhysicsEvaluator::new(setup.model.clone(), setup.fitness.clone()).map_err(|e| anyhow!("{e}"))?,
-            )),
-            cli.threads,
-        ),
-        EvaluatorArg::Ros => (
+    let (chosen, threads) = match physics {
+        Some(p) => (Chosen::Physics(Box::new(p)), cli.threads),
+        None => (
             Chosen::Ros(Box::new(
                 RosEvaluator::new(
                     setup.model.clone(),

@@ -401,9 +401,11 @@ fn a_missing_foreign_or_other_runs_checkpoint_is_refused_and_left_alone() {
     one_line_error(&o, 1, "seed 1 (asked 2)");
     let o = run(&dir, 6, 2, 1, &["--resume"]);
     one_line_error(&o, 1, "population 4 (asked 6)");
-    // The same run evolved under the other fitness shape (a fall's distance counted).
+    // The same run evolved under the other fitness shape (a fall's distance counted, so
+    // without the robust score).
     let mut v: serde_json::Value = serde_json::from_str(&before).unwrap();
     v["setup"]["fitness"]["distance_on_fall"] = serde_json::json!(true);
+    v["setup"]["fitness"]["robust_check"] = serde_json::json!(false);
     let other_shape = v.to_string();
     std::fs::write(dir.join("checkpoint.json"), &other_shape).unwrap();
     let o = run(&dir, 4, 2, 1, &["--resume"]);
@@ -478,8 +480,22 @@ fn a_missing_foreign_or_other_runs_checkpoint_is_refused_and_left_alone() {
     let fresh = scratch("distance_on_fall_robust");
     let o = run(&fresh, 4, 2, 1, &["--params", params.to_str().unwrap()]);
     one_line_error(&o, 1, "robust_check needs distance_on_fall false");
-    assert!(!fresh.join("checkpoint.json").exists());
+    assert!(!fresh.exists(), "a refused setup created {}", fresh.display());
     let _ = std::fs::remove_dir_all(&fresh);
+    // A run scored under that combination (before it was refused) cannot be continued, with
+    // the robust score or without.
+    let mut v: serde_json::Value = serde_json::from_str(&before).unwrap();
+    v["setup"]["fitness"]["distance_on_fall"] = serde_json::json!(true);
+    let unoffered = v.to_string();
+    std::fs::write(dir.join("checkpoint.json"), &unoffered).unwrap();
+    let without = shipped
+        .replace("distance_on_fall: false", "distance_on_fall: true")
+        .replace("robust_check: true", "robust_check: false");
+    std::fs::write(&params, without).unwrap();
+    let o = run(&dir, 4, 2, 1, &["--resume", "--params", params.to_str().unwrap()]);
+    one_line_error(&o, 1, "no longer offered");
+    assert_eq!(read(&dir.join("checkpoint.json")), unoffered);
+    std::fs::write(dir.join("checkpoint.json"), &before).unwrap();
     std::fs::remove_file(&params).unwrap();
     // A new run over an existing one.
     let o = run(&dir, 4, 2, 1, &[]);

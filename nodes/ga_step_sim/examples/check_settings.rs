@@ -56,7 +56,14 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         .filter(|a| !a.starts_with("random:") && !a.ends_with(".motion"))
     {
         let state = mobil_ga_step::read_checkpoint(std::path::Path::new(arg))?;
-        let theirs = (state.setup.model, state.setup.fitness);
+        // Compared without the robust score's switch, which is off here anyway.
+        let theirs = (
+            state.setup.model,
+            FitnessConfig {
+                robust_check: false,
+                ..state.setup.fitness
+            },
+        );
         match &setup {
             None => setup = Some(theirs),
             Some(s) if *s != theirs => {
@@ -65,11 +72,13 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             Some(_) => {}
         }
     }
-    let (model, fitness) = setup.unwrap_or_default();
-    let fitness = FitnessConfig {
-        robust_check: false,
-        ..fitness
-    };
+    let (model, fitness) = setup.unwrap_or_else(|| {
+        let fitness = FitnessConfig {
+            robust_check: false,
+            ..FitnessConfig::default()
+        };
+        (NaoModel::default(), fitness)
+    });
     let mut motions: Vec<(String, Individual)> = Vec::new();
     for arg in args {
         if let Some(spec) = arg.strip_prefix("random:") {
@@ -100,7 +109,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let duration = fitness.sim_time(model.step_time);
     let evaluators: Vec<PhysicsEvaluator> = settings
         .iter()
-        .map(|(_, b)| PhysicsEvaluator::with_body(model.clone(), fitness.clone(), b.clone()))
+        .map(|(_, b)| PhysicsEvaluator::with_checks(model.clone(), fitness.clone(), b.clone(), &[]))
         .collect::<Result<_, _>>()?;
     // (fell, t_end, dx) per motion and setting; simulated and wall seconds per setting.
     let results = Mutex::new(vec![Vec::new(); motions.len()]);

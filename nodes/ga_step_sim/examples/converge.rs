@@ -108,7 +108,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 pgs_iterations: pgs,
                 ..BodyParams::default()
             };
-            let ev = PhysicsEvaluator::with_body(model.clone(), fitness.clone(), body)?;
+            let ev = PhysicsEvaluator::with_checks(model.clone(), fitness.clone(), body, &[])?;
             let t = Instant::now();
             let mut lowest: f64 = f64::INFINITY;
             let o = ev.simulate_observed(ind, fitness.sim_time(ev.model().step_time), &mut |s| {

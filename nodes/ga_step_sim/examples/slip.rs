@@ -19,7 +19,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     if let Some(dt) = std::env::args().nth(5) {
         body.dt = dt.parse()?;
     }
-    let ev = PhysicsEvaluator::with_body(state.setup.model.clone(), state.setup.fitness.clone(), body)?;
+    let ev = PhysicsEvaluator::with_checks(state.setup.model.clone(), state.setup.fitness.clone(), body, &[])?;
     let dt = ev.body().dt;
     let best = &state.best().individual;
     let mut slid = [0.0f64; 2];

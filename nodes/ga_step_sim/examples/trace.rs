@@ -1,11 +1,16 @@
 //! Prints the torso's path for the best individual of a `ga_step` checkpoint, every 50 ms:
 //! `cargo run --release -p mobil_ga_step_sim --example trace -- DIR/checkpoint.json`.
-use mobil_ga_step_sim::PhysicsEvaluator;
+use mobil_ga_step_sim::{BodyParams, PhysicsEvaluator};
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let path = std::env::args().nth(1).ok_or("usage: trace CHECKPOINT")?;
     let state = mobil_ga_step::read_checkpoint(std::path::Path::new(&path))?;
-    let ev = PhysicsEvaluator::new(state.setup.model.clone(), state.setup.fitness.clone())?;
+    let ev = PhysicsEvaluator::with_checks(
+        state.setup.model.clone(),
+        state.setup.fitness.clone(),
+        BodyParams::default(),
+        &[],
+    )?;
     let best = &state.best().individual;
     let mut n = 0;
     let o = ev.simulate_observed(best, 3.0, &mut |s| {

@@ -887,6 +887,31 @@ fn the_robust_score_scores_individuals_of_a_physics_3_run_exactly_as_the_run_did
 }
 
 #[test]
+fn the_robust_score_scores_upright_individuals_of_a_physics_3_run_exactly_as_the_run_did() {
+    // The six upright individuals of the same run at generation 200 (ranks 0–5), upright under
+    // both settings: each stored with the smaller of the two settings' Δx, which the robust
+    // evaluator gives again, to the bit.
+    let (ev, a, b) = (evaluator(), single(DEFAULT), single(CHECK_SETTING));
+    let stored = parse_fixture(include_str!("fixtures/blx1_p3_gen200.txt"));
+    assert_eq!(stored.len(), 6);
+    let (mut by_check, mut by_default) = (0, 0);
+    for (i, (ind, want)) in stored.iter().enumerate() {
+        assert!(!want.fell, "individual {i}");
+        let got = ev.evaluate(ind);
+        assert_eq!(got, *want, "individual {i}");
+        assert_eq!(got.fitness.to_bits(), want.fitness.to_bits(), "individual {i}");
+        let (oa, ob) = (a.simulate(ind), b.simulate(ind));
+        assert!(!oa.fell && !ob.fell, "individual {i}: {oa:?} {ob:?}");
+        let smaller = oa.forward_distance.min(ob.forward_distance);
+        assert_eq!(want.forward_distance.to_bits(), smaller.to_bits(), "individual {i}");
+        by_check += usize::from(ob.forward_distance < oa.forward_distance);
+        by_default += usize::from(oa.forward_distance < ob.forward_distance);
+    }
+    // Both branches of "the smaller Δx": some kept the check's, some the default's.
+    assert!(by_check >= 1 && by_default >= 1, "{by_check} {by_default}");
+}
+
+#[test]
 fn checks_are_refused_when_a_falls_distance_counts() {
     // With distance_on_fall a lunge that falls 0.8 m ahead at 1.5 s scores 0.5 + 1.6 = 2.1,
     // above an upright step at −0.5 m (1 + 2·0.5 = 2): "the worse outcome" would then keep the
