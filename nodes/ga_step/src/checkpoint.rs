@@ -70,22 +70,6 @@ struct Header {
     version: Option<u64>,
 }
 
-/// Whether the checkpoint's fitness names `robust_check` at all.
-#[derive(Deserialize)]
-struct RobustProbe {
-    setup: Option<SetupProbe>,
-}
-
-#[derive(Deserialize)]
-struct SetupProbe {
-    fitness: Option<FitnessProbe>,
-}
-
-#[derive(Deserialize)]
-struct FitnessProbe {
-    robust_check: Option<bool>,
-}
-
 #[derive(Serialize, Deserialize)]
 struct Document {
     format: String,
@@ -151,15 +135,11 @@ pub fn from_json_tagged(text: &str) -> Result<(GaState, EvaluatorTag), Checkpoin
         }
         None => return Err(CheckpointError::Corrupt("no version".into())),
     };
-    let mut doc: Document = serde_json::from_str(text).map_err(|e| CheckpointError::Corrupt(e.to_string()))?;
+    let value: serde_json::Value = serde_json::from_str(text).map_err(|e| CheckpointError::Corrupt(e.to_string()))?;
     // A checkpoint written before the robust score existed was scored without it (a missing
     // key elsewhere takes its default, which for this one is on).
-    let probe: Option<RobustProbe> = serde_json::from_str(text).ok();
-    let named = probe
-        .and_then(|p| p.setup)
-        .and_then(|s| s.fitness)
-        .and_then(|f| f.robust_check)
-        .is_some();
+    let named = value.pointer("/setup/fitness/robust_check").is_some();
+    let mut doc: Document = serde_json::from_value(value).map_err(|e| CheckpointError::Corrupt(e.to_string()))?;
     if !named {
         doc.setup.fitness.robust_check = false;
     }

@@ -114,7 +114,7 @@ fn a_motion_file_gives_back_its_individual_within_the_files_rounding() {
     // 2 s steps: knots every 100 ms, rows every 40 ms, so the odd knots lie between rows and are
     // extrapolated from the first and last rows before them in their interval (a knot at 100 ms
     // from the rows at 0 and 80: r = 20/80, within 5e-5·1.5 of the file's rounding; at 300 ms
-    // from 200 and 280). A 1.2 s step: knots every 60 ms, one in three on a row, the others
+    // from 200 and 280). A 1.2 s step: knots every 60 ms, every other one on a row, the others
     // from two rows 40 ms apart 20 ms before them (r = ½: 1e-4). A 2.08 s step: knots every
     // 104 ms; knot 1 at 104 ms from the rows at 0 and 80 (r = 24/80), knot 2 at 208 from 120
     // and 200 (r = 8/80), and the worst, knot 3 at 312 ms from the only two rows in its
@@ -140,6 +140,28 @@ fn a_motion_file_gives_back_its_individual_within_the_files_rounding() {
                 }
                 assert_eq!((got[0], got[got.len() - 1]), (want[0], want[want.len() - 1]));
             }
+        }
+    }
+    // Knots at the servos' limits (evolved individuals have many; the clamp must not move them
+    // off), in a 60 s step (1500 rows, knots every 3 s).
+    let long = NaoModel {
+        step_time: 60.0,
+        ..NaoModel::default()
+    };
+    let mut limits = long.random_individual(&mut ChaCha8Rng::seed_from_u64(21));
+    for s in mobil_ga_step::Servo::ALL {
+        let (lo, hi) = s.limits();
+        for k in 1..mobil_ga_step::KNOTS - 1 {
+            limits.knots[s.index()][k] = if k % 2 == 0 { lo } else { hi };
+        }
+    }
+    let back = read_motion(motion_text(&long, &limits).as_bytes())
+        .unwrap()
+        .to_individual(&long)
+        .unwrap();
+    for (got, want) in back.knots.iter().zip(&limits.knots) {
+        for (g, w) in got.iter().zip(want) {
+            assert!((g - w).abs() <= 7.5e-5, "{g} vs {w}");
         }
     }
     // By hand: one interval's rows at 0 ms (the standing −0.4), 40 ms and 80 ms, set on a line
@@ -185,6 +207,14 @@ fn a_motion_no_individual_of_the_model_gives_is_refused() {
     let s = short.random_individual(&mut ChaCha8Rng::seed_from_u64(5));
     let r = not_a_step(&read_motion(motion_text(&short, &s).as_bytes()).unwrap(), &short);
     assert!(r.starts_with("knot 1 at 20 ms has fewer than two rows"), "{r}");
+    // 0.88 s: knots every 44 ms; the one at 88 ms has the row at 80 ms alone in its interval.
+    let odd = NaoModel {
+        step_time: 0.88,
+        ..NaoModel::default()
+    };
+    let s = odd.random_individual(&mut ChaCha8Rng::seed_from_u64(6));
+    let r = not_a_step(&read_motion(motion_text(&odd, &s).as_bytes()).unwrap(), &odd);
+    assert!(r.starts_with("knot 2 at 88 ms has fewer than two rows"), "{r}");
     // Another standing pose: the first row is not this model's.
     let crouched = NaoModel {
         standing_pose: m.standing_pose.map(|q| q * 1.1),

@@ -244,13 +244,19 @@ fn run_differences(
         was_f.shape(),
         now_f.shape(),
     );
+    // The robust score is the built-in physics' alone: other evaluators ignore the switch.
+    let robust_counts = matches!(asked, EvaluatorTag::Physics { .. });
     differ(
-        was_f.robust_check == now_f.robust_check,
+        !robust_counts || was_f.robust_check == now_f.robust_check,
         "robust_check",
         was_f.robust_check.to_string(),
         now_f.robust_check.to_string(),
     );
-    if differences.is_empty() && state.setup != *setup {
+    let mut theirs = state.setup.clone();
+    if !robust_counts {
+        theirs.fitness.robust_check = now_f.robust_check;
+    }
+    if differences.is_empty() && theirs != *setup {
         differences.push("other parameters of the robot, the algorithm or the fitness (--params)".to_owned());
     }
     differences

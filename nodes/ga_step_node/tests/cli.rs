@@ -497,6 +497,22 @@ fn a_missing_foreign_or_other_runs_checkpoint_is_refused_and_left_alone() {
     assert_eq!(read(&dir.join("checkpoint.json")), unoffered);
     std::fs::write(dir.join("checkpoint.json"), &before).unwrap();
     std::fs::remove_file(&params).unwrap();
+    // A run of the external evaluator from before the robust score's switch (no key, read as
+    // off): the switch is the built-in physics' alone, so the shipped parameters (on) resume it.
+    let mut v: serde_json::Value = serde_json::from_str(&before).unwrap();
+    v["evaluator"] = serde_json::json!({"kind": "ros"});
+    v["setup"]["fitness"].as_object_mut().unwrap().remove("robust_check");
+    std::fs::write(dir.join("checkpoint.json"), v.to_string()).unwrap();
+    let o = run(
+        &dir,
+        4,
+        1,
+        1,
+        &["--resume", "--evaluator", "ros", "--eval-timeout", "1"],
+    );
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(o.status.success(), "{err}");
+    std::fs::write(dir.join("checkpoint.json"), &before).unwrap();
     // A new run over an existing one.
     let o = run(&dir, 4, 2, 1, &[]);
     one_line_error(&o, 1, "already holds a run");

@@ -912,6 +912,38 @@ fn the_robust_score_scores_upright_individuals_of_a_physics_3_run_exactly_as_the
 }
 
 #[test]
+fn evolved_individuals_come_back_from_their_motion_files() {
+    // The fixtures' 19 evolved individuals (many knots at a servo's limit) through the motion
+    // file and back: within 7.5e-5 rad for the 2 s step, as Motion::to_individual states.
+    let model = NaoModel::default();
+    let mut all = stored_individuals();
+    all.extend(edge_individuals());
+    all.extend(parse_fixture(include_str!("fixtures/blx1_p3_gen55.txt")));
+    all.extend(parse_fixture(include_str!("fixtures/blx1_p3_gen200.txt")));
+    assert_eq!(all.len(), 19);
+    let at_limit = all
+        .iter()
+        .flat_map(|(ind, _)| Servo::ALL.map(|s| (s, ind.knots[s.index()])))
+        .flat_map(|(s, knots)| knots.map(|q| q == s.limits().0 || q == s.limits().1))
+        .filter(|&b| b)
+        .count();
+    assert!(at_limit >= 100, "{at_limit}");
+    for (i, (ind, _)) in all.iter().enumerate() {
+        let mut text = Vec::new();
+        mobil_ga_step::write_motion(&mut text, &model, ind).unwrap();
+        let back = mobil_ga_step::read_motion(&text[..])
+            .unwrap()
+            .to_individual(&model)
+            .unwrap();
+        for (got, want) in back.knots.iter().zip(&ind.knots) {
+            for (g, w) in got.iter().zip(want) {
+                assert!((g - w).abs() <= 7.5e-5 + 1e-12, "individual {i}: {g} vs {w}");
+            }
+        }
+    }
+}
+
+#[test]
 fn checks_are_refused_when_a_falls_distance_counts() {
     // With distance_on_fall a lunge that falls 0.8 m ahead at 1.5 s scores 0.5 + 1.6 = 2.1,
     // above an upright step at −0.5 m (1 + 2·0.5 = 2): "the worse outcome" would then keep the
