@@ -5,8 +5,8 @@
 //! robust score (the default and the check setting) and under the default setting alone; and
 //! both on a batch of gentle motions that mostly stay up, as a late generation's do.
 
-use mobil_ga_step::{evaluate_all, resolve_threads, FitnessConfig, GaSetup, GaState, NaoModel, Servo, KNOTS};
-use mobil_ga_step_sim::PhysicsEvaluator;
+use mobil_ga_step::{evaluate_all, resolve_threads, FitnessConfig, GaSetup, GaState, NaoModel};
+use mobil_ga_step_sim::{motions, PhysicsEvaluator};
 use rand::{Rng, SeedableRng};
 use std::time::Instant;
 
@@ -41,17 +41,7 @@ fn main() {
     // the whole 3 s, as a late generation's individuals do.
     let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(3);
     let gentle: Vec<_> = (0..20)
-        .map(|_| {
-            let mut ind = model.standing();
-            for s in Servo::ALL {
-                let (lo, hi) = s.limits();
-                for k in 1..KNOTS - 1 {
-                    let v = model.standing_pose[s.index()] + 0.05 * (hi - lo) * (2.0 * rng.random::<f64>() - 1.0);
-                    ind.knots[s.index()][k] = s.clamp(v);
-                }
-            }
-            ind
-        })
+        .map(|_| motions::gentle(&model, 0.05, &mut || rng.random::<f64>()))
         .collect();
     let threads = resolve_threads(0);
     for (name, e) in [("default setting alone", &single), ("robust score", &ev)] {

@@ -12,8 +12,8 @@
 //! cost in simulated s per wall s, and the pair's wall time over the default's alone (without
 //! the robust score's cut at the default's fall). Checkpoints give the robot and fitness too
 //! (all must share them); without one, the defaults.
-use mobil_ga_step::{FitnessConfig, Individual, NaoModel, Servo, KNOTS};
-use mobil_ga_step_sim::{BodyParams, PhysicsEvaluator};
+use mobil_ga_step::{FitnessConfig, Individual, NaoModel};
+use mobil_ga_step_sim::{motions, BodyParams, PhysicsEvaluator};
 use rand::{Rng, SeedableRng};
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::Mutex;
@@ -86,14 +86,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             let (n, f): (usize, f64) = (n.parse()?, f.parse()?);
             let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(5);
             for j in 0..n {
-                let mut ind = model.standing();
-                for s in Servo::ALL {
-                    let (lo, hi) = s.limits();
-                    for k in 1..KNOTS - 1 {
-                        let v = model.standing_pose[s.index()] + f * (hi - lo) * (2.0 * rng.random::<f64>() - 1.0);
-                        ind.knots[s.index()][k] = s.clamp(v);
-                    }
-                }
+                let ind = motions::gentle(&model, f, &mut || rng.random::<f64>());
                 motions.push((format!("random {j}"), ind));
             }
         } else if arg.ends_with(".motion") {

@@ -48,14 +48,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 let (n, f): (usize, f64) = (n.parse()?, f.parse()?);
                 let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(5);
                 for j in 0..n {
-                    let mut ind = model.standing();
-                    for s in Servo::ALL {
-                        let (lo, hi) = s.limits();
-                        for k in 1..mobil_ga_step::KNOTS - 1 {
-                            let v = model.standing_pose[s.index()] + f * (hi - lo) * (2.0 * rng.random::<f64>() - 1.0);
-                            ind.knots[s.index()][k] = s.clamp(v);
-                        }
-                    }
+                    let ind = motions::gentle(&model, f, &mut || rng.random::<f64>());
                     sources.push((format!("random {j}"), model.clone(), FitnessConfig::default(), ind));
                 }
                 continue;

@@ -1,5 +1,6 @@
 //! Reference motions whose outcome is known without a simulation, to check the physics against:
-//! the robot bobbing in place on both feet, and poses held after a ramp from standing.
+//! the robot bobbing in place on both feet, and poses held after a ramp from standing; and
+//! gentle random motions about the standing pose, for samples.
 
 use mobil_ga_step::{Individual, NaoModel, Servo, KNOTS};
 
@@ -40,6 +41,22 @@ pub fn ramp_to(model: &NaoModel, angles: &[(Servo, f64)], ramp_knots: usize) -> 
         for k in 1..KNOTS - 1 {
             let f = (k as f64 / ramp as f64).min(1.0);
             ind.knots[i][k] = servo.clamp(q0 + (target - q0) * f);
+        }
+    }
+    ind
+}
+
+/// A gentle random motion: every inner knot uniform within `fraction` of its servo's range
+/// about the standing pose (stand + fraction·(hi − lo)·(2u − 1), u from `uniform` in [0, 1),
+/// drawn servo by servo, knot by knot), clamped into the limits. 0.05–0.125 give motions that
+/// mostly stay up for a while; the generator is the caller's, so a sample is reproducible.
+pub fn gentle(model: &NaoModel, fraction: f64, uniform: &mut dyn FnMut() -> f64) -> Individual {
+    let mut ind = model.standing();
+    for s in Servo::ALL {
+        let (lo, hi) = s.limits();
+        for k in 1..KNOTS - 1 {
+            let v = model.standing_pose[s.index()] + fraction * (hi - lo) * (2.0 * uniform() - 1.0);
+            ind.knots[s.index()][k] = s.clamp(v);
         }
     }
     ind

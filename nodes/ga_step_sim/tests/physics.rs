@@ -138,17 +138,7 @@ fn the_same_individual_gives_the_same_evaluation_bit_for_bit_on_any_thread() {
     // Gentle random motions (a quarter of each range around the standing pose) that stay up
     // for a while, so the comparison covers many steps.
     let batch: Vec<Individual> = (0..4)
-        .map(|_| {
-            let mut ind = model.standing();
-            for s in Servo::ALL {
-                let (lo, hi) = s.limits();
-                for k in 1..KNOTS - 1 {
-                    let v = model.standing_pose[s.index()] + 0.125 * (hi - lo) * (2.0 * rng.random::<f64>() - 1.0);
-                    ind.knots[s.index()][k] = s.clamp(v);
-                }
-            }
-            ind
-        })
+        .map(|_| motions::gentle(&model, 0.125, &mut || rng.random::<f64>()))
         .collect();
     let one = evaluate_all(&ev, &batch, 1);
     let two = evaluate_all(&ev, &batch, 2);
@@ -757,14 +747,7 @@ fn the_robust_score_is_the_worst_of_the_scores_under_each_setting() {
     batch.extend(edge.iter().cloned());
     let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(11);
     for _ in 0..6 {
-        let mut ind = model.standing();
-        for s in Servo::ALL {
-            let (lo, hi) = s.limits();
-            for k in 1..KNOTS - 1 {
-                let v = model.standing_pose[s.index()] + 0.1 * (hi - lo) * (2.0 * rng.random::<f64>() - 1.0);
-                ind.knots[s.index()][k] = s.clamp(v);
-            }
-        }
+        let ind = motions::gentle(&model, 0.1, &mut || rng.random::<f64>());
         batch.push(ind);
     }
     // The evaluator of ga_step (the default, checked at 4 ms/4/2) on the whole batch, and the
