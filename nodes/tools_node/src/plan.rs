@@ -115,6 +115,15 @@ pub fn missed_waypoints(waypoints: &[(f64, f64)], track: &[(f64, f64)], toleranc
         .collect()
 }
 
+/// Whether an odometry sample stamped `stamp` (ns, if valid) belongs to the route's track:
+/// every sample received while the route is under way (`route_active`), and after its end
+/// (stamped `route_end`) those stamped no later. The sample the planner judged the last
+/// waypoint reached on comes from another writer than the status that ends the route, and can
+/// be received after it; without it the track misses that waypoint.
+pub fn odom_in_route(route_active: bool, route_end: Option<i64>, stamp: Option<i64>) -> bool {
+    route_active || matches!((route_end, stamp), (Some(end), Some(t)) if t <= end)
+}
+
 /// Three significant digits, without exponent (1.43, 0.0523, 0.000123).
 pub fn three_digits(v: f64) -> String {
     if !v.is_finite() || v == 0.0 {
@@ -353,6 +362,20 @@ mod tests {
             dock_outcome: dock,
             final_truth: Some((3.03, 1.04, FRAC_PI_2 + 0.05)),
         }
+    }
+
+    #[test]
+    fn odometry_stamped_by_the_route_end_counts_when_received_after_it() {
+        // Under way: every sample, stamped or not.
+        assert!(odom_in_route(true, None, None));
+        assert!(odom_in_route(true, None, Some(5)));
+        // Ended at t = 100 ns: a late sample stamped at or before it counts, a later one not.
+        assert!(odom_in_route(false, Some(100), Some(99)));
+        assert!(odom_in_route(false, Some(100), Some(100)));
+        assert!(!odom_in_route(false, Some(100), Some(101)));
+        assert!(!odom_in_route(false, Some(100), None));
+        // Not started: nothing.
+        assert!(!odom_in_route(false, None, Some(1)));
     }
 
     #[test]

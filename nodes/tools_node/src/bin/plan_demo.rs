@@ -20,7 +20,9 @@ use mobil_ros::params::ParamValues;
 use mobil_ros::time::{nanos_from_stamp, stamp_from_nanos};
 use mobil_ros::{qos, run_node, shutdown_signal, NodeDecl, ParamSpec, RosNode};
 use mobil_sim::world::World;
-use mobil_tools_node::plan::{figure, DockSample, Outcome, PlanRun, Problem, Summary, DEMO_DOCK, DEMO_ROUTE};
+use mobil_tools_node::plan::{
+    figure, odom_in_route, DockSample, Outcome, PlanRun, Problem, Summary, DEMO_DOCK, DEMO_ROUTE,
+};
 use mobil_tools_node::plot::write_file;
 use ros2_client::{Name, ServiceMapping};
 use tracing::info;
@@ -197,7 +199,8 @@ async fn run(node: &mut RosNode) -> anyhow::Result<()> {
     let route_pub = node.publisher::<Path>("waypoints", &qos::default_qos())?;
     let dock_pub = node.publisher::<PoseStamped>("dock_pose", &qos::default_qos())?;
     let truth_sub = node.subscription::<Odometry>("ground_truth", &qos::default_qos())?;
-    let odom_sub = node.subscription::<Odometry>("odom", &qos::default_qos())?;
+    // Deep enough that a recorder behind by a few seconds drops no sample of the track.
+    let odom_sub = node.subscription::<Odometry>("odom", &qos::reliable(500))?;
     let status_sub = node.subscription::<NavStatus>("planner/status", &qos::latched())?;
 
     info!("asking planner/check_route about {} waypoints...", route.len());
@@ -258,6 +261,7 @@ async fn run(node: &mut RosNode) -> anyhow::Result<()> {
         final_truth: None,
     };
     let mut phase = Phase::RouteSent;
+    let mut route_end: Option<i64> = None;
     loop {
         tokio::select! {
             _ = &mut shutdown => anyhow::bail!("interrupted"),
@@ -282,7 +286,7 @@ async fn run(node: &mut RosNode) -> anyhow::Result<()> {
                 record.final_truth = Some((pose.position.x, pose.position.y, yaw_of(&pose.orientation)));
             }
             Some(Ok((m, _))) = odom.next() => {
-                if matches!(phase, Phase::Route(_)) {
+                if odom_in_route(matches!(phase, Phase::Route(_)), route_end, nanos_from_stamp(&m.header.stamp)) {
                     record.odom_path.push((m.pose.pose.position.x, m.pose.pose.position.y));
                 }
             }
@@ -299,6 +303,7 @@ async fn run(node: &mut RosNode) -> anyhow::Result<()> {
                     Phase::Route(t0) if finished => {
                         record.route_outcome = outcome();
                         record.route_s = secs(t0, stamp);
+                        route_end = Some(stamp);
                         info!("route ended: {:?}; sending the dock", record.route_outcome);
                         phase = Phase::DockSent(now);
                         let _ = dock_pub.publish(pose_stamped(node, dock.0, dock.1, dock.2));
