@@ -94,7 +94,7 @@ def test_demo_drives_the_route_and_plots_it():
                   r"after [\d.]+ s at e ([\d.]+) m, heading error ([\d.]+) rad \(RESIDUAL: a steered chassis", out.stdout)
     assert m, out.stdout
     missed, route_s, e, heading = int(m.group(1)), float(m.group(2)), float(m.group(3)), float(m.group(4))
-    assert missed == 0
+    assert missed == 0, out.stdout + out.stderr
     # The straight legs from (3, 3.9) through the waypoints sum to 10.50 m; each may end
     # Z_crit = 0.16 m short and the start lies within 0.14 m of (3, 3.9): at least 9.56 m at no
     # more than the planner's 0.3 m/s cruise speed, 31.9 s; the turns and the slow-down add.

@@ -115,13 +115,25 @@ pub fn missed_waypoints(waypoints: &[(f64, f64)], track: &[(f64, f64)], toleranc
         .collect()
 }
 
-/// Whether an odometry sample stamped `stamp` (ns, if valid) belongs to the route's track:
-/// every sample received while the route is under way (`route_active`), and after its end
-/// (stamped `route_end`) those stamped no later. The sample the planner judged the last
-/// waypoint reached on comes from another writer than the status that ends the route, and can
-/// be received after it; without it the track misses that waypoint.
-pub fn odom_in_route(route_active: bool, route_end: Option<i64>, stamp: Option<i64>) -> bool {
-    route_active || matches!((route_end, stamp), (Some(end), Some(t)) if t <= end)
+/// The distance from `waypoint` to the nearest point of `track` (infinite for an empty track).
+pub fn closest_approach(waypoint: (f64, f64), track: &[(f64, f64)]) -> f64 {
+    track
+        .iter()
+        .map(|p| (p.0 - waypoint.0).hypot(p.1 - waypoint.1))
+        .fold(f64::INFINITY, f64::min)
+}
+
+/// The route's odometry track: the positions of the samples (stamp in ns, x, y) stamped from
+/// the route's start to its end plus `slack` (ns), whatever order they were received in. The
+/// planner ends the route on the first sample within Z_crit of the last waypoint, but its status
+/// comes from another writer than the odometry and can be received first; and the status is
+/// stamped by the planner's clock, which may lag the sample's stamp by a clock period.
+pub fn route_track(samples: &[(i64, f64, f64)], start: i64, end: i64, slack: i64) -> Vec<(f64, f64)> {
+    samples
+        .iter()
+        .filter(|&&(t, _, _)| t >= start && t <= end.saturating_add(slack))
+        .map(|&(_, x, y)| (x, y))
+        .collect()
 }
 
 /// Three significant digits, without exponent (1.43, 0.0523, 0.000123).
@@ -365,17 +377,25 @@ mod tests {
     }
 
     #[test]
-    fn odometry_stamped_by_the_route_end_counts_when_received_after_it() {
-        // Under way: every sample, stamped or not.
-        assert!(odom_in_route(true, None, None));
-        assert!(odom_in_route(true, None, Some(5)));
-        // Ended at t = 100 ns: a late sample stamped at or before it counts, a later one not.
-        assert!(odom_in_route(false, Some(100), Some(99)));
-        assert!(odom_in_route(false, Some(100), Some(100)));
-        assert!(!odom_in_route(false, Some(100), Some(101)));
-        assert!(!odom_in_route(false, Some(100), None));
-        // Not started: nothing.
-        assert!(!odom_in_route(false, None, Some(1)));
+    fn route_track_is_the_samples_stamped_within_the_route() {
+        // Received out of order: the sample the route ended on (t = 100) after later ones.
+        let samples = [
+            (5, 0.0, 0.0),
+            (10, 1.0, 0.0),
+            (130, 3.0, 0.0),
+            (100, 2.0, 0.0),
+            (121, 4.0, 0.0),
+        ];
+        assert_eq!(route_track(&samples, 10, 100, 0), vec![(1.0, 0.0), (2.0, 0.0)]);
+        // A status stamped a clock period behind its sample: the slack takes the sample in.
+        assert_eq!(route_track(&samples, 10, 90, 20), vec![(1.0, 0.0), (2.0, 0.0)]);
+        assert_eq!(
+            route_track(&samples, 10, 100, 21),
+            vec![(1.0, 0.0), (2.0, 0.0), (4.0, 0.0)]
+        );
+        // Before the start: nothing; an end at the extreme does not overflow.
+        assert!(route_track(&samples, 200, i64::MAX, 20).is_empty());
+        assert_eq!(route_track(&samples, 0, i64::MAX, 1).len(), 5);
     }
 
     #[test]
@@ -388,6 +408,16 @@ mod tests {
         );
         assert_eq!(missed_waypoints(&run.waypoints, &run.odom_path, 0.12), vec![1, 2]);
         assert_eq!(missed_waypoints(&run.waypoints, &[], 1.0), vec![0, 1, 2]);
+        // The track's nearest points: (0, 0.1), (2, 0.15), (2, 1.7) at 0.1, 0.15 and 0.3 m.
+        let closest: Vec<f64> = run
+            .waypoints
+            .iter()
+            .map(|&w| closest_approach(w, &run.odom_path))
+            .collect();
+        for (c, want) in closest.iter().zip([0.1, 0.15, 0.3]) {
+            assert!((c - want).abs() < 1e-12, "{c} vs {want}");
+        }
+        assert_eq!(closest_approach((0.0, 0.0), &[]), f64::INFINITY);
     }
 
     #[test]

@@ -1,10 +1,11 @@
 //! `plan_demo`: the demo's third act. Asks `planner_node` to pre-check a waypoint route
 //! (`planner/check_route`, from the robot's odometry pose) and prints the answer, sends the route
 //! on `waypoints` and follows `planner/status` until it ends, then sends a dock on `dock_pose` and
-//! follows the docking to its end; records the true path (`ground_truth`) and the docking status
-//! (e, α, Θ, V, mode), writes one SVG (map: obstacles, route, predicted and true paths, dock,
-//! problems; panels: V(t) and e(t)) and prints a one-line summary. The record, summary and figure
-//! are `mobil_tools_node::plan` (tested there).
+//! follows the docking to its end; records the true path (`ground_truth`), the odometry track of
+//! the route (the samples stamped within it: waypoints it never came within `reach_tolerance` of
+//! count as missed) and the docking status (e, α, Θ, V, mode), writes one SVG (map: obstacles,
+//! route, predicted and true paths, dock, problems; panels: V(t) and e(t)) and prints a one-line
+//! summary. The record, summary and figure are `mobil_tools_node::plan` (tested there).
 
 use std::process::ExitCode;
 use std::time::{Duration, Instant};
@@ -21,7 +22,7 @@ use mobil_ros::time::{nanos_from_stamp, stamp_from_nanos};
 use mobil_ros::{qos, run_node, shutdown_signal, NodeDecl, ParamSpec, RosNode};
 use mobil_sim::world::World;
 use mobil_tools_node::plan::{
-    figure, odom_in_route, DockSample, Outcome, PlanRun, Problem, Summary, DEMO_DOCK, DEMO_ROUTE,
+    closest_approach, figure, route_track, DockSample, Outcome, PlanRun, Problem, Summary, DEMO_DOCK, DEMO_ROUTE,
 };
 use mobil_tools_node::plot::write_file;
 use ros2_client::{Name, ServiceMapping};
@@ -199,7 +200,7 @@ async fn run(node: &mut RosNode) -> anyhow::Result<()> {
     let route_pub = node.publisher::<Path>("waypoints", &qos::default_qos())?;
     let dock_pub = node.publisher::<PoseStamped>("dock_pose", &qos::default_qos())?;
     let truth_sub = node.subscription::<Odometry>("ground_truth", &qos::default_qos())?;
-    // Deep enough that a recorder behind by a few seconds drops no sample of the track.
+    // 500 samples: 10 simulated seconds at 50 Hz, so that a recorder seconds behind drops none.
     let odom_sub = node.subscription::<Odometry>("odom", &qos::reliable(500))?;
     let status_sub = node.subscription::<NavStatus>("planner/status", &qos::latched())?;
 
@@ -261,7 +262,10 @@ async fn run(node: &mut RosNode) -> anyhow::Result<()> {
         final_truth: None,
     };
     let mut phase = Phase::RouteSent;
-    let mut route_end: Option<i64> = None;
+    // Every odometry sample (stamp, x, y); the route's are chosen by stamp once it has ended.
+    let mut odom_samples: Vec<(i64, f64, f64)> = Vec::new();
+    let mut route_window: Option<(i64, i64)> = None;
+    let mut route_reason = String::new();
     loop {
         tokio::select! {
             _ = &mut shutdown => anyhow::bail!("interrupted"),
@@ -286,8 +290,8 @@ async fn run(node: &mut RosNode) -> anyhow::Result<()> {
                 record.final_truth = Some((pose.position.x, pose.position.y, yaw_of(&pose.orientation)));
             }
             Some(Ok((m, _))) = odom.next() => {
-                if odom_in_route(matches!(phase, Phase::Route(_)), route_end, nanos_from_stamp(&m.header.stamp)) {
-                    record.odom_path.push((m.pose.pose.position.x, m.pose.pose.position.y));
+                if let Some(t) = nanos_from_stamp(&m.header.stamp) {
+                    odom_samples.push((t, m.pose.pose.position.x, m.pose.pose.position.y));
                 }
             }
             Some(Ok((s, _))) = status.next() => {
@@ -303,7 +307,8 @@ async fn run(node: &mut RosNode) -> anyhow::Result<()> {
                     Phase::Route(t0) if finished => {
                         record.route_outcome = outcome();
                         record.route_s = secs(t0, stamp);
-                        route_end = Some(stamp);
+                        route_window = Some((t0, stamp));
+                        route_reason = s.reason.clone();
                         info!("route ended: {:?}; sending the dock", record.route_outcome);
                         phase = Phase::DockSent(now);
                         let _ = dock_pub.publish(pose_stamped(node, dock.0, dock.1, dock.2));
@@ -333,6 +338,11 @@ async fn run(node: &mut RosNode) -> anyhow::Result<()> {
         }
     }
 
+    if let Some((start, end)) = route_window {
+        // One joint_states period (20 ms simulated) of slack: the planner's clock may lag the
+        // stamp of the sample it ended the route on.
+        record.odom_path = route_track(&odom_samples, start, end, 20_000_000);
+    }
     let summary = Summary::of(&record, tolerance);
     let title = format!(
         "{}: planner route and Lyapunov docking",
@@ -340,5 +350,22 @@ async fn run(node: &mut RosNode) -> anyhow::Result<()> {
     );
     write_file(&out, &figure(&world, &record, &title)).map_err(|e| anyhow::anyhow!("cannot write {out}: {e}"))?;
     println!("{}", summary.line(&out, steered));
+    if !summary.missed.is_empty() {
+        let closest: Vec<String> = summary
+            .missed
+            .iter()
+            .map(|&i| {
+                format!(
+                    "{i} ({:.3} m)",
+                    closest_approach(record.waypoints[i], &record.odom_path)
+                )
+            })
+            .collect();
+        println!(
+            "  missed waypoints (the odometry's closest approach; reach within {tolerance} m): {}; the planner said: {}",
+            closest.join(", "),
+            if route_reason.is_empty() { "nothing" } else { &route_reason }
+        );
+    }
     Ok(())
 }
