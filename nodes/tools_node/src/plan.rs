@@ -110,7 +110,7 @@ pub fn missed_waypoints(waypoints: &[(f64, f64)], track: &[(f64, f64)], toleranc
     waypoints
         .iter()
         .enumerate()
-        .filter(|(_, w)| !track.iter().any(|p| (p.0 - w.0).hypot(p.1 - w.1) <= tolerance))
+        .filter(|&(_, &w)| closest_approach(w, track) > tolerance)
         .map(|(i, _)| i)
         .collect()
 }
