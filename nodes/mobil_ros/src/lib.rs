@@ -27,11 +27,13 @@
 //!   parameter;
 //! - [`qos`]: the QoS presets of the interface contract; [`log`]: `tracing` set-up and
 //!   rate-limited warnings ([`warn_throttled!`]); [`geometry`]: planar poses in messages;
-//!   [`args`], [`params`], [`names`]: the ROS command line, parameter files, names.
+//!   [`args`], [`params`], [`names`]: the ROS command line, parameter files, names;
+//!   [`docs`]: the parameter tables of `docs/`, which `--params-markdown` prints.
 
 pub mod action;
 pub mod args;
 pub mod config;
+pub mod docs;
 pub mod geometry;
 pub mod input;
 pub mod latest;

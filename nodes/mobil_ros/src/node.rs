@@ -117,8 +117,8 @@ impl NodeDecl {
         s
     }
 
-    /// Parses the process arguments. `Ok(None)` means `--help`/`--version` was answered and the
-    /// program should exit successfully.
+    /// Parses the process arguments. `Ok(None)` means `--help`, `--version` or
+    /// `--params-markdown` was answered and the program should exit successfully.
     pub fn parse_command_line<I, S>(&self, argv: I) -> anyhow::Result<Option<RosArgs>>
     where
         I: IntoIterator<Item = S>,
@@ -137,8 +137,18 @@ impl NodeDecl {
         let command = clap::Command::new(program)
             .about(self.about.clone())
             .version(env!("CARGO_PKG_VERSION"))
+            .arg(
+                clap::Arg::new("params-markdown")
+                    .long(&crate::docs::PARAMS_MARKDOWN_OPTION[2..])
+                    .action(clap::ArgAction::SetTrue)
+                    .help("Print the parameter table in Markdown (as docs/ has it) and exit"),
+            )
             .after_help(format!("{}\n{}", self.params_help(), ROS_ARGS_HELP));
         match command.try_get_matches_from(std::iter::once(String::from("node")).chain(own)) {
+            Ok(m) if m.get_flag("params-markdown") => {
+                print!("{}", crate::docs::params_markdown(&self.params));
+                Ok(None)
+            }
             Ok(_) => Ok(Some(ros)),
             Err(e)
                 if matches!(
