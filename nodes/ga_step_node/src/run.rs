@@ -114,10 +114,58 @@ pub struct Cli {
     /// the rule off (default 20, params/nao_step.yaml). A resume must repeat it.
     #[arg(long, value_name = "N")]
     pub level_window: Option<usize>,
+    /// Print the options and the parameter file's keys as Markdown tables (as docs/ has them)
+    /// and exit. Given alone; the executable answers it before parsing the other options.
+    #[arg(long, exclusive = true)]
+    pub params_markdown: bool,
     /// Testing only: pause this many ms inside each output's write (after its temporary file is
     /// written, before the rename), holding the write lock.
     #[arg(long, value_name = "MS", default_value_t = 0, hide = true)]
     pub write_delay_ms: u64,
+}
+
+/// The command line's options as a Markdown table (option, value, default, description), from
+/// the one declaration above; hidden options are left out.
+pub fn options_markdown() -> String {
+    use clap::CommandFactory as _;
+    use mobil_ros::docs::{cell, markdown_table};
+    let command = Cli::command();
+    let rows: Vec<Vec<String>> = command
+        .get_arguments()
+        .filter(|a| !a.is_hide_set())
+        .filter_map(|a| {
+            let long = a.get_long()?;
+            let takes_value = a.get_action().takes_values();
+            let choices: Vec<String> = a
+                .get_possible_values()
+                .iter()
+                .filter(|_| takes_value)
+                .map(|v| format!("`{}`", v.get_name()))
+                .collect();
+            let value = if !takes_value {
+                String::new()
+            } else if !choices.is_empty() {
+                choices.join(", ")
+            } else {
+                a.get_value_names()
+                    .map(|n| n.iter().map(|n| n.to_string()).collect::<Vec<_>>().join(" "))
+                    .unwrap_or_default()
+            };
+            let defaults: Vec<String> = a
+                .get_default_values()
+                .iter()
+                .map(|v| format!("`{}`", v.to_string_lossy()))
+                .collect();
+            let default = if a.is_required_set() {
+                "required".to_owned()
+            } else {
+                defaults.join(", ")
+            };
+            let help = a.get_help().map(|h| h.to_string()).unwrap_or_default();
+            Some(vec![format!("`--{long}`"), cell(&value), default, cell(&help)])
+        })
+        .collect();
+    markdown_table(&["option", "value", "default", "description"], &rows)
 }
 
 /// How a run ended.

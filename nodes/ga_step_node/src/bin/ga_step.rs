@@ -20,6 +20,15 @@ fn main() -> ExitCode {
             return ExitCode::from(2);
         }
     };
+    // Alone, it needs none of the required options (clap would ask for them first).
+    if own.len() == 1 && own[0] == "--params-markdown" {
+        print!(
+            "{}\nThe parameter file (`--params FILE`, `ga_step: ros__parameters:`):\n\n{}",
+            mobil_ga_step_node::run::options_markdown(),
+            mobil_ga_step_node::params::keys_markdown()
+        );
+        return ExitCode::SUCCESS;
+    }
     let cli = match Cli::try_parse_from(std::iter::once("ga_step".to_owned()).chain(own)) {
         Ok(cli) => cli,
         Err(e) => {
