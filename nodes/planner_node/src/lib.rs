@@ -822,7 +822,9 @@ impl Outcome {
                  collision ({virtual_robots} virtual robots simulated): robot stopped"
             ),
             Outcome::OptimisationBudget { index, tries, .. } => format!(
-                "optimisation budget exhausted: {tries} optimisations in a row ran out of vfo.optimise_budget_s                  before finding any path to waypoint {index} (none was proven unsafe; the scene needs a larger                  budget or a faster machine): robot stopped"
+                "optimisation budget exhausted: {tries} optimisations in a row ran out of vfo.optimise_budget_s \
+                 before finding any path to waypoint {index} (none was proven unsafe; the scene needs a larger \
+                 budget or a faster machine): robot stopped"
             ),
             Outcome::Collision {
                 centre,

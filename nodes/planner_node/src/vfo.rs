@@ -1000,6 +1000,7 @@ mod tests {
             r.error_msg
         );
         assert!(r.error_msg.contains("waypoint 1") && !r.error_msg.contains("NO_SAFE_PATH"));
+        assert!(!r.error_msg.contains("  "), "one space between words: {}", r.error_msg);
     }
 
     #[test]
