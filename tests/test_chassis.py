@@ -590,7 +590,7 @@ def test_cmd_vel_without_any_joint_states_never_turns_a_wheel(robot, start_node,
     assert len(received) - start >= 60, f"only {len(received) - start} wheel_commands in 2 s"
     moving = [m for m in received if any(v != 0.0 for v in m.velocity)]
     assert not moving, f"{len(moving)} of {len(received)} wheel_commands were not zero: {moving[0]}"
-    # Decision (README): a stop holds the steering angles last sent; never sent, they are straight.
+    # Decision (docs/chassis_node.md): a stop holds the steering angles last sent; never sent, they are straight.
     assert all(p == 0.0 for m in received for p in m.position)
 
 

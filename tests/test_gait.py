@@ -158,9 +158,9 @@ def test_compute_plan_the_papers_experiment_refusals_preemption_and_uneven_groun
         assert not reply.success and words in reply.reason and not reply.steps, reply.reason
 
     # Pre-emption: a search that cannot end soon (under Tab. 1's rearward reading A,(3) finds
-    # no plan within 200 000 expansions, README; here 1 000 000 are allowed, beyond the 5 s
-    # time limit) is pre-empted by the next request; its caller gets "pre-empted", the newer
-    # one its plan.
+    # no plan within 200 000 expansions, docs/experiments/gait-paper-table.md; here 1 000 000
+    # are allowed, beyond the 5 s time limit) is pre-empted by the next request; its caller
+    # gets "pre-empted", the newer one its plan.
     assert param_set(ros_node, "gait", "reading", "rearward").successful
     far = request(start, goal, "A", 3, 1_000_000)
     searching = gait.log_text().count("searching")

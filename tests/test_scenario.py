@@ -7,8 +7,8 @@ is measured from ``/clock`` as it arrives here and must be at least 4.
 
 Commands: cmd_vel is published every 0.05 simulated seconds (what a node under the simulation
 would do) and, in addition, at least every 0.1 wall seconds (harness.publish_on_sim_time).
-chassis_node's cmd_vel and feedback watchdogs run on the steady clock by design (README, "time
-rule"): at 5× a 0.5 s timeout is 2.5 simulated seconds, and a command stream scheduled only in
+chassis_node's cmd_vel and feedback watchdogs run on the steady clock by design (docs/ros2.md,
+"Time"; docs/chassis_node.md): at 5× a 0.5 s timeout is 2.5 simulated seconds, and a command stream scheduled only in
 simulated time leaves wall-clock gaps whenever the simulation or this process waits for the CPU.
 With a message at least every 0.1 wall seconds the watchdog, five times longer, never fires
 while the test drives; the repeats carry the same command, so they change nothing in the

@@ -6,9 +6,9 @@ Expected values are worked out by hand, not taken from the node:
 * Table 1 (cm) at the default footholds of params/hexapod.yaml, 0.10 m below the body. Every
   column has mean 0, so σ² = Σz²/6: zero → 0; small [2, −1, −2, 0, 1, 0], Σz² = 10 →
   √(10/6) = 1.2910 cm; large [4, −3, 1, −4, 0, 2], Σz² = 46 → √(46/6) = 2.7689 cm (the paper's
-  3.02 is a misprint, see README). α12 by Cramer's rule on the planes z = p·x + q·y + r: small
-  7.590°, large 19.276° (both > ε_α = 3°: UNEVEN); advice ripple up to σ_wave = 2.5 cm, wave
-  above.
+  3.02 is a misprint, see docs/experiments/terrain-table1.md). α12 by Cramer's rule on the
+  planes z = p·x + q·y + r: small 7.590°, large 19.276° (both > ε_α = 3°: UNEVEN); advice
+  ripple up to σ_wave = 2.5 cm, wave above.
 * A 10° slope rising ahead, walked with a level body: every foot on one plane, so α12 = 0 and
   α13 = α23 = 10°; the normal (−tan 10°, 0, 1) points downhill toward −x (180°); σ = tan 10° ·
   sd(foothold x) = 0.176327 · √0.015 = 2.1596 cm (the stride shifts every foot alike): SLOPE,

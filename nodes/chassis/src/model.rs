@@ -74,10 +74,9 @@ pub struct ChassisConfig {
     /// Distance R (m) from the centre to each omni wheel (omni).
     pub omni_wheel_distance: f64,
     /// Steering limit δ_max (rad), in (0, π/2] (tricycle, car-like), of the model's one steering
-    /// angle δ: the tricycle's wheel, the car-like chassis' virtual centre (bicycle) wheel, as in
-    /// SPEC §1 (δ = 70° on a 0.60 m wheelbase gives the 0.22 m radius L / tan δ). The inner
-    /// Ackermann wheel steers further, atan(L / (L / tan δ − B/2)); a limit δ_w of the inner
-    /// wheel is δ_max = atan(L / (L / tan δ_w + B/2)).
+    /// angle δ: the tricycle's wheel, the car-like chassis' virtual centre (bicycle) wheel. The
+    /// inner Ackermann wheel steers further, atan(L / (L / tan δ − B/2)); a limit δ_w of the inner
+    /// wheel is δ_max = atan(L / (L / tan δ_w + B/2)) (see docs/chassis_node.md).
     pub max_steering: f64,
     /// Minimum turning radius R_min (m) at the kinematic origin (tricycle, car-like).
     pub min_turning_radius: f64,

@@ -1,6 +1,7 @@
-//! The genetic algorithm's and the fitness formula's parameters, every default justified on its
-//! field; `params/nao_step.yaml` holds the same values (its test loads it). Both structs
-//! deserialize from a flat parameter section: a missing key takes its default.
+//! The genetic algorithm's and the fitness formula's parameters, each default justified on its
+//! field or on the docs page it cites; `params/nao_step.yaml` holds the same values (its test
+//! loads it). Both structs deserialize from a flat parameter section: a missing key takes its
+//! default.
 
 use crate::error::GaError;
 use serde::{Deserialize, Serialize};
@@ -102,12 +103,9 @@ pub struct GaConfig {
     /// Half-width (rad) of the uniform move of each picked knot. Default 1/6, the source's
     /// `(0.5 − random)/3`.
     pub mutation_step: f64,
-    /// Generations over which the mean fitness must rise for the run to go on. Default 20: the
-    /// source stopped when the mean "practically stopped changing"; 20 generations is a seventh
-    /// of the source's slower (arithmetic) run, long enough that a plateau between two of the
-    /// best individual's jumps does not end a run that still improves. 0 turns the rule off (the
-    /// source stopped its runs by hand at the first step; a population that is all upright and
-    /// equally fit sits on a plateau that only the operators can leave).
+    /// Generations over which the mean fitness must rise by `level_tolerance` for the run to go
+    /// on; 0 turns the rule off. Default 20, a seventh of the source's slower run (see
+    /// docs/ga_step.md, "Stopping").
     pub level_window: usize,
     /// Relative rise of the mean fitness over `level_window` generations below which it has
     /// levelled off. Default 0.001 (0.1 %): the mean can only rise under best-N replacement,
@@ -138,12 +136,9 @@ impl Default for GaConfig {
     }
 }
 
-/// The largest population (and offspring count): 10 000, a hundred times the source's 100.
-/// Every generation's checkpoint holds the whole population at about 4.0 KB of JSON an
-/// individual, so 10 000 is about 40 MB written each generation (100 000 would be 400 MB); and
-/// a generation of 10 000 already takes the built-in physics about 10 minutes on two cores when
-/// its individuals fall early (the README's 17 a second under the robust score), and over an
-/// hour when they stay up for the whole 3 s.
+/// The largest population (and offspring count): 10 000, a hundred times the source's 100. Its
+/// checkpoint is about 40 MB, written every generation, and one generation takes the built-in
+/// physics 10 minutes or more (see docs/ga_step.md, "Checkpoints and resume" and "Speed").
 pub const MAX_POPULATION: usize = 10_000;
 
 pub(crate) fn check(name: &'static str, value: f64, ok: bool, reason: &'static str) -> Result<(), GaError> {
@@ -241,13 +236,9 @@ pub struct FitnessConfig {
     /// a 10 cm gain buys back (staying up matters most, as in the source: its robots first
     /// learned not to fall), while among non-falling individuals distance decides.
     pub forward_weight: f64,
-    /// h₀ (m): the torso frame below this height is a fall. Default 0.20: the standing pose puts
-    /// it about 0.32 m up (foot 0.045 + legs 0.203·cos 0.4 + hip offset 0.085). The lowest
-    /// upright, flat-footed posture within the limits, a full squat (ankle pitch at its limit
-    /// −1.309, knee at 2.2689, so the shank 1.309 rad and the thigh 0.960 rad from the
-    /// vertical), puts it at 0.045 + 0.1·cos 0.960 + 0.1029·cos 1.309 + 0.085 ≈ 0.214 m: only
-    /// 14 mm above h₀. Tipped feet, a leaning torso or kneeling go lower, so this rule is a
-    /// backstop: the physics evaluator's tilt and floor-contact rules decide most falls.
+    /// h₀ (m): the torso frame below this height is a fall. Default 0.20, below the 0.214 m of
+    /// a full squat (the standing pose: about 0.32 m), so the rule is a backstop to the tilt and
+    /// floor-contact rules (see docs/ga_step.md, "Fitness").
     pub fall_height: f64,
     /// θ₀ (rad): a torso tilted more than this from upright (pitch or roll) is a fall. Default
     /// 0.5 rad (29°): a Nao standing with its torso leaning that far has its centre of mass
@@ -257,28 +248,18 @@ pub struct FitnessConfig {
     /// Default 0.04 m, the default maximum step length of Nao's own walk (ALMotion's MaxStepX).
     pub step_min_forward: f64,
     /// Whether a fall's forward distance counts too: `true` is the SPEC's example shape
-    /// f = t_fall / T_sim + w·max(0, Δx) for every step, `false` (default) counts distance only
-    /// for a step that does not fall. Default `false`: with distance on a fall, four runs of
-    /// population 100 bred forward lunges (0.5–1 m, falling at 1–2 s, f = 1.5–2.6) that beat
-    /// standing (1.0) and every upright step shorter than 25–80 cm; only one of the four reached
-    /// a non-falling forward step (README, "Humanoid step by a genetic algorithm").
+    /// f = t_fall / T_sim + w·max(0, Δx) for every step, `false` counts distance only for a step
+    /// that does not fall. Default `false`: with a fall's distance counted, runs bred falling
+    /// lunges (see docs/experiments/ga-step-fitness.md).
     pub distance_on_fall: bool,
-    /// b (m): the backward distance an upright individual may move before its fitness bottoms
-    /// out at 1, f = 1 + w·max(0, Δx + b). Default 1.0 m: the runs with b = 0 bred individuals
-    /// that stay up while moving 0.2–0.7 m backward in 3 s, all scored 1 like standing still, so
-    /// selection had no gradient towards moving forward; 1 m covers every such shuffle seen with
-    /// room to spare, and standing scores 1 + 2·1 = 3. 0 gives the previous shape.
+    /// b (m), ≥ 0: the backward distance an upright individual may move before its fitness
+    /// bottoms out at 1, f = 1 + w·max(0, Δx + b). Default 1.0 m; 0 gives the upright-only shape,
+    /// under which runs bred backward shufflers (see docs/experiments/ga-step-fitness.md).
     pub backward_allowance: f64,
-    /// Whether the built-in physics scores an individual under a second, finer solver setting
-    /// too and keeps the worse of the two scores, so an individual counts as upright only if it
-    /// stays up under both (a fall under either is a fall, at the earlier time; upright under
-    /// both scores the smaller Δx). Default `true`: near the edge of a fall the simulation's
-    /// verdict does not converge, and under the default setting alone selection bred motions
-    /// upright there and falling at every finer setting (README, "Humanoid step by a genetic
-    /// algorithm"). `false` scores under the default setting alone, at less than half the cost.
-    /// The built-in physics refuses it with [`distance_on_fall`](Self::distance_on_fall) (a
-    /// fall's distance can score a fall above the upright outcome, so the worse of two outcomes
-    /// would not be the lower score). Other evaluators ignore it.
+    /// Whether the built-in physics also scores an individual under a second solver setting and
+    /// keeps the worse outcome (a fall under either is a fall, at the earlier time; upright under
+    /// both scores the smaller Δx). Default `true` (see docs/experiments/ga-step-physics.md). The
+    /// built-in physics refuses it with [`distance_on_fall`](Self::distance_on_fall); others ignore it.
     pub robust_check: bool,
 }
 

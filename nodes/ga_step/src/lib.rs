@@ -63,8 +63,8 @@
 //! - **Parallelism**: `std::thread::scope` with an atomic work counter, not rayon (see
 //!   [`evaluate`]).
 //! - **Checkpoint**: one JSON document (readable, and with serde_json's exact float parsing
-//!   every f64 comes back to the same bits), tagged `mobil_ga_step checkpoint`, version 2,
-//!   written to `<file>.tmp`, synced and renamed. See [`checkpoint`].
+//!   every f64 comes back to the same bits), tagged `mobil_ga_step checkpoint`, version
+//!   [`CHECKPOINT_VERSION`], written to `<file>.tmp`, synced and renamed. See [`checkpoint`].
 //! - **Motion files** list only the ten evolved joints (Webots leaves the others where they are)
 //!   and write `-0.0000` as `0.0000`. The JointTrajectory YAML gives the 21 knots, exact for a
 //!   linearly interpolating follower.

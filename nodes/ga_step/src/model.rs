@@ -111,18 +111,14 @@ pub fn joint_names() -> [&'static str; SERVO_COUNT] {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(default)]
 pub struct NaoModel {
-    /// T (s): the duration of the step, split into 20 equal intervals. Must be a whole number of
-    /// 40 ms rows (the motion file has a row at T). Default 2.0 s: a slow step from standing to
-    /// standing, long enough for a statically stable one (shift the weight over one foot, swing
-    /// the other forward, shift, close up: both feet must move, as the pose at T equals the pose
-    /// at 0), with a knot every 0.1 s and 51 motion rows.
+    /// T (s), in (0, 3600]: the duration of the step, split into 20 equal intervals; a whole
+    /// number of 40 ms rows (the motion file has a row at T). Default 2.0 s, long enough for a
+    /// statically stable step (see docs/ga_step.md, "Model").
     pub step_time: f64,
-    /// The standing pose (rad), one angle per servo in genome order: first and last knot of every
-    /// individual, and the pose the robot stands in before the step. Default: knees bent 0.8 rad,
-    /// hip and ankle pitch −0.4 rad each, rolls 0. Hip + knee + ankle pitch = 0, so the torso is
-    /// parallel to the flat feet (upright); bent knees leave the servos room both ways (a
-    /// straight knee sits on its 0 limit and can only bend), as Nao's own stance does; the legs
-    /// stay 0.92 of their straight length (cos 0.4 = 0.921).
+    /// The standing pose (rad), one angle per servo in genome order, each within its servo's
+    /// limits: first and last knot of every individual, and the pose before the step. Default:
+    /// knees 0.8, hip and ankle pitch −0.4, rolls 0 (hip + knee + ankle pitch = 0: the torso
+    /// upright over flat feet; see docs/ga_step.md, "Model").
     pub standing_pose: [f64; SERVO_COUNT],
 }
 

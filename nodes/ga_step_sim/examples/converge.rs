@@ -2,11 +2,13 @@
 //! `cargo run --release -p mobil_ga_step_sim --example converge -- [SETTINGS...] MOTION...`.
 //! A MOTION is `stand`, `bob` (both legs bobbing in place, ±0.15 rad at 1.25 Hz), `knees` (both
 //! knees fully bent at once), `ramp:INDEX=ANGLE,...` (servos by genome index ramped to the
-//! angles over 0.5 s and held) or a `ga_step` checkpoint (its best individual). A SETTINGS
-//! argument `DT_MS:ITERATIONS:PGS` (e.g. `5:4:1`) replaces the default list (the README table's
-//! columns, 5:4:1 5:4:2 5:8:2 2.5:8:2 2.5:16:2 1.25:16:4; the last is the reference). Prints per motion
-//! and setting: fall or not (and why), fall time, Δx, Δy, and the cost in simulated seconds per
-//! wall second.
+//! angles over 0.5 s and held), `random:N:FRACTION` (N gentle random motions, every inner knot
+//! uniform within FRACTION of its servo's range about the standing pose, seed 5) or a `ga_step`
+//! checkpoint (its best individual). `perturb=RAD` moves the inner RHipPitch knots of every
+//! motion by RAD. A SETTINGS argument `DT_MS:ITERATIONS:PGS` (e.g. `5:4:1`) replaces the default
+//! list (the columns of the solver table of docs/experiments/ga-step-physics.md, 5:4:1 5:4:2
+//! 5:8:2 2.5:8:2 2.5:16:2 1.25:16:4; the last is the reference). Prints per motion and setting:
+//! fall or not (and why), fall time, Δx, Δy, and the cost in simulated seconds per wall second.
 use mobil_ga_step::{FitnessConfig, Individual, NaoModel, Servo};
 use mobil_ga_step_sim::{motions, BodyParams, PhysicsEvaluator};
 use rand::{Rng, SeedableRng};
@@ -78,8 +80,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         }
     }
     if settings.is_empty() {
-        // The README's table: one pass (physics 1's solver), the default, then finer; the last
-        // is the reference the others are compared with.
+        // The solver table of docs/experiments/ga-step-physics.md: one pass (physics 1's
+        // solver), the default, then finer; the last is the reference the others are compared
+        // with.
         settings = vec![
             (0.005, 4, 1),
             (0.005, 4, 2),

@@ -81,11 +81,8 @@ pub struct BodyParams {
     /// continuously; the stall torque is a momentary figure that would burn the winding.
     pub pitch_max_torque: f64,
     /// Continuous torque of the roll joints (hip, ankle roll; N·m): the same motor through the
-    /// type A reduction 201.3. 12.3 mN·m × 201.3 is 2.476 N·m; 2.47 N·m is the figure
-    /// Aldebaran's motor table prints for it ("Nominal torque 2.47 Nm (without the ratio
-    /// efficiency)", beside 11.97 N·m stall and 188.67 °/s nominal speed), kept as printed: the
-    /// 6 mN·m between them is under the documentation's own rounding and the runs were scored
-    /// with 2.47.
+    /// type A reduction 201.3, 2.47 N·m as Aldebaran's motor table prints it (see docs/ga_step.md,
+    /// "The physics evaluator").
     pub roll_max_torque: f64,
     /// Stall torque of the pitch joints (N·m): 59.5 mN·m × 130.85 = 7.78 N·m. It only fixes the
     /// slope of the DC motor's torque–speed line, τ_stall·(1 − ω/ω₀), which caps the torque

@@ -41,7 +41,7 @@
 //! crept 11 mm in 3 s and evolved motions travelled 0.3–0.6 m by hopping and sliding, motions
 //! that fall at any finer setting; with 2 passes the outcomes of standing, bobbing in place and
 //! those motions match those at a quarter of the step with four times the iterations (the
-//! README's table), at the same cost.
+//! solver table of docs/experiments/ga-step-physics.md), at the same cost.
 //!
 //! **The robust score** ([`FitnessConfig::robust_check`], on by default): near the edge of a
 //! fall the verdict does not converge with the setting, and selection finds such edges, so
@@ -125,8 +125,8 @@ pub enum SimError {
 }
 
 /// The largest solver iteration or Gauss–Seidel pass count accepted: 64 times the default, far
-/// beyond any setting that changes an outcome (the README's convergence table), and small
-/// enough that a step cannot take unbounded time.
+/// beyond any setting that changes an outcome (the solver table of
+/// docs/experiments/ga-step-physics.md), and small enough that a step cannot take unbounded time.
 pub const MAX_SOLVER_COUNT: usize = 256;
 
 /// The time steps accepted (s): 10 µs, 1/500 of the default, takes 300 000 steps for one
@@ -159,11 +159,12 @@ impl SolverSetting {
 
 /// The second setting of the robust score ([`FitnessConfig::robust_check`]): 4 ms steps, 4
 /// iterations of 2 passes, a step that is no multiple of the default's, so no step's numbers
-/// are shared. Compared (README) with 5 ms/8/2, 2.5 ms/8/2 and μ 0.7 against the reference
-/// 1.25 ms/16/4, on the 100 individuals of a physics-2 run upright at the default and 53 other
-/// motions: each of them turned all 100 into falls, as the reference does, and each called the
-/// same single motion a fall that the reference calls upright; 4 ms/4/2 costs the least of the
-/// solver settings: 5/4 of the default's steps, 1.34 times its time in the benchmark.
+/// are shared. Compared (docs/experiments/ga-step-physics.md, "The second setting of the robust
+/// score") with 5 ms/8/2, 2.5 ms/8/2 and μ 0.7 against the reference 1.25 ms/16/4, on the 100
+/// individuals of a physics-2 run upright at the default and 53 other motions: each of them
+/// turned all 100 into falls, as the reference does, and each called the same single motion a
+/// fall that the reference calls upright; 4 ms/4/2 costs the least of the solver settings: 5/4
+/// of the default's steps, 1.34 times its time in the benchmark.
 pub const CHECK_SETTING: SolverSetting = SolverSetting {
     dt: 0.004,
     solver_iterations: 4,

@@ -95,27 +95,10 @@ pub struct Weights {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(default)]
 pub struct GaitConfig {
-    /// Least distance \[j\] of the centre of gravity inside the support triangle while a leg moves
-    /// (and inside the four feet's hull while the body moves). Default 0.03, 1.5 % of the body
-    /// width. In the nominal stance the centre lies exactly on both diagonals of the feet
-    /// (margin 0): with a margin of 0 a leg may lift there and the robot stands on the edge of
-    /// its support triangle, where the least disturbance tips it over. Any positive margin
-    /// forbids that, so the body shifts first, as a real walker's does. The value is small
-    /// beside the 0.086 \[j\] by which a foot at the front of its sector still lies ahead of the
-    /// centre. Set B under (1), (2) is sensitive to it (plateaus of tied leg configurations):
-    /// at 0.005 and 0.01 B,(1) exhausts 200 000 expansions, at 0.05 it needs 23 220; from 0.02
-    /// to 0.04 every row of the paper's table (forward reading) plans within 5 000 expansions
-    /// with the paper's trends, and 0.03, the middle, gives the fewest (B,(3): 1 208 expanded,
-    /// 103 states against the paper's 100). Margin 0 reproduces the SPEC's check figures
-    /// (52 / 37 / 96 states). The price of any positive margin: A,(1) returns the same 37-state
-    /// plan as A,(3) (the paper has 45 against 40). At margin 0, (1), blind to leg moves, takes
-    /// the lowest-h state, reached by full √1.75 shifts that need each leg set nominal and then
-    /// to max (40 leg moves, 9 of them lifted with the centre on the triangle's edge): the
-    /// paper's redundant leg moves. A positive margin forbids those 9 lifts, and (1) falls into
-    /// the cycle (3) chooses (21 leg moves, shifts of 1, 0.51 and 1.32). Neither is the fewest:
-    /// a 20-leg plan exists (32 states, found by (1) at 0.05 and valid at 0.03), but (3)'s h
-    /// (1 per \[j\]) outweighs its cost (0.4 per leg move, about 0.6 per \[j\]), so algorithm A
-    /// is not bound to find it. The key quantum (1e-6..1e-2) changes none of this.
+    /// Least distance \[j\], in [0, 1), of the centre of gravity inside the support triangle
+    /// while a leg moves (and inside the four feet's hull while the body moves). Default 0.03,
+    /// 1.5 % of the body width: a positive margin keeps a leg from lifting with the centre on the
+    /// triangle's edge (see docs/experiments/gait-paper-table.md#the-stability-margin).
     pub stability_margin: f64,
     /// ΔY of rule 2 \[j\]. Default b/3 = 1 (the paper's, SPEC §7).
     pub translation_step: f64,

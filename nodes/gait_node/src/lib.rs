@@ -49,8 +49,8 @@ use thiserror::Error;
 /// plan by plan.
 pub const MAX_COORDINATE: f64 = 1000.0;
 
-/// Most successors one expansion can generate with a rule set: each rule gives at most two
-/// (a leg rule may place the foot at either of two points).
+/// A bound on the successors one expansion can generate with a rule set: two per rule. It is
+/// conservative: rule 2 gives two (+ΔY and −ΔY), every other rule at most one.
 pub fn max_successors(set: RuleSet) -> u32 {
     let rules = match set {
         RuleSet::A => 11,
@@ -77,7 +77,8 @@ pub struct NodeParams {
     pub time_limit_s: f64,
     /// Metres per \[j\]: `goal_pose`, the markers and `gait/body` are in metres.
     pub unit_length: f64,
-    /// The frame of `goal_pose`, the markers and `gait/body` (and the header of `gait/plan`).
+    /// The frame of `goal_pose`, the markers and `gait/body` (`gait/plan` is in \[j\] and sends
+    /// an empty `frame_id`).
     pub frame: String,
     /// Rule set of the walk's short-time plans.
     pub walk_rule_set: RuleSet,
@@ -250,7 +251,7 @@ fn declare_node(d: &mut Decl<NodeParams>) {
     d.string(
         "frame",
         &c.frame,
-        "frame of goal_pose, gait/markers, gait/body and gait/plan's header",
+        "frame of goal_pose, gait/markers and gait/body (gait/plan is in [j], with an empty frame_id)",
         |c, v| c.frame = v,
     );
     d.parsed::<SetName>(

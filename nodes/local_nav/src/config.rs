@@ -1,5 +1,6 @@
 //! Configuration of the navigator, validated once: sector count, weight profile (eq. 3.53–3.55),
-//! distances, step counters and thresholds. Every default is justified on its field.
+//! distances, step counters and thresholds. Every default is justified on its field or on the
+//! docs page it cites.
 
 use crate::field::WeightProfile;
 use crate::sectors::UnseenSectors;
@@ -92,14 +93,10 @@ pub struct NavConfig {
     /// so the n-step test of eq. 3.58 alone would never fire). Default 0.02: at that speed the n
     /// steps (2 m) would take 100 s.
     pub stall_speed: f64,
-    /// Car-like chassis: the least speed (m/s) of a turn whose arc (the robot's circle swept
-    /// along the commanded arc) is clear of the scan points; the slow-downs of the turn itself
-    /// (angle to the direction, sliding) never go below it, only the arc's clearance and the
-    /// goal can. Default 0.10: Nav2's progress checker wants 0.5 m in 10 s, i.e. 0.05 m/s on
-    /// average, and a turn away from a wall at 0.10 m/s covers the quarter circle of MOBIL-II's
-    /// 0.73 m turning radius (1.15 m) in 11.5 s; it stops within a centimetre (a 0.05 s motor
-    /// lag and a 40 Hz scan's age: 0.1 × 0.1 s), well inside the 0.10–0.12 m between the body
-    /// and the hard stop. 0 restores a turn as slow as its own slow-downs make it.
+    /// Car-like chassis: the least speed (m/s), ≥ 0, of a turn whose arc (the robot's circle swept
+    /// along it) is clear of the scan points; the turn's own slow-downs never go below it, only the
+    /// arc's clearance and the goal can. 0: no floor. Default 0.10, twice the average speed Nav2's
+    /// progress checker asks for (see docs/local_nav_node.md, "Parameters").
     pub min_turn_speed: f64,
     /// c2 (m): least progress toward G over m steps of T-mode (eq. 3.60). Default 0.50.
     pub track_min_progress: f64,
@@ -111,12 +108,12 @@ pub struct NavConfig {
     pub goal_tolerance: f64,
     /// Distance (m) to G inside which the speed falls linearly toward zero. Default 0.60.
     pub slow_down_radius: f64,
-    /// Gain (rad/m) that bends the tracking direction toward or away from the boundary per metre
-    /// of distance error in T-mode. Default 1.5: a 0.35 m error gives the full ±π/6 correction.
+    /// Gain (rad/m), ≥ 0, of T-mode's bend b = gain·(d − d_sa) of the tracking direction toward
+    /// (d > d_sa) or away from (d < d_sa) the boundary, b clamped to ±π/3. Default 1.5: the bend
+    /// reaches ±π/3 at a 0.70 m error.
     pub track_gain: f64,
-    /// Gain (1/s) of the omni chassis' turn toward a direction outside the field of view, and in
-    /// T-mode toward its direction of motion.
-    /// Default 1.5.
+    /// Gain (1/s), > 0, of an omni chassis' turns: in place toward a direction outside the field
+    /// of view, and in T-mode to face its direction of motion. Default 1.5.
     pub heading_gain: f64,
 }
 

@@ -212,7 +212,7 @@ impl Config for LocalNavConfig {
         d.double(
             "heading_gain",
             n.heading_gain,
-            "omni: gain of the turn toward a direction outside the field of view [1/s]",
+            "omni: gain of the turn toward a direction outside the field of view, and in T-mode toward the direction of motion [1/s]",
             |c, v| c.nav.heading_gain = v,
         )
         .above(0.0);

@@ -89,9 +89,9 @@ pub const MAX_INPUT_TIMEOUT_S: f64 = 60.0;
 /// The largest `result_timeout_s` (s).
 pub const MAX_RESULT_TIMEOUT_S: f64 = 3600.0;
 /// Most waypoints of one route (after `number_of_loops`): the pre-check of 200 legs each at the
-/// 50 m leg bound takes 0.47–0.64 s at worst (measured; a real route is far shorter: 20
-/// waypoints, 0.36 ms), so every check runs off the event loop, a superseded goal's check
-/// stopped within one virtual step.
+/// 50 m leg bound takes 0.47–0.64 s at worst (measured; a real route is far shorter: see the
+/// 20-waypoint bench in docs/planner_node.md and docs/performance.md), so every check runs off
+/// the event loop, a superseded goal's check stopped within one virtual step.
 pub const MAX_WAYPOINTS: usize = 200;
 /// Most poses of `simulated_path` in a `check_route` reply (about 90 bytes each: 36 KB, well
 /// under the 64 KB a reply should stay below).

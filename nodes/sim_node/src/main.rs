@@ -113,7 +113,7 @@ impl Config for SimConfig {
         d.double(
             "motor_time_constant",
             0.05,
-            "first-order lag of the wheels [s]",
+            "first-order lag of the wheel speeds and steering angles (0: none) [s]",
             |c, v| c.motor_time_constant = v,
         )
         .min(0.0);

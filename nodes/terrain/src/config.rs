@@ -1,6 +1,7 @@
 //! Thresholds, body points and frame names of the assessment, and the hexapod's geometry.
-//! Every default is justified on its field; `params/hexapod.yaml` holds the same values, and a
-//! test checks that the file's values classify a 10° slope, Table 1's feet and ε_α as stated there.
+//! Every default is justified on its field or on the docs page it cites; `params/hexapod.yaml`
+//! holds the same values, and a test checks that the file's values classify a 10° slope, Table
+//! 1's feet and ε_α as stated there.
 //!
 //! Both structs deserialize from a ROS 2 parameter section (flat names; nested maps for the
 //! footholds): a missing key takes its default, keys of other structs are ignored.
@@ -18,33 +19,19 @@ const DEG: f64 = std::f64::consts::PI / 180.0;
 #[derive(Debug, Clone, PartialEq, Deserialize)]
 #[serde(default)]
 pub struct TerrainConfig {
-    /// σ_flat (m): the largest σ of the feet that still counts as flat. FLAT needs all three
-    /// angles within ε_α, the planes' offset within `plane_offset_max` *and* σ ≤ σ_flat: a cap
-    /// on the height spread the tripod gait must clear, however it arises. With the default
-    /// thresholds and footholds it cannot bind (the angle and offset tests already keep σ below
-    /// 0.94 cm: parallel planes tilted 3° along y, 1 cm apart), but it still does for a larger
-    /// ε_α or plane_offset_max. Default 0.010: above the 0.70 cm that a plane tilted by ε_α (3°)
-    /// gives with the default footholds (0.1347 m × tan 3°, the largest over directions), so a
-    /// coplanar stance within ε_α is never refused by σ, and well above leg kinematics'
-    /// millimetre noise. **Depends on the footholds**: wider ones need a larger σ_flat (see
-    /// [`TerrainConfig::warnings`]).
+    /// σ_flat (m), > 0 and ≤ `sigma_wave`: the largest σ of the feet that still counts as flat.
+    /// FLAT needs all three angles within ε_α, the planes' offset within `plane_offset_max` *and*
+    /// σ ≤ σ_flat. Default 0.010. Depends on the footholds: it must exceed their largest spread ×
+    /// tan ε_α ([`TerrainConfig::warnings`]; see docs/experiments/terrain-table1.md#the-thresholds).
     pub sigma_flat: f64,
-    /// Largest offset (m) between the two foot planes that still counts as one plane, when they
-    /// are parallel within ε_α (see [`plane_offset`](crate::assess::plane_offset): the larger
-    /// distance of each tripod's foot centroid from the other's plane). Above it the stance is
-    /// UNEVEN: a step between the tripods, which no angle sees, level or on a slope. Default
-    /// 0.010: ten times leg kinematics' millimetre noise, and more than three times the 2.8 mm
-    /// that two planes crossing at ε_α put between them at the default footholds' tripod
-    /// centroids (0.053 m apart: 0.053 × tan 3°), so a coplanar stance is never refused by it; a
-    /// 1 cm step is a tenth of the default body height. A new parameter rather than σ_flat: it is
-    /// a distance between planes, independent of the footholds' spread, while σ is a spread of
-    /// heights (a level step h gives σ = h/2, so σ_flat = 1 cm saw only steps over 2 cm).
+    /// Largest offset (m), > 0, between the two foot planes, parallel within ε_α, that still
+    /// counts as one plane ([`plane_offset`](crate::assess::plane_offset)); above it the stance is
+    /// UNEVEN, a step between the tripods. Default 0.010 (see
+    /// docs/experiments/terrain-table1.md#the-thresholds).
     pub plane_offset_max: f64,
-    /// σ (m) between the ripple and the wave gait: SLOPE and UNEVEN get ripple up to it, wave
-    /// above (the paper names both for irregular ground without choosing; wave is the slower,
-    /// safer one). Default 0.025: a plain 10° slope (σ 2.16–2.37 cm with the default footholds,
-    /// coplanar feet) keeps the ripple gait, as do Table 1's "small" feet (1.29 cm), while its
-    /// "large" feet (2.77 cm) get the wave gait. (At 2 cm every plain 10° slope got wave.)
+    /// σ (m), from `sigma_flat` to `sigma_max`, between the ripple and the wave gait: SLOPE and
+    /// UNEVEN get ripple up to it, wave above. Default 0.025, between a plain 10° slope's σ and
+    /// Table 1's "large" feet (see docs/experiments/terrain-table1.md#the-thresholds).
     pub sigma_wave: f64,
     /// σ_max (m): above it the ground is BEYOND_LIMITS (reroute). Default 0.040: above Table 1's
     /// "large" feet (2.77 cm, UNEVEN) and a plain 10° slope in any direction (at most 2.37 cm
@@ -60,11 +47,10 @@ pub struct TerrainConfig {
     /// about where a small hexapod's static stability on a tripod with ordinary friction
     /// (μ ≈ 0.5 gives 26°) leaves no margin for the swing leg's disturbance.
     pub tilt_max: f64,
-    /// Body points 1, 2, 3 of plane 3 (m, body frame), as nine numbers x1 y1 z1 x2 y2 z2 x3 y3
-    /// z3 (a ROS double array). The paper defines them only in a lost figure (SPEC Decision:
-    /// parameters). Default: a front point on the axis and two rear points at ±0.08 m, all in
-    /// the body's xy-plane, so plane 3 is the body's "horizontal" and α13, α23 are the foot
-    /// planes' inclinations to it; symmetric about x, so swapping left and right mirrors it.
+    /// Body points 1, 2, 3 of plane 3 (m, body frame, finite, not collinear), as nine numbers
+    /// x1 y1 z1 x2 y2 z2 x3 y3 z3 (a ROS double array). Default: a front point on the axis and two
+    /// rear points at ±0.08 m, all in the body's xy-plane, so α13 and α23 are the foot planes'
+    /// inclinations to the body (see docs/experiments/terrain-table1.md#the-thresholds).
     pub body_points: [f64; 9],
     /// Frame of the touchdowns and of the assessment (the body frame from leg kinematics, x
     /// forward, y left, z up). Default `base_link` (REP-105).
@@ -214,10 +200,8 @@ impl Footholds {
 #[serde(default)]
 pub struct HexapodGeometry {
     /// Nominal footholds (m, body frame). Default: front and rear feet at x = ±0.15 m,
-    /// y = ±0.12 m, middle feet at x = 0, y = ±0.16 m (a small hexapod of about 0.25 m body
-    /// length; the middle legs reach wider, as on most hexapods, so the stance is not a
-    /// rectangle). With it a plain 10° slope gives σ of 2.16 cm uphill along x and 2.37 cm
-    /// along y: "about 2 cm" (SPEC §6); Table 1's foot heights (±4 cm) fit its legs.
+    /// y = ±0.12 m, middle feet at x = 0, y = ±0.16 m (see
+    /// docs/experiments/terrain-table1.md#the-thresholds).
     pub footholds: Footholds,
     /// Height (m) of the body's origin above the local ground (the mean ground height under the
     /// six nominal footholds). Default 0.10.

@@ -52,8 +52,8 @@ pub struct OptimiseConfig {
     /// K_D, K_B, K_E, K_S. Default the paper's {1, 2, 1, 1}.
     pub weights: QualityWeights,
     /// T_p (s): the virtual robots' integration step and the indices' sampling period (SPEC
-    /// §5 Decision: T_p = the integration step). Default 0.02 s, the planner's 50 Hz tick:
-    /// 6 mm of path at 0.3 m/s.
+    /// §5 Decision: T_p = the integration step). Default 0.01 s: 3 mm of path at 0.3 m/s;
+    /// `planner_node` sets it to its control period, one odometry period.
     pub time_step: f64,
     /// Most virtual robots per optimisation. Default 4096: 2^12 leaves, far beyond the |D| of
     /// any layout the paper shows, and about a second of work at 30 obstacles.
@@ -62,11 +62,9 @@ pub struct OptimiseConfig {
     /// warning. Default 120 s: 36 m at 0.3 m/s, beyond any segment the planner is given.
     pub max_path_time_s: f64,
     /// A path is also dropped (with the same warning) once its simulated time exceeds
-    /// `path_time_factor` × the straight drive time (‖e*‖ at the start / U_2) plus
-    /// `path_time_margin_s`, whichever limit is lower. Virtual robots that circle inside one
-    /// zone never re-enter a zone, so the cycle check cannot cut them; without this bound each
-    /// would run to `max_path_time_s` and dominate the optimisation's time. Default 3: a
-    /// detour of three times the straight way is no path worth choosing.
+    /// `path_time_factor` (> 0) × the straight drive time (‖e*‖ at the start / U_2) plus
+    /// `path_time_margin_s`, when that is below `max_path_time_s`. Default 3 (see
+    /// docs/experiments/vfo.md, "The per-path time limit").
     pub path_time_factor: f64,
     /// See `path_time_factor` (s). Default 20: the slow final approach at the last waypoint
     /// (v = min(U_2, ‖H*‖)·cos e_a) plus turning round at the start.
