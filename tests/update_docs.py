@@ -49,13 +49,21 @@ def blocks(text: str) -> list[re.Match]:
 
 
 def workspace_executables() -> set[str]:
-    """Every executable of the workspace: the [[bin]] names of the crates' manifests and the
-    files of their src/bin/ (which cargo builds without a [[bin]] entry)."""
+    """Every executable of the workspace, as cargo names them: each crate's [[bin]] entries, the
+    files of its src/bin/ (built without an entry), and its src/main.rs under the package's name
+    unless a [[bin]] entry builds that file."""
+    import tomllib
     names: set[str] = set()
     for manifest in ROOT.glob("nodes/*/Cargo.toml"):
-        text = manifest.read_text()
-        names.update(re.findall(r'^\[\[bin\]\]\s*\nname\s*=\s*"([^"]+)"', text, re.M))
-        names.update(p.stem for p in (manifest.parent / "src" / "bin").glob("*.rs"))
+        data = tomllib.loads(manifest.read_text())
+        bins = data.get("bin", [])
+        names.update(b["name"] for b in bins)
+        paths = {b.get("path") for b in bins}
+        names.update(p.stem for p in (manifest.parent / "src" / "bin").glob("*.rs")
+                     if f"src/bin/{p.name}" not in paths)
+        if (manifest.parent / "src" / "main.rs").exists() and not any(
+                b.get("path") == "src/main.rs" for b in bins):
+            names.add(data["package"]["name"])
     return names
 
 

@@ -138,7 +138,7 @@ impl Default for GaConfig {
 
 /// The largest population (and offspring count): 10 000, a hundred times the source's 100. Its
 /// checkpoint is about 40 MB, written every generation, and one generation takes the built-in
-/// physics 10 minutes or more (see docs/ga_step.md, "Checkpoints and resume" and "Speed").
+/// physics minutes (see docs/ga_step.md, "Checkpoints and resume" and "Speed").
 pub const MAX_POPULATION: usize = 10_000;
 
 pub(crate) fn check(name: &'static str, value: f64, ok: bool, reason: &'static str) -> Result<(), GaError> {

@@ -163,7 +163,9 @@ pub fn keys_markdown() -> String {
             let value = defaults.iter().find(|(k, _)| k == d.key).map(|(_, v)| v.clone());
             let (kind, default) = match &value {
                 Some(Value::Bool(b)) => ("bool", b.to_string()),
-                Some(Value::Number(n)) if n.is_f64() => ("double", n.to_string()),
+                Some(Value::Number(n)) if n.is_f64() => {
+                    ("double", n.as_f64().map_or_else(String::new, |x| x.to_string()))
+                }
                 Some(Value::Number(n)) => ("integer", n.to_string()),
                 Some(Value::String(s)) => ("string", format!("\"{s}\"")),
                 Some(Value::Sequence(items)) => (
@@ -172,7 +174,7 @@ pub fn keys_markdown() -> String {
                         "[{}]",
                         items
                             .iter()
-                            .map(|v| serde_norway::to_string(v).unwrap_or_default().trim().to_owned())
+                            .map(|v| v.as_f64().map_or_else(|| "?".to_owned(), |x| x.to_string()))
                             .collect::<Vec<_>>()
                             .join(", ")
                     ),
@@ -357,6 +359,8 @@ mod tests {
                     let list = |k: usize| format!("{:?}", &pose[..k.min(pose.len())]);
                     assert!(accepts(d.key, &list(*n)));
                     assert!(!accepts(d.key, &list(n - 1)));
+                    let longer = format!("{:?}", [pose.as_slice(), &pose[..1]].concat());
+                    assert!(!accepts(d.key, &longer));
                 }
                 Constraint::Any => {
                     assert!(accepts(d.key, "true") && accepts(d.key, "false"), "{}", d.key);
@@ -368,7 +372,7 @@ mod tests {
     #[test]
     fn the_table_shows_the_built_in_defaults() {
         let table = keys_markdown();
-        assert!(table.contains("| `step_time` | double | `2.0` |"), "{table}");
+        assert!(table.contains("| `step_time` | double | `2` |"), "{table}");
         assert!(
             table.contains("| `mutation_picks` | integer | `10` | [0, 1000000] |"),
             "{table}"
@@ -377,7 +381,23 @@ mod tests {
             table.contains("| `blx_variant` | string | `\"per-knot\"` | `per-knot`, `single-draw` |"),
             "{table}"
         );
-        assert!(table.contains("| `standing_pose` | double array | `[-0.4, 0.0, 0.8, -0.4, 0.0, -0.4, 0.0, 0.8, -0.4, 0.0]` | 10 elements |"), "{table}");
+        assert!(
+            table.contains(
+                "| `standing_pose` | double array | `[-0.4, 0, 0.8, -0.4, 0, -0.4, 0, 0.8, -0.4, 0]` | 10 elements |"
+            ),
+            "{table}"
+        );
+        // Every key's default was found in the built-in setup, with a known type.
+        for d in key_docs() {
+            let row = table
+                .lines()
+                .find(|l| l.starts_with(&format!("| `{}` |", d.key)))
+                .unwrap();
+            assert!(
+                !row.contains("| ? |") && !row.contains("| `` |") && !row.contains('?'),
+                "{row}"
+            );
+        }
     }
 
     #[test]

@@ -110,8 +110,9 @@ pub struct Cli {
     /// repeat it.
     #[arg(long, value_name = "FILE")]
     pub params: Option<PathBuf>,
-    /// Stop when the mean fitness rose by less than 0.1 % over this many generations; 0 turns
-    /// the rule off (default 20, params/nao_step.yaml). A resume must repeat it.
+    /// Stop when the mean fitness rose by less than the parameter file's level_tolerance over
+    /// this many generations; 0 turns the rule off (without it: the file's level_window). A
+    /// resume must repeat it.
     #[arg(long, value_name = "N")]
     pub level_window: Option<usize>,
     /// Print the options and the parameter file's keys as Markdown tables (as docs/ has them)

@@ -164,7 +164,7 @@ impl SolverSetting {
 /// individuals of a physics-2 run upright at the default and 53 other motions: each of them
 /// turned all 100 into falls, as the reference does, and each called the same single motion a
 /// fall that the reference calls upright; 4 ms/4/2 costs the least of the solver settings: 5/4
-/// of the default's steps, 1.34 times its time in the benchmark.
+/// of the default's steps (its time beside the default's: docs/performance.md).
 pub const CHECK_SETTING: SolverSetting = SolverSetting {
     dt: 0.004,
     solver_iterations: 4,

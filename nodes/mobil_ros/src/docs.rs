@@ -93,7 +93,7 @@ pub fn params_markdown(specs: &[ParamSpec]) -> String {
             vec![
                 code(&p.name),
                 type_name(&p.default).to_owned(),
-                value_markdown(&p.default),
+                cell(&value_markdown(&p.default)),
                 cell(&allowed),
                 cell(&p.description),
             ]
@@ -119,6 +119,7 @@ mod tests {
             ParamSpec::boolean("free", false, "unseen sectors\nare free"),
             ParamSpec::doubles("pose", &[0.0, 0.5, -1.25], "x, y, yaw").length(3),
             ParamSpec::string("frame", "", "frame").read_only(),
+            ParamSpec::string("sep", "a|b", "a separator"),
         ];
         let table = params_markdown(&specs);
         let lines: Vec<&str> = table.lines().collect();
@@ -134,6 +135,7 @@ mod tests {
             "| `pose` | double array | `[0, 0.5, -1.25]` | 3 elements | x, y, yaw |"
         );
         assert_eq!(lines[6], "| `frame` | string | `\"\"` | read-only | frame |");
+        assert_eq!(lines[7], "| `sep` | string | `\"a\\|b\"` |  | a separator |");
     }
 
     #[test]

@@ -332,7 +332,8 @@ pub struct DockingConfig {
     /// drifts while turning). Default 2.
     pub rotate_exit_factor: f64,
     /// A docking not done after this long (s) fails. Default 120: from the paper's start the law
-    /// docks in 14.55 s unlimited, 15.60 s within Nav2's limits (docs/experiments/docking.md).
+    /// and the final rotation dock in 14.55 s unlimited, 15.60 s within Nav2's limits
+    /// (docs/experiments/docking.md).
     pub time_limit_s: f64,
     /// A docking whose progress measure (V while approaching, the heading error while rotating)
     /// has not fallen by `stall_fraction` for this long (s) fails as not converging. Default 5:

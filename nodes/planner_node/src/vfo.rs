@@ -239,7 +239,7 @@ pub fn declare_vfo(d: &mut Decl<PlannerConfig>) {
     d.double(
         "vfo.time_step",
         o.time_step,
-        "T_p, the virtual robots' step: the node's control period, one odom period [s]",
+        "T_p, the virtual robots' integration step; set it to the odometry period the node steps on [s]",
         |c, x| c.vfo.optimise.time_step = x,
     )
     .above(0.0)

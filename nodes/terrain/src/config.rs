@@ -21,8 +21,9 @@ const DEG: f64 = std::f64::consts::PI / 180.0;
 pub struct TerrainConfig {
     /// σ_flat (m), > 0 and ≤ `sigma_wave`: the largest σ of the feet that still counts as flat.
     /// FLAT needs all three angles within ε_α, the planes' offset within `plane_offset_max` *and*
-    /// σ ≤ σ_flat. Default 0.010. Depends on the footholds: it must exceed their largest spread ×
-    /// tan ε_α ([`TerrainConfig::warnings`]; see docs/experiments/terrain-table1.md#the-thresholds).
+    /// σ ≤ σ_flat. Default 0.010. Depends on the footholds: below their largest spread × tan ε_α it
+    /// refuses coplanar stances within ε_α, which [`TerrainConfig::warnings`] reports (see
+    /// docs/experiments/terrain-table1.md#the-thresholds).
     pub sigma_flat: f64,
     /// Largest offset (m), > 0, between the two foot planes, parallel within ε_α, that still
     /// counts as one plane ([`plane_offset`](crate::assess::plane_offset)); above it the stance is

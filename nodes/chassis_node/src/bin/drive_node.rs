@@ -83,7 +83,8 @@ impl Config for DriveConfig {
             "how long a finished goal's result waits for the client to ask for it [s]",
             |c, v| c.result_timeout_s = v,
         )
-        .above(0.0);
+        .above(0.0)
+        .read_only();
     }
 
     fn validate(&self) -> Result<(), ConfigError> {

@@ -52,8 +52,8 @@ pub struct OptimiseConfig {
     /// K_D, K_B, K_E, K_S. Default the paper's {1, 2, 1, 1}.
     pub weights: QualityWeights,
     /// T_p (s): the virtual robots' integration step and the indices' sampling period (SPEC
-    /// §5 Decision: T_p = the integration step). Default 0.01 s: 3 mm of path at 0.3 m/s;
-    /// `planner_node` sets it to its control period, one odometry period.
+    /// §5 Decision: T_p = the integration step). Default 0.01 s: 3 mm of path at 0.3 m/s. A node
+    /// stepping once per odometry message sets it to that period (`vfo.time_step`).
     pub time_step: f64,
     /// Most virtual robots per optimisation. Default 4096: 2^12 leaves, far beyond the |D| of
     /// any layout the paper shows, and about a second of work at 30 obstacles.
