@@ -12,7 +12,7 @@
 use mobil_ga_step::{
     write_fitness_csv, write_joint_trajectory_yaml, write_motion, EvaluatorTag, GaState, GenerationStats,
 };
-use mobil_tools_node::plot::{SeriesPanel, Stroke, Svg};
+use mobil_tools::plot::{SeriesPanel, Stroke, Svg};
 use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicU64, Ordering};

@@ -17,7 +17,7 @@ use mobil_planner::{
     check_route, simulate_docking, DockingConfig, DockingController, DockingGains, DockingPhase, Finish, Kinematics,
     RouteCheckConfig, VelocityLimits,
 };
-use mobil_sim::world::World;
+use mobil_world::World;
 
 fn bench(c: &mut Criterion) {
     // One control step: polar error, law, common factor, V, V̇, phase logic.

@@ -17,7 +17,7 @@
 //!   path quality, Algorithm 2 (virtual robots choose each obstacle's side), the online
 //!   [`vfo::VfoFollower`] and obstacles from a laser scan.
 //! - [`route`]: the route pre-check — a virtual robot drives the route on the chassis model
-//!   against a [`mobil_sim::world::World`] and reports every collision, turn below the minimum
+//!   against a [`mobil_world::World`] and reports every collision, turn below the minimum
 //!   radius and unreachable waypoint with its index.
 //!
 //! Where the SPEC leaves a choice open, the library chooses as follows (each tested in
@@ -55,8 +55,8 @@
 //!   to the smallest |δ|, then to the left.
 //! - **Route pre-check**: the virtual robot is the planner's own goal approach on the chassis
 //!   model (δ within δ_eff, steps of path length) at the model's origin, with the collision
-//!   geometry (a disc at the reference point) of `mobil_sim`'s [`World`](mobil_sim::world::World). `mobil_sim`'s wheel-level plant is not
-//!   used: it stops at the first contact (so later problems would stay hidden) and the robot
+//!   geometry (a disc at the reference point) of the simulator's [`World`](mobil_world::World)
+//!   (`mobil_world`). `mobil_sim`'s wheel-level plant is not used: it stops at the first contact (so later problems would stay hidden) and the robot
 //!   will run this same approach law. Collisions are checked at every step (0.02 m). A
 //!   waypoint whose single arc from the leg's start pose is below the minimum radius is a turn
 //!   radius problem, reached or not; any other missed one is unreachable (blocked, passed by,
@@ -69,7 +69,7 @@
 //!     check_route, simulate_docking, DockingConfig, DockingController, DockingGains, DockingPhase, Finish,
 //!     Kinematics, RouteCheckConfig, VelocityLimits,
 //! };
-//! use mobil_sim::world::World;
+//! use mobil_world::World;
 //! use nalgebra::Point2;
 //!
 //! // Dock OMR-III from the paper's start onto the origin, facing +x.

@@ -1,7 +1,7 @@
 //! Route pre-check by a virtual robot (SPEC §4, MOBIL-II HIGH-LEVEL): before a route is sent to
 //! the robot, a virtual robot drives it in simulation — the goal approach of
 //! [`mod@crate::approach`] on the chosen chassis model, waypoint after waypoint — against a known
-//! map (a [`mobil_sim::world::World`], the sim's world format and geometry) and every problem is
+//! map (a [`mobil_world::World`], the sim's world format and geometry) and every problem is
 //! reported with the index of its waypoint:
 //!
 //! Poses are those of the chassis' reference point, `reference_offset` ahead of the kinematic
@@ -31,7 +31,7 @@ use std::f64::consts::TAU;
 
 use mobil_chassis::ChassisParams;
 use mobil_geom::Pose2;
-use mobil_sim::world::World;
+use mobil_world::World;
 use nalgebra::Point2;
 
 use crate::approach::{approach_with, check_point, distance, ApproachConfig, ApproachEnd, Motion};

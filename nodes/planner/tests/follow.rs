@@ -9,7 +9,7 @@ use mobil_planner::{
     approach, check_route, ApproachConfig, ApproachEnd, FollowConfig, FollowEnd, FollowEvent, Motion, PlannerError,
     RouteCheckConfig, Steering, UnreachableCause, WaypointFollower,
 };
-use mobil_sim::world::World;
+use mobil_world::World;
 use nalgebra::Point2;
 
 fn mobil2_motion() -> Motion {

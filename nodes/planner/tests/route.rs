@@ -12,7 +12,7 @@ use mobil_planner::{
     arc_radius, check_route, check_route_until, ApproachConfig, PlannerError, ProblemKind, RouteCheckConfig,
     RouteReport, UnreachableCause,
 };
-use mobil_sim::world::{Obstacle, World};
+use mobil_world::{Obstacle, World};
 use nalgebra::Point2;
 use proptest::prelude::*;
 

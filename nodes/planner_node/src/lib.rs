@@ -28,7 +28,7 @@ use mobil_planner::{
 };
 use mobil_ros::config::{Config, ConfigError, Decl};
 use mobil_ros::geometry::{yaw_of, yaw_quaternion};
-use mobil_sim::world::World;
+use mobil_world::World;
 use nalgebra::Point2;
 use std::time::Duration;
 use thiserror::Error;
@@ -341,7 +341,7 @@ impl PlannerConfig {
 }
 
 /// The pre-check's world: `""` the sim's built-in world, `none` no obstacles, else the file.
-pub fn load_world(world_file: &str) -> Result<World, mobil_sim::world::WorldError> {
+pub fn load_world(world_file: &str) -> Result<World, mobil_world::WorldError> {
     match world_file {
         "" => Ok(World::builtin()),
         "none" => Ok(World::default()),

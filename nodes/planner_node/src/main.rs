@@ -62,7 +62,7 @@ use mobil_ros::ticker::Ticker;
 use mobil_ros::time::{secs_from_stamp, DtClock, DtError};
 use mobil_ros::OffLoop;
 use mobil_ros::{qos, run_node, shutdown_signal, warn_throttled, ConfigError, LogThrottle, NodeDecl, RosNode};
-use mobil_sim::world::World;
+use mobil_world::World;
 use nalgebra::Point2;
 use ros2_client::{Publisher, RmwRequestId, Server, Subscription};
 use std::process::ExitCode;

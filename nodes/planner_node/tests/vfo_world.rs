@@ -3,7 +3,7 @@
 //! the node's control period (one step per 50 Hz odometry message, a scan every other step as
 //! at 40 Hz), the unicycle moved by the exact arc — at once, or through a first-order lag as
 //! the real drives answer. The same route as tests/test_planner_vfo.py; the clearance is the
-//! world geometry's (mobil_sim's signed distance), not the follower's.
+//! world geometry's (mobil_world's signed distance), not the follower's.
 
 use mobil_chassis::ChassisParams;
 use mobil_geom::Pose2;
@@ -14,7 +14,7 @@ use mobil_planner::vfo::{
 use mobil_planner_node::route_from_poses;
 use mobil_planner_node::vfo::{vfo_gains, vfo_waypoints, VfoSettings};
 use mobil_sim::lidar::{Lidar, LidarConfig};
-use mobil_sim::world::World;
+use mobil_world::World;
 use nalgebra::Point2;
 
 const ROUTE: [(f64, f64); 4] = [(2.0, 2.6), (3.6, 0.3), (1.0, -0.3), (0.0, 2.2)];
@@ -184,7 +184,7 @@ fn a_waypoint_passed_early_in_the_box_s_zone_with_lagging_drives_still_ends_at_t
 #[test]
 fn an_obstacle_appearing_mid_segment_re_optimises_the_segment_round_it() {
     use mobil_planner::vfo::{Reoptimised, Sigma};
-    use mobil_sim::world::Obstacle as Shape;
+    use mobil_world::Obstacle as Shape;
     let mut world = World::builtin();
     let settings = VfoSettings::default();
     let start = Pose2::identity();

@@ -4,7 +4,7 @@
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use mobil_sim::lidar::{Lidar, LidarConfig};
-use mobil_sim::world::World;
+use mobil_world::World;
 use nalgebra::Point2;
 use std::hint::black_box;
 

@@ -5,7 +5,7 @@
 use criterion::{criterion_group, criterion_main, Criterion};
 use mobil_chassis::{inverse, BodyTwist, ChassisParams};
 use mobil_sim::plant::{Plant, PlantConfig};
-use mobil_sim::world::World;
+use mobil_world::World;
 use std::hint::black_box;
 
 fn bench(c: &mut Criterion) {

@@ -13,7 +13,7 @@ use rand_chacha::ChaCha8Rng;
 use rand_distr::{Distribution, Normal};
 use thiserror::Error;
 
-use crate::world::World;
+use mobil_world::World;
 
 /// Settings of the simulated LIDAR.
 #[derive(Debug, Clone, Copy, PartialEq)]

@@ -34,7 +34,7 @@ use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use rand_distr::{Distribution, Normal};
 
-use crate::world::World;
+use mobil_world::World;
 
 /// Longest integration sub-step (s): at the fastest wheel speed of the presets (about 1.2 m/s)
 /// the robot moves 6 mm between collision checks, far less than any footprint.
@@ -575,10 +575,10 @@ impl Plant {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::world::Obstacle;
     use approx::assert_relative_eq;
     use mobil_chassis::kinematics::inverse;
     use mobil_chassis::model::ChassisConfig;
+    use mobil_world::Obstacle;
     use std::f64::consts::{FRAC_PI_2, PI};
 
     fn plant_with(params: ChassisParams, tau: f64, slip: f64, radius: f64) -> Plant {

@@ -16,7 +16,7 @@ use mobil_chassis::{
     forward, inverse, BodyTwist, ChassisConfig, ChassisModel, ChassisParams, Odometry, OdometryNoise, WheelState,
 };
 use mobil_sim::plant::{Plant, PlantConfig};
-use mobil_sim::world::World;
+use mobil_world::World;
 
 /// A forward model: the twist at the kinematic origin from measured wheels.
 type ForwardModel = fn(&ChassisParams, &WheelState) -> BodyTwist;

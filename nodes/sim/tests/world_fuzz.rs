@@ -7,7 +7,7 @@
 //! the wrong shape) and compares it with the loader's answer.
 
 use mobil_sim::lidar::{Lidar, LidarConfig};
-use mobil_sim::world::{Obstacle, World, WorldError};
+use mobil_world::{Obstacle, World, WorldError};
 use nalgebra::Point2;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;

@@ -26,7 +26,7 @@ use mobil_ros::time::{stamp_from_nanos, stamp_from_secs};
 use mobil_ros::{qos, run_node, shutdown_signal, warn_throttled, LogThrottle, NodeDecl, RosNode, Ticker};
 use mobil_sim::lidar::{Lidar, LidarConfig};
 use mobil_sim::plant::{CommandOutcome, Plant, PlantConfig};
-use mobil_sim::world::{Obstacle, World};
+use mobil_world::{Obstacle, World};
 use nalgebra::Vector3 as V3;
 use std::process::ExitCode;
 use std::time::{Duration, Instant};

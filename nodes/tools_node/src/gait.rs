@@ -5,9 +5,9 @@
 //! foot from where it was lifted to where it was set). Everything here works on the recorded
 //! plan; the binary only fills a [`GaitWalk`].
 
-use mobil_sim::world::World;
+use mobil_world::World;
 
-use crate::plot::{MapView, Stroke, Svg};
+use mobil_tools::plot::{MapView, Stroke, Svg};
 
 /// The demo's request: rule set B, evaluation (3), from the origin at φ = 3π/2 to (−10, 10)
 /// (SPEC §7, the paper's experiment B,(3), judged the best walking style).

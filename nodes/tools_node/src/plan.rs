@@ -5,9 +5,9 @@
 use std::f64::consts::{FRAC_PI_2, PI};
 
 use mobil_geom::wrap;
-use mobil_sim::world::World;
+use mobil_world::World;
 
-use crate::plot::{MapView, SeriesPanel, Stroke, Svg};
+use mobil_tools::plot::{MapView, SeriesPanel, Stroke, Svg};
 
 /// The demo's route (odom frame, metres): from where the second act ends, near its goal
 /// (3, 4), west above the pillar at (1, 1.5), down the room's west side and back east. Legs of
@@ -345,7 +345,7 @@ pub fn dock_needs_a_turn(dock: (f64, f64, f64), heading: f64) -> bool {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use mobil_sim::world::Obstacle;
+    use mobil_world::Obstacle;
 
     /// A recorded run, small enough to work out by hand.
     fn recorded(route: Outcome, dock: Outcome) -> PlanRun {

@@ -4,8 +4,8 @@
 //! the planner saw with r and R, every virtual robot's path of that optimisation (grey; orange
 //! where dropped), the chosen one (green), the executed path (blue) and the waypoints.
 
-use crate::plot::{MapView, Stroke, Svg};
-use mobil_sim::world::World;
+use mobil_tools::plot::{MapView, Stroke, Svg};
+use mobil_world::World;
 
 /// The demo's route: past the pillar at (1, 1.5) (the first leg runs through it), beside the
 /// box, back west and north past the pillar again (tests/test_planner_vfo.py drives it too).

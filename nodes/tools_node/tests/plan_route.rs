@@ -10,8 +10,8 @@ use mobil_planner::{
     check_route, simulate_docking, DockingConfig, DockingController, DockingGains, DockingPhase, Finish, Kinematics,
     RouteCheckConfig, VelocityLimits,
 };
-use mobil_sim::world::World;
 use mobil_tools_node::plan::{dock_needs_a_turn, route_end_heading, DEMO_DOCK, DEMO_ROUTE};
+use mobil_world::World;
 use nalgebra::Point2;
 
 /// The chassis, their `robot_radius` from the params files, and the heading the second act

@@ -12,8 +12,8 @@ use mobil_msgs::mobil_msgs::srv::{PlanGait, PlanGaitRequest, PlanGaitResponse};
 use mobil_msgs::RosService;
 use mobil_ros::params::ParamValues;
 use mobil_ros::{qos, run_node, shutdown_signal, NodeDecl, ParamSpec, RosNode};
+use mobil_tools::plot::write_file;
 use mobil_tools_node::gait::{figure, summary, GaitWalk, WalkState, DEMO_GOAL, DEMO_START};
-use mobil_tools_node::plot::write_file;
 use ros2_client::{Name, ServiceMapping};
 use tracing::info;
 

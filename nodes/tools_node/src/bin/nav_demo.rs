@@ -11,8 +11,8 @@ use mobil_msgs::nav_msgs::msg::Odometry;
 use mobil_ros::params::ParamValues;
 use mobil_ros::time::stamp_from_nanos;
 use mobil_ros::{qos, run_node, shutdown_signal, NodeDecl, ParamSpec, RosNode};
-use mobil_sim::world::World;
-use mobil_tools_node::plot::{write_file, MapView, Stroke, Svg};
+use mobil_tools::plot::{write_file, MapView, Stroke, Svg};
+use mobil_world::World;
 use std::process::ExitCode;
 use std::time::{Duration, Instant};
 use tracing::info;
@@ -211,7 +211,7 @@ async fn run(node: &mut RosNode) -> anyhow::Result<()> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use mobil_sim::world::Obstacle;
+    use mobil_world::Obstacle;
 
     #[test]
     fn mode_letters_from_status_text() {

@@ -20,11 +20,11 @@ use mobil_ros::geometry::{yaw_of, yaw_quaternion};
 use mobil_ros::params::ParamValues;
 use mobil_ros::time::{nanos_from_stamp, stamp_from_nanos};
 use mobil_ros::{qos, run_node, shutdown_signal, NodeDecl, ParamSpec, RosNode};
-use mobil_sim::world::World;
+use mobil_tools::plot::write_file;
 use mobil_tools_node::plan::{
     closest_approach, figure, route_track, DockSample, Outcome, PlanRun, Problem, Summary, DEMO_DOCK, DEMO_ROUTE,
 };
-use mobil_tools_node::plot::write_file;
+use mobil_world::World;
 use ros2_client::{Name, ServiceMapping};
 use tracing::info;
 

@@ -17,9 +17,9 @@ use mobil_ros::geometry::yaw_quaternion;
 use mobil_ros::params::ParamValues;
 use mobil_ros::time::{nanos_from_stamp, stamp_from_nanos};
 use mobil_ros::{qos, run_node, shutdown_signal, NodeDecl, ParamSpec, RosNode};
-use mobil_sim::world::World;
-use mobil_tools_node::plot::write_file;
+use mobil_tools::plot::write_file;
 use mobil_tools_node::vfo::{figure, Optimisation, SeenObstacle, VfoRun, DEMO_ROUTE};
+use mobil_world::World;
 use tracing::info;
 
 fn decl() -> NodeDecl {

@@ -5,7 +5,7 @@
 
 use std::fmt::Write as _;
 
-use mobil_sim::world::{Obstacle, World};
+use mobil_world::{Obstacle, World};
 
 /// Fill of the world's obstacles.
 pub const OBSTACLE_FILL: &str = "#969696";
