@@ -76,6 +76,7 @@ pub mod model;
 pub mod planner;
 pub mod rules;
 pub mod search;
+pub mod walker;
 
 pub use config::{Evaluation, GaitConfig, RuleSet, Weights};
 pub use error::GaitError;
@@ -83,3 +84,4 @@ pub use horizon::{Chunk, RecedingHorizon, Walk};
 pub use model::{is_stable, is_supported, BodyPose, GaitState, LegAngleReading, QuadrupedModel, Workspace};
 pub use planner::{plan, GaitProblem, Plan, PlanFailure, PlanStep};
 pub use rules::{dev, vzd, Rule};
+pub use walker::{WalkNext, Walker};

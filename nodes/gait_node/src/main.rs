@@ -15,10 +15,10 @@
 //! The rules for bad input are in the crate docs.
 
 use futures::StreamExt;
-use mobil_gait::{Chunk, Evaluation, RuleSet};
+use mobil_gait::{Chunk, Evaluation, RuleSet, WalkNext, Walker};
 use mobil_gait_node::{
     body_pose, chunk_reason, goal_from_pose, ground_from_assessment, header, markers, plan_reason, query_from_request,
-    refused_plan, reply_plan, run_query, GaitNodeConfig, Ground, StopCause, WalkNext, Walker, PREEMPTED,
+    refused_plan, reply_plan, run_query, GaitNodeConfig, Ground, StopCause, PREEMPTED,
 };
 use mobil_msgs::geometry_msgs::msg::PoseStamped;
 use mobil_msgs::mobil_msgs::msg::{GaitPlan, TerrainAssessment};
