@@ -25,7 +25,7 @@ use mobil_msgs::tf2_msgs::msg::TFMessage;
 use mobil_ros::geometry::{planar_odometry, yaw_quaternion};
 use mobil_ros::time::{stamp_from_nanos, stamp_from_secs};
 use mobil_ros::{qos, run_node, shutdown_signal, warn_throttled, LogThrottle, NodeDecl, RosNode, Ticker};
-use mobil_terrain_node::{touchdown_message, HexapodSimConfig};
+use mobil_terrain_node::hexapod_sim::{touchdown_message, HexapodSimConfig};
 use std::process::ExitCode;
 use std::time::Instant;
 use tokio::time::MissedTickBehavior;
