@@ -9,21 +9,20 @@
 #![warn(missing_docs)]
 
 use mobil_chassis::model::ChassisConfig;
-use mobil_chassis_node::{chassis_params, declare_chassis};
 use mobil_geom::Pose2;
 use mobil_local_nav::{
     Drive, Mode, MotionLimits, NavConfig, NoPathReason, ProgressChecker, ProgressSettings, Sectors, Side,
     UnseenSectors, VelocityCommand, WeightProfile,
 };
-use mobil_msgs::builtin_interfaces::msg::{Duration as RosDuration, Time};
+use mobil_msgs::builtin_interfaces::msg::Time;
 use mobil_msgs::geometry_msgs::msg::{Point, Pose, PoseStamped, Twist, Vector3};
 use mobil_msgs::mobil_msgs::msg::NavStatus;
-use mobil_msgs::nav_msgs::msg::Odometry;
 use mobil_msgs::std_msgs::msg::{ColorRGBA, Header};
 use mobil_msgs::visualization_msgs::msg::{Marker, MarkerArray};
+use mobil_ros::chassis::{chassis_params, declare_chassis};
 use mobil_ros::config::{Config, ConfigError, Decl};
 use mobil_ros::geometry::{yaw_of, yaw_quaternion};
-use mobil_ros::scan::StaticFrames;
+use mobil_ros::time::seconds;
 use nalgebra::{Point2, Vector2};
 use std::time::Duration;
 use thiserror::Error;
@@ -353,13 +352,6 @@ pub const MAX_INPUT_TIMEOUT_S: f64 = 60.0;
 /// The largest `result_timeout_s` (s): an hour.
 pub const MAX_RESULT_TIMEOUT_S: f64 = 3600.0;
 
-/// `s` seconds as a duration, held to [0, `max_s`] (NaN gives `max_s`): never a panic, whatever
-/// the number.
-pub fn seconds(s: f64, max_s: f64) -> Duration {
-    let s = if s.is_nan() { max_s } else { s.clamp(0.0, max_s) };
-    Duration::try_from_secs_f64(s).unwrap_or(Duration::ZERO)
-}
-
 /// Why a goal pose is refused.
 #[derive(Debug, Clone, PartialEq, Error)]
 pub enum GoalError {
@@ -429,21 +421,6 @@ pub fn twist_from_command(command: VelocityCommand, limits: &MotionLimits) -> Tw
     t.linear.y = c.vy;
     t.angular.z = c.omega;
     t
-}
-
-/// A duration message of `seconds` (navigation time, time remaining): negative (the clock went
-/// backwards), NaN or infinite give zero, and it saturates at 10⁹ s.
-pub fn duration_msg(seconds: f64) -> RosDuration {
-    let s = if seconds.is_finite() {
-        seconds.clamp(0.0, 1e9)
-    } else {
-        0.0
-    };
-    let sec = s.floor();
-    RosDuration {
-        sec: sec as i32,
-        nanosec: ((s - sec) * 1e9).min(999_999_999.0) as u32,
-    }
 }
 
 /// Which input went stale.
@@ -602,134 +579,6 @@ impl StepErrors {
     pub fn failed(&mut self) -> Option<u32> {
         self.count = self.count.saturating_add(1);
         (self.count >= MAX_STEP_ERRORS).then_some(self.count)
-    }
-}
-
-/// Whether the robot is (as far as this node commanded it) moving: a refused input stops it
-/// with one zero command, not one per refusal.
-#[derive(Debug, Clone, Default, PartialEq, Eq)]
-pub struct CommandGate {
-    moving: bool,
-}
-
-impl CommandGate {
-    /// A command went out (zero or not).
-    pub fn sent(&mut self, twist: &Twist) {
-        let t = twist;
-        self.moving = [
-            t.linear.x,
-            t.linear.y,
-            t.linear.z,
-            t.angular.x,
-            t.angular.y,
-            t.angular.z,
-        ]
-        .iter()
-        .any(|v| *v != 0.0);
-    }
-
-    /// An input was refused while a goal runs: `true` when a zero command must go out now (the
-    /// last command moved the robot); the gate then counts the robot as stopped.
-    pub fn refused(&mut self) -> bool {
-        std::mem::take(&mut self.moving)
-    }
-}
-
-/// Why a scan gives no navigator step.
-#[derive(Debug, Clone, PartialEq, Error)]
-pub enum ScanRefusal {
-    /// The scan's frame has no pose in the base frame: not in `tf_static`, and no `laser_pose`
-    /// parameter was given.
-    #[error("no laser pose: frame `{frame}` not in tf_static (from `{base}`) and no laser_pose parameter set")]
-    NoLaserPose {
-        /// The scan's frame.
-        frame: String,
-        /// The base frame.
-        base: String,
-    },
-    /// The scan itself is malformed.
-    #[error("scan refused: {0}")]
-    Invalid(String),
-}
-
-/// Where the laser pose of a scan came from.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum LaserPoseFrom {
-    /// `tf_static`, for the scan's own frame.
-    TfStatic,
-    /// The `laser_pose` parameter (the scan's frame is not in `tf_static`).
-    Parameter,
-}
-
-/// The pose in `base_frame` of the laser of a scan in `scan_frame` (empty: `laser_frame`): the
-/// `tf_static` chain to the scan's own frame, else the `laser_pose` parameter if one was given,
-/// else refused, naming the frame.
-pub fn scan_laser_pose(
-    frames: &StaticFrames,
-    base_frame: &str,
-    scan_frame: &str,
-    laser_frame: &str,
-    parameter: Option<Pose2>,
-) -> Result<(Pose2, LaserPoseFrom), ScanRefusal> {
-    let frame = match scan_frame.trim_start_matches('/') {
-        "" => laser_frame.trim_start_matches('/'),
-        f => f,
-    };
-    if let Some(p) = frames.lookup(base_frame, frame) {
-        return Ok((p, LaserPoseFrom::TfStatic));
-    }
-    parameter
-        .map(|p| (p, LaserPoseFrom::Parameter))
-        .ok_or_else(|| ScanRefusal::NoLaserPose {
-            frame: frame.to_owned(),
-            base: base_frame.to_owned(),
-        })
-}
-
-/// Why an odometry message is refused.
-#[derive(Debug, Clone, PartialEq, Eq, Error)]
-pub enum OdomError {
-    /// `header.frame_id` or `child_frame_id` is not the configured frame (a leading `/` and an
-    /// empty frame are accepted, as many drivers leave it empty).
-    #[error("odom in frames `{frame}` → `{child}`, expected `{want_frame}` → `{want_child}`")]
-    Frames {
-        /// The message's `header.frame_id`.
-        frame: String,
-        /// The message's `child_frame_id`.
-        child: String,
-        /// `odom_frame`.
-        want_frame: String,
-        /// `base_frame`.
-        want_child: String,
-    },
-    /// NaN or infinity in the pose.
-    #[error("odom with a non-finite pose")]
-    NotFinite,
-}
-
-/// The robot pose of an odometry message, or why it is refused: frames other than
-/// `odom_frame` → `base_frame` (an empty frame passes), or a non-finite pose.
-pub fn odom_pose(m: &Odometry, odom_frame: &str, base_frame: &str) -> Result<Pose2, OdomError> {
-    let same = |got: &str, want: &str| {
-        let got = got.trim_start_matches('/');
-        got.is_empty() || got == want.trim_start_matches('/')
-    };
-    if !same(&m.header.frame_id, odom_frame) || !same(&m.child_frame_id, base_frame) {
-        return Err(OdomError::Frames {
-            frame: m.header.frame_id.clone(),
-            child: m.child_frame_id.clone(),
-            want_frame: odom_frame.to_owned(),
-            want_child: base_frame.to_owned(),
-        });
-    }
-    let p = &m.pose.pose;
-    let q = &p.orientation;
-    let pose = Pose2::new(p.position.x, p.position.y, yaw_of(q));
-    // The yaw of a quaternion with an infinity in it can come out finite: each part is checked.
-    if pose.is_finite() && [q.x, q.y, q.z, q.w].iter().all(|v| v.is_finite()) {
-        Ok(pose)
-    } else {
-        Err(OdomError::NotFinite)
     }
 }
 
@@ -1070,17 +919,6 @@ mod tests {
     }
 
     #[test]
-    fn durations_never_go_negative() {
-        let d = duration_msg(12.25);
-        assert_eq!((d.sec, d.nanosec), (12, 250_000_000));
-        for bad in [-3.0, f64::NAN, f64::INFINITY] {
-            let d = duration_msg(bad);
-            assert_eq!((d.sec, d.nanosec), (0, 0), "{bad}");
-        }
-        assert_eq!(duration_msg(5e9).sec, 1_000_000_000);
-    }
-
-    #[test]
     fn outcomes_give_status_reasons_and_nav2_codes() {
         let stale = GoalOutcome::Stale(StaleInput::Scan);
         assert_eq!(stale.reason(), "STALE_INPUT: scan stale: robot stopped");
@@ -1233,12 +1071,6 @@ mod tests {
         assert_eq!(c.result_timeout(), Duration::from_secs(3600));
         // The result timeout is read once, at start-up.
         assert!(specs.iter().any(|s| s.name == "result_timeout_s" && s.read_only));
-        // Whatever reaches the conversion, it is held: no panic.
-        assert_eq!(seconds(1e300, 60.0), Duration::from_secs(60));
-        assert_eq!(seconds(f64::INFINITY, 60.0), Duration::from_secs(60));
-        assert_eq!(seconds(f64::NAN, 60.0), Duration::from_secs(60));
-        assert_eq!(seconds(-1.0, 60.0), Duration::ZERO);
-        assert_eq!(seconds(0.25, 60.0), Duration::from_millis(250));
     }
 
     #[test]
@@ -1257,54 +1089,6 @@ mod tests {
     }
 
     #[test]
-    fn a_refusal_stops_a_moving_robot_once() {
-        let mut g = CommandGate::default();
-        // Nothing commanded yet: no zero needed.
-        assert!(!g.refused());
-        let mut moving = Twist::default();
-        moving.angular.z = 0.3;
-        g.sent(&moving);
-        assert!(g.refused());
-        // The zero went out: a second refusal in a row sends none.
-        assert!(!g.refused());
-        g.sent(&moving);
-        g.sent(&Twist::default());
-        assert!(!g.refused());
-    }
-
-    fn tf(parent: &str, child: &str, x: f64) -> mobil_msgs::geometry_msgs::msg::TransformStamped {
-        let mut t = mobil_msgs::geometry_msgs::msg::TransformStamped::default();
-        t.header.frame_id = parent.into();
-        t.child_frame_id = child.into();
-        t.transform.translation.x = x;
-        t.transform.rotation = yaw_quaternion(0.0);
-        t
-    }
-
-    #[test]
-    fn the_scan_s_own_frame_gives_the_laser_pose() {
-        let mut frames = StaticFrames::default();
-        frames.add(&mobil_msgs::tf2_msgs::msg::TFMessage {
-            transforms: vec![tf("base_link", "laser", 0.3), tf("base_link", "rear_laser", -0.4)],
-        });
-        let param = Some(Pose2::new(0.1, 0.0, 0.0));
-        // The scan says rear_laser: its transform (−0.4 m), not laser_frame's (0.3 m).
-        let (p, from) = scan_laser_pose(&frames, "base_link", "rear_laser", "laser", None).unwrap();
-        assert_eq!((p.x, from), (-0.4, LaserPoseFrom::TfStatic));
-        // tf_static wins over the parameter; an empty frame means laser_frame.
-        let (p, from) = scan_laser_pose(&frames, "base_link", "", "laser", param).unwrap();
-        assert_eq!((p.x, from), (0.3, LaserPoseFrom::TfStatic));
-        // An unknown frame: the parameter if one was set, else refused, naming the frame.
-        let (p, from) = scan_laser_pose(&frames, "base_link", "/other", "laser", param).unwrap();
-        assert_eq!((p.x, from), (0.1, LaserPoseFrom::Parameter));
-        let e = scan_laser_pose(&frames, "base_link", "other", "laser", None).unwrap_err();
-        assert_eq!(
-            e.to_string(),
-            "no laser pose: frame `other` not in tf_static (from `base_link`) and no laser_pose parameter set"
-        );
-    }
-
-    #[test]
     fn laser_pose_is_unset_by_default_and_takes_three_values() {
         let mut values = ParamValues::defaults(&Decl::<LocalNavConfig>::of().specs());
         let c: LocalNavConfig = mobil_ros::config::load(&values).unwrap();
@@ -1317,42 +1101,6 @@ mod tests {
         assert_eq!(c.laser_pose(), Some(Pose2::new(0.2, -0.1, 0.5)));
         values.set("laser_pose", ros2_client::ParameterValue::DoubleArray(vec![0.2, -0.1]));
         assert!(mobil_ros::config::load::<LocalNavConfig>(&values).is_err());
-    }
-
-    fn odom(frame: &str, child: &str, x: f64) -> Odometry {
-        let mut m = Odometry::default();
-        m.header.frame_id = frame.into();
-        m.child_frame_id = child.into();
-        m.pose.pose.position.x = x;
-        m.pose.pose.orientation.w = 1.0;
-        m
-    }
-
-    #[test]
-    fn odometry_in_other_frames_or_with_nan_is_refused() {
-        assert_eq!(
-            odom_pose(&odom("odom", "base_link", 1.5), "odom", "base_link"),
-            Ok(Pose2::new(1.5, 0.0, 0.0))
-        );
-        // Empty frames (many drivers) and a leading slash pass.
-        assert!(odom_pose(&odom("", "", 1.0), "odom", "base_link").is_ok());
-        assert!(odom_pose(&odom("/odom", "base_link", 1.0), "odom", "base_link").is_ok());
-        let e = odom_pose(&odom("map", "base_link", 1.0), "odom", "base_link").unwrap_err();
-        assert_eq!(
-            e.to_string(),
-            "odom in frames `map` → `base_link`, expected `odom` → `base_link`"
-        );
-        assert!(matches!(
-            odom_pose(&odom("odom", "laser", 1.0), "odom", "base_link"),
-            Err(OdomError::Frames { .. })
-        ));
-        assert_eq!(
-            odom_pose(&odom("odom", "base_link", f64::NAN), "odom", "base_link"),
-            Err(OdomError::NotFinite)
-        );
-        let mut q_inf = odom("odom", "base_link", 0.0);
-        q_inf.pose.pose.orientation.z = f64::INFINITY;
-        assert_eq!(odom_pose(&q_inf, "odom", "base_link"), Err(OdomError::NotFinite));
     }
 
     #[test]

@@ -21,9 +21,8 @@ use futures::StreamExt;
 use mobil_geom::Pose2;
 use mobil_local_nav::{Mode, MotionLimits, Navigator, Progress, ProgressChecker, StepOutput};
 use mobil_local_nav_node::{
-    clear_markers, duration_msg, goal_heading, goal_in_odom, markers, odom_pose, reconfigured_progress,
-    scan_laser_pose, stale_input, status_message, twist_from_command, CommandGate, GoalOutcome, LaserPoseFrom,
-    LocalNavConfig, MarkerView, ScanRefusal, StatusView, StepErrors,
+    clear_markers, goal_heading, goal_in_odom, markers, reconfigured_progress, stale_input, status_message,
+    twist_from_command, GoalOutcome, LocalNavConfig, MarkerView, StatusView, StepErrors,
 };
 use mobil_msgs::builtin_interfaces::msg::Time;
 use mobil_msgs::geometry_msgs::msg::{Pose, PoseStamped, Twist};
@@ -34,11 +33,15 @@ use mobil_msgs::sensor_msgs::msg::LaserScan;
 use mobil_msgs::std_msgs::msg::Header;
 use mobil_msgs::visualization_msgs::msg::MarkerArray;
 use mobil_ros::action::{ActionEvent, GoalEnd, GoalRequest, GoalServer, GoalServerConfig};
+use mobil_ros::geometry::odom_pose;
 use mobil_ros::input::{decoded, Input};
 use mobil_ros::latest::Latest;
 use mobil_ros::scan::{scan_from_msg, tf_static_subscription, StaticFrames};
+use mobil_ros::scan::{scan_laser_pose, LaserPoseFrom, ScanRefusal};
+use mobil_ros::stop::CommandGate;
 use mobil_ros::stop::{final_stop, FINAL_STOP_WAIT};
 use mobil_ros::ticker::Ticker;
+use mobil_ros::time::duration_msg;
 use mobil_ros::{qos, run_node, shutdown_signal, warn_throttled, ConfigError, LogThrottle, NodeDecl, RosNode};
 use nalgebra::Point2;
 use ros2_client::{Publisher, Subscription};

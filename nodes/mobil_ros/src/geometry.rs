@@ -1,8 +1,10 @@
 //! Planar poses and twists in ROS messages (REP-103: x forward, y left, z up, yaw about z).
 
+use mobil_geom::Pose2;
 use mobil_msgs::geometry_msgs::msg::Quaternion;
 use mobil_msgs::nav_msgs::msg::Odometry;
 use mobil_msgs::std_msgs::msg::Header;
+use thiserror::Error;
 
 /// The quaternion of a rotation by `yaw` about z.
 pub fn yaw_quaternion(yaw: f64) -> Quaternion {
@@ -36,6 +38,53 @@ pub fn planar_odometry(header: Header, child_frame_id: &str, pose: [f64; 3], twi
     msg
 }
 
+/// Why an odometry message is refused.
+#[derive(Debug, Clone, PartialEq, Eq, Error)]
+pub enum OdomError {
+    /// `header.frame_id` or `child_frame_id` is not the configured frame (a leading `/` and an
+    /// empty frame are accepted, as many drivers leave it empty).
+    #[error("odom in frames `{frame}` → `{child}`, expected `{want_frame}` → `{want_child}`")]
+    Frames {
+        /// The message's `header.frame_id`.
+        frame: String,
+        /// The message's `child_frame_id`.
+        child: String,
+        /// `odom_frame`.
+        want_frame: String,
+        /// `base_frame`.
+        want_child: String,
+    },
+    /// NaN or infinity in the pose.
+    #[error("odom with a non-finite pose")]
+    NotFinite,
+}
+
+/// The robot pose of an odometry message, or why it is refused: frames other than
+/// `odom_frame` → `base_frame` (an empty frame passes), or a non-finite pose.
+pub fn odom_pose(m: &Odometry, odom_frame: &str, base_frame: &str) -> Result<Pose2, OdomError> {
+    let same = |got: &str, want: &str| {
+        let got = got.trim_start_matches('/');
+        got.is_empty() || got == want.trim_start_matches('/')
+    };
+    if !same(&m.header.frame_id, odom_frame) || !same(&m.child_frame_id, base_frame) {
+        return Err(OdomError::Frames {
+            frame: m.header.frame_id.clone(),
+            child: m.child_frame_id.clone(),
+            want_frame: odom_frame.to_owned(),
+            want_child: base_frame.to_owned(),
+        });
+    }
+    let p = &m.pose.pose;
+    let q = &p.orientation;
+    let pose = Pose2::new(p.position.x, p.position.y, yaw_of(q));
+    // The yaw of a quaternion with an infinity in it can come out finite: each part is checked.
+    if pose.is_finite() && [q.x, q.y, q.z, q.w].iter().all(|v| v.is_finite()) {
+        Ok(pose)
+    } else {
+        Err(OdomError::NotFinite)
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -48,5 +97,41 @@ mod tests {
         for yaw in [-3.1, -1.0, 0.0, 0.5, 3.1] {
             assert!((yaw_of(&yaw_quaternion(yaw)) - yaw).abs() < 1e-12);
         }
+    }
+
+    fn odom(frame: &str, child: &str, x: f64) -> Odometry {
+        let mut m = Odometry::default();
+        m.header.frame_id = frame.into();
+        m.child_frame_id = child.into();
+        m.pose.pose.position.x = x;
+        m.pose.pose.orientation.w = 1.0;
+        m
+    }
+
+    #[test]
+    fn odometry_in_other_frames_or_with_nan_is_refused() {
+        assert_eq!(
+            odom_pose(&odom("odom", "base_link", 1.5), "odom", "base_link"),
+            Ok(Pose2::new(1.5, 0.0, 0.0))
+        );
+        // Empty frames (many drivers) and a leading slash pass.
+        assert!(odom_pose(&odom("", "", 1.0), "odom", "base_link").is_ok());
+        assert!(odom_pose(&odom("/odom", "base_link", 1.0), "odom", "base_link").is_ok());
+        let e = odom_pose(&odom("map", "base_link", 1.0), "odom", "base_link").unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "odom in frames `map` → `base_link`, expected `odom` → `base_link`"
+        );
+        assert!(matches!(
+            odom_pose(&odom("odom", "laser", 1.0), "odom", "base_link"),
+            Err(OdomError::Frames { .. })
+        ));
+        assert_eq!(
+            odom_pose(&odom("odom", "base_link", f64::NAN), "odom", "base_link"),
+            Err(OdomError::NotFinite)
+        );
+        let mut q_inf = odom("odom", "base_link", 0.0);
+        q_inf.pose.pose.orientation.z = f64::INFINITY;
+        assert_eq!(odom_pose(&q_inf, "odom", "base_link"), Err(OdomError::NotFinite));
     }
 }

@@ -2,7 +2,8 @@
 //! algorithm crate, so that every node is written the same way.
 //!
 //! A node is a thin shell (see `nodes/chassis_node` for the pattern):
-//! - [`config`]: the configuration declared once — each parameter's name, type, default, range,
+//! - [`config`]: the configuration declared once (the chassis group every chassis-modelling
+//!   node nests is [`chassis`]) — each parameter's name, type, default, range,
 //!   description and read-only flag, bound to the typed field it fills; from it come the ROS
 //!   declarations, `--help`, validation of files, `-p` and `set_parameters` (refused with a
 //!   reason), and the typed configuration ([`NodeDecl::for_config`], [`RosNode::config`],
@@ -32,6 +33,7 @@
 
 pub mod action;
 pub mod args;
+pub mod chassis;
 pub mod config;
 pub mod docs;
 pub mod geometry;

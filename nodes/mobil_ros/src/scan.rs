@@ -36,6 +36,7 @@ use mobil_msgs::sensor_msgs::msg::LaserScan;
 use mobil_msgs::tf2_msgs::msg::TFMessage;
 use ros2_client::Subscription;
 use std::collections::HashMap;
+use thiserror::Error;
 
 /// The checked scan of a LaserScan message, the laser at `base_from_laser` in the base frame.
 pub fn scan_from_msg(msg: &LaserScan, base_from_laser: Pose2) -> Result<Scan, ScanError> {
@@ -217,6 +218,57 @@ pub fn tf_static_subscription(node: &mut RosNode) -> anyhow::Result<Subscription
     node.subscription::<TFMessage>("tf_static", &crate::qos::tf_static())
 }
 
+/// Why a scan gives no navigator step.
+#[derive(Debug, Clone, PartialEq, Error)]
+pub enum ScanRefusal {
+    /// The scan's frame has no pose in the base frame: not in `tf_static`, and no `laser_pose`
+    /// parameter was given.
+    #[error("no laser pose: frame `{frame}` not in tf_static (from `{base}`) and no laser_pose parameter set")]
+    NoLaserPose {
+        /// The scan's frame.
+        frame: String,
+        /// The base frame.
+        base: String,
+    },
+    /// The scan itself is malformed.
+    #[error("scan refused: {0}")]
+    Invalid(String),
+}
+
+/// Where the laser pose of a scan came from.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum LaserPoseFrom {
+    /// `tf_static`, for the scan's own frame.
+    TfStatic,
+    /// The `laser_pose` parameter (the scan's frame is not in `tf_static`).
+    Parameter,
+}
+
+/// The pose in `base_frame` of the laser of a scan in `scan_frame` (empty: `laser_frame`): the
+/// `tf_static` chain to the scan's own frame, else the `laser_pose` parameter if one was given,
+/// else refused, naming the frame.
+pub fn scan_laser_pose(
+    frames: &StaticFrames,
+    base_frame: &str,
+    scan_frame: &str,
+    laser_frame: &str,
+    parameter: Option<Pose2>,
+) -> Result<(Pose2, LaserPoseFrom), ScanRefusal> {
+    let frame = match scan_frame.trim_start_matches('/') {
+        "" => laser_frame.trim_start_matches('/'),
+        f => f,
+    };
+    if let Some(p) = frames.lookup(base_frame, frame) {
+        return Ok((p, LaserPoseFrom::TfStatic));
+    }
+    parameter
+        .map(|p| (p, LaserPoseFrom::Parameter))
+        .ok_or_else(|| ScanRefusal::NoLaserPose {
+            frame: frame.to_owned(),
+            base: base_frame.to_owned(),
+        })
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -315,5 +367,31 @@ mod tests {
             scan_from_msg(&bad, Pose2::identity()),
             Err(ScanError::SpanMismatch { beams: 7, .. })
         ));
+    }
+
+    #[test]
+    fn the_scan_s_own_frame_gives_the_laser_pose() {
+        let mut frames = StaticFrames::default();
+        frames.add(&mobil_msgs::tf2_msgs::msg::TFMessage {
+            transforms: vec![
+                tf("base_link", "laser", 0.3, 0.0, 0.0),
+                tf("base_link", "rear_laser", -0.4, 0.0, 0.0),
+            ],
+        });
+        let param = Some(Pose2::new(0.1, 0.0, 0.0));
+        // The scan says rear_laser: its transform (−0.4 m), not laser_frame's (0.3 m).
+        let (p, from) = scan_laser_pose(&frames, "base_link", "rear_laser", "laser", None).unwrap();
+        assert_eq!((p.x, from), (-0.4, LaserPoseFrom::TfStatic));
+        // tf_static wins over the parameter; an empty frame means laser_frame.
+        let (p, from) = scan_laser_pose(&frames, "base_link", "", "laser", param).unwrap();
+        assert_eq!((p.x, from), (0.3, LaserPoseFrom::TfStatic));
+        // An unknown frame: the parameter if one was set, else refused, naming the frame.
+        let (p, from) = scan_laser_pose(&frames, "base_link", "/other", "laser", param).unwrap();
+        assert_eq!((p.x, from), (0.1, LaserPoseFrom::Parameter));
+        let e = scan_laser_pose(&frames, "base_link", "other", "laser", None).unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "no laser pose: frame `other` not in tf_static (from `base_link`) and no laser_pose parameter set"
+        );
     }
 }

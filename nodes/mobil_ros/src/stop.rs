@@ -18,6 +18,7 @@
 //! # }
 //! ```
 
+use mobil_msgs::geometry_msgs::msg::Twist;
 use ros2_client::Publisher;
 use serde::Serialize;
 use std::time::{Duration, Instant};
@@ -70,5 +71,56 @@ async fn publish_and_wait<M: Serialize + std::fmt::Debug>(
             Ok(false) => tokio::time::sleep(Duration::from_millis(2)).await,
             Err(e) => return FinalStop::Failed(format!("{e:?}")),
         }
+    }
+}
+
+/// Whether the robot is (as far as this node commanded it) moving: a refused input stops it
+/// with one zero command, not one per refusal.
+#[derive(Debug, Clone, Default, PartialEq, Eq)]
+pub struct CommandGate {
+    moving: bool,
+}
+
+impl CommandGate {
+    /// A command went out (zero or not).
+    pub fn sent(&mut self, twist: &Twist) {
+        let t = twist;
+        self.moving = [
+            t.linear.x,
+            t.linear.y,
+            t.linear.z,
+            t.angular.x,
+            t.angular.y,
+            t.angular.z,
+        ]
+        .iter()
+        .any(|v| *v != 0.0);
+    }
+
+    /// An input was refused while a goal runs: `true` when a zero command must go out now (the
+    /// last command moved the robot); the gate then counts the robot as stopped.
+    pub fn refused(&mut self) -> bool {
+        std::mem::take(&mut self.moving)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_refusal_stops_a_moving_robot_once() {
+        let mut g = CommandGate::default();
+        // Nothing commanded yet: no zero needed.
+        assert!(!g.refused());
+        let mut moving = Twist::default();
+        moving.angular.z = 0.3;
+        g.sent(&moving);
+        assert!(g.refused());
+        // The zero went out: a second refusal in a row sends none.
+        assert!(!g.refused());
+        g.sent(&moving);
+        g.sent(&Twist::default());
+        assert!(!g.refused());
     }
 }

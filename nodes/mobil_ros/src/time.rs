@@ -20,7 +20,8 @@
 //! assert_eq!(dt.step(520_000_000), Ok(Some(0.02))); // restarted at the reset
 //! ```
 
-use mobil_msgs::builtin_interfaces::msg::Time;
+use mobil_msgs::builtin_interfaces::msg::{Duration as RosDuration, Time};
+use std::time::Duration;
 use thiserror::Error;
 
 /// Why [`DtClock::step`] yields no `dt`.
@@ -111,6 +112,28 @@ pub fn is_zero(t: &Time) -> bool {
     t.sec == 0 && t.nanosec == 0
 }
 
+/// `s` seconds as a duration, held to [0, `max_s`] (NaN gives `max_s`): never a panic, whatever
+/// the number.
+pub fn seconds(s: f64, max_s: f64) -> Duration {
+    let s = if s.is_nan() { max_s } else { s.clamp(0.0, max_s) };
+    Duration::try_from_secs_f64(s).unwrap_or(Duration::ZERO)
+}
+
+/// A duration message of `seconds` (navigation time, time remaining): negative (the clock went
+/// backwards), NaN or infinite give zero, and it saturates at 10⁹ s.
+pub fn duration_msg(seconds: f64) -> RosDuration {
+    let s = if seconds.is_finite() {
+        seconds.clamp(0.0, 1e9)
+    } else {
+        0.0
+    };
+    let sec = s.floor();
+    RosDuration {
+        sec: sec as i32,
+        nanosec: ((s - sec) * 1e9).min(999_999_999.0) as u32,
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -156,5 +179,25 @@ mod tests {
             }),
             None
         );
+    }
+
+    #[test]
+    fn durations_never_go_negative() {
+        let d = duration_msg(12.25);
+        assert_eq!((d.sec, d.nanosec), (12, 250_000_000));
+        for bad in [-3.0, f64::NAN, f64::INFINITY] {
+            let d = duration_msg(bad);
+            assert_eq!((d.sec, d.nanosec), (0, 0), "{bad}");
+        }
+        assert_eq!(duration_msg(5e9).sec, 1_000_000_000);
+    }
+
+    #[test]
+    fn seconds_are_bounded_and_never_panic() {
+        assert_eq!(seconds(1e300, 60.0), Duration::from_secs(60));
+        assert_eq!(seconds(f64::INFINITY, 60.0), Duration::from_secs(60));
+        assert_eq!(seconds(f64::NAN, 60.0), Duration::from_secs(60));
+        assert_eq!(seconds(-1.0, 60.0), Duration::ZERO);
+        assert_eq!(seconds(0.25, 60.0), Duration::from_millis(250));
     }
 }

@@ -11,7 +11,6 @@
 use mobil_chassis::kinematics::{twist_at_origin, twist_at_reference};
 use mobil_chassis::model::ChassisConfig;
 use mobil_chassis::{clamp_command, BodyTwist, ChassisParams};
-use mobil_chassis_node::{chassis_params, declare_chassis};
 use mobil_geom::Pose2;
 use mobil_msgs::builtin_interfaces::msg::Time;
 use mobil_msgs::geometry_msgs::msg::{Point, Pose, PoseStamped, Twist, Vector3};
@@ -26,6 +25,7 @@ use mobil_planner::{
     DockingConfig, DockingFailure, DockingGains, Finish, FollowConfig, ProblemKind, Residual, RouteCheckConfig,
     RouteProblem, RouteReport, UnreachableCause,
 };
+use mobil_ros::chassis::{chassis_params, declare_chassis};
 use mobil_ros::config::{Config, ConfigError, Decl};
 use mobil_ros::geometry::{yaw_of, yaw_quaternion};
 use mobil_world::World;
@@ -33,7 +33,7 @@ use nalgebra::Point2;
 use std::time::Duration;
 use thiserror::Error;
 
-pub use mobil_local_nav_node::{duration_msg, odom_pose, seconds, CommandGate, OdomError};
+use mobil_ros::time::seconds;
 
 pub mod vfo;
 

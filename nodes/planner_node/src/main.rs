@@ -23,7 +23,6 @@
 use futures::StreamExt;
 use mobil_chassis::{BodyTwist, ChassisParams};
 use mobil_geom::Pose2;
-use mobil_local_nav_node::scan_laser_pose;
 use mobil_msgs::geometry_msgs::msg::{PoseStamped, Twist};
 use mobil_msgs::mobil_msgs::msg::NavStatus;
 use mobil_msgs::mobil_msgs::srv::{CheckRoute, CheckRouteRequest, CheckRouteResponse};
@@ -48,17 +47,21 @@ use mobil_planner_node::vfo::{
     SegmentReport, VfoDrawing, VfoSlot, WaypointMethod,
 };
 use mobil_planner_node::{
-    backed_out, check_reply, clamp_twist, dock_goal, docking_offset, docking_outcome, duration_msg, load_world,
-    markers, missed_from_report, odom_pose, odom_stale, pose_in_odom, refused_reply, route_from_path, route_from_poses,
-    status_message, CommandGate, GoalError, MarkerView, Missed, Mode, Outcome, PlannerConfig, Route, StatusView,
+    backed_out, check_reply, clamp_twist, dock_goal, docking_offset, docking_outcome, load_world, markers,
+    missed_from_report, odom_stale, pose_in_odom, refused_reply, route_from_path, route_from_poses, status_message,
+    GoalError, MarkerView, Missed, Mode, Outcome, PlannerConfig, Route, StatusView,
 };
 use mobil_ros::action::{ActionEvent, GoalEnd, GoalRequest, GoalServer, GoalServerConfig};
+use mobil_ros::geometry::odom_pose;
 use mobil_ros::input::{decoded, Input};
 use mobil_ros::latest::Latest;
 use mobil_ros::offloop::CancelToken;
+use mobil_ros::scan::scan_laser_pose;
 use mobil_ros::scan::{scan_from_msg, tf_static_subscription, StaticFrames};
+use mobil_ros::stop::CommandGate;
 use mobil_ros::stop::{final_stop, FINAL_STOP_WAIT};
 use mobil_ros::ticker::Ticker;
+use mobil_ros::time::duration_msg;
 use mobil_ros::time::{secs_from_stamp, DtClock, DtError};
 use mobil_ros::OffLoop;
 use mobil_ros::{qos, run_node, shutdown_signal, warn_throttled, ConfigError, LogThrottle, NodeDecl, RosNode};

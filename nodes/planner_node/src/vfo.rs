@@ -120,7 +120,7 @@ pub const DEFAULT_OPTIMISE_BUDGET_S: f64 = 2.0;
 impl VfoSettings {
     /// The optimisation's wall-clock budget.
     pub fn optimise_budget(&self) -> Duration {
-        crate::seconds(self.optimise_budget_s, MAX_OPTIMISE_BUDGET_S)
+        mobil_ros::time::seconds(self.optimise_budget_s, MAX_OPTIMISE_BUDGET_S)
     }
 
     /// The laser's pose from `laser_pose` (`None` when empty or malformed).
@@ -133,7 +133,7 @@ impl VfoSettings {
 
     /// The scan timeout.
     pub fn scan_timeout(&self) -> Duration {
-        crate::seconds(self.scan_timeout_s, crate::MAX_INPUT_TIMEOUT_S)
+        mobil_ros::time::seconds(self.scan_timeout_s, crate::MAX_INPUT_TIMEOUT_S)
     }
 
     /// The obstacle extraction with the robot's radius.

@@ -9,7 +9,6 @@
 use futures::StreamExt;
 use mobil_chassis::joints::wheel_state_from_joints;
 use mobil_chassis::model::ChassisConfig;
-use mobil_chassis_node::{chassis_params, declare_chassis};
 use mobil_msgs::geometry_msgs::msg::{Point, Transform, TransformStamped, Vector3};
 use mobil_msgs::nav_msgs::msg::Odometry;
 use mobil_msgs::rosgraph_msgs::msg::Clock;
@@ -18,6 +17,7 @@ use mobil_msgs::std_msgs::msg::ColorRGBA;
 use mobil_msgs::std_msgs::msg::Header;
 use mobil_msgs::tf2_msgs::msg::TFMessage;
 use mobil_msgs::visualization_msgs::msg::{Marker, MarkerArray};
+use mobil_ros::chassis::{chassis_params, declare_chassis};
 use mobil_ros::config::{Config, ConfigError, Decl};
 use mobil_ros::geometry::{planar_odometry, yaw_quaternion};
 use mobil_ros::input::{decoded, Input};

@@ -1,11 +1,11 @@
-//! The ROS side of [`mobil_chassis`]: the `chassis_node` executable (src/main.rs), and the
-//! chassis geometry and limits as ROS parameters, declared once here and nested by every node
-//! that models the chassis (`chassis_node`, `sim_node`, and the planners), so one `/**` section
-//! of a robot's params file configures them all.
+//! The chassis geometry and limits of [`mobil_chassis`] as ROS parameters, declared once here
+//! and nested by every node that models the chassis (`chassis_node`, `sim_node`,
+//! `local_nav_node`, `planner_node`), so one `/**` section of a robot's params file configures
+//! them all.
 //!
 //! ```
 //! use mobil_chassis::ChassisConfig;
-//! use mobil_chassis_node::{chassis_params, declare_chassis};
+//! use mobil_ros::chassis::{chassis_params, declare_chassis};
 //! use mobil_ros::config::{Config, Decl};
 //!
 //! #[derive(Debug, Clone, Default)]
@@ -29,8 +29,8 @@
 //! assert!(names.contains(&"v_max".to_string()) && names.contains(&"lookahead".to_string()));
 //! ```
 
+use crate::config::{ConfigError, Decl};
 use mobil_chassis::model::{ChassisConfig, ChassisModel, ChassisParams};
-use mobil_ros::config::{ConfigError, Decl};
 
 /// Declares the chassis geometry and limits, each filling its field of [`ChassisConfig`];
 /// defaults are MOBIL-II's (`omni_wheel_distance`: OMR-III's, so that switching `model` to
@@ -109,8 +109,8 @@ pub fn chassis_params(c: &ChassisConfig) -> Result<ChassisParams, ConfigError> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use mobil_ros::config::Config;
-    use mobil_ros::params::ParamValues;
+    use crate::config::Config;
+    use crate::params::ParamValues;
     use ros2_client::ParameterValue;
 
     #[derive(Debug, Clone, Default)]
@@ -131,15 +131,15 @@ mod tests {
         let mut values = ParamValues::defaults(&Decl::<Only>::of().specs());
         let mut expected = ChassisConfig::mobil2();
         expected.omni_wheel_distance = ChassisConfig::omr3().omni_wheel_distance;
-        assert_eq!(mobil_ros::config::load::<Only>(&values).unwrap().0, expected);
+        assert_eq!(crate::config::load::<Only>(&values).unwrap().0, expected);
         values.set("model", ParameterValue::String("omni".into()));
         // MOBIL-II's omni_wheel_distance default is OMR-III's, so switching the model is valid.
         assert_eq!(
-            mobil_ros::config::load::<Only>(&values).unwrap().0.model,
+            crate::config::load::<Only>(&values).unwrap().0.model,
             ChassisModel::Omni
         );
         values.set("wheel_radius", ParameterValue::Double(0.0));
-        let e = mobil_ros::config::load::<Only>(&values).unwrap_err();
+        let e = crate::config::load::<Only>(&values).unwrap_err();
         assert!(matches!(e, ConfigError::Inconsistent(_)), "{e}");
     }
 }
