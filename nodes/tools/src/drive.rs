@@ -8,6 +8,7 @@
 //! arrives slowly enough to stop within `tolerance`.
 
 pub use mobil_geom::Pose2;
+use mobil_motion::{BodyTwist, GoalLaw, Outcome, Step, StepInput};
 use thiserror::Error;
 
 /// How a drive is carried out.
@@ -128,6 +129,30 @@ impl DistanceDrive {
     }
 }
 
+/// A drive as a goal law: the forward speed of [`DistanceDrive::command`] as the body twist, the
+/// progress as the feedback, and the progress at the end as the report. A non-finite pose is
+/// refused (the robot stops for that step).
+impl GoalLaw for DistanceDrive {
+    type Sensors = ();
+    type Feedback = Progress;
+    type Report = Progress;
+
+    fn step(&mut self, input: &StepInput, _: &()) -> Step<Progress, Progress> {
+        if !input.pose.is_finite() {
+            return Step::Refused("non-finite pose".to_owned());
+        }
+        let progress = self.update(input.pose);
+        if progress.arrived {
+            let detail = format!("travelled {:.3} m of {} m", progress.travelled, self.distance);
+            return Step::end(Outcome::succeeded(detail), progress);
+        }
+        Step::Command {
+            twist: BodyTwist::new(self.command(), 0.0, 0.0),
+            feedback: progress,
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -231,5 +256,38 @@ mod tests {
         d.update(pose(0.3, 0.0, 0.0));
         let p = d.update(pose(f64::NAN, 0.0, 0.0));
         assert_relative_eq!(p.travelled, 0.3, epsilon = 1e-12);
+    }
+
+    #[test]
+    fn as_a_goal_law_it_commands_the_ramp_and_ends_within_tolerance() {
+        use mobil_motion::{GoalLaw, Step, StepInput};
+        // 1 m ahead at 0.3 m/s, the default settings: decel 0.5, min 0.03, tolerance 0.005.
+        let mut d = DistanceDrive::new(Pose2::new(0.0, 0.0, 0.0), 1.0, 0.3, DriveSettings::default()).unwrap();
+        let at = |x: f64| StepInput::new(0.0, 0.05, Pose2::new(x, 0.0, 0.0));
+        // 0.5 m left: √(2·0.5·0.5) = 0.707 > 0.3, so the goal's speed.
+        match d.step(&at(0.5), &()) {
+            Step::Command { twist, feedback } => {
+                assert_eq!((twist.vx, twist.vy, twist.wz), (0.3, 0.0, 0.0));
+                assert!((feedback.remaining - 0.5).abs() < 1e-12);
+            }
+            other => panic!("{other:?}"),
+        }
+        // 0.01 m left: √(2·0.5·0.01) = 0.1.
+        match d.step(&at(0.99), &()) {
+            Step::Command { twist, .. } => assert!((twist.vx - 0.1).abs() < 1e-9, "{}", twist.vx),
+            other => panic!("{other:?}"),
+        }
+        assert!(matches!(
+            d.step(&StepInput::new(0.0, 0.05, Pose2::new(f64::NAN, 0.0, 0.0)), &()),
+            Step::Refused(_)
+        ));
+        // 0.002 m left, within 0.005: the end, reporting what was travelled.
+        match d.step(&at(0.998), &()) {
+            Step::End(end) => {
+                assert!(end.outcome.is_success());
+                assert!((end.report.travelled - 0.998).abs() < 1e-12);
+            }
+            other => panic!("{other:?}"),
+        }
     }
 }

@@ -1,0 +1,254 @@
+//! One interface for every goal law of the suite, ROS-free.
+//!
+//! A *goal law* drives the robot towards one goal — a dock, a route, a distance, a position
+//! behind obstacles — one step at a time. Its step takes the time, the robot's pose and
+//! velocity and whatever the law senses besides (a checked scan, an obstacle map), and answers
+//! one of three things ([`Step`]):
+//! - a command, the body twist to drive, with the law's feedback;
+//! - the end of the goal, succeeded or failed, with a reason and Nav2's error code
+//!   ([`Outcome`]) and whatever the law reports at its end;
+//! - a refusal of this step's input: the law could not use it (a non-finite pose, a scan it
+//!   cannot read), and the robot is to be stopped for this step.
+//!
+//! The law never reads a clock, never publishes and never decides what happens around it: the
+//! motion server of the node kit (`mobil_ros::motion`) owns the goals, their pre-emption, the
+//! time step, the count of refused steps, the one zero command at every end, the feedback and
+//! the status, as Nav2's `controller_server` owns them around a `nav2_core::Controller`.
+//!
+//! ```
+//! use mobil_motion::{BodyTwist, GoalLaw, Outcome, Pose2, Step, StepInput};
+//!
+//! /// Drives forward until x passes 1 m.
+//! struct ToOneMetre;
+//!
+//! impl GoalLaw for ToOneMetre {
+//!     type Sensors = ();
+//!     type Feedback = f64;
+//!     type Report = ();
+//!     fn step(&mut self, input: &StepInput, _: &()) -> Step<f64, ()> {
+//!         if !input.pose.is_finite() {
+//!             return Step::Refused("non-finite pose".into());
+//!         }
+//!         let left = 1.0 - input.pose.x;
+//!         if left <= 0.0 {
+//!             return Step::end(Outcome::succeeded("at 1 m"), ());
+//!         }
+//!         Step::Command { twist: BodyTwist::new(0.2, 0.0, 0.0), feedback: left }
+//!     }
+//! }
+//!
+//! let mut law = ToOneMetre;
+//! let at = |x| StepInput::new(0.0, 0.05, Pose2::new(x, 0.0, 0.0));
+//! assert!(matches!(law.step(&at(0.5), &()), Step::Command { feedback, .. } if (feedback - 0.5).abs() < 1e-12));
+//! assert!(matches!(law.step(&at(1.2), &()), Step::End(end) if end.outcome.is_success()));
+//! ```
+#![warn(missing_docs)]
+
+pub use mobil_chassis::BodyTwist;
+pub use mobil_geom::Pose2;
+
+/// What a law sees at one step, besides its own sensors.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct StepInput {
+    /// ROS time (s, any origin; simulated time under `use_sim_time`), never decreasing over a
+    /// goal's steps.
+    pub t: f64,
+    /// The time since the goal's previous step (s), held by the server to the law's range; the
+    /// first step gets the server's first step.
+    pub dt: f64,
+    /// The robot's pose (the reference point, `base_link`, in the goal's frame).
+    pub pose: Pose2,
+    /// The robot's measured body twist at the reference point (zero when unknown).
+    pub velocity: BodyTwist,
+}
+
+impl StepInput {
+    /// An input at `t` with time step `dt` and pose `pose`, the velocity unknown (zero).
+    pub fn new(t: f64, dt: f64, pose: Pose2) -> Self {
+        StepInput {
+            t,
+            dt,
+            pose,
+            velocity: BodyTwist::ZERO,
+        }
+    }
+
+    /// The same input with a measured velocity.
+    pub fn with_velocity(self, velocity: BodyTwist) -> Self {
+        StepInput { velocity, ..self }
+    }
+}
+
+/// How a goal ended: Nav2's view of it.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Outcome {
+    /// The goal was reached.
+    Succeeded {
+        /// What was reached, for the log and the status.
+        detail: String,
+    },
+    /// The goal ended without being reached.
+    Failed {
+        /// The status reason's code, upper case (`RESIDUAL`, `NO_PATH`, `STALLED`, …).
+        code: &'static str,
+        /// The figures behind it, for the log and the status.
+        detail: String,
+        /// Nav2's error code for the action that serves the law (0 when it has none).
+        nav2_error: u16,
+    },
+}
+
+impl Outcome {
+    /// A success with `detail`.
+    pub fn succeeded(detail: impl Into<String>) -> Self {
+        Outcome::Succeeded { detail: detail.into() }
+    }
+
+    /// A failure with its code, detail and Nav2 error code.
+    pub fn failed(code: &'static str, detail: impl Into<String>, nav2_error: u16) -> Self {
+        Outcome::Failed {
+            code,
+            detail: detail.into(),
+            nav2_error,
+        }
+    }
+
+    /// Whether the goal was reached.
+    pub fn is_success(&self) -> bool {
+        matches!(self, Outcome::Succeeded { .. })
+    }
+
+    /// The status reason, "CODE: detail" (`SUCCEEDED` alone for a success without detail).
+    pub fn reason(&self) -> String {
+        let (code, detail) = match self {
+            Outcome::Succeeded { detail } => ("SUCCEEDED", detail.as_str()),
+            Outcome::Failed { code, detail, .. } => (*code, detail.as_str()),
+        };
+        if detail.is_empty() {
+            code.to_owned()
+        } else {
+            format!("{code}: {detail}")
+        }
+    }
+
+    /// Nav2's error code: 0 for a success.
+    pub fn nav2_error(&self) -> u16 {
+        match self {
+            Outcome::Succeeded { .. } => 0,
+            Outcome::Failed { nav2_error, .. } => *nav2_error,
+        }
+    }
+}
+
+/// The end of a goal: its outcome and what the law reports with it (the distance travelled,
+/// the waypoints missed, the residual left, …).
+#[derive(Debug, Clone, PartialEq)]
+pub struct End<R> {
+    /// How it ended.
+    pub outcome: Outcome,
+    /// The law's report.
+    pub report: R,
+}
+
+/// One step's answer.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Step<F, R> {
+    /// Drive this body twist (at the point the law says it steers; finite), and report this.
+    Command {
+        /// The command.
+        twist: BodyTwist,
+        /// The law's feedback for this step.
+        feedback: F,
+    },
+    /// The goal is over; the robot is to stop.
+    End(End<R>),
+    /// This step's input could not be used (the reason says why); the robot is to stop for
+    /// this step, and the goal goes on.
+    Refused(String),
+}
+
+impl<F, R> Step<F, R> {
+    /// The end with `outcome` and `report`.
+    pub fn end(outcome: Outcome, report: R) -> Self {
+        Step::End(End { outcome, report })
+    }
+}
+
+/// A goal law: one goal, stepped until it ends.
+pub trait GoalLaw {
+    /// What the law senses besides the pose and velocity (`()` for none; a checked scan, an
+    /// obstacle map, …).
+    type Sensors: ?Sized;
+    /// What each commanding step reports.
+    type Feedback;
+    /// What the end reports besides its outcome.
+    type Report;
+
+    /// One step. After an [`Step::End`] the law is not stepped again.
+    fn step(&mut self, input: &StepInput, sensors: &Self::Sensors) -> Step<Self::Feedback, Self::Report>;
+}
+
+/// Nav2 Jazzy's error codes the suite's laws end with, by the action that serves them.
+pub mod nav2 {
+    /// `FollowPath`'s (the controller server's) codes, which Nav2's navigator passes on.
+    pub mod follow_path {
+        /// No error.
+        pub const NONE: u16 = 0;
+        /// Unknown.
+        pub const UNKNOWN: u16 = 100;
+        /// The robot did not move enough within the progress checker's time.
+        pub const FAILED_TO_MAKE_PROGRESS: u16 = 105;
+        /// No valid control could be computed.
+        pub const NO_VALID_CONTROL: u16 = 106;
+    }
+    /// `ComputePathToPose`'s (the planner server's) codes.
+    pub mod compute_path {
+        /// The goal lies inside an obstacle.
+        pub const GOAL_OCCUPIED: u16 = 206;
+        /// No valid path.
+        pub const NO_VALID_PATH: u16 = 208;
+    }
+    /// `DockRobot`'s and `UndockRobot`'s codes.
+    pub mod docking {
+        /// The dock is not in the database.
+        pub const DOCK_NOT_IN_DB: u16 = 901;
+        /// The dock is not valid.
+        pub const DOCK_NOT_VALID: u16 = 902;
+        /// The controller failed.
+        pub const FAILED_TO_CONTROL: u16 = 905;
+        /// Unknown.
+        pub const UNKNOWN: u16 = 999;
+    }
+    /// `FollowWaypoints`'s codes.
+    pub mod follow_waypoints {
+        /// Unknown.
+        pub const UNKNOWN: u16 = 600;
+        /// The task executor (the law following the route) failed.
+        pub const TASK_EXECUTOR_FAILED: u16 = 601;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn outcomes_give_reasons_and_codes() {
+        assert_eq!(Outcome::succeeded("").reason(), "SUCCEEDED");
+        assert_eq!(Outcome::succeeded("docked").reason(), "SUCCEEDED: docked");
+        let f = Outcome::failed("RESIDUAL", "e = 0.097 m", nav2::docking::FAILED_TO_CONTROL);
+        assert_eq!(f.reason(), "RESIDUAL: e = 0.097 m");
+        assert_eq!((f.is_success(), f.nav2_error()), (false, 905));
+        assert_eq!(Outcome::succeeded("x").nav2_error(), 0);
+        assert_eq!(Outcome::failed("STALLED", "", 601).reason(), "STALLED");
+    }
+
+    #[test]
+    fn an_input_carries_its_velocity() {
+        let i = StepInput::new(1.0, 0.02, Pose2::new(1.0, 2.0, 0.5));
+        assert_eq!(i.velocity, BodyTwist::ZERO);
+        let v = BodyTwist::new(0.3, 0.0, 0.1);
+        assert_eq!(i.with_velocity(v).velocity, v);
+        assert_eq!(i.with_velocity(v).pose, i.pose);
+    }
+}
