@@ -22,6 +22,9 @@
 //!   requests;
 //! - [`action`]: [`action::GoalServer`], an action server with one active goal for a node's
 //!   select loop (accept/reject, feedback, result, cancel, pre-emption);
+//! - [`motion`]: [`motion::MotionSession`], the motion server every node that moves the robot
+//!   runs its goals through (one goal, pre-emption, the time step, refused input, the one zero
+//!   command at every end, stale input, shutdown), around a [`mobil_motion::GoalLaw`];
 //! - [`stop`]: [`stop::final_stop`], the bounded last zero command of a motion node;
 //! - [`scan`]: LaserScan → checked [`mobil_geom::Scan`] at the edge, laser pose from `tf_static`
 //!   ([`scan::tf_static_subscription`] feeding [`scan::LaserPose`]; `tf_static` wins) or a
@@ -40,6 +43,7 @@ pub mod geometry;
 pub mod input;
 pub mod latest;
 pub mod log;
+pub mod motion;
 pub mod names;
 pub mod node;
 pub mod offloop;
