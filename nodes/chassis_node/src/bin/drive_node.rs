@@ -2,14 +2,17 @@
 //! straight ahead or back by a distance, following `odom` and commanding `cmd_vel`, like Nav2's
 //! DriveOnHeading / BackUp behaviours. The logic is `mobil_tools::drive`; this is its shell.
 //!
-//! It publishes `cmd_vel` only while it has a goal, and one zero `cmd_vel` when the goal ends:
-//! reached, canceled, pre-empted by a newer goal (the old one ends ABORTED), odometry stale for
-//! `odom_timeout_s` (steady clock; ABORTED) or shutdown (ABORTED). However the node leaves
-//! (shutdown or a failure), its last `cmd_vel` is a zero one, waited for until the readers
-//! acknowledge it (at most `mobil_ros::stop::FINAL_STOP_WAIT`). A goal that cannot be started (a
-//! DDS send to that client failed) is logged and the node goes on serving.
+//! Its goals run through the kit's motion server ([`MotionSession`]): `cmd_vel` only while a
+//! goal runs, one zero `cmd_vel` when it ends — reached, canceled, odometry stale for
+//! `odom_timeout_s` (steady clock; ABORTED) — and none between a goal and the newer goal that
+//! pre-empts it (the old one ends ABORTED; the new one commands at once). A node leaving
+//! (shutdown or a failure) with a goal under way sends a last zero `cmd_vel`, waited for until
+//! the readers acknowledge it (at most `mobil_ros::stop::FINAL_STOP_WAIT`); an idle one sends
+//! none. A goal that cannot be started (a DDS send to that client failed) is logged and the
+//! node goes on serving.
 
 use futures::StreamExt;
+use mobil_motion::{BodyTwist, GoalLaw, StepInput};
 use mobil_msgs::geometry_msgs::msg::Twist;
 use mobil_msgs::mobil_msgs::action::{DriveDistance, DriveDistanceFeedback, DriveDistanceResult};
 use mobil_msgs::nav_msgs::msg::Odometry;
@@ -18,13 +21,14 @@ use mobil_ros::config::{Config, ConfigError, Decl};
 use mobil_ros::geometry::yaw_of;
 use mobil_ros::input::{decoded, Input};
 use mobil_ros::latest::Latest;
+use mobil_ros::motion::{Applied, CmdVel, EndCause, EndKind, Ended, MotionSession, SessionSettings};
 use mobil_ros::stop::{final_stop, FINAL_STOP_WAIT};
 use mobil_ros::ticker::Ticker;
 use mobil_ros::{qos, run_node, shutdown_signal, warn_throttled, LogThrottle, NodeDecl, RosNode};
 use mobil_tools::drive::{DistanceDrive, DriveSettings, Pose2};
 use ros2_client::{Publisher, Subscription};
 use std::process::ExitCode;
-use std::time::Duration;
+use std::time::{Duration, Instant};
 use tracing::{info, warn};
 
 /// The node's configuration: each parameter declared once, bound to its field.
@@ -131,23 +135,73 @@ fn result(travelled: f64, reason: &str) -> DriveDistanceResult {
     }
 }
 
-fn twist(v: f64) -> Twist {
+/// The one goal source: the action.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+struct DriveAction;
+
+impl From<DriveAction> for &'static str {
+    fn from(_: DriveAction) -> &'static str {
+        "drive_distance"
+    }
+}
+
+type Session = MotionSession<DistanceDrive, DriveAction>;
+
+/// The action's answer for an ended goal: its status and result (the reason as the action has
+/// always given it).
+fn answer(ended: &Ended<DistanceDrive, DriveAction>) -> (GoalEnd, DriveDistanceResult) {
+    let reason = match &ended.cause {
+        EndCause::Outcome(o) if o.is_success() => "reached".to_owned(),
+        EndCause::Canceled => "canceled".to_owned(),
+        EndCause::Preempted(_) => "preempted by a newer goal".to_owned(),
+        EndCause::Stale(_) => "odometry stale".to_owned(),
+        EndCause::Shutdown => "shutting down".to_owned(),
+        other => other.reason(),
+    };
+    let status = match ended.cause.kind() {
+        EndKind::Succeeded => GoalEnd::Succeeded,
+        EndKind::Canceled => GoalEnd::Canceled,
+        EndKind::Aborted => GoalEnd::Aborted,
+    };
+    (status, result(ended.goal.progress().travelled, &reason))
+}
+
+fn finish(server: &mut GoalServer<DriveDistance>, ended: Option<Ended<DistanceDrive, DriveAction>>) {
+    if let Some(ended) = ended {
+        let (status, result) = answer(&ended);
+        match status {
+            GoalEnd::Succeeded | GoalEnd::Canceled => info!("goal ends: {}", result.reason),
+            GoalEnd::Aborted => warn!("goal ends: {}", result.reason),
+        }
+        server.finish(status, result);
+    }
+}
+
+fn twist(b: BodyTwist) -> Twist {
     let mut t = Twist::default();
-    t.linear.x = v;
+    t.linear.x = b.vx;
     t
 }
 
 async fn serve(node: &mut RosNode) -> anyhow::Result<()> {
     let config: DriveConfig = node.config()?;
     let cmd = node.publisher::<Twist>("cmd_vel", &qos::default_qos())?;
-    // Whatever ends the loop (shutdown or a failure), the last command is a zero one, waited
-    // for, so the chassis does not keep the last speed until its own watchdog fires.
-    let outcome = drive_loop(node, &cmd, config).await;
-    final_stop(&cmd, Twist::default(), FINAL_STOP_WAIT).await;
+    let mut session = Session::new(SessionSettings::default());
+    let outcome = drive_loop(node, &cmd, &mut session, config).await;
+    // Whatever ends the loop (shutdown or a failure), a goal under way gets its zero command,
+    // waited for, so the chassis does not keep the last speed until its own watchdog fires.
+    if session.shutdown().1 {
+        final_stop(&cmd, Twist::default(), FINAL_STOP_WAIT).await;
+    }
     outcome
 }
 
-async fn drive_loop(node: &mut RosNode, cmd: &Publisher<Twist>, mut config: DriveConfig) -> anyhow::Result<()> {
+async fn drive_loop(
+    node: &mut RosNode,
+    cmd: &Publisher<Twist>,
+    session: &mut Session,
+    mut config: DriveConfig,
+) -> anyhow::Result<()> {
     let odom_sub = node.subscription::<Odometry>("odom", &qos::default_qos())?;
     let mut server = GoalServer::<DriveDistance>::create(
         node,
@@ -156,9 +210,8 @@ async fn drive_loop(node: &mut RosNode, cmd: &Publisher<Twist>, mut config: Driv
             result_timeout: Duration::from_secs_f64(config.result_timeout_s),
         },
     )?;
-    let mut drive: Option<DistanceDrive> = None;
-    let outcome = event_loop(node, cmd, &odom_sub, &mut server, &mut drive, &mut config).await;
-    let travelled = drive.take().map_or(0.0, |d| d.progress().travelled);
+    let outcome = event_loop(node, cmd, &odom_sub, &mut server, session, &mut config).await;
+    let travelled = session.active().map_or(0.0, |a| a.goal.progress().travelled);
     let reason = if outcome.is_ok() {
         "shutting down"
     } else {
@@ -173,7 +226,7 @@ async fn event_loop(
     cmd: &Publisher<Twist>,
     odom_sub: &Subscription<Odometry>,
     server: &mut GoalServer<DriveDistance>,
-    drive: &mut Option<DistanceDrive>,
+    session: &mut Session,
     config: &mut DriveConfig,
 ) -> anyhow::Result<()> {
     let odom = decoded(odom_sub.async_stream(), "odom", "odom-read", "sample ignored");
@@ -181,15 +234,11 @@ async fn event_loop(
     tokio::pin!(odom, shutdown);
     let mut ticker = Ticker::new(config.rate_hz)?;
     let mut throttle = LogThrottle::new(Duration::from_secs(2));
+    let mut sink = CmdVel::new(cmd);
 
     // The latest valid odometry pose, with its stamp and steady receive instant: the one
     // place odom freshness is judged.
     let mut latest: Latest<Pose2> = Latest::new();
-    let stop = |why: &str| {
-        if let Err(e) = cmd.publish(Twist::default()) {
-            warn!("cannot publish the zero cmd_vel ({why}): {e:?}");
-        }
-    };
     info!("serving drive_distance");
     loop {
         tokio::select! {
@@ -224,53 +273,53 @@ async fn event_loop(
                     match DistanceDrive::new(start, goal.distance, goal.speed, config.settings()) {
                         Err(e) => server.reject(request, &e.to_string()).await,
                         Ok(new) => {
-                            let old = drive.take();
-                            if old.is_some() {
-                                stop("preempted");
-                            }
-                            let travelled = old.map_or(0.0, |d| d.progress().travelled);
-                            // A failure here is one client's goal (a DDS send failed): logged,
-                            // and the node goes on serving the others.
+                            let travelled = session.active().map_or(0.0, |a| a.goal.progress().travelled);
+                            // The server ends the goal it replaces itself, with this result.
                             match server.accept(request, |_| result(travelled, "preempted by a newer goal")).await {
                                 Ok(()) => {
                                     info!("driving {} m at {} m/s", goal.distance, goal.speed);
-                                    *drive = Some(new);
+                                    session.start(new, DriveAction, Instant::now());
                                 }
-                                Err(e) => warn_throttled!(throttle, "accept", "goal not started: {e}"),
+                                // One client's goal (a DDS send failed): logged, and the node
+                                // goes on serving the others; a goal it replaced was ended.
+                                Err(e) => {
+                                    warn_throttled!(throttle, "accept", "goal not started: {e}");
+                                    session.end(EndCause::Preempted("drive_distance"), &mut sink);
+                                }
                             }
                         }
                     }
                 }
                 ActionEvent::CancelRequested(_) => {
-                    stop("canceled");
-                    let travelled = drive.take().map_or(0.0, |d| d.progress().travelled);
-                    server.finish(GoalEnd::Canceled, result(travelled, "canceled"));
+                    let ended = session.end(EndCause::Canceled, &mut sink);
+                    finish(server, ended);
                 }
             },
             _ = ticker.tick() => {
-                let Some(d) = drive.as_mut() else { continue };
+                if session.active().is_none() {
+                    continue;
+                }
                 let Some(&pose) = latest.get(config.odom_timeout()) else {
-                    stop("odom stale");
                     warn!("no odom for {:?}: goal aborted", config.odom_timeout());
-                    let travelled = d.progress().travelled;
-                    *drive = None;
-                    server.finish(GoalEnd::Aborted, result(travelled, "odometry stale"));
+                    let ended = session.end(EndCause::Stale("odom".into()), &mut sink);
+                    finish(server, ended);
                     continue;
                 };
-                let progress = d.update(pose);
-                if progress.arrived {
-                    stop("reached");
-                    info!("reached: travelled {:.3} m of {} m", progress.travelled, d.distance());
-                    *drive = None;
-                    server.finish(GoalEnd::Succeeded, result(progress.travelled, "reached"));
-                } else {
-                    if let Err(e) = cmd.publish(twist(d.command())) {
-                        warn_throttled!(throttle, "cmd", "cannot publish cmd_vel: {e:?}");
+                // The law reads no time; the goal's own time is kept for the record.
+                let dt = session.advance(node.now_nanos()).and_then(Result::ok).unwrap_or(0.0);
+                let t = session.active().map_or(0.0, |a| a.t());
+                let Some(active) = session.active_mut() else { continue };
+                let step = active.goal.step(&StepInput::new(t, dt, pose), &());
+                match session.apply(step, twist, &mut sink) {
+                    Applied::Commanded(progress) => {
+                        let feedback = DriveDistanceFeedback { travelled: progress.travelled, remaining: progress.remaining };
+                        if let Err(e) = server.feedback(feedback).await {
+                            warn_throttled!(throttle, "feedback", "{e}");
+                        }
                     }
-                    let feedback = DriveDistanceFeedback { travelled: progress.travelled, remaining: progress.remaining };
-                    if let Err(e) = server.feedback(feedback).await {
-                        warn_throttled!(throttle, "feedback", "{e}");
-                    }
+                    Applied::Ended(ended, _) => finish(server, Some(ended)),
+                    Applied::Refused(ended) => finish(server, ended),
+                    Applied::Idle => {}
                 }
             }
         }
