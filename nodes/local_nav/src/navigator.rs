@@ -7,6 +7,7 @@ use crate::field::{vector_distance, Side};
 use crate::motion::{car_arc, command_along, Drive, MotionInput, MotionLimits, SpeedProfile, VelocityCommand};
 use crate::sectors::Sectors;
 use mobil_geom::{wrap, Pose2, Scan};
+use mobil_motion::{nav2, BodyTwist, GoalLaw, Outcome, Step, StepInput};
 use nalgebra::{Point2, Vector2};
 use std::f64::consts::{FRAC_PI_2, FRAC_PI_3};
 use thiserror::Error;
@@ -501,6 +502,44 @@ fn crossing_of_segment(p: Point2<f64>, q: Point2<f64>, h: Point2<f64>, g: Point2
     let l = p + (q - p) * (sp / (sp - sq));
     let t = (l - h).dot(&line) / len2;
     (t > 0.0 && t < 1.0).then_some(l)
+}
+
+impl NoPathReason {
+    /// The reason in words.
+    pub fn describe(self) -> &'static str {
+        match self {
+            NoPathReason::ReturnedToHitPoint => "boundary following returned to the hit point",
+            NoPathReason::NoProgress => "boundary following made too little progress toward the goal",
+        }
+    }
+}
+
+/// The navigator as a goal law, stepped once per scan (the method counts path, not time): the
+/// command along F or the boundary as the body twist, the step's output as the feedback and
+/// the report. Within the goal tolerance it succeeds; no path ends it `NO_PATH` (Nav2's
+/// `NO_VALID_PATH`); an input it refuses (a non-finite pose, no goal) is refused.
+impl GoalLaw for Navigator {
+    type Sensors = Scan;
+    type Feedback = StepOutput;
+    type Report = StepOutput;
+
+    fn step(&mut self, input: &StepInput, scan: &Scan) -> Step<StepOutput, StepOutput> {
+        let out = Navigator::step(self, input.pose, scan);
+        if let Some(e) = &out.input_error {
+            return Step::Refused(e.to_string());
+        }
+        match out.mode {
+            Mode::Reached => Step::end(Outcome::succeeded("goal reached"), out),
+            Mode::NoPath(r) => Step::end(
+                Outcome::failed("NO_PATH", r.describe(), nav2::compute_path::NO_VALID_PATH),
+                out,
+            ),
+            _ => Step::Command {
+                twist: BodyTwist::new(out.command.vx, out.command.vy, out.command.omega),
+                feedback: out,
+            },
+        }
+    }
 }
 
 #[cfg(test)]

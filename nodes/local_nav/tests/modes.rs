@@ -340,3 +340,34 @@ fn omni_turns_toward_a_goal_behind_its_field_of_view() {
     assert_relative_eq!(out.command.vy, 0.5, epsilon = 1e-12);
     assert_eq!(out.command.omega, 0.0);
 }
+
+#[test]
+fn as_a_goal_law_it_commands_the_navigators_command_and_ends_at_the_goal() {
+    use mobil_motion::{GoalLaw, Step, StepInput};
+    let free = scan(|_| None);
+    let mut nav = navigator(NavConfig::default());
+    let mut twin = nav.clone();
+    let at = |x: f64| StepInput::new(0.0, 0.05, Pose2::new(x, 0.0, 0.0));
+    // In open space the goal law's twist is the navigator's own command, straight at G.
+    let own = twin.step(Pose2::new(0.0, 0.0, 0.0), &free).command;
+    match GoalLaw::step(&mut nav, &at(0.0), &free) {
+        Step::Command { twist, feedback } => {
+            assert_eq!((twist.vx, twist.vy, twist.wz), (own.vx, own.vy, own.omega));
+            assert!(twist.vx > 0.0 && twist.vy.abs() < 1e-9 && twist.wz.abs() < 1e-9);
+            assert_eq!(feedback.mode, Mode::Rotate);
+            assert_relative_eq!(feedback.goal_distance, 5.0, epsilon = 1e-12);
+        }
+        other => panic!("{other:?}"),
+    }
+    // A non-finite pose is refused; the goal goes on.
+    let nan = StepInput::new(0.0, 0.05, Pose2::new(f64::NAN, 0.0, 0.0));
+    assert!(matches!(GoalLaw::step(&mut nav, &nan, &free), Step::Refused(_)));
+    // Within the 0.1 m tolerance of (5, 0): the end, succeeded.
+    match GoalLaw::step(&mut nav, &at(4.95), &free) {
+        Step::End(end) => {
+            assert!(end.outcome.is_success(), "{:?}", end.outcome);
+            assert_eq!(end.report.mode, Mode::Reached);
+        }
+        other => panic!("{other:?}"),
+    }
+}

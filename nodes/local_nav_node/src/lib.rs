@@ -11,9 +11,10 @@
 use mobil_chassis::model::ChassisConfig;
 use mobil_geom::Pose2;
 use mobil_local_nav::{
-    Drive, Mode, MotionLimits, NavConfig, NoPathReason, ProgressChecker, ProgressSettings, Sectors, Side,
-    UnseenSectors, VelocityCommand, WeightProfile,
+    Drive, Mode, MotionLimits, NavConfig, ProgressChecker, ProgressSettings, Sectors, Side, UnseenSectors,
+    VelocityCommand, WeightProfile,
 };
+use mobil_motion::Outcome;
 use mobil_msgs::builtin_interfaces::msg::Time;
 use mobil_msgs::geometry_msgs::msg::{Point, Pose, PoseStamped, Twist, Vector3};
 use mobil_msgs::mobil_msgs::msg::NavStatus;
@@ -22,6 +23,7 @@ use mobil_msgs::visualization_msgs::msg::{Marker, MarkerArray};
 use mobil_ros::chassis::{chassis_params, declare_chassis};
 use mobil_ros::config::{Config, ConfigError, Decl};
 use mobil_ros::geometry::{yaw_of, yaw_quaternion};
+use mobil_ros::motion::{EndCause, EndKind};
 use mobil_ros::time::seconds;
 use nalgebra::{Point2, Vector2};
 use std::time::Duration;
@@ -423,165 +425,6 @@ pub fn twist_from_command(command: VelocityCommand, limits: &MotionLimits) -> Tw
     t
 }
 
-/// Which input went stale.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum StaleInput {
-    /// The scan.
-    Scan,
-    /// The odometry.
-    Odom,
-    /// Both.
-    ScanAndOdom,
-}
-
-impl StaleInput {
-    /// For the status reason: "scan", "odom", "scan and odom".
-    pub fn as_str(&self) -> &'static str {
-        match self {
-            StaleInput::Scan => "scan",
-            StaleInput::Odom => "odom",
-            StaleInput::ScanAndOdom => "scan and odom",
-        }
-    }
-}
-
-/// Whether an input is stale for a running goal (steady clock). An input counts as old as its
-/// last valid message (`None`: never), but never older than the goal: a goal gets one timeout
-/// from its start for the inputs to arrive, so a goal sent just before the first scan does not
-/// fail at once.
-pub fn stale_input(
-    scan_age: Option<Duration>,
-    odom_age: Option<Duration>,
-    goal_age: Duration,
-    scan_timeout: Duration,
-    odom_timeout: Duration,
-) -> Option<StaleInput> {
-    let old = |age: Option<Duration>, timeout: Duration| age.map_or(goal_age, |a| a.min(goal_age)) > timeout;
-    match (old(scan_age, scan_timeout), old(odom_age, odom_timeout)) {
-        (true, true) => Some(StaleInput::ScanAndOdom),
-        (true, false) => Some(StaleInput::Scan),
-        (false, true) => Some(StaleInput::Odom),
-        (false, false) => None,
-    }
-}
-
-/// How a goal ended.
-#[derive(Debug, Clone, PartialEq)]
-pub enum GoalOutcome {
-    /// Within `xy_goal_tolerance`.
-    Succeeded,
-    /// The method found no path (eq. 3.60).
-    NoPath(NoPathReason),
-    /// The progress checker fired after this many seconds without progress.
-    NoProgress {
-        /// Seconds since the last progress.
-        since: f64,
-        /// The required movement radius (m).
-        radius: f64,
-    },
-    /// An input went stale.
-    Stale(StaleInput),
-    /// The action client canceled it.
-    Canceled,
-    /// A newer goal took over (from `goal_pose` or the action).
-    Preempted(&'static str),
-    /// The goal was refused (frame, NaN, too far).
-    Invalid(GoalError),
-    /// The navigator refused its input on this many scans in a row (the last error given).
-    StepErrors {
-        /// Consecutive refused steps.
-        count: u32,
-        /// The navigator's last error.
-        error: String,
-    },
-    /// The node shut down.
-    ShuttingDown,
-}
-
-impl GoalOutcome {
-    /// The reason code of the status: SUCCEEDED, NO_PATH, ABORTED, STALE_INPUT, CANCELED,
-    /// PREEMPTED, INVALID_GOAL, SHUTDOWN.
-    pub fn code(&self) -> &'static str {
-        match self {
-            GoalOutcome::Succeeded => "SUCCEEDED",
-            GoalOutcome::NoPath(_) => "NO_PATH",
-            GoalOutcome::NoProgress { .. } | GoalOutcome::StepErrors { .. } => "ABORTED",
-            GoalOutcome::Stale(_) => "STALE_INPUT",
-            GoalOutcome::Canceled => "CANCELED",
-            GoalOutcome::Preempted(_) => "PREEMPTED",
-            GoalOutcome::Invalid(_) => "INVALID_GOAL",
-            GoalOutcome::ShuttingDown => "SHUTDOWN",
-        }
-    }
-
-    /// The status reason: the code, a colon and the detail ("NO_PATH: returned to the hit
-    /// point").
-    pub fn reason(&self) -> String {
-        let detail = match self {
-            GoalOutcome::Succeeded => "goal reached".to_owned(),
-            GoalOutcome::NoPath(NoPathReason::ReturnedToHitPoint) => {
-                "boundary following returned to the hit point".to_owned()
-            }
-            GoalOutcome::NoPath(NoPathReason::NoProgress) => {
-                "boundary following made too little progress toward the goal".to_owned()
-            }
-            GoalOutcome::NoProgress { since, radius } => {
-                format!("no progress: moved less than {radius} m in {since:.2} s")
-            }
-            GoalOutcome::StepErrors { count, error } => {
-                format!("the navigator refused its input on {count} scans in a row: {error}")
-            }
-            GoalOutcome::Stale(which) => format!("{} stale: robot stopped", which.as_str()),
-            GoalOutcome::Canceled => "canceled by the client".to_owned(),
-            GoalOutcome::Preempted(by) => format!("preempted by a newer goal ({by})"),
-            GoalOutcome::Invalid(e) => e.to_string(),
-            GoalOutcome::ShuttingDown => "the node is shutting down".to_owned(),
-        };
-        format!("{}: {detail}", self.code())
-    }
-
-    /// The NavStatus state it leaves: SUCCEEDED or FAILED.
-    pub fn state(&self) -> u8 {
-        match self {
-            GoalOutcome::Succeeded => NavStatus::SUCCEEDED,
-            _ => NavStatus::FAILED,
-        }
-    }
-
-    /// The Nav2 error code of the action result (see [`nav2_error`]).
-    pub fn nav2_error_code(&self) -> u16 {
-        match self {
-            GoalOutcome::Succeeded | GoalOutcome::Canceled | GoalOutcome::Preempted(_) => nav2_error::NONE,
-            GoalOutcome::NoPath(_) => nav2_error::NO_VALID_PATH,
-            GoalOutcome::NoProgress { .. } => nav2_error::FAILED_TO_MAKE_PROGRESS,
-            GoalOutcome::Stale(_) | GoalOutcome::StepErrors { .. } => nav2_error::NO_VALID_CONTROL,
-            GoalOutcome::Invalid(_) | GoalOutcome::ShuttingDown => nav2_error::UNKNOWN,
-        }
-    }
-}
-
-/// After this many scans in a row that the navigator refuses, the goal ends ABORTED.
-pub const MAX_STEP_ERRORS: u32 = 20;
-
-/// Counts the navigator's consecutive refusals of one goal.
-#[derive(Debug, Clone, Default, PartialEq, Eq)]
-pub struct StepErrors {
-    count: u32,
-}
-
-impl StepErrors {
-    /// A step the navigator took: the count starts again.
-    pub fn ok(&mut self) {
-        self.count = 0;
-    }
-
-    /// A refused step; `Some(count)` once the count reaches [`MAX_STEP_ERRORS`] (the goal ends).
-    pub fn failed(&mut self) -> Option<u32> {
-        self.count = self.count.saturating_add(1);
-        (self.count >= MAX_STEP_ERRORS).then_some(self.count)
-    }
-}
-
 /// The heading a goal asks for, when it asks for one: the yaw of its orientation, `None` for
 /// the identity (or a quaternion within 1 mrad of it, or a zero one). The method reaches a
 /// position only, so the node says the heading is not kept.
@@ -794,6 +637,38 @@ pub fn clear_markers(stamp: Time, frame: &str) -> MarkerArray {
     MarkerArray { markers: vec![m] }
 }
 
+/// How the progress checker ends a goal: `ABORTED` with Nav2's `FAILED_TO_MAKE_PROGRESS`
+/// (two decimals, so 1.04 s against an allowance of 1 s does not print "1.0 s").
+pub fn no_progress(since: f64, radius: f64) -> EndCause {
+    EndCause::Outcome(Outcome::failed(
+        "ABORTED",
+        format!("no progress: moved less than {radius} m in {since:.2} s"),
+        nav2_error::FAILED_TO_MAKE_PROGRESS,
+    ))
+}
+
+/// How a goal's end is told: the status state, the status reason (also the action's
+/// `error_msg`) and `navigate_to_pose`'s error code. Stale or refused input is Nav2's
+/// `NO_VALID_CONTROL`, a shutdown `UNKNOWN`, a cancel or a pre-emption no error.
+pub fn end_answer(cause: &EndCause) -> (u8, String, u16) {
+    let state = match cause.kind() {
+        EndKind::Succeeded => NavStatus::SUCCEEDED,
+        EndKind::Canceled | EndKind::Aborted => NavStatus::FAILED,
+    };
+    let code = match cause {
+        EndCause::Outcome(o) => o.nav2_error(),
+        EndCause::Canceled | EndCause::Preempted(_) => nav2_error::NONE,
+        EndCause::Stale(_) | EndCause::Refused { .. } => nav2_error::NO_VALID_CONTROL,
+        EndCause::Shutdown => nav2_error::UNKNOWN,
+    };
+    (state, cause.reason(), code)
+}
+
+/// The status reason of a refused goal.
+pub fn invalid_goal(e: &GoalError) -> String {
+    format!("INVALID_GOAL: {e}")
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -897,65 +772,6 @@ mod tests {
     }
 
     #[test]
-    fn stale_inputs_are_named_after_a_grace_of_one_timeout() {
-        let ms = Duration::from_millis;
-        let (st, ot) = (ms(500), ms(300));
-        // Fresh both.
-        assert_eq!(stale_input(Some(ms(100)), Some(ms(100)), ms(5000), st, ot), None);
-        // Scan 600 ms old (> 500), odom 200 ms (< 300): the scan.
-        assert_eq!(
-            stale_input(Some(ms(600)), Some(ms(200)), ms(5000), st, ot),
-            Some(StaleInput::Scan)
-        );
-        assert_eq!(
-            stale_input(Some(ms(100)), Some(ms(400)), ms(5000), st, ot),
-            Some(StaleInput::Odom)
-        );
-        // Never any input, goal 200 ms old: within the grace. At 600 ms: both.
-        assert_eq!(stale_input(None, None, ms(200), st, ot), None);
-        assert_eq!(stale_input(None, None, ms(600), st, ot), Some(StaleInput::ScanAndOdom));
-        // A scan 10 s old when the goal came 400 ms ago: within the grace still.
-        assert_eq!(stale_input(Some(ms(10_000)), Some(ms(10)), ms(400), st, ot), None);
-    }
-
-    #[test]
-    fn outcomes_give_status_reasons_and_nav2_codes() {
-        let stale = GoalOutcome::Stale(StaleInput::Scan);
-        assert_eq!(stale.reason(), "STALE_INPUT: scan stale: robot stopped");
-        assert_eq!((stale.state(), stale.nav2_error_code()), (NavStatus::FAILED, 106));
-        assert_eq!(
-            GoalOutcome::NoPath(NoPathReason::ReturnedToHitPoint).nav2_error_code(),
-            208
-        );
-        let stuck = GoalOutcome::NoProgress {
-            since: 10.25,
-            radius: 0.5,
-        };
-        // Two decimals: an elapsed 1.04 s against an allowance of 1 s must not print "1.0 s".
-        assert_eq!(stuck.reason(), "ABORTED: no progress: moved less than 0.5 m in 10.25 s");
-        let just_over = GoalOutcome::NoProgress {
-            since: 1.04,
-            radius: 5.0,
-        };
-        assert_eq!(
-            just_over.reason(),
-            "ABORTED: no progress: moved less than 5 m in 1.04 s"
-        );
-        let errors = GoalOutcome::StepErrors {
-            count: 20,
-            error: "bad".into(),
-        };
-        assert_eq!(
-            errors.reason(),
-            "ABORTED: the navigator refused its input on 20 scans in a row: bad"
-        );
-        assert_eq!((errors.state(), errors.nav2_error_code()), (NavStatus::FAILED, 106));
-        assert_eq!(stuck.nav2_error_code(), 105);
-        assert_eq!(GoalOutcome::Succeeded.state(), NavStatus::SUCCEEDED);
-        assert_eq!(GoalOutcome::Invalid(GoalError::NotFinite).code(), "INVALID_GOAL");
-    }
-
-    #[test]
     fn defaults_build_the_library_defaults_and_bad_weights_are_refused() {
         let mut values = ParamValues::defaults(&Decl::<LocalNavConfig>::of().specs());
         let c: LocalNavConfig = mobil_ros::config::load(&values).unwrap();
@@ -1041,7 +857,7 @@ mod tests {
             Err(GoalError::TooFar { .. })
         ));
         assert_eq!(
-            GoalOutcome::Invalid(GoalError::TooFar { x: 2e4, y: 0.0 }).reason(),
+            invalid_goal(&GoalError::TooFar { x: 2e4, y: 0.0 }),
             "INVALID_GOAL: goal (20000, 0) is beyond ±10000 m"
         );
     }
@@ -1071,21 +887,6 @@ mod tests {
         assert_eq!(c.result_timeout(), Duration::from_secs(3600));
         // The result timeout is read once, at start-up.
         assert!(specs.iter().any(|s| s.name == "result_timeout_s" && s.read_only));
-    }
-
-    #[test]
-    fn consecutive_step_errors_end_the_goal_and_a_good_step_resets_them() {
-        let mut e = StepErrors::default();
-        for _ in 0..19 {
-            assert_eq!(e.failed(), None);
-        }
-        e.ok();
-        // After a good step, 19 more are allowed again; the 20th in a row ends the goal.
-        for _ in 0..19 {
-            assert_eq!(e.failed(), None);
-        }
-        assert_eq!(e.failed(), Some(20));
-        assert_eq!(MAX_STEP_ERRORS, 20);
     }
 
     #[test]
@@ -1144,6 +945,56 @@ mod tests {
         assert_eq!(
             p.check(Point2::new(0.1, 0.0), 131.5),
             mobil_local_nav::Progress::Stuck { since: 20.5 }
+        );
+    }
+
+    #[test]
+    fn ends_give_status_reasons_and_nav2_codes() {
+        use mobil_local_nav::NoPathReason;
+        let stale = end_answer(&EndCause::Stale("scan".into()));
+        assert_eq!(
+            stale,
+            (NavStatus::FAILED, "STALE_INPUT: scan stale: robot stopped".into(), 106)
+        );
+        let no_path = Outcome::failed("NO_PATH", NoPathReason::ReturnedToHitPoint.describe(), 208);
+        assert_eq!(
+            end_answer(&EndCause::Outcome(no_path)),
+            (
+                NavStatus::FAILED,
+                "NO_PATH: boundary following returned to the hit point".into(),
+                208
+            )
+        );
+        assert_eq!(
+            end_answer(&no_progress(10.25, 0.5)),
+            (
+                NavStatus::FAILED,
+                "ABORTED: no progress: moved less than 0.5 m in 10.25 s".into(),
+                105
+            )
+        );
+        // Two decimals: 1.04 s is not "1.0 s".
+        assert_eq!(
+            end_answer(&no_progress(1.04, 5.0)).1,
+            "ABORTED: no progress: moved less than 5 m in 1.04 s"
+        );
+        let refused = end_answer(&EndCause::Refused {
+            count: 20,
+            last: "bad".into(),
+        });
+        assert_eq!((refused.0, refused.2), (NavStatus::FAILED, 106));
+        assert!(refused.1.starts_with("INVALID_INPUT: "), "{}", refused.1);
+        let reached = end_answer(&EndCause::Outcome(Outcome::succeeded("goal reached")));
+        assert_eq!(reached, (NavStatus::SUCCEEDED, "SUCCEEDED: goal reached".into(), 0));
+        assert_eq!(end_answer(&EndCause::Canceled).2, 0);
+        assert_eq!(
+            end_answer(&EndCause::Preempted("goal_pose")).1,
+            "PREEMPTED: preempted by a newer goal (goal_pose)"
+        );
+        assert_eq!(end_answer(&EndCause::Shutdown).2, 100);
+        assert_eq!(
+            invalid_goal(&GoalError::NotFinite),
+            "INVALID_GOAL: goal pose is not finite"
         );
     }
 }

@@ -10,20 +10,23 @@
 //! action feedback; status and markers follow at `status_rate_hz` (and the status on every
 //! change of state or mode).
 //!
-//! `cmd_vel` goes out only while a goal is active, and exactly one zero `cmd_vel` when a goal
-//! ends (reached, no path, no progress, stale input, canceled, pre-empted, refused, shutdown);
-//! every command is held to the chassis limits ([`twist_from_command`]). A refused input while a
-//! goal runs (scan, laser pose, odometry, navigator step) stops the robot with one zero command.
-//! At shutdown with a goal under way, that goal's zero command is the last one, waited for
-//! ([`final_stop`]); an idle node sends none.
+//! Goals run through the kit's motion server ([`MotionSession`]), the navigator being the goal
+//! law: `cmd_vel` only while a goal is active, exactly one zero `cmd_vel` when a goal that moved
+//! the robot ends (reached, no path, no progress, stale input, canceled, refused), none between
+//! a goal and the newer goal that pre-empts it; every command is held to the chassis limits
+//! ([`twist_from_command`]). A refused input while a goal runs (scan, laser pose, odometry)
+//! stops the robot with one zero command; the navigator refusing its input on 20 scans in a row
+//! ends the goal `INVALID_INPUT`. At shutdown with a goal under way, its zero command is the last
+//! one, waited for ([`final_stop`]); an idle node sends none.
 
 use futures::StreamExt;
 use mobil_geom::Pose2;
-use mobil_local_nav::{Mode, MotionLimits, Navigator, Progress, ProgressChecker, StepOutput};
+use mobil_local_nav::{Mode, MotionLimits, Navigator, Progress, ProgressChecker, StepOutput, VelocityCommand};
 use mobil_local_nav_node::{
-    clear_markers, goal_heading, goal_in_odom, markers, reconfigured_progress, stale_input, status_message,
-    twist_from_command, GoalOutcome, LocalNavConfig, MarkerView, StatusView, StepErrors,
+    clear_markers, end_answer, goal_heading, goal_in_odom, invalid_goal, markers, no_progress, reconfigured_progress,
+    status_message, twist_from_command, LocalNavConfig, MarkerView, StatusView,
 };
+use mobil_motion::{BodyTwist, GoalLaw, Step, StepInput};
 use mobil_msgs::builtin_interfaces::msg::Time;
 use mobil_msgs::geometry_msgs::msg::{Pose, PoseStamped, Twist};
 use mobil_msgs::mobil_msgs::msg::NavStatus;
@@ -36,9 +39,9 @@ use mobil_ros::action::{ActionEvent, GoalEnd, GoalRequest, GoalServer, GoalServe
 use mobil_ros::geometry::odom_pose;
 use mobil_ros::input::{decoded, Input};
 use mobil_ros::latest::Latest;
+use mobil_ros::motion::{Applied, CmdVel, EndCause, EndKind, Ended, MotionSession, SessionSettings, Watched};
 use mobil_ros::scan::{scan_from_msg, tf_static_subscription, StaticFrames};
 use mobil_ros::scan::{scan_laser_pose, LaserPoseFrom, ScanRefusal};
-use mobil_ros::stop::CommandGate;
 use mobil_ros::stop::{final_stop, FINAL_STOP_WAIT};
 use mobil_ros::ticker::Ticker;
 use mobil_ros::time::duration_msg;
@@ -71,22 +74,31 @@ enum Source {
     Action,
 }
 
-impl Source {
-    fn name(self) -> &'static str {
-        match self {
+impl From<Source> for &'static str {
+    fn from(s: Source) -> &'static str {
+        match s {
             Source::Topic => "goal_pose",
             Source::Action => "navigate_to_pose",
         }
     }
 }
 
+impl Source {
+    fn name(self) -> &'static str {
+        self.into()
+    }
+}
+
+/// What the node keeps with the active goal (the navigator, the goal law, is the shell's: it
+/// is rebuilt on a parameter change and keeps the goal).
 #[derive(Debug, Clone)]
-struct ActiveGoal {
+struct NavGoal {
     goal: Point2<f64>,
-    source: Source,
-    started: Instant,
     started_ros_nanos: i64,
 }
+
+type Session = MotionSession<NavGoal, Source>;
+type NavEnded = Ended<NavGoal, Source>;
 
 /// The latest valid odometry: the pose for the navigator, the message pose and speed for the
 /// action feedback.
@@ -109,7 +121,7 @@ struct Shell {
     limits: MotionLimits,
     nav: Navigator,
     progress: ProgressChecker,
-    active: Option<ActiveGoal>,
+    session: Session,
     scan_seen: Latest<()>,
     odom: Latest<OdomSample>,
     /// The latest odometry message was refused: no step until a valid one comes (the last
@@ -117,8 +129,6 @@ struct Shell {
     odom_refused: bool,
     last_step: Option<StepOutput>,
     last_status: Option<Instant>,
-    gate: CommandGate,
-    step_errors: StepErrors,
     throttle: LogThrottle,
 }
 
@@ -142,32 +152,29 @@ async fn serve(node: &mut RosNode) -> anyhow::Result<()> {
         status: node.publisher::<NavStatus>("local_nav/status", &qos::latched())?,
         markers: node.publisher::<MarkerArray>("local_nav/markers", &qos::default_qos())?,
     };
-    let (outcome, was_active) = run(node, &outputs, config).await;
+    let (outcome, final_zero) = run(node, &outputs, config).await;
     // A goal under way at the end gets its zero command, waited for; an idle node sends none
     // (another node, teleop or a twist_mux input, may be commanding the robot).
-    if was_active {
+    if final_zero {
         final_stop(&outputs.cmd, Twist::default(), FINAL_STOP_WAIT).await;
     }
     outcome
 }
 
-fn result(outcome: &GoalOutcome) -> NavigateToPoseResult {
-    NavigateToPoseResult {
-        error_code: outcome.nav2_error_code(),
-        error_msg: outcome.reason(),
+fn result(cause: &EndCause) -> NavigateToPoseResult {
+    let (_, error_msg, error_code) = end_answer(cause);
+    NavigateToPoseResult { error_code, error_msg }
+}
+
+fn goal_end(cause: &EndCause) -> GoalEnd {
+    match cause.kind() {
+        EndKind::Succeeded => GoalEnd::Succeeded,
+        EndKind::Canceled => GoalEnd::Canceled,
+        EndKind::Aborted => GoalEnd::Aborted,
     }
 }
 
-fn goal_end(outcome: &GoalOutcome) -> GoalEnd {
-    match outcome {
-        GoalOutcome::Succeeded => GoalEnd::Succeeded,
-        GoalOutcome::Canceled => GoalEnd::Canceled,
-        _ => GoalEnd::Aborted,
-    }
-}
-
-/// The loop's outcome, and whether a goal was active when it ended (its zero command is then
-/// still to be sent).
+/// The loop's outcome, and whether the node's last word must be a zero command.
 async fn run(node: &mut RosNode, out: &Outputs, config: LocalNavConfig) -> (anyhow::Result<()>, bool) {
     match start(node, out, config).await {
         Ok(r) => r,
@@ -199,14 +206,12 @@ async fn start(
         config,
         limits,
         nav,
-        active: None,
+        session: Session::new(SessionSettings::default()),
         scan_seen: Latest::new(),
         odom: Latest::new(),
         odom_refused: false,
         last_step: None,
         last_status: None,
-        gate: CommandGate::default(),
-        step_errors: StepErrors::default(),
         throttle: LogThrottle::new(Duration::from_secs(2)),
     };
     shell.publish_status(node, out, NavStatus::IDLE, String::new());
@@ -226,13 +231,13 @@ async fn start(
         &tf_sub,
     )
     .await;
-    let was_active = shell.active.is_some();
-    if was_active {
-        // The zero command is the final, acknowledged one (serve); none here.
-        shell.end_goal_without_zero(node, out, &mut server, GoalOutcome::ShuttingDown);
+    // The zero command, if one is due, is the final, acknowledged one (serve); none here.
+    let (ended, final_zero) = shell.session.shutdown();
+    if let Some(ended) = ended {
+        shell.report(node, out, &mut server, ended, true);
     }
-    server.close(result(&GoalOutcome::ShuttingDown)).await;
-    Ok((outcome, was_active))
+    server.close(result(&EndCause::Shutdown)).await;
+    Ok((outcome, final_zero))
 }
 
 #[allow(clippy::too_many_arguments)]
@@ -275,12 +280,13 @@ async fn event_loop(
             e = server.next_event() => Event::Action(e),
             _ = ticker.tick() => Event::Tick,
         };
+        let mut sink = CmdVel::new(&out.cmd);
         match event {
             Event::Shutdown => return Ok(()),
             Event::Nothing => {}
             Event::Config(Ok(c)) => shell.reconfigure(c),
             Event::Config(Err(e)) => warn!("parameters not applied: {e}"),
-            Event::Odom(m) => shell.odom_in(out, &m),
+            Event::Odom(m) => shell.odom_in(&mut sink, &m),
             Event::Scan(m) => {
                 let skipped = laser.take_all(tf_sub);
                 if skipped > 0 {
@@ -290,21 +296,38 @@ async fn event_loop(
                         "{skipped} invalid tf_static transform(s) skipped"
                     );
                 }
-                shell.scan_in(node, out, server, laser, &m);
+                shell.scan_in(node, out, &mut sink, server, laser, &m);
             }
-            Event::GoalPose(m) => shell.goal_pose_in(node, out, server, &m),
-            Event::Action(ActionEvent::Goal(request)) => shell.action_goal_in(node, out, server, request).await,
+            Event::GoalPose(m) => shell.goal_pose_in(node, out, &mut sink, server, &m),
+            Event::Action(ActionEvent::Goal(request)) => {
+                shell.action_goal_in(node, out, &mut sink, server, request).await
+            }
             Event::Action(ActionEvent::CancelRequested(id)) => {
-                if shell.active.as_ref().is_some_and(|a| a.source == Source::Action) && server.active_id() == Some(id) {
-                    shell.end_goal(node, out, server, GoalOutcome::Canceled);
+                let ours = shell.session.active().is_some_and(|a| a.source == Source::Action);
+                if ours && server.active_id() == Some(id) {
+                    shell.end_goal(node, out, &mut sink, server, EndCause::Canceled);
                 }
             }
-            Event::Tick => shell.tick(node, out, server).await,
+            Event::Tick => shell.tick(node, out, &mut sink, server).await,
         }
     }
 }
 
 type TFMessageAlias = mobil_msgs::tf2_msgs::msg::TFMessage;
+
+/// A command of the navigator (a body twist) held to the chassis limits.
+fn limited(limits: &MotionLimits) -> impl Fn(BodyTwist) -> Twist + '_ {
+    move |b| {
+        twist_from_command(
+            VelocityCommand {
+                vx: b.vx,
+                vy: b.vy,
+                omega: b.wz,
+            },
+            limits,
+        )
+    }
+}
 
 impl Shell {
     fn reconfigure(&mut self, c: LocalNavConfig) {
@@ -315,9 +338,9 @@ impl Shell {
             .and_then(|(l, n)| Navigator::new(n, l).map(|nav| (l, nav)).map_err(|e| e.to_string()));
         match built {
             Ok((limits, mut nav)) => {
-                if let Some(a) = &self.active {
+                if let Some(a) = self.session.active() {
                     // A valid goal stays valid; the new navigator starts it again in R-mode.
-                    if nav.set_goal(a.goal).is_err() {
+                    if nav.set_goal(a.goal.goal).is_err() {
                         warn!("goal could not be carried over the parameter change");
                     }
                     info!("parameters changed: the goal restarts in R-mode with them");
@@ -334,7 +357,7 @@ impl Shell {
 
     /// A valid odometry message is kept; a refused one is dropped, and while a goal runs the
     /// robot stops (one zero command) until valid odometry comes again.
-    fn odom_in(&mut self, out: &Outputs, m: &Odometry) {
+    fn odom_in(&mut self, sink: &mut CmdVel<'_>, m: &Odometry) {
         let speed = m.twist.twist.linear.x.hypot(m.twist.twist.linear.y);
         match odom_pose(m, &self.config.odom_frame, &self.config.base_frame) {
             Ok(pose) => {
@@ -351,15 +374,8 @@ impl Shell {
             Err(e) => {
                 warn_throttled!(self.throttle, "odom-bad", "odom sample dropped: {e}; robot stopped");
                 self.odom_refused = true;
-                self.refused(out);
+                self.session.hold(sink);
             }
-        }
-    }
-
-    /// An input was refused while a goal may run: a zero command if the robot was moving.
-    fn refused(&mut self, out: &Outputs) {
-        if self.active.is_some() && self.gate.refused() {
-            self.zero(out);
         }
     }
 
@@ -393,64 +409,9 @@ impl Shell {
 
     /// The status of the current goal (or of none).
     fn publish_status(&mut self, node: &RosNode, out: &Outputs, state: u8, reason: String) {
-        let goal = self.active.as_ref().map(|a| a.goal).or(self.nav.goal());
+        let goal = self.session.active().map(|a| a.goal.goal).or(self.nav.goal());
         let view = self.status_view(state, reason, self.nav.mode(), goal);
         self.send_status(node, out, &view);
-    }
-
-    fn zero(&mut self, out: &Outputs) {
-        self.gate.sent(&Twist::default());
-        if let Err(e) = out.cmd.publish(Twist::default()) {
-            warn_throttled!(self.throttle, "cmd", "cannot publish the zero cmd_vel: {e:?}");
-        }
-    }
-
-    /// Ends the active goal: one zero command, the status with the reason, the action's result.
-    fn end_goal(
-        &mut self,
-        node: &RosNode,
-        out: &Outputs,
-        server: &mut GoalServer<NavigateToPose>,
-        outcome: GoalOutcome,
-    ) {
-        if self.active.is_some() {
-            self.zero(out);
-        }
-        self.end_goal_without_zero(node, out, server, outcome);
-    }
-
-    /// [`Shell::end_goal`] but for the zero command, which the caller sends.
-    fn end_goal_without_zero(
-        &mut self,
-        node: &RosNode,
-        out: &Outputs,
-        server: &mut GoalServer<NavigateToPose>,
-        outcome: GoalOutcome,
-    ) {
-        let Some(active) = self.active.take() else { return };
-        if active.source == Source::Action {
-            server.finish(goal_end(&outcome), result(&outcome));
-        }
-        match outcome {
-            GoalOutcome::Succeeded | GoalOutcome::Canceled | GoalOutcome::Preempted(_) => {
-                info!("goal ({}) ends: {}", active.source.name(), outcome.reason())
-            }
-            _ => warn!("goal ({}) ends: {}", active.source.name(), outcome.reason()),
-        }
-        // The status keeps the last step's mode, distance, H and L; the goal stays in it.
-        let state = outcome.state();
-        let mode_before = self.nav.mode();
-        self.publish_status_with_mode(node, out, state, outcome.reason(), mode_before, Some(active.goal));
-        self.nav.cancel();
-        self.progress.reset();
-        self.step_errors.ok();
-        self.last_step = None;
-        if let Err(e) = out
-            .markers
-            .publish(clear_markers(node.stamp(), &self.config.odom_frame))
-        {
-            warn_throttled!(self.throttle, "markers", "cannot publish local_nav/markers: {e:?}");
-        }
     }
 
     fn publish_status_with_mode(
@@ -466,22 +427,85 @@ impl Shell {
         self.send_status(node, out, &view);
     }
 
-    /// Starts a validated goal (the old one, if any, has been ended).
-    fn start_goal(&mut self, node: &RosNode, out: &Outputs, goal: Point2<f64>, heading: Option<f64>, source: Source) {
+    /// Ends the active goal with `cause` (the session sends its zero command, if one is due)
+    /// and reports it.
+    fn end_goal(
+        &mut self,
+        node: &RosNode,
+        out: &Outputs,
+        sink: &mut CmdVel<'_>,
+        server: &mut GoalServer<NavigateToPose>,
+        cause: EndCause,
+    ) {
+        if let Some(ended) = self.session.end(cause, sink) {
+            self.report(node, out, server, ended, true);
+        }
+    }
+
+    /// Tells an ended goal's end: the action's result (unless the server already ended it,
+    /// when a newer action goal took its place), the log, the status with the last step's mode,
+    /// distance, H and L; the navigator and the progress checker are cleared and the markers
+    /// deleted.
+    fn report(
+        &mut self,
+        node: &RosNode,
+        out: &Outputs,
+        server: &mut GoalServer<NavigateToPose>,
+        ended: NavEnded,
+        finish_action: bool,
+    ) {
+        let (state, reason, _) = end_answer(&ended.cause);
+        if ended.source == Source::Action && finish_action {
+            server.finish(goal_end(&ended.cause), result(&ended.cause));
+        }
+        match ended.cause.kind() {
+            EndKind::Succeeded | EndKind::Canceled => info!("goal ({}) ends: {reason}", ended.source.name()),
+            EndKind::Aborted if matches!(ended.cause, EndCause::Preempted(_)) => {
+                info!("goal ({}) ends: {reason}", ended.source.name())
+            }
+            EndKind::Aborted => warn!("goal ({}) ends: {reason}", ended.source.name()),
+        }
+        let mode_before = self.nav.mode();
+        self.publish_status_with_mode(node, out, state, reason, mode_before, Some(ended.goal.goal));
+        self.nav.cancel();
+        self.progress.reset();
+        self.last_step = None;
+        if let Err(e) = out
+            .markers
+            .publish(clear_markers(node.stamp(), &self.config.odom_frame))
+        {
+            warn_throttled!(self.throttle, "markers", "cannot publish local_nav/markers: {e:?}");
+        }
+    }
+
+    /// Starts a validated goal: the goal it replaces, if any, ends PREEMPTED (reported; its
+    /// action goal already ended by the server when `old_ended_by_server`).
+    #[allow(clippy::too_many_arguments)]
+    fn start_goal(
+        &mut self,
+        node: &RosNode,
+        out: &Outputs,
+        server: &mut GoalServer<NavigateToPose>,
+        goal: Point2<f64>,
+        heading: Option<f64>,
+        source: Source,
+        old_ended_by_server: bool,
+    ) {
+        let new = NavGoal {
+            goal,
+            started_ros_nanos: node.now_nanos(),
+        };
+        let (_, old) = self.session.start(new, source, Instant::now());
+        if let Some(old) = old {
+            let by_server = old_ended_by_server && old.source == Source::Action;
+            self.report(node, out, server, old, !by_server);
+        }
         if let Err(e) = self.nav.set_goal(goal) {
             // goal_in_odom checked it: unreachable in practice, and safe if reached.
             warn!("goal refused by the navigator: {e}");
-            return;
         }
         self.progress.reset();
-        self.step_errors.ok();
         self.last_step = None;
-        self.active = Some(ActiveGoal {
-            goal,
-            source,
-            started: Instant::now(),
-            started_ros_nanos: node.now_nanos(),
-        });
         info!(
             "goal ({}): ({:.3}, {:.3}) in {}",
             source.name(),
@@ -504,24 +528,18 @@ impl Shell {
         &mut self,
         node: &RosNode,
         out: &Outputs,
+        sink: &mut CmdVel<'_>,
         server: &mut GoalServer<NavigateToPose>,
         m: &PoseStamped,
     ) {
         match goal_in_odom(m, &self.config.odom_frame) {
-            Ok(goal) => {
-                if self.active.is_some() {
-                    self.end_goal(node, out, server, GoalOutcome::Preempted("goal_pose"));
-                }
-                self.start_goal(node, out, goal, goal_heading(m), Source::Topic);
-            }
+            Ok(goal) => self.start_goal(node, out, server, goal, goal_heading(m), Source::Topic, false),
             Err(e) => {
                 // A goal the user meant to replace the old one with: the old one stops too.
-                if self.active.is_some() {
-                    self.end_goal(node, out, server, GoalOutcome::Preempted("goal_pose, refused"));
-                }
-                let outcome = GoalOutcome::Invalid(e);
-                warn!("goal_pose refused: {}", outcome.reason());
-                self.publish_status_with_mode(node, out, NavStatus::FAILED, outcome.reason(), Mode::Idle, None);
+                self.end_goal(node, out, sink, server, EndCause::Preempted("goal_pose, refused"));
+                let reason = invalid_goal(&e);
+                warn!("goal_pose refused: {reason}");
+                self.publish_status_with_mode(node, out, NavStatus::FAILED, reason, Mode::Idle, None);
             }
         }
     }
@@ -530,20 +548,21 @@ impl Shell {
         &mut self,
         node: &RosNode,
         out: &Outputs,
+        sink: &mut CmdVel<'_>,
         server: &mut GoalServer<NavigateToPose>,
         request: GoalRequest<NavigateToPoseGoal>,
     ) {
         let goal = match goal_in_odom(&request.goal().pose, &self.config.odom_frame) {
             Ok(g) => g,
             Err(e) => {
-                let reason = GoalOutcome::Invalid(e).reason();
+                let reason = invalid_goal(&e);
                 warn!("navigate_to_pose goal rejected: {reason}");
                 server.reject(request, &reason).await;
                 // The status says so too; a running goal keeps running (unlike a refused
                 // goal_pose, a rejected action goal never replaces the active one), and its
                 // ACTIVE status follows, so that the latched status is the running goal's.
                 self.publish_status_with_mode(node, out, NavStatus::FAILED, reason, Mode::Idle, None);
-                if self.active.is_some() {
+                if self.session.active().is_some() {
                     self.publish_status(node, out, NavStatus::ACTIVE, String::new());
                 }
                 return;
@@ -557,31 +576,19 @@ impl Shell {
                 request.goal().behavior_tree
             );
         }
-        if let Some(old) = self.active.clone() {
-            let outcome = GoalOutcome::Preempted("navigate_to_pose");
-            if old.source == Source::Action {
-                // The server ends the old action goal itself on accept, with this result.
-                self.active = None;
-                self.zero(out);
-                info!("goal ({}) ends: {}", old.source.name(), outcome.reason());
-                self.publish_status_with_mode(
-                    node,
-                    out,
-                    NavStatus::FAILED,
-                    outcome.reason(),
-                    self.nav.mode(),
-                    Some(old.goal),
-                );
-                self.nav.cancel();
-            } else {
-                self.end_goal(node, out, server, outcome);
-            }
-        }
         let heading = goal_heading(&request.goal().pose);
-        let preempted = result(&GoalOutcome::Preempted("navigate_to_pose"));
+        // The server ends a running action goal itself on accept, with this result.
+        let preempted = result(&EndCause::Preempted("navigate_to_pose"));
         match server.accept(request, |_| preempted).await {
-            Ok(()) => self.start_goal(node, out, goal, heading, Source::Action),
-            Err(e) => warn_throttled!(self.throttle, "accept", "navigate_to_pose goal not started: {e}"),
+            Ok(()) => self.start_goal(node, out, server, goal, heading, Source::Action, true),
+            Err(e) => {
+                warn_throttled!(self.throttle, "accept", "navigate_to_pose goal not started: {e}");
+                // A running action goal was ended by the server: the robot stops with it.
+                if let Some(ended) = self.session.end(EndCause::Preempted("navigate_to_pose"), sink) {
+                    let by_server = ended.source == Source::Action;
+                    self.report(node, out, server, ended, !by_server);
+                }
+            }
         }
     }
 
@@ -589,6 +596,7 @@ impl Shell {
         &mut self,
         node: &RosNode,
         out: &Outputs,
+        sink: &mut CmdVel<'_>,
         server: &mut GoalServer<NavigateToPose>,
         laser: &StaticFrames,
         m: &LaserScan,
@@ -613,7 +621,7 @@ impl Shell {
                     ScanRefusal::Invalid(_) => "scan-bad",
                 };
                 warn_throttled!(self.throttle, key, "{e}; scan ignored");
-                return self.refused(out);
+                return self.session.hold(sink);
             }
         };
         if self.scan_seen.value().is_none() {
@@ -632,7 +640,7 @@ impl Shell {
             );
         }
         self.scan_seen.set((), m.header.stamp.clone());
-        if self.active.is_none() {
+        if self.session.active().is_none() {
             return;
         }
         let fresh = self.odom.get(self.config.odom_timeout()).filter(|_| !self.odom_refused);
@@ -644,61 +652,71 @@ impl Shell {
                 "odom-stale",
                 "scan ignored: odom stale or refused; robot stopped"
             );
-            return self.refused(out);
+            return self.session.hold(sink);
         };
-        let step = self.nav.step(odom.pose, &scan);
-        if let Some(e) = step.input_error {
+        // The method counts path, not time: the step's time is the progress checker's.
+        let now = node.now_nanos() as f64 * 1e-9;
+        let step = GoalLaw::step(&mut self.nav, &StepInput::new(now, 0.0, odom.pose), &scan);
+        if let Step::Command { .. } = &step
+            && let Progress::Stuck { since } = self.progress.check(odom.pose.position(), now)
+        {
+            let radius = self.progress.settings().required_movement_radius;
+            return self.end_goal(node, out, sink, server, no_progress(since, radius));
+        }
+        if let Step::Refused(why) = &step {
             warn_throttled!(
                 self.throttle,
                 "nav-input",
-                "navigator refused its input: {e}; robot stopped"
+                "navigator refused its input: {why}; robot stopped"
             );
-            if let Some(count) = self.step_errors.failed() {
-                let outcome = GoalOutcome::StepErrors {
-                    count,
-                    error: e.to_string(),
-                };
-                return self.end_goal(node, out, server, outcome);
+        }
+        match self.session.apply(step, limited(&self.limits), sink) {
+            Applied::Commanded(output) => {
+                let changed = output.changed_from.is_some();
+                let mode = output.mode;
+                self.last_step = Some(output);
+                if changed {
+                    info!("mode {}", mobil_local_nav_node::mode_name(mode));
+                    self.publish_status(node, out, NavStatus::ACTIVE, String::new());
+                }
             }
-            return self.refused(out);
-        }
-        self.step_errors.ok();
-        let changed = step.changed_from.is_some();
-        let mode = step.mode;
-        let command = step.command;
-        self.last_step = Some(step);
-        match mode {
-            Mode::Reached => return self.end_goal(node, out, server, GoalOutcome::Succeeded),
-            Mode::NoPath(r) => return self.end_goal(node, out, server, GoalOutcome::NoPath(r)),
-            _ => {}
-        }
-        let now = node.now_nanos() as f64 * 1e-9;
-        if let Progress::Stuck { since } = self.progress.check(odom.pose.position(), now) {
-            let radius = self.progress.settings().required_movement_radius;
-            return self.end_goal(node, out, server, GoalOutcome::NoProgress { since, radius });
-        }
-        let twist = twist_from_command(command, &self.limits);
-        self.gate.sent(&twist);
-        if let Err(e) = out.cmd.publish(twist) {
-            warn_throttled!(self.throttle, "cmd", "cannot publish cmd_vel: {e:?}");
-        }
-        if changed {
-            info!("mode {}", mobil_local_nav_node::mode_name(mode));
-            self.publish_status(node, out, NavStatus::ACTIVE, String::new());
+            Applied::Refused(ended) => {
+                if let Some(ended) = ended {
+                    self.report(node, out, server, ended, true);
+                }
+            }
+            Applied::Ended(ended, output) => {
+                self.last_step = Some(output);
+                self.report(node, out, server, ended, true);
+            }
+            Applied::Idle => {}
         }
     }
 
-    async fn tick(&mut self, node: &RosNode, out: &Outputs, server: &mut GoalServer<NavigateToPose>) {
-        let Some(active) = self.active.clone() else { return };
+    async fn tick(
+        &mut self,
+        node: &RosNode,
+        out: &Outputs,
+        sink: &mut CmdVel<'_>,
+        server: &mut GoalServer<NavigateToPose>,
+    ) {
+        let Some(active) = self.session.active() else { return };
+        let (goal, source) = (active.goal.clone(), active.source);
         let now = Instant::now();
-        if let Some(which) = stale_input(
-            self.scan_seen.age_at(now),
-            self.odom.age_at(now),
-            now.saturating_duration_since(active.started),
-            self.config.scan_timeout(),
-            self.config.odom_timeout(),
-        ) {
-            return self.end_goal(node, out, server, GoalOutcome::Stale(which));
+        let inputs = [
+            Watched {
+                name: "scan",
+                age: self.scan_seen.age_at(now),
+                timeout: self.config.scan_timeout(),
+            },
+            Watched {
+                name: "odom",
+                age: self.odom.age_at(now),
+                timeout: self.config.odom_timeout(),
+            },
+        ];
+        if let Some(stale) = self.session.stale(now, &inputs) {
+            return self.end_goal(node, out, sink, server, EndCause::Stale(stale));
         }
         let period = Duration::from_secs_f64(1.0 / self.config.status_rate_hz);
         let stamp = node.stamp();
@@ -707,17 +725,19 @@ impl Shell {
             .is_none_or(|t| now.saturating_duration_since(t) >= period)
         {
             self.publish_status(node, out, NavStatus::ACTIVE, String::new());
-            self.publish_markers(out, &active, stamp.clone());
+            self.publish_markers(out, goal.goal, stamp.clone());
         }
-        self.feedback(node, server, &active, stamp).await;
+        if source == Source::Action {
+            self.feedback(node, server, &goal, stamp).await;
+        }
     }
 
-    fn publish_markers(&mut self, out: &Outputs, active: &ActiveGoal, stamp: Time) {
+    fn publish_markers(&mut self, out: &Outputs, goal: Point2<f64>, stamp: Time) {
         if let Some(step) = &self.last_step {
             let view = MarkerView {
                 sectors: self.nav.sectors(),
                 direction: step.direction,
-                goal: Some(active.goal),
+                goal: Some(goal),
                 hit_point: step.hit_point,
                 leave_point: step.leave_point,
             };
@@ -729,34 +749,26 @@ impl Shell {
     }
 
     /// Action feedback, on every watchdog tick (20 Hz) while an action goal is active.
-    async fn feedback(
-        &mut self,
-        node: &RosNode,
-        server: &mut GoalServer<NavigateToPose>,
-        active: &ActiveGoal,
-        stamp: Time,
-    ) {
-        if active.source == Source::Action {
-            let Some(odom) = self.odom.value() else { return };
-            let distance = (active.goal - odom.pose.position()).norm();
-            let elapsed = (node.now_nanos().saturating_sub(active.started_ros_nanos)) as f64 * 1e-9;
-            let remaining = if odom.speed > 0.01 { distance / odom.speed } else { 0.0 };
-            let feedback = NavigateToPoseFeedback {
-                current_pose: PoseStamped {
-                    header: Header {
-                        stamp: stamp.clone(),
-                        frame_id: self.config.odom_frame.clone(),
-                    },
-                    pose: odom.msg_pose.clone(),
+    async fn feedback(&mut self, node: &RosNode, server: &mut GoalServer<NavigateToPose>, goal: &NavGoal, stamp: Time) {
+        let Some(odom) = self.odom.value() else { return };
+        let distance = (goal.goal - odom.pose.position()).norm();
+        let elapsed = (node.now_nanos().saturating_sub(goal.started_ros_nanos)) as f64 * 1e-9;
+        let remaining = if odom.speed > 0.01 { distance / odom.speed } else { 0.0 };
+        let feedback = NavigateToPoseFeedback {
+            current_pose: PoseStamped {
+                header: Header {
+                    stamp: stamp.clone(),
+                    frame_id: self.config.odom_frame.clone(),
                 },
-                navigation_time: duration_msg(elapsed),
-                estimated_time_remaining: duration_msg(remaining),
-                number_of_recoveries: 0,
-                distance_remaining: distance as f32,
-            };
-            if let Err(e) = server.feedback(feedback).await {
-                warn_throttled!(self.throttle, "feedback", "{e}");
-            }
+                pose: odom.msg_pose.clone(),
+            },
+            navigation_time: duration_msg(elapsed),
+            estimated_time_remaining: duration_msg(remaining),
+            number_of_recoveries: 0,
+            distance_remaining: distance as f32,
+        };
+        if let Err(e) = server.feedback(feedback).await {
+            warn_throttled!(self.throttle, "feedback", "{e}");
         }
     }
 }

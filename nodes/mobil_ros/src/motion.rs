@@ -168,13 +168,13 @@ impl EndCause {
     pub fn reason(&self) -> String {
         match self {
             EndCause::Outcome(o) => o.reason(),
-            EndCause::Canceled => "CANCELED".to_owned(),
-            EndCause::Preempted(by) => format!("PREEMPTED: a newer goal ({by})"),
+            EndCause::Canceled => "CANCELED: canceled by the client".to_owned(),
+            EndCause::Preempted(by) => format!("PREEMPTED: preempted by a newer goal ({by})"),
             EndCause::Refused { count, last } => {
-                format!("INVALID_INPUT: the law refused its input {count} times in a row ({last}): robot stopped")
+                format!("INVALID_INPUT: the input was refused on {count} steps in a row ({last}): robot stopped")
             }
             EndCause::Stale(inputs) => format!("STALE_INPUT: {inputs} stale: robot stopped"),
-            EndCause::Shutdown => "SHUTDOWN: the node shuts down".to_owned(),
+            EndCause::Shutdown => "SHUTDOWN: the node is shutting down".to_owned(),
         }
     }
 
@@ -659,7 +659,10 @@ mod tests {
         assert_ne!(first, second);
         assert_eq!((old.id, old.source), (first, Src::Topic));
         assert_eq!(old.cause, EndCause::Preempted("navigate_to_pose"));
-        assert_eq!(old.cause.reason(), "PREEMPTED: a newer goal (navigate_to_pose)");
+        assert_eq!(
+            old.cause.reason(),
+            "PREEMPTED: preempted by a newer goal (navigate_to_pose)"
+        );
         assert_eq!(old.cause.kind(), EndKind::Aborted);
         assert!(!old.zeroed);
         // The new goal continues the motion: no zero between the two goals' commands.
@@ -717,7 +720,10 @@ mod tests {
         match step_at(&mut s, f64::NAN, &mut sent) {
             Applied::Refused(Some(ended)) => {
                 assert_eq!(ended.cause.code(), "INVALID_INPUT");
-                assert!(ended.cause.reason().contains("3 times in a row (non-finite pose)"));
+                assert!(ended
+                    .cause
+                    .reason()
+                    .contains("refused on 3 steps in a row (non-finite pose)"));
             }
             other => panic!("{other:?}"),
         }
