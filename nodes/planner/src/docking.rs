@@ -508,6 +508,11 @@ impl DockingController {
         Ok(())
     }
 
+    /// How the docking ends once the position is reached.
+    pub fn finish(&self) -> Finish {
+        self.finish
+    }
+
     /// The goal pose.
     pub fn goal(&self) -> Pose2 {
         self.goal

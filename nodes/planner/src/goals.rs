@@ -1,0 +1,438 @@
+//! The planner's goals as goal laws ([`mobil_motion::GoalLaw`]): a docking by the Lyapunov law,
+//! a route by the goal approach, an undocking by [`DistanceDrive`]. Each takes the robot's
+//! reference point (`base_link`) and steers the point its law steers, answers with a body twist
+//! at that point, and ends with the planner's reasons and Nav2's codes. A node runs them through
+//! its motion server; nothing here reads a clock or publishes.
+
+use crate::docking::{DockingController, DockingFailure, DockingOutput, DockingPhase, Finish, PolarError, Residual};
+use crate::follow::{FollowEnd, FollowEvent, WaypointFollower};
+use crate::route::{ProblemKind, UnreachableCause};
+use mobil_geom::Pose2;
+use mobil_motion::{nav2, GoalLaw, Outcome, Step, StepInput};
+use mobil_tools::drive::{DistanceDrive, DriveSettings, Progress};
+use nalgebra::Point2;
+
+/// How a docking that failed is told: `TIME_LIMIT`, `NOT_CONVERGING`, or `RESIDUAL` — the
+/// heading left when a steered chassis reached ε_e, and a steered chassis' stall too (V stops
+/// falling there for one reason only: the law asks for turns tighter than the chassis' minimum
+/// radius). Nav2's `FAILED_TO_CONTROL` for all.
+pub fn docking_failure(failure: DockingFailure, residual: Residual, finish: Finish) -> Outcome {
+    let figures = format!(
+        "e = {:.3} m, heading error {:.3} rad ({:.1}°)",
+        residual.e,
+        residual.heading,
+        residual.heading.to_degrees()
+    );
+    let (code, detail) = match (failure, finish) {
+        (DockingFailure::NotConverging, Finish::ReportResidual) => (
+            "RESIDUAL",
+            format!(
+                "V stopped falling: the law asks for turns tighter than the chassis' minimum radius (no turn in \
+                 place): {figures}"
+            ),
+        ),
+        (DockingFailure::TimeLimit, _) => ("TIME_LIMIT", format!("{}: {figures}", failure.as_str())),
+        (DockingFailure::NotConverging, _) => ("NOT_CONVERGING", format!("{}: {figures}", failure.as_str())),
+        (DockingFailure::HeadingResidual, _) => ("RESIDUAL", format!("{}: {figures}", failure.as_str())),
+    };
+    Outcome::failed(code, detail, nav2::docking::FAILED_TO_CONTROL)
+}
+
+/// A docking onto a pose.
+///
+/// The law steers the chassis' kinematic origin, `offset` behind the reference point (the rear
+/// axle of a steered chassis, the one point that moves as the law's unicycle; 0 on the omni
+/// chassis), onto the dock pose moved back by the same offset.
+#[derive(Debug, Clone, PartialEq)]
+pub struct DockGoal {
+    controller: DockingController,
+    offset: f64,
+    last: Option<DockingOutput>,
+}
+
+/// One step of a docking: the controller's output, and whether its phase changed.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct DockStep {
+    /// The controller's output.
+    pub output: DockingOutput,
+    /// The phase differs from the previous step's (the first step's always does).
+    pub phase_changed: bool,
+}
+
+impl DockGoal {
+    /// A docking by `controller`, whose goal is the dock pose moved back by `offset` (m).
+    pub fn new(controller: DockingController, offset: f64) -> Self {
+        DockGoal {
+            controller,
+            offset,
+            last: None,
+        }
+    }
+
+    /// The dock pose of the reference point.
+    pub fn target(&self) -> Pose2 {
+        self.controller.goal().ahead(self.offset)
+    }
+
+    /// The steered point's offset behind the reference point (m).
+    pub fn offset(&self) -> f64 {
+        self.offset
+    }
+
+    /// The controller.
+    pub fn controller(&self) -> &DockingController {
+        &self.controller
+    }
+
+    /// The last step's output (`None` before the first).
+    pub fn last(&self) -> Option<&DockingOutput> {
+        self.last.as_ref()
+    }
+
+    /// The polar error and V with the reference point at `pose`: the last step's, or before
+    /// the first step the figures at `pose`.
+    pub fn figures(&self, pose: Option<&Pose2>) -> Option<(PolarError, f64)> {
+        self.last.map(|o| (o.polar, o.lyapunov)).or_else(|| {
+            pose.map(|p| {
+                let polar = crate::docking::polar_error(&p.ahead(-self.offset), &self.controller.goal());
+                (polar, self.controller.gains().lyapunov(&polar))
+            })
+        })
+    }
+}
+
+impl GoalLaw for DockGoal {
+    type Sensors = ();
+    type Feedback = DockStep;
+    type Report = DockingOutput;
+
+    fn step(&mut self, input: &StepInput, _: &()) -> Step<DockStep, DockingOutput> {
+        let o = match self.controller.update(&input.pose.ahead(-self.offset), input.t) {
+            Ok(o) => o,
+            Err(e) => return Step::Refused(e.to_string()),
+        };
+        let phase_changed = self.last.is_none_or(|l| l.phase != o.phase);
+        self.last = Some(o);
+        match o.phase {
+            DockingPhase::Docked => {
+                let detail = format!(
+                    "docked: e = {:.3} m, heading error {:.3} rad",
+                    o.polar.e, o.heading_error
+                );
+                Step::end(Outcome::succeeded(detail), o)
+            }
+            DockingPhase::Failed(f) => {
+                let residual = o.residual.unwrap_or(Residual {
+                    e: o.polar.e,
+                    heading: o.heading_error,
+                });
+                Step::end(docking_failure(f, residual, self.controller.finish()), o)
+            }
+            DockingPhase::Approach | DockingPhase::Rotate => Step::Command {
+                twist: o.command.to_twist(),
+                feedback: DockStep {
+                    output: o,
+                    phase_changed,
+                },
+            },
+        }
+    }
+}
+
+/// A waypoint a route did not take: its index in the request and why.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Missed {
+    /// Index in the request's poses.
+    pub index: usize,
+    /// Where (odom).
+    pub position: Point2<f64>,
+    /// The problem (from the pre-check or the run).
+    pub kind: ProblemKind,
+    /// True when the pre-check found it, false when the run missed it.
+    pub pre_check: bool,
+}
+
+/// The MissedWaypoint code of a waypoint the run gave up: FollowPath's FAILED_TO_MAKE_PROGRESS.
+pub const MISSED_BY_THE_RUN: u16 = nav2::follow_path::FAILED_TO_MAKE_PROGRESS;
+
+impl Missed {
+    /// "waypoint 2: turn_radius: turn radius 0.50 m below the chassis minimum 0.73 m".
+    pub fn describe(&self) -> String {
+        format!("waypoint {}: {}: {}", self.index, self.kind.as_str(), self.kind)
+    }
+
+    /// The MissedWaypoint error code: the pre-check's problems are Nav2's ComputePathToPose
+    /// codes (a waypoint inside an obstacle 206 GOAL_OCCUPIED, any other 208 NO_VALID_PATH);
+    /// a waypoint the run gave up is FollowPath's 105 FAILED_TO_MAKE_PROGRESS.
+    pub fn error_code(&self) -> u16 {
+        match (self.pre_check, self.kind) {
+            (true, ProblemKind::Unreachable(UnreachableCause::Blocked { .. })) => nav2::compute_path::GOAL_OCCUPIED,
+            (true, _) => nav2::compute_path::NO_VALID_PATH,
+            (false, _) => MISSED_BY_THE_RUN,
+        }
+    }
+}
+
+/// At most this many missed waypoints are listed in a reason.
+pub const MAX_LISTED_MISSED: usize = 5;
+
+/// "waypoint 1: …; waypoint 3: …; and 2 more".
+pub fn list_missed(missed: &[Missed]) -> String {
+    let mut s = missed
+        .iter()
+        .take(MAX_LISTED_MISSED)
+        .map(Missed::describe)
+        .collect::<Vec<_>>()
+        .join("; ");
+    if missed.len() > MAX_LISTED_MISSED {
+        s += &format!("; and {} more", missed.len() - MAX_LISTED_MISSED);
+    }
+    s
+}
+
+/// "route done: all 4 waypoints reached", or the waypoints missed.
+pub fn route_done(count: usize, missed: &[Missed]) -> String {
+    if missed.is_empty() {
+        format!("route done: all {count} waypoints reached")
+    } else {
+        format!(
+            "route done: {} of {count} waypoints missed: {}",
+            missed.len(),
+            list_missed(missed)
+        )
+    }
+}
+
+/// A route by the goal approach, after its pre-check: the follower, the request's index of
+/// each waypoint, and the waypoints missed so far.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RouteGoal {
+    follower: WaypointFollower,
+    request_index: Vec<usize>,
+    missed: Vec<Missed>,
+    distance: f64,
+}
+
+/// What happened to a waypoint in a step, by its index in the request.
+#[derive(Debug, Clone, PartialEq)]
+pub enum RouteEvent {
+    /// Reached within Z_crit.
+    Reached(usize),
+    /// Given up, the next one taken.
+    Missed(Missed),
+}
+
+/// One step of a route.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RouteStep {
+    /// The waypoint pursued (the request's index).
+    pub waypoint: usize,
+    /// Distance Z (m) of the reference point to it.
+    pub distance: f64,
+    /// Waypoints reached or missed in this step.
+    pub events: Vec<RouteEvent>,
+}
+
+impl RouteGoal {
+    /// A route for `follower`, the request's index of each of its waypoints alongside
+    /// (missing ones count as their own index).
+    pub fn new(follower: WaypointFollower, request_index: Vec<usize>, distance: f64) -> Self {
+        RouteGoal {
+            follower,
+            request_index,
+            missed: Vec::new(),
+            distance,
+        }
+    }
+
+    fn request(&self, i: usize) -> usize {
+        self.request_index.get(i).copied().unwrap_or(i)
+    }
+
+    /// The waypoint pursued (the request's index; the last once every one was taken).
+    pub fn waypoint(&self) -> usize {
+        let n = self.follower.waypoints().len();
+        self.request(self.follower.index().min(n.saturating_sub(1)))
+    }
+
+    /// The position of the waypoint pursued.
+    pub fn target(&self) -> Option<Point2<f64>> {
+        let w = self.follower.waypoints();
+        w.get(self.follower.index().min(w.len().saturating_sub(1))).copied()
+    }
+
+    /// Distance Z (m) to the waypoint pursued at the last step.
+    pub fn distance(&self) -> f64 {
+        self.distance
+    }
+
+    /// The waypoints missed so far.
+    pub fn missed(&self) -> &[Missed] {
+        &self.missed
+    }
+
+    /// The waypoints of the route, in driving order.
+    pub fn count(&self) -> usize {
+        self.follower.waypoints().len()
+    }
+}
+
+impl GoalLaw for RouteGoal {
+    type Sensors = ();
+    type Feedback = RouteStep;
+    type Report = Vec<Missed>;
+
+    fn step(&mut self, input: &StepInput, _: &()) -> Step<RouteStep, Vec<Missed>> {
+        let o = match self.follower.update(&input.pose, input.dt, input.t) {
+            Ok(o) => o,
+            Err(e) => return Step::Refused(e.to_string()),
+        };
+        let mut events = Vec::with_capacity(o.events.len());
+        for event in &o.events {
+            match *event {
+                FollowEvent::Reached { index } => events.push(RouteEvent::Reached(self.request(index))),
+                FollowEvent::Missed { index, cause } => {
+                    let m = Missed {
+                        index: self.request(index),
+                        position: self
+                            .follower
+                            .waypoints()
+                            .get(index)
+                            .copied()
+                            .unwrap_or_else(Point2::origin),
+                        kind: ProblemKind::Unreachable(cause),
+                        pre_check: false,
+                    };
+                    self.missed.push(m.clone());
+                    events.push(RouteEvent::Missed(m));
+                }
+            }
+        }
+        self.distance = o.distance;
+        match o.end {
+            Some(FollowEnd::Done) => Step::end(
+                Outcome::succeeded(route_done(self.count(), &self.missed)),
+                self.missed.clone(),
+            ),
+            Some(FollowEnd::Stalled) => Step::end(
+                Outcome::failed(
+                    "STALLED",
+                    format!(
+                        "the robot did not move on its way to waypoint {}: robot stopped",
+                        self.request(o.index)
+                    ),
+                    nav2::follow_waypoints::TASK_EXECUTOR_FAILED,
+                ),
+                self.missed.clone(),
+            ),
+            None => Step::Command {
+                twist: o.twist,
+                feedback: RouteStep {
+                    waypoint: self.request(o.index),
+                    distance: o.distance,
+                    events,
+                },
+            },
+        }
+    }
+}
+
+/// The ramp-down of an undocking (m/s²): √(2·0.075·d) reaches the default undocking speed,
+/// 0.15 m/s, 0.15 m before the end, and the last centimetres go at the floor speed.
+pub const UNDOCK_DECEL: f64 = 0.075;
+
+/// The slowest undocking speed before the end (m/s).
+pub const UNDOCK_MIN_SPEED: f64 = 0.03;
+
+/// Undocked when this close to the staging distance (m).
+pub const UNDOCK_TOLERANCE: f64 = 0.005;
+
+/// Backing straight out of a dock by `distance` along the heading of the first step, at
+/// `speed`, within a time limit: a [`DistanceDrive`] backwards.
+#[derive(Debug, Clone, PartialEq)]
+pub struct UndockGoal {
+    distance: f64,
+    speed: f64,
+    limit_s: f64,
+    drive: Option<DistanceDrive>,
+}
+
+impl UndockGoal {
+    /// Backs out `distance` (m, > 0) at `speed` (m/s, > 0), failing after `limit_s` of the
+    /// goal's time.
+    pub fn new(distance: f64, speed: f64, limit_s: f64) -> Self {
+        UndockGoal {
+            distance,
+            speed,
+            limit_s,
+            drive: None,
+        }
+    }
+
+    /// How far it has backed out (m).
+    pub fn backed(&self) -> f64 {
+        self.drive.as_ref().map_or(0.0, |d| -d.progress().travelled)
+    }
+
+    /// What is left (m).
+    pub fn remaining(&self) -> f64 {
+        self.drive.as_ref().map_or(self.distance, |d| d.progress().remaining)
+    }
+
+    /// The distance to back out (m).
+    pub fn distance(&self) -> f64 {
+        self.distance
+    }
+}
+
+impl GoalLaw for UndockGoal {
+    type Sensors = ();
+    type Feedback = Progress;
+    type Report = f64;
+
+    fn step(&mut self, input: &StepInput, _: &()) -> Step<Progress, f64> {
+        if !input.pose.is_finite() {
+            return Step::Refused("non-finite pose".to_owned());
+        }
+        if self.drive.is_none() {
+            let settings = DriveSettings {
+                max_speed: self.speed,
+                min_speed: UNDOCK_MIN_SPEED.min(self.speed),
+                decel: UNDOCK_DECEL,
+                tolerance: UNDOCK_TOLERANCE,
+            };
+            match DistanceDrive::new(input.pose, -self.distance, self.speed, settings) {
+                Ok(d) => self.drive = Some(d),
+                Err(e) => return Step::Refused(e.to_string()),
+            }
+        }
+        let Some(drive) = self.drive.as_mut() else {
+            return Step::Refused("no drive".to_owned());
+        };
+        match GoalLaw::step(drive, input, &()) {
+            Step::End(end) => {
+                let backed = -end.report.travelled;
+                Step::end(
+                    Outcome::succeeded(format!("undocked: backed out {backed:.3} m")),
+                    backed,
+                )
+            }
+            Step::Command { .. } if input.t > self.limit_s => {
+                let backed = self.backed();
+                Step::end(
+                    Outcome::failed(
+                        "TIME_LIMIT",
+                        format!(
+                            "not undocked within max_undocking_time {:.1} s (backed out {backed:.3} m)",
+                            self.limit_s
+                        ),
+                        nav2::docking::FAILED_TO_CONTROL,
+                    ),
+                    backed,
+                )
+            }
+            Step::Command { twist, feedback } => Step::Command { twist, feedback },
+            Step::Refused(why) => Step::Refused(why),
+        }
+    }
+}
