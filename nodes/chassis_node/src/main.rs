@@ -10,7 +10,6 @@
 //! last valid `cmd_vel` and the last feedback sample used); the gate decides on those ages with
 //! its timeouts. The node keeps no clock of its own for the watchdogs.
 
-use futures::StreamExt;
 use mobil_chassis::controller::{
     ChassisController, ControllerConfig, FeedbackError, FeedbackOutcome, GatedCommand, InputAges, Safety,
     DEFAULT_FEEDBACK_SPEED_FACTOR,
@@ -30,7 +29,7 @@ use mobil_msgs::tf2_msgs::msg::TFMessage;
 use mobil_ros::chassis::{chassis_params, declare_chassis};
 use mobil_ros::config::{Config, ConfigError, Decl};
 use mobil_ros::geometry::{planar_odometry, yaw_quaternion};
-use mobil_ros::input::{decoded, Input};
+use mobil_ros::input::Inputs as Streams;
 use mobil_ros::latest::Latest;
 use mobil_ros::stop::{final_stop, FINAL_STOP_WAIT};
 use mobil_ros::ticker::{self, Ticker};
@@ -160,6 +159,16 @@ fn decl() -> NodeDecl {
     )
 }
 
+/// A sample of the node's subscriptions.
+enum In {
+    Cmd(Twist),
+    /// An undecodable `cmd_vel` (logged): the wheels stop.
+    BadCmd,
+    Joints(JointState),
+    /// An undecodable `joint_states` (logged): counted.
+    BadJoints,
+}
+
 fn main() -> ExitCode {
     run_node(&decl(), |node| Box::pin(run(node)))
 }
@@ -210,16 +219,22 @@ async fn run(node: &mut RosNode) -> anyhow::Result<()> {
     let tf_pub = node.publisher::<TFMessage>("tf", &qos::reliable(100))?;
     let status_pub = node.publisher::<ChassisStatus>("~/status", &qos::latched())?;
 
-    let cmds = decoded(cmd_sub.async_stream(), "cmd_vel", "cmd_decode", "wheels stopped");
-    let joints = decoded(
-        joints_sub.async_stream(),
-        "joint_states",
-        "joints_decode",
-        "sample ignored",
-    );
+    // An undecodable cmd_vel stops the wheels at once; an undecodable joint_states is counted.
+    let mut streams = Streams::new();
+    streams
+        .add_guarded(cmd_sub.async_stream(), "cmd_vel", "wheels stopped", In::Cmd, || {
+            Some(In::BadCmd)
+        })
+        .add_guarded(
+            joints_sub.async_stream(),
+            "joint_states",
+            "sample ignored",
+            In::Joints,
+            || Some(In::BadJoints),
+        );
     let shutdown = shutdown_signal();
     let mut tick = Ticker::new(config.control_rate_hz)?;
-    tokio::pin!(cmds, joints, shutdown);
+    tokio::pin!(shutdown);
 
     let mut throttle = LogThrottle::default();
     let mut rejected: u64 = 0;
@@ -258,8 +273,8 @@ async fn run(node: &mut RosNode) -> anyhow::Result<()> {
                     Err(e) => warn!("parameter change not applied: {e}"),
                 }
             }
-            Some(msg) = cmds.next() => match msg {
-                Input::Message(twist) => {
+            input = streams.next() => match input? {
+                In::Cmd(twist) => {
                     let request = BodyTwist::new(twist.linear.x, twist.linear.y, twist.angular.z);
                     let accepted = controller.on_cmd_vel(request);
                     inputs.cmd_vel(accepted, node);
@@ -273,17 +288,15 @@ async fn run(node: &mut RosNode) -> anyhow::Result<()> {
                     }
                     publish_wheels(&wheel_pub, node, &gated);
                 }
-                // Logged (rate-limited) by the input stream.
-                Input::Undecodable => {
+                // Logged (rate-limited) by the streams.
+                In::BadCmd => {
                     rejected += 1;
                     let accepted = controller.on_unreadable_cmd_vel();
                     inputs.cmd_vel(accepted, node);
                     let gated = controller.gate(inputs.ages());
                     publish_wheels(&wheel_pub, node, &gated);
                 }
-            },
-            Some(msg) = joints.next() => match msg {
-                Input::Message(js) => {
+                In::Joints(js) => {
                     // An unstamped sample is stamped on arrival (node clock).
                     let stamp_msg = if is_zero(&js.header.stamp) { node.stamp() } else { js.header.stamp.clone() };
                     let Some(stamp) = secs_from_stamp(&stamp_msg) else {
@@ -333,8 +346,8 @@ async fn run(node: &mut RosNode) -> anyhow::Result<()> {
                         }
                     }
                 }
-                // Logged (rate-limited) by the input stream.
-                Input::Undecodable => rejected += 1,
+                // Logged (rate-limited) by the streams.
+                In::BadJoints => rejected += 1,
             },
             _ = tick.tick() => {
                 let cmd = controller.gate(inputs.ages());

@@ -14,7 +14,6 @@
 //!
 //! The rules for bad input are in the crate docs.
 
-use futures::StreamExt;
 use mobil_gait::{Chunk, Evaluation, RuleSet, WalkNext, Walker};
 use mobil_gait_node::{
     body_pose, chunk_reason, goal_from_pose, ground_from_assessment, header, markers, plan_reason, query_from_request,
@@ -24,7 +23,7 @@ use mobil_msgs::geometry_msgs::msg::PoseStamped;
 use mobil_msgs::mobil_msgs::msg::{GaitPlan, TerrainAssessment};
 use mobil_msgs::mobil_msgs::srv::{PlanGait, PlanGaitRequest, PlanGaitResponse};
 use mobil_msgs::visualization_msgs::msg::MarkerArray;
-use mobil_ros::input::{decoded, Input};
+use mobil_ros::input::Inputs;
 use mobil_ros::{qos, run_node, shutdown_signal, warn_throttled, ConfigError, LogThrottle, NodeDecl, OffLoop, RosNode};
 use ros2_client::{Publisher, RmwRequestId, Server};
 use std::process::ExitCode;
@@ -98,7 +97,6 @@ enum Event {
     Assessment(TerrainAssessment),
     Chunked(Chunked),
     Move,
-    Nothing,
 }
 
 async fn serve(node: &mut RosNode) -> anyhow::Result<()> {
@@ -131,46 +129,37 @@ async fn serve(node: &mut RosNode) -> anyhow::Result<()> {
     shell.publish_walk(node, &out);
     let mut searches: OffLoop<Answered> = OffLoop::new();
     let mut walk: OffLoop<Chunked> = OffLoop::new();
-    let requests = service.receive_request_stream();
-    let goals = decoded(goal_sub.async_stream(), "goal_pose", "goal-read", "goal ignored");
-    let terrain = decoded(
-        terrain_sub.async_stream(),
-        "terrain/assessment",
-        "terrain-read",
-        "assessment ignored",
-    );
+    let mut inputs = Inputs::new();
+    inputs
+        .add_requests(service.receive_request_stream(), "gait/compute_plan", Event::Request)
+        // An undecodable goal stops the walk where it is, as a refused one does.
+        .add_guarded(
+            goal_sub.async_stream(),
+            "goal_pose",
+            "goal ignored",
+            Event::Goal,
+            || Some(Event::BadGoal),
+        )
+        .add(
+            terrain_sub.async_stream(),
+            "terrain/assessment",
+            "assessment ignored",
+            Event::Assessment,
+        );
     let shutdown = shutdown_signal();
-    tokio::pin!(requests, goals, terrain, shutdown);
+    tokio::pin!(shutdown);
     loop {
         let move_at = shell.next_move;
         let event = tokio::select! {
             _ = &mut shutdown => Event::Shutdown,
             Some(changed) = node.config_changed::<GaitNodeConfig>() => Event::Config(changed),
-            r = requests.next() => match r {
-                Some(Ok((id, req))) => Event::Request(id, req),
-                Some(Err(e)) => {
-                    warn_throttled!(shell.throttle, "request-read", "gait/compute_plan: undecodable request dropped: {e:?}");
-                    Event::Nothing
-                }
-                None => anyhow::bail!("the gait/compute_plan service ended"),
-            },
+            e = inputs.next() => e?,
             done = searches.result() => Event::Answered(done),
             done = walk.result() => Event::Chunked(done),
-            m = goals.next() => match m {
-                Some(Input::Message(m)) => Event::Goal(m),
-                Some(Input::Undecodable) => Event::BadGoal,
-                None => anyhow::bail!("the goal_pose subscription ended"),
-            },
-            m = terrain.next() => match m {
-                Some(Input::Message(m)) => Event::Assessment(m),
-                Some(Input::Undecodable) => Event::Nothing,
-                None => anyhow::bail!("the terrain/assessment subscription ended"),
-            },
             _ = sleep_until(move_at) => Event::Move,
         };
         match event {
             Event::Shutdown => break,
-            Event::Nothing => {}
             Event::Config(Ok(c)) => {
                 info!("parameters changed: the walk, if any, replans with them now; requests get them from the next");
                 shell.config = c;

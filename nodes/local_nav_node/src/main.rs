@@ -19,7 +19,6 @@
 //! ends the goal `INVALID_INPUT`. At shutdown with a goal under way, its zero command is the last
 //! one, waited for ([`final_stop`]); an idle node sends none.
 
-use futures::StreamExt;
 use mobil_geom::Pose2;
 use mobil_local_nav::{Mode, MotionLimits, Navigator, Progress, ProgressChecker, StepOutput, VelocityCommand};
 use mobil_local_nav_node::{
@@ -37,7 +36,7 @@ use mobil_msgs::std_msgs::msg::Header;
 use mobil_msgs::visualization_msgs::msg::MarkerArray;
 use mobil_ros::action::{ActionEvent, GoalEnd, GoalRequest, GoalServer, GoalServerConfig};
 use mobil_ros::geometry::odom_pose;
-use mobil_ros::input::{decoded, Input};
+use mobil_ros::input::Inputs;
 use mobil_ros::latest::Latest;
 use mobil_ros::motion::{Applied, CmdVel, EndCause, EndKind, Ended, MotionSession, SessionSettings, Watched};
 use mobil_ros::scan::{scan_from_msg, tf_static_subscription, StaticFrames};
@@ -142,7 +141,6 @@ enum Event {
     GoalPose(PoseStamped),
     Action(ActionEvent<NavigateToPoseGoal>),
     Tick,
-    Nothing,
 }
 
 async fn serve(node: &mut RosNode) -> anyhow::Result<()> {
@@ -252,38 +250,25 @@ async fn event_loop(
     goal_sub: &Subscription<PoseStamped>,
     tf_sub: &Subscription<TFMessageAlias>,
 ) -> anyhow::Result<()> {
-    let scans = decoded(scan_sub.async_stream(), "scan", "scan-read", "scan ignored");
-    let odoms = decoded(odom_sub.async_stream(), "odom", "odom-read", "sample ignored");
-    let goals = decoded(goal_sub.async_stream(), "goal_pose", "goal-read", "goal ignored");
+    let mut inputs = Inputs::new();
+    inputs
+        .add(scan_sub.async_stream(), "scan", "scan ignored", Event::Scan)
+        .add(odom_sub.async_stream(), "odom", "sample ignored", Event::Odom)
+        .add(goal_sub.async_stream(), "goal_pose", "goal ignored", Event::GoalPose);
     let shutdown = shutdown_signal();
-    tokio::pin!(scans, odoms, goals, shutdown);
+    tokio::pin!(shutdown);
     let mut ticker = Ticker::new(WATCHDOG_RATE_HZ)?;
     loop {
         let event = tokio::select! {
             _ = &mut shutdown => Event::Shutdown,
             Some(changed) = node.config_changed::<LocalNavConfig>() => Event::Config(changed),
-            m = scans.next() => match m {
-                Some(Input::Message(m)) => Event::Scan(m),
-                Some(Input::Undecodable) => Event::Nothing,
-                None => anyhow::bail!("the scan subscription ended"),
-            },
-            m = odoms.next() => match m {
-                Some(Input::Message(m)) => Event::Odom(m),
-                Some(Input::Undecodable) => Event::Nothing,
-                None => anyhow::bail!("the odom subscription ended"),
-            },
-            m = goals.next() => match m {
-                Some(Input::Message(m)) => Event::GoalPose(m),
-                Some(Input::Undecodable) => Event::Nothing,
-                None => anyhow::bail!("the goal_pose subscription ended"),
-            },
+            e = inputs.next() => e?,
             e = server.next_event() => Event::Action(e),
             _ = ticker.tick() => Event::Tick,
         };
         let mut sink = CmdVel::new(&out.cmd);
         match event {
             Event::Shutdown => return Ok(()),
-            Event::Nothing => {}
             Event::Config(Ok(c)) => shell.reconfigure(c),
             Event::Config(Err(e)) => warn!("parameters not applied: {e}"),
             Event::Odom(m) => shell.odom_in(&mut sink, &m),

@@ -20,7 +20,6 @@
 //! with one zero command. At shutdown with a goal under way, that goal's zero command is the
 //! last one, waited for ([`final_stop`]); an idle node sends none.
 
-use futures::StreamExt;
 use mobil_chassis::{BodyTwist, ChassisParams};
 use mobil_geom::Pose2;
 use mobil_msgs::geometry_msgs::msg::{PoseStamped, Twist};
@@ -53,7 +52,7 @@ use mobil_planner_node::{
 };
 use mobil_ros::action::{ActionEvent, GoalEnd, GoalRequest, GoalServer, GoalServerConfig};
 use mobil_ros::geometry::odom_pose;
-use mobil_ros::input::{decoded, Input};
+use mobil_ros::input::Inputs;
 use mobil_ros::latest::Latest;
 use mobil_ros::offloop::CancelToken;
 use mobil_ros::scan::scan_laser_pose;
@@ -307,7 +306,6 @@ enum Event {
     Checked(RmwRequestId, CheckRouteResponse),
     PreChecked(PreCheckDone),
     Tick,
-    Nothing,
 }
 
 async fn serve(node: &mut RosNode) -> anyhow::Result<()> {
@@ -432,46 +430,21 @@ async fn event_loop(
     (scan_sub, tf_sub): (&Subscription<LaserScan>, &Subscription<TFMessage>),
     check: &Server<CheckRouteRequest, CheckRouteResponse>,
 ) -> anyhow::Result<()> {
-    let odoms = decoded(odom_sub.async_stream(), "odom", "odom-read", "sample ignored");
-    let docks = decoded(dock_sub.async_stream(), "dock_pose", "dock-read", "goal ignored");
-    let routes = decoded(route_sub.async_stream(), "waypoints", "route-read", "route ignored");
-    let scans = decoded(scan_sub.async_stream(), "scan", "scan-read", "scan ignored");
-    let requests = check.receive_request_stream();
+    let mut inputs = Inputs::new();
+    inputs
+        .add(odom_sub.async_stream(), "odom", "sample ignored", Event::Odom)
+        .add(scan_sub.async_stream(), "scan", "scan ignored", Event::Scan)
+        .add(dock_sub.async_stream(), "dock_pose", "goal ignored", Event::DockPose)
+        .add(route_sub.async_stream(), "waypoints", "route ignored", Event::Waypoints)
+        .add_requests(check.receive_request_stream(), "planner/check_route", Event::Check);
     let shutdown = shutdown_signal();
-    tokio::pin!(odoms, docks, routes, scans, requests, shutdown);
+    tokio::pin!(shutdown);
     let mut ticker = Ticker::new(WATCHDOG_RATE_HZ)?;
     loop {
         let event = tokio::select! {
             _ = &mut shutdown => Event::Shutdown,
             Some(changed) = node.config_changed::<PlannerConfig>() => Event::Config(changed),
-            m = odoms.next() => match m {
-                Some(Input::Message(m)) => Event::Odom(m),
-                Some(Input::Undecodable) => Event::Nothing,
-                None => anyhow::bail!("the odom subscription ended"),
-            },
-            m = scans.next() => match m {
-                Some(Input::Message(m)) => Event::Scan(m),
-                Some(Input::Undecodable) => Event::Nothing,
-                None => anyhow::bail!("the scan subscription ended"),
-            },
-            m = docks.next() => match m {
-                Some(Input::Message(m)) => Event::DockPose(m),
-                Some(Input::Undecodable) => Event::Nothing,
-                None => anyhow::bail!("the dock_pose subscription ended"),
-            },
-            m = routes.next() => match m {
-                Some(Input::Message(m)) => Event::Waypoints(m),
-                Some(Input::Undecodable) => Event::Nothing,
-                None => anyhow::bail!("the waypoints subscription ended"),
-            },
-            r = requests.next() => match r {
-                Some(Ok((id, req))) => Event::Check(id, req),
-                Some(Err(e)) => {
-                    warn_throttled!(shell.throttle, "check-read", "planner/check_route: undecodable request dropped: {e:?}");
-                    Event::Nothing
-                }
-                None => anyhow::bail!("the planner/check_route service ended"),
-            },
+            e = inputs.next() => e?,
             done = jobs.goal.result() => Event::PreChecked(done),
             done = jobs.vfo.result() => Event::VfoTicked(done),
             Some((id, reply)) = jobs.replies.recv() => Event::Checked(id, reply),
@@ -482,7 +455,6 @@ async fn event_loop(
         };
         match event {
             Event::Shutdown => return Ok(()),
-            Event::Nothing => {}
             Event::Config(Ok(c)) => shell.reconfigure(c),
             Event::Config(Err(e)) => warn!("parameters not applied: {e}"),
             Event::Odom(m) => shell.odom_in(node, out, servers, jobs, &m),

@@ -6,7 +6,6 @@
 //! judged by the kit's [`Latest`] holder), as a real motor driver does. Deterministic for a given seed. Real time by default; with `publish_clock` it publishes
 //! `/clock` and may run faster (`real_time_factor`) for nodes started with `use_sim_time:=true`.
 
-use futures::StreamExt;
 use mobil_chassis::joints::wheel_state_from_joints;
 use mobil_chassis::model::ChassisConfig;
 use mobil_msgs::geometry_msgs::msg::{Point, Transform, TransformStamped, Vector3};
@@ -20,7 +19,7 @@ use mobil_msgs::visualization_msgs::msg::{Marker, MarkerArray};
 use mobil_ros::chassis::{chassis_params, declare_chassis};
 use mobil_ros::config::{Config, ConfigError, Decl};
 use mobil_ros::geometry::{planar_odometry, yaw_quaternion};
-use mobil_ros::input::{decoded, Input};
+use mobil_ros::input::Inputs;
 use mobil_ros::latest::{Freshness, Latest};
 use mobil_ros::time::{stamp_from_nanos, stamp_from_secs};
 use mobil_ros::{qos, run_node, shutdown_signal, warn_throttled, LogThrottle, NodeDecl, RosNode, Ticker};
@@ -280,6 +279,13 @@ fn world_markers(world: &World, frame: &str, stamp: mobil_msgs::builtin_interfac
     MarkerArray { markers }
 }
 
+/// A `wheel_commands` sample.
+enum Command {
+    Joints(JointState),
+    /// Could not be decoded (logged): the wheels stop.
+    Undecodable,
+}
+
 fn main() -> ExitCode {
     run_node(&decl(), |node| Box::pin(run(node)))
 }
@@ -352,16 +358,20 @@ async fn run(node: &mut RosNode) -> anyhow::Result<()> {
         });
     }
 
-    let commands = decoded(
+    // A bad command stops the wheels, as real motor drivers do: the previous command must not
+    // keep them turning until the driver timeout.
+    let mut inputs = Inputs::new();
+    inputs.add_guarded(
         commands_sub.async_stream(),
         "wheel_commands",
-        "decode",
         "wheels stopped",
+        Command::Joints,
+        || Some(Command::Undecodable),
     );
     let shutdown = shutdown_signal();
     // Burst: a late physics step is caught up, so simulated time keeps its rate.
     let mut tick = Ticker::with_missed_tick_behavior(config.tick_rate_hz(), MissedTickBehavior::Burst)?;
-    tokio::pin!(commands, shutdown);
+    tokio::pin!(shutdown);
     let mut throttle = LogThrottle::default();
     let dt = 1.0 / config.physics_rate_hz;
     let (mut next_joints, mut next_scan) = (0.0f64, 0.0f64);
@@ -388,10 +398,8 @@ async fn run(node: &mut RosNode) -> anyhow::Result<()> {
                 }
                 Err(e) => warn!("parameter change not applied: {e}"),
             },
-            Some(msg) = commands.next() => match msg {
-                // A bad command stops the wheels, as real motor drivers do: the previous
-                // command must not keep them turning until the driver timeout.
-                Input::Message(js) => match wheel_state_from_joints(plant_config.params.model(), &js.name, &js.position, &js.velocity) {
+            command = inputs.next() => match command? {
+                Command::Joints(js) => match wheel_state_from_joints(plant_config.params.model(), &js.name, &js.position, &js.velocity) {
                     Ok(wheels) => match plant.command(&wheels) {
                         Ok(CommandOutcome::Accepted) => watch.commanded(js.header.stamp.clone(), Instant::now()),
                         Ok(CommandOutcome::Limited) => {
@@ -410,8 +418,8 @@ async fn run(node: &mut RosNode) -> anyhow::Result<()> {
                         warn_throttled!(throttle, "cmd", "wheel_commands dropped, wheels stopped: {e}");
                     }
                 },
-                // Logged (rate-limited) by the input stream.
-                Input::Undecodable => plant.stop(),
+                // Logged (rate-limited) by the inputs.
+                Command::Undecodable => plant.stop(),
             },
             _ = tick.tick() => {
                 if watch.check(config.command_timeout_s, Instant::now()) {

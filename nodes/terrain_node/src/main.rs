@@ -5,10 +5,9 @@
 //! A refused touchdown or an unassessable stance is logged (rate-limited), counted, and the last
 //! good assessment is published again with the new counts. The rules are in the crate docs.
 
-use futures::StreamExt;
 use mobil_msgs::mobil_msgs::msg::{FootTouchdown, TerrainAssessment};
 use mobil_msgs::visualization_msgs::msg::MarkerArray;
-use mobil_ros::input::{decoded, Input};
+use mobil_ros::input::Inputs;
 use mobil_ros::{qos, run_node, shutdown_signal, warn_throttled, LogThrottle, NodeDecl, RosNode};
 use mobil_terrain_node::{assessment_message, markers, TerrainNodeConfig, TerrainState, TouchdownOutcome};
 use ros2_client::Publisher;
@@ -55,14 +54,17 @@ async fn serve(node: &mut RosNode) -> anyhow::Result<()> {
         "waiting for touchdowns on terrain/touchdown (frame `{}`)",
         shell.state.config().body_frame
     );
-    let touchdowns = decoded(
+    // An undecodable touchdown is logged (rate-limited) by the inputs and not counted: the
+    // counter is of touchdowns the node could read and refused.
+    let mut inputs = Inputs::new();
+    inputs.add(
         sub.async_stream(),
         "terrain/touchdown",
-        "touchdown-read",
         "touchdown ignored",
+        |m: FootTouchdown| m,
     );
     let shutdown = shutdown_signal();
-    tokio::pin!(touchdowns, shutdown);
+    tokio::pin!(shutdown);
     loop {
         tokio::select! {
             _ = &mut shutdown => return Ok(()),
@@ -77,13 +79,7 @@ async fn serve(node: &mut RosNode) -> anyhow::Result<()> {
                 },
                 Err(e) => warn!("parameters not applied: {e}"),
             },
-            m = touchdowns.next() => match m {
-                Some(Input::Message(m)) => shell.touchdown(&out, &m),
-                // Logged (rate-limited) by the input stream. Not counted: the counter is of
-                // touchdowns the node could read and refused.
-                Some(Input::Undecodable) => {}
-                None => anyhow::bail!("the terrain/touchdown subscription ended"),
-            },
+            m = inputs.next() => shell.touchdown(&out, &m?),
         }
     }
 }

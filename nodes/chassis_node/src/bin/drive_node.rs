@@ -11,7 +11,6 @@
 //! none. A goal that cannot be started (a DDS send to that client failed) is logged and the
 //! node goes on serving.
 
-use futures::StreamExt;
 use mobil_motion::{BodyTwist, GoalLaw, StepInput};
 use mobil_msgs::geometry_msgs::msg::Twist;
 use mobil_msgs::mobil_msgs::action::{DriveDistance, DriveDistanceFeedback, DriveDistanceResult};
@@ -19,7 +18,7 @@ use mobil_msgs::nav_msgs::msg::Odometry;
 use mobil_ros::action::{ActionEvent, GoalEnd, GoalServer, GoalServerConfig};
 use mobil_ros::config::{Config, ConfigError, Decl};
 use mobil_ros::geometry::yaw_of;
-use mobil_ros::input::{decoded, Input};
+use mobil_ros::input::Inputs;
 use mobil_ros::latest::Latest;
 use mobil_ros::motion::{Applied, CmdVel, EndCause, EndKind, Ended, MotionSession, SessionSettings};
 use mobil_ros::stop::{final_stop, FINAL_STOP_WAIT};
@@ -229,9 +228,10 @@ async fn event_loop(
     session: &mut Session,
     config: &mut DriveConfig,
 ) -> anyhow::Result<()> {
-    let odom = decoded(odom_sub.async_stream(), "odom", "odom-read", "sample ignored");
+    let mut inputs = Inputs::new();
+    inputs.add(odom_sub.async_stream(), "odom", "sample ignored", |m: Odometry| m);
     let shutdown = shutdown_signal();
-    tokio::pin!(odom, shutdown);
+    tokio::pin!(shutdown);
     let mut ticker = Ticker::new(config.rate_hz)?;
     let mut throttle = LogThrottle::new(Duration::from_secs(2));
     let mut sink = CmdVel::new(cmd);
@@ -250,19 +250,16 @@ async fn event_loop(
                 },
                 Err(e) => warn!("parameters not applied: {e}"),
             },
-            message = odom.next() => match message {
-                Some(Input::Message(m)) => {
-                    let p = &m.pose.pose;
-                    let pose = Pose2::new(p.position.x, p.position.y, yaw_of(&p.orientation));
-                    if pose.is_finite() {
-                        latest.set(pose, m.header.stamp);
-                    } else {
-                        warn_throttled!(throttle, "odom-nan", "odom with a non-finite pose dropped");
-                    }
+            m = inputs.next() => {
+                let m = m?;
+                let p = &m.pose.pose;
+                let pose = Pose2::new(p.position.x, p.position.y, yaw_of(&p.orientation));
+                if pose.is_finite() {
+                    latest.set(pose, m.header.stamp);
+                } else {
+                    warn_throttled!(throttle, "odom-nan", "odom with a non-finite pose dropped");
                 }
-                Some(Input::Undecodable) => {}
-                None => anyhow::bail!("the odom subscription ended"),
-            },
+            }
             event = server.next_event() => match event {
                 ActionEvent::Goal(request) => {
                     let goal = request.goal().clone();
