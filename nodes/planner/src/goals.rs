@@ -173,8 +173,8 @@ impl Missed {
     }
 }
 
-/// At most this many missed waypoints are listed in a reason.
-pub const MAX_LISTED_MISSED: usize = 5;
+/// At most this many missed waypoints (or pre-check problems) are listed in a reason.
+pub const MAX_LISTED_MISSED: usize = 50;
 
 /// "waypoint 1: …; waypoint 3: …; and 2 more".
 pub fn list_missed(missed: &[Missed]) -> String {

@@ -21,13 +21,14 @@ use mobil_msgs::nav2_msgs::msg::MissedWaypoint;
 use mobil_msgs::nav_msgs::msg::Path;
 use mobil_msgs::std_msgs::msg::{ColorRGBA, Header};
 use mobil_msgs::visualization_msgs::msg::{Marker, MarkerArray};
+pub use mobil_planner::goals::{list_missed, Missed, MISSED_BY_THE_RUN};
 use mobil_planner::{
-    DockingConfig, DockingFailure, DockingGains, Finish, FollowConfig, ProblemKind, Residual, RouteCheckConfig,
-    RouteProblem, RouteReport, UnreachableCause,
+    DockingConfig, DockingGains, FollowConfig, ProblemKind, RouteCheckConfig, RouteProblem, RouteReport,
 };
 use mobil_ros::chassis::{chassis_params, declare_chassis};
 use mobil_ros::config::{Config, ConfigError, Decl};
 use mobil_ros::geometry::{yaw_of, yaw_quaternion};
+use mobil_ros::motion::SessionEnd;
 use mobil_world::World;
 use nalgebra::Point2;
 use std::time::Duration;
@@ -97,7 +98,7 @@ pub const MAX_WAYPOINTS: usize = 200;
 /// under the 64 KB a reply should stay below).
 pub const MAX_REPLY_POSES: usize = 400;
 /// Most problems listed in a reply, a reason or the markers (the rest are counted in `reason`).
-pub const MAX_LISTED_PROBLEMS: usize = 50;
+pub const MAX_LISTED_PROBLEMS: usize = mobil_planner::goals::MAX_LISTED_MISSED;
 /// Most missed waypoints in a FollowWaypoints result: every one a route of [`MAX_WAYPOINTS`]
 /// can miss while driving, and twice that from a pre-check; about 90 bytes each (index, pose,
 /// code), 36 KB, well under the 64 KB a reply should stay below.
@@ -621,81 +622,15 @@ impl Mode {
     }
 }
 
-/// A waypoint the route did not take: its index in the request and why.
-#[derive(Debug, Clone, PartialEq)]
-pub struct Missed {
-    /// Index in the request's poses.
-    pub index: usize,
-    /// Where (odom).
-    pub position: Point2<f64>,
-    /// The problem (from the pre-check or the run).
-    pub kind: ProblemKind,
-    /// True when the pre-check found it, false when the run missed it.
-    pub pre_check: bool,
-}
-
-impl Missed {
-    /// "waypoint 2: turn_radius: turn radius 0.50 m below the chassis minimum 0.73 m".
-    pub fn describe(&self) -> String {
-        format!("waypoint {}: {}: {}", self.index, self.kind.as_str(), self.kind)
-    }
-
-    /// The MissedWaypoint error code: the pre-check's problems are Nav2's ComputePathToPose
-    /// codes (a waypoint inside an obstacle 206 GOAL_OCCUPIED, any other 208 NO_VALID_PATH);
-    /// a waypoint the run gave up is FollowPath's 105 FAILED_TO_MAKE_PROGRESS.
-    pub fn error_code(&self) -> u16 {
-        match (self.pre_check, self.kind) {
-            (true, ProblemKind::Unreachable(UnreachableCause::Blocked { .. })) => 206,
-            (true, _) => 208,
-            (false, _) => MISSED_BY_THE_RUN,
-        }
-    }
-}
-
-/// The MissedWaypoint code of a waypoint the run gave up: FollowPath's FAILED_TO_MAKE_PROGRESS.
-pub const MISSED_BY_THE_RUN: u16 = 105;
-
 /// How a goal ended.
 #[derive(Debug, Clone, PartialEq)]
 pub enum Outcome {
-    /// Docked (e and the heading error at the end).
-    Docked {
-        /// e (m).
-        e: f64,
-        /// Heading error (rad).
-        heading: f64,
-    },
-    /// The route was driven to its end (missed waypoints listed).
-    RouteDone {
-        /// Waypoints in the route.
-        count: usize,
-        /// Those missed.
-        missed: Vec<Missed>,
-    },
-    /// Backed out to the staging distance.
-    Undocked {
-        /// Distance backed (m).
-        distance: f64,
-    },
-    /// The docking failed.
-    DockingFailed(DockingFailure, Residual),
-    /// A steered chassis stalled (V no longer falling): the law asks for turns the chassis
-    /// cannot make, the residual stays ([`docking_outcome`]).
-    ResidualStall(Residual),
-    /// The route stalled (the robot did not move).
-    Stalled {
-        /// The waypoint pursued.
-        index: usize,
-    },
+    /// The goal's law ended it ([`mobil_planner::goals`]): docked, undocked, a route driven to
+    /// its end, or the law's failure (TIME_LIMIT, NOT_CONVERGING, RESIDUAL, STALLED), with its
+    /// reason and Nav2 code; a route's missed waypoints are its goal's.
+    Law(mobil_motion::Outcome),
     /// The route pre-check found problems (and `execute_infeasible_routes` is false).
     RouteInfeasible(Vec<Missed>),
-    /// Undocking not done within `max_undocking_time`.
-    UndockTimeout {
-        /// The limit (s).
-        limit: f64,
-        /// Distance backed so far (m).
-        distance: f64,
-    },
     /// No valid odometry for `odom_timeout_s`.
     Stale,
     /// No valid scan for `vfo.scan_timeout_s` (a VFO route).
@@ -744,17 +679,29 @@ pub enum Outcome {
     ShuttingDown,
 }
 
+impl From<SessionEnd> for Outcome {
+    fn from(e: SessionEnd) -> Self {
+        match e {
+            SessionEnd::Preempted(by) => Outcome::Preempted(by),
+            SessionEnd::Refused { last, .. } => Outcome::Refused(last),
+            SessionEnd::Shutdown => Outcome::ShuttingDown,
+        }
+    }
+}
+
+impl From<mobil_motion::Outcome> for Outcome {
+    fn from(o: mobil_motion::Outcome) -> Self {
+        Outcome::Law(o)
+    }
+}
+
 impl Outcome {
     /// The reason code of the status.
     pub fn code(&self) -> &'static str {
         match self {
-            Outcome::Docked { .. } | Outcome::RouteDone { .. } | Outcome::Undocked { .. } => "SUCCEEDED",
-            Outcome::DockingFailed(DockingFailure::TimeLimit, _) => "TIME_LIMIT",
-            Outcome::DockingFailed(DockingFailure::NotConverging, _) => "NOT_CONVERGING",
-            Outcome::DockingFailed(DockingFailure::HeadingResidual, _) | Outcome::ResidualStall(_) => "RESIDUAL",
-            Outcome::Stalled { .. } => "STALLED",
+            Outcome::Law(mobil_motion::Outcome::Succeeded { .. }) => "SUCCEEDED",
+            Outcome::Law(mobil_motion::Outcome::Failed { code, .. }) => code,
             Outcome::RouteInfeasible(_) => "ROUTE_INFEASIBLE",
-            Outcome::UndockTimeout { .. } => "TIME_LIMIT",
             Outcome::Stale | Outcome::ScanStale => "STALE_INPUT",
             Outcome::NoSafePath { .. } => "NO_SAFE_PATH",
             Outcome::OptimisationBudget { .. } => "OPTIMISATION_BUDGET",
@@ -769,50 +716,9 @@ impl Outcome {
 
     /// The status reason: the code, a colon and the detail with the figures.
     pub fn reason(&self) -> String {
-        let list = |m: &[Missed]| {
-            let mut s = m
-                .iter()
-                .take(MAX_LISTED_PROBLEMS)
-                .map(Missed::describe)
-                .collect::<Vec<_>>()
-                .join("; ");
-            if m.len() > MAX_LISTED_PROBLEMS {
-                s += &format!("; and {} more", m.len() - MAX_LISTED_PROBLEMS);
-            }
-            s
-        };
         let detail = match self {
-            Outcome::Docked { e, heading } => format!("docked: e = {e:.3} m, heading error {heading:.3} rad"),
-            Outcome::RouteDone { count, missed } if missed.is_empty() => {
-                format!("route done: all {count} waypoints reached")
-            }
-            Outcome::RouteDone { count, missed } => format!(
-                "route done: {} of {count} waypoints missed: {}",
-                missed.len(),
-                list(missed)
-            ),
-            Outcome::Undocked { distance } => format!("undocked: backed out {distance:.3} m"),
-            Outcome::DockingFailed(f, r) => format!(
-                "{}: e = {:.3} m, heading error {:.3} rad ({:.1}°)",
-                f.as_str(),
-                r.e,
-                r.heading,
-                r.heading.to_degrees()
-            ),
-            Outcome::ResidualStall(r) => format!(
-                "V stopped falling: the law asks for turns tighter than the chassis' minimum radius (no turn \
-                 in place): e = {:.3} m, heading error {:.3} rad ({:.1}°)",
-                r.e,
-                r.heading,
-                r.heading.to_degrees()
-            ),
-            Outcome::Stalled { index } => {
-                format!("the robot did not move on its way to waypoint {index}: robot stopped")
-            }
-            Outcome::RouteInfeasible(m) => format!("{} problem(s): {}", m.len(), list(m)),
-            Outcome::UndockTimeout { limit, distance } => {
-                format!("not undocked within max_undocking_time {limit:.1} s (backed out {distance:.3} m)")
-            }
+            Outcome::Law(o) => return o.reason(),
+            Outcome::RouteInfeasible(m) => format!("{} problem(s): {}", m.len(), list_missed(m)),
             Outcome::Stale => "odom stale: robot stopped".to_owned(),
             Outcome::ScanStale => "scan stale: the obstacles are unknown, robot stopped".to_owned(),
             Outcome::NoSafePath {
@@ -848,7 +754,7 @@ impl Outcome {
     /// The NavStatus state it leaves.
     pub fn state(&self) -> u8 {
         match self {
-            Outcome::Docked { .. } | Outcome::RouteDone { .. } | Outcome::Undocked { .. } => NavStatus::SUCCEEDED,
+            Outcome::Law(o) if o.is_success() => NavStatus::SUCCEEDED,
             _ => NavStatus::FAILED,
         }
     }
@@ -863,11 +769,8 @@ impl Outcome {
     /// DOCK_NOT_VALID for a bad pose; UNKNOWN at shutdown; NONE otherwise.
     pub fn dock_result(&self) -> DockRobotResult {
         let error_code = match self {
-            Outcome::DockingFailed(..)
-            | Outcome::ResidualStall(_)
-            | Outcome::Stale
-            | Outcome::ScanStale
-            | Outcome::Refused(_) => DockRobotResult::FAILED_TO_CONTROL,
+            Outcome::Law(o) => o.nav2_error(),
+            Outcome::Stale | Outcome::ScanStale | Outcome::Refused(_) => DockRobotResult::FAILED_TO_CONTROL,
             Outcome::Invalid(GoalError::NoDockDatabase) => DockRobotResult::DOCK_NOT_IN_DB,
             Outcome::Invalid(_) => DockRobotResult::DOCK_NOT_VALID,
             Outcome::ShuttingDown => DockRobotResult::UNKNOWN,
@@ -885,9 +788,8 @@ impl Outcome {
     /// UNKNOWN at shutdown; NONE otherwise.
     pub fn undock_result(&self) -> UndockRobotResult {
         let error_code = match self {
-            Outcome::UndockTimeout { .. } | Outcome::Stale | Outcome::ScanStale | Outcome::Refused(_) => {
-                UndockRobotResult::FAILED_TO_CONTROL
-            }
+            Outcome::Law(o) => o.nav2_error(),
+            Outcome::Stale | Outcome::ScanStale | Outcome::Refused(_) => UndockRobotResult::FAILED_TO_CONTROL,
             Outcome::ShuttingDown => UndockRobotResult::UNKNOWN,
             _ => UndockRobotResult::NONE,
         };
@@ -907,13 +809,13 @@ impl Outcome {
     /// invalid goal or shutdown.
     pub fn follow_result(&self, poses: &[PoseStamped], so_far: &[Missed]) -> FollowWaypointsResult {
         let missed: &[Missed] = match self {
-            Outcome::RouteDone { missed, .. } | Outcome::RouteInfeasible(missed) => missed,
+            Outcome::RouteInfeasible(missed) => missed,
             _ => so_far,
         };
         let error_code = match self {
-            Outcome::RouteDone { .. } | Outcome::Canceled | Outcome::Preempted(_) => FollowWaypointsResult::NONE,
+            Outcome::Law(o) => o.nav2_error(),
+            Outcome::Canceled | Outcome::Preempted(_) => FollowWaypointsResult::NONE,
             Outcome::RouteInfeasible(_)
-            | Outcome::Stalled { .. }
             | Outcome::Stale
             | Outcome::ScanStale
             | Outcome::Refused(_)
@@ -971,22 +873,6 @@ impl Outcome {
                 .collect();
         }
         r
-    }
-}
-
-/// How a failed docking is reported. On a chassis that cannot turn in place
-/// ([`Finish::ReportResidual`]) V stops falling for one reason: the law asks for a turn tighter
-/// than the minimum radius (near the goal v = γ·e·cos α → 0 while ω does not; elsewhere a
-/// sharp turn), the chassis' curvature limit holds ω, and the robot runs on a line that passes
-/// the goal, backing and filling, with the position and heading residual the law cannot remove
-/// (under the common factor alone V̇ ≤ 0 holds: SPEC §3). That stall is reported as
-/// [`Outcome::ResidualStall`] (RESIDUAL, with e and the heading error); every other failure as
-/// the controller gives it.
-pub fn docking_outcome(failure: DockingFailure, residual: Residual, finish: Finish) -> Outcome {
-    if failure == DockingFailure::NotConverging && finish == Finish::ReportResidual {
-        Outcome::ResidualStall(residual)
-    } else {
-        Outcome::DockingFailed(failure, residual)
     }
 }
 
@@ -1365,20 +1251,6 @@ fn clear_marker(header: &Header) -> Marker {
     m
 }
 
-/// Whether a running goal's odometry is stale (steady clock): older than `timeout`, counted as
-/// old as the goal at most (`None`: none yet), so a goal gets one timeout from its start for
-/// odometry to arrive and never fails at once for an old one.
-pub fn odom_stale(odom_age: Option<Duration>, goal_age: Duration, timeout: Duration) -> bool {
-    odom_age.map_or(goal_age, |a| a.min(goal_age)) > timeout
-}
-
-/// The signed distance backed out along the start heading: how far the reference point moved
-/// against `start`'s heading (m).
-pub fn backed_out(start: &Pose2, now: &Pose2) -> f64 {
-    let (s, c) = start.yaw.sin_cos();
-    -((now.x - start.x) * c + (now.y - start.y) * s)
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -1583,37 +1455,20 @@ mod tests {
 
     #[test]
     fn outcomes_give_status_reasons_and_nav2_codes() {
+        use mobil_planner::goals::{docking_failure, route_done};
+        use mobil_planner::{DockingFailure, Finish, Residual};
+        // A law's end passes through: its reason, its state, its Nav2 code in every result.
         let residual = Residual { e: 0.015, heading: 0.5 };
-        let o = Outcome::DockingFailed(DockingFailure::HeadingResidual, residual);
+        let law = docking_failure(DockingFailure::HeadingResidual, residual, Finish::RotateInPlace);
+        let o = Outcome::from(law);
         assert_eq!(o.state(), NavStatus::FAILED);
+        assert_eq!(o.code(), "RESIDUAL");
         assert!(o.reason().starts_with("RESIDUAL: "), "{}", o.reason());
         assert!(o.reason().contains("e = 0.015 m"));
         assert!(o.reason().contains("0.500 rad (28.6°)"));
         let r = o.dock_result();
         assert_eq!((r.success, r.error_code), (false, 905));
-        let o = Outcome::DockingFailed(DockingFailure::NotConverging, residual);
-        assert_eq!((o.code(), o.dock_result().error_code), ("NOT_CONVERGING", 905));
-        let o = Outcome::DockingFailed(DockingFailure::TimeLimit, residual);
-        assert_eq!((o.code(), o.dock_result().error_code), ("TIME_LIMIT", 905));
-        // A steered chassis whose V stopped falling is stuck on its residual (RESIDUAL); the omni
-        // chassis, which can follow the law, is not converging.
-        let stall = DockingFailure::NotConverging;
-        let o = docking_outcome(stall, residual, Finish::ReportResidual);
-        assert_eq!(o, Outcome::ResidualStall(residual));
-        assert_eq!((o.code(), o.dock_result().error_code), ("RESIDUAL", 905));
-        assert!(
-            o.reason().ends_with("e = 0.015 m, heading error 0.500 rad (28.6°)"),
-            "{}",
-            o.reason()
-        );
-        assert_eq!(
-            docking_outcome(stall, residual, Finish::RotateInPlace),
-            Outcome::DockingFailed(stall, residual)
-        );
-        assert_eq!(
-            docking_outcome(DockingFailure::TimeLimit, residual, Finish::ReportResidual),
-            Outcome::DockingFailed(DockingFailure::TimeLimit, residual)
-        );
+        assert!(!o.succeeded());
         let o = Outcome::Invalid(GoalError::NoDockDatabase);
         assert_eq!((o.code(), o.dock_result().error_code), ("INVALID_GOAL", 901));
         let o = Outcome::Invalid(GoalError::NotFinite {
@@ -1621,18 +1476,26 @@ mod tests {
         });
         assert_eq!(o.dock_result().error_code, 902);
         assert_eq!(o.reason(), "INVALID_GOAL: dock pose is not finite");
-        let o = Outcome::Docked { e: 0.01, heading: 0.02 };
+        let o = Outcome::Law(mobil_motion::Outcome::succeeded(
+            "docked: e = 0.010 m, heading error 0.020 rad",
+        ));
+        assert_eq!(o.reason(), "SUCCEEDED: docked: e = 0.010 m, heading error 0.020 rad");
         let r = o.dock_result();
         assert_eq!((r.success, r.error_code, o.state()), (true, 0, NavStatus::SUCCEEDED));
         assert_eq!(Outcome::Stale.dock_result().error_code, 905);
         assert_eq!(Outcome::Stale.reason(), "STALE_INPUT: odom stale: robot stopped");
         assert_eq!(Outcome::Canceled.dock_result().error_code, 0);
-        let o = Outcome::UndockTimeout {
-            limit: 30.0,
-            distance: 0.2,
-        };
+        let o = Outcome::Law(mobil_motion::Outcome::failed("TIME_LIMIT", "not undocked", 905));
         assert_eq!((o.code(), o.undock_result().error_code), ("TIME_LIMIT", 905));
-        assert!(Outcome::Undocked { distance: 0.5 }.undock_result().success);
+        assert!(!o.undock_result().success);
+        assert!(
+            Outcome::Law(mobil_motion::Outcome::succeeded("undocked"))
+                .undock_result()
+                .success
+        );
+        // A route that stalled: FollowWaypoints' TASK_EXECUTOR_FAILED, as the law gives it.
+        let o = Outcome::Law(mobil_motion::Outcome::failed("STALLED", "did not move", 601));
+        assert_eq!((o.code(), o.follow_result(&[], &[]).error_code), ("STALLED", 601));
         // A refused route lists every problem, each with the request's index and its pose.
         let poses = vec![stamped("odom", 2.0, 0.0), stamped("odom", 2.0, 0.3)];
         let missed = vec![Missed {
@@ -1661,12 +1524,12 @@ mod tests {
             pre_check: false,
             ..missed[0].clone()
         };
-        let o = Outcome::RouteDone {
-            count: 2,
-            missed: vec![ran],
-        };
+        let o = Outcome::Law(mobil_motion::Outcome::succeeded(route_done(
+            2,
+            std::slice::from_ref(&ran),
+        )));
         assert_eq!(o.state(), NavStatus::SUCCEEDED);
-        let r = o.follow_result(&poses, &[]);
+        let r = o.follow_result(&poses, &[ran]);
         assert_eq!((r.error_code, r.missed_waypoints[0].error_code), (0, 105));
         // A cancel or a pre-emption lists what the run had missed until then.
         let so_far = [Missed {
@@ -1686,11 +1549,7 @@ mod tests {
                 ..missed[0].clone()
             })
             .collect();
-        let r = Outcome::RouteDone {
-            count: 60,
-            missed: many,
-        }
-        .follow_result(&poses, &[]);
+        let r = Outcome::Law(mobil_motion::Outcome::succeeded(route_done(60, &many))).follow_result(&poses, &many);
         assert_eq!(r.missed_waypoints.len(), 60);
         assert_eq!(r.missed_waypoints[59].index, 59);
         assert!(o.reason().starts_with("SUCCEEDED: route done: 1 of 2 waypoints missed"));
@@ -1758,7 +1617,7 @@ mod tests {
             .map(|i| Missed {
                 index: i,
                 position: Point2::new(i as f64, 0.0),
-                kind: ProblemKind::Unreachable(UnreachableCause::PassedBy { closest: 0.3 }),
+                kind: ProblemKind::Unreachable(mobil_planner::UnreachableCause::PassedBy { closest: 0.3 }),
                 pre_check: true,
             })
             .collect();
@@ -1781,29 +1640,6 @@ mod tests {
         let arrow = a.markers.last().expect("arrow");
         assert_eq!(arrow.r#type, Marker::ARROW);
         assert_relative_eq!(yaw_of(&arrow.pose.orientation), 0.5, epsilon = 1e-12);
-    }
-
-    #[test]
-    fn odometry_is_stale_after_one_timeout_from_the_goal_s_start() {
-        let ms = Duration::from_millis;
-        let timeout = ms(500);
-        // Fresh: 0.1 s old. Stale: 0.6 s old on a goal 2 s old.
-        assert!(!odom_stale(Some(ms(100)), ms(2000), timeout));
-        assert!(odom_stale(Some(ms(600)), ms(2000), timeout));
-        // A goal 0.3 s old with odometry 5 s old (or none yet) has its grace.
-        assert!(!odom_stale(Some(ms(5000)), ms(300), timeout));
-        assert!(!odom_stale(None, ms(300), timeout));
-        assert!(odom_stale(None, ms(501), timeout));
-        // Exactly the timeout is not yet stale.
-        assert!(!odom_stale(Some(ms(500)), ms(2000), timeout));
-    }
-
-    #[test]
-    fn backing_out_is_measured_against_the_start_heading() {
-        // Start facing +y at (1, 1); 0.4 m back along −y, 0.1 m sideways: 0.4 backed out.
-        let start = Pose2::new(1.0, 1.0, std::f64::consts::FRAC_PI_2);
-        assert_relative_eq!(backed_out(&start, &Pose2::new(1.1, 0.6, 1.5)), 0.4, epsilon = 1e-12);
-        assert_relative_eq!(backed_out(&start, &Pose2::new(1.0, 1.2, 1.5)), -0.2, epsilon = 1e-12);
     }
 
     #[test]

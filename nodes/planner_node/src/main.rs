@@ -20,48 +20,58 @@
 //! with one zero command. At shutdown with a goal under way, that goal's zero command is the
 //! last one, waited for ([`final_stop`]); an idle node sends none.
 
-use mobil_chassis::{BodyTwist, ChassisParams};
+//! Every goal runs through the motion server ([`MotionSession`]): one goal at a time, its time
+//! step, refusals, pre-emption and the zero command follow its rules (`cmd_vel` goes out only
+//! while a goal is active; one zero `cmd_vel` when a goal that moved the robot ends, however it
+//! ends, none between a goal and the newer one that replaces it and commands at its next step;
+//! a goal that must wait, a route's pre-check or a VFO segment's optimisation, stops the robot
+//! meanwhile). Every command is held to the chassis limits as chassis_node holds them
+//! ([`clamp_twist`]). A refused odometry message or step stops the robot. At shutdown with a
+//! goal that moved the robot, its zero command is the last one, waited for ([`final_stop`]);
+//! an idle node sends none.
+
+use mobil_chassis::ChassisParams;
 use mobil_geom::Pose2;
+use mobil_motion::{GoalLaw, Step, StepInput};
 use mobil_msgs::geometry_msgs::msg::{PoseStamped, Twist};
 use mobil_msgs::mobil_msgs::msg::NavStatus;
 use mobil_msgs::mobil_msgs::srv::{CheckRoute, CheckRouteRequest, CheckRouteResponse};
 use mobil_msgs::nav2_msgs::action::{
     DockRobot, DockRobotFeedback, DockRobotGoal, FollowWaypoints, FollowWaypointsFeedback, FollowWaypointsGoal,
-    UndockRobot, UndockRobotFeedback, UndockRobotGoal,
+    FollowWaypointsResult, UndockRobot, UndockRobotFeedback, UndockRobotGoal,
 };
 use mobil_msgs::nav_msgs::msg::{Odometry, Path};
 use mobil_msgs::sensor_msgs::msg::LaserScan;
 use mobil_msgs::tf2_msgs::msg::TFMessage;
 use mobil_msgs::visualization_msgs::msg::MarkerArray;
+use mobil_planner::goals::{DockGoal, RouteEvent, RouteGoal, UndockGoal};
 use mobil_planner::vfo::{
     Interrupt, ObstacleMap, OptimiseWarning, PoseHistory, VfoEnd, VfoEvent, VfoFollower, VfoOutput, MAX_BUDGET_RETRIES,
     MAX_SETTLE_S,
 };
 use mobil_planner::{
-    check_route_until, polar_error, DockingController, DockingOutput, DockingPhase, Finish, FollowEnd, FollowEvent,
-    PlannerError, ProblemKind, RouteReport, VelocityLimits, WaypointFollower,
+    check_route_until, DockingController, DockingPhase, Finish, PlannerError, RouteReport, VelocityLimits,
+    WaypointFollower,
 };
 use mobil_planner_node::vfo::{
     segment_report, vfo_command, vfo_drawing, vfo_gains, vfo_max_delay, vfo_waypoints, ArrivalPeriod, Handback,
     SegmentReport, VfoDrawing, VfoSlot, WaypointMethod,
 };
 use mobil_planner_node::{
-    backed_out, check_reply, clamp_twist, dock_goal, docking_offset, docking_outcome, load_world, markers,
-    missed_from_report, odom_stale, pose_in_odom, refused_reply, route_from_path, route_from_poses, status_message,
-    GoalError, MarkerView, Missed, Mode, Outcome, PlannerConfig, Route, StatusView,
+    check_reply, clamp_twist, dock_goal, docking_offset, load_world, markers, missed_from_report, pose_in_odom,
+    refused_reply, route_from_path, route_from_poses, status_message, GoalError, MarkerView, Missed, Mode, Outcome,
+    PlannerConfig, Route, StatusView,
 };
 use mobil_ros::action::{ActionEvent, GoalEnd, GoalRequest, GoalServer, GoalServerConfig};
 use mobil_ros::geometry::odom_pose;
 use mobil_ros::input::Inputs;
 use mobil_ros::latest::Latest;
+use mobil_ros::motion::{Applied, CmdVel, Ended, GoalId, MotionSession, SessionSettings, Watched};
 use mobil_ros::offloop::CancelToken;
-use mobil_ros::scan::scan_laser_pose;
-use mobil_ros::scan::{scan_from_msg, tf_static_subscription, StaticFrames};
-use mobil_ros::stop::CommandGate;
+use mobil_ros::scan::{scan_from_msg, scan_laser_pose, tf_static_subscription, StaticFrames};
 use mobil_ros::stop::{final_stop, FINAL_STOP_WAIT};
 use mobil_ros::ticker::Ticker;
-use mobil_ros::time::duration_msg;
-use mobil_ros::time::{secs_from_stamp, DtClock, DtError};
+use mobil_ros::time::{duration_msg, secs_from_stamp, DtError};
 use mobil_ros::OffLoop;
 use mobil_ros::{qos, run_node, shutdown_signal, warn_throttled, ConfigError, LogThrottle, NodeDecl, RosNode};
 use mobil_world::World;
@@ -75,20 +85,8 @@ use tracing::{info, warn};
 
 /// The watchdog tick (steady clock): stale odometry is noticed within 50 ms of its timeout.
 const WATCHDOG_RATE_HZ: f64 = 20.0;
-/// The follower's `dt` on a goal's first step, before ROS time has ticked twice (it sets only
-/// the step's length, not its direction or speed).
-const FIRST_DT: f64 = 0.02;
-/// The follower's longest `dt` (s): a tick after a gap in odometry (five 50 Hz periods) steps
-/// no further than this, so one step stays a short one of the approach.
-const MAX_FOLLOW_DT: f64 = 0.1;
-/// After this many refused steps in a row the goal ends.
-const MAX_REFUSED_STEPS: u32 = 20;
 /// A route shorter than this (m), start included, is refused as zero-length.
 const MIN_ROUTE_LENGTH: f64 = 1e-3;
-/// Undocking succeeds within this of the staging distance (m).
-const UNDOCK_TOLERANCE: f64 = 0.005;
-/// The slowest reversing speed near the staging distance (m/s).
-const UNDOCK_MIN_SPEED: f64 = 0.03;
 
 fn decl() -> NodeDecl {
     NodeDecl::for_config::<PlannerConfig>(
@@ -113,9 +111,9 @@ enum Source {
     FollowAction,
 }
 
-impl Source {
-    fn name(self) -> &'static str {
-        match self {
+impl From<Source> for &'static str {
+    fn from(s: Source) -> &'static str {
+        match s {
             Source::DockPose => "dock_pose",
             Source::Waypoints => "waypoints",
             Source::DockAction => "dock_robot",
@@ -125,81 +123,95 @@ impl Source {
     }
 }
 
-/// What the active goal does.
-#[allow(clippy::large_enum_variant)]
-enum Task {
-    /// A route waiting for its pre-check (off the event loop); no command meanwhile.
-    PreCheck { route: Route, start: Pose2, seq: u64 },
-    Dock {
-        controller: DockingController,
-        last: Option<DockingOutput>,
-        /// The steered point's offset behind the reference point ([`docking_offset`]).
-        offset: f64,
-    },
-    Follow {
-        follower: WaypointFollower,
-        route: Route,
-        missed: Vec<Missed>,
-        distance: f64,
-    },
-    Undock {
-        start: Option<Pose2>,
-        distance: f64,
-        limit_s: f64,
-        backed: f64,
-    },
-    /// VFO waypoint following: the follower at home or out on a tick ([`VfoSlot`]).
-    Vfo {
-        slot: VfoSlot,
-        route: Route,
-        /// The goal's number: a tick's result for another goal is dropped.
-        seq: u64,
-        /// The steered point's offset behind the reference point ([`docking_offset`]).
-        offset: f64,
-        /// The waypoint pursued (route index) and ‖e*‖ to it.
-        index: usize,
-        distance: f64,
-        report: SegmentReport,
-        /// The obstacle map changed since the follower last saw it (`Some(true)`: with new
-        /// obstacles, which re-optimise the segment).
-        obstacles_changed: Option<bool>,
-        /// The map's ids of the obstacles the follower holds, by its index: its σ follow them
-        /// over removals from the map.
-        ids: Vec<u64>,
-        /// Cancelled when the goal ends: a tick's optimisation under way stops at once.
-        stop: CancelToken,
-    },
+impl Source {
+    fn name(self) -> &'static str {
+        self.into()
+    }
+
+    fn is_action(self) -> bool {
+        matches!(self, Source::DockAction | Source::UndockAction | Source::FollowAction)
+    }
 }
 
-struct Active {
+/// A VFO route's state: the follower at home or out on a tick ([`VfoSlot`]) and what the
+/// status shows of it.
+struct VfoTask {
+    slot: VfoSlot,
+    route: Route,
+    /// The steered point's offset behind the reference point ([`docking_offset`]).
+    offset: f64,
+    /// The waypoint pursued (route index) and ‖e*‖ to it.
+    index: usize,
+    distance: f64,
+    report: SegmentReport,
+    /// The obstacle map changed since the follower last saw it (`Some(true)`: with new
+    /// obstacles, which re-optimise the segment).
+    obstacles_changed: Option<bool>,
+    /// The map's ids of the obstacles the follower holds, by its index: its σ follow them
+    /// over removals from the map.
+    ids: Vec<u64>,
+    /// Cancelled when the goal ends: a tick's optimisation under way stops at once.
+    stop: CancelToken,
+}
+
+/// What the active goal does: each a goal law of [`mobil_planner::goals`] but the pre-check
+/// (a wait, off the event loop) and VFO (its ticks off the event loop).
+#[allow(clippy::large_enum_variant)]
+enum Task {
+    /// A route waiting for its pre-check; the robot stopped meanwhile.
+    PreCheck {
+        route: Route,
+        start: Pose2,
+    },
+    Dock(DockGoal),
+    Follow {
+        goal: RouteGoal,
+        route: Route,
+    },
+    Undock(UndockGoal),
+    Vfo(VfoTask),
+}
+
+/// The goal state the session holds.
+struct Goal {
     task: Task,
-    source: Source,
     /// The chassis and parameters when the goal began: a parameter change applies from the
     /// next goal, so the limits the controller scales by stay those the commands are held to.
     chassis: ChassisParams,
     config: PlannerConfig,
-    started: Instant,
-    clock: DtClock,
-    t: f64,
-    refused: u32,
-    /// Whether this goal has sent a command (its end then sends the zero one).
-    commanded: bool,
 }
 
-impl Active {
+impl Goal {
     fn mode(&self) -> Mode {
         match &self.task {
-            Task::Dock { last, .. } => match last.map(|o| o.phase) {
+            Task::Dock(d) => match d.last().map(|o| o.phase) {
                 Some(DockingPhase::Rotate) => Mode::Rotate,
                 _ => Mode::Dock,
             },
             Task::PreCheck { .. } => Mode::PreCheck,
             Task::Follow { .. } => Mode::Approach,
-            Task::Undock { .. } => Mode::Undock,
-            Task::Vfo { .. } => Mode::Vfo,
+            Task::Undock(_) => Mode::Undock,
+            Task::Vfo(_) => Mode::Vfo,
+        }
+    }
+
+    /// The route's request index pursued, if a route.
+    fn waypoint(&self) -> Option<usize> {
+        let at = |route: &Route, i: usize| {
+            let i = i.min(route.points.len().saturating_sub(1));
+            route.request_index.get(i).copied().unwrap_or(0)
+        };
+        match &self.task {
+            Task::Follow { goal, .. } => Some(goal.waypoint()),
+            Task::Vfo(v) => Some(at(&v.route, v.index)),
+            Task::PreCheck { route, .. } => Some(at(route, 0)),
+            Task::Dock(_) | Task::Undock(_) => None,
         }
     }
 }
+
+type Session = MotionSession<Goal, Source, Outcome>;
+type PlannerEnded = Ended<Goal, Source, Outcome>;
 
 struct Outputs {
     cmd: Publisher<Twist>,
@@ -213,9 +225,17 @@ struct Servers {
     follow: GoalServer<FollowWaypoints>,
 }
 
-/// A route pre-check done off the event loop, for the goal numbered `seq`.
+/// What a handler reaches of the node: its clock, its outputs and commands, its action servers.
+struct Io<'a, 'c> {
+    node: &'a RosNode,
+    out: &'a Outputs,
+    sink: &'a mut CmdVel<'c>,
+    servers: &'a mut Servers,
+}
+
+/// A route pre-check done off the event loop, for goal `id`.
 struct PreCheckDone {
-    seq: u64,
+    id: GoalId,
     report: Result<RouteReport, String>,
 }
 
@@ -232,7 +252,7 @@ const ODOM_HISTORY: usize = 100;
 /// One VFO tick done on the blocking pool: the follower back, its output, and when the tick
 /// optimised, what the status and markers show of it.
 struct VfoTickDone {
-    seq: u64,
+    id: GoalId,
     follower: Box<VfoFollower>,
     output: Result<VfoOutput, PlannerError>,
     optimised: Option<(SegmentReport, VfoDrawing)>,
@@ -243,7 +263,6 @@ struct VfoTickDone {
 struct Jobs {
     goal: OffLoop<PreCheckDone>,
     vfo: OffLoop<VfoTickDone>,
-    seq: u64,
     replies_tx: mpsc::UnboundedSender<(RmwRequestId, CheckRouteResponse)>,
     replies: mpsc::UnboundedReceiver<(RmwRequestId, CheckRouteResponse)>,
     pending: usize,
@@ -264,13 +283,12 @@ struct Shell {
     config: PlannerConfig,
     chassis: ChassisParams,
     world: Arc<World>,
-    active: Option<Active>,
+    session: Session,
     odom: Latest<Pose2>,
     odom_refused: bool,
     last_status: Option<Instant>,
     last_markers: Option<Instant>,
     drawing: Drawing,
-    gate: CommandGate,
     throttle: LogThrottle,
     /// Obstacles seen by the LIDAR, in odom (VFO); kept between goals.
     map: ObstacleMap,
@@ -359,13 +377,12 @@ async fn start(node: &mut RosNode, out: &Outputs, config: PlannerConfig) -> anyh
         config,
         chassis,
         world: Arc::new(world),
-        active: None,
+        session: Session::new(SessionSettings::default()),
         odom: Latest::new(),
         odom_refused: false,
         last_status: None,
         last_markers: None,
         drawing: Drawing::default(),
-        gate: CommandGate::default(),
         throttle: LogThrottle::new(Duration::from_secs(2)),
         map,
         map_rebuild: false,
@@ -380,14 +397,15 @@ async fn start(node: &mut RosNode, out: &Outputs, config: PlannerConfig) -> anyh
     let mut jobs = Jobs {
         goal: OffLoop::new(),
         vfo: OffLoop::new(),
-        seq: 0,
         replies_tx,
         replies,
         pending: 0,
     };
+    let mut sink = CmdVel::new(&out.cmd);
     let outcome = event_loop(
         node,
         out,
+        &mut sink,
         &mut shell,
         &mut servers,
         &mut jobs,
@@ -396,13 +414,22 @@ async fn start(node: &mut RosNode, out: &Outputs, config: PlannerConfig) -> anyh
         &check,
     )
     .await;
+    // A goal under way (a pre-check included: it stopped a robot a goal before it moved) ends,
+    // and its zero command, waited for, goes out before anything that may take time; then the
+    // three servers close at once (each waits up to 2 s for its results).
     jobs.vfo.cancel();
-    // A goal under way (a pre-check included: a command may be in flight from a goal it
-    // pre-empted) ends, and its zero command, waited for, goes out before anything that may
-    // take time; then the three servers close at once (each waits up to 2 s for its results).
     jobs.goal.cancel();
-    if shell.active.is_some() {
-        shell.end_goal_without_zero(node, out, &mut servers, Outcome::ShuttingDown);
+    let (ended, final_zero) = shell.session.shutdown();
+    if let Some(ended) = ended {
+        let mut io = Io {
+            node,
+            out,
+            sink: &mut sink,
+            servers: &mut servers,
+        };
+        shell.report(&mut io, ended, true);
+    }
+    if final_zero {
         final_stop(&out.cmd, Twist::default(), FINAL_STOP_WAIT).await;
     }
     let down = Outcome::ShuttingDown;
@@ -419,14 +446,11 @@ async fn start(node: &mut RosNode, out: &Outputs, config: PlannerConfig) -> anyh
 async fn event_loop(
     node: &mut RosNode,
     out: &Outputs,
+    sink: &mut CmdVel<'_>,
     shell: &mut Shell,
     servers: &mut Servers,
     jobs: &mut Jobs,
-    (odom_sub, dock_sub, route_sub): (
-        &ros2_client::Subscription<Odometry>,
-        &ros2_client::Subscription<PoseStamped>,
-        &ros2_client::Subscription<Path>,
-    ),
+    (odom_sub, dock_sub, route_sub): (&Subscription<Odometry>, &Subscription<PoseStamped>, &Subscription<Path>),
     (scan_sub, tf_sub): (&Subscription<LaserScan>, &Subscription<TFMessage>),
     check: &Server<CheckRouteRequest, CheckRouteResponse>,
 ) -> anyhow::Result<()> {
@@ -453,11 +477,17 @@ async fn event_loop(
             e = servers.follow.next_event() => Event::Follow(e),
             _ = ticker.tick() => Event::Tick,
         };
+        let mut io = Io {
+            node,
+            out,
+            sink,
+            servers,
+        };
         match event {
             Event::Shutdown => return Ok(()),
             Event::Config(Ok(c)) => shell.reconfigure(c),
             Event::Config(Err(e)) => warn!("parameters not applied: {e}"),
-            Event::Odom(m) => shell.odom_in(node, out, servers, jobs, &m),
+            Event::Odom(m) => shell.odom_in(&mut io, jobs, &m),
             Event::Scan(m) => {
                 let skipped = shell.laser.take_all(tf_sub);
                 if skipped > 0 {
@@ -469,14 +499,12 @@ async fn event_loop(
                 }
                 shell.scan_in(&m);
             }
-            Event::VfoTicked(done) => shell.vfo_ticked(node, out, servers, done),
+            Event::VfoTicked(done) => shell.vfo_ticked(&mut io, done),
             Event::DockPose(m) => {
                 let target = dock_goal(&m, &shell.config.odom_frame);
-                shell.new_goal(node, out, servers, Source::DockPose).await;
-                shell.start_dock(node, out, servers, target, Source::DockPose);
+                shell.start_dock(&mut io, target, Source::DockPose);
             }
             Event::Waypoints(m) => {
-                shell.new_goal(node, out, servers, Source::Waypoints).await;
                 let start = shell.fresh_odom();
                 let route = route_from_path(
                     &m,
@@ -484,69 +512,30 @@ async fn event_loop(
                     start.map(|p| p.position()),
                     MIN_ROUTE_LENGTH,
                 );
-                shell.start_route(node, out, servers, jobs, route, start, Source::Waypoints);
+                shell.start_route(&mut io, jobs, route, start, Source::Waypoints);
             }
-            Event::Dock(ActionEvent::Goal(request)) => shell.dock_action(node, out, servers, request).await,
-            Event::Undock(ActionEvent::Goal(request)) => shell.undock_action(node, out, servers, request).await,
-            Event::Follow(ActionEvent::Goal(request)) => shell.follow_action(node, out, servers, jobs, request).await,
+            Event::Dock(ActionEvent::Goal(request)) => shell.dock_action(&mut io, request).await,
+            Event::Undock(ActionEvent::Goal(request)) => shell.undock_action(&mut io, request).await,
+            Event::Follow(ActionEvent::Goal(request)) => shell.follow_action(&mut io, jobs, request).await,
             Event::Dock(ActionEvent::CancelRequested(id)) => {
-                let is_active = servers.dock.active_id() == Some(id);
-                shell.cancel(node, out, servers, Source::DockAction, is_active)
+                let is_active = io.servers.dock.active_id() == Some(id);
+                shell.cancel(&mut io, Source::DockAction, is_active)
             }
             Event::Undock(ActionEvent::CancelRequested(id)) => {
-                let is_active = servers.undock.active_id() == Some(id);
-                shell.cancel(node, out, servers, Source::UndockAction, is_active)
+                let is_active = io.servers.undock.active_id() == Some(id);
+                shell.cancel(&mut io, Source::UndockAction, is_active)
             }
             Event::Follow(ActionEvent::CancelRequested(id)) => {
-                let is_active = servers.follow.active_id() == Some(id);
-                shell.cancel(node, out, servers, Source::FollowAction, is_active)
+                let is_active = io.servers.follow.active_id() == Some(id);
+                shell.cancel(&mut io, Source::FollowAction, is_active)
             }
-            Event::Check(id, req) => match shell.check_request(&req) {
-                Err(reply) => respond(check, id, reply, &mut shell.throttle),
-                Ok(_) if jobs.pending + 1 >= MAX_CHECKS => {
-                    let reply = refused_reply(format!(
-                        "BUSY: {} route checks are already being computed; ask again",
-                        jobs.pending
-                    ));
-                    respond(check, id, reply, &mut shell.throttle)
-                }
-                Ok((start, route)) => {
-                    jobs.pending += 1;
-                    let tx = jobs.replies_tx.clone();
-                    let (world, chassis, config) = (shell.world.clone(), shell.chassis, shell.config.route_check());
-                    let (stamp, frame, step) = (
-                        node.stamp(),
-                        shell.config.odom_frame.clone(),
-                        shell.config.follow.check_length,
-                    );
-                    tokio::task::spawn_blocking(move || {
-                        let began = Instant::now();
-                        let reply = match check_route_until(&start, &route.points, &chassis, &world, &config, || false)
-                        {
-                            Ok(report) => check_reply(&report, &route, stamp, &frame, step),
-                            Err(e) => refused_reply(Outcome::Refused(e.to_string()).reason()),
-                        };
-                        info!(
-                            "planner/check_route: {} waypoints, {} in {:.2} ms",
-                            route.points.len(),
-                            if reply.feasible {
-                                "feasible".to_owned()
-                            } else {
-                                format!("{} problem(s)", reply.problems.len())
-                            },
-                            began.elapsed().as_secs_f64() * 1e3
-                        );
-                        // The receiver lives as long as the loop; if it is gone nobody waits.
-                        let _ = tx.send((id, reply));
-                    });
-                }
-            },
+            Event::Check(id, req) => shell.check_in(io.node, jobs, check, id, &req),
             Event::Checked(id, reply) => {
                 jobs.pending = jobs.pending.saturating_sub(1);
                 respond(check, id, reply, &mut shell.throttle);
             }
-            Event::PreChecked(done) => shell.pre_checked(node, out, servers, done),
-            Event::Tick => shell.tick(node, out, servers).await,
+            Event::PreChecked(done) => shell.pre_checked(&mut io, done),
+            Event::Tick => shell.tick(&mut io).await,
         }
     }
 }
@@ -576,6 +565,22 @@ fn goal_end(outcome: &Outcome) -> GoalEnd {
     }
 }
 
+/// FollowWaypoints' result for a route goal ending with `outcome`: the waypoints missed so far
+/// (a VFO route: those not reached), the request's poses.
+fn follow_answer(task: &Task, outcome: &Outcome) -> FollowWaypointsResult {
+    match task {
+        Task::Follow { goal, route } => outcome.follow_result(&route.poses, goal.missed()),
+        Task::Vfo(v) => outcome.vfo_follow_result(&v.route.poses, &v.route.unreached_from(v.index)),
+        Task::PreCheck { route, .. } => outcome.follow_result(&route.poses, &[]),
+        Task::Dock(_) | Task::Undock(_) => outcome.follow_result(&[], &[]),
+    }
+}
+
+/// Holds a law's body twist to the chassis limits, as a `cmd_vel`.
+fn limited(chassis: &ChassisParams) -> impl Fn(mobil_chassis::BodyTwist) -> Twist + '_ {
+    move |b| clamp_twist(b, chassis)
+}
+
 impl Shell {
     fn reconfigure(&mut self, c: PlannerConfig) {
         let scan = c.vfo.scan_config(c.robot_radius);
@@ -583,7 +588,7 @@ impl Shell {
             if let Err(e) = ObstacleMap::new(scan) {
                 return warn!("parameters not applied: {e}");
             }
-            if self.active.is_some() {
+            if self.session.active().is_some() {
                 // The goal keeps the map its parameters built (its obstacles and σ stay valid).
                 info!("vfo obstacle extraction changed: the obstacle map starts afresh once the goal ends");
                 self.map_rebuild = true;
@@ -599,7 +604,7 @@ impl Shell {
             Ok(chassis) => {
                 self.chassis = chassis;
                 self.config = c;
-                if self.active.is_some() {
+                if self.session.active().is_some() {
                     info!("parameters changed: they apply from the next goal");
                 }
             }
@@ -614,27 +619,6 @@ impl Shell {
             .copied()
     }
 
-    fn publish_cmd(&mut self, out: &Outputs, twist: Twist) {
-        if let Some(a) = self.active.as_mut() {
-            a.commanded = true;
-        }
-        self.gate.sent(&twist);
-        if let Err(e) = out.cmd.publish(twist) {
-            warn_throttled!(self.throttle, "cmd", "cannot publish cmd_vel: {e:?}");
-        }
-    }
-
-    fn zero(&mut self, out: &Outputs) {
-        self.publish_cmd(out, Twist::default());
-    }
-
-    /// A refused input while a goal runs: one zero command if the robot was moving.
-    fn refused(&mut self, out: &Outputs) {
-        if self.active.is_some() && self.gate.refused() {
-            self.zero(out);
-        }
-    }
-
     fn send_status(&mut self, node: &RosNode, out: &Outputs, view: &StatusView) {
         let msg = status_message(view, node.stamp(), &self.config.odom_frame);
         if let Err(e) = out.status.publish(msg) {
@@ -644,124 +628,55 @@ impl Shell {
     }
 
     fn send_idle_status(&mut self, node: &RosNode, out: &Outputs) {
-        let view = StatusView {
-            state: NavStatus::IDLE,
-            mode: Mode::Idle,
-            goal: None,
-            distance_to_goal: f64::NAN,
-            reason: String::new(),
-            waypoint_index: -1,
-            docking: None,
-            vfo: None,
-        };
-        self.send_status(node, out, &view);
+        self.send_status(node, out, &self.status_view(None, NavStatus::IDLE, String::new()));
     }
 
-    /// The status of the active goal in `state` with `reason`.
-    fn status_view(&self, state: u8, reason: String) -> StatusView {
-        let Some(active) = &self.active else {
-            return StatusView {
-                state,
-                mode: Mode::Idle,
-                goal: None,
-                distance_to_goal: f64::NAN,
-                reason,
-                waypoint_index: -1,
-                docking: None,
-                vfo: None,
-            };
-        };
-        let (goal, distance, index, docking) = match &active.task {
-            Task::Dock {
-                controller,
-                last,
-                offset,
-            } => {
-                // Before the first step, the figures at the latest pose.
-                let figures = last.map(|o| (o.polar, o.lyapunov)).or_else(|| {
-                    self.odom.value().map(|p| {
-                        let polar = polar_error(&p.ahead(-*offset), &controller.goal());
-                        (polar, controller.gains().lyapunov(&polar))
-                    })
-                });
-                (
-                    Some(controller.goal().ahead(*offset)),
-                    figures.map_or(f64::NAN, |(p, _)| p.e),
-                    -1,
-                    Some(figures.map_or([f64::NAN; 4], |(p, v)| [p.e, p.alpha, p.theta, v])),
-                )
-            }
-            Task::Follow {
-                follower,
-                route,
-                distance,
-                ..
-            } => {
-                let i = follower.index().min(route.points.len().saturating_sub(1));
-                let index = route.request_index.get(i).copied().unwrap_or(0);
-                (
-                    route.points.get(i).map(|p| Pose2::new(p.x, p.y, 0.0)),
-                    *distance,
-                    i32::try_from(index).unwrap_or(i32::MAX),
-                    None,
-                )
-            }
-            Task::Undock { distance, backed, .. } => (None, distance - backed, -1, None),
-            Task::Vfo {
-                route, index, distance, ..
-            } => {
-                let i = (*index).min(route.points.len().saturating_sub(1));
-                let request = route.request_index.get(i).copied().unwrap_or(0);
-                (
-                    route.points.get(i).map(|p| Pose2::new(p.x, p.y, 0.0)),
-                    *distance,
-                    i32::try_from(request).unwrap_or(i32::MAX),
-                    None,
-                )
-            }
-            Task::PreCheck { route, .. } => (
-                route.points.first().map(|p| Pose2::new(p.x, p.y, 0.0)),
-                f64::NAN,
-                route
-                    .request_index
-                    .first()
-                    .map_or(-1, |&i| i32::try_from(i).unwrap_or(i32::MAX)),
-                None,
-            ),
-        };
-        let vfo = match &active.task {
-            Task::Vfo { report, .. } => Some(*report),
-            _ => None,
-        };
-        StatusView {
+    /// The status of `goal` (none: idle, or a refusal) in `state` with `reason`.
+    fn status_view(&self, goal: Option<&Goal>, state: u8, reason: String) -> StatusView {
+        let mut view = StatusView {
             state,
-            mode: active.mode(),
-            goal,
-            distance_to_goal: distance,
-            reason,
-            waypoint_index: index,
-            docking,
-            vfo,
-        }
-    }
-
-    fn publish_status(&mut self, node: &RosNode, out: &Outputs, state: u8, reason: String) {
-        let view = self.status_view(state, reason);
-        self.send_status(node, out, &view);
-    }
-
-    /// A refused goal's status: FAILED with the reason, no goal.
-    fn publish_refusal(&mut self, node: &RosNode, out: &Outputs, outcome: &Outcome) {
-        let view = StatusView {
-            state: NavStatus::FAILED,
             mode: Mode::Idle,
             goal: None,
             distance_to_goal: f64::NAN,
-            reason: outcome.reason(),
+            reason,
             waypoint_index: -1,
             docking: None,
             vfo: None,
         };
+        let Some(g) = goal else { return view };
+        view.mode = g.mode();
+        view.waypoint_index = g.waypoint().map_or(-1, |i| i32::try_from(i).unwrap_or(i32::MAX));
+        let at = |p: Option<Point2<f64>>| p.map(|p| Pose2::new(p.x, p.y, 0.0));
+        match &g.task {
+            Task::Dock(d) => {
+                // Before the first step, the figures at the latest pose.
+                let figures = d.figures(self.odom.value());
+                view.goal = Some(d.target());
+                view.distance_to_goal = figures.map_or(f64::NAN, |(p, _)| p.e);
+                view.docking = Some(figures.map_or([f64::NAN; 4], |(p, v)| [p.e, p.alpha, p.theta, v]));
+            }
+            Task::Follow { goal, .. } => {
+                view.goal = at(goal.target());
+                view.distance_to_goal = goal.distance();
+            }
+            Task::Undock(u) => view.distance_to_goal = u.remaining(),
+            Task::Vfo(v) => {
+                view.goal = at(v
+                    .route
+                    .points
+                    .get(v.index.min(v.route.points.len().saturating_sub(1)))
+                    .copied());
+                view.distance_to_goal = v.distance;
+                view.vfo = Some(v.report);
+            }
+            Task::PreCheck { route, .. } => view.goal = at(route.points.first().copied()),
+        }
+        view
+    }
+
+    /// The active goal's status in `state` with `reason`.
+    fn publish_status(&mut self, node: &RosNode, out: &Outputs, state: u8, reason: String) {
+        let view = self.status_view(self.session.active().map(|a| &a.goal), state, reason);
         self.send_status(node, out, &view);
     }
 
@@ -781,58 +696,48 @@ impl Shell {
         self.last_markers = Some(Instant::now());
     }
 
-    /// Ends the active goal: one zero command (if it commanded the robot at all), the status
-    /// with the reason, the action's result.
-    fn end_goal(&mut self, node: &RosNode, out: &Outputs, servers: &mut Servers, outcome: Outcome) {
-        if self.active.as_ref().is_some_and(|a| a.commanded) {
-            self.zero(out);
+    /// Ends the active goal with `outcome` (the session sends its zero command, if one is due)
+    /// and reports it.
+    fn end_goal(&mut self, io: &mut Io<'_, '_>, outcome: Outcome) {
+        if let Some(ended) = self.session.end(outcome, io.sink) {
+            self.report(io, ended, true);
         }
-        self.end_goal_without_zero(node, out, servers, outcome);
     }
 
-    /// [`Shell::end_goal`] but for the zero command, which the caller sends.
-    fn end_goal_without_zero(&mut self, node: &RosNode, out: &Outputs, servers: &mut Servers, outcome: Outcome) {
-        let Some(active) = self.active.as_ref() else { return };
-        if let Task::Vfo { stop, .. } = &active.task {
-            stop.cancel();
+    /// Tells an ended goal's end: the action's result (unless the server already ended it:
+    /// a newer goal on the same action server took its place), the log, the status with the
+    /// goal's last figures, the markers; a VFO optimisation under way stops.
+    fn report(&mut self, io: &mut Io<'_, '_>, ended: PlannerEnded, finish_action: bool) {
+        let Ended {
+            goal, source, cause, ..
+        } = ended;
+        if let Task::Vfo(v) = &goal.task {
+            v.stop.cancel();
         }
-        let source = active.source;
-        let end = goal_end(&outcome);
-        match (source, &active.task) {
-            (Source::DockAction, _) => {
-                servers.dock.finish(end, outcome.dock_result());
+        if finish_action {
+            let end = goal_end(&cause);
+            match source {
+                Source::DockAction => {
+                    io.servers.dock.finish(end, cause.dock_result());
+                }
+                Source::UndockAction => {
+                    io.servers.undock.finish(end, cause.undock_result());
+                }
+                Source::FollowAction => {
+                    io.servers.follow.finish(end, follow_answer(&goal.task, &cause));
+                }
+                Source::DockPose | Source::Waypoints => {}
             }
-            (Source::UndockAction, _) => {
-                servers.undock.finish(end, outcome.undock_result());
-            }
-            (Source::FollowAction, Task::Follow { route, missed, .. }) => {
-                servers.follow.finish(end, outcome.follow_result(&route.poses, missed));
-            }
-            (Source::FollowAction, Task::Vfo { route, index, .. }) => {
-                servers.follow.finish(
-                    end,
-                    outcome.vfo_follow_result(&route.poses, &route.unreached_from(*index)),
-                );
-            }
-            (Source::FollowAction, Task::PreCheck { route, .. }) => {
-                servers.follow.finish(end, outcome.follow_result(&route.poses, &[]));
-            }
-            (Source::FollowAction, _) => {
-                servers.follow.finish(end, outcome.follow_result(&[], &[]));
-            }
-            _ => {}
         }
-        match outcome {
-            Outcome::Docked { .. }
-            | Outcome::RouteDone { .. }
-            | Outcome::Undocked { .. }
-            | Outcome::Canceled
-            | Outcome::Preempted(_) => info!("goal ({}) ends: {}", source.name(), outcome.reason()),
-            _ => warn!("goal ({}) ends: {}", source.name(), outcome.reason()),
+        let reason = cause.reason();
+        match cause {
+            Outcome::Law(ref o) if o.is_success() => info!("goal ({}) ends: {reason}", source.name()),
+            Outcome::Canceled | Outcome::Preempted(_) => info!("goal ({}) ends: {reason}", source.name()),
+            _ => warn!("goal ({}) ends: {reason}", source.name()),
         }
-        self.publish_status(node, out, outcome.state(), outcome.reason());
-        self.active = None;
-        if std::mem::take(&mut self.map_rebuild) {
+        let view = self.status_view(Some(&goal), cause.state(), reason);
+        self.send_status(io.node, io.out, &view);
+        if self.session.active().is_none() && std::mem::take(&mut self.map_rebuild) {
             match ObstacleMap::new(self.config.vfo.scan_config(self.config.robot_radius)) {
                 Ok(map) => {
                     info!("the obstacle map starts afresh with the new extraction parameters");
@@ -841,57 +746,59 @@ impl Shell {
                 Err(e) => warn!("the obstacle map keeps its old parameters: {e}"),
             }
         }
-        self.publish_markers(node, out);
+        self.publish_markers(io.node, io.out);
     }
 
-    /// Before a new goal from `source` starts (or is refused): the running goal ends PREEMPTED
-    /// with its zero command. An action goal on the same server is ended by the server's accept
-    /// (with the result built there); here only its status and command.
-    async fn new_goal(&mut self, node: &RosNode, out: &Outputs, servers: &mut Servers, source: Source) {
-        let Some(active) = &self.active else { return };
-        let outcome = Outcome::Preempted(source.name());
-        if active.source == source && matches!(source, Source::DockAction | Source::UndockAction | Source::FollowAction)
-        {
-            let old = active.source;
-            // The old goal's optimisation under way stops too (its result would be dropped).
-            if let Task::Vfo { stop, .. } = &active.task {
-                stop.cancel();
-            }
-            if active.commanded {
-                self.zero(out);
-            }
-            info!("goal ({}) ends: {}", old.name(), outcome.reason());
-            self.publish_status(node, out, NavStatus::FAILED, outcome.reason());
-            self.active = None;
-        } else {
-            self.end_goal(node, out, servers, outcome);
-        }
-    }
-
-    fn activate(&mut self, task: Task, source: Source) {
-        self.gate = CommandGate::default();
-        self.active = Some(Active {
+    /// Makes `task` from `source` the active goal: the goal it replaces ends PREEMPTED
+    /// (reported; an action goal on the same server was ended by the server's accept).
+    fn begin(&mut self, io: &mut Io<'_, '_>, task: Task, source: Source) -> GoalId {
+        let goal = Goal {
             task,
-            source,
             chassis: self.chassis,
             config: self.config.clone(),
-            started: Instant::now(),
-            clock: DtClock::new(),
-            t: 0.0,
-            refused: 0,
-            commanded: false,
-        });
+        };
+        let (id, old) = self.session.start(goal, source, Instant::now());
+        if let Some(old) = old {
+            let by_server = source.is_action() && old.source == source;
+            self.report(io, old, !by_server);
+        }
+        id
     }
 
-    /// Starts a docking onto `target` (or refuses it: status, and for an action its result).
-    fn start_dock(
-        &mut self,
-        node: &RosNode,
-        out: &Outputs,
-        servers: &mut Servers,
-        target: Result<Pose2, GoalError>,
-        source: Source,
-    ) {
+    /// A goal from `source` refused before it started: the goal it was to replace ends
+    /// PREEMPTED (the robot stops with it); an action goal (accepted already) gets its result;
+    /// the status is FAILED with the reason.
+    fn refuse(&mut self, io: &mut Io<'_, '_>, source: Source, outcome: Outcome) {
+        if let Some(old) = self.session.end(Outcome::Preempted(source.name()), io.sink) {
+            let by_server = source.is_action() && old.source == source;
+            self.report(io, old, !by_server);
+        }
+        warn!("goal ({}) refused: {}", source.name(), outcome.reason());
+        match source {
+            Source::DockAction => {
+                io.servers.dock.finish(GoalEnd::Aborted, outcome.dock_result());
+            }
+            Source::UndockAction => {
+                io.servers.undock.finish(GoalEnd::Aborted, outcome.undock_result());
+            }
+            Source::FollowAction => {
+                let poses = match &outcome {
+                    Outcome::RouteInfeasible(_) => io.servers.follow.active_goal().map(|g| g.poses.clone()),
+                    _ => None,
+                };
+                io.servers.follow.finish(
+                    GoalEnd::Aborted,
+                    outcome.follow_result(poses.as_deref().unwrap_or(&[]), &[]),
+                );
+            }
+            Source::DockPose | Source::Waypoints => {}
+        }
+        let view = self.status_view(None, NavStatus::FAILED, outcome.reason());
+        self.send_status(io.node, io.out, &view);
+    }
+
+    /// Starts a docking onto `target` (or refuses it).
+    fn start_dock(&mut self, io: &mut Io<'_, '_>, target: Result<Pose2, GoalError>, source: Source) {
         let offset = docking_offset(&self.chassis);
         let built = target.map_err(Outcome::Invalid).and_then(|goal| {
             let gains = self.config.gains().map_err(|e| Outcome::Refused(e.to_string()))?;
@@ -904,75 +811,38 @@ impl Shell {
             )
             .map_err(|e| Outcome::Refused(e.to_string()))
         });
-        match built {
-            Ok(controller) => {
-                let goal = controller.goal().ahead(offset);
-                info!(
-                    "goal ({}): dock at ({:.3}, {:.3}, {:.3} rad) in {}",
-                    source.name(),
-                    goal.x,
-                    goal.y,
-                    goal.yaw,
-                    self.config.odom_frame
-                );
-                if Finish::for_chassis(&self.chassis) == Finish::ReportResidual {
-                    info!(
-                        "a steered chassis cannot turn in place: the law steers its kinematic origin ({offset:.2} m \
-                         behind), and the heading left at the dock is reported as RESIDUAL"
-                    );
-                }
-                self.drawing = Drawing {
-                    dock: Some(goal),
-                    ..Drawing::default()
-                };
-                self.activate(
-                    Task::Dock {
-                        controller,
-                        last: None,
-                        offset,
-                    },
-                    source,
-                );
-                self.publish_status(node, out, NavStatus::ACTIVE, String::new());
-                self.publish_markers(node, out);
-            }
-            Err(outcome) => self.refuse(node, out, servers, source, outcome),
+        let dock = match built {
+            Ok(controller) => DockGoal::new(controller, offset),
+            Err(outcome) => return self.refuse(io, source, outcome),
+        };
+        let goal = dock.target();
+        info!(
+            "goal ({}): dock at ({:.3}, {:.3}, {:.3} rad) in {}",
+            source.name(),
+            goal.x,
+            goal.y,
+            goal.yaw,
+            self.config.odom_frame
+        );
+        if Finish::for_chassis(&self.chassis) == Finish::ReportResidual {
+            info!(
+                "a steered chassis cannot turn in place: the law steers its kinematic origin ({offset:.2} m \
+                 behind), and the heading left at the dock is reported as RESIDUAL"
+            );
         }
-    }
-
-    /// A goal refused before it started: for an action (accepted already) its result; the
-    /// status FAILED with the reason.
-    fn refuse(&mut self, node: &RosNode, out: &Outputs, servers: &mut Servers, source: Source, outcome: Outcome) {
-        warn!("goal ({}) refused: {}", source.name(), outcome.reason());
-        match source {
-            Source::DockAction => {
-                servers.dock.finish(GoalEnd::Aborted, outcome.dock_result());
-            }
-            Source::UndockAction => {
-                servers.undock.finish(GoalEnd::Aborted, outcome.undock_result());
-            }
-            Source::FollowAction => {
-                let poses = match &outcome {
-                    Outcome::RouteInfeasible(_) => servers.follow.active_goal().map(|g| g.poses.clone()),
-                    _ => None,
-                };
-                servers.follow.finish(
-                    GoalEnd::Aborted,
-                    outcome.follow_result(poses.as_deref().unwrap_or(&[]), &[]),
-                );
-            }
-            _ => {}
-        }
-        self.publish_refusal(node, out, &outcome);
+        self.begin(io, Task::Dock(dock), source);
+        self.drawing = Drawing {
+            dock: Some(goal),
+            ..Drawing::default()
+        };
+        self.publish_status(io.node, io.out, NavStatus::ACTIVE, String::new());
+        self.publish_markers(io.node, io.out);
     }
 
     /// Validates a route and starts its pre-check off the event loop (or refuses it).
-    #[allow(clippy::too_many_arguments)]
     fn start_route(
         &mut self,
-        node: &RosNode,
-        out: &Outputs,
-        servers: &mut Servers,
+        io: &mut Io<'_, '_>,
         jobs: &mut Jobs,
         route: Result<Route, GoalError>,
         start: Option<Pose2>,
@@ -980,11 +850,10 @@ impl Shell {
     ) {
         let route = match route {
             Ok(r) => r,
-            Err(e) => return self.refuse(node, out, servers, source, Outcome::Invalid(e)),
+            Err(e) => return self.refuse(io, source, Outcome::Invalid(e)),
         };
         if self.config.waypoint_method == WaypointMethod::Vfo {
-            jobs.seq += 1;
-            return self.start_vfo(node, out, servers, route, start, source, jobs.seq);
+            return self.start_vfo(io, route, start, source);
         }
         if let Some(i) = route.first_oriented() {
             info!(
@@ -994,49 +863,39 @@ impl Shell {
             );
         }
         let Some(start) = start else {
-            return self.refuse(node, out, servers, source, Outcome::Stale);
+            return self.refuse(io, source, Outcome::Stale);
         };
-        jobs.seq += 1;
-        let seq = jobs.seq;
         let (points, world, chassis, config) = (
             route.points.clone(),
             self.world.clone(),
             self.chassis,
             self.config.route_check(),
         );
-        jobs.goal.start(move |cancel| PreCheckDone {
-            seq,
-            report: check_route_until(&start, &points, &chassis, &world, &config, || cancel.is_cancelled())
-                .map_err(|e| e.to_string()),
-        });
         info!(
             "goal ({}): pre-check of {} waypoints (the virtual robot drives them first)",
             source.name(),
             route.points.len()
         );
-        self.activate(Task::PreCheck { route, start, seq }, source);
-        self.publish_status(node, out, NavStatus::ACTIVE, String::new());
+        let id = self.begin(io, Task::PreCheck { route, start }, source);
+        // The robot waits for the pre-check.
+        self.session.hold(io.sink);
+        jobs.goal.start(move |cancel| PreCheckDone {
+            id,
+            report: check_route_until(&start, &points, &chassis, &world, &config, || cancel.is_cancelled())
+                .map_err(|e| e.to_string()),
+        });
+        self.publish_status(io.node, io.out, NavStatus::ACTIVE, String::new());
     }
 
     /// Starts VFO waypoint following of `route` from `start` (or refuses it).
-    #[allow(clippy::too_many_arguments)]
-    fn start_vfo(
-        &mut self,
-        node: &RosNode,
-        out: &Outputs,
-        servers: &mut Servers,
-        route: Route,
-        start: Option<Pose2>,
-        source: Source,
-        seq: u64,
-    ) {
+    fn start_vfo(&mut self, io: &mut Io<'_, '_>, route: Route, start: Option<Pose2>, source: Source) {
         let Some(start) = start else {
-            return self.refuse(node, out, servers, source, Outcome::Stale);
+            return self.refuse(io, source, Outcome::Stale);
         };
         // Without a fresh scan the obstacles are unknown: the first tick would optimise the
         // segment through a map with nothing in it.
         if self.scan_seen.get(self.config.vfo.scan_timeout()).is_none() {
-            return self.refuse(node, out, servers, source, Outcome::ScanStale);
+            return self.refuse(io, source, Outcome::ScanStale);
         }
         let offset = docking_offset(&self.chassis);
         let settings = &self.config.vfo;
@@ -1049,7 +908,7 @@ impl Shell {
             });
         let follower = match built {
             Ok(f) => f,
-            Err(outcome) => return self.refuse(node, out, servers, source, outcome),
+            Err(outcome) => return self.refuse(io, source, outcome),
         };
         info!(
             "goal ({}): {} waypoints by VFO ({} obstacles known; U_2 {:.2} m/s, |ω| ≤ {:.2} rad/s, T_p {:.3} s)",
@@ -1073,63 +932,48 @@ impl Shell {
         let max_delay = vfo_max_delay(self.odom_period.period(), settings.optimise.time_step);
         // Progress is the follower's: from the point the law steers (the guide point).
         let distance = (route.points[0] - start.ahead(-offset).position()).norm();
+        let points = route.points.clone();
+        let task = VfoTask {
+            slot: VfoSlot::new(follower, max_delay),
+            route,
+            offset,
+            index: 0,
+            distance,
+            report: SegmentReport::default(),
+            obstacles_changed: None,
+            ids: self.map.ids(),
+            stop: CancelToken::new(),
+        };
+        self.begin(io, Task::Vfo(task), source);
         self.drawing = Drawing {
-            route: route.points.clone(),
+            route: points,
             ..Drawing::default()
         };
-        self.activate(
-            Task::Vfo {
-                slot: VfoSlot::new(follower, max_delay),
-                route,
-                seq,
-                offset,
-                index: 0,
-                distance,
-                report: SegmentReport::default(),
-                obstacles_changed: None,
-                ids: self.map.ids(),
-                stop: CancelToken::new(),
-            },
-            source,
-        );
-        self.publish_status(node, out, NavStatus::ACTIVE, String::new());
-        self.publish_markers(node, out);
+        self.publish_status(io.node, io.out, NavStatus::ACTIVE, String::new());
+        self.publish_markers(io.node, io.out);
     }
 
     /// A pre-check is done: the route it was for (if still the active goal) starts or is
     /// refused.
-    fn pre_checked(&mut self, node: &RosNode, out: &Outputs, servers: &mut Servers, done: PreCheckDone) {
-        let Some(Active {
-            task: Task::PreCheck { seq, .. },
-            source,
-            ..
-        }) = self.active.as_ref()
-        else {
-            return;
-        };
-        if *seq != done.seq {
+    fn pre_checked(&mut self, io: &mut Io<'_, '_>, done: PreCheckDone) {
+        if !self.session.is_current(done.id) {
             return;
         }
-        let source = *source;
-        let Some(Active {
-            task: Task::PreCheck { route, start, .. },
-            chassis,
-            config,
-            ..
-        }) = self.active.as_ref()
-        else {
+        let Some(active) = self.session.active() else { return };
+        let source = active.source;
+        let Task::PreCheck { route, start } = &active.goal.task else {
             return;
         };
         let (route, start, chassis, follow, execute_infeasible) = (
             route.clone(),
             *start,
-            *chassis,
-            config.follow,
-            config.execute_infeasible_routes,
+            active.goal.chassis,
+            active.goal.config.follow,
+            active.goal.config.execute_infeasible_routes,
         );
         let report = match done.report {
             Ok(r) => r,
-            Err(e) => return self.end_goal(node, out, servers, Outcome::Refused(e)),
+            Err(e) => return self.end_goal(io, Outcome::Refused(e)),
         };
         let problems = missed_from_report(&report.problems, &route);
         self.drawing = Drawing {
@@ -1142,7 +986,7 @@ impl Shell {
         if !problems.is_empty() {
             let outcome = Outcome::RouteInfeasible(problems.clone());
             if !execute_infeasible {
-                return self.end_goal(node, out, servers, outcome);
+                return self.end_goal(io, outcome);
             }
             warn!(
                 "goal ({}): driven although execute_infeasible_routes: {}",
@@ -1152,7 +996,7 @@ impl Shell {
         }
         let follower = match WaypointFollower::new(follow, &chassis, route.points.clone()) {
             Ok(f) => f,
-            Err(e) => return self.end_goal(node, out, servers, Outcome::Refused(e.to_string())),
+            Err(e) => return self.end_goal(io, Outcome::Refused(e.to_string())),
         };
         info!(
             "goal ({}): {} waypoints, pre-check {} ({:.2} m predicted)",
@@ -1166,25 +1010,15 @@ impl Shell {
             mobil_planner_node::path_length(&report.path, follow.check_length)
         );
         let distance = (route.points[0] - start.position()).norm();
-        if let Some(active) = self.active.as_mut() {
-            active.task = Task::Follow {
-                follower,
-                route,
-                missed: Vec::new(),
-                distance,
-            };
+        let goal = RouteGoal::new(follower, route.request_index.clone(), distance);
+        if let Some(active) = self.session.active_mut() {
+            active.goal.task = Task::Follow { goal, route };
         }
-        self.publish_status(node, out, NavStatus::ACTIVE, String::new());
-        self.publish_markers(node, out);
+        self.publish_status(io.node, io.out, NavStatus::ACTIVE, String::new());
+        self.publish_markers(io.node, io.out);
     }
 
-    async fn dock_action(
-        &mut self,
-        node: &RosNode,
-        out: &Outputs,
-        servers: &mut Servers,
-        request: GoalRequest<DockRobotGoal>,
-    ) {
+    async fn dock_action(&mut self, io: &mut Io<'_, '_>, request: GoalRequest<DockRobotGoal>) {
         let g = request.goal();
         let target = if g.use_dock_id {
             Err(GoalError::NoDockDatabase)
@@ -1204,22 +1038,34 @@ impl Shell {
                 }
             );
         }
-        self.new_goal(node, out, servers, Source::DockAction).await;
         let preempted = Outcome::Preempted("dock_robot").dock_result();
-        if let Err(e) = servers.dock.accept(request, |_| preempted).await {
-            warn_throttled!(self.throttle, "accept", "dock_robot goal not started: {e}");
-            return;
+        let accept = io.servers.dock.accept(request, |_| preempted).await;
+        if self.accepted(io, accept, Source::DockAction) {
+            self.start_dock(io, target, Source::DockAction);
         }
-        self.start_dock(node, out, servers, target, Source::DockAction);
     }
 
-    async fn undock_action(
+    /// Whether an action goal from `source` was accepted; if not, a goal of the same server that
+    /// was running was ended by the server, and the robot stops with it.
+    fn accepted(
         &mut self,
-        node: &RosNode,
-        out: &Outputs,
-        servers: &mut Servers,
-        request: GoalRequest<UndockRobotGoal>,
-    ) {
+        io: &mut Io<'_, '_>,
+        accept: Result<(), mobil_ros::action::ActionError>,
+        source: Source,
+    ) -> bool {
+        let Err(e) = accept else { return true };
+        warn_throttled!(self.throttle, "accept", "{} goal not started: {e}", source.name());
+        let ours = self.session.active().is_some_and(|a| a.source == source);
+        if let Some(ended) = ours
+            .then(|| self.session.end(Outcome::Preempted(source.name()), io.sink))
+            .flatten()
+        {
+            self.report(io, ended, false);
+        }
+        false
+    }
+
+    async fn undock_action(&mut self, io: &mut Io<'_, '_>, request: GoalRequest<UndockRobotGoal>) {
         let limit = request.goal().max_undocking_time;
         let limit_s = if limit.is_finite() && limit > 0.0 {
             f64::from(limit)
@@ -1227,35 +1073,23 @@ impl Shell {
             warn!("undock_robot: max_undocking_time {limit} is not a positive time: 30 s (its default) taken");
             30.0
         };
-        self.new_goal(node, out, servers, Source::UndockAction).await;
         let preempted = Outcome::Preempted("undock_robot").undock_result();
-        if let Err(e) = servers.undock.accept(request, |_| preempted).await {
-            warn_throttled!(self.throttle, "accept", "undock_robot goal not started: {e}");
+        let accept = io.servers.undock.accept(request, |_| preempted).await;
+        if !self.accepted(io, accept, Source::UndockAction) {
             return;
         }
-        let distance = self.config.staging_distance;
+        let (distance, speed) = (self.config.staging_distance, self.config.undock_speed);
         info!("goal (undock_robot): back out {distance:.3} m along the heading, within {limit_s:.1} s");
-        self.drawing = Drawing::default();
-        self.activate(
-            Task::Undock {
-                start: None,
-                distance,
-                limit_s,
-                backed: 0.0,
-            },
+        self.begin(
+            io,
+            Task::Undock(UndockGoal::new(distance, speed, limit_s)),
             Source::UndockAction,
         );
-        self.publish_status(node, out, NavStatus::ACTIVE, String::new());
+        self.drawing = Drawing::default();
+        self.publish_status(io.node, io.out, NavStatus::ACTIVE, String::new());
     }
 
-    async fn follow_action(
-        &mut self,
-        node: &RosNode,
-        out: &Outputs,
-        servers: &mut Servers,
-        jobs: &mut Jobs,
-        request: GoalRequest<FollowWaypointsGoal>,
-    ) {
+    async fn follow_action(&mut self, io: &mut Io<'_, '_>, jobs: &mut Jobs, request: GoalRequest<FollowWaypointsGoal>) {
         let start = self.fresh_odom();
         let g = request.goal();
         let route = route_from_poses(
@@ -1268,35 +1102,74 @@ impl Shell {
             MIN_ROUTE_LENGTH,
         );
         // A follow_waypoints goal pre-empted by this one lists what it had missed.
-        let preempted = match &self.active {
-            Some(Active {
-                task: Task::Follow { route, missed, .. },
-                source: Source::FollowAction,
-                ..
-            }) => Outcome::Preempted("follow_waypoints").follow_result(&route.poses, missed),
-            Some(Active {
-                task: Task::Vfo { route, index, .. },
-                source: Source::FollowAction,
-                ..
-            }) => Outcome::Preempted("follow_waypoints").vfo_follow_result(&route.poses, &route.unreached_from(*index)),
-            _ => Outcome::Preempted("follow_waypoints").follow_result(&[], &[]),
+        let by = Outcome::Preempted("follow_waypoints");
+        let preempted = match self.session.active() {
+            Some(a) if a.source == Source::FollowAction => follow_answer(&a.goal.task, &by),
+            _ => by.follow_result(&[], &[]),
         };
-        self.new_goal(node, out, servers, Source::FollowAction).await;
-        if let Err(e) = servers.follow.accept(request, |_| preempted).await {
-            warn_throttled!(self.throttle, "accept", "follow_waypoints goal not started: {e}");
-            return;
-        }
-        self.start_route(node, out, servers, jobs, route, start, Source::FollowAction);
-    }
-
-    fn cancel(&mut self, node: &RosNode, out: &Outputs, servers: &mut Servers, source: Source, is_active: bool) {
-        if is_active && self.active.as_ref().is_some_and(|a| a.source == source) {
-            self.end_goal(node, out, servers, Outcome::Canceled);
+        let accept = io.servers.follow.accept(request, |_| preempted).await;
+        if self.accepted(io, accept, Source::FollowAction) {
+            self.start_route(io, jobs, route, start, Source::FollowAction);
         }
     }
 
-    /// A `planner/check_route` request: the start and route to check, or the reply refusing it
-    /// (at once, never hanging).
+    fn cancel(&mut self, io: &mut Io<'_, '_>, source: Source, is_active: bool) {
+        if is_active && self.session.active().is_some_and(|a| a.source == source) {
+            self.end_goal(io, Outcome::Canceled);
+        }
+    }
+
+    /// A `planner/check_route` request: refused at once, answered BUSY when too many are being
+    /// computed, or checked on the blocking pool and answered from there.
+    fn check_in(
+        &mut self,
+        node: &RosNode,
+        jobs: &mut Jobs,
+        check: &Server<CheckRouteRequest, CheckRouteResponse>,
+        id: RmwRequestId,
+        req: &CheckRouteRequest,
+    ) {
+        let (start, route) = match self.check_request(req) {
+            Err(reply) => return respond(check, id, reply, &mut self.throttle),
+            Ok(_) if jobs.pending + 1 >= MAX_CHECKS => {
+                let reply = refused_reply(format!(
+                    "BUSY: {} route checks are already being computed; ask again",
+                    jobs.pending
+                ));
+                return respond(check, id, reply, &mut self.throttle);
+            }
+            Ok(checked) => checked,
+        };
+        jobs.pending += 1;
+        let tx = jobs.replies_tx.clone();
+        let (world, chassis, config) = (self.world.clone(), self.chassis, self.config.route_check());
+        let (stamp, frame, step) = (
+            node.stamp(),
+            self.config.odom_frame.clone(),
+            self.config.follow.check_length,
+        );
+        tokio::task::spawn_blocking(move || {
+            let began = Instant::now();
+            let reply = match check_route_until(&start, &route.points, &chassis, &world, &config, || false) {
+                Ok(report) => check_reply(&report, &route, stamp, &frame, step),
+                Err(e) => refused_reply(Outcome::Refused(e.to_string()).reason()),
+            };
+            info!(
+                "planner/check_route: {} waypoints, {} in {:.2} ms",
+                route.points.len(),
+                if reply.feasible {
+                    "feasible".to_owned()
+                } else {
+                    format!("{} problem(s)", reply.problems.len())
+                },
+                began.elapsed().as_secs_f64() * 1e3
+            );
+            // The receiver lives as long as the loop; if it is gone nobody waits.
+            let _ = tx.send((id, reply));
+        });
+    }
+
+    /// The start and route of a `planner/check_route` request, or the reply refusing it.
     fn check_request(&self, req: &CheckRouteRequest) -> Result<(Pose2, Route), CheckRouteResponse> {
         let frame = &self.config.odom_frame;
         let start = if req.use_start {
@@ -1314,7 +1187,7 @@ impl Shell {
         Ok((start, route))
     }
 
-    fn odom_in(&mut self, node: &RosNode, out: &Outputs, servers: &mut Servers, jobs: &mut Jobs, m: &Odometry) {
+    fn odom_in(&mut self, io: &mut Io<'_, '_>, jobs: &mut Jobs, m: &Odometry) {
         match odom_pose(m, &self.config.odom_frame, &self.config.base_frame) {
             Ok(pose) => {
                 self.odom_refused = false;
@@ -1324,201 +1197,107 @@ impl Shell {
                 }
                 self.odom_period.arrived(Instant::now());
                 self.odom.set(pose, m.header.stamp.clone());
-                if self.active.is_some() {
-                    self.step(node, out, servers, jobs, pose);
+                if self.session.active().is_some() {
+                    self.step(io, jobs, pose);
                 }
             }
             Err(e) => {
                 warn_throttled!(self.throttle, "odom-bad", "odom sample dropped: {e}; robot stopped");
                 self.odom_refused = true;
                 self.odom_history.clear();
-                self.refused(out);
+                self.session.hold(io.sink);
             }
         }
     }
 
-    /// One control step at `pose`.
-    fn step(&mut self, node: &RosNode, out: &Outputs, servers: &mut Servers, jobs: &mut Jobs, pose: Pose2) {
-        let now = node.now_nanos();
-        let Some(active) = self.active.as_mut() else { return };
-        let dt = match active.clock.step(now) {
-            Ok(dt) => dt,
-            Err(DtError::Zero) => return,
-            Err(e @ DtError::Backwards { .. }) => {
-                warn_throttled!(
+    /// One control step at `pose`: the active goal's law, its command out through the session.
+    fn step(&mut self, io: &mut Io<'_, '_>, jobs: &mut Jobs, pose: Pose2) {
+        let dt = match self.session.advance(io.node.now_nanos()) {
+            Some(Ok(dt)) => dt,
+            None | Some(Err(DtError::Zero)) => return,
+            Some(Err(e)) => {
+                return warn_throttled!(
                     self.throttle,
                     "time-back",
                     "{e}; the step is skipped, the goal's time carries on"
-                );
-                return;
+                )
             }
         };
-        active.t += dt.unwrap_or(0.0);
-        let t = active.t;
-        let chassis = active.chassis;
-        let undock_speed = active.config.undock_speed;
-        let finish = Finish::for_chassis(&chassis);
-        if matches!(active.task, Task::Vfo { .. }) {
-            return self.vfo_step(out, jobs, pose, t);
-        }
-        let mut ended: Option<Outcome> = None;
-        let mut changed = false;
-        let command: Result<BodyTwist, String> = match &mut active.task {
-            Task::PreCheck { .. } => return,
-            // Handled above.
-            Task::Vfo { .. } => return,
-            Task::Dock {
-                controller,
-                last,
-                offset,
-            } => match controller.update(&pose.ahead(-*offset), t) {
-                Ok(o) => {
-                    changed = last.is_none_or(|l| l.phase != o.phase);
-                    *last = Some(o);
-                    match o.phase {
-                        DockingPhase::Docked => {
-                            ended = Some(Outcome::Docked {
-                                e: o.polar.e,
-                                heading: o.heading_error,
-                            })
-                        }
-                        DockingPhase::Failed(f) => {
-                            let residual = o.residual.unwrap_or(mobil_planner::Residual {
-                                e: o.polar.e,
-                                heading: o.heading_error,
-                            });
-                            ended = Some(docking_outcome(f, residual, finish));
-                        }
-                        _ => {}
-                    }
-                    Ok(o.command.to_twist())
-                }
-                Err(e) => Err(e.to_string()),
-            },
-            Task::Follow {
-                follower,
-                route,
-                missed,
-                distance,
-            } => match follower.update(&pose, dt.unwrap_or(FIRST_DT).min(MAX_FOLLOW_DT), t) {
-                Ok(o) => {
-                    for event in &o.events {
-                        changed = true;
-                        match *event {
-                            FollowEvent::Reached { index } => {
-                                let i = route.request_index.get(index).copied().unwrap_or(index);
-                                info!("waypoint {i} reached");
-                            }
-                            FollowEvent::Missed { index, cause } => {
-                                let m = Missed {
-                                    index: route.request_index.get(index).copied().unwrap_or(index),
-                                    position: route.points.get(index).copied().unwrap_or_else(Point2::origin),
-                                    kind: ProblemKind::Unreachable(cause),
-                                    pre_check: false,
-                                };
-                                warn!("{} (missed; the next one is taken)", m.describe());
-                                missed.push(m);
-                            }
-                        }
-                    }
-                    *distance = o.distance;
-                    match o.end {
-                        Some(FollowEnd::Done) => {
-                            ended = Some(Outcome::RouteDone {
-                                count: route.points.len(),
-                                missed: missed.clone(),
-                            })
-                        }
-                        Some(FollowEnd::Stalled) => ended = Some(Outcome::Stalled { index: o.index }),
-                        None => {}
-                    }
-                    Ok(o.twist)
-                }
-                Err(e) => Err(e.to_string()),
-            },
-            Task::Undock {
-                start,
-                distance,
-                limit_s,
-                backed,
-            } => {
-                let origin = *start.get_or_insert(pose);
-                *backed = backed_out(&origin, &pose);
-                let remaining = *distance - *backed;
-                if remaining <= UNDOCK_TOLERANCE {
-                    ended = Some(Outcome::Undocked { distance: *backed });
-                } else if t > *limit_s {
-                    ended = Some(Outcome::UndockTimeout {
-                        limit: *limit_s,
-                        distance: *backed,
-                    });
-                }
-                let speed = undock_speed.min(remaining.max(UNDOCK_MIN_SPEED));
-                Ok(BodyTwist::new(-speed, 0.0, 0.0))
-            }
+        let Some(active) = self.session.active_mut() else {
+            return;
         };
-        if let Some(outcome) = ended {
-            return self.end_goal(node, out, servers, outcome);
-        }
-        match command {
-            Ok(twist) => {
-                active.refused = 0;
-                let cmd = clamp_twist(twist, &chassis);
-                self.publish_cmd(out, cmd);
-                if changed {
-                    self.publish_status(node, out, NavStatus::ACTIVE, String::new());
-                }
+        let input = StepInput::new(active.t(), dt, pose);
+        let chassis = active.goal.chassis;
+        match &mut active.goal.task {
+            Task::PreCheck { .. } => {}
+            Task::Vfo(_) => self.vfo_step(io, jobs, pose, input.t),
+            Task::Dock(d) => {
+                let step = d.step(&input, &());
+                self.apply(io, step, &chassis, |f| f.phase_changed);
             }
-            Err(e) => self.refused_step(node, out, servers, e),
+            Task::Follow { goal, .. } => {
+                let step = goal.step(&input, &());
+                self.apply(io, step, &chassis, |f| {
+                    for event in &f.events {
+                        match event {
+                            RouteEvent::Reached(i) => info!("waypoint {i} reached"),
+                            RouteEvent::Missed(m) => warn!("{} (missed; the next one is taken)", m.describe()),
+                        }
+                    }
+                    !f.events.is_empty()
+                });
+            }
+            Task::Undock(u) => {
+                let step = u.step(&input, &());
+                self.apply(io, step, &chassis, |_| false);
+            }
         }
     }
 
-    /// A step whose input the planner refused: the robot stops, and after
-    /// [`MAX_REFUSED_STEPS`] in a row the goal ends refused.
-    fn refused_step(&mut self, node: &RosNode, out: &Outputs, servers: &mut Servers, e: String) {
-        let Some(active) = self.active.as_mut() else { return };
-        active.refused += 1;
-        let refused = active.refused;
-        warn_throttled!(
-            self.throttle,
-            "step",
-            "the planner refused its input: {e}; robot stopped"
-        );
-        if refused >= MAX_REFUSED_STEPS {
-            self.end_goal(node, out, servers, Outcome::Refused(e));
-        } else {
-            self.refused(out);
+    /// What comes of a law's step: its command held to the chassis limits, a refusal (the robot
+    /// stops; the goal ends after the session's count of them in a row) or the goal's end. The
+    /// status goes out when `changed` says the feedback changed it.
+    fn apply<F, R>(
+        &mut self,
+        io: &mut Io<'_, '_>,
+        step: Step<F, R>,
+        chassis: &ChassisParams,
+        changed: impl FnOnce(&F) -> bool,
+    ) {
+        if let Step::Refused(why) = &step {
+            warn_throttled!(
+                self.throttle,
+                "step",
+                "the planner refused its input: {why}; robot stopped"
+            );
+        }
+        match self.session.apply(step, limited(chassis), io.sink) {
+            Applied::Commanded(f) => {
+                if changed(&f) {
+                    self.publish_status(io.node, io.out, NavStatus::ACTIVE, String::new());
+                }
+            }
+            Applied::Refused(Some(ended)) | Applied::Ended(ended, _) => self.report(io, ended, true),
+            Applied::Refused(None) | Applied::Idle => {}
         }
     }
 
     /// A VFO tick at `pose`, time `t`: the follower goes to the blocking pool with the map's
     /// latest obstacles, or, while it is still out (optimising), the robot stops.
-    fn vfo_step(&mut self, out: &Outputs, jobs: &mut Jobs, pose: Pose2, t: f64) {
-        let Some(Active {
-            task:
-                Task::Vfo {
-                    slot,
-                    seq,
-                    offset,
-                    obstacles_changed,
-                    ids,
-                    stop,
-                    ..
-                },
-            config,
-            ..
-        }) = self.active.as_mut()
-        else {
+    fn vfo_step(&mut self, io: &mut Io<'_, '_>, jobs: &mut Jobs, pose: Pose2, t: f64) {
+        let Some(active) = self.session.active_mut() else {
             return;
         };
-        let Some(mut follower) = slot.lend(Instant::now()) else {
-            return self.zero(out);
+        let id = active.id();
+        let budget = active.goal.config.vfo.optimise_budget();
+        let Task::Vfo(v) = &mut active.goal.task else { return };
+        let Some(mut follower) = v.slot.lend(Instant::now()) else {
+            return self.session.hold(io.sink);
         };
-        if let Some(new) = obstacles_changed.take() {
-            follower.follow_map(&self.map, ids, new);
+        if let Some(new) = v.obstacles_changed.take() {
+            follower.follow_map(&self.map, &mut v.ids, new);
         }
-        let (seq, guide, stop, stamp) = (*seq, pose.ahead(-*offset), stop.clone(), self.odom_stamp);
-        let budget = config.vfo.optimise_budget();
+        let (guide, stop, stamp) = (pose.ahead(-v.offset), v.stop.clone(), self.odom_stamp);
         jobs.vfo.start(move |cancel| {
             let started = Instant::now();
             let interrupt = || {
@@ -1538,7 +1317,7 @@ impl Shell {
                 .flatten()
                 .map(|o| (segment_report(o), vfo_drawing(o, follower.obstacles())));
             VfoTickDone {
-                seq,
+                id,
                 follower,
                 output,
                 optimised,
@@ -1548,39 +1327,30 @@ impl Shell {
 
     /// A VFO tick came back: its command goes out (zero when it came back late), its events
     /// are logged, the route may end.
-    fn vfo_ticked(&mut self, node: &RosNode, out: &Outputs, servers: &mut Servers, done: VfoTickDone) {
-        let Some(active) = self.active.as_mut() else { return };
-        let chassis = active.chassis;
-        let Task::Vfo {
-            slot,
-            route,
-            seq,
-            index,
-            distance,
-            report,
-            offset,
-            ..
-        } = &mut active.task
-        else {
-            return;
-        };
-        if *seq != done.seq {
+    fn vfo_ticked(&mut self, io: &mut Io<'_, '_>, done: VfoTickDone) {
+        if !self.session.is_current(done.id) {
             return;
         }
-        let handback = slot.give_back(done.follower, Instant::now());
+        let Some(active) = self.session.active_mut() else {
+            return;
+        };
+        let chassis = active.goal.chassis;
+        let Task::Vfo(v) = &mut active.goal.task else { return };
+        let handback = v.slot.give_back(done.follower, Instant::now());
         if let Some((r, drawing)) = done.optimised {
-            *report = r;
+            v.report = r;
             self.drawing.vfo = Some(drawing);
         }
         let o = match done.output {
             Ok(o) => o,
-            Err(e) => return self.refused_step(node, out, servers, e.to_string()),
+            Err(e) => {
+                let step: Step<(), ()> = Step::Refused(e.to_string());
+                return self.apply(io, step, &chassis, |_| false);
+            }
         };
-        active.refused = 0;
+        let route = &v.route;
         let request = |i: usize| route.request_index.get(i).copied().unwrap_or(i);
-        let mut changed = false;
         for event in &o.events {
-            changed = true;
             match event {
                 VfoEvent::Reached { index, vortex } => info!(
                     "waypoint {} reached{}",
@@ -1601,8 +1371,8 @@ impl Shell {
                         "segment to waypoint {} optimised ({reason:?}): Ψ_z {}, {} virtual robots, {} candidates",
                         request(*index),
                         score.map_or("none".to_owned(), |s| format!("{s:.3}")),
-                        report.virtual_robots,
-                        report.candidates
+                        v.report.virtual_robots,
+                        v.report.candidates
                     );
                     for w in warnings.iter().filter(|w| !matches!(w, OptimiseWarning::NoSafeSigma)) {
                         warn_throttled!(self.throttle, "vfo-caps", "segment optimisation: {w:?}");
@@ -1610,7 +1380,7 @@ impl Shell {
                 }
             }
         }
-        if o.end.is_none() && slot.follower().is_some_and(|f| f.is_settling()) {
+        if o.end.is_none() && v.slot.follower().is_some_and(|f| f.is_settling()) {
             warn_throttled!(
                 self.throttle,
                 "vfo-settle",
@@ -1619,18 +1389,17 @@ impl Shell {
                 request(o.index)
             );
         }
-        *index = o.index;
-        *distance = o.distance;
+        v.index = o.index;
+        v.distance = o.distance;
         let unreached = |from: usize| route.unreached_from(from);
         let ended = match o.end {
             None => None,
-            Some(VfoEnd::Done) => Some(Outcome::RouteDone {
-                count: route.points.len(),
-                missed: Vec::new(),
-            }),
+            Some(VfoEnd::Done) => Some(Outcome::Law(mobil_motion::Outcome::succeeded(
+                mobil_planner::goals::route_done(route.points.len(), &[]),
+            ))),
             Some(VfoEnd::NoSafePath { index }) => Some(Outcome::NoSafePath {
                 index: request(index),
-                virtual_robots: report.virtual_robots,
+                virtual_robots: v.report.virtual_robots,
                 unreached: unreached(index),
             }),
             Some(VfoEnd::BudgetExhausted { index }) => Some(Outcome::OptimisationBudget {
@@ -1639,22 +1408,22 @@ impl Shell {
                 unreached: unreached(index),
             }),
             Some(VfoEnd::Collision { obstacle }) => {
-                let o = slot.follower().and_then(|f| f.obstacles().get(obstacle).copied());
+                let ob = v.slot.follower().and_then(|f| f.obstacles().get(obstacle).copied());
                 // The guide point's distance, as the follower measured the collision.
-                let at = self.odom.value().map(|p| p.ahead(-*offset).position());
+                let at = self.odom.value().map(|p| p.ahead(-v.offset).position());
                 Some(Outcome::Collision {
-                    centre: o.map_or_else(Point2::origin, |o| o.centre()),
-                    radius: o.map_or(f64::NAN, |o| o.forbidden_radius()),
-                    distance: match (o, at) {
-                        (Some(o), Some(at)) => o.distance(&at),
+                    centre: ob.map_or_else(Point2::origin, |o| o.centre()),
+                    radius: ob.map_or(f64::NAN, |o| o.forbidden_radius()),
+                    distance: match (ob, at) {
+                        (Some(ob), Some(at)) => ob.distance(&at),
                         _ => f64::NAN,
                     },
-                    unreached: unreached(*index),
+                    unreached: unreached(o.index),
                 })
             }
         };
         if let Some(outcome) = ended {
-            return self.end_goal(node, out, servers, outcome);
+            return self.end_goal(io, outcome);
         }
         if handback == Handback::Late {
             warn_throttled!(
@@ -1662,22 +1431,23 @@ impl Shell {
                 "vfo-late",
                 "a tick took longer than {:.0} ms (an optimisation): its command is dropped, the robot stops \
                  meanwhile",
-                slot.max_delay().as_secs_f64() * 1e3
+                v.slot.max_delay().as_secs_f64() * 1e3
             );
         }
-        let cmd = clamp_twist(vfo_command(&o, handback), &chassis);
-        self.publish_cmd(out, cmd);
-        if changed {
-            self.publish_status(node, out, NavStatus::ACTIVE, String::new());
-        }
+        let changed = !o.events.is_empty();
+        let step: Step<bool, ()> = Step::Command {
+            twist: vfo_command(&o, handback),
+            feedback: changed,
+        };
+        self.apply(io, step, &chassis, |changed| *changed);
     }
 
     /// A scan: its obstacles go into the map (in odom, with the odometry pose at the scan's
     /// stamp); a VFO route's follower gets them at its next tick. A goal's scans are read with
     /// the parameters it began with.
     fn scan_in(&mut self, m: &LaserScan) {
-        let config = match &self.active {
-            Some(a) if matches!(a.task, Task::Vfo { .. }) => &a.config,
+        let config = match self.session.active() {
+            Some(a) if matches!(a.goal.task, Task::Vfo(_)) => &a.goal.config,
             _ if self.config.waypoint_method == WaypointMethod::Vfo => &self.config,
             _ => return,
         };
@@ -1753,65 +1523,66 @@ impl Shell {
             );
         }
         self.scan_seen.set((), m.header.stamp.clone());
-        if let Some(Active {
-            task: Task::Vfo { obstacles_changed, .. },
-            ..
-        }) = self.active.as_mut()
-        {
-            let new = !update.new.is_empty() || obstacles_changed.unwrap_or(false);
-            *obstacles_changed = Some(new);
+        if let Some(Task::Vfo(v)) = self.session.active_mut().map(|a| &mut a.goal.task) {
+            let new = !update.new.is_empty() || v.obstacles_changed.unwrap_or(false);
+            v.obstacles_changed = Some(new);
         }
     }
 
-    async fn tick(&mut self, node: &RosNode, out: &Outputs, servers: &mut Servers) {
-        let Some(active) = &self.active else { return };
+    async fn tick(&mut self, io: &mut Io<'_, '_>) {
+        let Some(active) = self.session.active() else { return };
         let now = Instant::now();
-        let goal_age = now.saturating_duration_since(active.started);
-        if odom_stale(self.odom.age_at(now), goal_age, active.config.odom_timeout()) {
-            return self.end_goal(node, out, servers, Outcome::Stale);
+        let odom = Watched {
+            name: "odom",
+            age: self.odom.age_at(now),
+            timeout: active.goal.config.odom_timeout(),
+        };
+        if self.session.stale(now, &[odom]).is_some() {
+            return self.end_goal(io, Outcome::Stale);
         }
-        if matches!(active.task, Task::Vfo { .. })
-            && odom_stale(self.scan_seen.age_at(now), goal_age, active.config.vfo.scan_timeout())
-        {
-            return self.end_goal(node, out, servers, Outcome::ScanStale);
+        let scan = Watched {
+            name: "scan",
+            age: self.scan_seen.age_at(now),
+            timeout: active.goal.config.vfo.scan_timeout(),
+        };
+        if matches!(active.goal.task, Task::Vfo(_)) && self.session.stale(now, &[scan]).is_some() {
+            return self.end_goal(io, Outcome::ScanStale);
         }
         let status_period = Duration::from_secs_f64(1.0 / self.config.status_rate_hz);
         if self
             .last_status
             .is_none_or(|t| now.saturating_duration_since(t) >= status_period)
         {
-            self.publish_status(node, out, NavStatus::ACTIVE, String::new());
+            self.publish_status(io.node, io.out, NavStatus::ACTIVE, String::new());
         }
         let markers_period = Duration::from_secs_f64(1.0 / self.config.markers_rate_hz);
         if self
             .last_markers
             .is_none_or(|t| now.saturating_duration_since(t) >= markers_period)
         {
-            self.publish_markers(node, out);
+            self.publish_markers(io.node, io.out);
         }
-        self.feedback(servers).await;
+        self.feedback(io.servers).await;
     }
 
     /// Action feedback, on every watchdog tick (20 Hz) while an action goal is active.
     async fn feedback(&mut self, servers: &Servers) {
-        let Some(active) = &self.active else { return };
-        // The goal's own time: ROS time summed step by step, never running backwards (a step
-        // whose clock went back is skipped), so docking_time never falls on a clock reset.
-        let elapsed = active.t;
-        let sent = match (&active.task, active.source) {
-            (Task::Dock { .. }, Source::DockAction) => {
+        let Some(active) = self.session.active() else { return };
+        let sent = match (&active.goal.task, active.source) {
+            // The goal's own time: its steps' dt summed, never running backwards (a step whose
+            // clock went back is skipped), so docking_time never falls on a clock reset.
+            (Task::Dock(_), Source::DockAction) => {
                 servers
                     .dock
                     .feedback(DockRobotFeedback {
                         state: DockRobotFeedback::CONTROLLING,
-                        docking_time: duration_msg(elapsed),
+                        docking_time: duration_msg(active.t()),
                         num_retries: 0,
                     })
                     .await
             }
-            (Task::Follow { follower, route, .. }, Source::FollowAction) => {
-                let i = follower.index().min(route.points.len().saturating_sub(1));
-                let index = route.request_index.get(i).copied().unwrap_or(0);
+            (_, Source::FollowAction) => {
+                let index = active.goal.waypoint().unwrap_or(0);
                 servers
                     .follow
                     .feedback(FollowWaypointsFeedback {
@@ -1819,26 +1590,7 @@ impl Shell {
                     })
                     .await
             }
-            (Task::Vfo { route, index, .. }, Source::FollowAction) => {
-                let i = (*index).min(route.points.len().saturating_sub(1));
-                let index = route.request_index.get(i).copied().unwrap_or(0);
-                servers
-                    .follow
-                    .feedback(FollowWaypointsFeedback {
-                        current_waypoint: u32::try_from(index).unwrap_or(u32::MAX),
-                    })
-                    .await
-            }
-            (Task::PreCheck { route, .. }, Source::FollowAction) => {
-                let index = route.request_index.first().copied().unwrap_or(0);
-                servers
-                    .follow
-                    .feedback(FollowWaypointsFeedback {
-                        current_waypoint: u32::try_from(index).unwrap_or(u32::MAX),
-                    })
-                    .await
-            }
-            (Task::Undock { .. }, Source::UndockAction) => {
+            (Task::Undock(_), Source::UndockAction) => {
                 servers
                     .undock
                     .feedback(UndockRobotFeedback {
