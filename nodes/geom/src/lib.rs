@@ -23,8 +23,10 @@
 
 pub mod angle;
 pub mod pose;
+pub mod sample;
 pub mod scan;
 
 pub use angle::wrap;
 pub use pose::Pose2;
+pub use sample::downsample;
 pub use scan::{Beam, Scan, ScanError};

@@ -44,6 +44,8 @@
 //! ```
 #![warn(missing_docs)]
 
+pub mod slot;
+
 pub use mobil_chassis::BodyTwist;
 pub use mobil_geom::Pose2;
 

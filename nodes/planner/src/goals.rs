@@ -1,8 +1,9 @@
 //! The planner's goals as goal laws ([`mobil_motion::GoalLaw`]): a docking by the Lyapunov law,
-//! a route by the goal approach, an undocking by [`DistanceDrive`]. Each takes the robot's
-//! reference point (`base_link`) and steers the point its law steers, answers with a body twist
-//! at that point, and ends with the planner's reasons and Nav2's codes. A node runs them through
-//! its motion server; nothing here reads a clock or publishes.
+//! a route by the goal approach, an undocking by [`DistanceDrive`], a route by VFO
+//! ([`VfoGoal`]). Each takes the robot's reference point (`base_link`) and steers the point its
+//! law steers, answers with a body twist at that point, and ends with the planner's reasons and
+//! Nav2's codes. A node runs them through its motion server; nothing here reads a clock or
+//! publishes.
 
 use crate::docking::{DockingController, DockingFailure, DockingOutput, DockingPhase, Finish, PolarError, Residual};
 use crate::follow::{FollowEnd, FollowEvent, WaypointFollower};
@@ -11,6 +12,8 @@ use mobil_geom::Pose2;
 use mobil_motion::{nav2, GoalLaw, Outcome, Step, StepInput};
 use mobil_tools::drive::{DistanceDrive, DriveSettings, Progress};
 use nalgebra::Point2;
+
+pub use crate::vfo::goal::VfoGoal;
 
 /// How a docking that failed is told: `TIME_LIMIT`, `NOT_CONVERGING`, or `RESIDUAL` — the
 /// heading left when a steered chassis reached ε_e, and a steered chassis' stall too (V stops

@@ -194,6 +194,16 @@ impl RouteReport {
     pub fn is_ok(&self) -> bool {
         self.problems.is_empty()
     }
+
+    /// The length (m) of the predicted path, without the jumps where the virtual robot was set
+    /// down on a waypoint it missed (any move longer than 2 `step`s, the check's step length).
+    pub fn driven_length(&self, step: f64) -> f64 {
+        self.path
+            .windows(2)
+            .map(|w| (w[1].position() - w[0].position()).norm())
+            .filter(|d| *d <= 2.0 * step)
+            .sum()
+    }
 }
 
 /// Radius (m) of the arc that the origin drives from `origin` (tangent to its heading) so that

@@ -475,6 +475,22 @@ fn a_stopped_check_ends_at_once_with_stopped() {
     assert_eq!((stopped, asked), (Err(PlannerError::Stopped), 1));
 }
 
+#[test]
+fn the_driven_length_leaves_out_the_set_downs() {
+    // Two steps of 0.02 m, a 1 m jump (a set-down), one more step: 0.06 m driven.
+    let report = RouteReport {
+        problems: Vec::new(),
+        path: [0.0, 0.02, 0.04, 1.04, 1.06]
+            .iter()
+            .map(|&x| Pose2::new(x, 0.0, 0.0))
+            .collect(),
+        reached: vec![true],
+    };
+    assert_relative_eq!(report.driven_length(0.02), 0.06, epsilon = 1e-12);
+    // With a 1 m step the jump is a move: 1.06 m.
+    assert_relative_eq!(report.driven_length(1.0), 1.06, epsilon = 1e-12);
+}
+
 proptest! {
     #![proptest_config(ProptestConfig::with_cases(256))]
     #[test]

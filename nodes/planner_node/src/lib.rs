@@ -11,6 +11,7 @@
 use mobil_chassis::kinematics::{twist_at_origin, twist_at_reference};
 use mobil_chassis::model::ChassisConfig;
 use mobil_chassis::{clamp_command, BodyTwist, ChassisParams};
+use mobil_geom::downsample;
 use mobil_geom::Pose2;
 use mobil_msgs::builtin_interfaces::msg::Time;
 use mobil_msgs::geometry_msgs::msg::{Point, Pose, PoseStamped, Twist, Vector3};
@@ -22,6 +23,7 @@ use mobil_msgs::nav_msgs::msg::Path;
 use mobil_msgs::std_msgs::msg::{ColorRGBA, Header};
 use mobil_msgs::visualization_msgs::msg::{Marker, MarkerArray};
 pub use mobil_planner::goals::{list_missed, Missed, MISSED_BY_THE_RUN};
+use mobil_planner::vfo::{SegmentReport, VfoDrawing, MAX_DRAWN_OBSTACLES, MAX_DRAWN_ROBOTS};
 use mobil_planner::{
     DockingConfig, DockingGains, FollowConfig, ProblemKind, RouteCheckConfig, RouteProblem, RouteReport,
 };
@@ -635,38 +637,6 @@ pub enum Outcome {
     Stale,
     /// No valid scan for `vfo.scan_timeout_s` (a VFO route).
     ScanStale,
-    /// VFO: no left/right decisions take the robot to waypoint `index` without a collision
-    /// (none found within the caps): the robot stopped where the segment began.
-    NoSafePath {
-        /// The waypoint (request index).
-        index: usize,
-        /// Virtual robots simulated by the optimisation that found none.
-        virtual_robots: usize,
-        /// The waypoints not reached (request indices).
-        unreached: Vec<usize>,
-    },
-    /// VFO: the optimisation's wall-clock budget (`vfo.optimise_budget_s`) ran out before any
-    /// candidate path to waypoint `index`, `tries` times in a row: no path was proven unsafe,
-    /// none was found in time.
-    OptimisationBudget {
-        /// The waypoint (request index).
-        index: usize,
-        /// Optimisations in a row that ran out.
-        tries: u32,
-        /// The waypoints not reached (request indices).
-        unreached: Vec<usize>,
-    },
-    /// VFO: the robot is inside the forbidden zone (d ≤ r) of an obstacle seen on the way.
-    Collision {
-        /// The obstacle's centre (odom).
-        centre: Point2<f64>,
-        /// Its forbidden radius r (m).
-        radius: f64,
-        /// The robot's distance to the centre (m).
-        distance: f64,
-        /// The waypoints not reached (request indices).
-        unreached: Vec<usize>,
-    },
     /// The client canceled.
     Canceled,
     /// A newer goal took over.
@@ -703,9 +673,6 @@ impl Outcome {
             Outcome::Law(mobil_motion::Outcome::Failed { code, .. }) => code,
             Outcome::RouteInfeasible(_) => "ROUTE_INFEASIBLE",
             Outcome::Stale | Outcome::ScanStale => "STALE_INPUT",
-            Outcome::NoSafePath { .. } => "NO_SAFE_PATH",
-            Outcome::OptimisationBudget { .. } => "OPTIMISATION_BUDGET",
-            Outcome::Collision { .. } => "COLLISION",
             Outcome::Canceled => "CANCELED",
             Outcome::Preempted(_) => "PREEMPTED",
             Outcome::Invalid(_) => "INVALID_GOAL",
@@ -721,27 +688,6 @@ impl Outcome {
             Outcome::RouteInfeasible(m) => format!("{} problem(s): {}", m.len(), list_missed(m)),
             Outcome::Stale => "odom stale: robot stopped".to_owned(),
             Outcome::ScanStale => "scan stale: the obstacles are unknown, robot stopped".to_owned(),
-            Outcome::NoSafePath {
-                index, virtual_robots, ..
-            } => format!(
-                "no left/right decisions round the obstacles take the robot to waypoint {index} without a \
-                 collision ({virtual_robots} virtual robots simulated): robot stopped"
-            ),
-            Outcome::OptimisationBudget { index, tries, .. } => format!(
-                "optimisation budget exhausted: {tries} optimisations in a row ran out of vfo.optimise_budget_s \
-                 before finding any path to waypoint {index} (none was proven unsafe; the scene needs a larger \
-                 budget or a faster machine): robot stopped"
-            ),
-            Outcome::Collision {
-                centre,
-                radius,
-                distance,
-                ..
-            } => format!(
-                "the robot is {distance:.2} m from the centre of the obstacle at ({:.2}, {:.2}), inside its \
-                 forbidden radius r = {radius:.2} m (an obstacle seen too late or moving): robot stopped",
-                centre.x, centre.y
-            ),
             Outcome::Canceled => "canceled by the client".to_owned(),
             Outcome::Preempted(by) => format!("preempted by a newer goal ({by})"),
             Outcome::Invalid(e) => e.to_string(),
@@ -815,28 +761,15 @@ impl Outcome {
         let error_code = match self {
             Outcome::Law(o) => o.nav2_error(),
             Outcome::Canceled | Outcome::Preempted(_) => FollowWaypointsResult::NONE,
-            Outcome::RouteInfeasible(_)
-            | Outcome::Stale
-            | Outcome::ScanStale
-            | Outcome::Refused(_)
-            | Outcome::NoSafePath { .. }
-            | Outcome::OptimisationBudget { .. }
-            | Outcome::Collision { .. } => FollowWaypointsResult::TASK_EXECUTOR_FAILED,
+            Outcome::RouteInfeasible(_) | Outcome::Stale | Outcome::ScanStale | Outcome::Refused(_) => {
+                FollowWaypointsResult::TASK_EXECUTOR_FAILED
+            }
             _ => FollowWaypointsResult::UNKNOWN,
-        };
-        // A VFO route that ended early: the waypoints it did not reach, as FollowPath's
-        // FAILED_TO_MAKE_PROGRESS (the run gave them up).
-        let unreached: &[usize] = match self {
-            Outcome::NoSafePath { unreached, .. }
-            | Outcome::OptimisationBudget { unreached, .. }
-            | Outcome::Collision { unreached, .. } => unreached,
-            _ => &[],
         };
         FollowWaypointsResult {
             missed_waypoints: missed
                 .iter()
                 .map(|m| (m.index, m.error_code()))
-                .chain(unreached.iter().map(|&i| (i, MISSED_BY_THE_RUN)))
                 .take(MAX_RESULT_MISSED)
                 .map(|(index, error_code)| MissedWaypoint {
                     index: u32::try_from(index).unwrap_or(u32::MAX),
@@ -852,16 +785,12 @@ impl Outcome {
 
 impl Outcome {
     /// FollowWaypoints' result for a VFO route: as [`Outcome::follow_result`], and every early
-    /// end (stale input, a refusal, a cancel, a pre-emption, shutdown, as well as NO_SAFE_PATH
-    /// and COLLISION, which carry their own) lists the waypoints not reached, `unreached`
-    /// (request indices, from the one pursued on), as given up by the run.
+    /// end (the law's NO_SAFE_PATH, OPTIMISATION_BUDGET or COLLISION, stale input, a refusal,
+    /// a cancel, a pre-emption, shutdown) lists the waypoints not reached, `unreached` (request
+    /// indices, from the one pursued on), as given up by the run.
     pub fn vfo_follow_result(&self, poses: &[PoseStamped], unreached: &[usize]) -> FollowWaypointsResult {
         let mut r = self.follow_result(poses, &[]);
-        let own = matches!(
-            self,
-            Outcome::NoSafePath { .. } | Outcome::OptimisationBudget { .. } | Outcome::Collision { .. }
-        );
-        if !self.succeeded() && !own {
+        if !self.succeeded() {
             r.missed_waypoints = unreached
                 .iter()
                 .take(MAX_RESULT_MISSED)
@@ -908,24 +837,6 @@ fn pose_msg(p: &Pose2) -> Pose {
     }
 }
 
-/// At most `max` items of `items`, evenly spread, the first and the last always kept.
-pub fn downsample<T: Clone>(items: &[T], max: usize) -> Vec<T> {
-    if items.len() <= max || max < 2 {
-        return items.iter().take(max.max(items.len().min(max))).cloned().collect();
-    }
-    let last = items.len() - 1;
-    (0..max).map(|i| items[i * last / (max - 1)].clone()).collect()
-}
-
-/// Path length (m) of the reference point's poses, without the jumps where the virtual robot
-/// was set down on a waypoint it missed (longer than 2 steps).
-pub fn path_length(path: &[Pose2], step: f64) -> f64 {
-    path.windows(2)
-        .map(|w| (w[1].position() - w[0].position()).norm())
-        .filter(|d| *d <= 2.0 * step)
-        .sum()
-}
-
 /// The `check_route` reply of a report: every problem (up to [`MAX_LISTED_PROBLEMS`]) with its
 /// index, kind, detail and position; `feasible`, `failed_waypoint`, the simulated path
 /// (downsampled to [`MAX_REPLY_POSES`]) and its length.
@@ -965,7 +876,7 @@ pub fn check_reply(report: &RouteReport, route: &Route, stamp: Time, frame: &str
             .map_or(-1, |m| i32::try_from(m.index).unwrap_or(i32::MAX)),
         problems,
         simulated_path: Path { header, poses },
-        length: path_length(&report.path, step),
+        length: report.driven_length(step),
     }
 }
 
@@ -998,7 +909,7 @@ pub struct StatusView {
     /// before the first pose is known.
     pub docking: Option<[f64; 4]>,
     /// A VFO route's current segment: `None` otherwise (Ψ_z and the χ's sent as NaN, counts 0).
-    pub vfo: Option<vfo::SegmentReport>,
+    pub vfo: Option<SegmentReport>,
 }
 
 /// The NavStatus message of a view, stamped `stamp`, in `frame`.
@@ -1081,7 +992,7 @@ pub struct MarkerView<'a> {
     /// The dock pose.
     pub dock: Option<Pose2>,
     /// A VFO route's last optimisation.
-    pub vfo: Option<&'a vfo::VfoDrawing>,
+    pub vfo: Option<&'a VfoDrawing>,
     /// The robot's position: the obstacles nearest to it are drawn first.
     pub robot: Option<Point2<f64>>,
 }
@@ -1089,8 +1000,8 @@ pub struct MarkerView<'a> {
 /// Most points over the whole marker array — the route's line and dots, the predicted path,
 /// the virtual robots' paths and the chosen one — shared among them by [`markers`]: 24 bytes
 /// each in CDR, 24 KB. With the markers' own bytes (about 250 each, at most
-/// 2 + 1 + 2·[`MAX_LISTED_PROBLEMS`] + 1 + [`vfo::MAX_DRAWN_ROBOTS`] + 1 +
-/// 2·[`vfo::MAX_DRAWN_OBSTACLES`] of them) the array stays below the 80 KB a message to rclpy
+/// 2 + 1 + 2·[`MAX_LISTED_PROBLEMS`] + 1 + [`MAX_DRAWN_ROBOTS`] + 1 +
+/// 2·[`MAX_DRAWN_OBSTACLES`] of them) the array stays below the 80 KB a message to rclpy
 /// should stay below (tested on the worst case).
 pub const MAX_MARKER_POINTS: usize = 1000;
 
@@ -1166,21 +1077,21 @@ pub fn markers(view: &MarkerView<'_>, stamp: Time, frame: &str) -> MarkerArray {
 
 /// A VFO optimisation's markers: each virtual robot's path a thin LINE_STRIP (`vfo_robots`,
 /// grey; orange where the path was dropped on a collision or the time cap), the chosen path a
-/// thick green one (`vfo_chosen`), each obstacle (at most [`vfo::MAX_DRAWN_OBSTACLES`], the
+/// thick green one (`vfo_chosen`), each obstacle (at most [`MAX_DRAWN_OBSTACLES`], the
 /// nearest to `robot` first) a red CYLINDER of radius r (`vfo_forbidden`) inside a pale yellow
 /// one of radius R (`vfo_influence`). The paths share `budget` points: the chosen one up to a
 /// third, the virtual robots the rest, evenly (at least two points each, so the first
 /// `budget / 2` robots at most).
 fn vfo_markers(
     header: &Header,
-    drawing: &vfo::VfoDrawing,
+    drawing: &VfoDrawing,
     robot: Option<Point2<f64>>,
     budget: usize,
     out: &mut Vec<Marker>,
 ) {
     let chosen = downsample(&drawing.chosen, budget / 3);
     let rest = budget - chosen.len();
-    let robots = &drawing.robots[..drawing.robots.len().min(rest / 2).min(vfo::MAX_DRAWN_ROBOTS)];
+    let robots = &drawing.robots[..drawing.robots.len().min(rest / 2).min(MAX_DRAWN_ROBOTS)];
     let per_robot = (rest / robots.len().max(1)).max(2);
     for (i, r) in robots.iter().enumerate() {
         let id = i32::try_from(i).unwrap_or(i32::MAX);
@@ -1206,7 +1117,7 @@ fn vfo_markers(
                 .total_cmp(&drawing.obstacles[b].distance(&at))
         });
     }
-    for (k, &i) in order.iter().take(vfo::MAX_DRAWN_OBSTACLES).enumerate() {
+    for (k, &i) in order.iter().take(MAX_DRAWN_OBSTACLES).enumerate() {
         let o = &drawing.obstacles[i];
         let id = i32::try_from(k).unwrap_or(i32::MAX);
         for (ns, radius, height, c) in [
@@ -1557,23 +1468,6 @@ mod tests {
             Outcome::Preempted("dock_pose").reason(),
             "PREEMPTED: preempted by a newer goal (dock_pose)"
         );
-    }
-
-    #[test]
-    fn downsampling_keeps_the_ends_and_the_count() {
-        let v: Vec<usize> = (0..1001).collect();
-        let d = downsample(&v, 5);
-        assert_eq!(d, vec![0, 250, 500, 750, 1000]);
-        assert_eq!(downsample(&v[..3], 5), vec![0, 1, 2]);
-        // Path length without the set-down jumps: 3 steps of 0.02 and a 1 m jump → 0.06.
-        let p = [
-            Pose2::new(0.0, 0.0, 0.0),
-            Pose2::new(0.02, 0.0, 0.0),
-            Pose2::new(0.04, 0.0, 0.0),
-            Pose2::new(1.04, 0.0, 0.0),
-            Pose2::new(1.06, 0.0, 0.0),
-        ];
-        assert_relative_eq!(path_length(&p, 0.02), 0.06, epsilon = 1e-12);
     }
 
     #[test]

@@ -32,7 +32,8 @@
 
 use mobil_chassis::ChassisParams;
 use mobil_geom::Pose2;
-use mobil_motion::{GoalLaw, Step, StepInput};
+use mobil_motion::slot::{late_bound, ArrivalPeriod, Handback, LawSlot};
+use mobil_motion::{BodyTwist, GoalLaw, Step, StepInput};
 use mobil_msgs::geometry_msgs::msg::{PoseStamped, Twist};
 use mobil_msgs::mobil_msgs::msg::NavStatus;
 use mobil_msgs::mobil_msgs::srv::{CheckRoute, CheckRouteRequest, CheckRouteResponse};
@@ -46,17 +47,13 @@ use mobil_msgs::tf2_msgs::msg::TFMessage;
 use mobil_msgs::visualization_msgs::msg::MarkerArray;
 use mobil_planner::goals::{DockGoal, RouteEvent, RouteGoal, UndockGoal};
 use mobil_planner::vfo::{
-    Interrupt, ObstacleMap, OptimiseWarning, PoseHistory, VfoEnd, VfoEvent, VfoFollower, VfoOutput, MAX_BUDGET_RETRIES,
-    MAX_SETTLE_S,
+    vfo_gains, Interrupt, ObstacleMap, OptimiseWarning, PoseHistory, VfoDrawing, VfoEvent, VfoFollower, VfoGoal,
+    VfoStep, VfoTick, VfoView, MAX_SETTLE_S,
 };
 use mobil_planner::{
-    check_route_until, DockingController, DockingPhase, Finish, PlannerError, RouteReport, VelocityLimits,
-    WaypointFollower,
+    check_route_until, DockingController, DockingPhase, Finish, RouteReport, VelocityLimits, WaypointFollower,
 };
-use mobil_planner_node::vfo::{
-    segment_report, vfo_command, vfo_drawing, vfo_gains, vfo_max_delay, vfo_waypoints, ArrivalPeriod, Handback,
-    SegmentReport, VfoDrawing, VfoSlot, WaypointMethod,
-};
+use mobil_planner_node::vfo::{vfo_waypoints, WaypointMethod};
 use mobil_planner_node::{
     check_reply, clamp_twist, dock_goal, docking_offset, load_world, markers, missed_from_report, pose_in_odom,
     refused_reply, route_from_path, route_from_poses, status_message, GoalError, MarkerView, Missed, Mode, Outcome,
@@ -133,24 +130,17 @@ impl Source {
     }
 }
 
-/// A VFO route's state: the follower at home or out on a tick ([`VfoSlot`]) and what the
-/// status shows of it.
-struct VfoTask {
-    slot: VfoSlot,
+/// A VFO route: the law at home or out on a step ([`LawSlot`]), and what the status shows of it
+/// meanwhile.
+struct VfoRun {
+    slot: LawSlot<VfoGoal>,
     route: Route,
-    /// The steered point's offset behind the reference point ([`docking_offset`]).
-    offset: f64,
-    /// The waypoint pursued (route index) and ‖e*‖ to it.
-    index: usize,
-    distance: f64,
-    report: SegmentReport,
-    /// The obstacle map changed since the follower last saw it (`Some(true)`: with new
-    /// obstacles, which re-optimise the segment).
-    obstacles_changed: Option<bool>,
-    /// The map's ids of the obstacles the follower holds, by its index: its σ follow them
-    /// over removals from the map.
-    ids: Vec<u64>,
-    /// Cancelled when the goal ends: a tick's optimisation under way stops at once.
+    /// The status' figures as the law last came back.
+    view: VfoView,
+    /// The obstacle map changed since the law last took it (`Some(true)`: with new obstacles,
+    /// which re-optimise the segment).
+    map_changed: Option<bool>,
+    /// Cancelled when the goal ends: a step's optimisation under way stops at once.
     stop: CancelToken,
 }
 
@@ -169,7 +159,7 @@ enum Task {
         route: Route,
     },
     Undock(UndockGoal),
-    Vfo(VfoTask),
+    Vfo(VfoRun),
 }
 
 /// The goal state the session holds.
@@ -203,7 +193,7 @@ impl Goal {
         };
         match &self.task {
             Task::Follow { goal, .. } => Some(goal.waypoint()),
-            Task::Vfo(v) => Some(at(&v.route, v.index)),
+            Task::Vfo(v) => Some(v.view.waypoint),
             Task::PreCheck { route, .. } => Some(at(route, 0)),
             Task::Dock(_) | Task::Undock(_) => None,
         }
@@ -249,13 +239,11 @@ const MAX_CHECKS: usize = 4;
 /// `vfo.scan_odom_max_gap_s`'s range.
 const ODOM_HISTORY: usize = 100;
 
-/// One VFO tick done on the blocking pool: the follower back, its output, and when the tick
-/// optimised, what the status and markers show of it.
+/// One VFO step done on the blocking pool: the law back, and its step.
 struct VfoTickDone {
     id: GoalId,
-    follower: Box<VfoFollower>,
-    output: Result<VfoOutput, PlannerError>,
-    optimised: Option<(SegmentReport, VfoDrawing)>,
+    law: Box<VfoGoal>,
+    step: Step<VfoStep, Vec<usize>>,
 }
 
 /// The pre-checks off the event loop: the goal's (a newer goal stops the older one's) and
@@ -570,14 +558,14 @@ fn goal_end(outcome: &Outcome) -> GoalEnd {
 fn follow_answer(task: &Task, outcome: &Outcome) -> FollowWaypointsResult {
     match task {
         Task::Follow { goal, route } => outcome.follow_result(&route.poses, goal.missed()),
-        Task::Vfo(v) => outcome.vfo_follow_result(&v.route.poses, &v.route.unreached_from(v.index)),
+        Task::Vfo(v) => outcome.vfo_follow_result(&v.route.poses, &v.route.unreached_from(v.view.index)),
         Task::PreCheck { route, .. } => outcome.follow_result(&route.poses, &[]),
         Task::Dock(_) | Task::Undock(_) => outcome.follow_result(&[], &[]),
     }
 }
 
 /// Holds a law's body twist to the chassis limits, as a `cmd_vel`.
-fn limited(chassis: &ChassisParams) -> impl Fn(mobil_chassis::BodyTwist) -> Twist + '_ {
+fn limited(chassis: &ChassisParams) -> impl Fn(BodyTwist) -> Twist + '_ {
     move |b| clamp_twist(b, chassis)
 }
 
@@ -661,13 +649,9 @@ impl Shell {
             }
             Task::Undock(u) => view.distance_to_goal = u.remaining(),
             Task::Vfo(v) => {
-                view.goal = at(v
-                    .route
-                    .points
-                    .get(v.index.min(v.route.points.len().saturating_sub(1)))
-                    .copied());
-                view.distance_to_goal = v.distance;
-                view.vfo = Some(v.report);
+                view.goal = at(v.view.target);
+                view.distance_to_goal = v.view.distance;
+                view.vfo = Some(v.view.report);
             }
             Task::PreCheck { route, .. } => view.goal = at(route.points.first().copied()),
         }
@@ -928,20 +912,15 @@ impl Shell {
                 self.chassis.model().as_str()
             );
         }
-        // A tick's command later than the next odometry or two is dropped (the robot stops).
-        let max_delay = vfo_max_delay(self.odom_period.period(), settings.optimise.time_step);
-        // Progress is the follower's: from the point the law steers (the guide point).
-        let distance = (route.points[0] - start.ahead(-offset).position()).norm();
+        // A step's command later than the next odometry or two is dropped (the robot stops).
+        let max_delay = late_bound(self.odom_period.period(), settings.optimise.time_step);
         let points = route.points.clone();
-        let task = VfoTask {
-            slot: VfoSlot::new(follower, max_delay),
+        let law = VfoGoal::new(follower, route.request_index.clone(), offset, &start, self.map.ids());
+        let task = VfoRun {
+            view: law.view(),
+            slot: LawSlot::new(law, max_delay),
             route,
-            offset,
-            index: 0,
-            distance,
-            report: SegmentReport::default(),
-            obstacles_changed: None,
-            ids: self.map.ids(),
+            map_changed: None,
             stop: CancelToken::new(),
         };
         self.begin(io, Task::Vfo(task), source);
@@ -1007,7 +986,7 @@ impl Shell {
             } else {
                 format!("{} problem(s)", problems.len())
             },
-            mobil_planner_node::path_length(&report.path, follow.check_length)
+            report.driven_length(follow.check_length)
         );
         let distance = (route.points[0] - start.position()).norm();
         let goal = RouteGoal::new(follower, route.request_index.clone(), distance);
@@ -1230,7 +1209,7 @@ impl Shell {
         let chassis = active.goal.chassis;
         match &mut active.goal.task {
             Task::PreCheck { .. } => {}
-            Task::Vfo(_) => self.vfo_step(io, jobs, pose, input.t),
+            Task::Vfo(_) => self.vfo_step(io, jobs, input),
             Task::Dock(d) => {
                 let step = d.step(&input, &());
                 self.apply(io, step, &chassis, |f| f.phase_changed);
@@ -1282,25 +1261,25 @@ impl Shell {
         }
     }
 
-    /// A VFO tick at `pose`, time `t`: the follower goes to the blocking pool with the map's
-    /// latest obstacles, or, while it is still out (optimising), the robot stops.
-    fn vfo_step(&mut self, io: &mut Io<'_, '_>, jobs: &mut Jobs, pose: Pose2, t: f64) {
+    /// A VFO step: the law goes to the blocking pool with the map's latest obstacles, or,
+    /// while it is still out (optimising), the robot stops.
+    fn vfo_step(&mut self, io: &mut Io<'_, '_>, jobs: &mut Jobs, input: StepInput) {
         let Some(active) = self.session.active_mut() else {
             return;
         };
         let id = active.id();
         let budget = active.goal.config.vfo.optimise_budget();
         let Task::Vfo(v) = &mut active.goal.task else { return };
-        let Some(mut follower) = v.slot.lend(Instant::now()) else {
+        let Some(mut law) = v.slot.lend(Instant::now()) else {
             return self.session.hold(io.sink);
         };
-        if let Some(new) = v.obstacles_changed.take() {
-            follower.follow_map(&self.map, &mut v.ids, new);
+        if let Some(new) = v.map_changed.take() {
+            law.follow_map(&self.map, new);
         }
-        let (guide, stop, stamp) = (pose.ahead(-v.offset), v.stop.clone(), self.odom_stamp);
+        let (stop, stamp) = (v.stop.clone(), self.odom_stamp);
         jobs.vfo.start(move |cancel| {
-            let started = Instant::now();
-            let interrupt = || {
+            let (cancel, started) = (cancel.clone(), Instant::now());
+            let interrupt = move || {
                 if cancel.is_cancelled() || stop.is_cancelled() {
                     Some(Interrupt::Cancel)
                 } else if started.elapsed() > budget {
@@ -1309,24 +1288,17 @@ impl Shell {
                     None
                 }
             };
-            let output = follower.update_stamped(&guide, t, stamp, &interrupt);
-            let optimised = output
-                .as_ref()
-                .is_ok_and(|o| o.events.iter().any(|e| matches!(e, VfoEvent::Optimised { .. })))
-                .then(|| follower.last_optimisation())
-                .flatten()
-                .map(|o| (segment_report(o), vfo_drawing(o, follower.obstacles())));
-            VfoTickDone {
-                id,
-                follower,
-                output,
-                optimised,
-            }
+            let tick = VfoTick {
+                stamp,
+                interrupt: Box::new(interrupt),
+            };
+            let step = law.step(&input, &tick);
+            VfoTickDone { id, law, step }
         });
     }
 
-    /// A VFO tick came back: its command goes out (zero when it came back late), its events
-    /// are logged, the route may end.
+    /// A VFO step came back: its events are logged, its command goes out (zero when it came
+    /// back late), or the route ends.
     fn vfo_ticked(&mut self, io: &mut Io<'_, '_>, done: VfoTickDone) {
         if !self.session.is_current(done.id) {
             return;
@@ -1336,110 +1308,66 @@ impl Shell {
         };
         let chassis = active.goal.chassis;
         let Task::Vfo(v) = &mut active.goal.task else { return };
-        let handback = v.slot.give_back(done.follower, Instant::now());
-        if let Some((r, drawing)) = done.optimised {
-            v.report = r;
-            self.drawing.vfo = Some(drawing);
-        }
-        let o = match done.output {
-            Ok(o) => o,
-            Err(e) => {
-                let step: Step<(), ()> = Step::Refused(e.to_string());
-                return self.apply(io, step, &chassis, |_| false);
-            }
-        };
-        let route = &v.route;
-        let request = |i: usize| route.request_index.get(i).copied().unwrap_or(i);
-        for event in &o.events {
-            match event {
-                VfoEvent::Reached { index, vortex } => info!(
-                    "waypoint {} reached{}",
-                    request(*index),
-                    if *vortex {
-                        " (early: the robot was caught between obstacles, Algorithm 3)"
-                    } else {
-                        ""
-                    }
-                ),
-                VfoEvent::Optimised {
-                    index,
-                    reason,
-                    score,
-                    warnings,
-                } => {
-                    info!(
-                        "segment to waypoint {} optimised ({reason:?}): Ψ_z {}, {} virtual robots, {} candidates",
+        v.view = done.law.view();
+        let handback = v.slot.give_back(done.law, Instant::now());
+        let Some(law) = v.slot.law() else { return };
+        let mut step = done.step;
+        if let Step::Command { twist, feedback } = &mut step {
+            let request = |i: usize| law.request(i);
+            for event in &feedback.events {
+                match event {
+                    VfoEvent::Reached { index, vortex } => info!(
+                        "waypoint {} reached{}",
                         request(*index),
-                        score.map_or("none".to_owned(), |s| format!("{s:.3}")),
-                        v.report.virtual_robots,
-                        v.report.candidates
-                    );
-                    for w in warnings.iter().filter(|w| !matches!(w, OptimiseWarning::NoSafeSigma)) {
-                        warn_throttled!(self.throttle, "vfo-caps", "segment optimisation: {w:?}");
+                        if *vortex {
+                            " (early: the robot was caught between obstacles, Algorithm 3)"
+                        } else {
+                            ""
+                        }
+                    ),
+                    VfoEvent::Optimised {
+                        index,
+                        reason,
+                        score,
+                        warnings,
+                    } => {
+                        info!(
+                            "segment to waypoint {} optimised ({reason:?}): Ψ_z {}, {} virtual robots, {} candidates",
+                            request(*index),
+                            score.map_or("none".to_owned(), |s| format!("{s:.3}")),
+                            v.view.report.virtual_robots,
+                            v.view.report.candidates
+                        );
+                        for w in warnings.iter().filter(|w| !matches!(w, OptimiseWarning::NoSafeSigma)) {
+                            warn_throttled!(self.throttle, "vfo-caps", "segment optimisation: {w:?}");
+                        }
                     }
                 }
             }
-        }
-        if o.end.is_none() && v.slot.follower().is_some_and(|f| f.is_settling()) {
-            warn_throttled!(
-                self.throttle,
-                "vfo-settle",
-                "robot held at zero inside an influence zone until it stands (at most {MAX_SETTLE_S} s), then the \
-                 segment to waypoint {} is optimised from there",
-                request(o.index)
-            );
-        }
-        v.index = o.index;
-        v.distance = o.distance;
-        let unreached = |from: usize| route.unreached_from(from);
-        let ended = match o.end {
-            None => None,
-            Some(VfoEnd::Done) => Some(Outcome::Law(mobil_motion::Outcome::succeeded(
-                mobil_planner::goals::route_done(route.points.len(), &[]),
-            ))),
-            Some(VfoEnd::NoSafePath { index }) => Some(Outcome::NoSafePath {
-                index: request(index),
-                virtual_robots: v.report.virtual_robots,
-                unreached: unreached(index),
-            }),
-            Some(VfoEnd::BudgetExhausted { index }) => Some(Outcome::OptimisationBudget {
-                index: request(index),
-                tries: MAX_BUDGET_RETRIES,
-                unreached: unreached(index),
-            }),
-            Some(VfoEnd::Collision { obstacle }) => {
-                let ob = v.slot.follower().and_then(|f| f.obstacles().get(obstacle).copied());
-                // The guide point's distance, as the follower measured the collision.
-                let at = self.odom.value().map(|p| p.ahead(-v.offset).position());
-                Some(Outcome::Collision {
-                    centre: ob.map_or_else(Point2::origin, |o| o.centre()),
-                    radius: ob.map_or(f64::NAN, |o| o.forbidden_radius()),
-                    distance: match (ob, at) {
-                        (Some(ob), Some(at)) => ob.distance(&at),
-                        _ => f64::NAN,
-                    },
-                    unreached: unreached(o.index),
-                })
+            if feedback.settling {
+                warn_throttled!(
+                    self.throttle,
+                    "vfo-settle",
+                    "robot held at zero inside an influence zone until it stands (at most {MAX_SETTLE_S} s), then \
+                     the segment to waypoint {} is optimised from there",
+                    v.view.waypoint
+                );
             }
-        };
-        if let Some(outcome) = ended {
-            return self.end_goal(io, outcome);
+            if let Some(drawing) = feedback.drawing.take() {
+                self.drawing.vfo = Some(drawing);
+            }
+            if handback == Handback::Late {
+                warn_throttled!(
+                    self.throttle,
+                    "vfo-late",
+                    "a tick took longer than {:.0} ms (an optimisation): its command is dropped, the robot stops \
+                     meanwhile",
+                    v.slot.max_delay().as_secs_f64() * 1e3
+                );
+                *twist = BodyTwist::new(0.0, 0.0, 0.0);
+            }
         }
-        if handback == Handback::Late {
-            warn_throttled!(
-                self.throttle,
-                "vfo-late",
-                "a tick took longer than {:.0} ms (an optimisation): its command is dropped, the robot stops \
-                 meanwhile",
-                v.slot.max_delay().as_secs_f64() * 1e3
-            );
-        }
-        let changed = !o.events.is_empty();
-        let step: Step<bool, ()> = Step::Command {
-            twist: vfo_command(&o, handback),
-            feedback: changed,
-        };
-        self.apply(io, step, &chassis, |changed| *changed);
+        self.apply(io, step, &chassis, |f| !f.events.is_empty());
     }
 
     /// A scan: its obstacles go into the map (in odom, with the odometry pose at the scan's
@@ -1524,8 +1452,8 @@ impl Shell {
         }
         self.scan_seen.set((), m.header.stamp.clone());
         if let Some(Task::Vfo(v)) = self.session.active_mut().map(|a| &mut a.goal.task) {
-            let new = !update.new.is_empty() || v.obstacles_changed.unwrap_or(false);
-            v.obstacles_changed = Some(new);
+            let new = !update.new.is_empty() || v.map_changed.unwrap_or(false);
+            v.map_changed = Some(new);
         }
     }
 

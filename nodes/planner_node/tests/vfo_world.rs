@@ -8,11 +8,12 @@
 use mobil_chassis::ChassisParams;
 use mobil_geom::Pose2;
 use mobil_msgs::geometry_msgs::msg::PoseStamped;
+use mobil_planner::vfo::vfo_gains;
 use mobil_planner::vfo::{
     integrate_unicycle, ObstacleMap, OptimiseConfig, PoseHistory, VfoEnd, VfoEvent, VfoFollower, VfoGains,
 };
 use mobil_planner_node::route_from_poses;
-use mobil_planner_node::vfo::{vfo_gains, vfo_waypoints, VfoSettings};
+use mobil_planner_node::vfo::{vfo_waypoints, VfoSettings};
 use mobil_sim::lidar::{Lidar, LidarConfig};
 use mobil_world::World;
 use nalgebra::Point2;

@@ -10,6 +10,8 @@
 //!   segment, re-optimised on new obstacles; the last optimisation for display.
 //! - [`scan`]: obstacles from a laser scan (clusters → circles) merged over time in odom,
 //!   forgotten when seen through, when not seen for a while, and beyond a cap.
+//! - [`goal`]: [`VfoGoal`], the follower as a goal law (`mobil_motion::GoalLaw`), with the
+//!   reasons and codes of its ends and what the status and markers show of an optimisation.
 //! - [`history`]: a short history of odometry poses, to place each scan with the pose at its
 //!   stamp.
 //!
@@ -29,6 +31,7 @@
 
 pub mod controller;
 pub mod follower;
+pub mod goal;
 pub mod history;
 pub mod obstacles;
 pub mod optimise;
@@ -42,6 +45,10 @@ pub use controller::{
 pub use follower::{
     Reoptimised, VfoEnd, VfoEvent, VfoFollower, VfoOutput, MAX_BUDGET_RETRIES, MAX_SETTLE_S, REST_INTERVALS,
     REST_SPEED, REST_TURN_RATE,
+};
+pub use goal::{
+    vfo_gains, DrawnRobot, SegmentReport, VfoDrawing, VfoGoal, VfoStep, VfoTick, VfoView, MAX_DRAWN_OBSTACLES,
+    MAX_DRAWN_POINTS, MAX_DRAWN_ROBOTS,
 };
 pub use history::{Placement, PoseHistory};
 pub use obstacles::{potential, potential_derivative, Obstacle, Sigma};
