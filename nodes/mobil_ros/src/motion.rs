@@ -149,33 +149,6 @@ pub enum EndKind {
     Aborted,
 }
 
-/// The ends the session itself makes (a newer goal, refused input, shutdown); a node with its
-/// own vocabulary of ends converts them ([`MotionSession`]'s cause type `C`).
-#[derive(Debug, Clone, PartialEq)]
-pub enum SessionEnd {
-    /// A newer goal took its place (named by its source).
-    Preempted(&'static str),
-    /// The input was refused on this many steps in a row (the last reason).
-    Refused {
-        /// Steps refused in a row.
-        count: u32,
-        /// The last reason.
-        last: String,
-    },
-    /// The node shut down.
-    Shutdown,
-}
-
-impl From<SessionEnd> for EndCause {
-    fn from(e: SessionEnd) -> Self {
-        match e {
-            SessionEnd::Preempted(by) => EndCause::Preempted(by),
-            SessionEnd::Refused { count, last } => EndCause::Refused { count, last },
-            SessionEnd::Shutdown => EndCause::Shutdown,
-        }
-    }
-}
-
 impl From<Outcome> for EndCause {
     fn from(o: Outcome) -> Self {
         EndCause::Outcome(o)
@@ -223,7 +196,7 @@ impl EndCause {
 
 /// A goal that ended, handed back to the node to tell its client and its status.
 #[derive(Debug, Clone, PartialEq)]
-pub struct Ended<G, S, C = EndCause> {
+pub struct Ended<G, S> {
     /// Which goal.
     pub id: GoalId,
     /// The node's goal state as it ended.
@@ -231,7 +204,7 @@ pub struct Ended<G, S, C = EndCause> {
     /// Where it came from.
     pub source: S,
     /// Why it ended.
-    pub cause: C,
+    pub cause: EndCause,
     /// Its own time at the end (s since its first step).
     pub t: f64,
     /// Whether a zero command went out at this end.
@@ -272,13 +245,13 @@ impl<G, S> Active<G, S> {
 
 /// What [`MotionSession::apply`] did with a law's step.
 #[derive(Debug, Clone, PartialEq)]
-pub enum Applied<F, R, G, S, C = EndCause> {
+pub enum Applied<F, R, G, S> {
     /// The command went out; the law's feedback.
     Commanded(F),
     /// The input was refused; the robot stopped. `Some` when this refusal ended the goal.
-    Refused(Option<Ended<G, S, C>>),
+    Refused(Option<Ended<G, S>>),
     /// The law ended the goal; its report.
-    Ended(Ended<G, S, C>, R),
+    Ended(Ended<G, S>, R),
     /// No goal was active: nothing was sent.
     Idle,
 }
@@ -294,17 +267,14 @@ pub struct Watched {
     pub timeout: Duration,
 }
 
-/// One goal at a time, its time, its commands and its end (module docs). `C` is how the node
-/// names an end: [`EndCause`] by default, or a node's own type that the session's ends
-/// ([`SessionEnd`]) convert into.
+/// One goal at a time, its time, its commands and its end (module docs).
 #[derive(Debug, Clone)]
-pub struct MotionSession<G, S, C = EndCause> {
+pub struct MotionSession<G, S> {
     settings: SessionSettings,
     active: Option<Active<G, S>>,
     /// The last command sent moved the robot (not zero).
     moving: bool,
     next_id: u64,
-    cause: std::marker::PhantomData<C>,
 }
 
 fn is_zero(t: &Twist) -> bool {
@@ -320,7 +290,7 @@ fn is_zero(t: &Twist) -> bool {
     .all(|v| *v == 0.0)
 }
 
-impl<G, S, C: From<SessionEnd>> MotionSession<G, S, C> {
+impl<G, S> MotionSession<G, S> {
     /// A session with no goal.
     pub fn new(settings: SessionSettings) -> Self {
         MotionSession {
@@ -328,7 +298,6 @@ impl<G, S, C: From<SessionEnd>> MotionSession<G, S, C> {
             active: None,
             moving: false,
             next_id: 0,
-            cause: std::marker::PhantomData,
         }
     }
 
@@ -365,7 +334,7 @@ impl<G, S, C: From<SessionEnd>> MotionSession<G, S, C> {
     /// Makes `goal` the active goal at `now`; the goal it replaces, if any, ends `PREEMPTED`
     /// (named by the new goal's source) without a zero command: the new goal commands at its
     /// first step, or [`MotionSession::hold`]s.
-    pub fn start(&mut self, goal: G, source: S, now: Instant) -> (GoalId, Option<Ended<G, S, C>>)
+    pub fn start(&mut self, goal: G, source: S, now: Instant) -> (GoalId, Option<Ended<G, S>>)
     where
         S: Copy + Into<&'static str>,
     {
@@ -373,7 +342,7 @@ impl<G, S, C: From<SessionEnd>> MotionSession<G, S, C> {
             id: a.id,
             goal: a.goal,
             source: a.source,
-            cause: SessionEnd::Preempted(source.into()).into(),
+            cause: EndCause::Preempted(source.into()),
             t: a.t,
             zeroed: false,
         });
@@ -437,13 +406,13 @@ impl<G, S, C: From<SessionEnd>> MotionSession<G, S, C> {
     /// The active goal's input was refused (`why`): the robot stops (one zero command while it
     /// moves), and the goal ends `INVALID_INPUT` at the
     /// [`SessionSettings::max_refused_steps`]-th refusal in a row.
-    pub fn refuse(&mut self, why: String, sink: &mut impl CommandSink) -> Option<Ended<G, S, C>> {
+    pub fn refuse(&mut self, why: String, sink: &mut impl CommandSink) -> Option<Ended<G, S>> {
         let limit = self.settings.max_refused_steps;
         let active = self.active.as_mut()?;
         active.refused = active.refused.saturating_add(1);
         let count = active.refused;
         if count >= limit {
-            return self.end(SessionEnd::Refused { count, last: why }.into(), sink);
+            return self.end(EndCause::Refused { count, last: why }, sink);
         }
         self.hold(sink);
         None
@@ -451,7 +420,7 @@ impl<G, S, C: From<SessionEnd>> MotionSession<G, S, C> {
 
     /// Ends the active goal with `cause`: one zero command if the goal commanded the robot or
     /// the robot may still be moving, none otherwise. `None` without a goal.
-    pub fn end(&mut self, cause: C, sink: &mut impl CommandSink) -> Option<Ended<G, S, C>> {
+    pub fn end(&mut self, cause: EndCause, sink: &mut impl CommandSink) -> Option<Ended<G, S>> {
         let commanded = self.active.as_ref()?.commanded;
         let zeroed = commanded || self.moving;
         if zeroed {
@@ -470,7 +439,7 @@ impl<G, S, C: From<SessionEnd>> MotionSession<G, S, C> {
 
     /// Ends goal `id` with `cause` if it is still the active one (a cancel, a result computed
     /// off the loop); `None` if it already ended.
-    pub fn end_if_current(&mut self, id: GoalId, cause: C, sink: &mut impl CommandSink) -> Option<Ended<G, S, C>> {
+    pub fn end_if_current(&mut self, id: GoalId, cause: EndCause, sink: &mut impl CommandSink) -> Option<Ended<G, S>> {
         if self.is_current(id) {
             self.end(cause, sink)
         } else {
@@ -486,10 +455,7 @@ impl<G, S, C: From<SessionEnd>> MotionSession<G, S, C> {
         step: Step<F, R>,
         to_twist: impl FnOnce(BodyTwist) -> Twist,
         sink: &mut impl CommandSink,
-    ) -> Applied<F, R, G, S, C>
-    where
-        C: From<Outcome>,
-    {
+    ) -> Applied<F, R, G, S> {
         if self.active.is_none() {
             return Applied::Idle;
         }
@@ -499,7 +465,7 @@ impl<G, S, C: From<SessionEnd>> MotionSession<G, S, C> {
                 Applied::Commanded(feedback)
             }
             Step::Refused(why) => Applied::Refused(self.refuse(why, sink)),
-            Step::End(End { outcome, report }) => match self.end(outcome.into(), sink) {
+            Step::End(End { outcome, report }) => match self.end(EndCause::Outcome(outcome), sink) {
                 Some(ended) => Applied::Ended(ended, report),
                 None => Applied::Idle,
             },
@@ -524,7 +490,7 @@ impl<G, S, C: From<SessionEnd>> MotionSession<G, S, C> {
     /// the answer says whether the node's last word must be a zero command (waited for): the
     /// goal commanded the robot, or it may still be moving. An idle node sends none at exit,
     /// so it never cuts into another node commanding the robot.
-    pub fn shutdown(&mut self) -> (Option<Ended<G, S, C>>, bool) {
+    pub fn shutdown(&mut self) -> (Option<Ended<G, S>>, bool) {
         let Some(a) = self.active.take() else {
             return (None, false);
         };
@@ -535,7 +501,7 @@ impl<G, S, C: From<SessionEnd>> MotionSession<G, S, C> {
                 id: a.id,
                 goal: a.goal,
                 source: a.source,
-                cause: SessionEnd::Shutdown.into(),
+                cause: EndCause::Shutdown,
                 t: a.t,
                 zeroed: false,
             }),

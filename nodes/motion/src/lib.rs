@@ -192,6 +192,8 @@ pub trait GoalLaw {
 
 /// Nav2 Jazzy's error codes the suite's laws end with, by the action that serves them.
 pub mod nav2 {
+    /// No error, in every action's result.
+    pub const NONE: u16 = 0;
     /// `FollowPath`'s (the controller server's) codes, which Nav2's navigator passes on.
     pub mod follow_path {
         /// No error.

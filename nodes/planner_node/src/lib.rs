@@ -13,6 +13,7 @@ use mobil_chassis::model::ChassisConfig;
 use mobil_chassis::{clamp_command, BodyTwist, ChassisParams};
 use mobil_geom::downsample;
 use mobil_geom::Pose2;
+use mobil_motion::{nav2, Outcome};
 use mobil_msgs::builtin_interfaces::msg::Time;
 use mobil_msgs::geometry_msgs::msg::{Point, Pose, PoseStamped, Twist, Vector3};
 use mobil_msgs::mobil_msgs::msg::{NavStatus, RouteProblem as ProblemMsg};
@@ -30,7 +31,7 @@ use mobil_planner::{
 use mobil_ros::chassis::{chassis_params, declare_chassis};
 use mobil_ros::config::{Config, ConfigError, Decl};
 use mobil_ros::geometry::{yaw_of, yaw_quaternion};
-use mobil_ros::motion::SessionEnd;
+use mobil_ros::motion::{EndCause, EndKind};
 use mobil_world::World;
 use nalgebra::Point2;
 use std::time::Duration;
@@ -624,184 +625,148 @@ impl Mode {
     }
 }
 
-/// How a goal ended.
-#[derive(Debug, Clone, PartialEq)]
-pub enum Outcome {
-    /// The goal's law ended it ([`mobil_planner::goals`]): docked, undocked, a route driven to
-    /// its end, or the law's failure (TIME_LIMIT, NOT_CONVERGING, RESIDUAL, STALLED), with its
-    /// reason and Nav2 code; a route's missed waypoints are its goal's.
-    Law(mobil_motion::Outcome),
-    /// The route pre-check found problems (and `execute_infeasible_routes` is false).
-    RouteInfeasible(Vec<Missed>),
-    /// No valid odometry for `odom_timeout_s`.
-    Stale,
-    /// No valid scan for `vfo.scan_timeout_s` (a VFO route).
-    ScanStale,
-    /// The client canceled.
-    Canceled,
-    /// A newer goal took over.
-    Preempted(&'static str),
-    /// Refused.
-    Invalid(GoalError),
-    /// The library refused its input (the pose), on too many ticks in a row.
-    Refused(String),
-    /// The node shut down.
-    ShuttingDown,
+/// The action a goal came from, for Nav2's error codes of the ends the node itself makes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Action {
+    /// `dock_robot`, and the `dock_pose` topic (no result).
+    Dock,
+    /// `undock_robot`.
+    Undock,
+    /// `follow_waypoints`, and the `waypoints` topic (no result).
+    Follow,
 }
 
-impl From<SessionEnd> for Outcome {
-    fn from(e: SessionEnd) -> Self {
-        match e {
-            SessionEnd::Preempted(by) => Outcome::Preempted(by),
-            SessionEnd::Refused { last, .. } => Outcome::Refused(last),
-            SessionEnd::Shutdown => Outcome::ShuttingDown,
-        }
-    }
-}
-
-impl From<mobil_motion::Outcome> for Outcome {
-    fn from(o: mobil_motion::Outcome) -> Self {
-        Outcome::Law(o)
-    }
-}
-
-impl Outcome {
-    /// The reason code of the status.
-    pub fn code(&self) -> &'static str {
+impl Action {
+    /// A goal that lost control (stale or refused input): DockRobot's and UndockRobot's
+    /// FAILED_TO_CONTROL, FollowWaypoints' TASK_EXECUTOR_FAILED.
+    pub fn control_failure(self) -> u16 {
         match self {
-            Outcome::Law(mobil_motion::Outcome::Succeeded { .. }) => "SUCCEEDED",
-            Outcome::Law(mobil_motion::Outcome::Failed { code, .. }) => code,
-            Outcome::RouteInfeasible(_) => "ROUTE_INFEASIBLE",
-            Outcome::Stale | Outcome::ScanStale => "STALE_INPUT",
-            Outcome::Canceled => "CANCELED",
-            Outcome::Preempted(_) => "PREEMPTED",
-            Outcome::Invalid(_) => "INVALID_GOAL",
-            Outcome::Refused(_) => "INVALID_INPUT",
-            Outcome::ShuttingDown => "SHUTDOWN",
+            Action::Dock | Action::Undock => nav2::docking::FAILED_TO_CONTROL,
+            Action::Follow => nav2::follow_waypoints::TASK_EXECUTOR_FAILED,
         }
     }
 
-    /// The status reason: the code, a colon and the detail with the figures.
-    pub fn reason(&self) -> String {
-        let detail = match self {
-            Outcome::Law(o) => return o.reason(),
-            Outcome::RouteInfeasible(m) => format!("{} problem(s): {}", m.len(), list_missed(m)),
-            Outcome::Stale => "odom stale: robot stopped".to_owned(),
-            Outcome::ScanStale => "scan stale: the obstacles are unknown, robot stopped".to_owned(),
-            Outcome::Canceled => "canceled by the client".to_owned(),
-            Outcome::Preempted(by) => format!("preempted by a newer goal ({by})"),
-            Outcome::Invalid(e) => e.to_string(),
-            Outcome::Refused(e) => format!("the planner refused its input: {e}; robot stopped"),
-            Outcome::ShuttingDown => "the node is shutting down".to_owned(),
-        };
-        format!("{}: {detail}", self.code())
-    }
-
-    /// The NavStatus state it leaves.
-    pub fn state(&self) -> u8 {
+    /// Shutdown, or a request the action cannot take: UNKNOWN.
+    pub fn unknown(self) -> u16 {
         match self {
-            Outcome::Law(o) if o.is_success() => NavStatus::SUCCEEDED,
-            _ => NavStatus::FAILED,
-        }
-    }
-
-    /// Whether an action goal ending so succeeded (else canceled or aborted).
-    pub fn succeeded(&self) -> bool {
-        self.state() == NavStatus::SUCCEEDED
-    }
-
-    /// DockRobot's result: FAILED_TO_CONTROL for a docking that failed (V not falling, time
-    /// limit, residual), stale odometry or refused input; DOCK_NOT_IN_DB for `use_dock_id`;
-    /// DOCK_NOT_VALID for a bad pose; UNKNOWN at shutdown; NONE otherwise.
-    pub fn dock_result(&self) -> DockRobotResult {
-        let error_code = match self {
-            Outcome::Law(o) => o.nav2_error(),
-            Outcome::Stale | Outcome::ScanStale | Outcome::Refused(_) => DockRobotResult::FAILED_TO_CONTROL,
-            Outcome::Invalid(GoalError::NoDockDatabase) => DockRobotResult::DOCK_NOT_IN_DB,
-            Outcome::Invalid(_) => DockRobotResult::DOCK_NOT_VALID,
-            Outcome::ShuttingDown => DockRobotResult::UNKNOWN,
-            _ => DockRobotResult::NONE,
-        };
-        DockRobotResult {
-            success: self.succeeded(),
-            error_code,
-            num_retries: 0,
-            error_msg: self.reason(),
-        }
-    }
-
-    /// UndockRobot's result: FAILED_TO_CONTROL on a time-out, stale odometry or refused input;
-    /// UNKNOWN at shutdown; NONE otherwise.
-    pub fn undock_result(&self) -> UndockRobotResult {
-        let error_code = match self {
-            Outcome::Law(o) => o.nav2_error(),
-            Outcome::Stale | Outcome::ScanStale | Outcome::Refused(_) => UndockRobotResult::FAILED_TO_CONTROL,
-            Outcome::ShuttingDown => UndockRobotResult::UNKNOWN,
-            _ => UndockRobotResult::NONE,
-        };
-        UndockRobotResult {
-            success: self.succeeded(),
-            error_code,
-            error_msg: self.reason(),
-        }
-    }
-
-    /// FollowWaypoints' result: the missed waypoints (the run's, or the pre-check's for a
-    /// refused route; for an outcome that carries none, such as a cancel or a pre-emption,
-    /// `so_far`, those the run had missed until then), up to [`MAX_RESULT_MISSED`], each with
-    /// its pose and code; error_code NONE when the route was driven
-    /// to its end (Nav2 then lists what it missed), TASK_EXECUTOR_FAILED (601) for a route the
-    /// pre-check refused, a stall, stale odometry or refused input, UNKNOWN (600) for an
-    /// invalid goal or shutdown.
-    pub fn follow_result(&self, poses: &[PoseStamped], so_far: &[Missed]) -> FollowWaypointsResult {
-        let missed: &[Missed] = match self {
-            Outcome::RouteInfeasible(missed) => missed,
-            _ => so_far,
-        };
-        let error_code = match self {
-            Outcome::Law(o) => o.nav2_error(),
-            Outcome::Canceled | Outcome::Preempted(_) => FollowWaypointsResult::NONE,
-            Outcome::RouteInfeasible(_) | Outcome::Stale | Outcome::ScanStale | Outcome::Refused(_) => {
-                FollowWaypointsResult::TASK_EXECUTOR_FAILED
-            }
-            _ => FollowWaypointsResult::UNKNOWN,
-        };
-        FollowWaypointsResult {
-            missed_waypoints: missed
-                .iter()
-                .map(|m| (m.index, m.error_code()))
-                .take(MAX_RESULT_MISSED)
-                .map(|(index, error_code)| MissedWaypoint {
-                    index: u32::try_from(index).unwrap_or(u32::MAX),
-                    goal: poses.get(index).cloned().unwrap_or_default(),
-                    error_code,
-                })
-                .collect(),
-            error_code,
-            error_msg: self.reason(),
+            Action::Dock | Action::Undock => nav2::docking::UNKNOWN,
+            Action::Follow => nav2::follow_waypoints::UNKNOWN,
         }
     }
 }
 
-impl Outcome {
-    /// FollowWaypoints' result for a VFO route: as [`Outcome::follow_result`], and every early
-    /// end (the law's NO_SAFE_PATH, OPTIMISATION_BUDGET or COLLISION, stale input, a refusal,
-    /// a cancel, a pre-emption, shutdown) lists the waypoints not reached, `unreached` (request
-    /// indices, from the one pursued on), as given up by the run.
-    pub fn vfo_follow_result(&self, poses: &[PoseStamped], unreached: &[usize]) -> FollowWaypointsResult {
-        let mut r = self.follow_result(poses, &[]);
-        if !self.succeeded() {
-            r.missed_waypoints = unreached
-                .iter()
-                .take(MAX_RESULT_MISSED)
-                .map(|&index| MissedWaypoint {
-                    index: u32::try_from(index).unwrap_or(u32::MAX),
-                    goal: poses.get(index).cloned().unwrap_or_default(),
-                    error_code: MISSED_BY_THE_RUN,
-                })
-                .collect();
-        }
-        r
+/// Nav2's error code of a goal from `action` ending with `cause`: the law's own, none for a
+/// cancel or a pre-emption, [`Action::control_failure`] for stale or refused input,
+/// [`Action::unknown`] at shutdown.
+pub fn error_code(cause: &EndCause, action: Action) -> u16 {
+    match cause {
+        EndCause::Outcome(o) => o.nav2_error(),
+        EndCause::Canceled | EndCause::Preempted(_) => nav2::NONE,
+        EndCause::Refused { .. } | EndCause::Stale(_) => action.control_failure(),
+        EndCause::Shutdown => action.unknown(),
+    }
+}
+
+/// An invalid goal, refused before it starts: `INVALID_GOAL` with DockRobot's DOCK_NOT_IN_DB
+/// (a dock by id) or DOCK_NOT_VALID, or the action's UNKNOWN.
+pub fn invalid_goal(e: &GoalError, action: Action) -> Outcome {
+    let code = match (action, e) {
+        (Action::Dock, GoalError::NoDockDatabase) => nav2::docking::DOCK_NOT_IN_DB,
+        (Action::Dock, _) => nav2::docking::DOCK_NOT_VALID,
+        (Action::Undock | Action::Follow, _) => action.unknown(),
+    };
+    Outcome::failed("INVALID_GOAL", e.to_string(), code)
+}
+
+/// A goal the planner cannot start (its parameters or the law refuse it): `INVALID_INPUT`.
+pub fn refused_goal(e: impl std::fmt::Display, action: Action) -> Outcome {
+    Outcome::failed(
+        "INVALID_INPUT",
+        format!("the planner refused its input: {e}; robot stopped"),
+        action.control_failure(),
+    )
+}
+
+/// A goal that needs an input it has not got fresh (`odom`, `scan`): `STALE_INPUT`.
+pub fn stale_at_start(input: &str, action: Action) -> Outcome {
+    Outcome::failed(
+        "STALE_INPUT",
+        format!("{input} stale: robot stopped"),
+        action.control_failure(),
+    )
+}
+
+/// The route pre-check found `problems` (and `execute_infeasible_routes` is false):
+/// `ROUTE_INFEASIBLE`, every problem listed (up to [`MAX_LISTED_PROBLEMS`]).
+pub fn route_infeasible(problems: &[Missed]) -> Outcome {
+    Outcome::failed(
+        "ROUTE_INFEASIBLE",
+        format!("{} problem(s): {}", problems.len(), list_missed(problems)),
+        nav2::follow_waypoints::TASK_EXECUTOR_FAILED,
+    )
+}
+
+/// The NavStatus state an end leaves.
+pub fn end_state(cause: &EndCause) -> u8 {
+    match cause.kind() {
+        EndKind::Succeeded => NavStatus::SUCCEEDED,
+        EndKind::Canceled | EndKind::Aborted => NavStatus::FAILED,
+    }
+}
+
+/// DockRobot's result of `cause`.
+pub fn dock_result(cause: &EndCause) -> DockRobotResult {
+    DockRobotResult {
+        success: cause.kind() == EndKind::Succeeded,
+        error_code: error_code(cause, Action::Dock),
+        num_retries: 0,
+        error_msg: cause.reason(),
+    }
+}
+
+/// UndockRobot's result of `cause`.
+pub fn undock_result(cause: &EndCause) -> UndockRobotResult {
+    UndockRobotResult {
+        success: cause.kind() == EndKind::Succeeded,
+        error_code: error_code(cause, Action::Undock),
+        error_msg: cause.reason(),
+    }
+}
+
+/// FollowWaypoints' result of `cause`: the waypoints `missed` (the run's, or the pre-check's
+/// problems for a route it refused), up to [`MAX_RESULT_MISSED`], each with its pose from
+/// `poses` and its code; Nav2 lists them on success too.
+pub fn follow_result(cause: &EndCause, poses: &[PoseStamped], missed: &[Missed]) -> FollowWaypointsResult {
+    FollowWaypointsResult {
+        missed_waypoints: missed
+            .iter()
+            .take(MAX_RESULT_MISSED)
+            .map(|m| missed_waypoint(m.index, m.error_code(), poses))
+            .collect(),
+        error_code: error_code(cause, Action::Follow),
+        error_msg: cause.reason(),
+    }
+}
+
+/// FollowWaypoints' result for a VFO route: every end but success lists the waypoints not
+/// reached, `unreached` (request indices, from the one pursued on), as given up by the run.
+pub fn vfo_follow_result(cause: &EndCause, poses: &[PoseStamped], unreached: &[usize]) -> FollowWaypointsResult {
+    let mut r = follow_result(cause, poses, &[]);
+    if cause.kind() != EndKind::Succeeded {
+        r.missed_waypoints = unreached
+            .iter()
+            .take(MAX_RESULT_MISSED)
+            .map(|&i| missed_waypoint(i, MISSED_BY_THE_RUN, poses))
+            .collect();
+    }
+    r
+}
+
+fn missed_waypoint(index: usize, error_code: u16, poses: &[PoseStamped]) -> MissedWaypoint {
+    MissedWaypoint {
+        index: u32::try_from(index).unwrap_or(u32::MAX),
+        goal: poses.get(index).cloned().unwrap_or_default(),
+        error_code,
     }
 }
 
@@ -869,7 +834,7 @@ pub fn check_reply(report: &RouteReport, route: &Route, stamp: Time, frame: &str
         reason: if feasible {
             String::new()
         } else {
-            Outcome::RouteInfeasible(missed.clone()).reason()
+            route_infeasible(&missed).reason()
         },
         failed_waypoint: missed
             .first()
@@ -1365,48 +1330,74 @@ mod tests {
     }
 
     #[test]
-    fn outcomes_give_status_reasons_and_nav2_codes() {
+    fn ends_give_status_reasons_and_nav2_codes() {
         use mobil_planner::goals::{docking_failure, route_done};
         use mobil_planner::{DockingFailure, Finish, Residual};
         // A law's end passes through: its reason, its state, its Nav2 code in every result.
         let residual = Residual { e: 0.015, heading: 0.5 };
-        let law = docking_failure(DockingFailure::HeadingResidual, residual, Finish::RotateInPlace);
-        let o = Outcome::from(law);
-        assert_eq!(o.state(), NavStatus::FAILED);
-        assert_eq!(o.code(), "RESIDUAL");
-        assert!(o.reason().starts_with("RESIDUAL: "), "{}", o.reason());
-        assert!(o.reason().contains("e = 0.015 m"));
-        assert!(o.reason().contains("0.500 rad (28.6°)"));
-        let r = o.dock_result();
-        assert_eq!((r.success, r.error_code), (false, 905));
-        assert!(!o.succeeded());
-        let o = Outcome::Invalid(GoalError::NoDockDatabase);
-        assert_eq!((o.code(), o.dock_result().error_code), ("INVALID_GOAL", 901));
-        let o = Outcome::Invalid(GoalError::NotFinite {
-            what: "dock pose".into(),
-        });
-        assert_eq!(o.dock_result().error_code, 902);
-        assert_eq!(o.reason(), "INVALID_GOAL: dock pose is not finite");
-        let o = Outcome::Law(mobil_motion::Outcome::succeeded(
-            "docked: e = 0.010 m, heading error 0.020 rad",
+        let law = EndCause::Outcome(docking_failure(
+            DockingFailure::HeadingResidual,
+            residual,
+            Finish::RotateInPlace,
         ));
-        assert_eq!(o.reason(), "SUCCEEDED: docked: e = 0.010 m, heading error 0.020 rad");
-        let r = o.dock_result();
-        assert_eq!((r.success, r.error_code, o.state()), (true, 0, NavStatus::SUCCEEDED));
-        assert_eq!(Outcome::Stale.dock_result().error_code, 905);
-        assert_eq!(Outcome::Stale.reason(), "STALE_INPUT: odom stale: robot stopped");
-        assert_eq!(Outcome::Canceled.dock_result().error_code, 0);
-        let o = Outcome::Law(mobil_motion::Outcome::failed("TIME_LIMIT", "not undocked", 905));
-        assert_eq!((o.code(), o.undock_result().error_code), ("TIME_LIMIT", 905));
-        assert!(!o.undock_result().success);
-        assert!(
-            Outcome::Law(mobil_motion::Outcome::succeeded("undocked"))
-                .undock_result()
-                .success
+        assert_eq!((end_state(&law), law.code()), (NavStatus::FAILED, "RESIDUAL"));
+        assert!(law.reason().contains("e = 0.015 m") && law.reason().contains("0.500 rad (28.6°)"));
+        let r = dock_result(&law);
+        assert_eq!((r.success, r.error_code), (false, 905));
+        assert_eq!(r.error_msg, law.reason());
+        let docked = EndCause::Outcome(Outcome::succeeded("docked: e = 0.010 m, heading error 0.020 rad"));
+        let r = dock_result(&docked);
+        assert_eq!(
+            (r.success, r.error_code, end_state(&docked)),
+            (true, 0, NavStatus::SUCCEEDED)
         );
-        // A route that stalled: FollowWaypoints' TASK_EXECUTOR_FAILED, as the law gives it.
-        let o = Outcome::Law(mobil_motion::Outcome::failed("STALLED", "did not move", 601));
-        assert_eq!((o.code(), o.follow_result(&[], &[]).error_code), ("STALLED", 601));
+        assert_eq!(r.error_msg, "SUCCEEDED: docked: e = 0.010 m, heading error 0.020 rad");
+        // The ends the session makes, by action: stale or refused input is a loss of control
+        // (DockRobot/UndockRobot 905, FollowWaypoints 601), a shutdown UNKNOWN (999, 600), a cancel
+        // or a pre-emption no error.
+        let stale = EndCause::Stale("odom".into());
+        assert_eq!(stale.reason(), "STALE_INPUT: odom stale: robot stopped");
+        let refused = EndCause::Refused {
+            count: 20,
+            last: "pose is not finite".into(),
+        };
+        for (cause, codes) in [
+            (&stale, [905, 905, 601]),
+            (&refused, [905, 905, 601]),
+            (&EndCause::Shutdown, [999, 999, 600]),
+            (&EndCause::Canceled, [0, 0, 0]),
+            (&EndCause::Preempted("dock_pose"), [0, 0, 0]),
+        ] {
+            let got = [Action::Dock, Action::Undock, Action::Follow].map(|a| error_code(cause, a));
+            assert_eq!(got, codes, "{cause:?}");
+            assert_eq!(end_state(cause), NavStatus::FAILED);
+        }
+        assert_eq!(undock_result(&stale).error_code, 905);
+        assert!(undock_result(&EndCause::Outcome(Outcome::succeeded("undocked"))).success);
+        // Refusals before a goal starts, by action.
+        let e = GoalError::NoDockDatabase;
+        assert_eq!(invalid_goal(&e, Action::Dock).nav2_error(), 901);
+        let nan = GoalError::NotFinite {
+            what: "dock pose".into(),
+        };
+        assert_eq!(invalid_goal(&nan, Action::Dock).nav2_error(), 902);
+        assert_eq!(invalid_goal(&nan, Action::Follow).nav2_error(), 600);
+        assert_eq!(
+            invalid_goal(&nan, Action::Dock).reason(),
+            "INVALID_GOAL: dock pose is not finite"
+        );
+        let r = refused_goal("gamma 0 is not positive", Action::Follow);
+        assert_eq!(
+            (r.reason().as_str(), r.nav2_error()),
+            (
+                "INVALID_INPUT: the planner refused its input: gamma 0 is not positive; robot stopped",
+                601
+            )
+        );
+        assert_eq!(
+            stale_at_start("scan", Action::Dock).reason(),
+            "STALE_INPUT: scan stale: robot stopped"
+        );
         // A refused route lists every problem, each with the request's index and its pose.
         let poses = vec![stamped("odom", 2.0, 0.0), stamped("odom", 2.0, 0.3)];
         let missed = vec![Missed {
@@ -1418,56 +1409,41 @@ mod tests {
             },
             pre_check: true,
         }];
-        let o = Outcome::RouteInfeasible(missed.clone());
+        let infeasible = EndCause::Outcome(route_infeasible(&missed));
         assert_eq!(
-            o.reason(),
+            infeasible.reason(),
             "ROUTE_INFEASIBLE: 1 problem(s): waypoint 1: turn_radius: turn radius 0.20 m below the chassis minimum 0.73 m"
         );
-        let r = o.follow_result(&poses, &[]);
+        let r = follow_result(&infeasible, &poses, &missed);
         assert_eq!(r.error_code, 601);
-        assert_eq!(r.missed_waypoints.len(), 1);
-        assert_eq!(
-            (r.missed_waypoints[0].index, r.missed_waypoints[0].error_code),
-            (1, 208)
-        );
+        let listed: Vec<(u32, u16)> = r.missed_waypoints.iter().map(|m| (m.index, m.error_code)).collect();
+        assert_eq!(listed, vec![(1, 208)]);
         assert_eq!(r.missed_waypoints[0].goal.pose.position.y, 0.3);
+        // A route done lists what the run missed (FollowPath's 105), with no error.
         let ran = Missed {
             pre_check: false,
             ..missed[0].clone()
         };
-        let o = Outcome::Law(mobil_motion::Outcome::succeeded(route_done(
-            2,
-            std::slice::from_ref(&ran),
-        )));
-        assert_eq!(o.state(), NavStatus::SUCCEEDED);
-        let r = o.follow_result(&poses, &[ran]);
+        let done = EndCause::Outcome(Outcome::succeeded(route_done(2, std::slice::from_ref(&ran))));
+        assert_eq!(end_state(&done), NavStatus::SUCCEEDED);
+        assert!(done
+            .reason()
+            .starts_with("SUCCEEDED: route done: 1 of 2 waypoints missed"));
+        let r = follow_result(&done, &poses, std::slice::from_ref(&ran));
         assert_eq!((r.error_code, r.missed_waypoints[0].error_code), (0, 105));
-        // A cancel or a pre-emption lists what the run had missed until then.
-        let so_far = [Missed {
-            pre_check: false,
-            ..missed[0].clone()
-        }];
-        for o in [Outcome::Canceled, Outcome::Preempted("dock_pose")] {
-            let r = o.follow_result(&poses, &so_far);
-            let codes: Vec<(u32, u16)> = r.missed_waypoints.iter().map(|m| (m.index, m.error_code)).collect();
-            assert_eq!((r.error_code, codes), (0, vec![(1, 105)]));
-        }
         // More missed than the 50 a reason lists: every one is in the result (60 here).
         let many: Vec<Missed> = (0..60)
             .map(|i| Missed {
                 index: i,
-                pre_check: false,
-                ..missed[0].clone()
+                ..ran.clone()
             })
             .collect();
-        let r = Outcome::Law(mobil_motion::Outcome::succeeded(route_done(60, &many))).follow_result(&poses, &many);
+        let r = follow_result(&done, &poses, &many);
         assert_eq!(r.missed_waypoints.len(), 60);
         assert_eq!(r.missed_waypoints[59].index, 59);
-        assert!(o.reason().starts_with("SUCCEEDED: route done: 1 of 2 waypoints missed"));
-        assert_eq!(
-            Outcome::Preempted("dock_pose").reason(),
-            "PREEMPTED: preempted by a newer goal (dock_pose)"
-        );
+        // A stalled route: the law's TASK_EXECUTOR_FAILED.
+        let stalled = EndCause::Outcome(Outcome::failed("STALLED", "did not move", 601));
+        assert_eq!(follow_result(&stalled, &[], &[]).error_code, 601);
     }
 
     #[test]

@@ -55,15 +55,16 @@ use mobil_planner::{
 };
 use mobil_planner_node::vfo::{vfo_waypoints, WaypointMethod};
 use mobil_planner_node::{
-    check_reply, clamp_twist, dock_goal, docking_offset, load_world, markers, missed_from_report, pose_in_odom,
-    refused_reply, route_from_path, route_from_poses, status_message, GoalError, MarkerView, Missed, Mode, Outcome,
-    PlannerConfig, Route, StatusView,
+    check_reply, clamp_twist, dock_goal, dock_result, docking_offset, end_state, follow_result, invalid_goal,
+    load_world, markers, missed_from_report, pose_in_odom, refused_goal, refused_reply, route_from_path,
+    route_from_poses, route_infeasible, stale_at_start, status_message, undock_result, vfo_follow_result, Action,
+    GoalError, MarkerView, Missed, Mode, PlannerConfig, Route, StatusView,
 };
 use mobil_ros::action::{ActionEvent, GoalEnd, GoalRequest, GoalServer, GoalServerConfig};
 use mobil_ros::geometry::odom_pose;
 use mobil_ros::input::Inputs;
 use mobil_ros::latest::Latest;
-use mobil_ros::motion::{Applied, CmdVel, Ended, GoalId, MotionSession, SessionSettings, Watched};
+use mobil_ros::motion::{Applied, CmdVel, EndCause, EndKind, Ended, GoalId, MotionSession, SessionSettings, Watched};
 use mobil_ros::offloop::CancelToken;
 use mobil_ros::scan::{scan_from_msg, scan_laser_pose, tf_static_subscription, StaticFrames};
 use mobil_ros::stop::{final_stop, FINAL_STOP_WAIT};
@@ -128,6 +129,14 @@ impl Source {
     fn is_action(self) -> bool {
         matches!(self, Source::DockAction | Source::UndockAction | Source::FollowAction)
     }
+
+    fn action(self) -> Action {
+        match self {
+            Source::DockPose | Source::DockAction => Action::Dock,
+            Source::UndockAction => Action::Undock,
+            Source::Waypoints | Source::FollowAction => Action::Follow,
+        }
+    }
 }
 
 /// A VFO route: the law at home or out on a step ([`LawSlot`]), and what the status shows of it
@@ -152,6 +161,8 @@ enum Task {
     PreCheck {
         route: Route,
         start: Pose2,
+        /// The problems it found, kept for the result of a route it refuses.
+        problems: Vec<Missed>,
     },
     Dock(DockGoal),
     Follow {
@@ -200,8 +211,8 @@ impl Goal {
     }
 }
 
-type Session = MotionSession<Goal, Source, Outcome>;
-type PlannerEnded = Ended<Goal, Source, Outcome>;
+type Session = MotionSession<Goal, Source>;
+type PlannerEnded = Ended<Goal, Source>;
 
 struct Outputs {
     cmd: Publisher<Twist>,
@@ -420,12 +431,12 @@ async fn start(node: &mut RosNode, out: &Outputs, config: PlannerConfig) -> anyh
     if final_zero {
         final_stop(&out.cmd, Twist::default(), FINAL_STOP_WAIT).await;
     }
-    let down = Outcome::ShuttingDown;
+    let down = EndCause::Shutdown;
     let Servers { dock, undock, follow } = servers;
     tokio::join!(
-        dock.close(down.dock_result()),
-        undock.close(down.undock_result()),
-        follow.close(down.follow_result(&[], &[])),
+        dock.close(dock_result(&down)),
+        undock.close(undock_result(&down)),
+        follow.close(follow_result(&down, &[], &[])),
     );
     Ok(outcome)
 }
@@ -543,24 +554,23 @@ fn respond(
     }
 }
 
-fn goal_end(outcome: &Outcome) -> GoalEnd {
-    if outcome.succeeded() {
-        GoalEnd::Succeeded
-    } else if *outcome == Outcome::Canceled {
-        GoalEnd::Canceled
-    } else {
-        GoalEnd::Aborted
+fn goal_end(cause: &EndCause) -> GoalEnd {
+    match cause.kind() {
+        EndKind::Succeeded => GoalEnd::Succeeded,
+        EndKind::Canceled => GoalEnd::Canceled,
+        EndKind::Aborted => GoalEnd::Aborted,
     }
 }
 
-/// FollowWaypoints' result for a route goal ending with `outcome`: the waypoints missed so far
-/// (a VFO route: those not reached), the request's poses.
-fn follow_answer(task: &Task, outcome: &Outcome) -> FollowWaypointsResult {
+/// FollowWaypoints' result for a route goal ending with `cause`: the waypoints missed so far
+/// (the pre-check's problems for a route it refused; a VFO route: those not reached), the
+/// request's poses.
+fn follow_answer(task: &Task, cause: &EndCause) -> FollowWaypointsResult {
     match task {
-        Task::Follow { goal, route } => outcome.follow_result(&route.poses, goal.missed()),
-        Task::Vfo(v) => outcome.vfo_follow_result(&v.route.poses, &v.route.unreached_from(v.view.index)),
-        Task::PreCheck { route, .. } => outcome.follow_result(&route.poses, &[]),
-        Task::Dock(_) | Task::Undock(_) => outcome.follow_result(&[], &[]),
+        Task::Follow { goal, route } => follow_result(cause, &route.poses, goal.missed()),
+        Task::Vfo(v) => vfo_follow_result(cause, &v.route.poses, &v.route.unreached_from(v.view.index)),
+        Task::PreCheck { route, problems, .. } => follow_result(cause, &route.poses, problems),
+        Task::Dock(_) | Task::Undock(_) => follow_result(cause, &[], &[]),
     }
 }
 
@@ -682,8 +692,8 @@ impl Shell {
 
     /// Ends the active goal with `outcome` (the session sends its zero command, if one is due)
     /// and reports it.
-    fn end_goal(&mut self, io: &mut Io<'_, '_>, outcome: Outcome) {
-        if let Some(ended) = self.session.end(outcome, io.sink) {
+    fn end_goal(&mut self, io: &mut Io<'_, '_>, cause: EndCause) {
+        if let Some(ended) = self.session.end(cause, io.sink) {
             self.report(io, ended, true);
         }
     }
@@ -702,10 +712,10 @@ impl Shell {
             let end = goal_end(&cause);
             match source {
                 Source::DockAction => {
-                    io.servers.dock.finish(end, cause.dock_result());
+                    io.servers.dock.finish(end, dock_result(&cause));
                 }
                 Source::UndockAction => {
-                    io.servers.undock.finish(end, cause.undock_result());
+                    io.servers.undock.finish(end, undock_result(&cause));
                 }
                 Source::FollowAction => {
                     io.servers.follow.finish(end, follow_answer(&goal.task, &cause));
@@ -714,12 +724,13 @@ impl Shell {
             }
         }
         let reason = cause.reason();
-        match cause {
-            Outcome::Law(ref o) if o.is_success() => info!("goal ({}) ends: {reason}", source.name()),
-            Outcome::Canceled | Outcome::Preempted(_) => info!("goal ({}) ends: {reason}", source.name()),
+        match (cause.kind(), &cause) {
+            (EndKind::Succeeded | EndKind::Canceled, _) | (_, EndCause::Preempted(_)) => {
+                info!("goal ({}) ends: {reason}", source.name())
+            }
             _ => warn!("goal ({}) ends: {reason}", source.name()),
         }
-        let view = self.status_view(Some(&goal), cause.state(), reason);
+        let view = self.status_view(Some(&goal), end_state(&cause), reason);
         self.send_status(io.node, io.out, &view);
         if self.session.active().is_none() && std::mem::take(&mut self.map_rebuild) {
             match ObstacleMap::new(self.config.vfo.scan_config(self.config.robot_radius)) {
@@ -752,40 +763,37 @@ impl Shell {
     /// A goal from `source` refused before it started: the goal it was to replace ends
     /// PREEMPTED (the robot stops with it); an action goal (accepted already) gets its result;
     /// the status is FAILED with the reason.
-    fn refuse(&mut self, io: &mut Io<'_, '_>, source: Source, outcome: Outcome) {
-        if let Some(old) = self.session.end(Outcome::Preempted(source.name()), io.sink) {
+    fn refuse(&mut self, io: &mut Io<'_, '_>, source: Source, refusal: mobil_motion::Outcome) {
+        if let Some(old) = self.session.end(EndCause::Preempted(source.name()), io.sink) {
             let by_server = source.is_action() && old.source == source;
             self.report(io, old, !by_server);
         }
-        warn!("goal ({}) refused: {}", source.name(), outcome.reason());
+        let cause = EndCause::Outcome(refusal);
+        warn!("goal ({}) refused: {}", source.name(), cause.reason());
         match source {
             Source::DockAction => {
-                io.servers.dock.finish(GoalEnd::Aborted, outcome.dock_result());
+                io.servers.dock.finish(GoalEnd::Aborted, dock_result(&cause));
             }
             Source::UndockAction => {
-                io.servers.undock.finish(GoalEnd::Aborted, outcome.undock_result());
+                io.servers.undock.finish(GoalEnd::Aborted, undock_result(&cause));
             }
             Source::FollowAction => {
-                let poses = match &outcome {
-                    Outcome::RouteInfeasible(_) => io.servers.follow.active_goal().map(|g| g.poses.clone()),
-                    _ => None,
-                };
-                io.servers.follow.finish(
-                    GoalEnd::Aborted,
-                    outcome.follow_result(poses.as_deref().unwrap_or(&[]), &[]),
-                );
+                io.servers
+                    .follow
+                    .finish(GoalEnd::Aborted, follow_result(&cause, &[], &[]));
             }
             Source::DockPose | Source::Waypoints => {}
         }
-        let view = self.status_view(None, NavStatus::FAILED, outcome.reason());
+        let view = self.status_view(None, NavStatus::FAILED, cause.reason());
         self.send_status(io.node, io.out, &view);
     }
 
     /// Starts a docking onto `target` (or refuses it).
     fn start_dock(&mut self, io: &mut Io<'_, '_>, target: Result<Pose2, GoalError>, source: Source) {
         let offset = docking_offset(&self.chassis);
-        let built = target.map_err(Outcome::Invalid).and_then(|goal| {
-            let gains = self.config.gains().map_err(|e| Outcome::Refused(e.to_string()))?;
+        let action = source.action();
+        let built = target.map_err(|e| invalid_goal(&e, action)).and_then(|goal| {
+            let gains = self.config.gains().map_err(|e| refused_goal(e, action))?;
             DockingController::new(
                 gains,
                 self.config.docking,
@@ -793,7 +801,7 @@ impl Shell {
                 Finish::for_chassis(&self.chassis),
                 goal.ahead(-offset),
             )
-            .map_err(|e| Outcome::Refused(e.to_string()))
+            .map_err(|e| refused_goal(e, action))
         });
         let dock = match built {
             Ok(controller) => DockGoal::new(controller, offset),
@@ -834,7 +842,7 @@ impl Shell {
     ) {
         let route = match route {
             Ok(r) => r,
-            Err(e) => return self.refuse(io, source, Outcome::Invalid(e)),
+            Err(e) => return self.refuse(io, source, invalid_goal(&e, source.action())),
         };
         if self.config.waypoint_method == WaypointMethod::Vfo {
             return self.start_vfo(io, route, start, source);
@@ -847,7 +855,7 @@ impl Shell {
             );
         }
         let Some(start) = start else {
-            return self.refuse(io, source, Outcome::Stale);
+            return self.refuse(io, source, stale_at_start("odom", source.action()));
         };
         let (points, world, chassis, config) = (
             route.points.clone(),
@@ -860,7 +868,8 @@ impl Shell {
             source.name(),
             route.points.len()
         );
-        let id = self.begin(io, Task::PreCheck { route, start }, source);
+        let problems = Vec::new();
+        let id = self.begin(io, Task::PreCheck { route, start, problems }, source);
         // The robot waits for the pre-check.
         self.session.hold(io.sink);
         jobs.goal.start(move |cancel| PreCheckDone {
@@ -874,21 +883,21 @@ impl Shell {
     /// Starts VFO waypoint following of `route` from `start` (or refuses it).
     fn start_vfo(&mut self, io: &mut Io<'_, '_>, route: Route, start: Option<Pose2>, source: Source) {
         let Some(start) = start else {
-            return self.refuse(io, source, Outcome::Stale);
+            return self.refuse(io, source, stale_at_start("odom", source.action()));
         };
         // Without a fresh scan the obstacles are unknown: the first tick would optimise the
         // segment through a map with nothing in it.
         if self.scan_seen.get(self.config.vfo.scan_timeout()).is_none() {
-            return self.refuse(io, source, Outcome::ScanStale);
+            return self.refuse(io, source, stale_at_start("scan", source.action()));
         }
         let offset = docking_offset(&self.chassis);
         let settings = &self.config.vfo;
         let gains = vfo_gains(&settings.gains, &self.chassis);
         let built = vfo_waypoints(&route, &start.ahead(-offset), settings.guiding)
-            .map_err(Outcome::Invalid)
+            .map_err(|e| invalid_goal(&e, Action::Follow))
             .and_then(|waypoints| {
                 VfoFollower::new(gains, settings.optimise, waypoints, self.map.obstacles())
-                    .map_err(|e| Outcome::Refused(e.to_string()))
+                    .map_err(|e| refused_goal(e, Action::Follow))
             });
         let follower = match built {
             Ok(f) => f,
@@ -940,7 +949,7 @@ impl Shell {
         }
         let Some(active) = self.session.active() else { return };
         let source = active.source;
-        let Task::PreCheck { route, start } = &active.goal.task else {
+        let Task::PreCheck { route, start, .. } = &active.goal.task else {
             return;
         };
         let (route, start, chassis, follow, execute_infeasible) = (
@@ -952,7 +961,7 @@ impl Shell {
         );
         let report = match done.report {
             Ok(r) => r,
-            Err(e) => return self.end_goal(io, Outcome::Refused(e)),
+            Err(e) => return self.end_goal(io, refused_goal(e, Action::Follow).into()),
         };
         let problems = missed_from_report(&report.problems, &route);
         self.drawing = Drawing {
@@ -963,19 +972,23 @@ impl Shell {
             vfo: None,
         };
         if !problems.is_empty() {
-            let outcome = Outcome::RouteInfeasible(problems.clone());
+            let infeasible = route_infeasible(&problems);
             if !execute_infeasible {
-                return self.end_goal(io, outcome);
+                if let Some(Task::PreCheck { problems: kept, .. }) = self.session.active_mut().map(|a| &mut a.goal.task)
+                {
+                    kept.clone_from(&problems);
+                }
+                return self.end_goal(io, infeasible.into());
             }
             warn!(
                 "goal ({}): driven although execute_infeasible_routes: {}",
                 source.name(),
-                outcome.reason()
+                infeasible.reason()
             );
         }
         let follower = match WaypointFollower::new(follow, &chassis, route.points.clone()) {
             Ok(f) => f,
-            Err(e) => return self.end_goal(io, Outcome::Refused(e.to_string())),
+            Err(e) => return self.end_goal(io, refused_goal(e, Action::Follow).into()),
         };
         info!(
             "goal ({}): {} waypoints, pre-check {} ({:.2} m predicted)",
@@ -1017,7 +1030,7 @@ impl Shell {
                 }
             );
         }
-        let preempted = Outcome::Preempted("dock_robot").dock_result();
+        let preempted = dock_result(&EndCause::Preempted("dock_robot"));
         let accept = io.servers.dock.accept(request, |_| preempted).await;
         if self.accepted(io, accept, Source::DockAction) {
             self.start_dock(io, target, Source::DockAction);
@@ -1036,7 +1049,7 @@ impl Shell {
         warn_throttled!(self.throttle, "accept", "{} goal not started: {e}", source.name());
         let ours = self.session.active().is_some_and(|a| a.source == source);
         if let Some(ended) = ours
-            .then(|| self.session.end(Outcome::Preempted(source.name()), io.sink))
+            .then(|| self.session.end(EndCause::Preempted(source.name()), io.sink))
             .flatten()
         {
             self.report(io, ended, false);
@@ -1052,7 +1065,7 @@ impl Shell {
             warn!("undock_robot: max_undocking_time {limit} is not a positive time: 30 s (its default) taken");
             30.0
         };
-        let preempted = Outcome::Preempted("undock_robot").undock_result();
+        let preempted = undock_result(&EndCause::Preempted("undock_robot"));
         let accept = io.servers.undock.accept(request, |_| preempted).await;
         if !self.accepted(io, accept, Source::UndockAction) {
             return;
@@ -1081,10 +1094,10 @@ impl Shell {
             MIN_ROUTE_LENGTH,
         );
         // A follow_waypoints goal pre-empted by this one lists what it had missed.
-        let by = Outcome::Preempted("follow_waypoints");
+        let by = EndCause::Preempted("follow_waypoints");
         let preempted = match self.session.active() {
             Some(a) if a.source == Source::FollowAction => follow_answer(&a.goal.task, &by),
-            _ => by.follow_result(&[], &[]),
+            _ => follow_result(&by, &[], &[]),
         };
         let accept = io.servers.follow.accept(request, |_| preempted).await;
         if self.accepted(io, accept, Source::FollowAction) {
@@ -1094,7 +1107,7 @@ impl Shell {
 
     fn cancel(&mut self, io: &mut Io<'_, '_>, source: Source, is_active: bool) {
         if is_active && self.session.active().is_some_and(|a| a.source == source) {
-            self.end_goal(io, Outcome::Canceled);
+            self.end_goal(io, EndCause::Canceled);
         }
     }
 
@@ -1131,7 +1144,7 @@ impl Shell {
             let began = Instant::now();
             let reply = match check_route_until(&start, &route.points, &chassis, &world, &config, || false) {
                 Ok(report) => check_reply(&report, &route, stamp, &frame, step),
-                Err(e) => refused_reply(Outcome::Refused(e.to_string()).reason()),
+                Err(e) => refused_reply(refused_goal(e, Action::Follow).reason()),
             };
             info!(
                 "planner/check_route: {} waypoints, {} in {:.2} ms",
@@ -1152,7 +1165,8 @@ impl Shell {
     fn check_request(&self, req: &CheckRouteRequest) -> Result<(Pose2, Route), CheckRouteResponse> {
         let frame = &self.config.odom_frame;
         let start = if req.use_start {
-            pose_in_odom("start", frame, &req.start, frame).map_err(|e| refused_reply(Outcome::Invalid(e).reason()))?
+            pose_in_odom("start", frame, &req.start, frame)
+                .map_err(|e| refused_reply(invalid_goal(&e, Action::Follow).reason()))?
         } else {
             self.fresh_odom().ok_or_else(|| {
                 refused_reply(
@@ -1162,7 +1176,7 @@ impl Shell {
             })?
         };
         let route = route_from_path(&req.route, frame, Some(start.position()), MIN_ROUTE_LENGTH)
-            .map_err(|e| refused_reply(Outcome::Invalid(e).reason()))?;
+            .map_err(|e| refused_reply(invalid_goal(&e, Action::Follow).reason()))?;
         Ok((start, route))
     }
 
@@ -1460,21 +1474,20 @@ impl Shell {
     async fn tick(&mut self, io: &mut Io<'_, '_>) {
         let Some(active) = self.session.active() else { return };
         let now = Instant::now();
-        let odom = Watched {
+        let mut inputs = vec![Watched {
             name: "odom",
             age: self.odom.age_at(now),
             timeout: active.goal.config.odom_timeout(),
-        };
-        if self.session.stale(now, &[odom]).is_some() {
-            return self.end_goal(io, Outcome::Stale);
+        }];
+        if matches!(active.goal.task, Task::Vfo(_)) {
+            inputs.push(Watched {
+                name: "scan",
+                age: self.scan_seen.age_at(now),
+                timeout: active.goal.config.vfo.scan_timeout(),
+            });
         }
-        let scan = Watched {
-            name: "scan",
-            age: self.scan_seen.age_at(now),
-            timeout: active.goal.config.vfo.scan_timeout(),
-        };
-        if matches!(active.goal.task, Task::Vfo(_)) && self.session.stale(now, &[scan]).is_some() {
-            return self.end_goal(io, Outcome::ScanStale);
+        if let Some(stale) = self.session.stale(now, &inputs) {
+            return self.end_goal(io, EndCause::Stale(stale));
         }
         let status_period = Duration::from_secs_f64(1.0 / self.config.status_rate_hz);
         if self

@@ -406,7 +406,9 @@ pub fn vfo_waypoints(route: &Route, start: &Pose2, guiding: f64) -> Result<Vec<V
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::{markers, route_from_poses, status_message, MarkerView, Mode, Outcome, StatusView, MISSED_BY_THE_RUN};
+    use crate::{
+        markers, route_from_poses, status_message, vfo_follow_result, MarkerView, Mode, StatusView, MISSED_BY_THE_RUN,
+    };
     use approx::assert_relative_eq;
     use mobil_msgs::builtin_interfaces::msg::Time;
     use mobil_msgs::geometry_msgs::msg::PoseStamped;
@@ -416,6 +418,7 @@ mod tests {
     use mobil_planner::vfo::{DrawnRobot, Obstacle, SegmentReport, VfoDrawing, MAX_DRAWN_OBSTACLES};
     use mobil_ros::config::{load, Decl};
     use mobil_ros::geometry::yaw_quaternion;
+    use mobil_ros::motion::EndCause;
     use mobil_ros::params::ParamValues;
     use nalgebra::Point2;
     use ros2_client::ParameterValue;
@@ -611,26 +614,19 @@ mod tests {
         let poses: Vec<PoseStamped> = (0..4).map(|i| pose(i as f64, 1.0, None)).collect();
         // The law's failure (its reason and code, as mobil_planner's VfoGoal gives them), a
         // stale scan, a cancel: each lists what was not reached as given up by the run.
-        let law = Outcome::Law(mobil_motion::Outcome::failed(
-            "NO_SAFE_PATH",
-            "no way to waypoint 2",
-            601,
-        ));
-        for outcome in [law, Outcome::ScanStale, Outcome::Canceled] {
-            let r = outcome.vfo_follow_result(&poses, &[2, 3]);
+        let law = EndCause::Outcome(mobil_motion::Outcome::failed("NO_SAFE_PATH", "no way", 601));
+        for cause in [law.clone(), EndCause::Stale("scan".into()), EndCause::Canceled] {
+            let r = vfo_follow_result(&cause, &poses, &[2, 3]);
             let listed: Vec<(u32, u16)> = r.missed_waypoints.iter().map(|m| (m.index, m.error_code)).collect();
             assert_eq!(listed, vec![(2, MISSED_BY_THE_RUN), (3, MISSED_BY_THE_RUN)]);
             assert_eq!(r.missed_waypoints[1].goal.pose.position.x, 3.0);
-            assert_eq!(outcome.state(), NavStatus::FAILED);
         }
-        let r =
-            Outcome::Law(mobil_motion::Outcome::failed("NO_SAFE_PATH", "no way", 601)).vfo_follow_result(&poses, &[3]);
+        let r = vfo_follow_result(&law, &poses, &[3]);
         assert_eq!(r.error_code, FollowWaypointsResult::TASK_EXECUTOR_FAILED);
         assert_eq!(r.error_msg, "NO_SAFE_PATH: no way");
-        assert_eq!(Outcome::ScanStale.code(), "STALE_INPUT");
         // A route done lists nothing.
-        let done = Outcome::Law(mobil_motion::Outcome::succeeded("route done: all 4 waypoints reached"));
-        let r = done.vfo_follow_result(&poses, &[]);
+        let done = EndCause::Outcome(mobil_motion::Outcome::succeeded("route done: all 4 waypoints reached"));
+        let r = vfo_follow_result(&done, &poses, &[]);
         assert!(r.missed_waypoints.is_empty() && r.error_code == 0);
     }
 
