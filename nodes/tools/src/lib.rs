@@ -3,7 +3,15 @@
 //! bookkeeping that turns two pose streams (odometry, ground truth) into the demo's summary.
 //! [`plot`] draws the demo's and `ga_step`'s SVG figures (maps of a [`mobil_world::World`] and
 //! time series) as plain SVG text.
+//!
+//! The demo's acts, each its record, one-line summary and figure, worked on recorded data (the
+//! executables of `mobil_tools_node` are the shells that fill them): [`plan`], the third act's
+//! route, dock and docking record; [`gait`], the fifth act's planned walk; [`vfo`], the sixth
+//! act's VFO waypoint following.
 
 pub mod drive;
+pub mod gait;
+pub mod plan;
 pub mod plot;
 pub mod route;
+pub mod vfo;

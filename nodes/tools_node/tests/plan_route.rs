@@ -1,6 +1,10 @@
 //! The third act's route and dock against the planner library: the route passes the pre-check on
 //! every chassis from wherever the second act leaves the robot, and the dock is docked on
 //! OMR-III (`mobil_planner`'s own check and docking, the ones `planner_node` runs).
+//!
+//! The route and dock are `mobil_tools::plan`'s, but the test lives here: `mobil_planner`
+//! depends on `mobil_tools`, so `mobil_tools` cannot take it as a dependency (not even a
+//! dev-dependency without a cycle), and this crate already has both.
 
 use std::f64::consts::FRAC_PI_2;
 
@@ -10,7 +14,7 @@ use mobil_planner::{
     check_route, simulate_docking, DockingConfig, DockingController, DockingGains, DockingPhase, Finish, Kinematics,
     RouteCheckConfig, VelocityLimits,
 };
-use mobil_tools_node::plan::{dock_needs_a_turn, route_end_heading, DEMO_DOCK, DEMO_ROUTE};
+use mobil_tools::plan::{dock_needs_a_turn, route_end_heading, DEMO_DOCK, DEMO_ROUTE};
 use mobil_world::World;
 use nalgebra::Point2;
 

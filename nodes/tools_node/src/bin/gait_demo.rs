@@ -1,7 +1,7 @@
 //! `gait_demo`: the demo's fifth act. Asks a running `gait_node` for the paper's experiment
 //! B,(3) on `gait/compute_plan` (from the origin at φ = 3π/2, legs nominal, to (−10, 10)),
 //! writes the planned walk as an SVG (the map of the walk and a strip of its leg moves) and
-//! prints a one-line summary. The summary and figure are `mobil_tools_node::gait` (tested
+//! prints a one-line summary. The summary and figure are `mobil_tools::gait` (tested
 //! there).
 
 use std::process::ExitCode;
@@ -12,8 +12,8 @@ use mobil_msgs::mobil_msgs::srv::{PlanGait, PlanGaitRequest, PlanGaitResponse};
 use mobil_msgs::RosService;
 use mobil_ros::params::ParamValues;
 use mobil_ros::{qos, run_node, shutdown_signal, NodeDecl, ParamSpec, RosNode};
+use mobil_tools::gait::{figure, summary, GaitWalk, WalkState, DEMO_GOAL, DEMO_START};
 use mobil_tools::plot::write_file;
-use mobil_tools_node::gait::{figure, summary, GaitWalk, WalkState, DEMO_GOAL, DEMO_START};
 use ros2_client::{Name, ServiceMapping};
 use tracing::info;
 

@@ -5,7 +5,7 @@
 //! the route (the samples stamped within it: waypoints it never came within `reach_tolerance` of
 //! count as missed) and the docking status (e, α, Θ, V, mode), writes one SVG (map: obstacles,
 //! route, predicted and true paths, dock, problems; panels: V(t) and e(t)) and prints a one-line
-//! summary. The record, summary and figure are `mobil_tools_node::plan` (tested there).
+//! summary. The record, summary and figure are `mobil_tools::plan` (tested there).
 
 use std::process::ExitCode;
 use std::time::{Duration, Instant};
@@ -20,10 +20,10 @@ use mobil_ros::geometry::{yaw_of, yaw_quaternion};
 use mobil_ros::params::ParamValues;
 use mobil_ros::time::{nanos_from_stamp, stamp_from_nanos};
 use mobil_ros::{qos, run_node, shutdown_signal, NodeDecl, ParamSpec, RosNode};
-use mobil_tools::plot::write_file;
-use mobil_tools_node::plan::{
+use mobil_tools::plan::{
     closest_approach, figure, route_track, DockSample, Outcome, PlanRun, Problem, Summary, DEMO_DOCK, DEMO_ROUTE,
 };
+use mobil_tools::plot::write_file;
 use mobil_world::World;
 use ros2_client::{Name, ServiceMapping};
 use tracing::info;

@@ -3,7 +3,7 @@
 //! path (`ground_truth`) and, from `planner/markers`, the optimisation with the most virtual
 //! robots; writes one SVG (world, obstacles seen with r and R, every virtual robot of that
 //! segment, the chosen path, the executed path) and prints one line. The record, summary and
-//! figure are `mobil_tools_node::vfo` (tested there).
+//! figure are `mobil_tools::vfo` (tested there).
 
 use std::process::ExitCode;
 use std::time::{Duration, Instant};
@@ -18,7 +18,7 @@ use mobil_ros::params::ParamValues;
 use mobil_ros::time::{nanos_from_stamp, stamp_from_nanos};
 use mobil_ros::{qos, run_node, shutdown_signal, NodeDecl, ParamSpec, RosNode};
 use mobil_tools::plot::write_file;
-use mobil_tools_node::vfo::{figure, Optimisation, SeenObstacle, VfoRun, DEMO_ROUTE};
+use mobil_tools::vfo::{figure, Optimisation, SeenObstacle, VfoRun, DEMO_ROUTE};
 use mobil_world::World;
 use tracing::info;
 

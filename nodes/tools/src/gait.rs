@@ -7,7 +7,7 @@
 
 use mobil_world::World;
 
-use mobil_tools::plot::{MapView, Stroke, Svg};
+use crate::plot::{MapView, Stroke, Svg};
 
 /// The demo's request: rule set B, evaluation (3), from the origin at φ = 3π/2 to (−10, 10)
 /// (SPEC §7, the paper's experiment B,(3), judged the best walking style).

@@ -4,7 +4,7 @@
 //! the planner saw with r and R, every virtual robot's path of that optimisation (grey; orange
 //! where dropped), the chosen one (green), the executed path (blue) and the waypoints.
 
-use mobil_tools::plot::{MapView, Stroke, Svg};
+use crate::plot::{MapView, Stroke, Svg};
 use mobil_world::World;
 
 /// The demo's route: past the pillar at (1, 1.5) (the first leg runs through it), beside the

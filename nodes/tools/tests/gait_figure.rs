@@ -1,6 +1,6 @@
 //! The fifth act's summary and figure on a hand-made plan: two body moves and two leg moves.
 
-use mobil_tools_node::gait::{figure, outline, summary, support, GaitWalk, WalkState};
+use mobil_tools::gait::{figure, outline, summary, support, GaitWalk, WalkState};
 use std::f64::consts::FRAC_PI_2;
 
 fn nominal(x: f64, y: f64) -> [(f64, f64); 4] {

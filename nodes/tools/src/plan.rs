@@ -7,7 +7,7 @@ use std::f64::consts::{FRAC_PI_2, PI};
 use mobil_geom::wrap;
 use mobil_world::World;
 
-use mobil_tools::plot::{MapView, SeriesPanel, Stroke, Svg};
+use crate::plot::{MapView, SeriesPanel, Stroke, Svg};
 
 /// The demo's route (odom frame, metres): from where the second act ends, near its goal
 /// (3, 4), west above the pillar at (1, 1.5), down the room's west side and back east. Legs of
