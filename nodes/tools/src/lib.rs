@@ -5,13 +5,16 @@
 //! time series) as plain SVG text.
 //!
 //! The demo's acts, each its record, one-line summary and figure, worked on recorded data (the
-//! executables of `mobil_tools_node` are the shells that fill them): [`plan`], the third act's
-//! route, dock and docking record; [`gait`], the fifth act's planned walk; [`vfo`], the sixth
-//! act's VFO waypoint following.
+//! executables of `mobil_tools_node` are the shells that fill them): [`route`], the first act's
+//! drift and figure; [`nav`], the second act's path and mode changes; [`plan`], the third act's
+//! route, dock and docking record; [`terrain`], the fourth act's terrain assessments; [`gait`],
+//! the fifth act's planned walk; [`vfo`], the sixth act's VFO waypoint following.
 
 pub mod drive;
 pub mod gait;
+pub mod nav;
 pub mod plan;
 pub mod plot;
 pub mod route;
+pub mod terrain;
 pub mod vfo;

@@ -533,6 +533,16 @@ impl Svg {
     }
 }
 
+/// The world a figure draws: the file `world_file` names, or the built-in world when it is empty
+/// (the demo executables' `world_file` parameter).
+pub fn world_to_draw(world_file: &str) -> Result<World, mobil_world::WorldError> {
+    if world_file.is_empty() {
+        Ok(World::builtin())
+    } else {
+        World::load(world_file)
+    }
+}
+
 /// Writes `text` to `path`, creating its directory.
 pub fn write_file(path: &str, text: &str) -> std::io::Result<()> {
     if let Some(dir) = std::path::Path::new(path).parent()
@@ -546,6 +556,12 @@ pub fn write_file(path: &str, text: &str) -> std::io::Result<()> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn an_empty_world_file_is_the_built_in_world() {
+        assert_eq!(world_to_draw("").expect("built in"), World::builtin());
+        assert!(world_to_draw("/nonexistent/world.yaml").is_err());
+    }
 
     #[test]
     fn map_view_by_hand() {

@@ -1,4 +1,10 @@
-//! Scripted routes (timed body-velocity segments) and odometry-versus-truth bookkeeping.
+//! Scripted routes (timed body-velocity segments) and odometry-versus-truth bookkeeping: the
+//! demo's first act (`demo_driver`), its one-line summary ([`Drift`]) and its figure.
+
+use mobil_geom::wrap;
+use mobil_world::World;
+
+use crate::plot::{MapView, Stroke, Svg};
 
 /// One segment of a scripted route: hold this body twist for `duration` seconds.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -86,9 +92,100 @@ pub fn path_length(points: &[(f64, f64)]) -> f64 {
         .sum()
 }
 
+/// How far the odometry drifted from the truth over a drive.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Drift {
+    /// The true path's length (m).
+    pub distance: f64,
+    /// The distance between the last odometry and the last true position (m).
+    pub error: f64,
+    /// |wrap(odometry yaw − true yaw)| at the end (°).
+    pub heading_error_deg: f64,
+}
+
+impl Drift {
+    /// The drift of the odometry track `odom` from the true track `truth` (each pose x, y,
+    /// yaw); `None` when either is empty.
+    pub fn of(truth: &[(f64, f64, f64)], odom: &[(f64, f64, f64)]) -> Option<Drift> {
+        let (o, g) = (odom.last()?, truth.last()?);
+        let xy: Vec<(f64, f64)> = truth.iter().map(|p| (p.0, p.1)).collect();
+        Some(Drift {
+            distance: path_length(&xy),
+            error: (o.0 - g.0).hypot(o.1 - g.1),
+            heading_error_deg: wrap(o.2 - g.2).abs().to_degrees(),
+        })
+    }
+
+    /// The act's line: the distance, the final error (also as a share of the distance), the
+    /// heading error, the plot.
+    pub fn line(&self, svg: &str) -> String {
+        let share = if self.distance > 0.0 {
+            100.0 * self.error / self.distance
+        } else {
+            0.0
+        };
+        format!(
+            "demo: drove {:.2} m; final odometry error {:.3} m ({share:.2} % of distance), heading {:.2}°; plot {svg}",
+            self.distance, self.error, self.heading_error_deg
+        )
+    }
+}
+
+/// The first act's figure: both tracks over the world at 60 px/m, the title and the legend
+/// below.
+pub fn figure(world: &World, truth: &[(f64, f64)], odom: &[(f64, f64)], title: &str) -> String {
+    let map = MapView::fit(world, truth.iter().chain(odom).copied(), 60.0, 0.5);
+    let base = map.height();
+    let mut s = Svg::new(map.width(), base + 60.0);
+    s.world(&map, world);
+    s.metre_axes(&map);
+    s.path(&map, truth, Stroke::solid("#141414", 2.0));
+    s.path(&map, odom, Stroke::solid("#DC3220", 2.0));
+    s.text(10.0, base + 22.0, 16.0, title);
+    s.polyline(
+        &[(10.0, base + 44.0), (40.0, base + 44.0)],
+        Stroke::solid("#141414", 2.0),
+    );
+    s.text(46.0, base + 49.0, 14.0, "ground truth");
+    s.polyline(
+        &[(160.0, base + 44.0), (190.0, base + 44.0)],
+        Stroke::solid("#DC3220", 2.0),
+    );
+    s.text(196.0, base + 49.0, 14.0, "odometry");
+    s.finish()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn drift_at_the_end_of_the_tracks() {
+        // Truth 3 m east then 4 m north, ending facing north; odometry 0.06 m west and 0.08 m
+        // south of it (0.1 m), 2° to the left of it.
+        let truth = [(0.0, 0.0, 0.0), (3.0, 0.0, 0.0), (3.0, 4.0, 1.5)];
+        let odom = [(0.0, 0.0, 0.0), (2.94, 3.92, 1.5 + 2f64.to_radians())];
+        let d = Drift::of(&truth, &odom).expect("both tracks");
+        assert!((d.distance - 7.0).abs() < 1e-12 && (d.error - 0.1).abs() < 1e-12);
+        assert!((d.heading_error_deg - 2.0).abs() < 1e-9);
+        assert_eq!(
+            d.line("x.svg"),
+            "demo: drove 7.00 m; final odometry error 0.100 m (1.43 % of distance), heading 2.00°; plot x.svg"
+        );
+        assert_eq!(Drift::of(&truth, &[]), None);
+        let still = Drift::of(&[(1.0, 1.0, 0.0)], &[(1.0, 1.0, 0.0)]).expect("both tracks");
+        assert!(still.line("y").contains("(0.00 % of distance)"));
+    }
+
+    #[test]
+    fn the_figure_draws_both_tracks_and_the_legend() {
+        let truth = [(0.0, 0.0), (1.0, 0.0)];
+        let odom = [(0.0, 0.0), (1.0, 0.1)];
+        let svg = figure(&World::default(), &truth, &odom, "t <&>");
+        // The two tracks and the two legend strokes.
+        assert_eq!(svg.matches("<polyline").count(), 4);
+        assert!(svg.contains("ground truth") && svg.contains("odometry") && svg.contains("t &lt;&amp;&gt;"));
+    }
 
     #[test]
     fn default_loop_closes() {

@@ -5,6 +5,7 @@
 //! where dropped), the chosen one (green), the executed path (blue) and the waypoints.
 
 use crate::plot::{MapView, Stroke, Svg};
+use crate::route::path_length;
 use mobil_world::World;
 
 /// The demo's route: past the pillar at (1, 1.5) (the first leg runs through it), beside the
@@ -55,10 +56,7 @@ pub struct VfoRun {
 impl VfoRun {
     /// Length of the true path (m).
     pub fn length(&self) -> f64 {
-        self.path
-            .windows(2)
-            .map(|w| (w[1].0 - w[0].0).hypot(w[1].1 - w[0].1))
-            .sum()
+        path_length(&self.path)
     }
 
     /// The true path's closest approach to the world's surfaces (m).

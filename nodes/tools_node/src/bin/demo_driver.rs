@@ -3,15 +3,13 @@
 //! world's obstacles and prints a one-line summary: distance driven and final odometry error.
 
 use futures::StreamExt;
-use mobil_geom::wrap;
 use mobil_msgs::geometry_msgs::msg::Twist;
 use mobil_msgs::nav_msgs::msg::Odometry;
 use mobil_ros::geometry::yaw_of;
 use mobil_ros::params::ParamValues;
 use mobil_ros::{qos, run_node, shutdown_signal, NodeDecl, ParamSpec, RosNode};
-use mobil_tools::plot::{write_file, MapView, Stroke, Svg};
-use mobil_tools::route::{default_loop, parse_route, path_length, twist_at};
-use mobil_world::World;
+use mobil_tools::plot::{world_to_draw, write_file};
+use mobil_tools::route::{default_loop, figure, parse_route, twist_at, Drift};
 use std::process::ExitCode;
 use std::time::Duration;
 use tracing::info;
@@ -53,29 +51,6 @@ fn pose(m: &Odometry) -> (f64, f64, f64) {
     )
 }
 
-/// The plot: both tracks over the world at 60 px/m, the title and the legend below.
-fn plot(world: &World, truth: &[(f64, f64)], odom: &[(f64, f64)], title: &str) -> String {
-    let map = MapView::fit(world, truth.iter().chain(odom).copied(), 60.0, 0.5);
-    let base = map.height();
-    let mut s = Svg::new(map.width(), base + 60.0);
-    s.world(&map, world);
-    s.metre_axes(&map);
-    s.path(&map, truth, Stroke::solid("#141414", 2.0));
-    s.path(&map, odom, Stroke::solid("#DC3220", 2.0));
-    s.text(10.0, base + 22.0, 16.0, title);
-    s.polyline(
-        &[(10.0, base + 44.0), (40.0, base + 44.0)],
-        Stroke::solid("#141414", 2.0),
-    );
-    s.text(46.0, base + 49.0, 14.0, "ground truth");
-    s.polyline(
-        &[(160.0, base + 44.0), (190.0, base + 44.0)],
-        Stroke::solid("#DC3220", 2.0),
-    );
-    s.text(196.0, base + 49.0, 14.0, "odometry");
-    s.finish()
-}
-
 async fn drive(node: &mut RosNode) -> anyhow::Result<()> {
     let p = node.params();
     let map_err = anyhow::Error::msg;
@@ -84,11 +59,7 @@ async fn drive(node: &mut RosNode) -> anyhow::Result<()> {
     let svg = p.string("output_svg").map_err(map_err)?;
     let world_file = p.string("world_file").map_err(map_err)?;
     let start_timeout = Duration::from_secs_f64(p.f64("start_timeout_s").map_err(map_err)?);
-    let world = if world_file.is_empty() {
-        World::builtin()
-    } else {
-        World::load(&world_file)?
-    };
+    let world = world_to_draw(&world_file)?;
 
     let cmd = node.publisher::<Twist>("cmd_vel", &qos::default_qos())?;
     let odom_sub = node.subscription::<Odometry>("odom", &qos::default_qos())?;
@@ -148,20 +119,13 @@ async fn drive(node: &mut RosNode) -> anyhow::Result<()> {
         }
     }
 
-    let (Some(o), Some(g)) = (odom_track.last(), truth_track.last()) else {
+    let Some(drift) = Drift::of(&truth_track, &odom_track) else {
         anyhow::bail!("odom or ground_truth stopped arriving");
     };
     let xy = |v: &[(f64, f64, f64)]| v.iter().map(|p| (p.0, p.1)).collect::<Vec<_>>();
-    let distance = path_length(&xy(&truth_track));
-    let error = (o.0 - g.0).hypot(o.1 - g.1);
-    let heading_error = wrap(o.2 - g.2).abs().to_degrees();
-    let (truth_xy, odom_xy) = (xy(&truth_track), xy(&odom_track));
     let title = format!("{}: odometry vs ground truth", node.names().fully_qualified_node());
-    write_file(&svg, &plot(&world, &truth_xy, &odom_xy, &title))
+    write_file(&svg, &figure(&world, &xy(&truth_track), &xy(&odom_track), &title))
         .map_err(|e| anyhow::anyhow!("cannot write {svg}: {e}"))?;
-    println!(
-        "demo: drove {distance:.2} m; final odometry error {error:.3} m ({:.2} % of distance), heading {heading_error:.2}°; plot {svg}",
-        if distance > 0.0 { 100.0 * error / distance } else { 0.0 }
-    );
+    println!("{}", drift.line(&svg));
     Ok(())
 }

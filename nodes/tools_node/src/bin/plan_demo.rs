@@ -23,8 +23,7 @@ use mobil_ros::{qos, run_node, shutdown_signal, NodeDecl, ParamSpec, RosNode};
 use mobil_tools::plan::{
     closest_approach, figure, route_track, DockSample, Outcome, PlanRun, Problem, Summary, DEMO_DOCK, DEMO_ROUTE,
 };
-use mobil_tools::plot::write_file;
-use mobil_world::World;
+use mobil_tools::plot::{world_to_draw, write_file};
 use ros2_client::{Name, ServiceMapping};
 use tracing::info;
 
@@ -190,11 +189,7 @@ async fn run(node: &mut RosNode) -> anyhow::Result<()> {
     let steered = matches!(p.string("model").map_err(map_err)?.as_str(), "car_like" | "tricycle");
     let tolerance = p.f64("reach_tolerance").map_err(map_err)?;
     let timeout = Duration::from_secs_f64(p.f64("timeout_s").map_err(map_err)?);
-    let world = if world_file.is_empty() {
-        World::builtin()
-    } else {
-        World::load(&world_file)?
-    };
+    let world = world_to_draw(&world_file)?;
     let deadline = Instant::now() + timeout;
 
     let route_pub = node.publisher::<Path>("waypoints", &qos::default_qos())?;
