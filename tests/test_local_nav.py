@@ -489,7 +489,7 @@ def test_refusals_preemption_and_stale_scan(start_scenario, start_node, sim_cloc
         assert in_map.reason == "INVALID_GOAL: goal in frame `map`, but goals must be in `odom`"
         nan = publish_until_status(goal_pose(float("nan"), 0.0),
                                    lambda s: s.state == NavStatus.FAILED)
-        assert nan.reason == "INVALID_GOAL: goal pose is not finite"
+        assert nan.reason == "INVALID_GOAL: goal is not finite"
         assert len(cmd) == 0, "a refused goal moved the robot"
 
         nav.wait_for_log("first scan", timeout=REPLY_TIMEOUT)

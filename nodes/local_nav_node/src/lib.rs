@@ -22,12 +22,13 @@ use mobil_msgs::std_msgs::msg::{ColorRGBA, Header};
 use mobil_msgs::visualization_msgs::msg::{Marker, MarkerArray};
 use mobil_ros::chassis::{chassis_params, declare_chassis};
 use mobil_ros::config::{Config, ConfigError, Decl};
-use mobil_ros::geometry::{yaw_of, yaw_quaternion};
+use mobil_ros::geometry::yaw_quaternion;
+use mobil_ros::goal::goal_pose;
+pub use mobil_ros::goal::{goal_heading, GoalError};
 use mobil_ros::motion::{EndCause, EndKind};
 use mobil_ros::time::seconds;
 use nalgebra::{Point2, Vector2};
 use std::time::Duration;
-use thiserror::Error;
 
 /// Nav2's Jazzy error codes used in `NavigateToPose` results. Jazzy's NavigateToPose defines
 /// only `NONE`; its navigator passes on the code of the failing server, so a failure here gets
@@ -354,52 +355,10 @@ pub const MAX_INPUT_TIMEOUT_S: f64 = 60.0;
 /// The largest `result_timeout_s` (s): an hour.
 pub const MAX_RESULT_TIMEOUT_S: f64 = 3600.0;
 
-/// Why a goal pose is refused.
-#[derive(Debug, Clone, PartialEq, Error)]
-pub enum GoalError {
-    /// Not in the odometry frame (the node has no map, and no other transform).
-    #[error("goal in frame `{got}`, but goals must be in `{want}`")]
-    Frame {
-        /// The goal's frame.
-        got: String,
-        /// The odometry frame.
-        want: String,
-    },
-    /// NaN or infinity in the position or orientation.
-    #[error("goal pose is not finite")]
-    NotFinite,
-    /// A coordinate beyond [`MAX_GOAL_COORD`]: farther than any reactive drive can mean.
-    #[error("goal ({x}, {y}) is beyond ±{MAX_GOAL_COORD} m")]
-    TooFar {
-        /// The goal's x (m).
-        x: f64,
-        /// The goal's y (m).
-        y: f64,
-    },
-}
-
-/// The largest |x| and |y| of a goal (m, odom).
-pub const MAX_GOAL_COORD: f64 = 1e4;
-
-/// The goal point in the odometry frame, or why it is refused: a frame other than `odom_frame`
-/// (a leading `/` ignored, as tf2 ignores it), any non-finite number in the pose, or a
-/// coordinate beyond ±[`MAX_GOAL_COORD`].
+/// The goal point in the odometry frame, or why it is refused ([`mobil_ros::goal::goal_pose`]:
+/// another frame, anything non-finite, a coordinate beyond ±10 km).
 pub fn goal_in_odom(goal: &PoseStamped, odom_frame: &str) -> Result<Point2<f64>, GoalError> {
-    let frame = goal.header.frame_id.trim_start_matches('/');
-    if frame != odom_frame.trim_start_matches('/') {
-        return Err(GoalError::Frame {
-            got: goal.header.frame_id.clone(),
-            want: odom_frame.to_owned(),
-        });
-    }
-    let (p, q) = (&goal.pose.position, &goal.pose.orientation);
-    if ![p.x, p.y, p.z, q.x, q.y, q.z, q.w].iter().all(|v| v.is_finite()) {
-        return Err(GoalError::NotFinite);
-    }
-    if p.x.abs() > MAX_GOAL_COORD || p.y.abs() > MAX_GOAL_COORD {
-        return Err(GoalError::TooFar { x: p.x, y: p.y });
-    }
-    Ok(Point2::new(p.x, p.y))
+    goal_pose("goal", goal, odom_frame).map(|p| p.position())
 }
 
 /// The command as a Twist, held to the chassis limits whatever the navigator asked: speed at
@@ -423,19 +382,6 @@ pub fn twist_from_command(command: VelocityCommand, limits: &MotionLimits) -> Tw
     t.linear.y = c.vy;
     t.angular.z = c.omega;
     t
-}
-
-/// The heading a goal asks for, when it asks for one: the yaw of its orientation, `None` for
-/// the identity (or a quaternion within 1 mrad of it, or a zero one). The method reaches a
-/// position only, so the node says the heading is not kept.
-pub fn goal_heading(goal: &PoseStamped) -> Option<f64> {
-    let q = &goal.pose.orientation;
-    let n = q.x * q.x + q.y * q.y + q.z * q.z + q.w * q.w;
-    if !(n.is_finite() && n > 0.0) {
-        return None;
-    }
-    let yaw = yaw_of(q);
-    (yaw.abs() > 1e-3).then_some(yaw)
 }
 
 /// The progress checker after a parameter change: the same one (its window and anchor kept)
@@ -676,53 +622,6 @@ mod tests {
     use mobil_geom::Scan;
     use mobil_ros::params::ParamValues;
 
-    fn pose_stamped(frame: &str, x: f64, y: f64) -> PoseStamped {
-        let mut g = PoseStamped::default();
-        g.header.frame_id = frame.into();
-        g.pose.position.x = x;
-        g.pose.position.y = y;
-        g.pose.orientation.w = 1.0;
-        g
-    }
-
-    #[test]
-    fn goals_outside_odom_or_with_nan_are_refused() {
-        assert_eq!(
-            goal_in_odom(&pose_stamped("odom", 2.5, -1.0), "odom"),
-            Ok(Point2::new(2.5, -1.0))
-        );
-        assert_eq!(
-            goal_in_odom(&pose_stamped("/odom", 1.0, 0.0), "odom"),
-            Ok(Point2::new(1.0, 0.0))
-        );
-        assert_eq!(
-            goal_in_odom(&pose_stamped("map", 1.0, 0.0), "odom"),
-            Err(GoalError::Frame {
-                got: "map".into(),
-                want: "odom".into()
-            })
-        );
-        assert!(matches!(
-            goal_in_odom(&pose_stamped("", 1.0, 0.0), "odom"),
-            Err(GoalError::Frame { .. })
-        ));
-        assert_eq!(
-            goal_in_odom(&pose_stamped("odom", f64::NAN, 0.0), "odom"),
-            Err(GoalError::NotFinite)
-        );
-        let mut g = pose_stamped("odom", 1.0, 0.0);
-        g.pose.orientation.z = f64::INFINITY;
-        assert_eq!(goal_in_odom(&g, "odom"), Err(GoalError::NotFinite));
-        assert_eq!(
-            GoalError::Frame {
-                got: "map".into(),
-                want: "odom".into()
-            }
-            .to_string(),
-            "goal in frame `map`, but goals must be in `odom`"
-        );
-    }
-
     #[test]
     fn commands_are_held_to_the_chassis_limits() {
         // OMR-III: v_max 0.5, ω_max 1.5. (0.6, 0.8) is 1.0 m/s: scaled by 0.5 to (0.3, 0.4).
@@ -842,27 +741,6 @@ mod tests {
     }
 
     #[test]
-    fn far_goals_are_refused() {
-        // 1e4 m is the last accepted coordinate; 1e200 (finite) and -10000.5 are refused.
-        assert_eq!(
-            goal_in_odom(&pose_stamped("odom", 1e4, -1e4), "odom"),
-            Ok(Point2::new(1e4, -1e4))
-        );
-        assert_eq!(
-            goal_in_odom(&pose_stamped("odom", 1e200, 0.0), "odom"),
-            Err(GoalError::TooFar { x: 1e200, y: 0.0 })
-        );
-        assert!(matches!(
-            goal_in_odom(&pose_stamped("odom", 0.0, -10_000.5), "odom"),
-            Err(GoalError::TooFar { .. })
-        ));
-        assert_eq!(
-            invalid_goal(&GoalError::TooFar { x: 2e4, y: 0.0 }),
-            "INVALID_GOAL: goal (20000, 0) is beyond ±10000 m"
-        );
-    }
-
-    #[test]
     fn timeouts_are_bounded_and_never_panic() {
         let specs = Decl::<LocalNavConfig>::of().specs();
         let mut values = ParamValues::defaults(&specs);
@@ -902,20 +780,6 @@ mod tests {
         assert_eq!(c.laser_pose(), Some(Pose2::new(0.2, -0.1, 0.5)));
         values.set("laser_pose", ros2_client::ParameterValue::DoubleArray(vec![0.2, -0.1]));
         assert!(mobil_ros::config::load::<LocalNavConfig>(&values).is_err());
-    }
-
-    #[test]
-    fn a_goal_heading_is_noticed_only_when_there_is_one() {
-        let mut g = pose_stamped("odom", 1.0, 0.0);
-        assert_eq!(goal_heading(&g), None);
-        // 90°: (0, 0, sin 45°, cos 45°).
-        g.pose.orientation = yaw_quaternion(std::f64::consts::FRAC_PI_2);
-        let yaw = goal_heading(&g).unwrap();
-        assert!((yaw - std::f64::consts::FRAC_PI_2).abs() < 1e-12);
-        // An all-zero quaternion (RViz-less tools often send it) asks for nothing.
-        g.pose.orientation = Default::default();
-        g.pose.orientation.w = 0.0;
-        assert_eq!(goal_heading(&g), None);
     }
 
     #[test]
@@ -993,8 +857,8 @@ mod tests {
         );
         assert_eq!(end_answer(&EndCause::Shutdown).2, 100);
         assert_eq!(
-            invalid_goal(&GoalError::NotFinite),
-            "INVALID_GOAL: goal pose is not finite"
+            invalid_goal(&GoalError::NotFinite { what: "goal".into() }),
+            "INVALID_GOAL: goal is not finite"
         );
     }
 }

@@ -25,6 +25,8 @@
 //! - [`motion`]: [`motion::MotionSession`], the motion server every node that moves the robot
 //!   runs its goals through (one goal, pre-emption, the time step, refused input, the one zero
 //!   command at every end, stale input, shutdown), around a [`mobil_motion::GoalLaw`];
+//! - [`goal`]: goal poses and routes from messages, checked in the node's frame (the reasons of
+//!   an `INVALID_GOAL`);
 //! - [`stop`]: [`stop::final_stop`], the bounded last zero command of a motion node;
 //! - [`scan`]: LaserScan → checked [`mobil_geom::Scan`] at the edge, laser pose from `tf_static`
 //!   ([`scan::tf_static_subscription`] feeding [`scan::LaserPose`]; `tf_static` wins) or a
@@ -40,6 +42,7 @@ pub mod chassis;
 pub mod config;
 pub mod docs;
 pub mod geometry;
+pub mod goal;
 pub mod input;
 pub mod latest;
 pub mod log;

@@ -30,12 +30,13 @@ use mobil_planner::{
 };
 use mobil_ros::chassis::{chassis_params, declare_chassis};
 use mobil_ros::config::{Config, ConfigError, Decl};
-use mobil_ros::geometry::{yaw_of, yaw_quaternion};
+use mobil_ros::geometry::yaw_quaternion;
+use mobil_ros::goal::RouteLimits;
+pub use mobil_ros::goal::{GoalError, Route};
 use mobil_ros::motion::{EndCause, EndKind};
 use mobil_world::World;
 use nalgebra::Point2;
 use std::time::Duration;
-use thiserror::Error;
 
 use mobil_ros::time::seconds;
 
@@ -353,203 +354,12 @@ pub fn load_world(world_file: &str) -> Result<World, mobil_world::WorldError> {
     }
 }
 
-/// Why a goal or route is refused.
-#[derive(Debug, Clone, PartialEq, Error)]
-pub enum GoalError {
-    /// Not in the odometry frame.
-    #[error("{what} in frame `{got}`, but goals must be in `{want}`")]
-    Frame {
-        /// What (`dock pose`, `waypoint 2`, `route`).
-        what: String,
-        /// Its frame.
-        got: String,
-        /// The odometry frame.
-        want: String,
-    },
-    /// NaN or infinity.
-    #[error("{what} is not finite")]
-    NotFinite {
-        /// What.
-        what: String,
-    },
-    /// Beyond ±[`MAX_GOAL_COORD`].
-    #[error("{what} ({x}, {y}) is beyond ±{MAX_GOAL_COORD} m")]
-    TooFar {
-        /// What.
-        what: String,
-        /// x (m).
-        x: f64,
-        /// y (m).
-        y: f64,
-    },
-    /// A route without waypoints.
-    #[error("the route has no waypoints")]
-    EmptyRoute,
-    /// A route longer than [`MAX_WAYPOINTS`].
-    #[error("the route has {0} waypoints; at most {MAX_WAYPOINTS} are taken")]
-    TooLong(usize),
-    /// A route whose waypoints all lie on the start point: nothing to drive.
-    #[error("zero-length route: every waypoint lies within {0} m of the first and of the start")]
-    ZeroLength(f64),
-    /// Nav2's dock database is not available here.
-    #[error("use_dock_id is true, but this planner has no dock database (give dock_pose with use_dock_id false)")]
-    NoDockDatabase,
-    /// `goal_index` beyond the poses.
-    #[error("goal_index {index} is not below the {len} poses")]
-    GoalIndex {
-        /// The index asked for.
-        index: u32,
-        /// How many poses there are.
-        len: usize,
-    },
-}
-
-/// The largest |x| and |y| of a goal or waypoint (m, odom).
-pub const MAX_GOAL_COORD: f64 = 1e4;
-
-fn same_frame(got: &str, want: &str) -> bool {
-    got.trim_start_matches('/') == want.trim_start_matches('/')
-}
-
-/// The pose of `p` in the odometry frame, or why not: `frame` must be `odom_frame` (a leading
-/// `/` ignored), everything finite, |x|, |y| within [`MAX_GOAL_COORD`].
-pub fn pose_in_odom(what: &str, frame: &str, p: &Pose, odom_frame: &str) -> Result<Pose2, GoalError> {
-    if !same_frame(frame, odom_frame) {
-        return Err(GoalError::Frame {
-            what: what.to_owned(),
-            got: frame.to_owned(),
-            want: odom_frame.to_owned(),
-        });
-    }
-    let (a, q) = (&p.position, &p.orientation);
-    if ![a.x, a.y, a.z, q.x, q.y, q.z, q.w].iter().all(|v| v.is_finite()) {
-        return Err(GoalError::NotFinite { what: what.to_owned() });
-    }
-    if a.x.abs() > MAX_GOAL_COORD || a.y.abs() > MAX_GOAL_COORD {
-        return Err(GoalError::TooFar {
-            what: what.to_owned(),
-            x: a.x,
-            y: a.y,
-        });
-    }
-    Ok(Pose2::new(a.x, a.y, yaw_of(q)))
-}
-
-/// The dock pose of a PoseStamped (frame `odom_frame`, finite, in range).
-pub fn dock_goal(goal: &PoseStamped, odom_frame: &str) -> Result<Pose2, GoalError> {
-    pose_in_odom("dock pose", &goal.header.frame_id, &goal.pose, odom_frame)
-}
-
-/// A route to drive: the waypoints and, for each, its index in the request (FollowWaypoints
-/// with `goal_index` or `number_of_loops` repeats or skips poses).
-#[derive(Debug, Clone, PartialEq)]
-pub struct Route {
-    /// The waypoints in driving order (odom).
-    pub points: Vec<Point2<f64>>,
-    /// For each, its index in the request's poses.
-    pub request_index: Vec<usize>,
-    /// The request's poses (for the results' missed waypoints).
-    pub poses: Vec<PoseStamped>,
-}
-
-impl Route {
-    /// The index (in the request) of the first waypoint whose orientation is not the identity:
-    /// the goal approach reaches a point, not a heading, so such an orientation is ignored (and
-    /// the node says so once per route). An all-zero quaternion (an orientation never set) and
-    /// one within 1e-6 of ±identity count as none.
-    pub fn first_oriented(&self) -> Option<usize> {
-        self.poses
-            .iter()
-            .enumerate()
-            .find(|(_, p)| vfo::oriented(&p.pose.orientation))
-            .map(|(i, _)| i)
-    }
-
-    /// The request indices of the waypoints from route index `from` on (those not reached
-    /// when the run stops while pursuing `from`).
-    pub fn unreached_from(&self, from: usize) -> Vec<usize> {
-        (from..self.points.len())
-            .map(|i| self.request_index.get(i).copied().unwrap_or(i))
-            .collect()
-    }
-}
-
-/// A route from `poses` (each in `odom_frame`; an empty frame takes `default_frame`, the path's
-/// own header), starting at `goal_index` and driven `1 + number_of_loops` times (Nav2's
-/// FollowWaypoints: later rounds from index 0). Refuses an empty route, frames, NaN, far points,
-/// more than [`MAX_WAYPOINTS`] in all, and a route of zero length: every waypoint within
-/// `min_length` of the first and of `start` (when known).
-pub fn route_from_poses(
-    poses: &[PoseStamped],
-    default_frame: &str,
-    odom_frame: &str,
-    goal_index: u32,
-    number_of_loops: u32,
-    start: Option<Point2<f64>>,
-    min_length: f64,
-) -> Result<Route, GoalError> {
-    if poses.is_empty() {
-        return Err(GoalError::EmptyRoute);
-    }
-    let mut points = Vec::with_capacity(poses.len());
-    for (i, p) in poses.iter().enumerate() {
-        let frame = if p.header.frame_id.is_empty() {
-            default_frame
-        } else {
-            &p.header.frame_id
-        };
-        let pose = pose_in_odom(&format!("waypoint {i}"), frame, &p.pose, odom_frame)?;
-        points.push(pose.position());
-    }
-    let first = goal_index as usize;
-    if first >= poses.len() {
-        return Err(GoalError::GoalIndex {
-            index: goal_index,
-            len: poses.len(),
-        });
-    }
-    let total = (poses.len() - first).saturating_add(poses.len().saturating_mul(number_of_loops as usize));
-    if total > MAX_WAYPOINTS {
-        return Err(GoalError::TooLong(total));
-    }
-    let mut request_index: Vec<usize> = (first..poses.len()).collect();
-    for _ in 0..number_of_loops {
-        request_index.extend(0..poses.len());
-    }
-    let route_points: Vec<Point2<f64>> = request_index.iter().map(|&i| points[i]).collect();
-    let anchor = route_points[0];
-    let near = |p: &Point2<f64>| (p - anchor).norm() < min_length && start.is_none_or(|s| (p - s).norm() < min_length);
-    if route_points.iter().all(near) {
-        return Err(GoalError::ZeroLength(min_length));
-    }
-    Ok(Route {
-        points: route_points,
-        request_index,
-        poses: poses.to_vec(),
-    })
-}
-
-/// A `nav_msgs/Path` as a route (its header's frame for poses without one).
-pub fn route_from_path(
-    path: &Path,
-    odom_frame: &str,
-    start: Option<Point2<f64>>,
-    min_length: f64,
-) -> Result<Route, GoalError> {
-    if !path.header.frame_id.is_empty() && !same_frame(&path.header.frame_id, odom_frame) {
-        return Err(GoalError::Frame {
-            what: "route".into(),
-            got: path.header.frame_id.clone(),
-            want: odom_frame.to_owned(),
-        });
-    }
-    let frame = if path.header.frame_id.is_empty() {
-        odom_frame
-    } else {
-        &path.header.frame_id
-    };
-    route_from_poses(&path.poses, frame, odom_frame, 0, 0, start, min_length)
-}
+/// The routes the planner takes: at most [`MAX_WAYPOINTS`] waypoints, repeats included; a
+/// route shorter than 1 mm, start included, is refused as zero-length.
+pub const ROUTE_LIMITS: RouteLimits = RouteLimits {
+    min_length: 1e-3,
+    max_waypoints: MAX_WAYPOINTS,
+};
 
 /// The command as a Twist at the reference point, held to the chassis limits as chassis_node
 /// holds them: on a steered chassis `linear.x` and `angular.z` are the kinematic origin's (the
@@ -667,15 +477,24 @@ pub fn error_code(cause: &EndCause, action: Action) -> u16 {
     }
 }
 
-/// An invalid goal, refused before it starts: `INVALID_GOAL` with DockRobot's DOCK_NOT_IN_DB
-/// (a dock by id) or DOCK_NOT_VALID, or the action's UNKNOWN.
+/// An invalid goal, refused before it starts: `INVALID_GOAL` with DockRobot's DOCK_NOT_VALID
+/// or the action's UNKNOWN.
 pub fn invalid_goal(e: &GoalError, action: Action) -> Outcome {
-    let code = match (action, e) {
-        (Action::Dock, GoalError::NoDockDatabase) => nav2::docking::DOCK_NOT_IN_DB,
-        (Action::Dock, _) => nav2::docking::DOCK_NOT_VALID,
-        (Action::Undock | Action::Follow, _) => action.unknown(),
+    let code = match action {
+        Action::Dock => nav2::docking::DOCK_NOT_VALID,
+        Action::Undock | Action::Follow => action.unknown(),
     };
     Outcome::failed("INVALID_GOAL", e.to_string(), code)
+}
+
+/// A dock asked for by id: `INVALID_GOAL` with DockRobot's DOCK_NOT_IN_DB (the planner docks
+/// onto a pose; it has no dock database).
+pub fn no_dock_database() -> Outcome {
+    Outcome::failed(
+        "INVALID_GOAL",
+        "use_dock_id is true, but this planner has no dock database (give dock_pose with use_dock_id false)",
+        nav2::docking::DOCK_NOT_IN_DB,
+    )
 }
 
 /// A goal the planner cannot start (its parameters or the law refuse it): `INVALID_INPUT`.
@@ -1131,39 +950,8 @@ fn clear_marker(header: &Header) -> Marker {
 mod tests {
     use super::*;
     use approx::assert_relative_eq;
+    use mobil_ros::geometry::yaw_of;
     use mobil_ros::params::ParamValues;
-
-    #[test]
-    fn a_waypoint_orientation_is_noticed() {
-        let pose = |x: f64, y: f64, z: f64, w: f64| {
-            let mut p = PoseStamped::default();
-            p.pose.orientation.x = x;
-            p.pose.orientation.y = y;
-            p.pose.orientation.z = z;
-            p.pose.orientation.w = w;
-            p
-        };
-        let route = |poses: Vec<PoseStamped>| Route {
-            points: vec![Point2::origin(); poses.len()],
-            request_index: (0..poses.len()).collect(),
-            poses,
-        };
-        // Identity, −identity and never set (all zero): none.
-        let plain = route(vec![
-            pose(0.0, 0.0, 0.0, 1.0),
-            pose(0.0, 0.0, 0.0, -1.0),
-            pose(0.0, 0.0, 0.0, 0.0),
-        ]);
-        assert_eq!(plain.first_oriented(), None);
-        // 90° about z: (0, 0, sin 45°, cos 45°) at index 1.
-        let h = std::f64::consts::FRAC_1_SQRT_2;
-        let turned = route(vec![
-            pose(0.0, 0.0, 0.0, 1.0),
-            pose(0.0, 0.0, h, h),
-            pose(0.0, 0.0, 0.0, 1.0),
-        ]);
-        assert_eq!(turned.first_oriented(), Some(1));
-    }
 
     fn stamped(frame: &str, x: f64, y: f64) -> PoseStamped {
         let mut g = PoseStamped::default();
@@ -1189,94 +977,6 @@ mod tests {
         bad.set("min_speed", ros2_client::ParameterValue::Double(0.4));
         // min_speed above approach_speed (0.3) is inconsistent.
         assert!(mobil_ros::config::load::<PlannerConfig>(&bad).is_err());
-    }
-
-    #[test]
-    fn dock_poses_outside_odom_or_with_nan_are_refused() {
-        let g = dock_goal(&stamped("odom", 1.5, -0.5), "odom").expect("valid");
-        assert_eq!((g.x, g.y, g.yaw), (1.5, -0.5, 0.0));
-        assert_eq!(
-            dock_goal(&stamped("map", 1.0, 0.0), "odom"),
-            Err(GoalError::Frame {
-                what: "dock pose".into(),
-                got: "map".into(),
-                want: "odom".into()
-            })
-        );
-        assert!(matches!(
-            dock_goal(&stamped("", 1.0, 0.0), "odom"),
-            Err(GoalError::Frame { .. })
-        ));
-        assert!(matches!(
-            dock_goal(&stamped("odom", f64::NAN, 0.0), "odom"),
-            Err(GoalError::NotFinite { .. })
-        ));
-        assert!(matches!(
-            dock_goal(&stamped("odom", 2e4, 0.0), "odom"),
-            Err(GoalError::TooFar { .. })
-        ));
-        let mut q = stamped("odom", 1.0, 0.0);
-        q.pose.orientation.z = f64::INFINITY;
-        assert!(matches!(dock_goal(&q, "odom"), Err(GoalError::NotFinite { .. })));
-    }
-
-    #[test]
-    fn routes_are_checked_and_loops_repeat_from_the_first_pose() {
-        let poses = vec![
-            stamped("odom", 1.0, 0.0),
-            stamped("", 2.0, 0.0),
-            stamped("odom", 2.0, 1.0),
-        ];
-        let r = route_from_poses(&poses, "odom", "odom", 1, 1, None, 0.01).expect("valid");
-        // From index 1, then one more round from 0: 1, 2, 0, 1, 2.
-        assert_eq!(r.request_index, vec![1, 2, 0, 1, 2]);
-        assert_eq!(r.points[2], Point2::new(1.0, 0.0));
-        assert_eq!(
-            route_from_poses(&poses, "odom", "odom", 3, 0, None, 0.01),
-            Err(GoalError::GoalIndex { index: 3, len: 3 })
-        );
-        assert_eq!(
-            route_from_poses(&[], "odom", "odom", 0, 0, None, 0.01),
-            Err(GoalError::EmptyRoute)
-        );
-        let mut bad = poses.clone();
-        bad[2].header.frame_id = "map".into();
-        assert!(matches!(
-            route_from_poses(&bad, "odom", "odom", 0, 0, None, 0.01),
-            Err(GoalError::Frame { what, .. }) if what == "waypoint 2"
-        ));
-        bad[2] = stamped("odom", 0.0, f64::NAN);
-        assert!(matches!(
-            route_from_poses(&bad, "odom", "odom", 0, 0, None, 0.01),
-            Err(GoalError::NotFinite { .. })
-        ));
-        // 100 poses × (1 + 1 loop) = 200 is the most; one loop more is refused.
-        let many: Vec<_> = (0..100).map(|i| stamped("odom", i as f64, 0.0)).collect();
-        assert!(route_from_poses(&many, "odom", "odom", 0, 1, None, 0.01).is_ok());
-        assert_eq!(
-            route_from_poses(&many, "odom", "odom", 0, 2, None, 0.01),
-            Err(GoalError::TooLong(300))
-        );
-        // Zero length: every point on the first and on the robot.
-        let same = vec![stamped("odom", 0.0, 0.0), stamped("odom", 0.001, 0.0)];
-        assert_eq!(
-            route_from_poses(&same, "odom", "odom", 0, 0, Some(Point2::origin()), 0.01),
-            Err(GoalError::ZeroLength(0.01))
-        );
-        // A single waypoint away from the robot is a route.
-        assert!(route_from_poses(&same[..1], "odom", "odom", 0, 0, Some(Point2::new(1.0, 0.0)), 0.01).is_ok());
-        // A Path in `map` is refused as a whole.
-        let path = Path {
-            header: Header {
-                frame_id: "map".into(),
-                ..Default::default()
-            },
-            poses: poses.clone(),
-        };
-        assert!(matches!(
-            route_from_path(&path, "odom", None, 0.01),
-            Err(GoalError::Frame { what, .. }) if what == "route"
-        ));
     }
 
     #[test]
@@ -1375,8 +1075,10 @@ mod tests {
         assert_eq!(undock_result(&stale).error_code, 905);
         assert!(undock_result(&EndCause::Outcome(Outcome::succeeded("undocked"))).success);
         // Refusals before a goal starts, by action.
-        let e = GoalError::NoDockDatabase;
-        assert_eq!(invalid_goal(&e, Action::Dock).nav2_error(), 901);
+        assert_eq!(no_dock_database().nav2_error(), 901);
+        assert!(no_dock_database()
+            .reason()
+            .starts_with("INVALID_GOAL: use_dock_id is true"));
         let nan = GoalError::NotFinite {
             what: "dock pose".into(),
         };

@@ -55,13 +55,14 @@ use mobil_planner::{
 };
 use mobil_planner_node::vfo::{vfo_waypoints, WaypointMethod};
 use mobil_planner_node::{
-    check_reply, clamp_twist, dock_goal, dock_result, docking_offset, end_state, follow_result, invalid_goal,
-    load_world, markers, missed_from_report, pose_in_odom, refused_goal, refused_reply, route_from_path,
-    route_from_poses, route_infeasible, stale_at_start, status_message, undock_result, vfo_follow_result, Action,
-    GoalError, MarkerView, Missed, Mode, PlannerConfig, Route, StatusView,
+    check_reply, clamp_twist, dock_result, docking_offset, end_state, follow_result, invalid_goal, load_world, markers,
+    missed_from_report, no_dock_database, refused_goal, refused_reply, route_infeasible, stale_at_start,
+    status_message, undock_result, vfo_follow_result, Action, GoalError, MarkerView, Missed, Mode, PlannerConfig,
+    Route, StatusView, ROUTE_LIMITS,
 };
 use mobil_ros::action::{ActionEvent, GoalEnd, GoalRequest, GoalServer, GoalServerConfig};
 use mobil_ros::geometry::odom_pose;
+use mobil_ros::goal::{goal_pose, pose_in_frame, route_from_path, route_from_poses};
 use mobil_ros::input::Inputs;
 use mobil_ros::latest::Latest;
 use mobil_ros::motion::{Applied, CmdVel, EndCause, EndKind, Ended, GoalId, MotionSession, SessionSettings, Watched};
@@ -83,8 +84,6 @@ use tracing::{info, warn};
 
 /// The watchdog tick (steady clock): stale odometry is noticed within 50 ms of its timeout.
 const WATCHDOG_RATE_HZ: f64 = 20.0;
-/// A route shorter than this (m), start included, is refused as zero-length.
-const MIN_ROUTE_LENGTH: f64 = 1e-3;
 
 fn decl() -> NodeDecl {
     NodeDecl::for_config::<PlannerConfig>(
@@ -500,17 +499,13 @@ async fn event_loop(
             }
             Event::VfoTicked(done) => shell.vfo_ticked(&mut io, done),
             Event::DockPose(m) => {
-                let target = dock_goal(&m, &shell.config.odom_frame);
+                let target = goal_pose("dock pose", &m, &shell.config.odom_frame);
+                let target = target.map_err(|e| invalid_goal(&e, Action::Dock));
                 shell.start_dock(&mut io, target, Source::DockPose);
             }
             Event::Waypoints(m) => {
                 let start = shell.fresh_odom();
-                let route = route_from_path(
-                    &m,
-                    &shell.config.odom_frame,
-                    start.map(|p| p.position()),
-                    MIN_ROUTE_LENGTH,
-                );
+                let route = route_from_path(&m, &shell.config.odom_frame, start.map(|p| p.position()), ROUTE_LIMITS);
                 shell.start_route(&mut io, jobs, route, start, Source::Waypoints);
             }
             Event::Dock(ActionEvent::Goal(request)) => shell.dock_action(&mut io, request).await,
@@ -789,10 +784,10 @@ impl Shell {
     }
 
     /// Starts a docking onto `target` (or refuses it).
-    fn start_dock(&mut self, io: &mut Io<'_, '_>, target: Result<Pose2, GoalError>, source: Source) {
+    fn start_dock(&mut self, io: &mut Io<'_, '_>, target: Result<Pose2, mobil_motion::Outcome>, source: Source) {
         let offset = docking_offset(&self.chassis);
         let action = source.action();
-        let built = target.map_err(|e| invalid_goal(&e, action)).and_then(|goal| {
+        let built = target.and_then(|goal| {
             let gains = self.config.gains().map_err(|e| refused_goal(e, action))?;
             DockingController::new(
                 gains,
@@ -1013,9 +1008,9 @@ impl Shell {
     async fn dock_action(&mut self, io: &mut Io<'_, '_>, request: GoalRequest<DockRobotGoal>) {
         let g = request.goal();
         let target = if g.use_dock_id {
-            Err(GoalError::NoDockDatabase)
+            Err(no_dock_database())
         } else {
-            dock_goal(&g.dock_pose, &self.config.odom_frame)
+            goal_pose("dock pose", &g.dock_pose, &self.config.odom_frame).map_err(|e| invalid_goal(&e, Action::Dock))
         };
         if !g.use_dock_id {
             info!(
@@ -1084,15 +1079,9 @@ impl Shell {
     async fn follow_action(&mut self, io: &mut Io<'_, '_>, jobs: &mut Jobs, request: GoalRequest<FollowWaypointsGoal>) {
         let start = self.fresh_odom();
         let g = request.goal();
-        let route = route_from_poses(
-            &g.poses,
-            &self.config.odom_frame,
-            &self.config.odom_frame,
-            g.goal_index,
-            g.number_of_loops,
-            start.map(|p| p.position()),
-            MIN_ROUTE_LENGTH,
-        );
+        let frame = &self.config.odom_frame;
+        let (round, at) = ((g.goal_index, g.number_of_loops), start.map(|p| p.position()));
+        let route = route_from_poses(&g.poses, frame, frame, round, at, ROUTE_LIMITS);
         // A follow_waypoints goal pre-empted by this one lists what it had missed.
         let by = EndCause::Preempted("follow_waypoints");
         let preempted = match self.session.active() {
@@ -1165,7 +1154,7 @@ impl Shell {
     fn check_request(&self, req: &CheckRouteRequest) -> Result<(Pose2, Route), CheckRouteResponse> {
         let frame = &self.config.odom_frame;
         let start = if req.use_start {
-            pose_in_odom("start", frame, &req.start, frame)
+            pose_in_frame("start", frame, &req.start, frame)
                 .map_err(|e| refused_reply(invalid_goal(&e, Action::Follow).reason()))?
         } else {
             self.fresh_odom().ok_or_else(|| {
@@ -1175,7 +1164,7 @@ impl Shell {
                 )
             })?
         };
-        let route = route_from_path(&req.route, frame, Some(start.position()), MIN_ROUTE_LENGTH)
+        let route = route_from_path(&req.route, frame, Some(start.position()), ROUTE_LIMITS)
             .map_err(|e| refused_reply(invalid_goal(&e, Action::Follow).reason()))?;
         Ok((start, route))
     }

@@ -47,7 +47,7 @@ impl FromStr for WaypointMethod {
 /// The VFO settings, each filled by one `vfo.*` parameter (defaults: the library's).
 #[derive(Debug, Clone, PartialEq)]
 pub struct VfoSettings {
-    /// The law's gains (U_2 and |ω| are further held to the chassis: [`vfo_gains`]).
+    /// The law's gains (U_2 and |ω| are further held to the chassis: [`mobil_planner::vfo::vfo_gains`]).
     pub gains: VfoGains,
     /// Algorithm 2's settings (`time_step` = the node's control period).
     pub optimise: OptimiseConfig,
@@ -360,14 +360,6 @@ pub fn declare_vfo(d: &mut Decl<PlannerConfig>) {
     );
 }
 
-/// Whether a quaternion carries an orientation: not all-zero (never set) and not within 1e-6 of
-/// ±identity.
-pub(crate) fn oriented(q: &mobil_msgs::geometry_msgs::msg::Quaternion) -> bool {
-    let unset = q.x == 0.0 && q.y == 0.0 && q.z == 0.0 && q.w == 0.0;
-    let identity = q.x.abs() < 1e-6 && q.y.abs() < 1e-6 && q.z.abs() < 1e-6 && (q.w.abs() - 1.0).abs() < 1e-6;
-    !(unset || identity)
-}
-
 /// The route as VFO waypoints from `start`, μ = `guiding` for every one. θ_r, by one rule for
 /// the whole route (a ROS pose's orientation defaults to the identity, so a single identity
 /// cannot tell "heading 0" from "no heading"):
@@ -406,9 +398,8 @@ pub fn vfo_waypoints(route: &Route, start: &Pose2, guiding: f64) -> Result<Vec<V
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::{
-        markers, route_from_poses, status_message, vfo_follow_result, MarkerView, Mode, StatusView, MISSED_BY_THE_RUN,
-    };
+    use crate::ROUTE_LIMITS;
+    use crate::{markers, status_message, vfo_follow_result, MarkerView, Mode, StatusView, MISSED_BY_THE_RUN};
     use approx::assert_relative_eq;
     use mobil_msgs::builtin_interfaces::msg::Time;
     use mobil_msgs::geometry_msgs::msg::PoseStamped;
@@ -418,6 +409,7 @@ mod tests {
     use mobil_planner::vfo::{DrawnRobot, Obstacle, SegmentReport, VfoDrawing, MAX_DRAWN_OBSTACLES};
     use mobil_ros::config::{load, Decl};
     use mobil_ros::geometry::yaw_quaternion;
+    use mobil_ros::goal::route_from_poses;
     use mobil_ros::motion::EndCause;
     use mobil_ros::params::ParamValues;
     use nalgebra::Point2;
@@ -501,7 +493,7 @@ mod tests {
             pose(1.0, 2.0, None),
             pose(0.0, 2.0, None),
         ];
-        let route = route_from_poses(&plain, "odom", "odom", 0, 0, None, 0.01).expect("valid");
+        let route = route_from_poses(&plain, "odom", "odom", (0, 0), None, ROUTE_LIMITS).expect("valid");
         let w = vfo_waypoints(&route, &Pose2::new(0.0, 0.0, 0.3), 0.4).expect("valid");
         let headings: Vec<f64> = w.iter().map(|w| w.heading).collect();
         assert_relative_eq!(headings[0], 0.0, epsilon = 1e-12);
@@ -520,7 +512,7 @@ mod tests {
             pose(0.0, 2.0, None),
             unset,
         ];
-        let route = route_from_poses(&oriented, "odom", "odom", 0, 0, None, 0.01).expect("valid");
+        let route = route_from_poses(&oriented, "odom", "odom", (0, 0), None, ROUTE_LIMITS).expect("valid");
         let w = vfo_waypoints(&route, &Pose2::new(0.0, 0.0, 0.3), 0.4).expect("valid");
         let headings: Vec<f64> = w.iter().map(|w| w.heading).collect();
         assert_relative_eq!(headings[0], 0.0, epsilon = 1e-12);
@@ -532,10 +524,9 @@ mod tests {
             &[pose(0.0, 0.0, None), pose(1.0, 1.0, None)],
             "odom",
             "odom",
-            0,
-            0,
+            (0, 0),
             None,
-            0.01,
+            ROUTE_LIMITS,
         )
         .expect("valid");
         let w = vfo_waypoints(&route, &Pose2::new(0.0, 0.0, 0.3), 0.5).expect("valid");

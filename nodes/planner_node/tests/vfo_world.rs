@@ -12,8 +12,9 @@ use mobil_planner::vfo::vfo_gains;
 use mobil_planner::vfo::{
     integrate_unicycle, ObstacleMap, OptimiseConfig, PoseHistory, VfoEnd, VfoEvent, VfoFollower, VfoGains,
 };
-use mobil_planner_node::route_from_poses;
 use mobil_planner_node::vfo::{vfo_waypoints, VfoSettings};
+use mobil_planner_node::ROUTE_LIMITS;
+use mobil_ros::goal::route_from_poses;
 use mobil_sim::lidar::{Lidar, LidarConfig};
 use mobil_world::World;
 use nalgebra::Point2;
@@ -51,7 +52,7 @@ fn drive(route: &[(f64, f64)], start: Pose2, scan_phase: usize, hold: usize, lag
             p
         })
         .collect();
-    let route = route_from_poses(&poses, "odom", "odom", 0, 0, None, 1e-3).expect("valid route");
+    let route = route_from_poses(&poses, "odom", "odom", (0, 0), None, ROUTE_LIMITS).expect("valid route");
     let settings = VfoSettings {
         scan_range: 4.0,
         ..VfoSettings::default()
@@ -193,7 +194,8 @@ fn an_obstacle_appearing_mid_segment_re_optimises_the_segment_round_it() {
     p.header.frame_id = "odom".into();
     p.pose.position.x = 3.5;
     p.pose.orientation.w = 1.0;
-    let route = route_from_poses(&[p], "odom", "odom", 0, 0, Some(start.position()), 1e-3).expect("valid route");
+    let route =
+        route_from_poses(&[p], "odom", "odom", (0, 0), Some(start.position()), ROUTE_LIMITS).expect("valid route");
     let waypoints = vfo_waypoints(&route, &start, settings.guiding).expect("valid");
     let gains = vfo_gains(&VfoGains::default(), &ChassisParams::omr3());
     let config = OptimiseConfig {
