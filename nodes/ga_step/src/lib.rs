@@ -15,7 +15,12 @@
 //!   [`TestLandscape`], an analytic **test** evaluator (not physics) for tests and benchmarks.
 //! - [`ga`]: [`GaState`], the generation loop, statistics, stop rules.
 //! - [`checkpoint`]: the state as tagged, versioned JSON, written atomically.
-//! - [`output`]: `fitness.csv`, Webots motion files (writer and reader), JointTrajectory YAML.
+//! - [`output`]: `fitness.csv`, Webots motion files (writer and reader), JointTrajectory YAML,
+//!   the names of a run's files.
+//! - [`resume`]: whether a checkpoint continues the run asked for ([`check_resume`]).
+//! - [`summary`]: how a run ended, [`RunSummary`] and its line.
+//! - [`external`]: the ROS-free half of an external simulator's evaluation (its answer's
+//!   values, the void score).
 //! - [`config`]: [`GaConfig`], [`FitnessConfig`], every default justified; `params/nao_step.yaml`
 //!   holds the same values.
 //!
@@ -90,11 +95,14 @@ pub mod checkpoint;
 pub mod config;
 pub mod error;
 pub mod evaluate;
+pub mod external;
 pub mod ga;
 pub mod model;
 pub mod operators;
 pub mod output;
+pub mod resume;
 pub mod selection;
+pub mod summary;
 
 pub use checkpoint::{
     read_checkpoint, read_checkpoint_tagged, write_checkpoint, EvaluatorTag, CHECKPOINT_FORMAT, CHECKPOINT_VERSION,
@@ -110,4 +118,6 @@ pub use operators::{
     MutationPick,
 };
 pub use output::{read_motion, write_fitness_csv, write_joint_trajectory_yaml, write_motion, Motion, MotionRow};
+pub use resume::{check_resume, ResumeRefusal};
 pub use selection::{choose_operator, replace_best, roulette, roulette_excluding, Operator, Scored};
+pub use summary::RunSummary;

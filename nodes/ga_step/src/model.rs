@@ -165,6 +165,12 @@ impl NaoModel {
         (self.step_time * 1000.0).round() as u64
     }
 
+    /// The time of knot `k` from the start of the step (ns), k·T/20: k·T_ms·1e6/20 =
+    /// k·T_ms·50 000, exact in integers.
+    pub fn knot_time_ns(&self, k: usize) -> u64 {
+        k as u64 * (self.step_time_ms() * 1_000_000 / INTERVALS as u64)
+    }
+
     /// The individual that stands still: every knot at the standing pose.
     pub fn standing(&self) -> Individual {
         Individual {

@@ -1,6 +1,8 @@
 //! The run's files, as pure functions over writers and readers: `fitness.csv`, Webots motion
 //! files (writer and reader) and the best individual as a `trajectory_msgs/JointTrajectory`
-//! in YAML.
+//! in YAML; and their names in a run's output directory ([`OUTPUTS`],
+//! [`generation_motion_name`]), with the temporary files a killed writer may leave
+//! ([`is_own_temporary`], [`remove_temporaries`]).
 
 use crate::error::MotionError;
 use crate::ga::GenerationStats;
@@ -286,10 +288,8 @@ pub fn write_joint_trajectory_yaml<W: Write>(mut w: W, model: &NaoModel, individ
     writeln!(w, "  frame_id: ''")?;
     writeln!(w, "joint_names: [{}]", joint_names().join(", "))?;
     writeln!(w, "points:")?;
-    // Knot i at i·T/20: in ns, i·T_ms·1e6/20 = i·T_ms·50 000 (exact in integers).
-    let step_ns = model.step_time_ms() * 1_000_000 / INTERVALS as u64;
     for k in 0..KNOTS {
-        let ns = k as u64 * step_ns;
+        let ns = model.knot_time_ns(k);
         let positions: Vec<String> = individual.knots.iter().map(|s| yaml_float(s[k])).collect();
         writeln!(w, "  - positions: [{}]", positions.join(", "))?;
         writeln!(
@@ -305,4 +305,50 @@ pub fn write_joint_trajectory_yaml<W: Write>(mut w: W, model: &NaoModel, individ
 /// Rows a motion file of `model`'s step has: T/40 ms + 1.
 pub fn motion_rows(model: &NaoModel) -> u64 {
     model.step_time_ms() / SAMPLE_PERIOD_MS + 1
+}
+
+/// The checkpoint's file name in a run's output directory.
+pub const CHECKPOINT: &str = "checkpoint.json";
+/// The outputs with a fixed name (besides `best_gen_NNNN.motion`).
+pub const OUTPUTS: [&str; 5] = [
+    "fitness.csv",
+    "fitness.svg",
+    "best.motion",
+    "best_trajectory.yaml",
+    CHECKPOINT,
+];
+/// Generations between two `best_gen_NNNN.motion` files.
+pub const MOTION_EVERY: u32 = 10;
+
+/// The name of generation `g`'s motion file.
+pub fn generation_motion_name(g: u32) -> String {
+    format!("best_gen_{g:04}.motion")
+}
+
+/// Whether `name` is a temporary file of a run's outputs: one of their names (the fixed ones,
+/// or `best_gen_` with four or more digits `.motion`) followed by `.tmp`.
+pub fn is_own_temporary(name: &str) -> bool {
+    let Some(output) = name.strip_suffix(".tmp") else {
+        return false;
+    };
+    if OUTPUTS.contains(&output) {
+        return true;
+    }
+    output
+        .strip_prefix("best_gen_")
+        .and_then(|rest| rest.strip_suffix(".motion"))
+        .is_some_and(|digits| digits.len() >= 4 && digits.bytes().all(|b| b.is_ascii_digit()))
+}
+
+/// Removes the temporary files of a run's outputs from `dir` (left by a process killed while
+/// writing); any other file, `*.tmp` or not, is left alone. Best effort.
+pub fn remove_temporaries(dir: &std::path::Path) {
+    let Ok(entries) = std::fs::read_dir(dir) else {
+        return;
+    };
+    for e in entries.flatten() {
+        if e.file_name().to_str().is_some_and(is_own_temporary) {
+            let _ = std::fs::remove_file(e.path());
+        }
+    }
 }

@@ -1,7 +1,7 @@
 //! The run's files: the Webots motion file's exact format and its round trip through our reader,
 //! the JointTrajectory YAML and `fitness.csv`.
 
-use mobil_ga_step::output::{motion_rows, motion_time, FITNESS_CSV_HEADER};
+use mobil_ga_step::output::{generation_motion_name, motion_rows, motion_time, remove_temporaries, FITNESS_CSV_HEADER};
 use mobil_ga_step::{
     read_motion, write_fitness_csv, write_joint_trajectory_yaml, write_motion, GenerationStats, Individual,
     MotionError, NaoModel,
@@ -331,4 +331,47 @@ fn fitness_csv_has_a_header_and_one_row_per_generation() {
         format!("{FITNESS_CSV_HEADER}\n0,0.9,0.25,0\n1,1.125,0.5,0.1\n")
     );
     assert_eq!(FITNESS_CSV_HEADER, "generation,max,mean,min");
+}
+
+#[test]
+fn only_a_runs_temporaries_are_removed() {
+    let dir = std::env::temp_dir().join(format!("ga_step_temporaries_{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    let ours = [
+        "fitness.csv.tmp",
+        "fitness.svg.tmp",
+        "best.motion.tmp",
+        "best_trajectory.yaml.tmp",
+        "checkpoint.json.tmp",
+        "best_gen_0010.motion.tmp",
+        "best_gen_12340.motion.tmp",
+    ];
+    let theirs = [
+        "notes.tmp",
+        "fitness.csv",
+        "best_gen_12.motion.tmp",
+        "best_gen_00x0.motion.tmp",
+        "my_fitness.csv.tmp",
+        "checkpoint.json.tmp.tmp",
+    ];
+    for name in ours.iter().chain(&theirs) {
+        std::fs::write(dir.join(name), b"x").unwrap();
+    }
+    remove_temporaries(&dir);
+    let mut left: Vec<String> = std::fs::read_dir(&dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().into_string().unwrap())
+        .collect();
+    left.sort();
+    let mut want: Vec<String> = theirs.iter().map(|s| s.to_string()).collect();
+    want.sort();
+    assert_eq!(left, want);
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn motion_files_are_numbered_with_four_digits() {
+    assert_eq!(generation_motion_name(0), "best_gen_0000.motion");
+    assert_eq!(generation_motion_name(140), "best_gen_0140.motion");
 }

@@ -1,7 +1,8 @@
 //! What a run leaves in its output directory, every file written atomically (to `<name>.tmp`,
 //! synced, renamed, the directory synced), so an interrupted run never leaves a half-written
 //! file; the writes hold [`WRITING`], which a second Ctrl-C takes before it exits, and a run
-//! starts by removing the `.tmp` files of these names a killed run may have left (no other):
+//! starts by removing the `.tmp` files of these names a killed run may have left (no other;
+//! the names and that rule are `mobil_ga_step::output`'s):
 //! - `fitness.csv`: `generation,max,mean,min`, one row per generation;
 //! - `fitness.svg`: max, mean and min fitness per generation (the source's Fig. 2–3);
 //! - `best.motion`: the best individual as a Webots motion file, and `best_gen_NNNN.motion`, the
@@ -9,6 +10,7 @@
 //! - `best_trajectory.yaml`: the best individual as a `trajectory_msgs/JointTrajectory` (YAML);
 //! - `checkpoint.json`: the run's state (see `mobil_ga_step::checkpoint`).
 
+use mobil_ga_step::output::{generation_motion_name, CHECKPOINT, MOTION_EVERY};
 use mobil_ga_step::{
     write_fitness_csv, write_joint_trajectory_yaml, write_motion, EvaluatorTag, GaState, GenerationStats,
 };
@@ -21,19 +23,6 @@ use std::sync::{Mutex, PoisonError};
 /// Held while a generation's outputs are written: whoever must end the process at once (a
 /// second Ctrl-C) takes it first, so the process ends between two files' writes, never in one.
 pub static WRITING: Mutex<()> = Mutex::new(());
-
-/// The checkpoint's file name.
-pub const CHECKPOINT: &str = "checkpoint.json";
-/// The outputs with a fixed name (besides `best_gen_NNNN.motion`).
-pub const OUTPUTS: [&str; 5] = [
-    "fitness.csv",
-    "fitness.svg",
-    "best.motion",
-    "best_trajectory.yaml",
-    CHECKPOINT,
-];
-/// Generations between two `best_gen_NNNN.motion` files.
-pub const MOTION_EVERY: u32 = 10;
 
 /// A pause (ms) between writing each output's temporary file and renaming it, 0 by default: a
 /// test's way to land a signal while a write holds [`WRITING`] (`ga_step`'s hidden
@@ -63,11 +52,6 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
     result
 }
 
-/// The name of generation `g`'s motion file.
-pub fn generation_motion_name(g: u32) -> String {
-    format!("best_gen_{g:04}.motion")
-}
-
 /// `fitness.svg`: max (dark), mean (blue) and min (grey, dashed) fitness per generation, with a
 /// title line naming the crossover and the seed.
 pub fn fitness_svg(history: &[GenerationStats], title: &str) -> String {
@@ -87,34 +71,6 @@ pub fn fitness_svg(history: &[GenerationStats], title: &str) -> String {
     svg.series(&panel, &max, Stroke::solid("#141414", 2.2));
     svg.text(60.0, 392.0, 11.0, "max — black, mean — blue, min — grey dashed");
     svg.finish()
-}
-
-/// Whether `name` is a temporary file this program writes: one of its outputs' names (the
-/// fixed ones, or `best_gen_` with four or more digits `.motion`) followed by `.tmp`.
-pub fn is_own_temporary(name: &str) -> bool {
-    let Some(output) = name.strip_suffix(".tmp") else {
-        return false;
-    };
-    if OUTPUTS.contains(&output) {
-        return true;
-    }
-    output
-        .strip_prefix("best_gen_")
-        .and_then(|rest| rest.strip_suffix(".motion"))
-        .is_some_and(|digits| digits.len() >= 4 && digits.bytes().all(|b| b.is_ascii_digit()))
-}
-
-/// Removes the temporary files of this program's outputs from `dir` (left by a process killed
-/// while writing); any other file, `*.tmp` or not, is left alone. Best effort.
-pub fn remove_temporaries(dir: &Path) {
-    let Ok(entries) = std::fs::read_dir(dir) else {
-        return;
-    };
-    for e in entries.flatten() {
-        if e.file_name().to_str().is_some_and(is_own_temporary) {
-            let _ = std::fs::remove_file(e.path());
-        }
-    }
 }
 
 /// Writes every output of `state` (scored by `evaluator`) into `dir` (the checkpoint last, so
@@ -190,48 +146,5 @@ mod tests {
         // A directory that does not exist: an error, and nothing left behind.
         assert!(write_atomic(&dir.join("missing/b.txt"), b"x").is_err());
         std::fs::remove_dir_all(&dir).unwrap();
-    }
-
-    #[test]
-    fn only_this_programs_temporaries_are_removed() {
-        let dir = std::env::temp_dir().join(format!("ga_step_temporaries_{}", std::process::id()));
-        let _ = std::fs::remove_dir_all(&dir);
-        std::fs::create_dir_all(&dir).unwrap();
-        let ours = [
-            "fitness.csv.tmp",
-            "fitness.svg.tmp",
-            "best.motion.tmp",
-            "best_trajectory.yaml.tmp",
-            "checkpoint.json.tmp",
-            "best_gen_0010.motion.tmp",
-            "best_gen_12340.motion.tmp",
-        ];
-        let theirs = [
-            "notes.tmp",
-            "fitness.csv",
-            "best_gen_12.motion.tmp",
-            "best_gen_00x0.motion.tmp",
-            "my_fitness.csv.tmp",
-            "checkpoint.json.tmp.tmp",
-        ];
-        for name in ours.iter().chain(&theirs) {
-            std::fs::write(dir.join(name), b"x").unwrap();
-        }
-        remove_temporaries(&dir);
-        let mut left: Vec<String> = std::fs::read_dir(&dir)
-            .unwrap()
-            .map(|e| e.unwrap().file_name().into_string().unwrap())
-            .collect();
-        left.sort();
-        let mut want: Vec<String> = theirs.iter().map(|s| s.to_string()).collect();
-        want.sort();
-        assert_eq!(left, want);
-        std::fs::remove_dir_all(&dir).unwrap();
-    }
-
-    #[test]
-    fn motion_files_are_numbered_with_four_digits() {
-        assert_eq!(generation_motion_name(0), "best_gen_0000.motion");
-        assert_eq!(generation_motion_name(140), "best_gen_0140.motion");
     }
 }

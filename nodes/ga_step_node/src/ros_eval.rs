@@ -37,7 +37,8 @@
 //! generation in flight, so the run resumes from its last checkpoint. Evaluations are sequential
 //! (one simulator): run this evaluator on one thread.
 
-use mobil_ga_step::{Evaluation, Evaluator, FitnessConfig, Individual, NaoModel, INTERVALS, KNOTS};
+use mobil_ga_step::external::{candidate_name, Outcome, VOID};
+use mobil_ga_step::{Evaluation, Evaluator, FitnessConfig, Individual, NaoModel, KNOTS};
 use mobil_msgs::builtin_interfaces::msg::{Duration as RosDuration, Time};
 use mobil_msgs::sensor_msgs::msg::JointState;
 use mobil_msgs::std_msgs::msg::Header;
@@ -88,7 +89,7 @@ pub enum RosEvalError {
 pub fn candidate_header(n: u64, stamp: Time) -> Header {
     Header {
         stamp,
-        frame_id: format!("candidate {n}"),
+        frame_id: candidate_name(n),
     }
 }
 
@@ -98,7 +99,7 @@ pub fn candidate_message(model: &NaoModel, individual: &Individual, header: Head
     let names = mobil_ga_step::joint_names();
     let points = (0..KNOTS)
         .map(|k| {
-            let ns = (k as u128 * model.step_time_ms() as u128 * 1_000_000) / INTERVALS as u128;
+            let ns = model.knot_time_ns(k);
             JointTrajectoryPoint {
                 positions: individual.knots.iter().map(|s| s[k]).collect(),
                 time_from_start: RosDuration {
@@ -116,46 +117,10 @@ pub fn candidate_message(model: &NaoModel, individual: &Individual, header: Head
     }
 }
 
-/// A simulator's answer, read from an outcome message (see the module's documentation).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Outcome {
-    /// Whether the robot fell.
-    pub fell: bool,
-    /// When it fell (s), 0 without a fall.
-    pub fall_time: f64,
-    /// The torso's forward displacement (m).
-    pub forward_distance: f64,
-}
-
-/// Reads the named values of an outcome: `fell` (0 or 1), `forward_distance` (finite) and, for
-/// a fall, `fall_time` (finite, ≥ 0). The reason when one is missing or bad.
+/// Reads the named values of an outcome (`mobil_ga_step::external::Outcome::from_named`): the
+/// reason when one is missing or bad.
 pub fn parse_outcome(m: &JointState) -> Result<Outcome, String> {
-    if m.name.len() != m.position.len() {
-        return Err(format!("{} names but {} positions", m.name.len(), m.position.len()));
-    }
-    let value = |key: &str| m.name.iter().position(|n| n == key).map(|i| m.position[i]);
-    let fell = match value("fell") {
-        Some(1.0) => true,
-        Some(0.0) => false,
-        Some(v) => return Err(format!("fell = {v}, expected 0 or 1")),
-        None => return Err("no `fell`".into()),
-    };
-    let forward_distance = match value("forward_distance") {
-        Some(v) if v.is_finite() => v,
-        Some(v) => return Err(format!("forward_distance = {v} is not finite")),
-        None => return Err("no `forward_distance`".into()),
-    };
-    let fall_time = match (fell, value("fall_time")) {
-        (false, _) => 0.0,
-        (true, Some(t)) if t.is_finite() && t >= 0.0 => t,
-        (true, Some(t)) => return Err(format!("fall_time = {t}, expected a finite time ≥ 0")),
-        (true, None) => return Err("a fall without `fall_time`".into()),
-    };
-    Ok(Outcome {
-        fell,
-        fall_time,
-        forward_distance,
-    })
+    Outcome::from_named(&m.name, &m.position)
 }
 
 // Field order is drop order: the writer and reader go before the node that owns their
@@ -184,13 +149,6 @@ pub struct RosEvaluator {
     interrupt: Arc<AtomicBool>,
     runtime: tokio::runtime::Runtime,
 }
-
-const ZERO: Evaluation = Evaluation {
-    fitness: 0.0,
-    fell: true,
-    t_fall: 0.0,
-    forward_distance: 0.0,
-};
 
 /// How often the wait for a simulator looks at the interrupt.
 const POLL: Duration = Duration::from_millis(10);
@@ -430,20 +388,14 @@ impl RosEvaluator {
                     continue;
                 }
                 return Ok(Some(match parse_outcome(&m) {
-                    Ok(o) => Evaluation::from_outcome(
-                        &self.fitness,
-                        self.model.step_time,
-                        o.fell,
-                        o.fall_time,
-                        o.forward_distance,
-                    ),
+                    Ok(o) => o.evaluation(&self.fitness, &self.model),
                     Err(reason) => {
                         warn_throttled!(
                             link.throttle,
                             "bad",
                             "candidate {n}: bad outcome ({reason}); scored 0 as a fall at 0 s"
                         );
-                        ZERO
+                        VOID
                     }
                 }));
             }
@@ -470,10 +422,10 @@ impl Evaluator for RosEvaluator {
     fn evaluate(&self, individual: &Individual) -> Evaluation {
         let mut guard = self.link.lock().unwrap_or_else(PoisonError::into_inner);
         let Some(link) = guard.as_mut() else {
-            return ZERO;
+            return VOID;
         };
         if link.failed.is_some() {
-            return ZERO;
+            return VOID;
         }
         match self.round_trip(link, individual) {
             Ok(Some(e)) => {
@@ -489,11 +441,11 @@ impl Evaluator for RosEvaluator {
                     "candidate {n}: unanswered after {ATTEMPTS} attempts; scored 0 as a fall at 0 s ({} so far)",
                     link.void_scores
                 );
-                ZERO
+                VOID
             }
             Err(e) => {
                 link.failed = Some(e);
-                ZERO
+                VOID
             }
         }
     }

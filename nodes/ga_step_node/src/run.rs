@@ -1,12 +1,16 @@
 //! One run of the executable: the command line, a fresh or resumed state, the generation loop
 //! with its outputs and progress bar, and the way it ends.
 
-use crate::outputs::{self, CHECKPOINT};
+use crate::outputs;
 use crate::ros_eval::{RosEvalError, RosEvaluator};
 use anyhow::{anyhow, bail, Context as _};
 use clap::{Parser, ValueEnum};
 use indicatif::{ProgressBar, ProgressStyle};
-use mobil_ga_step::{Crossover, Evaluator, EvaluatorTag, GaSetup, GaState, StopReason, MAX_POPULATION};
+use mobil_ga_step::output::{remove_temporaries, CHECKPOINT};
+use mobil_ga_step::{
+    check_resume, Crossover, Evaluator, EvaluatorTag, GaSetup, GaState, ResumeRefusal, RunSummary, StopReason,
+    MAX_POPULATION,
+};
 use mobil_ga_step_sim::{PhysicsEvaluator, PHYSICS_VERSION};
 use mobil_ros::args::RosArgs;
 use std::ops::ControlFlow;
@@ -169,57 +173,6 @@ pub fn options_markdown() -> String {
     markdown_table(&["option", "value", "default", "description"], &rows)
 }
 
-/// How a run ended.
-#[derive(Debug, Clone, PartialEq)]
-pub struct Summary {
-    /// Why it stopped.
-    pub reason: StopReason,
-    /// Generations done.
-    pub generation: u32,
-    /// Best fitness.
-    pub best_fitness: f64,
-    /// Whether the best falls.
-    pub best_fell: bool,
-    /// The best's forward distance (m).
-    pub best_forward: f64,
-    /// First generation with a non-falling forward step.
-    pub first_step_generation: Option<u32>,
-    /// Wall time of this invocation.
-    pub wall: Duration,
-    /// With an external simulator: the candidates it left unanswered after every attempt,
-    /// scored 0 (void scores). `None` with the built-in physics.
-    pub void_scores: Option<u64>,
-}
-
-impl Summary {
-    /// The line printed at the end.
-    pub fn line(&self, out: &Path) -> String {
-        let why = match self.reason {
-            StopReason::ForwardStep => "a non-falling forward step",
-            StopReason::Levelled => "the mean fitness levelled off",
-            StopReason::MaxGenerations => "the requested generations",
-            StopReason::Interrupted => "an interrupt (resume with --resume)",
-        };
-        let step = match self.first_step_generation {
-            Some(g) => format!("first forward step at generation {g}"),
-            None => "no forward step yet".to_owned(),
-        };
-        let void = match self.void_scores {
-            Some(v) => format!("; {v} unanswered candidates scored 0"),
-            None => String::new(),
-        };
-        format!(
-            "ga_step: stopped at generation {} by {why}; best fitness {:.4} ({}, {:+.3} m forward); {step}{void}; {:.1} s; wrote {}",
-            self.generation,
-            self.best_fitness,
-            if self.best_fell { "falls" } else { "stands" },
-            self.best_forward,
-            self.wall.as_secs_f64(),
-            out.display()
-        )
-    }
-}
-
 /// The setup the command line asks for: the parameter file's (or the defaults) with the
 /// options' population, crossover and level window.
 pub fn setup_of(cli: &Cli) -> anyhow::Result<GaSetup> {
@@ -245,91 +198,22 @@ fn check_writable(dir: &Path) -> anyhow::Result<()> {
     Ok(())
 }
 
-/// What differs between a checkpoint's run and the one the command line asks for, one phrase
-/// each (empty: the same run).
-fn run_differences(
-    state: &GaState,
-    recorded: &EvaluatorTag,
-    cli: &Cli,
-    setup: &GaSetup,
-    asked: &EvaluatorTag,
-) -> Vec<String> {
-    let mut differences = Vec::new();
-    let mut differ = |same: bool, what: &str, theirs: String, ours: String| {
-        if !same {
-            differences.push(format!("{what} {theirs} (asked {ours})"));
-        }
-    };
-    differ(recorded == asked, "evaluator", recorded.to_string(), asked.to_string());
-    differ(
-        state.seed == cli.seed,
-        "seed",
-        state.seed.to_string(),
-        cli.seed.to_string(),
-    );
-    let (was, now) = (&state.setup.ga, &setup.ga);
-    differ(
-        was.population == now.population && was.offspring == now.offspring,
-        "population",
-        was.population.to_string(),
-        now.population.to_string(),
-    );
-    differ(
-        was.crossover == now.crossover,
-        "crossover",
-        was.crossover.to_string(),
-        now.crossover.to_string(),
-    );
-    differ(
-        was.level_window == now.level_window,
-        "level window",
-        was.level_window.to_string(),
-        now.level_window.to_string(),
-    );
-    let (was_f, now_f) = (&state.setup.fitness, &setup.fitness);
-    differ(
-        was_f.distance_on_fall == now_f.distance_on_fall && was_f.backward_allowance == now_f.backward_allowance,
-        "fitness",
-        was_f.shape(),
-        now_f.shape(),
-    );
-    // The robust score is the built-in physics' alone: other evaluators ignore the switch.
-    let robust_counts = matches!(asked, EvaluatorTag::Physics { .. });
-    differ(
-        !robust_counts || was_f.robust_check == now_f.robust_check,
-        "robust_check",
-        was_f.robust_check.to_string(),
-        now_f.robust_check.to_string(),
-    );
-    let mut theirs = state.setup.clone();
-    if !robust_counts {
-        theirs.fitness.robust_check = now_f.robust_check;
-    }
-    if differences.is_empty() && theirs != *setup {
-        differences.push("other parameters of the robot, the algorithm or the fitness (--params)".to_owned());
-    }
-    differences
-}
-
 /// Reads the checkpoint in `dir` and checks that it is the run the command line names.
 fn resume_state(cli: &Cli, setup: &GaSetup, asked: &EvaluatorTag) -> anyhow::Result<GaState> {
     let path = cli.out.join(CHECKPOINT);
     let (state, recorded) = mobil_ga_step::read_checkpoint_tagged(&path)
         .map_err(|e| anyhow!("cannot resume from {}: {e}", path.display()))?;
-    let f = &state.setup.fitness;
-    if matches!(recorded, EvaluatorTag::Physics { .. }) && f.robust_check && f.distance_on_fall {
-        bail!(
+    match check_resume(&state, &recorded, cli.seed, setup, asked) {
+        Ok(()) => {}
+        Err(ResumeRefusal::Retired) => bail!(
             "cannot resume from {}: its run was scored by the robust score with a fall's distance counted, which is no longer offered (the worse of two outcomes is not the lower score there)",
             path.display()
-        );
-    }
-    let differences = run_differences(&state, &recorded, cli, setup, asked);
-    if !differences.is_empty() {
-        bail!(
+        ),
+        Err(ResumeRefusal::OtherRun(differences)) => bail!(
             "the checkpoint in {} is of another run: {}",
             cli.out.display(),
             differences.join(", ")
-        );
+        ),
     }
     Ok(state)
 }
@@ -383,7 +267,7 @@ pub struct InterruptedBeforeStart;
 
 /// Runs the command line to its end. `interrupt` is polled between generations, and by the ROS
 /// evaluator while it waits; `ros_args` name, place and remap the ROS evaluator's node.
-pub fn run(cli: &Cli, ros_args: &RosArgs, interrupt: &Arc<AtomicBool>) -> anyhow::Result<Summary> {
+pub fn run(cli: &Cli, ros_args: &RosArgs, interrupt: &Arc<AtomicBool>) -> anyhow::Result<RunSummary> {
     let started = Instant::now();
     let setup = setup_of(cli)?;
     setup.validate().map_err(|e| anyhow!("{e}"))?;
@@ -436,7 +320,7 @@ pub fn run(cli: &Cli, ros_args: &RosArgs, interrupt: &Arc<AtomicBool>) -> anyhow
     let evaluator = chosen.evaluator();
     // Once the evaluator is up, just before the first write: a run that could not start leaves
     // DIR as it was.
-    outputs::remove_temporaries(&cli.out);
+    remove_temporaries(&cli.out);
 
     let bar = ProgressBar::new(cli.generations as u64);
     bar.set_style(
@@ -513,20 +397,6 @@ pub fn run(cli: &Cli, ros_args: &RosArgs, interrupt: &Arc<AtomicBool>) -> anyhow
     if let Some(e) = failure {
         return Err(e);
     }
-    // The generation the outputs hold: the one before a lost one.
-    let generation = if lost { state.generation - 1 } else { state.generation };
-    let row = state
-        .history
-        .get(generation as usize)
-        .ok_or_else(|| anyhow!("no statistics of generation {generation}"))?;
-    Ok(Summary {
-        reason,
-        generation,
-        best_fitness: row.max,
-        best_fell: row.best_fell,
-        best_forward: row.best_forward,
-        first_step_generation: state.first_step_generation.filter(|g| *g <= generation),
-        wall: started.elapsed(),
-        void_scores: chosen.void_scores(),
-    })
+    RunSummary::of(&state, reason, lost, started.elapsed(), chosen.void_scores())
+        .ok_or_else(|| anyhow!("no statistics of the generation the outputs hold"))
 }
