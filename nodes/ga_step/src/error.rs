@@ -73,6 +73,12 @@ pub enum CheckpointError {
     },
 }
 
+/// A parameter file that cannot be read or does not describe a valid setup: one line, naming
+/// the file.
+#[derive(Debug, Clone, PartialEq, Error)]
+#[error("{0}")]
+pub struct ParamsError(pub String);
+
 /// Why a motion file could not be read.
 #[derive(Debug, Clone, PartialEq, Error)]
 pub enum MotionError {

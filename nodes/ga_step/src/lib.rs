@@ -23,6 +23,7 @@
 //!   values, the void score).
 //! - [`config`]: [`GaConfig`], [`FitnessConfig`], every default justified; `params/nao_step.yaml`
 //!   holds the same values.
+//! - [`params`]: a parameter file of `params/nao_step.yaml`'s form read into a [`GaSetup`].
 //!
 //! Choices beyond the SPEC (its Decisions are implemented as written):
 //! - **Standing pose and T** (SPEC: a documented choice): knees 0.8 rad, hip and ankle pitch
@@ -100,6 +101,7 @@ pub mod ga;
 pub mod model;
 pub mod operators;
 pub mod output;
+pub mod params;
 pub mod resume;
 pub mod selection;
 pub mod summary;
@@ -109,7 +111,7 @@ pub use checkpoint::{
     MAX_CHECKPOINT_BYTES,
 };
 pub use config::{BlxVariant, Crossover, FitnessConfig, GaConfig, MAX_POPULATION};
-pub use error::{CheckpointError, GaError, MotionError};
+pub use error::{CheckpointError, GaError, MotionError, ParamsError};
 pub use evaluate::{evaluate_all, resolve_threads, Evaluation, Evaluator, TestLandscape};
 pub use ga::{GaRng, GaSetup, GaState, GenerationStats, StopReason};
 pub use model::{joint_names, Individual, NaoModel, Servo, INTERVALS, KNOTS, SERVO_COUNT};

@@ -3,13 +3,16 @@
 //! 40 ms rows; (2) hip + knee + ankle pitch = 0 on each leg; (3) the standing pose lies within
 //! Table 1's limits; (4) with its fitness constants standing still scores 1 + w·b = 3 (b = 1.0 m),
 //! a 10 cm non-falling step adds 0.2, and a fall scores its time alone (0.8 at 80 % of T_sim,
-//! whatever its distance), below any upright individual.
+//! whatever its distance), below any upright individual. Read by `mobil_ga_step::params` (what
+//! `ga_step --params` reads), it is the built-in setup, and a bad file is a one-line error.
 
 // Table 1's values as printed (4 decimals): 0.7854 is the table's, not π/4.
 #![allow(clippy::approx_constant)]
 
-use mobil_ga_step::{FitnessConfig, GaConfig, NaoModel, Servo};
+use mobil_ga_step::params::{read_setup, setup_from_yaml};
+use mobil_ga_step::{FitnessConfig, GaConfig, GaSetup, NaoModel, Servo};
 use serde_norway::Value;
+use std::path::Path;
 
 fn section() -> Value {
     let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../../params/nao_step.yaml");
@@ -125,4 +128,48 @@ fn statement_4_staying_up_comes_before_distance() {
     assert!((fitness.fitness(t, Some(0.8 * t_sim), 0.10) - 0.8).abs() < 1e-12);
     assert!((fitness.fitness(t, Some(2.9), 1.0) - 2.9 / 3.0).abs() < 1e-12);
     assert!(fitness.fitness(t, Some(2.9), 1.0) < standing);
+}
+
+/// `--params FILE`'s reading (`mobil_ga_step::params`), on the shipped file.
+const FILE: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../../params/nao_step.yaml");
+
+#[test]
+fn the_shipped_file_is_the_built_in_defaults() {
+    let setup = read_setup(Path::new(FILE)).unwrap();
+    assert_eq!(setup, GaSetup::default());
+    // A value of the file is read, not just defaulted: the step time is 2.0 s there.
+    let text = std::fs::read_to_string(FILE)
+        .unwrap()
+        .replace("step_time: 2.0", "step_time: 2.4");
+    let changed = setup_from_yaml(&text, "f").unwrap();
+    assert_eq!(changed.model.step_time, 2.4);
+    assert_ne!(changed, GaSetup::default());
+}
+
+#[test]
+fn unknown_keys_and_bad_values_are_one_line_errors() {
+    let text = std::fs::read_to_string(FILE).unwrap();
+    let cases = [
+        (text.replace("blx_alpha:", "blx_alpa:"), "unknown parameter `blx_alpa`"),
+        (text.replace("fall_tilt: 0.5", "fall_tilt: 2.0"), "fall_tilt"),
+        (text.replace("mutation_picks: 10", "mutation_picks: ten"), "algorithm"),
+        (
+            text.replace("blx_alpha: 0.7", "blx_alpha: 0.7\n    population: 5"),
+            "`population` is set by the --population option",
+        ),
+        (
+            text.replace("blx_alpha: 0.7", "blx_alpha: 0.7\n    offspring: 100"),
+            "`offspring` is set by the --population option",
+        ),
+        (
+            text.replace("blx_alpha: 0.7", "blx_alpha: 0.7\n    crossover: arithmetic"),
+            "`crossover` is set by the --crossover option",
+        ),
+        ("ga_step: 3".to_owned(), "no `ga_step: ros__parameters:`"),
+    ];
+    for (t, want) in cases {
+        let e = setup_from_yaml(&t, "f").unwrap_err().to_string();
+        assert!(e.contains(want), "{e}");
+        assert_eq!(e.lines().count(), 1, "{e}");
+    }
 }

@@ -177,7 +177,7 @@ pub fn options_markdown() -> String {
 /// options' population, crossover and level window.
 pub fn setup_of(cli: &Cli) -> anyhow::Result<GaSetup> {
     let mut setup = match &cli.params {
-        Some(path) => crate::params::read_setup(path)?,
+        Some(path) => mobil_ga_step::params::read_setup(path)?,
         None => GaSetup::default(),
     };
     setup.ga.population = cli.population as usize;
