@@ -155,6 +155,22 @@ impl Route {
         self.poses.iter().position(|p| oriented(&p.pose.orientation))
     }
 
+    /// The heading each waypoint asks for, by one rule for the whole route (a ROS pose's
+    /// orientation defaults to the identity, so a single identity cannot tell "heading 0" from
+    /// "no heading"): in a route in which some pose carries an orientation
+    /// ([`Route::first_oriented`]) every waypoint's is its pose's yaw, the identity's 0 rad
+    /// included, but for an all-zero quaternion (never set); in any other route none.
+    pub fn headings(&self) -> Vec<Option<f64>> {
+        let oriented_route = self.first_oriented().is_some();
+        (0..self.points.len())
+            .map(|k| {
+                let q = &self.poses.get(self.request(k))?.pose.orientation;
+                let unset = q.x == 0.0 && q.y == 0.0 && q.z == 0.0 && q.w == 0.0;
+                (oriented_route && !unset).then(|| yaw_of(q))
+            })
+            .collect()
+    }
+
     /// The request's index of route waypoint `i` (its own index if none is known).
     pub fn request(&self, i: usize) -> usize {
         self.request_index.get(i).copied().unwrap_or(i)
@@ -331,6 +347,31 @@ mod tests {
             poses,
         };
         assert_eq!(r.first_oriented(), Some(1));
+    }
+
+    #[test]
+    fn a_route_carries_headings_only_when_some_pose_is_oriented() {
+        let posed = |x: f64, yaw: Option<f64>| {
+            let mut p = stamped("odom", x, 0.0);
+            if let Some(yaw) = yaw {
+                p.pose.orientation = yaw_quaternion(yaw);
+            }
+            p
+        };
+        // Every orientation the identity: no heading anywhere.
+        let plain = vec![posed(1.0, None), posed(2.0, None)];
+        let r = route_from_poses(&plain, "odom", "odom", (0, 0), None, LIMITS).unwrap();
+        assert_eq!(r.headings(), vec![None, None]);
+        // One pose at 0.5 rad: the identity of the next is a heading of 0 rad, an unset
+        // (all-zero) quaternion none; a loop repeats the request's headings.
+        let mut unset = posed(3.0, None);
+        unset.pose.orientation.w = 0.0;
+        let oriented = vec![posed(1.0, Some(0.5)), posed(2.0, None), unset];
+        let r = route_from_poses(&oriented, "odom", "odom", (1, 1), None, LIMITS).unwrap();
+        let h = r.headings();
+        assert_eq!(r.request_index, vec![1, 2, 0, 1, 2]);
+        assert_eq!((h[0], h[1], h[3], h[4]), (Some(0.0), None, Some(0.0), None));
+        assert!((h[2].unwrap() - 0.5).abs() < 1e-9);
     }
 
     #[test]

@@ -5,9 +5,14 @@
 //! Nav2's codes. A node runs them through its motion server; nothing here reads a clock or
 //! publishes.
 
-use crate::docking::{DockingController, DockingFailure, DockingOutput, DockingPhase, Finish, PolarError, Residual};
-use crate::follow::{FollowEnd, FollowEvent, WaypointFollower};
-use crate::route::{ProblemKind, UnreachableCause};
+use crate::docking::{
+    DockingConfig, DockingController, DockingFailure, DockingGains, DockingOutput, DockingPhase, Finish, PolarError,
+    Residual, VelocityLimits,
+};
+use crate::error::PlannerError;
+use crate::follow::{FollowConfig, FollowEnd, FollowEvent, WaypointFollower};
+use crate::route::{ProblemKind, RouteProblem, RouteReport, UnreachableCause};
+use mobil_chassis::ChassisParams;
 use mobil_geom::Pose2;
 use mobil_motion::{nav2, GoalLaw, Outcome, Step, StepInput};
 use mobil_tools::drive::{DistanceDrive, DriveSettings, Progress};
@@ -62,7 +67,39 @@ pub struct DockStep {
     pub phase_changed: bool,
 }
 
+/// The offset (m) of the point the docking law steers, behind the reference point: on a steered
+/// chassis the kinematic origin (`reference_offset` behind), the one point that moves as the
+/// law's unicycle does (no sideways speed), so V̇ ≤ 0 holds wherever the curvature limit does
+/// not bind; on the omni chassis the reference point itself (any twist is executed there).
+pub fn docking_offset(chassis: &ChassisParams) -> f64 {
+    if chassis.model().is_nonholonomic() {
+        chassis.reference_offset()
+    } else {
+        0.0
+    }
+}
+
 impl DockGoal {
+    /// A docking of the reference point onto `dock` on `chassis`, the law scaled to its limits
+    /// and finishing as it can ([`Finish::for_chassis`]), steering the point [`docking_offset`]
+    /// behind.
+    pub fn onto(
+        dock: Pose2,
+        gains: DockingGains,
+        config: DockingConfig,
+        chassis: &ChassisParams,
+    ) -> Result<Self, PlannerError> {
+        let offset = docking_offset(chassis);
+        let controller = DockingController::new(
+            gains,
+            config,
+            VelocityLimits::from_chassis(chassis),
+            Finish::for_chassis(chassis),
+            dock.ahead(-offset),
+        )?;
+        Ok(DockGoal::new(controller, offset))
+    }
+
     /// A docking by `controller`, whose goal is the dock pose moved back by `offset` (m).
     pub fn new(controller: DockingController, offset: f64) -> Self {
         DockGoal {
@@ -203,6 +240,89 @@ pub fn route_done(count: usize, missed: &[Missed]) -> String {
             missed.len(),
             list_missed(missed)
         )
+    }
+}
+
+/// The pre-check's problems as missed waypoints: each with the request's index of its waypoint
+/// (`request_index`, by route index; a missing one is its own), where it is (a collision where
+/// it begins, else its waypoint of `points`).
+pub fn missed_from_report(problems: &[RouteProblem], points: &[Point2<f64>], request_index: &[usize]) -> Vec<Missed> {
+    problems
+        .iter()
+        .map(|p| Missed {
+            index: request_index.get(p.index).copied().unwrap_or(p.index),
+            position: match p.kind {
+                ProblemKind::Collision { at, .. } => at,
+                _ => points.get(p.index).copied().unwrap_or_else(Point2::origin),
+            },
+            kind: p.kind,
+            pre_check: true,
+        })
+        .collect()
+}
+
+/// The route the pre-check found `problems` on: `ROUTE_INFEASIBLE`, every problem listed (up
+/// to [`MAX_LISTED_MISSED`]), FollowWaypoints' TASK_EXECUTOR_FAILED.
+pub fn route_infeasible(problems: &[Missed]) -> Outcome {
+    Outcome::failed(
+        "ROUTE_INFEASIBLE",
+        format!("{} problem(s): {}", problems.len(), list_missed(problems)),
+        nav2::follow_waypoints::TASK_EXECUTOR_FAILED,
+    )
+}
+
+/// What comes of a route's pre-check ([`after_pre_check`]).
+#[derive(Debug, Clone, PartialEq)]
+pub enum PreChecked {
+    /// Drive it, by `goal`; `problems` found (only when infeasible routes are driven).
+    Drive {
+        /// The route goal.
+        goal: Box<RouteGoal>,
+        /// The problems found, driven through.
+        problems: Vec<Missed>,
+    },
+    /// The route is refused: `ROUTE_INFEASIBLE` with `problems`, or the follower refused it.
+    Refuse {
+        /// Why.
+        outcome: Outcome,
+        /// The problems found.
+        problems: Vec<Missed>,
+    },
+}
+
+/// The decision after a route's pre-check `report`: a route with problems is refused unless
+/// `execute_infeasible`; else it is driven from `start` by the goal approach (`follow` on
+/// `chassis`), the request's index of each waypoint alongside.
+pub fn after_pre_check(
+    report: &RouteReport,
+    (points, request_index): (&[Point2<f64>], &[usize]),
+    start: &Pose2,
+    (follow, chassis): (FollowConfig, &ChassisParams),
+    execute_infeasible: bool,
+) -> PreChecked {
+    let problems = missed_from_report(&report.problems, points, request_index);
+    if !problems.is_empty() && !execute_infeasible {
+        return PreChecked::Refuse {
+            outcome: route_infeasible(&problems),
+            problems,
+        };
+    }
+    match WaypointFollower::new(follow, chassis, points.to_vec()) {
+        Ok(follower) => {
+            let distance = points.first().map_or(f64::NAN, |p| (p - start.position()).norm());
+            PreChecked::Drive {
+                goal: Box::new(RouteGoal::new(follower, request_index.to_vec(), distance)),
+                problems,
+            }
+        }
+        Err(e) => PreChecked::Refuse {
+            outcome: Outcome::failed(
+                "INVALID_INPUT",
+                format!("the planner refused its input: {e}; robot stopped"),
+                nav2::follow_waypoints::TASK_EXECUTOR_FAILED,
+            ),
+            problems,
+        },
     }
 }
 

@@ -3,13 +3,16 @@
 //! Figures worked out by hand from the laws (SPEC §3, §4) and DistanceDrive's ramp.
 
 use approx::assert_relative_eq;
+use mobil_chassis::model::ChassisConfig;
 use mobil_chassis::ChassisParams;
 use mobil_geom::Pose2;
 use mobil_motion::{GoalLaw, Step, StepInput};
-use mobil_planner::goals::{docking_failure, DockGoal, RouteEvent, RouteGoal, UndockGoal};
+use mobil_planner::goals::{
+    after_pre_check, docking_failure, docking_offset, DockGoal, PreChecked, RouteEvent, RouteGoal, UndockGoal,
+};
 use mobil_planner::{
-    DockingConfig, DockingController, DockingFailure, DockingGains, Finish, FollowConfig, Residual, VelocityLimits,
-    WaypointFollower,
+    DockingConfig, DockingController, DockingFailure, DockingGains, Finish, FollowConfig, ProblemKind, Residual,
+    RouteProblem, RouteReport, VelocityLimits, WaypointFollower,
 };
 use nalgebra::Point2;
 
@@ -189,4 +192,93 @@ fn an_undocking_backs_out_on_the_ramp_and_ends_within_tolerance_or_time() {
         other => panic!("{other:?}"),
     }
     assert!(matches!(g.step(&at(32.0, f64::NAN, 0.0, 0.0), &()), Step::Refused(_)));
+}
+
+#[test]
+fn a_docking_onto_a_pose_steers_the_kinematic_origin_of_a_steered_chassis() {
+    // MOBIL-II with its reference point 0.30 m ahead of the rear axle (params/mobil2.yaml).
+    let mobil2 = ChassisParams::new(ChassisConfig {
+        reference_offset: 0.30,
+        ..ChassisConfig::mobil2()
+    })
+    .unwrap();
+    let (omni, steered) = (&ChassisParams::omr3(), &mobil2);
+    assert_eq!((docking_offset(omni), docking_offset(steered)), (0.0, 0.30));
+    let dock = Pose2::new(1.0, 0.5, 1.0);
+    let g = DockGoal::onto(dock, DockingGains::paper(), DockingConfig::default(), steered).unwrap();
+    // The law's goal is the dock pose moved back 0.30 m along its heading 1 rad.
+    let goal = g.controller().goal();
+    assert_relative_eq!(goal.x, 1.0 - 0.30 * 1.0f64.cos(), epsilon = 1e-12);
+    assert_relative_eq!(goal.y, 0.5 - 0.30 * 1.0f64.sin(), epsilon = 1e-12);
+    assert_relative_eq!(g.target().x, 1.0, epsilon = 1e-12);
+    assert_eq!(g.controller().finish(), Finish::ReportResidual);
+    let g = DockGoal::onto(dock, DockingGains::paper(), DockingConfig::default(), omni).unwrap();
+    assert_eq!((g.controller().goal(), g.offset()), (dock, 0.0));
+    assert!(DockGoal::onto(
+        Pose2::new(f64::NAN, 0.0, 0.0),
+        DockingGains::paper(),
+        DockingConfig::default(),
+        omni
+    )
+    .is_err());
+}
+
+#[test]
+fn a_pre_check_with_problems_refuses_the_route_unless_told_to_drive_it() {
+    // Route waypoints (1, 0), (2, 0), (2, 1) from the request's poses 4, 5, 6 (a goal_index).
+    let points = [Point2::new(1.0, 0.0), Point2::new(2.0, 0.0), Point2::new(2.0, 1.0)];
+    let request = [4, 5, 6];
+    let hit = Point2::new(1.6, 0.1);
+    let report = RouteReport {
+        problems: vec![
+            RouteProblem {
+                index: 1,
+                kind: ProblemKind::Collision {
+                    at: hit,
+                    clearance: -0.1,
+                },
+            },
+            RouteProblem {
+                index: 2,
+                kind: ProblemKind::TurnRadius {
+                    required: 0.2,
+                    minimum: 0.73,
+                },
+            },
+        ],
+        path: Vec::new(),
+        reached: vec![true, true, true],
+    };
+    let omr3 = ChassisParams::omr3();
+    let start = Pose2::new(0.0, 0.0, 0.0);
+    let rules = (FollowConfig::default(), &omr3);
+    match after_pre_check(&report, (&points, &request), &start, rules, false) {
+        PreChecked::Refuse { outcome, problems } => {
+            // Each problem by the request's index, a collision where it begins, the other at its
+            // waypoint.
+            let got: Vec<_> = problems.iter().map(|m| (m.index, m.position, m.pre_check)).collect();
+            assert_eq!(got, vec![(5, hit, true), (6, points[2], true)]);
+            assert!(outcome
+                .reason()
+                .starts_with("ROUTE_INFEASIBLE: 2 problem(s): waypoint 5: collision"));
+            assert_eq!(outcome.nav2_error(), 601);
+        }
+        other => panic!("{other:?}"),
+    }
+    match after_pre_check(&report, (&points, &request), &start, rules, true) {
+        PreChecked::Drive { goal, problems } => {
+            assert_eq!(problems.len(), 2);
+            // Pursuing the first waypoint, 1 m from the start, by its request index.
+            assert_eq!((goal.waypoint(), goal.distance()), (4, 1.0));
+        }
+        other => panic!("{other:?}"),
+    }
+    let clean = RouteReport {
+        problems: Vec::new(),
+        ..report
+    };
+    assert!(matches!(
+        after_pre_check(&clean, (&points, &request), &start, rules, false),
+        PreChecked::Drive { problems, .. } if problems.is_empty()
+    ));
 }

@@ -9,8 +9,9 @@ use mobil_chassis::ChassisParams;
 use mobil_geom::Pose2;
 use mobil_motion::{GoalLaw, Outcome, Step, StepInput};
 use mobil_planner::vfo::{
-    find_sigmas, vfo_gains, Interrupt, Obstacle, OptimiseConfig, Segment, SegmentReport, VfoController, VfoDrawing,
-    VfoEvent, VfoFollower, VfoGains, VfoGoal, VfoTick, VfoWaypoint, MAX_BUDGET_RETRIES,
+    find_sigmas, vfo_gains, vfo_waypoints, Interrupt, Obstacle, ObstacleMap, OptimiseConfig, Reoptimised,
+    ScanObstacleConfig, Segment, SegmentReport, VfoController, VfoDrawing, VfoEvent, VfoFollower, VfoGains, VfoGoal,
+    VfoSetup, VfoTick, VfoWaypoint, MAX_BUDGET_RETRIES,
 };
 use nalgebra::Point2;
 
@@ -209,4 +210,104 @@ fn the_report_and_the_drawing_of_an_optimisation() {
     assert_eq!(SegmentReport::of(&o).candidates, 2);
     let r = SegmentReport::default();
     assert!(r.psi_z.is_nan() && r.virtual_robots == 0);
+}
+
+#[test]
+fn waypoint_headings_follow_the_legs_unless_given() {
+    use std::f64::consts::PI;
+    // From (0, 0) facing 0.3 rad: (1, 0) along +x (0); (1, 0) again keeps 0; (1, 2) along +y
+    // (π/2); (0, 2) along −x (π).
+    let points = [
+        Point2::new(1.0, 0.0),
+        Point2::new(1.0, 0.0),
+        Point2::new(1.0, 2.0),
+        Point2::new(0.0, 2.0),
+    ];
+    let w = vfo_waypoints(&points, &[None; 4], &Pose2::new(0.0, 0.0, 0.3), 0.4).unwrap();
+    let headings: Vec<f64> = w.iter().map(|w| w.heading).collect();
+    for (got, want) in headings.iter().zip([0.0, 0.0, PI / 2.0, PI]) {
+        assert_relative_eq!(*got, want, epsilon = 1e-12);
+    }
+    assert!(w.iter().all(|w| w.guiding == 0.4) && w[2].position == Point2::new(1.0, 2.0));
+    // A given heading is taken (0 rad at (0, 2), not the leg's π); the next leg's follows.
+    let given = [None, Some(0.5), Some(0.0), None];
+    let w = vfo_waypoints(&points, &given, &Pose2::new(0.0, 0.0, 0.3), 0.4).unwrap();
+    assert_relative_eq!(w[1].heading, 0.5, epsilon = 1e-12);
+    assert_relative_eq!(w[2].heading, 0.0, epsilon = 1e-12);
+    // A waypoint on the start keeps the start's heading; a non-finite one is refused by index.
+    let w = vfo_waypoints(&[Point2::origin()], &[None], &Pose2::new(0.0, 0.0, 0.3), 0.5).unwrap();
+    assert_relative_eq!(w[0].heading, 0.3, epsilon = 1e-12);
+    let bad = [Point2::new(1.0, 0.0), Point2::new(f64::NAN, 0.0)];
+    assert_eq!(vfo_waypoints(&bad, &[None; 2], &Pose2::identity(), 0.5), Err(1));
+}
+
+#[test]
+fn a_route_goal_is_built_for_the_chassis_and_tells_its_events() {
+    let map = ObstacleMap::new(ScanObstacleConfig::default()).unwrap();
+    let setup = VfoSetup {
+        gains: VfoGains::default(),
+        optimise: OptimiseConfig::default(),
+        guiding: 0.5,
+    };
+    let points = [Point2::new(2.0, 0.0), Point2::new(2.0, 2.0)];
+    let g = VfoGoal::for_route(
+        (&points, &[None, None], &[7, 8]),
+        &Pose2::identity(),
+        &setup,
+        &ChassisParams::omr3(),
+        &map,
+    )
+    .unwrap();
+    // OMR-III holds |ω| ≤ 4 to its 1.5 rad/s; the first waypoint 2 m from the start.
+    assert_eq!(g.follower().waypoints().len(), 2);
+    assert_eq!((g.view().waypoint, g.view().distance), (7, 2.0));
+    let reached = VfoEvent::Reached { index: 1, vortex: true };
+    assert_eq!(
+        g.describe(&reached),
+        "waypoint 8 reached (early: the robot was caught between obstacles, Algorithm 3)"
+    );
+    let optimised = VfoEvent::Optimised {
+        index: 0,
+        reason: Reoptimised::SegmentStart,
+        score: None,
+        warnings: Vec::new(),
+    };
+    assert_eq!(
+        g.describe(&optimised),
+        "segment to waypoint 7 optimised (SegmentStart): Ψ_z none, 0 virtual robots, 0 candidates"
+    );
+    // A bad waypoint or bad settings are refused with the request's index and the codes.
+    let bad = [Point2::new(2.0, 0.0), Point2::new(f64::INFINITY, 0.0)];
+    let e = VfoGoal::for_route(
+        (&bad, &[None, None], &[7, 8]),
+        &Pose2::identity(),
+        &setup,
+        &ChassisParams::omr3(),
+        &map,
+    )
+    .unwrap_err();
+    assert_eq!(
+        (e.reason().as_str(), e.nav2_error()),
+        ("INVALID_GOAL: waypoint 8 is not finite", 600)
+    );
+    let broken = VfoSetup {
+        optimise: OptimiseConfig {
+            time_step: -1.0,
+            ..OptimiseConfig::default()
+        },
+        ..setup
+    };
+    let e = VfoGoal::for_route(
+        (&points, &[None, None], &[7, 8]),
+        &Pose2::identity(),
+        &broken,
+        &ChassisParams::omr3(),
+        &map,
+    )
+    .unwrap_err();
+    assert!(
+        e.reason().starts_with("INVALID_INPUT: the planner refused its input"),
+        "{}",
+        e.reason()
+    );
 }

@@ -7,7 +7,7 @@ use std::f64::consts::{FRAC_PI_2, PI};
 
 use approx::assert_relative_eq;
 use mobil_geom::{Pose2, Scan};
-use mobil_planner::vfo::{Circle, ObstacleMap, Placement, PoseHistory, ScanObstacleConfig};
+use mobil_planner::vfo::{Circle, ObstacleMap, Placement, PoseHistory, ScanObstacleConfig, ScanSkipped};
 use nalgebra::{Point2, Vector2};
 
 /// Ranges of a scan from `odom_from_laser` with `beams` beams over `fov` (centred), seeing
@@ -238,6 +238,32 @@ fn a_scan_placed_with_the_pose_at_its_stamp_finds_the_obstacle_where_it_is() {
         .expect("valid");
     let off = (late.circles()[0].centre - pillar.0).norm();
     assert!((off - 0.46).abs() < 0.02, "{off}");
+    // The same through add_scan, which finds the pose at the stamp itself; without fresh
+    // odometry, or with none near the stamp, the scan is skipped and says why.
+    let scan = Scan::new(
+        -fov / 2.0,
+        fov / 2.0,
+        inc,
+        0.06,
+        10.0,
+        ranges.clone(),
+        Vec::new(),
+        Pose2::identity(),
+    )
+    .expect("valid");
+    let mut map = ObstacleMap::new(ScanObstacleConfig::default()).expect("valid");
+    map.add_scan(&scan, 0.05, Some(&h), 0.05).expect("placed");
+    assert!((map.circles()[0].centre - pillar.0).norm() < 1e-3);
+    let skipped = map.add_scan(&scan, 0.05, None, 0.05).unwrap_err();
+    assert_eq!(
+        skipped.to_string(),
+        "scan at 0.050 s ignored: no fresh odometry within 0.05 s of its stamp (obstacles are placed by the pose \
+         at the scan's time)"
+    );
+    assert!(matches!(
+        map.add_scan(&scan, 5.0, Some(&h), 0.05),
+        Err(ScanSkipped::NoPose { .. })
+    ));
 }
 
 #[test]

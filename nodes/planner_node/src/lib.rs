@@ -23,11 +23,9 @@ use mobil_msgs::nav2_msgs::msg::MissedWaypoint;
 use mobil_msgs::nav_msgs::msg::Path;
 use mobil_msgs::std_msgs::msg::{ColorRGBA, Header};
 use mobil_msgs::visualization_msgs::msg::{Marker, MarkerArray};
-pub use mobil_planner::goals::{list_missed, Missed, MISSED_BY_THE_RUN};
+pub use mobil_planner::goals::{list_missed, missed_from_report, route_infeasible, Missed, MISSED_BY_THE_RUN};
 use mobil_planner::vfo::{SegmentReport, VfoDrawing, MAX_DRAWN_OBSTACLES, MAX_DRAWN_ROBOTS};
-use mobil_planner::{
-    DockingConfig, DockingGains, FollowConfig, ProblemKind, RouteCheckConfig, RouteProblem, RouteReport,
-};
+use mobil_planner::{DockingConfig, DockingGains, FollowConfig, RouteCheckConfig, RouteReport};
 use mobil_ros::chassis::{chassis_params, declare_chassis};
 use mobil_ros::config::{Config, ConfigError, Decl};
 use mobil_ros::geometry::yaw_quaternion;
@@ -389,18 +387,6 @@ pub fn clamp_twist(twist: BodyTwist, params: &ChassisParams) -> Twist {
     t
 }
 
-/// The offset (m) of the point the docking law steers, behind the reference point: on a steered
-/// chassis the kinematic origin (`reference_offset` behind), the one point that moves as the
-/// law's unicycle does (no sideways speed), so V̇ ≤ 0 holds wherever the curvature limit does
-/// not bind; on the omni chassis the reference point itself (any twist is executed there).
-pub fn docking_offset(params: &ChassisParams) -> f64 {
-    if params.model().is_nonholonomic() {
-        params.reference_offset()
-    } else {
-        0.0
-    }
-}
-
 /// What the node is doing.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Mode {
@@ -515,16 +501,6 @@ pub fn stale_at_start(input: &str, action: Action) -> Outcome {
     )
 }
 
-/// The route pre-check found `problems` (and `execute_infeasible_routes` is false):
-/// `ROUTE_INFEASIBLE`, every problem listed (up to [`MAX_LISTED_PROBLEMS`]).
-pub fn route_infeasible(problems: &[Missed]) -> Outcome {
-    Outcome::failed(
-        "ROUTE_INFEASIBLE",
-        format!("{} problem(s): {}", problems.len(), list_missed(problems)),
-        nav2::follow_waypoints::TASK_EXECUTOR_FAILED,
-    )
-}
-
 /// The NavStatus state an end leaves.
 pub fn end_state(cause: &EndCause) -> u8 {
     match cause.kind() {
@@ -589,27 +565,6 @@ fn missed_waypoint(index: usize, error_code: u16, poses: &[PoseStamped]) -> Miss
     }
 }
 
-/// The pre-check's problems as missed waypoints (indices mapped to the request's).
-pub fn missed_from_report(problems: &[RouteProblem], route: &Route) -> Vec<Missed> {
-    problems
-        .iter()
-        .map(|p| Missed {
-            index: route.request_index.get(p.index).copied().unwrap_or(p.index),
-            position: problem_position(p, &route.points),
-            kind: p.kind,
-            pre_check: true,
-        })
-        .collect()
-}
-
-/// Where a problem is: a collision where it begins, else its waypoint.
-pub fn problem_position(p: &RouteProblem, waypoints: &[Point2<f64>]) -> Point2<f64> {
-    match p.kind {
-        ProblemKind::Collision { at, .. } => at,
-        _ => waypoints.get(p.index).copied().unwrap_or_else(Point2::origin),
-    }
-}
-
 fn point(p: Point2<f64>) -> Point {
     Point { x: p.x, y: p.y, z: 0.0 }
 }
@@ -625,7 +580,7 @@ fn pose_msg(p: &Pose2) -> Pose {
 /// index, kind, detail and position; `feasible`, `failed_waypoint`, the simulated path
 /// (downsampled to [`MAX_REPLY_POSES`]) and its length.
 pub fn check_reply(report: &RouteReport, route: &Route, stamp: Time, frame: &str, step: f64) -> CheckRouteResponse {
-    let missed = missed_from_report(&report.problems, route);
+    let missed = missed_from_report(&report.problems, &route.points, &route.request_index);
     let header = Header {
         stamp,
         frame_id: frame.to_owned(),
@@ -950,6 +905,7 @@ fn clear_marker(header: &Header) -> Marker {
 mod tests {
     use super::*;
     use approx::assert_relative_eq;
+    use mobil_planner::ProblemKind;
     use mobil_ros::geometry::yaw_of;
     use mobil_ros::params::ParamValues;
 
@@ -1020,8 +976,6 @@ mod tests {
         assert_relative_eq!(t.linear.x, 0.5 * s, epsilon = 1e-9);
         assert_relative_eq!(t.linear.y, 0.05 * (1.0 - s), epsilon = 1e-12);
         assert_relative_eq!(t.angular.z, 0.25, epsilon = 1e-12);
-        assert_eq!(docking_offset(&mobil2), 0.30);
-        assert_eq!(docking_offset(&omni), 0.0);
         // Non-finite → zero.
         let t = clamp_twist(BodyTwist::new(f64::NAN, 0.0, 1.0), &omr3);
         assert_eq!((t.linear.x, t.linear.y, t.angular.z), (0.0, 0.0, 0.0));
@@ -1158,7 +1112,7 @@ mod tests {
             poses: vec![],
         };
         let report = RouteReport {
-            problems: vec![RouteProblem {
+            problems: vec![mobil_planner::RouteProblem {
                 index: 1,
                 kind: ProblemKind::Collision {
                     at: Point2::new(300.0, 0.0),

@@ -45,20 +45,19 @@ use mobil_msgs::nav_msgs::msg::{Odometry, Path};
 use mobil_msgs::sensor_msgs::msg::LaserScan;
 use mobil_msgs::tf2_msgs::msg::TFMessage;
 use mobil_msgs::visualization_msgs::msg::MarkerArray;
-use mobil_planner::goals::{DockGoal, RouteEvent, RouteGoal, UndockGoal};
+use mobil_planner::goals::{
+    after_pre_check, route_infeasible, DockGoal, PreChecked, RouteEvent, RouteGoal, UndockGoal,
+};
 use mobil_planner::vfo::{
-    vfo_gains, Interrupt, ObstacleMap, OptimiseWarning, PoseHistory, VfoDrawing, VfoEvent, VfoFollower, VfoGoal,
+    vfo_gains, Interrupt, ObstacleMap, OptimiseWarning, PoseHistory, ScanSkipped, VfoDrawing, VfoEvent, VfoGoal,
     VfoStep, VfoTick, VfoView, MAX_SETTLE_S,
 };
-use mobil_planner::{
-    check_route_until, DockingController, DockingPhase, Finish, RouteReport, VelocityLimits, WaypointFollower,
-};
-use mobil_planner_node::vfo::{vfo_waypoints, WaypointMethod};
+use mobil_planner::{check_route_until, DockingPhase, Finish, RouteReport};
+use mobil_planner_node::vfo::WaypointMethod;
 use mobil_planner_node::{
-    check_reply, clamp_twist, dock_result, docking_offset, end_state, follow_result, invalid_goal, load_world, markers,
-    missed_from_report, no_dock_database, refused_goal, refused_reply, route_infeasible, stale_at_start,
-    status_message, undock_result, vfo_follow_result, Action, GoalError, MarkerView, Missed, Mode, PlannerConfig,
-    Route, StatusView, ROUTE_LIMITS,
+    check_reply, clamp_twist, dock_result, end_state, follow_result, invalid_goal, load_world, markers,
+    no_dock_database, refused_goal, refused_reply, stale_at_start, status_message, undock_result, vfo_follow_result,
+    Action, GoalError, MarkerView, Missed, Mode, PlannerConfig, Route, StatusView, ROUTE_LIMITS,
 };
 use mobil_ros::action::{ActionEvent, GoalEnd, GoalRequest, GoalServer, GoalServerConfig};
 use mobil_ros::geometry::odom_pose;
@@ -320,7 +319,7 @@ enum Event {
     Follow(ActionEvent<FollowWaypointsGoal>),
     Check(RmwRequestId, CheckRouteRequest),
     Checked(RmwRequestId, CheckRouteResponse),
-    PreChecked(PreCheckDone),
+    RouteChecked(PreCheckDone),
     Tick,
 }
 
@@ -467,7 +466,7 @@ async fn event_loop(
             _ = &mut shutdown => Event::Shutdown,
             Some(changed) = node.config_changed::<PlannerConfig>() => Event::Config(changed),
             e = inputs.next() => e?,
-            done = jobs.goal.result() => Event::PreChecked(done),
+            done = jobs.goal.result() => Event::RouteChecked(done),
             done = jobs.vfo.result() => Event::VfoTicked(done),
             Some((id, reply)) = jobs.replies.recv() => Event::Checked(id, reply),
             e = servers.dock.next_event() => Event::Dock(e),
@@ -528,7 +527,7 @@ async fn event_loop(
                 jobs.pending = jobs.pending.saturating_sub(1);
                 respond(check, id, reply, &mut shell.throttle);
             }
-            Event::PreChecked(done) => shell.pre_checked(&mut io, done),
+            Event::RouteChecked(done) => shell.pre_checked(&mut io, done),
             Event::Tick => shell.tick(&mut io).await,
         }
     }
@@ -785,22 +784,14 @@ impl Shell {
 
     /// Starts a docking onto `target` (or refuses it).
     fn start_dock(&mut self, io: &mut Io<'_, '_>, target: Result<Pose2, mobil_motion::Outcome>, source: Source) {
-        let offset = docking_offset(&self.chassis);
         let action = source.action();
-        let built = target.and_then(|goal| {
+        let built = target.and_then(|dock| {
             let gains = self.config.gains().map_err(|e| refused_goal(e, action))?;
-            DockingController::new(
-                gains,
-                self.config.docking,
-                VelocityLimits::from_chassis(&self.chassis),
-                Finish::for_chassis(&self.chassis),
-                goal.ahead(-offset),
-            )
-            .map_err(|e| refused_goal(e, action))
+            DockGoal::onto(dock, gains, self.config.docking, &self.chassis).map_err(|e| refused_goal(e, action))
         });
         let dock = match built {
-            Ok(controller) => DockGoal::new(controller, offset),
-            Err(outcome) => return self.refuse(io, source, outcome),
+            Ok(dock) => dock,
+            Err(refusal) => return self.refuse(io, source, refusal),
         };
         let goal = dock.target();
         info!(
@@ -811,10 +802,11 @@ impl Shell {
             goal.yaw,
             self.config.odom_frame
         );
-        if Finish::for_chassis(&self.chassis) == Finish::ReportResidual {
+        if dock.controller().finish() == Finish::ReportResidual {
             info!(
-                "a steered chassis cannot turn in place: the law steers its kinematic origin ({offset:.2} m \
-                 behind), and the heading left at the dock is reported as RESIDUAL"
+                "a steered chassis cannot turn in place: the law steers its kinematic origin ({:.2} m behind), \
+                 and the heading left at the dock is reported as RESIDUAL",
+                dock.offset()
             );
         }
         self.begin(io, Task::Dock(dock), source);
@@ -885,24 +877,19 @@ impl Shell {
         if self.scan_seen.get(self.config.vfo.scan_timeout()).is_none() {
             return self.refuse(io, source, stale_at_start("scan", source.action()));
         }
-        let offset = docking_offset(&self.chassis);
         let settings = &self.config.vfo;
-        let gains = vfo_gains(&settings.gains, &self.chassis);
-        let built = vfo_waypoints(&route, &start.ahead(-offset), settings.guiding)
-            .map_err(|e| invalid_goal(&e, Action::Follow))
-            .and_then(|waypoints| {
-                VfoFollower::new(gains, settings.optimise, waypoints, self.map.obstacles())
-                    .map_err(|e| refused_goal(e, Action::Follow))
-            });
-        let follower = match built {
-            Ok(f) => f,
-            Err(outcome) => return self.refuse(io, source, outcome),
+        let setup = settings.setup();
+        let of_route = (&route.points[..], &route.headings()[..], &route.request_index[..]);
+        let law = match VfoGoal::for_route(of_route, &start, &setup, &self.chassis, &self.map) {
+            Ok(law) => law,
+            Err(refusal) => return self.refuse(io, source, refusal),
         };
+        let gains = vfo_gains(&setup.gains, &self.chassis);
         info!(
             "goal ({}): {} waypoints by VFO ({} obstacles known; U_2 {:.2} m/s, |ω| ≤ {:.2} rad/s, T_p {:.3} s)",
             source.name(),
             route.points.len(),
-            follower.obstacles().len(),
+            law.follower().obstacles().len(),
             gains.speed,
             gains.omega_max,
             settings.optimise.time_step
@@ -918,8 +905,10 @@ impl Shell {
         }
         // A step's command later than the next odometry or two is dropped (the robot stops).
         let max_delay = late_bound(self.odom_period.period(), settings.optimise.time_step);
-        let points = route.points.clone();
-        let law = VfoGoal::new(follower, route.request_index.clone(), offset, &start, self.map.ids());
+        self.drawing = Drawing {
+            route: route.points.clone(),
+            ..Drawing::default()
+        };
         let task = VfoRun {
             view: law.view(),
             slot: LawSlot::new(law, max_delay),
@@ -928,10 +917,6 @@ impl Shell {
             stop: CancelToken::new(),
         };
         self.begin(io, Task::Vfo(task), source);
-        self.drawing = Drawing {
-            route: points,
-            ..Drawing::default()
-        };
         self.publish_status(io.node, io.out, NavStatus::ACTIVE, String::new());
         self.publish_markers(io.node, io.out);
     }
@@ -939,67 +924,60 @@ impl Shell {
     /// A pre-check is done: the route it was for (if still the active goal) starts or is
     /// refused.
     fn pre_checked(&mut self, io: &mut Io<'_, '_>, done: PreCheckDone) {
-        if !self.session.is_current(done.id) {
-            return;
-        }
-        let Some(active) = self.session.active() else { return };
-        let source = active.source;
-        let Task::PreCheck { route, start, .. } = &active.goal.task else {
+        let Some(active) = self.session.active_mut().filter(|a| a.id() == done.id) else {
             return;
         };
-        let (route, start, chassis, follow, execute_infeasible) = (
-            route.clone(),
-            *start,
+        let source = active.source;
+        let (chassis, follow, execute) = (
             active.goal.chassis,
             active.goal.config.follow,
             active.goal.config.execute_infeasible_routes,
         );
+        let Task::PreCheck { route, start, problems } = &mut active.goal.task else {
+            return;
+        };
         let report = match done.report {
             Ok(r) => r,
             Err(e) => return self.end_goal(io, refused_goal(e, Action::Follow).into()),
         };
-        let problems = missed_from_report(&report.problems, &route);
+        let of_route = (&route.points[..], &route.request_index[..]);
+        let checked = after_pre_check(&report, of_route, start, (follow, &chassis), execute);
+        let found = match &checked {
+            PreChecked::Drive { problems, .. } | PreChecked::Refuse { problems, .. } => problems.clone(),
+        };
+        problems.clone_from(&found);
+        let route = route.clone();
         self.drawing = Drawing {
             route: route.points.clone(),
             predicted: report.path.clone(),
-            problems: problems.clone(),
+            problems: found.clone(),
             dock: None,
             vfo: None,
         };
-        if !problems.is_empty() {
-            let infeasible = route_infeasible(&problems);
-            if !execute_infeasible {
-                if let Some(Task::PreCheck { problems: kept, .. }) = self.session.active_mut().map(|a| &mut a.goal.task)
-                {
-                    kept.clone_from(&problems);
-                }
-                return self.end_goal(io, infeasible.into());
-            }
+        let goal = match checked {
+            PreChecked::Refuse { outcome, .. } => return self.end_goal(io, outcome.into()),
+            PreChecked::Drive { goal, .. } => goal,
+        };
+        if !found.is_empty() {
+            let reason = route_infeasible(&found).reason();
             warn!(
-                "goal ({}): driven although execute_infeasible_routes: {}",
-                source.name(),
-                infeasible.reason()
+                "goal ({}): driven although execute_infeasible_routes: {reason}",
+                source.name()
             );
         }
-        let follower = match WaypointFollower::new(follow, &chassis, route.points.clone()) {
-            Ok(f) => f,
-            Err(e) => return self.end_goal(io, refused_goal(e, Action::Follow).into()),
-        };
         info!(
             "goal ({}): {} waypoints, pre-check {} ({:.2} m predicted)",
             source.name(),
             route.points.len(),
-            if problems.is_empty() {
+            if found.is_empty() {
                 "clear".to_owned()
             } else {
-                format!("{} problem(s)", problems.len())
+                format!("{} problem(s)", found.len())
             },
             report.driven_length(follow.check_length)
         );
-        let distance = (route.points[0] - start.position()).norm();
-        let goal = RouteGoal::new(follower, route.request_index.clone(), distance);
         if let Some(active) = self.session.active_mut() {
-            active.goal.task = Task::Follow { goal, route };
+            active.goal.task = Task::Follow { goal: *goal, route };
         }
         self.publish_status(io.node, io.out, NavStatus::ACTIVE, String::new());
         self.publish_markers(io.node, io.out);
@@ -1316,34 +1294,11 @@ impl Shell {
         let Some(law) = v.slot.law() else { return };
         let mut step = done.step;
         if let Step::Command { twist, feedback } = &mut step {
-            let request = |i: usize| law.request(i);
             for event in &feedback.events {
-                match event {
-                    VfoEvent::Reached { index, vortex } => info!(
-                        "waypoint {} reached{}",
-                        request(*index),
-                        if *vortex {
-                            " (early: the robot was caught between obstacles, Algorithm 3)"
-                        } else {
-                            ""
-                        }
-                    ),
-                    VfoEvent::Optimised {
-                        index,
-                        reason,
-                        score,
-                        warnings,
-                    } => {
-                        info!(
-                            "segment to waypoint {} optimised ({reason:?}): Ψ_z {}, {} virtual robots, {} candidates",
-                            request(*index),
-                            score.map_or("none".to_owned(), |s| format!("{s:.3}")),
-                            v.view.report.virtual_robots,
-                            v.view.report.candidates
-                        );
-                        for w in warnings.iter().filter(|w| !matches!(w, OptimiseWarning::NoSafeSigma)) {
-                            warn_throttled!(self.throttle, "vfo-caps", "segment optimisation: {w:?}");
-                        }
+                info!("{}", law.describe(event));
+                if let VfoEvent::Optimised { warnings, .. } = event {
+                    for w in warnings.iter().filter(|w| !matches!(w, OptimiseWarning::NoSafeSigma)) {
+                        warn_throttled!(self.throttle, "vfo-caps", "segment optimisation: {w:?}");
                     }
                 }
             }
@@ -1414,20 +1369,11 @@ impl Shell {
                 "scan stamp invalid (nanosec ≥ 1e9); scan ignored"
             );
         };
-        let placed = self
-            .fresh_odom()
-            .and_then(|_| self.odom_history.placed_at(stamp, max_gap));
-        let Some((odom_from_base, placement)) = placed else {
-            return warn_throttled!(
-                self.throttle,
-                "scan-odom",
-                "scan at {stamp:.3} s ignored: no fresh odometry within {max_gap} s of its stamp (obstacles are \
-                 placed by the pose at the scan's time)"
-            );
-        };
-        let update = match self.map.update_placed(&scan, &odom_from_base, placement, stamp) {
+        let history = self.fresh_odom().map(|_| &self.odom_history);
+        let update = match self.map.add_scan(&scan, stamp, history, max_gap) {
             Ok(u) => u,
-            Err(e) => return warn_throttled!(self.throttle, "scan-bad", "scan refused: {e}; scan ignored"),
+            Err(e @ ScanSkipped::NoPose { .. }) => return warn_throttled!(self.throttle, "scan-odom", "{e}"),
+            Err(e) => return warn_throttled!(self.throttle, "scan-bad", "{e}; scan ignored"),
         };
         if !update.cleared.is_empty() {
             warn_throttled!(

@@ -7,10 +7,10 @@ use std::str::FromStr;
 use std::time::Duration;
 
 use mobil_geom::Pose2;
-use mobil_planner::vfo::{OptimiseConfig, QualityWeights, ScanObstacleConfig, VfoGains, VfoWaypoint, DEFAULT_GUIDING};
+use mobil_planner::vfo::{OptimiseConfig, QualityWeights, ScanObstacleConfig, VfoGains, VfoSetup, DEFAULT_GUIDING};
 use mobil_ros::config::Decl;
 
-use crate::{GoalError, PlannerConfig, Route};
+use crate::PlannerConfig;
 
 /// How `waypoints` and `follow_waypoints` are followed.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
@@ -104,6 +104,15 @@ pub const MAX_OPTIMISE_BUDGET_S: f64 = 30.0;
 pub const DEFAULT_OPTIMISE_BUDGET_S: f64 = 2.0;
 
 impl VfoSettings {
+    /// What a VFO route is driven with.
+    pub fn setup(&self) -> VfoSetup {
+        VfoSetup {
+            gains: self.gains,
+            optimise: self.optimise,
+            guiding: self.guiding,
+        }
+    }
+
     /// The optimisation's wall-clock budget.
     pub fn optimise_budget(&self) -> Duration {
         mobil_ros::time::seconds(self.optimise_budget_s, MAX_OPTIMISE_BUDGET_S)
@@ -360,47 +369,10 @@ pub fn declare_vfo(d: &mut Decl<PlannerConfig>) {
     );
 }
 
-/// The route as VFO waypoints from `start`, μ = `guiding` for every one. θ_r, by one rule for
-/// the whole route (a ROS pose's orientation defaults to the identity, so a single identity
-/// cannot tell "heading 0" from "no heading"):
-/// - a route in which some pose carries an orientation other than the identity is an
-///   **oriented route**: every waypoint's θ_r is its pose's yaw, the identity's 0 rad included
-///   (only an all-zero quaternion, never set, counts as none there);
-/// - in any other route (every orientation the identity or unset) no waypoint carries one.
-///
-/// A waypoint without a heading takes the direction from the waypoint before (the start for
-/// the first): the robot arrives moving along its leg; one on the point before keeps the
-/// heading before it.
-pub fn vfo_waypoints(route: &Route, start: &Pose2, guiding: f64) -> Result<Vec<VfoWaypoint>, GoalError> {
-    let oriented_route = route.first_oriented().is_some();
-    let mut previous = start.position();
-    let mut heading = start.yaw;
-    let mut out = Vec::with_capacity(route.points.len());
-    for (k, p) in route.points.iter().enumerate() {
-        let pose = route.request_index.get(k).and_then(|&i| route.poses.get(i));
-        let leg = p - previous;
-        let q = pose.map(|s| &s.pose.orientation);
-        let given = q.filter(|q| oriented_route && !(q.x == 0.0 && q.y == 0.0 && q.z == 0.0 && q.w == 0.0));
-        heading = match given {
-            Some(q) => mobil_ros::geometry::yaw_of(q),
-            None if leg.norm() > 1e-9 => leg.y.atan2(leg.x),
-            None => heading,
-        };
-        let w = VfoWaypoint::new(p.x, p.y, heading, guiding).map_err(|_| GoalError::NotFinite {
-            what: format!("waypoint {}", route.request_index.get(k).copied().unwrap_or(k)),
-        })?;
-        out.push(w);
-        previous = *p;
-    }
-    Ok(out)
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::ROUTE_LIMITS;
     use crate::{markers, status_message, vfo_follow_result, MarkerView, Mode, StatusView, MISSED_BY_THE_RUN};
-    use approx::assert_relative_eq;
     use mobil_msgs::builtin_interfaces::msg::Time;
     use mobil_msgs::geometry_msgs::msg::PoseStamped;
     use mobil_msgs::mobil_msgs::msg::NavStatus;
@@ -409,12 +381,10 @@ mod tests {
     use mobil_planner::vfo::{DrawnRobot, Obstacle, SegmentReport, VfoDrawing, MAX_DRAWN_OBSTACLES};
     use mobil_ros::config::{load, Decl};
     use mobil_ros::geometry::yaw_quaternion;
-    use mobil_ros::goal::route_from_poses;
     use mobil_ros::motion::EndCause;
     use mobil_ros::params::ParamValues;
     use nalgebra::Point2;
     use ros2_client::ParameterValue;
-    use std::f64::consts::PI;
 
     fn pose(x: f64, y: f64, yaw: Option<f64>) -> PoseStamped {
         let mut p = PoseStamped::default();
@@ -481,57 +451,6 @@ mod tests {
                 "{name} accepted"
             );
         }
-    }
-
-    #[test]
-    fn waypoint_headings_follow_the_legs_unless_the_route_carries_orientations() {
-        // No orientation in the route (all identity): from (0, 0) facing 0.3 rad, (1, 0) along
-        // +x (0); (1, 0) again keeps 0; (1, 2) along +y (π/2); (0, 2) along −x (π).
-        let plain = vec![
-            pose(1.0, 0.0, None),
-            pose(1.0, 0.0, None),
-            pose(1.0, 2.0, None),
-            pose(0.0, 2.0, None),
-        ];
-        let route = route_from_poses(&plain, "odom", "odom", (0, 0), None, ROUTE_LIMITS).expect("valid");
-        let w = vfo_waypoints(&route, &Pose2::new(0.0, 0.0, 0.3), 0.4).expect("valid");
-        let headings: Vec<f64> = w.iter().map(|w| w.heading).collect();
-        assert_relative_eq!(headings[0], 0.0, epsilon = 1e-12);
-        assert_relative_eq!(headings[1], 0.0, epsilon = 1e-12);
-        assert_relative_eq!(headings[2], PI / 2.0, epsilon = 1e-12);
-        assert_relative_eq!(headings[3], PI, epsilon = 1e-12);
-        assert!(w.iter().all(|w| w.guiding == 0.4));
-        assert_eq!(w[2].position, Point2::new(1.0, 2.0));
-        // An oriented route: (1, 2) carries 0.5 rad, so the identity of (0, 2) is a real
-        // heading of 0 rad (not the leg's π), and an unset (all-zero) one is none: the leg's.
-        let mut unset = pose(0.0, 3.0, None);
-        unset.pose.orientation.w = 0.0;
-        let oriented = vec![
-            pose(1.0, 0.0, None),
-            pose(1.0, 2.0, Some(0.5)),
-            pose(0.0, 2.0, None),
-            unset,
-        ];
-        let route = route_from_poses(&oriented, "odom", "odom", (0, 0), None, ROUTE_LIMITS).expect("valid");
-        let w = vfo_waypoints(&route, &Pose2::new(0.0, 0.0, 0.3), 0.4).expect("valid");
-        let headings: Vec<f64> = w.iter().map(|w| w.heading).collect();
-        assert_relative_eq!(headings[0], 0.0, epsilon = 1e-12);
-        assert_relative_eq!(headings[1], 0.5, epsilon = 1e-9);
-        assert_relative_eq!(headings[2], 0.0, epsilon = 1e-12);
-        assert_relative_eq!(headings[3], PI / 2.0, epsilon = 1e-12);
-        // A waypoint on the start keeps the start's heading.
-        let route = route_from_poses(
-            &[pose(0.0, 0.0, None), pose(1.0, 1.0, None)],
-            "odom",
-            "odom",
-            (0, 0),
-            None,
-            ROUTE_LIMITS,
-        )
-        .expect("valid");
-        let w = vfo_waypoints(&route, &Pose2::new(0.0, 0.0, 0.3), 0.5).expect("valid");
-        assert_relative_eq!(w[0].heading, 0.3, epsilon = 1e-12);
-        assert_relative_eq!(w[1].heading, PI / 4.0, epsilon = 1e-12);
     }
 
     #[test]

@@ -8,11 +8,11 @@
 use mobil_chassis::ChassisParams;
 use mobil_geom::Pose2;
 use mobil_msgs::geometry_msgs::msg::PoseStamped;
-use mobil_planner::vfo::vfo_gains;
 use mobil_planner::vfo::{
     integrate_unicycle, ObstacleMap, OptimiseConfig, PoseHistory, VfoEnd, VfoEvent, VfoFollower, VfoGains,
 };
-use mobil_planner_node::vfo::{vfo_waypoints, VfoSettings};
+use mobil_planner::vfo::{vfo_gains, vfo_waypoints};
+use mobil_planner_node::vfo::VfoSettings;
 use mobil_planner_node::ROUTE_LIMITS;
 use mobil_ros::goal::route_from_poses;
 use mobil_sim::lidar::{Lidar, LidarConfig};
@@ -57,7 +57,7 @@ fn drive(route: &[(f64, f64)], start: Pose2, scan_phase: usize, hold: usize, lag
         scan_range: 4.0,
         ..VfoSettings::default()
     };
-    let waypoints = vfo_waypoints(&route, &start, settings.guiding).expect("valid");
+    let waypoints = vfo_waypoints(&route.points, &route.headings(), &start, settings.guiding).expect("valid");
     let gains = vfo_gains(&VfoGains::default(), &ChassisParams::omr3());
     let config = OptimiseConfig {
         time_step: DT,
@@ -196,7 +196,7 @@ fn an_obstacle_appearing_mid_segment_re_optimises_the_segment_round_it() {
     p.pose.orientation.w = 1.0;
     let route =
         route_from_poses(&[p], "odom", "odom", (0, 0), Some(start.position()), ROUTE_LIMITS).expect("valid route");
-    let waypoints = vfo_waypoints(&route, &start, settings.guiding).expect("valid");
+    let waypoints = vfo_waypoints(&route.points, &route.headings(), &start, settings.guiding).expect("valid");
     let gains = vfo_gains(&VfoGains::default(), &ChassisParams::omr3());
     let config = OptimiseConfig {
         time_step: DT,

@@ -8,8 +8,8 @@
 //! or cut it short; the robot stops meanwhile.
 
 use crate::vfo::{
-    Interrupt, Obstacle, ObstacleMap, Optimisation, PathIndices, RobotEnd, VfoEnd, VfoEvent, VfoFollower, VfoGains,
-    MAX_BUDGET_RETRIES,
+    Interrupt, Obstacle, ObstacleMap, Optimisation, OptimiseConfig, PathIndices, RobotEnd, VfoEnd, VfoEvent,
+    VfoFollower, VfoGains, VfoWaypoint, MAX_BUDGET_RETRIES,
 };
 use mobil_chassis::{BodyTwist, ChassisParams};
 use mobil_geom::{downsample, Pose2};
@@ -118,6 +118,44 @@ impl VfoDrawing {
     }
 }
 
+/// A route's waypoints as VFO waypoints from `start` (the steered point's pose), μ = `guiding`
+/// for every one. A waypoint's θ_r is its `heading` when given; one without takes the direction
+/// from the waypoint before (the start for the first): the robot arrives moving along its leg;
+/// one on the point before keeps the heading before it. A waypoint that cannot be one (not
+/// finite) is refused by its index.
+pub fn vfo_waypoints(
+    points: &[Point2<f64>],
+    headings: &[Option<f64>],
+    start: &Pose2,
+    guiding: f64,
+) -> Result<Vec<VfoWaypoint>, usize> {
+    let mut previous = start.position();
+    let mut heading = start.yaw;
+    let mut out = Vec::with_capacity(points.len());
+    for (k, p) in points.iter().enumerate() {
+        let leg = p - previous;
+        heading = match headings.get(k).copied().flatten() {
+            Some(h) => h,
+            None if leg.norm() > 1e-9 => leg.y.atan2(leg.x),
+            None => heading,
+        };
+        out.push(VfoWaypoint::new(p.x, p.y, heading, guiding).map_err(|_| k)?);
+        previous = *p;
+    }
+    Ok(out)
+}
+
+/// What a VFO route is driven with: the law's gains, Algorithm 2's settings, the guiding μ.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct VfoSetup {
+    /// The law's gains (held to the chassis by [`vfo_gains`]).
+    pub gains: VfoGains,
+    /// The optimisation's settings.
+    pub optimise: OptimiseConfig,
+    /// μ of every waypoint.
+    pub guiding: f64,
+}
+
 /// What a VFO step senses besides the pose: the pose's stamp (s, on the odometry's clock; the
 /// rest test times by it) and the interrupt an optimisation asks before every batch of virtual
 /// robots: stop (the goal ended) or take the best so far (the budget is spent).
@@ -182,6 +220,32 @@ pub struct VfoGoal {
 }
 
 impl VfoGoal {
+    /// A route through `points` (their `headings` where given, the request's index of each
+    /// alongside) from the reference point at `start` on `chassis`, round the obstacles of
+    /// `map`, with `setup`'s gains held to the chassis; the law steers the point
+    /// [`crate::goals::docking_offset`] behind the reference point. Refused `INVALID_GOAL` for a
+    /// waypoint that cannot be one, `INVALID_INPUT` when the follower refuses its settings.
+    pub fn for_route(
+        (points, headings, request_index): (&[Point2<f64>], &[Option<f64>], &[usize]),
+        start: &Pose2,
+        setup: &VfoSetup,
+        chassis: &ChassisParams,
+        map: &ObstacleMap,
+    ) -> Result<Self, Outcome> {
+        let offset = crate::goals::docking_offset(chassis);
+        let request = |i: usize| request_index.get(i).copied().unwrap_or(i);
+        let waypoints = vfo_waypoints(points, headings, &start.ahead(-offset), setup.guiding).map_err(|k| {
+            let code = nav2::follow_waypoints::UNKNOWN;
+            Outcome::failed("INVALID_GOAL", format!("waypoint {} is not finite", request(k)), code)
+        })?;
+        let gains = vfo_gains(&setup.gains, chassis);
+        let follower = VfoFollower::new(gains, setup.optimise, waypoints, map.obstacles()).map_err(|e| {
+            let detail = format!("the planner refused its input: {e}; robot stopped");
+            Outcome::failed("INVALID_INPUT", detail, nav2::follow_waypoints::TASK_EXECUTOR_FAILED)
+        })?;
+        Ok(VfoGoal::new(follower, request_index.to_vec(), offset, start, map.ids()))
+    }
+
     /// A route for `follower`, which knows the obstacles of the map whose ids are `held_ids`;
     /// the request's index of each waypoint alongside (missing ones count as their own);
     /// starting with the reference point at `start`.
@@ -242,6 +306,31 @@ impl VfoGoal {
     /// with `new` obstacles (not seen before) the segment is re-optimised at the next step.
     pub fn follow_map(&mut self, map: &ObstacleMap, new: bool) {
         self.follower.follow_map(map, &mut self.held_ids, new);
+    }
+
+    /// What `event` says, by the request's waypoint indices: "waypoint 2 reached", "segment to
+    /// waypoint 3 optimised (SegmentStart): Ψ_z 1.234, 17 virtual robots, 4 candidates".
+    pub fn describe(&self, event: &VfoEvent) -> String {
+        match event {
+            VfoEvent::Reached { index, vortex } => format!(
+                "waypoint {} reached{}",
+                self.request(*index),
+                if *vortex {
+                    " (early: the robot was caught between obstacles, Algorithm 3)"
+                } else {
+                    ""
+                }
+            ),
+            VfoEvent::Optimised {
+                index, reason, score, ..
+            } => format!(
+                "segment to waypoint {} optimised ({reason:?}): Ψ_z {}, {} virtual robots, {} candidates",
+                self.request(*index),
+                score.map_or("none".to_owned(), |s| format!("{s:.3}")),
+                self.report.virtual_robots,
+                self.report.candidates
+            ),
+        }
     }
 
     fn fail(&self, code: &'static str, detail: String) -> Step<VfoStep, Vec<usize>> {

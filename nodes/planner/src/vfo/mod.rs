@@ -47,8 +47,8 @@ pub use follower::{
     REST_SPEED, REST_TURN_RATE,
 };
 pub use goal::{
-    vfo_gains, DrawnRobot, SegmentReport, VfoDrawing, VfoGoal, VfoStep, VfoTick, VfoView, MAX_DRAWN_OBSTACLES,
-    MAX_DRAWN_POINTS, MAX_DRAWN_ROBOTS,
+    vfo_gains, vfo_waypoints, DrawnRobot, SegmentReport, VfoDrawing, VfoGoal, VfoSetup, VfoStep, VfoTick, VfoView,
+    MAX_DRAWN_OBSTACLES, MAX_DRAWN_POINTS, MAX_DRAWN_ROBOTS,
 };
 pub use history::{Placement, PoseHistory};
 pub use obstacles::{potential, potential_derivative, Obstacle, Sigma};
@@ -58,4 +58,4 @@ pub use optimise::{
     PARALLEL_MIN_BATCH,
 };
 pub use quality::{normalise, normalised, path_score, PathIndices, QualityWeights};
-pub use scan::{extract_circles, fit_circle, Circle, MapUpdate, ObstacleMap, ScanObstacleConfig};
+pub use scan::{extract_circles, fit_circle, Circle, MapUpdate, ObstacleMap, ScanObstacleConfig, ScanSkipped};

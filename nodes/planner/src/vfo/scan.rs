@@ -44,7 +44,7 @@
 use mobil_geom::{Beam, Pose2, Scan};
 use nalgebra::{Matrix3, Point2, Vector3};
 
-use super::history::Placement;
+use super::history::{Placement, PoseHistory};
 use super::obstacles::Obstacle;
 use crate::error::{positive_finite, PlannerError};
 
@@ -314,6 +314,25 @@ pub struct ObstacleMap {
     next_id: u64,
 }
 
+/// Why a scan did not go into the map ([`ObstacleMap::add_scan`]).
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum ScanSkipped {
+    /// No odometry pose at the scan's stamp.
+    #[error(
+        "scan at {stamp:.3} s ignored: no fresh odometry within {max_gap} s of its stamp (obstacles are placed by \
+         the pose at the scan's time)"
+    )]
+    NoPose {
+        /// The scan's stamp (s).
+        stamp: f64,
+        /// The largest gap to a pose taken (s).
+        max_gap: f64,
+    },
+    /// The map refused the scan or its pose.
+    #[error("scan refused: {0}")]
+    Refused(PlannerError),
+}
+
 impl ObstacleMap {
     /// An empty map.
     pub fn new(config: ScanObstacleConfig) -> Result<Self, PlannerError> {
@@ -365,6 +384,24 @@ impl ObstacleMap {
     /// what exceeds the cap (module docs).
     pub fn update(&mut self, scan: &Scan, odom_from_base: &Pose2, t: f64) -> Result<MapUpdate, PlannerError> {
         self.update_placed(scan, odom_from_base, Placement::Interpolated, t)
+    }
+
+    /// Adds `scan`, taken at `stamp` (s, the odometry's clock), placed with the odometry pose
+    /// `history` gives at that stamp ([`PoseHistory::placed_at`] within `max_gap`); `history`
+    /// is `None` when the odometry is not fresh: obstacles are placed by the pose at the scan's
+    /// time, or not at all.
+    pub fn add_scan(
+        &mut self,
+        scan: &Scan,
+        stamp: f64,
+        history: Option<&PoseHistory>,
+        max_gap: f64,
+    ) -> Result<MapUpdate, ScanSkipped> {
+        let (pose, placement) = history
+            .and_then(|h| h.placed_at(stamp, max_gap))
+            .ok_or(ScanSkipped::NoPose { stamp, max_gap })?;
+        self.update_placed(scan, &pose, placement, stamp)
+            .map_err(ScanSkipped::Refused)
     }
 
     /// As [`Self::update`], the pose found as `placement` says: a [`Placement::Held`] scan
