@@ -8,7 +8,8 @@
 //! executables of `mobil_tools_node` are the shells that fill them): [`route`], the first act's
 //! drift and figure; [`nav`], the second act's path and mode changes; [`plan`], the third act's
 //! route, dock and docking record; [`terrain`], the fourth act's terrain assessments; [`gait`],
-//! the fifth act's planned walk; [`vfo`], the sixth act's VFO waypoint following.
+//! the fifth act's planned walk; [`vfo`], the sixth act's VFO waypoint following. [`status`]:
+//! a navigation node's status as the acts read it.
 
 pub mod drive;
 pub mod gait;
@@ -16,5 +17,6 @@ pub mod nav;
 pub mod plan;
 pub mod plot;
 pub mod route;
+pub mod status;
 pub mod terrain;
 pub mod vfo;

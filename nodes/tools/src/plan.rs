@@ -8,6 +8,7 @@ use mobil_geom::wrap;
 use mobil_world::World;
 
 use crate::plot::{MapView, SeriesPanel, Stroke, Svg};
+use crate::status::{GoalState, Status};
 
 /// The demo's route (odom frame, metres): from where the second act ends, near its goal
 /// (3, 4), west above the pillar at (1, 1.5), down the room's west side and back east. Legs of
@@ -342,6 +343,180 @@ pub fn dock_needs_a_turn(dock: (f64, f64, f64), heading: f64) -> bool {
     wrap(dock.2 - heading).abs() > PI / 6.0
 }
 
+/// Where the act is.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Phase {
+    /// The route was sent; waiting for the planner's ACTIVE.
+    RouteSent,
+    /// Following the route, accepted at this time (ns).
+    Route(i64),
+    /// The dock was sent at this time (ns); waiting for the planner's ACTIVE.
+    DockSent(i64),
+    /// Docking, sent at this time (ns).
+    Dock(i64),
+}
+
+/// What the act does after a status.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Next {
+    /// Nothing: wait for the next status.
+    Wait,
+    /// The planner took the route.
+    RouteAccepted,
+    /// The route ended: send the dock.
+    SendDock,
+    /// The planner took the dock.
+    DockAccepted,
+    /// The docking ended: the act is over.
+    Done,
+}
+
+/// One sample in the odometry's stream: its stamp (ns), x, y.
+pub type OdomSample = (i64, f64, f64);
+
+/// The third act's course, status by status: the route sent until the planner is active on it,
+/// followed to its end, then the dock sent until the planner docks, and the docking followed to
+/// its end, each status of the docking a [`DockSample`]. The shell sends what [`Next`] and the
+/// [`Phase`] say and fills in the true path.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PlanAct {
+    /// Where the act is.
+    pub phase: Phase,
+    /// The record so far.
+    pub run: PlanRun,
+    /// The route's start and end stamps (ns), once it has ended.
+    pub route_window: Option<(i64, i64)>,
+    /// The planner's reason when the route ended.
+    pub route_reason: String,
+}
+
+/// One joint_states period (20 ms simulated) of slack at the route's end: the planner's clock
+/// may lag the stamp of the sample it ended the route on.
+pub const ROUTE_END_SLACK_NS: i64 = 20_000_000;
+
+impl PlanAct {
+    /// The act from its start, the route sent; `run` holds the route, the pre-check's answer
+    /// and the dock.
+    pub fn new(run: PlanRun) -> PlanAct {
+        PlanAct {
+            phase: Phase::RouteSent,
+            run,
+            route_window: None,
+            route_reason: String::new(),
+        }
+    }
+
+    /// Takes a status stamped `stamp` (ns; the planner's clock) and received at `now` (ns).
+    /// Statuses of another phase (the route's last ones while the dock is sent, a docking
+    /// mode's before the route ends) change nothing; a final docking status with the docking
+    /// fields cleared adds no sample.
+    pub fn status(&mut self, s: &Status, stamp: i64, now: i64) -> Next {
+        let finished = s.state.finished();
+        let outcome = || {
+            if s.state == GoalState::Succeeded {
+                Outcome::Succeeded
+            } else {
+                Outcome::Failed(s.reason.clone())
+            }
+        };
+        let docking_mode = matches!(s.mode.as_str(), "dock" | "rotate");
+        match self.phase {
+            Phase::RouteSent if s.state == GoalState::Active && s.waypoint_index >= 0 => {
+                self.phase = Phase::Route(stamp);
+                Next::RouteAccepted
+            }
+            Phase::Route(t0) if finished => {
+                self.run.route_outcome = outcome();
+                self.run.route_s = secs(t0, stamp);
+                self.route_window = Some((t0, stamp));
+                self.route_reason = s.reason.clone();
+                self.phase = Phase::DockSent(now);
+                Next::SendDock
+            }
+            Phase::DockSent(t0) | Phase::Dock(t0) if docking_mode && (s.state == GoalState::Active || finished) => {
+                let accepted = matches!(self.phase, Phase::DockSent(_));
+                self.phase = Phase::Dock(t0);
+                let (e, alpha, theta, lyapunov) = s.docking;
+                let cleared = e == 0.0 && alpha == 0.0 && theta == 0.0 && lyapunov == 0.0;
+                if !(finished && cleared) {
+                    let t = secs(t0, stamp);
+                    let sample = DockSample::from_status(t, e, alpha, theta, lyapunov, &s.mode);
+                    self.run.docking.push(sample);
+                }
+                if finished {
+                    self.run.dock_outcome = outcome();
+                    Next::Done
+                } else if accepted {
+                    Next::DockAccepted
+                } else {
+                    Next::Wait
+                }
+            }
+            Phase::Dock(_) if finished => {
+                self.run.dock_outcome = outcome();
+                Next::Done
+            }
+            _ => Next::Wait,
+        }
+    }
+
+    /// At the act's end: the route's odometry track from every odometry sample received,
+    /// chosen by stamp ([`route_track`], with [`ROUTE_END_SLACK_NS`]).
+    pub fn finish(&mut self, odom: &[OdomSample]) {
+        if let Some((start, end)) = self.route_window {
+            self.run.odom_path = route_track(odom, start, end, ROUTE_END_SLACK_NS);
+        }
+    }
+}
+
+/// Seconds between two clock readings in nanoseconds.
+fn secs(from: i64, to: i64) -> f64 {
+    (to - from) as f64 * 1e-9
+}
+
+/// The lines printed once the pre-check answered (`reason`: its reason): the route feasible
+/// with the predicted path's length, or not, with each problem on a line of its own.
+pub fn precheck_lines(run: &PlanRun, reason: &str) -> Vec<String> {
+    let n = run.waypoints.len();
+    if run.feasible {
+        return vec![format!(
+            "  pre-check: route of {n} waypoints feasible, predicted path {:.2} m",
+            run.predicted_length
+        )];
+    }
+    let mut lines = vec![format!(
+        "  pre-check: route of {n} waypoints not feasible, {} problem(s): {reason}",
+        run.problems.len()
+    )];
+    lines.extend(
+        run.problems
+            .iter()
+            .map(|p| format!("    waypoint {}: {}: {}", p.index, p.kind, p.detail)),
+    );
+    lines
+}
+
+impl Summary {
+    /// The line after the summary when waypoints were missed: each one's closest approach of
+    /// the odometry in `run`, the tolerance and what the planner said when the route ended
+    /// (`planner_said`); `None` when none was missed.
+    pub fn missed_line(&self, run: &PlanRun, tolerance: f64, planner_said: &str) -> Option<String> {
+        if self.missed.is_empty() {
+            return None;
+        }
+        let closest: Vec<String> = self
+            .missed
+            .iter()
+            .map(|&i| format!("{i} ({:.3} m)", closest_approach(run.waypoints[i], &run.odom_path)))
+            .collect();
+        Some(format!(
+            "  missed waypoints (the odometry's closest approach; reach within {tolerance} m): {}; the planner said: {}",
+            closest.join(", "),
+            if planner_said.is_empty() { "nothing" } else { planner_said }
+        ))
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -554,5 +729,133 @@ mod tests {
         assert!(svg.contains("e 0.050 m, heading 0.050 rad"), "{svg}");
         assert!(svg.contains("t &lt;&amp;&gt;"));
         assert!(svg.contains("1 problem(s), red ✕"));
+    }
+
+    fn status(state: GoalState, index: i32, mode: &str, docking: (f64, f64, f64, f64)) -> Status {
+        Status {
+            state,
+            waypoint_index: index,
+            mode: mode.into(),
+            reason: if state == GoalState::Failed {
+                "RESIDUAL: e = 0.1 m".into()
+            } else {
+                String::new()
+            },
+            docking,
+        }
+    }
+
+    #[test]
+    fn the_act_follows_the_route_then_the_docking() {
+        use GoalState::*;
+        let mut run = recorded(
+            Outcome::Failed("not started".into()),
+            Outcome::Failed("not started".into()),
+        );
+        run.docking.clear();
+        let mut act = PlanAct::new(run);
+        let none = (0.0, 0.0, 0.0, 0.0);
+        let s = 1_000_000_000;
+        // Idle, then a status of no route: still sent.
+        assert_eq!(act.status(&status(Idle, -1, "idle", none), 0, 0), Next::Wait);
+        assert_eq!(act.status(&status(Active, -1, "pre_check", none), s, s), Next::Wait);
+        assert_eq!(
+            act.status(&status(Active, 0, "approach", none), 2 * s, 2 * s),
+            Next::RouteAccepted
+        );
+        assert_eq!(act.phase, Phase::Route(2 * s));
+        assert_eq!(
+            act.status(&status(Active, 2, "approach", none), 9 * s, 9 * s),
+            Next::Wait
+        );
+        // Ends at 23.5 s by its stamp, received at 24 s: the dock is sent then.
+        assert_eq!(
+            act.status(&status(Succeeded, 2, "approach", none), 23_500_000_000, 24 * s),
+            Next::SendDock
+        );
+        assert_eq!(act.phase, Phase::DockSent(24 * s));
+        assert_eq!(
+            (act.run.route_outcome.clone(), act.run.route_s),
+            (Outcome::Succeeded, 21.5)
+        );
+        assert_eq!(act.route_window, Some((2 * s, 23_500_000_000)));
+        // The route's last status again: nothing; then the docking, sample by sample.
+        assert_eq!(
+            act.status(&status(Succeeded, 2, "approach", none), 23_500_000_000, 25 * s),
+            Next::Wait
+        );
+        let d = (1.0, 0.2, 0.5, 1.43);
+        assert_eq!(
+            act.status(&status(Active, -1, "dock", d), 25 * s, 25 * s),
+            Next::DockAccepted
+        );
+        assert_eq!(act.status(&status(Active, -1, "rotate", d), 26 * s, 26 * s), Next::Wait);
+        // A final status with the docking fields cleared ends it without a sample.
+        assert_eq!(
+            act.status(&status(Failed, -1, "rotate", none), 27 * s, 27 * s),
+            Next::Done
+        );
+        assert_eq!(act.run.dock_outcome, Outcome::Failed("RESIDUAL: e = 0.1 m".into()));
+        let t: Vec<f64> = act.run.docking.iter().map(|d| d.t).collect();
+        assert_eq!(t, [1.0, 2.0]);
+        // The route's odometry: the samples stamped within it and the slack.
+        act.finish(&[
+            (s, 9.0, 9.0),
+            (3 * s, 1.0, 0.0),
+            (23_510_000_000, 2.0, 0.0),
+            (24 * s, 3.0, 0.0),
+        ]);
+        assert_eq!(act.run.odom_path, [(1.0, 0.0), (2.0, 0.0)]);
+    }
+
+    #[test]
+    fn a_final_docking_status_with_its_figures_is_a_sample() {
+        use GoalState::*;
+        let mut act = PlanAct::new(recorded(Outcome::Succeeded, Outcome::Succeeded));
+        act.run.docking.clear();
+        act.phase = Phase::DockSent(0);
+        let d = (0.018, 0.01, 0.03, 0.0001);
+        // A docking that ends on the status that first shows it.
+        assert_eq!(
+            act.status(&status(Succeeded, -1, "rotate", d), 500_000_000, 1),
+            Next::Done
+        );
+        assert_eq!(act.run.docking.len(), 1);
+        assert_eq!(act.run.dock_outcome, Outcome::Succeeded);
+        // A docking that ends in another mode: no sample, the outcome taken.
+        act.phase = Phase::Dock(0);
+        assert_eq!(
+            act.status(&status(Failed, -1, "idle", (0.0, 0.0, 0.0, 0.0)), 1, 1),
+            Next::Done
+        );
+        assert_eq!(act.run.docking.len(), 1);
+    }
+
+    #[test]
+    fn the_pre_check_and_missed_waypoint_lines() {
+        let run = recorded(Outcome::Succeeded, Outcome::Succeeded);
+        assert_eq!(
+            precheck_lines(&run, "turn too tight"),
+            [
+                "  pre-check: route of 3 waypoints not feasible, 1 problem(s): turn too tight",
+                "    waypoint 2: turn_radius: turn radius 0.50 m below the chassis minimum 0.73 m",
+            ]
+        );
+        let feasible = PlanRun {
+            feasible: true,
+            ..run.clone()
+        };
+        assert_eq!(
+            precheck_lines(&feasible, ""),
+            ["  pre-check: route of 3 waypoints feasible, predicted path 4.00 m"]
+        );
+        let summary = Summary::of(&run, 0.16);
+        assert_eq!(
+            summary.missed_line(&run, 0.16, "").as_deref(),
+            Some(
+                "  missed waypoints (the odometry's closest approach; reach within 0.16 m): 2 (0.300 m); the planner said: nothing"
+            )
+        );
+        assert_eq!(Summary::of(&run, 0.31).missed_line(&run, 0.31, "x"), None);
     }
 }

@@ -1,5 +1,6 @@
 //! Scripted routes (timed body-velocity segments) and odometry-versus-truth bookkeeping: the
-//! demo's first act (`demo_driver`), its one-line summary ([`Drift`]) and its figure.
+//! demo's first act (`demo_driver`), its one-line summary ([`Drift`]) and its figure; and the
+//! waypoint routes the later acts take as a parameter ([`parse_waypoints`]).
 
 use mobil_geom::wrap;
 use mobil_world::World;
@@ -84,6 +85,19 @@ pub fn default_loop() -> Vec<f64> {
     ]
 }
 
+/// A waypoint route from `[x0, y0, x1, y1, …]`: a non-empty list of finite pairs.
+pub fn parse_waypoints(flat: &[f64]) -> Result<Vec<(f64, f64)>, String> {
+    if flat.is_empty() || !flat.len().is_multiple_of(2) || !flat.iter().all(|v| v.is_finite()) {
+        return Err("route must be a non-empty list of finite x, y pairs".into());
+    }
+    Ok(flat.chunks_exact(2).map(|c| (c[0], c[1])).collect())
+}
+
+/// A waypoint route as `[x0, y0, x1, y1, …]` (a parameter's value).
+pub fn flat_waypoints(route: &[(f64, f64)]) -> Vec<f64> {
+    route.iter().flat_map(|&(x, y)| [x, y]).collect()
+}
+
 /// Length of a polyline.
 pub fn path_length(points: &[(f64, f64)]) -> f64 {
     points
@@ -158,6 +172,25 @@ pub fn figure(world: &World, truth: &[(f64, f64)], odom: &[(f64, f64)], title: &
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn waypoints_from_a_flat_list_and_back() {
+        let route = parse_waypoints(&[1.0, 2.0, -3.0, 0.5]).unwrap();
+        assert_eq!(route, [(1.0, 2.0), (-3.0, 0.5)]);
+        assert_eq!(flat_waypoints(&route), [1.0, 2.0, -3.0, 0.5]);
+        for bad in [
+            &[][..],
+            &[1.0],
+            &[1.0, 2.0, 3.0],
+            &[1.0, f64::NAN],
+            &[f64::INFINITY, 0.0],
+        ] {
+            assert_eq!(
+                parse_waypoints(bad),
+                Err("route must be a non-empty list of finite x, y pairs".to_string())
+            );
+        }
+    }
 
     #[test]
     fn drift_at_the_end_of_the_tracks() {

@@ -2,10 +2,12 @@
 //! through the built-in world's clutter. The record (the true path, one segment's optimisation
 //! as `planner/markers` drew it), the one-line summary and the figure: the world, the obstacles
 //! the planner saw with r and R, every virtual robot's path of that optimisation (grey; orange
-//! where dropped), the chosen one (green), the executed path (blue) and the waypoints.
+//! where dropped), the chosen one (green), the executed path (blue) and the waypoints. The
+//! act's course status by status is [`VfoAct`].
 
 use crate::plot::{MapView, Stroke, Svg};
 use crate::route::path_length;
+use crate::status::{GoalState, Status};
 use mobil_world::World;
 
 /// The demo's route: past the pillar at (1, 1.5) (the first leg runs through it), beside the
@@ -84,6 +86,67 @@ impl VfoRun {
             self.optimisation.robots.len(),
             self.optimisation.robots.iter().filter(|(_, dropped)| *dropped).count(),
         )
+    }
+}
+
+/// The sixth act's course: the route sent until the planner is active on it in mode `vfo`,
+/// then the true path and the largest optimisation recorded until the route ends. The shell
+/// sends the route while [`VfoAct::started`] is `None` and fills in what it receives.
+#[derive(Debug, Clone, PartialEq)]
+pub struct VfoAct {
+    /// The record so far.
+    pub run: VfoRun,
+    /// When the route started (ns, the planner's stamp), once it has.
+    pub started: Option<i64>,
+    /// The waypoint the planner pursues (request index), from the last status.
+    pub waypoint: i32,
+}
+
+impl VfoAct {
+    /// The act from its start; `run` holds the route and the robot's radius.
+    pub fn new(run: VfoRun) -> VfoAct {
+        VfoAct {
+            run,
+            started: None,
+            waypoint: 0,
+        }
+    }
+
+    /// A true position: part of the path once the route has started.
+    pub fn truth(&mut self, p: (f64, f64)) {
+        if self.started.is_some() {
+            self.run.path.push(p);
+        }
+    }
+
+    /// An optimisation the markers drew: kept when it has more virtual robots than the one
+    /// kept so far.
+    pub fn optimisation(&mut self, o: Optimisation) {
+        if o.robots.len() > self.run.optimisation.robots.len() {
+            self.run.optimisation = o;
+        }
+    }
+
+    /// Takes a status stamped `stamp` (ns); true when the route has ended (succeeded or
+    /// failed after it started), with its outcome and duration recorded.
+    pub fn status(&mut self, s: &Status, stamp: i64) -> bool {
+        self.waypoint = s.waypoint_index;
+        match self.started {
+            None if s.state == GoalState::Active && s.mode == "vfo" => {
+                self.started = Some(stamp);
+                false
+            }
+            Some(t0) if s.state.finished() => {
+                self.run.outcome = if s.state == GoalState::Succeeded {
+                    Ok(())
+                } else {
+                    Err(s.reason.clone())
+                };
+                self.run.duration_s = (stamp - t0) as f64 * 1e-9;
+                true
+            }
+            _ => false,
+        }
     }
 }
 
@@ -188,5 +251,43 @@ mod tests {
         assert_eq!(svg.matches("#ff8000").count(), 1);
         // r and R of the one obstacle at 60 px/m: radii 24 and 48 px.
         assert!(svg.contains(r#"r="24.0""#) && svg.contains(r#"r="48.0""#));
+    }
+
+    #[test]
+    fn the_act_records_from_the_start_of_the_vfo_route_to_its_end() {
+        let status = |state, index, mode: &str| Status {
+            state,
+            waypoint_index: index,
+            mode: mode.into(),
+            reason: "STALE_INPUT: odom stale".into(),
+            docking: (0.0, 0.0, 0.0, 0.0),
+        };
+        let mut act = VfoAct::new(VfoRun {
+            path: Vec::new(),
+            optimisation: Optimisation::default(),
+            outcome: Err("not started".into()),
+            duration_s: 0.0,
+            ..run()
+        });
+        act.truth((9.0, 9.0));
+        assert!(!act.status(&status(GoalState::Active, 0, "approach"), 1));
+        assert!(!act.status(&status(GoalState::Failed, 0, "approach"), 1));
+        assert_eq!(act.started, None);
+        assert!(!act.status(&status(GoalState::Active, 0, "vfo"), 2_000_000_000));
+        act.truth((0.0, 0.0));
+        let robots = |n| Optimisation {
+            robots: vec![(Vec::new(), false); n],
+            waypoint: n as i32,
+            ..Optimisation::default()
+        };
+        act.optimisation(robots(3));
+        act.optimisation(robots(2));
+        assert!(!act.status(&status(GoalState::Active, 1, "vfo"), 3_000_000_000));
+        assert_eq!(act.waypoint, 1);
+        assert!(act.status(&status(GoalState::Failed, 1, "vfo"), 14_500_000_000));
+        assert_eq!(act.run.path, [(0.0, 0.0)]);
+        assert_eq!(act.run.optimisation.robots.len(), 3);
+        assert_eq!(act.run.outcome, Err("STALE_INPUT: odom stale".into()));
+        assert!((act.run.duration_s - 12.5).abs() < 1e-12);
     }
 }

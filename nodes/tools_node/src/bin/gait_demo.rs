@@ -9,12 +9,11 @@ use std::time::{Duration, Instant};
 
 use mobil_gait::QuadrupedModel;
 use mobil_msgs::mobil_msgs::srv::{PlanGait, PlanGaitRequest, PlanGaitResponse};
-use mobil_msgs::RosService;
 use mobil_ros::params::ParamValues;
-use mobil_ros::{qos, run_node, shutdown_signal, NodeDecl, ParamSpec, RosNode};
+use mobil_ros::{run_node, shutdown_signal, NodeDecl, ParamSpec, RosNode};
 use mobil_tools::gait::{figure, summary, GaitWalk, WalkState, DEMO_GOAL, DEMO_START};
 use mobil_tools::plot::write_file;
-use ros2_client::{Name, ServiceMapping};
+use mobil_tools_node::service_client;
 use tracing::info;
 
 fn decl() -> NodeDecl {
@@ -55,19 +54,7 @@ fn main() -> ExitCode {
 /// Calls `gait/compute_plan`, re-sending each 3 s (a request sent before discovery matched is
 /// lost) until `deadline`: the last attempt gets only the time left.
 async fn call(node: &mut RosNode, request: PlanGaitRequest, deadline: Instant) -> anyhow::Result<PlanGaitResponse> {
-    let name = node.names().resolve("gait/compute_plan")?;
-    let name = Name::parse(&name).map_err(|e| anyhow::anyhow!("bad service name {name}: {e:?}"))?;
-    let qos = qos::reliable(10);
-    let client = node
-        .inner()
-        .create_client::<PlanGaitRequest, PlanGaitResponse>(
-            ServiceMapping::Enhanced,
-            &name,
-            &PlanGait::type_name(),
-            qos.clone(),
-            qos,
-        )
-        .map_err(|e| anyhow::anyhow!("cannot create a client of {name}: {e:?}"))?;
+    let client = service_client::<PlanGait>(node, "gait/compute_plan")?;
     let shutdown = shutdown_signal();
     tokio::pin!(shutdown);
     // Matched before the first call, so that it is not lost to discovery (ROS2-NOTES).

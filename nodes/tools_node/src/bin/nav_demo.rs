@@ -9,10 +9,10 @@ use mobil_msgs::geometry_msgs::msg::PoseStamped;
 use mobil_msgs::mobil_msgs::msg::NavStatus;
 use mobil_msgs::nav_msgs::msg::Odometry;
 use mobil_ros::params::ParamValues;
-use mobil_ros::time::stamp_from_nanos;
 use mobil_ros::{qos, run_node, shutdown_signal, NodeDecl, ParamSpec, RosNode};
 use mobil_tools::nav::{figure, outcome_text, NavRun};
 use mobil_tools::plot::{world_to_draw, write_file};
+use mobil_tools_node::pose_now;
 use std::process::ExitCode;
 use std::time::{Duration, Instant};
 use tracing::info;
@@ -77,13 +77,7 @@ async fn run(node: &mut RosNode) -> anyhow::Result<()> {
                 }
                 // Repeated until the navigator shows it active: the first may be lost in discovery.
                 if accepted_at.is_none() && !record.path.is_empty() {
-                    let mut msg = PoseStamped::default();
-                    msg.header.frame_id = "odom".into();
-                    msg.header.stamp = stamp_from_nanos(node.now_nanos());
-                    msg.pose.position.x = goal.0;
-                    msg.pose.position.y = goal.1;
-                    msg.pose.orientation.w = 1.0;
-                    let _ = goal_pub.publish(msg);
+                    let _ = goal_pub.publish(pose_now(node, (goal.0, goal.1, 0.0)));
                 }
             }
             Some(Ok((m, _))) = truth.next() => {

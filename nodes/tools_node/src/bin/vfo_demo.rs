@@ -2,28 +2,27 @@
 //! `waypoint_method: vfo` and follows `planner/status` until the route ends; records the true
 //! path (`ground_truth`) and, from `planner/markers`, the optimisation with the most virtual
 //! robots; writes one SVG (world, obstacles seen with r and R, every virtual robot of that
-//! segment, the chosen path, the executed path) and prints one line. The record, summary and
-//! figure are `mobil_tools::vfo` (tested there).
+//! segment, the chosen path, the executed path) and prints one line. The act's course, record,
+//! summary and figure are `mobil_tools::vfo` (tested there).
 
 use std::process::ExitCode;
 use std::time::{Duration, Instant};
 
 use futures::StreamExt;
-use mobil_msgs::geometry_msgs::msg::PoseStamped;
 use mobil_msgs::mobil_msgs::msg::NavStatus;
 use mobil_msgs::nav_msgs::msg::{Odometry, Path};
 use mobil_msgs::visualization_msgs::msg::{Marker, MarkerArray};
-use mobil_ros::geometry::yaw_quaternion;
 use mobil_ros::params::ParamValues;
-use mobil_ros::time::{nanos_from_stamp, stamp_from_nanos};
 use mobil_ros::{qos, run_node, shutdown_signal, NodeDecl, ParamSpec, RosNode};
 use mobil_tools::plot::write_file;
-use mobil_tools::vfo::{figure, Optimisation, SeenObstacle, VfoRun, DEMO_ROUTE};
+use mobil_tools::route::{flat_waypoints, parse_waypoints};
+use mobil_tools::vfo::{figure, Optimisation, SeenObstacle, VfoAct, VfoRun, DEMO_ROUTE};
+use mobil_tools_node::{route_now, stamp_or, status_of};
 use mobil_world::World;
 use tracing::info;
 
 fn decl() -> NodeDecl {
-    let route: Vec<f64> = DEMO_ROUTE.iter().flat_map(|&(x, y)| [x, y]).collect();
+    let route = flat_waypoints(&DEMO_ROUTE);
     NodeDecl::new(
         "vfo_demo",
         "Sends a route to planner_node in vfo mode, plots one segment's virtual robots and the run",
@@ -40,37 +39,11 @@ fn decl() -> NodeDecl {
     ))
     .param(ParamSpec::double("robot_radius", 0.25, "the robot's radius, for the clearance [m]").above(0.0))
     .param(ParamSpec::double("timeout_s", 90.0, "wall time allowed for the whole run [s]").above(0.0))
-    .check(|p: &ParamValues| {
-        let route = p.f64s("route")?;
-        if route.is_empty() || route.len() % 2 != 0 || !route.iter().all(|v| v.is_finite()) {
-            return Err("route must be a non-empty list of finite x, y pairs".into());
-        }
-        Ok(())
-    })
+    .check(|p: &ParamValues| parse_waypoints(&p.f64s("route")?).map(|_| ()))
 }
 
 fn main() -> ExitCode {
     run_node(&decl(), |node| Box::pin(run(node)))
-}
-
-fn route_msg(node: &RosNode, route: &[(f64, f64)]) -> Path {
-    let mut path = Path::default();
-    path.header.frame_id = "odom".into();
-    path.header.stamp = stamp_from_nanos(node.now_nanos());
-    path.poses = route
-        .iter()
-        .map(|&(x, y)| {
-            let mut p = PoseStamped {
-                header: path.header.clone(),
-                ..Default::default()
-            };
-            p.pose.position.x = x;
-            p.pose.position.y = y;
-            p.pose.orientation = yaw_quaternion(0.0);
-            p
-        })
-        .collect();
-    path
 }
 
 /// The optimisation drawn in `a`, if it has one.
@@ -114,12 +87,7 @@ fn optimisation(a: &MarkerArray, waypoint: i32) -> Option<Optimisation> {
 async fn run(node: &mut RosNode) -> anyhow::Result<()> {
     let p = node.params();
     let map_err = anyhow::Error::msg;
-    let route: Vec<(f64, f64)> = p
-        .f64s("route")
-        .map_err(map_err)?
-        .chunks_exact(2)
-        .map(|c| (c[0], c[1]))
-        .collect();
+    let route = parse_waypoints(&p.f64s("route").map_err(map_err)?).map_err(map_err)?;
     let out = p.string("output_svg").map_err(map_err)?;
     let robot_radius = p.f64("robot_radius").map_err(map_err)?;
     let timeout = Duration::from_secs_f64(p.f64("timeout_s").map_err(map_err)?);
@@ -137,16 +105,14 @@ async fn run(node: &mut RosNode) -> anyhow::Result<()> {
     let mut resend = tokio::time::interval(Duration::from_millis(1000));
     tokio::pin!(truth, status, markers, shutdown);
 
-    let mut record = VfoRun {
+    let mut act = VfoAct::new(VfoRun {
         waypoints: route.clone(),
         path: Vec::new(),
         optimisation: Optimisation::default(),
         outcome: Err("not started".into()),
         duration_s: 0.0,
         robot_radius,
-    };
-    let mut started: Option<i64> = None;
-    let mut waypoint = 0;
+    });
     loop {
         tokio::select! {
             _ = &mut shutdown => anyhow::bail!("interrupted"),
@@ -156,45 +122,33 @@ async fn run(node: &mut RosNode) -> anyhow::Result<()> {
                 }
                 // Repeated until the planner shows the route active: the first may be lost in
                 // discovery.
-                if started.is_none() {
-                    let _ = route_pub.publish(route_msg(node, &route));
+                if act.started.is_none() {
+                    let _ = route_pub.publish(route_now(node, &route));
                 }
             }
-            Some(Ok((m, _))) = truth.next() => {
-                if started.is_some() {
-                    record.path.push((m.pose.pose.position.x, m.pose.pose.position.y));
-                }
-            }
+            Some(Ok((m, _))) = truth.next() => act.truth((m.pose.pose.position.x, m.pose.pose.position.y)),
             Some(Ok((a, _))) = markers.next() => {
-                if let Some(o) = optimisation(&a, waypoint)
-                    && o.robots.len() > record.optimisation.robots.len()
-                {
-                    record.optimisation = o;
+                if let Some(o) = optimisation(&a, act.waypoint) {
+                    act.optimisation(o);
                 }
             }
             Some(Ok((s, _))) = status.next() => {
-                let stamp = nanos_from_stamp(&s.header.stamp).filter(|&t| t > 0).unwrap_or_else(|| node.now_nanos());
-                waypoint = s.waypoint_index;
-                match started {
-                    None if s.state == NavStatus::ACTIVE && s.mode == "vfo" => {
-                        info!("route accepted");
-                        started = Some(stamp);
-                    }
-                    Some(t0) if s.state == NavStatus::SUCCEEDED || s.state == NavStatus::FAILED => {
-                        record.outcome = if s.state == NavStatus::SUCCEEDED { Ok(()) } else { Err(s.reason.clone()) };
-                        record.duration_s = (stamp - t0) as f64 * 1e-9;
-                        break;
-                    }
-                    _ => {}
+                let was = act.started;
+                if act.status(&status_of(&s), stamp_or(&s.header.stamp, node.now_nanos())) {
+                    break;
+                }
+                if was.is_none() && act.started.is_some() {
+                    info!("route accepted");
                 }
             }
         }
     }
+    let record = &act.run;
     let title = format!(
         "{}: VFO waypoint following, virtual robots of one segment",
         node.names().fully_qualified_node()
     );
-    write_file(&out, &figure(&world, &record, &title)).map_err(|e| anyhow::anyhow!("cannot write {out}: {e}"))?;
+    write_file(&out, &figure(&world, record, &title)).map_err(|e| anyhow::anyhow!("cannot write {out}: {e}"))?;
     println!("{}", record.summary(&world, &out));
     Ok(())
 }
