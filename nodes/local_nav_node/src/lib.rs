@@ -25,6 +25,7 @@ use mobil_ros::config::{Config, ConfigError, Decl};
 use mobil_ros::geometry::yaw_quaternion;
 use mobil_ros::goal::goal_pose;
 pub use mobil_ros::goal::{goal_heading, GoalError};
+use mobil_ros::groups::{Frames, GoalTimeouts, MAX_INPUT_TIMEOUT_S};
 use mobil_ros::motion::{EndCause, EndKind};
 use mobil_ros::time::seconds;
 use nalgebra::{Point2, Vector2};
@@ -60,16 +61,12 @@ pub struct LocalNavConfig {
     pub progress: ProgressSettings,
     /// A goal fails STALE_INPUT when no scan arrived for this long (steady clock), in seconds.
     pub scan_timeout_s: f64,
-    /// A goal fails STALE_INPUT when no odometry arrived for this long (steady clock), in seconds.
-    pub odom_timeout_s: f64,
     /// Status and markers rate while a goal is active, in Hz.
     pub status_rate_hz: f64,
-    /// How long a finished action goal's result waits for the client to ask for it, in seconds.
-    pub result_timeout_s: f64,
-    /// Frame goals must be in, and the frame of `odom` (default `odom`).
-    pub odom_frame: String,
-    /// The robot frame (default `base_link`).
-    pub base_frame: String,
+    /// How long a goal waits for odometry, and its result for the client.
+    pub timeouts: GoalTimeouts,
+    /// The frames of odometry, goals and the robot.
+    pub frames: Frames,
     /// The scan's frame, looked up in `tf_static`.
     pub laser_frame: String,
     /// Laser pose (x, y, yaw) in the base frame, for scans whose frame `tf_static` does not
@@ -241,40 +238,14 @@ impl Config for LocalNavConfig {
         .above(0.0)
         .max(MAX_INPUT_TIMEOUT_S);
         d.double(
-            "odom_timeout_s",
-            0.5,
-            "a goal fails STALE_INPUT when no valid odom arrived for this long (steady clock) [s]",
-            |c, v| c.odom_timeout_s = v,
-        )
-        .above(0.0)
-        .max(MAX_INPUT_TIMEOUT_S);
-        d.double(
             "status_rate_hz",
             2.0,
             "local_nav/status and markers rate while a goal is active (action feedback: 20 Hz) [Hz]",
             |c, v| c.status_rate_hz = v,
         )
         .within(0.1, 50.0);
-        d.double(
-            "result_timeout_s",
-            10.0,
-            "how long a finished action goal's result waits for the client to ask for it [s]",
-            |c, v| c.result_timeout_s = v,
-        )
-        .above(0.0)
-        .max(MAX_RESULT_TIMEOUT_S)
-        .read_only();
-        d.string(
-            "odom_frame",
-            "odom",
-            "frame of odom; goals in any other frame are refused",
-            |c, v| c.odom_frame = v,
-        )
-        .read_only();
-        d.string("base_frame", "base_link", "robot frame (reference point)", |c, v| {
-            c.base_frame = v
-        })
-        .read_only();
+        d.nest(|c: &mut LocalNavConfig| &mut c.timeouts, GoalTimeouts::declare);
+        d.nest(|c: &mut LocalNavConfig| &mut c.frames, Frames::declare);
         d.string(
             "laser_frame",
             "laser",
@@ -337,23 +308,7 @@ impl LocalNavConfig {
     pub fn scan_timeout(&self) -> Duration {
         seconds(self.scan_timeout_s, MAX_INPUT_TIMEOUT_S)
     }
-
-    /// The odometry timeout.
-    pub fn odom_timeout(&self) -> Duration {
-        seconds(self.odom_timeout_s, MAX_INPUT_TIMEOUT_S)
-    }
-
-    /// How long a finished action goal's result waits for the client.
-    pub fn result_timeout(&self) -> Duration {
-        seconds(self.result_timeout_s, MAX_RESULT_TIMEOUT_S)
-    }
 }
-
-/// The largest `scan_timeout_s` and `odom_timeout_s` (s): an input silent for a minute is gone.
-pub const MAX_INPUT_TIMEOUT_S: f64 = 60.0;
-
-/// The largest `result_timeout_s` (s): an hour.
-pub const MAX_RESULT_TIMEOUT_S: f64 = 3600.0;
 
 /// The goal point in the odometry frame, or why it is refused ([`mobil_ros::goal::goal_pose`]:
 /// another frame, anything non-finite, a coordinate beyond ±10 km).
@@ -761,8 +716,8 @@ mod tests {
         values.set("result_timeout_s", ros2_client::ParameterValue::Double(3600.0));
         let c: LocalNavConfig = mobil_ros::config::load(&values).unwrap();
         assert_eq!(c.scan_timeout(), Duration::from_secs(60));
-        assert_eq!(c.odom_timeout(), Duration::from_millis(2500));
-        assert_eq!(c.result_timeout(), Duration::from_secs(3600));
+        assert_eq!(c.timeouts.odom_timeout(), Duration::from_millis(2500));
+        assert_eq!(c.timeouts.result_timeout(), Duration::from_secs(3600));
         // The result timeout is read once, at start-up.
         assert!(specs.iter().any(|s| s.name == "result_timeout_s" && s.read_only));
     }

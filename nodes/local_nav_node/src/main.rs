@@ -195,7 +195,7 @@ async fn start(
         node,
         "navigate_to_pose",
         GoalServerConfig {
-            result_timeout: config.result_timeout(),
+            result_timeout: config.timeouts.result_timeout(),
         },
     )?;
     let mut laser = StaticFrames::default();
@@ -215,7 +215,7 @@ async fn start(
     shell.publish_status(node, out, NavStatus::IDLE, String::new());
     info!(
         "waiting for goals on goal_pose and navigate_to_pose (frame `{}`)",
-        shell.config.odom_frame
+        shell.config.frames.odom_frame
     );
     let outcome = event_loop(
         node,
@@ -344,7 +344,7 @@ impl Shell {
     /// robot stops (one zero command) until valid odometry comes again.
     fn odom_in(&mut self, sink: &mut CmdVel<'_>, m: &Odometry) {
         let speed = m.twist.twist.linear.x.hypot(m.twist.twist.linear.y);
-        match odom_pose(m, &self.config.odom_frame, &self.config.base_frame) {
+        match odom_pose(m, &self.config.frames.odom_frame, &self.config.frames.base_frame) {
             Ok(pose) => {
                 self.odom_refused = false;
                 self.odom.set(
@@ -385,7 +385,7 @@ impl Shell {
     }
 
     fn send_status(&mut self, node: &RosNode, out: &Outputs, view: &StatusView) {
-        let msg = status_message(view, node.stamp(), &self.config.odom_frame);
+        let msg = status_message(view, node.stamp(), &self.config.frames.odom_frame);
         if let Err(e) = out.status.publish(msg) {
             warn_throttled!(self.throttle, "status", "cannot publish local_nav/status: {e:?}");
         }
@@ -457,7 +457,7 @@ impl Shell {
         self.last_step = None;
         if let Err(e) = out
             .markers
-            .publish(clear_markers(node.stamp(), &self.config.odom_frame))
+            .publish(clear_markers(node.stamp(), &self.config.frames.odom_frame))
         {
             warn_throttled!(self.throttle, "markers", "cannot publish local_nav/markers: {e:?}");
         }
@@ -496,7 +496,7 @@ impl Shell {
             source.name(),
             goal.x,
             goal.y,
-            self.config.odom_frame
+            self.config.frames.odom_frame
         );
         if let Some(yaw) = heading {
             info!(
@@ -517,7 +517,7 @@ impl Shell {
         server: &mut GoalServer<NavigateToPose>,
         m: &PoseStamped,
     ) {
-        match goal_in_odom(m, &self.config.odom_frame) {
+        match goal_in_odom(m, &self.config.frames.odom_frame) {
             Ok(goal) => self.start_goal(node, out, server, goal, goal_heading(m), Source::Topic, false),
             Err(e) => {
                 // A goal the user meant to replace the old one with: the old one stops too.
@@ -537,7 +537,7 @@ impl Shell {
         server: &mut GoalServer<NavigateToPose>,
         request: GoalRequest<NavigateToPoseGoal>,
     ) {
-        let goal = match goal_in_odom(&request.goal().pose, &self.config.odom_frame) {
+        let goal = match goal_in_odom(&request.goal().pose, &self.config.frames.odom_frame) {
             Ok(g) => g,
             Err(e) => {
                 let reason = invalid_goal(&e);
@@ -588,7 +588,7 @@ impl Shell {
     ) {
         let checked = scan_laser_pose(
             laser,
-            &self.config.base_frame,
+            &self.config.frames.base_frame,
             &m.header.frame_id,
             &self.config.laser_frame,
             self.config.laser_pose(),
@@ -617,7 +617,7 @@ impl Shell {
                 base_from_laser.x,
                 base_from_laser.y,
                 base_from_laser.yaw,
-                self.config.base_frame,
+                self.config.frames.base_frame,
                 match from {
                     LaserPoseFrom::TfStatic => "tf_static",
                     LaserPoseFrom::Parameter => "laser_pose",
@@ -628,7 +628,10 @@ impl Shell {
         if self.session.active().is_none() {
             return;
         }
-        let fresh = self.odom.get(self.config.odom_timeout()).filter(|_| !self.odom_refused);
+        let fresh = self
+            .odom
+            .get(self.config.timeouts.odom_timeout())
+            .filter(|_| !self.odom_refused);
         let Some(odom) = fresh.cloned() else {
             // No command from stale or refused odometry: the robot stops; the watchdog ends the
             // goal if this lasts.
@@ -697,7 +700,7 @@ impl Shell {
             Watched {
                 name: "odom",
                 age: self.odom.age_at(now),
-                timeout: self.config.odom_timeout(),
+                timeout: self.config.timeouts.odom_timeout(),
             },
         ];
         if let Some(stale) = self.session.stale(now, &inputs) {
@@ -726,7 +729,12 @@ impl Shell {
                 hit_point: step.hit_point,
                 leave_point: step.leave_point,
             };
-            let array = markers(&view, stamp, &self.config.odom_frame, &self.config.base_frame);
+            let array = markers(
+                &view,
+                stamp,
+                &self.config.frames.odom_frame,
+                &self.config.frames.base_frame,
+            );
             if let Err(e) = out.markers.publish(array) {
                 warn_throttled!(self.throttle, "markers", "cannot publish local_nav/markers: {e:?}");
             }
@@ -743,7 +751,7 @@ impl Shell {
             current_pose: PoseStamped {
                 header: Header {
                     stamp: stamp.clone(),
-                    frame_id: self.config.odom_frame.clone(),
+                    frame_id: self.config.frames.odom_frame.clone(),
                 },
                 pose: odom.msg_pose.clone(),
             },

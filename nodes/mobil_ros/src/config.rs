@@ -49,6 +49,45 @@ use ros2_client::ParameterValue;
 use std::sync::Arc;
 use thiserror::Error;
 
+/// Declares parameters on a [`Decl`] as a table, a row per parameter: its kind (the [`Decl`]
+/// method: `double`, `integer`, `boolean`, `string`, `parsed`, `doubles`, `double_list`), name,
+/// default, the field it fills, any bounds ([`Declared`]'s methods), and its description:
+///
+/// ```
+/// use mobil_ros::config::{load, Config, Decl};
+/// use mobil_ros::params::ParamValues;
+///
+/// #[derive(Debug, Clone, Default)]
+/// struct Limits { v_max: f64 }
+/// #[derive(Debug, Clone, Default)]
+/// struct Teleop { speed: f64, limits: Limits, frame: String }
+///
+/// impl Config for Teleop {
+///     fn declare(d: &mut Decl<Self>) {
+///         mobil_ros::params! { d;
+///             double "speed" = 0.2 => speed, min(0.0); "forward speed [m/s]";
+///             double "v_max" = 0.5 => limits.v_max, within(0.1, 2.0); "speed limit [m/s]";
+///             string "frame" = "base_link" => frame, read_only(); "command frame";
+///         }
+///     }
+/// }
+///
+/// let teleop: Teleop = load(&ParamValues::defaults(&Decl::<Teleop>::of().specs())).unwrap();
+/// assert_eq!((teleop.speed, teleop.limits.v_max, teleop.frame.as_str()), (0.2, 0.5, "base_link"));
+/// ```
+///
+/// Each row is the method call `d.KIND(NAME, DEFAULT, DESCRIPTION, |c, v| c.FIELD = v)` with
+/// its bounds chained; a parameter whose value fills more than one field, or is converted, is
+/// declared with the method itself.
+#[macro_export]
+macro_rules! params {
+    ($d:ident; $(
+        $kind:ident $name:literal = $default:expr => $($field:ident).+ $(, $bound:ident($($arg:expr),*))*; $doc:expr;
+    )*) => {
+        $( $d.$kind($name, $default, $doc, |c, v| c.$($field).+ = v)$(.$bound($($arg),*))*; )*
+    };
+}
+
 /// Why parameter values do not make a configuration.
 #[derive(Debug, Clone, PartialEq, Error)]
 pub enum ConfigError {

@@ -2,9 +2,10 @@
 //! algorithm crate, so that every node is written the same way.
 //!
 //! A node is a thin shell (see `nodes/chassis_node` for the pattern):
-//! - [`config`]: the configuration declared once (the chassis group every chassis-modelling
-//!   node nests is [`chassis`]) — each parameter's name, type, default, range,
-//!   description and read-only flag, bound to the typed field it fills; from it come the ROS
+//! - [`config`]: the configuration declared once (the groups nodes share: the chassis,
+//!   [`chassis`]; the frames and goal timeouts of every motion node, [`groups`]) — each
+//!   parameter's name, type, default, range, description and read-only flag, bound to the
+//!   typed field it fills, a row per parameter with [`params!`]; from it come the ROS
 //!   declarations, `--help`, validation of files, `-p` and `set_parameters` (refused with a
 //!   reason), and the typed configuration ([`NodeDecl::for_config`], [`RosNode::config`],
 //!   [`RosNode::config_changed`]);
@@ -43,6 +44,7 @@ pub mod config;
 pub mod docs;
 pub mod geometry;
 pub mod goal;
+pub mod groups;
 pub mod input;
 pub mod latest;
 pub mod log;

@@ -31,12 +31,10 @@ use mobil_ros::config::{Config, ConfigError, Decl};
 use mobil_ros::geometry::yaw_quaternion;
 use mobil_ros::goal::RouteLimits;
 pub use mobil_ros::goal::{GoalError, Route};
+use mobil_ros::groups::{Frames, GoalTimeouts};
 use mobil_ros::motion::{EndCause, EndKind};
 use mobil_world::World;
 use nalgebra::Point2;
-use std::time::Duration;
-
-use mobil_ros::time::seconds;
 
 pub mod vfo;
 
@@ -69,28 +67,20 @@ pub struct PlannerConfig {
     pub staging_distance: f64,
     /// Reversing speed of `undock_robot` (m/s).
     pub undock_speed: f64,
-    /// A goal fails STALE_INPUT when no valid odometry arrived for this long (steady clock), s.
-    pub odom_timeout_s: f64,
     /// Status rate while a goal is active (Hz).
     pub status_rate_hz: f64,
     /// Markers rate while a goal is active (Hz).
     pub markers_rate_hz: f64,
-    /// How long a finished action goal's result waits for the client to ask for it (s).
-    pub result_timeout_s: f64,
-    /// Frame of odometry and of every goal.
-    pub odom_frame: String,
-    /// The robot frame (reference point).
-    pub base_frame: String,
+    /// How long a goal waits for odometry, and its result for the client.
+    pub timeouts: GoalTimeouts,
+    /// The frames of odometry, goals and the robot.
+    pub frames: Frames,
     /// How `waypoints` and `follow_waypoints` are followed.
     pub waypoint_method: WaypointMethod,
     /// VFO waypoint following's settings.
     pub vfo: VfoSettings,
 }
 
-/// The largest `odom_timeout_s` (s).
-pub const MAX_INPUT_TIMEOUT_S: f64 = 60.0;
-/// The largest `result_timeout_s` (s).
-pub const MAX_RESULT_TIMEOUT_S: f64 = 3600.0;
 /// Most waypoints of one route (after `number_of_loops`): the pre-check of 200 legs each at the
 /// 50 m leg bound takes 0.47–0.64 s at worst (measured; a real route is far shorter: see the
 /// 20-waypoint bench in docs/planner_node.md and docs/performance.md), so every check runs off
@@ -112,51 +102,20 @@ impl Config for PlannerConfig {
         let dc = DockingConfig::default();
         let f = FollowConfig::default();
         d.nest(|c: &mut PlannerConfig| &mut c.chassis, declare_chassis);
-        d.double(
-            "robot_radius",
-            0.53,
-            "radius of the footprint around the reference point, for the route pre-check [m]",
-            |c, v| c.robot_radius = v,
-        )
-        .above(0.0);
-        d.double("gamma", g.gamma(), "γ: v = γ·e·cos α (eq. 3.43) [1/s]", |c, v| {
-            c.gamma = v
-        })
-        .above(0.0);
-        d.double("k", g.k(), "k: the turn gain on α (eq. 3.46) [1/s]", |c, v| c.k = v)
-            .above(0.0);
-        d.double(
-            "h",
-            g.h(),
-            "h: the weight of Θ in V and ω (eq. 3.41, 3.46)",
-            |c, v| c.h = v,
-        )
-        .above(0.0);
-        d.double("lambda", g.lambda(), "λ: the weight of e² in V (eq. 3.41)", |c, v| {
-            c.lambda = v
-        })
-        .above(0.0);
-        d.double(
-            "position_tolerance",
-            dc.position_tolerance,
-            "ε_e: docked needs e below this [m]",
-            |c, v| c.docking.position_tolerance = v,
-        )
-        .above(0.0);
-        d.double(
-            "heading_tolerance",
-            dc.heading_tolerance,
-            "ε_ϑ: docked needs the heading error below this [rad]",
-            |c, v| c.docking.heading_tolerance = v,
-        )
-        .above(0.0);
-        d.double(
-            "rotate_gain",
-            dc.rotate_gain,
-            "gain of the final in-place rotation (omni) [1/s]",
-            |c, v| c.docking.rotate_gain = v,
-        )
-        .above(0.0);
+        mobil_ros::params! { d;
+            double "robot_radius" = 0.53 => robot_radius, above(0.0);
+                "radius of the footprint around the reference point, for the route pre-check [m]";
+            double "gamma" = g.gamma() => gamma, above(0.0); "γ: v = γ·e·cos α (eq. 3.43) [1/s]";
+            double "k" = g.k() => k, above(0.0); "k: the turn gain on α (eq. 3.46) [1/s]";
+            double "h" = g.h() => h, above(0.0); "h: the weight of Θ in V and ω (eq. 3.41, 3.46)";
+            double "lambda" = g.lambda() => lambda, above(0.0); "λ: the weight of e² in V (eq. 3.41)";
+            double "position_tolerance" = dc.position_tolerance => docking.position_tolerance, above(0.0);
+                "ε_e: docked needs e below this [m]";
+            double "heading_tolerance" = dc.heading_tolerance => docking.heading_tolerance, above(0.0);
+                "ε_ϑ: docked needs the heading error below this [rad]";
+            double "rotate_gain" = dc.rotate_gain => docking.rotate_gain, above(0.0);
+                "gain of the final in-place rotation (omni) [1/s]";
+        }
         d.double(
             "stall_time_s",
             dc.stall_time_s,
@@ -168,122 +127,35 @@ impl Config for PlannerConfig {
             },
         )
         .above(0.0);
-        d.double(
-            "time_limit_s",
-            dc.time_limit_s,
-            "a docking not done after this long fails TIME_LIMIT [s, ROS time]",
-            |c, v| c.docking.time_limit_s = v,
-        )
-        .above(0.0);
-        d.double(
-            "approach_speed",
-            f.speed,
-            "cruise speed of the waypoint approach [m/s]",
-            |c, v| c.follow.speed = v,
-        )
-        .above(0.0);
-        d.double(
-            "min_speed",
-            f.min_speed,
-            "slowest speed of the slow-down at the last waypoint [m/s]",
-            |c, v| c.follow.min_speed = v,
-        )
-        .above(0.0);
-        d.double(
-            "slow_down_distance",
-            f.slow_down_distance,
-            "the speed falls linearly inside this distance to the last waypoint (0: no slow-down) [m]",
-            |c, v| c.follow.slow_down_distance = v,
-        )
-        .min(0.0);
-        d.double(
-            "critical_distance",
-            f.critical_distance,
-            "Z_crit: a waypoint nearer than this is reached (pre-check and run) [m]",
-            |c, v| c.follow.critical_distance = v,
-        )
-        .above(0.0);
-        d.double(
-            "step_length",
-            f.check_length,
-            "the pre-check's step, and the path between two progress checks of the run [m]",
-            |c, v| c.follow.check_length = v,
-        )
-        .above(0.0);
-        d.double(
-            "progress_epsilon",
-            f.progress_epsilon,
-            "ε: within steering reach, a step that brings the waypoint no nearer than this misses it [m]",
-            |c, v| c.follow.progress_epsilon = v,
-        )
-        .min(0.0);
-        d.string(
-            "world_file",
-            "",
-            "world YAML of the pre-check (the sim's format); empty: the sim's built-in world; none: no obstacles",
-            |c, v| c.world_file = v,
-        )
-        .read_only();
-        d.boolean(
-            "execute_infeasible_routes",
-            false,
-            "drive a route the pre-check found problems on (false: refused, FAILED ROUTE_INFEASIBLE)",
-            |c, v| c.execute_infeasible_routes = v,
-        );
-        d.double(
-            "staging_distance",
-            0.5,
-            "undock_robot backs straight out this far [m]",
-            |c, v| c.staging_distance = v,
-        )
-        .above(0.0)
-        .max(10.0);
-        d.double("undock_speed", 0.15, "undock_robot's reversing speed [m/s]", |c, v| {
-            c.undock_speed = v
-        })
-        .above(0.0);
-        d.double(
-            "odom_timeout_s",
-            0.5,
-            "a goal fails STALE_INPUT when no valid odom arrived for this long (steady clock) [s]",
-            |c, v| c.odom_timeout_s = v,
-        )
-        .above(0.0)
-        .max(MAX_INPUT_TIMEOUT_S);
-        d.double(
-            "status_rate_hz",
-            5.0,
-            "planner/status rate while a goal is active (and on every change) [Hz]",
-            |c, v| c.status_rate_hz = v,
-        )
-        .within(0.1, 50.0);
-        d.double(
-            "markers_rate_hz",
-            1.0,
-            "planner/markers rate while a goal is active [Hz]",
-            |c, v| c.markers_rate_hz = v,
-        )
-        .within(0.1, 10.0);
-        d.double(
-            "result_timeout_s",
-            10.0,
-            "how long a finished action goal's result waits for the client to ask for it [s]",
-            |c, v| c.result_timeout_s = v,
-        )
-        .above(0.0)
-        .max(MAX_RESULT_TIMEOUT_S)
-        .read_only();
-        d.string(
-            "odom_frame",
-            "odom",
-            "frame of odom; goals in any other frame are refused",
-            |c, v| c.odom_frame = v,
-        )
-        .read_only();
-        d.string("base_frame", "base_link", "robot frame (reference point)", |c, v| {
-            c.base_frame = v
-        })
-        .read_only();
+        mobil_ros::params! { d;
+            double "time_limit_s" = dc.time_limit_s => docking.time_limit_s, above(0.0);
+                "a docking not done after this long fails TIME_LIMIT [s, ROS time]";
+            double "approach_speed" = f.speed => follow.speed, above(0.0);
+                "cruise speed of the waypoint approach [m/s]";
+            double "min_speed" = f.min_speed => follow.min_speed, above(0.0);
+                "slowest speed of the slow-down at the last waypoint [m/s]";
+            double "slow_down_distance" = f.slow_down_distance => follow.slow_down_distance, min(0.0);
+                "the speed falls linearly inside this distance to the last waypoint (0: no slow-down) [m]";
+            double "critical_distance" = f.critical_distance => follow.critical_distance, above(0.0);
+                "Z_crit: a waypoint nearer than this is reached (pre-check and run) [m]";
+            double "step_length" = f.check_length => follow.check_length, above(0.0);
+                "the pre-check's step, and the path between two progress checks of the run [m]";
+            double "progress_epsilon" = f.progress_epsilon => follow.progress_epsilon, min(0.0);
+                "ε: within steering reach, a step that brings the waypoint no nearer than this misses it [m]";
+            string "world_file" = "" => world_file, read_only();
+                "world YAML of the pre-check (the sim's format); empty: the sim's built-in world; none: no obstacles";
+            boolean "execute_infeasible_routes" = false => execute_infeasible_routes;
+                "drive a route the pre-check found problems on (false: refused, FAILED ROUTE_INFEASIBLE)";
+            double "staging_distance" = 0.5 => staging_distance, above(0.0), max(10.0);
+                "undock_robot backs straight out this far [m]";
+            double "undock_speed" = 0.15 => undock_speed, above(0.0); "undock_robot's reversing speed [m/s]";
+            double "status_rate_hz" = 5.0 => status_rate_hz, within(0.1, 50.0);
+                "planner/status rate while a goal is active (and on every change) [Hz]";
+            double "markers_rate_hz" = 1.0 => markers_rate_hz, within(0.1, 10.0);
+                "planner/markers rate while a goal is active [Hz]";
+        }
+        d.nest(|c: &mut PlannerConfig| &mut c.timeouts, GoalTimeouts::declare);
+        d.nest(|c: &mut PlannerConfig| &mut c.frames, Frames::declare);
         vfo::declare_vfo(d);
     }
 
@@ -330,16 +202,6 @@ impl PlannerConfig {
         c.detour_factor = self.follow.detour_factor;
         c.max_leg_length = self.follow.max_leg_length;
         c
-    }
-
-    /// The odometry timeout.
-    pub fn odom_timeout(&self) -> Duration {
-        seconds(self.odom_timeout_s, MAX_INPUT_TIMEOUT_S)
-    }
-
-    /// How long a finished action goal's result waits for the client.
-    pub fn result_timeout(&self) -> Duration {
-        seconds(self.result_timeout_s, MAX_RESULT_TIMEOUT_S)
     }
 }
 

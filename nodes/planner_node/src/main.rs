@@ -351,7 +351,7 @@ async fn start(node: &mut RosNode, out: &Outputs, config: PlannerConfig) -> anyh
         .map_err(|e| anyhow::anyhow!("vfo obstacle extraction: {e}"))?;
     let check = node.service::<CheckRoute>("planner/check_route")?;
     let server_config = GoalServerConfig {
-        result_timeout: config.result_timeout(),
+        result_timeout: config.timeouts.result_timeout(),
     };
     let mut servers = Servers {
         dock: GoalServer::create(node, "dock_robot", server_config.clone())?,
@@ -368,7 +368,7 @@ async fn start(node: &mut RosNode, out: &Outputs, config: PlannerConfig) -> anyh
             f => f,
         },
         world.obstacles.len(),
-        config.odom_frame
+        config.frames.odom_frame
     );
     let mut shell = Shell {
         config,
@@ -498,13 +498,18 @@ async fn event_loop(
             }
             Event::VfoTicked(done) => shell.vfo_ticked(&mut io, done),
             Event::DockPose(m) => {
-                let target = goal_pose("dock pose", &m, &shell.config.odom_frame);
+                let target = goal_pose("dock pose", &m, &shell.config.frames.odom_frame);
                 let target = target.map_err(|e| invalid_goal(&e, Action::Dock));
                 shell.start_dock(&mut io, target, Source::DockPose);
             }
             Event::Waypoints(m) => {
                 let start = shell.fresh_odom();
-                let route = route_from_path(&m, &shell.config.odom_frame, start.map(|p| p.position()), ROUTE_LIMITS);
+                let route = route_from_path(
+                    &m,
+                    &shell.config.frames.odom_frame,
+                    start.map(|p| p.position()),
+                    ROUTE_LIMITS,
+                );
                 shell.start_route(&mut io, jobs, route, start, Source::Waypoints);
             }
             Event::Dock(ActionEvent::Goal(request)) => shell.dock_action(&mut io, request).await,
@@ -606,13 +611,13 @@ impl Shell {
 
     fn fresh_odom(&self) -> Option<Pose2> {
         self.odom
-            .get(self.config.odom_timeout())
+            .get(self.config.timeouts.odom_timeout())
             .filter(|_| !self.odom_refused)
             .copied()
     }
 
     fn send_status(&mut self, node: &RosNode, out: &Outputs, view: &StatusView) {
-        let msg = status_message(view, node.stamp(), &self.config.odom_frame);
+        let msg = status_message(view, node.stamp(), &self.config.frames.odom_frame);
         if let Err(e) = out.status.publish(msg) {
             warn_throttled!(self.throttle, "status", "cannot publish planner/status: {e:?}");
         }
@@ -677,7 +682,7 @@ impl Shell {
             vfo: self.drawing.vfo.as_ref(),
             robot: self.odom.value().map(|p| p.position()),
         };
-        let array = markers(&view, node.stamp(), &self.config.odom_frame);
+        let array = markers(&view, node.stamp(), &self.config.frames.odom_frame);
         if let Err(e) = out.markers.publish(array) {
             warn_throttled!(self.throttle, "markers", "cannot publish planner/markers: {e:?}");
         }
@@ -800,7 +805,7 @@ impl Shell {
             goal.x,
             goal.y,
             goal.yaw,
-            self.config.odom_frame
+            self.config.frames.odom_frame
         );
         if dock.controller().finish() == Finish::ReportResidual {
             info!(
@@ -988,7 +993,8 @@ impl Shell {
         let target = if g.use_dock_id {
             Err(no_dock_database())
         } else {
-            goal_pose("dock pose", &g.dock_pose, &self.config.odom_frame).map_err(|e| invalid_goal(&e, Action::Dock))
+            goal_pose("dock pose", &g.dock_pose, &self.config.frames.odom_frame)
+                .map_err(|e| invalid_goal(&e, Action::Dock))
         };
         if !g.use_dock_id {
             info!(
@@ -1057,7 +1063,7 @@ impl Shell {
     async fn follow_action(&mut self, io: &mut Io<'_, '_>, jobs: &mut Jobs, request: GoalRequest<FollowWaypointsGoal>) {
         let start = self.fresh_odom();
         let g = request.goal();
-        let frame = &self.config.odom_frame;
+        let frame = &self.config.frames.odom_frame;
         let (round, at) = ((g.goal_index, g.number_of_loops), start.map(|p| p.position()));
         let route = route_from_poses(&g.poses, frame, frame, round, at, ROUTE_LIMITS);
         // A follow_waypoints goal pre-empted by this one lists what it had missed.
@@ -1104,7 +1110,7 @@ impl Shell {
         let (world, chassis, config) = (self.world.clone(), self.chassis, self.config.route_check());
         let (stamp, frame, step) = (
             node.stamp(),
-            self.config.odom_frame.clone(),
+            self.config.frames.odom_frame.clone(),
             self.config.follow.check_length,
         );
         tokio::task::spawn_blocking(move || {
@@ -1130,7 +1136,7 @@ impl Shell {
 
     /// The start and route of a `planner/check_route` request, or the reply refusing it.
     fn check_request(&self, req: &CheckRouteRequest) -> Result<(Pose2, Route), CheckRouteResponse> {
-        let frame = &self.config.odom_frame;
+        let frame = &self.config.frames.odom_frame;
         let start = if req.use_start {
             pose_in_frame("start", frame, &req.start, frame)
                 .map_err(|e| refused_reply(invalid_goal(&e, Action::Follow).reason()))?
@@ -1148,7 +1154,7 @@ impl Shell {
     }
 
     fn odom_in(&mut self, io: &mut Io<'_, '_>, jobs: &mut Jobs, m: &Odometry) {
-        match odom_pose(m, &self.config.odom_frame, &self.config.base_frame) {
+        match odom_pose(m, &self.config.frames.odom_frame, &self.config.frames.base_frame) {
             Ok(pose) => {
                 self.odom_refused = false;
                 self.odom_stamp = secs_from_stamp(&m.header.stamp).unwrap_or(f64::NAN);
@@ -1340,7 +1346,7 @@ impl Shell {
         let (max_gap, scan_range) = (config.vfo.scan_odom_max_gap_s, config.vfo.scan_range);
         let checked = scan_laser_pose(
             &self.laser,
-            &config.base_frame,
+            &config.frames.base_frame,
             &m.header.frame_id,
             &config.vfo.laser_frame,
             config.vfo.laser_pose(),
@@ -1412,7 +1418,7 @@ impl Shell {
         let mut inputs = vec![Watched {
             name: "odom",
             age: self.odom.age_at(now),
-            timeout: active.goal.config.odom_timeout(),
+            timeout: active.goal.config.timeouts.odom_timeout(),
         }];
         if matches!(active.goal.task, Task::Vfo(_)) {
             inputs.push(Watched {

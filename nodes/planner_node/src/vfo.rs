@@ -128,7 +128,7 @@ impl VfoSettings {
 
     /// The scan timeout.
     pub fn scan_timeout(&self) -> Duration {
-        mobil_ros::time::seconds(self.scan_timeout_s, crate::MAX_INPUT_TIMEOUT_S)
+        mobil_ros::time::seconds(self.scan_timeout_s, mobil_ros::groups::MAX_INPUT_TIMEOUT_S)
     }
 
     /// The obstacle extraction with the robot's radius.
@@ -147,226 +147,111 @@ pub fn declare_vfo(d: &mut Decl<PlannerConfig>) {
     let w = QualityWeights::default();
     let s = ScanObstacleConfig::default();
     let v = VfoSettings::default();
-    d.parsed::<WaypointMethod>(
-        "waypoint_method",
-        "approach",
-        "how waypoints and follow_waypoints are followed: approach (the goal approach after the route \
-         pre-check) or vfo (VFO round the obstacles the LIDAR sees, left/right decisions optimised by \
-         virtual robots); applies from the next goal",
-        |c, m| c.waypoint_method = m,
-    )
-    .choices(&["approach", "vfo"]);
-    d.double(
-        "vfo.k_p",
-        g.k_p,
-        "k_p, the position gain of h* (eq. 10) [1/s]",
-        |c, x| c.vfo.gains.k_p = x,
-    )
-    .above(0.0);
-    d.double("vfo.k_a", g.k_a, "k_a, the orienting gain (eq. 13) [1/s]", |c, x| {
-        c.vfo.gains.k_a = x
-    })
-    .above(0.0);
-    d.double(
-        "vfo.speed",
-        g.speed,
-        "U_2, the speed profile (eq. 13), held to v_max [m/s]",
-        |c, x| c.vfo.gains.speed = x,
-    )
-    .above(0.0);
-    d.double(
-        "vfo.omega_max",
-        g.omega_max,
-        "|ω| limit of the law, held to the chassis' omega_max (and on a steered chassis to speed / R_min) [rad/s]",
-        |c, x| c.vfo.gains.omega_max = x,
-    )
-    .above(0.0);
-    d.double(
-        "vfo.switch_epsilon",
-        g.switch_epsilon,
-        "ϵ_i: an intermediate waypoint is passed within this (Algorithm 1) [m]",
-        |c, x| c.vfo.gains.switch_epsilon = x,
-    )
-    .above(0.0);
-    d.double(
-        "vfo.final_epsilon",
-        g.final_epsilon,
-        "ϵ: the route ends when ‖q_N − q‖ (heading included) is below this",
-        |c, x| c.vfo.gains.final_epsilon = x,
-    )
-    .above(0.0);
-    d.double(
-        "vfo.guiding",
-        v.guiding,
-        "μ, the guiding coefficient of every waypoint (eq. 11), in (0, 1)",
-        |c, x| c.vfo.guiding = x,
-    )
-    .above(0.0)
-    .max(0.999);
-    d.double(
-        "vfo.k_d",
-        w.length,
-        "K_D, the weight of path length in Ψ_z (eq. 22)",
-        |c, x| c.vfo.optimise.weights.length = x,
-    )
-    .min(0.0);
-    d.double(
-        "vfo.k_b",
-        w.danger,
-        "K_B, the weight of danger in Ψ_z (eq. 22)",
-        |c, x| c.vfo.optimise.weights.danger = x,
-    )
-    .min(0.0);
-    d.double(
-        "vfo.k_e",
-        w.control,
-        "K_E, the weight of control cost in Ψ_z (eq. 22)",
-        |c, x| c.vfo.optimise.weights.control = x,
-    )
-    .min(0.0);
-    d.double(
-        "vfo.k_s",
-        w.smoothness,
-        "K_S, the weight of smoothness in Ψ_z (eq. 22)",
-        |c, x| c.vfo.optimise.weights.smoothness = x,
-    )
-    .min(0.0);
-    d.double(
-        "vfo.time_step",
-        o.time_step,
-        "T_p, the virtual robots' integration step; set it to the odometry period the node steps on [s]",
-        |c, x| c.vfo.optimise.time_step = x,
-    )
-    .above(0.0)
-    .max(0.1);
+    // A count: a negative value is refused by the bound, and reads as 0 should one get through.
+    let count = |x: i64| usize::try_from(x).unwrap_or(0);
+    mobil_ros::params! { d;
+        parsed "waypoint_method" = "approach" => waypoint_method, choices(&["approach", "vfo"]);
+            "how waypoints and follow_waypoints are followed: approach (the goal approach after the route \
+             pre-check) or vfo (VFO round the obstacles the LIDAR sees, left/right decisions optimised by \
+             virtual robots); applies from the next goal";
+        double "vfo.k_p" = g.k_p => vfo.gains.k_p, above(0.0); "k_p, the position gain of h* (eq. 10) [1/s]";
+        double "vfo.k_a" = g.k_a => vfo.gains.k_a, above(0.0); "k_a, the orienting gain (eq. 13) [1/s]";
+        double "vfo.speed" = g.speed => vfo.gains.speed, above(0.0);
+            "U_2, the speed profile (eq. 13), held to v_max [m/s]";
+        double "vfo.omega_max" = g.omega_max => vfo.gains.omega_max, above(0.0);
+            "|ω| limit of the law, held to the chassis' omega_max (and on a steered chassis to speed / R_min) [rad/s]";
+        double "vfo.switch_epsilon" = g.switch_epsilon => vfo.gains.switch_epsilon, above(0.0);
+            "ϵ_i: an intermediate waypoint is passed within this (Algorithm 1) [m]";
+        double "vfo.final_epsilon" = g.final_epsilon => vfo.gains.final_epsilon, above(0.0);
+            "ϵ: the route ends when ‖q_N − q‖ (heading included) is below this";
+        double "vfo.guiding" = v.guiding => vfo.guiding, above(0.0), max(0.999);
+            "μ, the guiding coefficient of every waypoint (eq. 11), in (0, 1)";
+        double "vfo.k_d" = w.length => vfo.optimise.weights.length, min(0.0);
+            "K_D, the weight of path length in Ψ_z (eq. 22)";
+        double "vfo.k_b" = w.danger => vfo.optimise.weights.danger, min(0.0);
+            "K_B, the weight of danger in Ψ_z (eq. 22)";
+        double "vfo.k_e" = w.control => vfo.optimise.weights.control, min(0.0);
+            "K_E, the weight of control cost in Ψ_z (eq. 22)";
+        double "vfo.k_s" = w.smoothness => vfo.optimise.weights.smoothness, min(0.0);
+            "K_S, the weight of smoothness in Ψ_z (eq. 22)";
+        double "vfo.time_step" = o.time_step => vfo.optimise.time_step, above(0.0), max(0.1);
+            "T_p, the virtual robots' integration step; set it to the odometry period the node steps on [s]";
+    }
     d.integer(
         "vfo.max_virtual_robots",
         o.max_virtual_robots as i64,
         "most virtual robots per optimisation (then the best so far, with a warning)",
-        |c, x| c.vfo.optimise.max_virtual_robots = usize::try_from(x).unwrap_or(0),
+        move |c, x| c.vfo.optimise.max_virtual_robots = count(x),
     )
     .min(1.0);
-    d.double(
-        "vfo.max_path_time_s",
-        o.max_path_time_s,
-        "a virtual robot's path longer than this in simulated time is dropped [s]",
-        |c, x| c.vfo.optimise.max_path_time_s = x,
-    )
-    .above(0.0);
-    d.double(
-        "vfo.max_total_time_s",
-        o.max_total_time_s,
-        "most simulated time over all virtual robots of one optimisation [s]",
-        |c, x| c.vfo.optimise.max_total_time_s = x,
-    )
-    .above(0.0);
+    mobil_ros::params! { d;
+        double "vfo.max_path_time_s" = o.max_path_time_s => vfo.optimise.max_path_time_s, above(0.0);
+            "a virtual robot's path longer than this in simulated time is dropped [s]";
+        double "vfo.max_total_time_s" = o.max_total_time_s => vfo.optimise.max_total_time_s, above(0.0);
+            "most simulated time over all virtual robots of one optimisation [s]";
+    }
     d.integer(
         "vfo.threads",
         o.threads as i64,
         "threads for a batch of virtual robots (0: every core)",
-        |c, x| c.vfo.optimise.threads = usize::try_from(x).unwrap_or(0),
+        move |c, x| c.vfo.optimise.threads = count(x),
     )
     .min(0.0);
-    d.double(
-        "vfo.influence_margin",
-        s.influence_margin,
-        "R − r of every obstacle seen [m]",
-        |c, x| c.vfo.scan.influence_margin = x,
-    )
-    .above(0.0);
-    d.double(
-        "vfo.cluster_gap",
-        s.cluster_gap,
-        "largest gap between the echoes of one obstacle (plus two beam spacings) [m]",
-        |c, x| c.vfo.scan.cluster_gap = x,
-    )
-    .above(0.0);
+    mobil_ros::params! { d;
+        double "vfo.influence_margin" = s.influence_margin => vfo.scan.influence_margin, above(0.0);
+            "R − r of every obstacle seen [m]";
+        double "vfo.cluster_gap" = s.cluster_gap => vfo.scan.cluster_gap, above(0.0);
+            "largest gap between the echoes of one obstacle (plus two beam spacings) [m]";
+    }
     d.integer(
         "vfo.min_points",
         s.min_points as i64,
         "fewest echoes of one obstacle",
-        |c, x| c.vfo.scan.min_points = usize::try_from(x).unwrap_or(0),
+        move |c, x| c.vfo.scan.min_points = count(x),
     )
     .min(3.0);
-    d.double(
-        "vfo.max_radius",
-        s.max_radius,
-        "largest circle fitted to one cluster; larger shapes become chains of circles [m]",
-        |c, x| c.vfo.scan.max_radius = x,
-    )
-    .above(0.0);
-    d.double(
-        "vfo.association_distance",
-        s.association_distance,
-        "circles whose centres lie nearer than this are one obstacle [m]",
-        |c, x| c.vfo.scan.association_distance = x,
-    )
-    .above(0.0);
+    mobil_ros::params! { d;
+        double "vfo.max_radius" = s.max_radius => vfo.scan.max_radius, above(0.0);
+            "largest circle fitted to one cluster; larger shapes become chains of circles [m]";
+        double "vfo.association_distance" = s.association_distance => vfo.scan.association_distance, above(0.0);
+            "circles whose centres lie nearer than this are one obstacle [m]";
+    }
     d.integer(
         "vfo.memory",
         s.memory as i64,
         "detections an obstacle's running mean remembers",
-        |c, x| c.vfo.scan.memory = usize::try_from(x).unwrap_or(0),
+        move |c, x| c.vfo.scan.memory = count(x),
     )
     .min(1.0);
-    d.double(
-        "vfo.optimise_budget_s",
-        v.optimise_budget_s,
-        "wall-clock budget of one optimisation: then the best Σ so far, with a warning (the robot stands meanwhile) [s]",
-        |c, x| c.vfo.optimise_budget_s = x,
-    )
-    .above(0.0)
-    .max(MAX_OPTIMISE_BUDGET_S);
-    d.double(
-        "vfo.decay_s",
-        s.decay_s,
-        "an obstacle not seen again for this long is forgotten [s]",
-        |c, x| c.vfo.scan.decay_s = x,
-    )
-    .above(0.0);
+    mobil_ros::params! { d;
+        double "vfo.optimise_budget_s" = v.optimise_budget_s => vfo.optimise_budget_s, above(0.0),
+            max(MAX_OPTIMISE_BUDGET_S);
+            "wall-clock budget of one optimisation: then the best Σ so far, with a warning (the robot stands \
+             meanwhile) [s]";
+        double "vfo.decay_s" = s.decay_s => vfo.scan.decay_s, above(0.0);
+            "an obstacle not seen again for this long is forgotten [s]";
+    }
     d.integer(
         "vfo.max_obstacles",
         s.max_obstacles as i64,
         "most obstacles in the map; beyond, the least recently seen are dropped (with a warning)",
-        |c, x| c.vfo.scan.max_obstacles = usize::try_from(x).unwrap_or(0),
+        move |c, x| c.vfo.scan.max_obstacles = count(x),
     )
     .min(1.0);
-    d.double(
-        "vfo.scan_odom_max_gap_s",
-        v.scan_odom_max_gap_s,
-        "a scan is placed with the odometry pose at its stamp; refused when no odometry lies within this of it [s]",
-        |c, x| c.vfo.scan_odom_max_gap_s = x,
-    )
-    .above(0.0)
-    .max(1.0);
-    d.double(
-        "vfo.scan_range",
-        v.scan_range,
-        "echoes farther than this are not turned into obstacles [m]",
-        |c, x| c.vfo.scan_range = x,
-    )
-    .above(0.0);
-    d.double(
-        "vfo.scan_timeout_s",
-        v.scan_timeout_s,
-        "a vfo goal fails STALE_INPUT when no valid scan arrived for this long (steady clock) [s]",
-        |c, x| c.vfo.scan_timeout_s = x,
-    )
-    .above(0.0)
-    .max(crate::MAX_INPUT_TIMEOUT_S);
-    d.string(
-        "vfo.laser_frame",
-        &v.laser_frame,
-        "the scan's frame when its header has none; its pose comes from tf_static",
-        |c, x| c.vfo.laser_frame = x,
-    )
-    .read_only();
-    d.double_list(
-        "vfo.laser_pose",
-        &v.laser_pose,
-        "x, y, yaw of the laser in base_link for a scan frame tf_static does not give; [] = none",
-        |c, x| c.vfo.laser_pose = x,
-    );
+    mobil_ros::params! { d;
+        double "vfo.scan_odom_max_gap_s" = v.scan_odom_max_gap_s => vfo.scan_odom_max_gap_s, above(0.0), max(1.0);
+            "a scan is placed with the odometry pose at its stamp; refused when no odometry lies within this of it \
+             [s]";
+        double "vfo.scan_range" = v.scan_range => vfo.scan_range, above(0.0);
+            "echoes farther than this are not turned into obstacles [m]";
+        double "vfo.scan_timeout_s" = v.scan_timeout_s => vfo.scan_timeout_s, above(0.0),
+            max(mobil_ros::groups::MAX_INPUT_TIMEOUT_S);
+            "a vfo goal fails STALE_INPUT when no valid scan arrived for this long (steady clock) [s]";
+        string "vfo.laser_frame" = &v.laser_frame => vfo.laser_frame, read_only();
+            "the scan's frame when its header has none; its pose comes from tf_static";
+        double_list "vfo.laser_pose" = &v.laser_pose => vfo.laser_pose;
+            "x, y, yaw of the laser in base_link for a scan frame tf_static does not give; [] = none";
+    }
 }
 
 #[cfg(test)]

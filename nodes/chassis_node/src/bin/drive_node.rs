@@ -18,6 +18,7 @@ use mobil_msgs::nav_msgs::msg::Odometry;
 use mobil_ros::action::{ActionEvent, GoalEnd, GoalServer, GoalServerConfig};
 use mobil_ros::config::{Config, ConfigError, Decl};
 use mobil_ros::geometry::yaw_of;
+use mobil_ros::groups::GoalTimeouts;
 use mobil_ros::input::Inputs;
 use mobil_ros::latest::Latest;
 use mobil_ros::motion::{Applied, CmdVel, EndCause, EndKind, Ended, MotionSession, SessionSettings};
@@ -38,8 +39,7 @@ struct DriveConfig {
     decel: f64,
     tolerance: f64,
     rate_hz: f64,
-    odom_timeout_s: f64,
-    result_timeout_s: f64,
+    timeouts: GoalTimeouts,
 }
 
 impl Config for DriveConfig {
@@ -73,21 +73,7 @@ impl Config for DriveConfig {
             |c, v| c.rate_hz = v,
         )
         .within(1.0, 200.0);
-        d.double(
-            "odom_timeout_s",
-            0.5,
-            "a goal is aborted when no odom arrived for this long (steady clock) [s]",
-            |c, v| c.odom_timeout_s = v,
-        )
-        .above(0.0);
-        d.double(
-            "result_timeout_s",
-            10.0,
-            "how long a finished goal's result waits for the client to ask for it [s]",
-            |c, v| c.result_timeout_s = v,
-        )
-        .above(0.0)
-        .read_only();
+        d.nest(|c: &mut DriveConfig| &mut c.timeouts, GoalTimeouts::declare);
     }
 
     fn validate(&self) -> Result<(), ConfigError> {
@@ -109,10 +95,6 @@ impl DriveConfig {
             decel: self.decel,
             tolerance: self.tolerance,
         }
-    }
-
-    fn odom_timeout(&self) -> Duration {
-        Duration::from_secs_f64(self.odom_timeout_s)
     }
 }
 
@@ -206,7 +188,7 @@ async fn drive_loop(
         node,
         "drive_distance",
         GoalServerConfig {
-            result_timeout: Duration::from_secs_f64(config.result_timeout_s),
+            result_timeout: config.timeouts.result_timeout(),
         },
     )?;
     let outcome = event_loop(node, cmd, &odom_sub, &mut server, session, &mut config).await;
@@ -263,7 +245,7 @@ async fn event_loop(
             event = server.next_event() => match event {
                 ActionEvent::Goal(request) => {
                     let goal = request.goal().clone();
-                    let Some(&start) = latest.get(config.odom_timeout()) else {
+                    let Some(&start) = latest.get(config.timeouts.odom_timeout()) else {
                         server.reject(request, "no recent odom: is the chassis running?").await;
                         continue;
                     };
@@ -296,8 +278,8 @@ async fn event_loop(
                 if session.active().is_none() {
                     continue;
                 }
-                let Some(&pose) = latest.get(config.odom_timeout()) else {
-                    warn!("no odom for {:?}: goal aborted", config.odom_timeout());
+                let Some(&pose) = latest.get(config.timeouts.odom_timeout()) else {
+                    warn!("no odom for {:?}: goal aborted", config.timeouts.odom_timeout());
                     let ended = session.end(EndCause::Stale("odom".into()), &mut sink);
                     finish(server, ended);
                     continue;
