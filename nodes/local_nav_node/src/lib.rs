@@ -16,16 +16,16 @@ use mobil_local_nav::{
 };
 use mobil_motion::Outcome;
 use mobil_msgs::builtin_interfaces::msg::Time;
-use mobil_msgs::geometry_msgs::msg::{Point, Pose, PoseStamped, Twist, Vector3};
+use mobil_msgs::geometry_msgs::msg::{Point, Pose, PoseStamped, Twist};
 use mobil_msgs::mobil_msgs::msg::NavStatus;
-use mobil_msgs::std_msgs::msg::{ColorRGBA, Header};
+use mobil_msgs::std_msgs::msg::Header;
 use mobil_msgs::visualization_msgs::msg::{Marker, MarkerArray};
 use mobil_ros::chassis::{chassis_params, declare_chassis};
 use mobil_ros::config::{Config, ConfigError, Decl};
-use mobil_ros::geometry::yaw_quaternion;
 use mobil_ros::goal::goal_pose;
 pub use mobil_ros::goal::{goal_heading, GoalError};
 use mobil_ros::groups::{Frames, GoalTimeouts, MAX_INPUT_TIMEOUT_S};
+use mobil_ros::markers::{point, rgb, Markers};
 use mobil_ros::motion::{EndCause, EndKind};
 use mobil_ros::time::seconds;
 use nalgebra::{Point2, Vector2};
@@ -384,10 +384,6 @@ pub struct StatusView {
     pub leave_point: Option<Point2<f64>>,
 }
 
-fn point(p: Point2<f64>) -> Point {
-    Point { x: p.x, y: p.y, z: 0.0 }
-}
-
 /// The NavStatus message of a view, stamped `stamp`, in `frame` (odom).
 pub fn status_message(view: &StatusView, stamp: Time, frame: &str) -> NavStatus {
     let mut goal = Pose::default();
@@ -439,29 +435,6 @@ pub struct MarkerView<'a> {
     pub leave_point: Option<Point2<f64>>,
 }
 
-fn color(r: f32, g: f32, b: f32) -> ColorRGBA {
-    ColorRGBA { r, g, b, a: 1.0 }
-}
-
-fn marker(header: &Header, id: i32, kind: i32, scale: f64, c: ColorRGBA) -> Marker {
-    let mut m = Marker {
-        header: header.clone(),
-        ns: "local_nav".into(),
-        id,
-        r#type: kind,
-        action: Marker::ADD,
-        color: c,
-        scale: Vector3 {
-            x: scale,
-            y: scale,
-            z: scale,
-        },
-        ..Default::default()
-    };
-    m.pose.orientation = yaw_quaternion(0.0);
-    m
-}
-
 /// Longest sector vector drawn (m): an open sector is drawn at this length.
 const MAX_DRAWN: f64 = 5.0;
 
@@ -470,72 +443,45 @@ const MAX_DRAWN: f64 = 5.0;
 /// L when known (a DELETE for those not, so RViz drops stale ones). At most 5 markers and
 /// 2·N + 2 points: a few kilobytes.
 pub fn markers(view: &MarkerView<'_>, stamp: Time, odom_frame: &str, base_frame: &str) -> MarkerArray {
-    let base = Header {
-        stamp: stamp.clone(),
-        frame_id: base_frame.to_owned(),
-    };
-    let odom = Header {
-        stamp,
-        frame_id: odom_frame.to_owned(),
-    };
-    let mut sectors = marker(&base, 0, Marker::LINE_LIST, 0.02, color(0.2, 0.6, 1.0));
-    for i in 0..view.sectors.len() {
+    let mut m = Markers::new(stamp, base_frame);
+    let tips = (0..view.sectors.len()).flat_map(|i| {
         let d = view.sectors.effective_distance(i).min(MAX_DRAWN);
         let d = if d.is_finite() { d } else { 0.0 };
         let (s, c) = view.sectors.bearing(i).sin_cos();
-        sectors.points.push(Point::default());
-        sectors.points.push(Point {
-            x: d * c,
-            y: d * s,
-            z: 0.0,
-        });
-    }
-    let mut f = marker(&base, 1, Marker::ARROW, 0.0, color(1.0, 0.5, 0.0));
-    f.scale = Vector3 {
-        x: 0.05,
-        y: 0.1,
-        z: 0.1,
-    };
+        [Point2::origin(), Point2::new(d * c, d * s)]
+    });
+    m.line_list(NS, 0, tips, 0.02, rgb(0.2, 0.6, 1.0));
     let tip = if view.direction.iter().all(|v| v.is_finite()) {
         view.direction
     } else {
         Vector2::zeros()
     };
-    f.points = vec![
-        Point::default(),
-        Point {
-            x: tip.x,
-            y: tip.y,
-            z: 0.0,
-        },
-    ];
-    let mut out = vec![sectors, f];
+    let f = m.add(NS, 1, Marker::ARROW, [0.05, 0.1, 0.1], rgb(1.0, 0.5, 0.0));
+    f.points = vec![Point::default(), point(Point2::from(tip))];
+    m.set_frame(odom_frame);
     let spots = [
-        (2, view.goal, color(0.0, 0.8, 0.0)),
-        (3, view.hit_point, color(0.9, 0.0, 0.0)),
-        (4, view.leave_point, color(0.8, 0.0, 0.8)),
+        (2, view.goal, rgb(0.0, 0.8, 0.0)),
+        (3, view.hit_point, rgb(0.9, 0.0, 0.0)),
+        (4, view.leave_point, rgb(0.8, 0.0, 0.8)),
     ];
     for (id, at, c) in spots {
-        let mut m = marker(&odom, id, Marker::SPHERE, 0.15, c);
         match at {
-            Some(p) if p.x.is_finite() && p.y.is_finite() => m.pose.position = point(p),
-            _ => m.action = Marker::DELETE,
+            Some(p) if p.x.is_finite() && p.y.is_finite() => {
+                m.sphere(NS, id, p, 0.15, c);
+            }
+            _ => m.delete(NS, id),
         }
-        out.push(m);
     }
-    MarkerArray { markers: out }
+    m.array()
 }
+
+/// The namespace of every local_nav marker.
+const NS: &str = "local_nav";
 
 /// The marker array that removes every local_nav marker (sent when a goal ends, so RViz does not
 /// keep showing the sectors and points of a goal that is over).
 pub fn clear_markers(stamp: Time, frame: &str) -> MarkerArray {
-    let header = Header {
-        stamp,
-        frame_id: frame.to_owned(),
-    };
-    let mut m = marker(&header, 0, Marker::SPHERE, 0.0, color(0.0, 0.0, 0.0));
-    m.action = Marker::DELETEALL;
-    MarkerArray { markers: vec![m] }
+    Markers::replacing(stamp, frame).array()
 }
 
 /// How the progress checker ends a goal: `ABORTED` with Nav2's `FAILED_TO_MAKE_PROGRESS`
@@ -689,10 +635,7 @@ mod tests {
         assert_eq!(a.markers[2].header.frame_id, "odom");
         let cleared = clear_markers(Time::default(), "odom");
         assert_eq!(cleared.markers.len(), 1);
-        assert_eq!(
-            (cleared.markers[0].action, cleared.markers[0].ns.as_str()),
-            (Marker::DELETEALL, "local_nav")
-        );
+        assert_eq!(cleared.markers[0].action, Marker::DELETEALL);
     }
 
     #[test]

@@ -28,13 +28,14 @@
 //!   command at every end, stale input, shutdown), around a [`mobil_motion::GoalLaw`];
 //! - [`goal`]: goal poses and routes from messages, checked in the node's frame (the reasons of
 //!   an `INVALID_GOAL`);
+//! - [`markers`]: RViz markers, built one call per marker;
 //! - [`stop`]: [`stop::final_stop`], the bounded last zero command of a motion node;
 //! - [`scan`]: LaserScan → checked [`mobil_geom::Scan`] at the edge, laser pose from `tf_static`
 //!   ([`scan::tf_static_subscription`] feeding [`scan::LaserPose`]; `tf_static` wins) or a
 //!   parameter;
 //! - [`qos`]: the QoS presets of the interface contract; [`log`]: `tracing` set-up and
 //!   rate-limited warnings ([`warn_throttled!`]); [`geometry`]: planar poses in messages;
-//!   [`args`], [`params`], [`names`]: the ROS command line, parameter files, names;
+//!   [`args`], [`mod@params`], [`names`]: the ROS command line, parameter files, names;
 //!   [`docs`]: the parameter tables of `docs/`, which `--params-markdown` prints.
 
 pub mod action;
@@ -48,6 +49,7 @@ pub mod groups;
 pub mod input;
 pub mod latest;
 pub mod log;
+pub mod markers;
 pub mod motion;
 pub mod names;
 pub mod node;

@@ -15,14 +15,14 @@ use mobil_geom::downsample;
 use mobil_geom::Pose2;
 use mobil_motion::{nav2, Outcome};
 use mobil_msgs::builtin_interfaces::msg::Time;
-use mobil_msgs::geometry_msgs::msg::{Point, Pose, PoseStamped, Twist, Vector3};
+use mobil_msgs::geometry_msgs::msg::{Point, Pose, PoseStamped, Twist};
 use mobil_msgs::mobil_msgs::msg::{NavStatus, RouteProblem as ProblemMsg};
 use mobil_msgs::mobil_msgs::srv::CheckRouteResponse;
 use mobil_msgs::nav2_msgs::action::{DockRobotResult, FollowWaypointsResult, UndockRobotResult};
 use mobil_msgs::nav2_msgs::msg::MissedWaypoint;
 use mobil_msgs::nav_msgs::msg::Path;
-use mobil_msgs::std_msgs::msg::{ColorRGBA, Header};
-use mobil_msgs::visualization_msgs::msg::{Marker, MarkerArray};
+use mobil_msgs::std_msgs::msg::Header;
+use mobil_msgs::visualization_msgs::msg::MarkerArray;
 pub use mobil_planner::goals::{list_missed, missed_from_report, route_infeasible, Missed, MISSED_BY_THE_RUN};
 use mobil_planner::vfo::{SegmentReport, VfoDrawing, MAX_DRAWN_OBSTACLES, MAX_DRAWN_ROBOTS};
 use mobil_planner::{DockingConfig, DockingGains, FollowConfig, RouteCheckConfig, RouteReport};
@@ -32,6 +32,7 @@ use mobil_ros::geometry::yaw_quaternion;
 use mobil_ros::goal::RouteLimits;
 pub use mobil_ros::goal::{GoalError, Route};
 use mobil_ros::groups::{Frames, GoalTimeouts};
+use mobil_ros::markers::{point, rgb, rgba, Markers};
 use mobil_ros::motion::{EndCause, EndKind};
 use mobil_world::World;
 use nalgebra::Point2;
@@ -427,10 +428,6 @@ fn missed_waypoint(index: usize, error_code: u16, poses: &[PoseStamped]) -> Miss
     }
 }
 
-fn point(p: Point2<f64>) -> Point {
-    Point { x: p.x, y: p.y, z: 0.0 }
-}
-
 fn pose_msg(p: &Pose2) -> Pose {
     Pose {
         position: point(p.position()),
@@ -555,29 +552,6 @@ pub fn status_message(view: &StatusView, stamp: Time, frame: &str) -> NavStatus 
     }
 }
 
-fn color(r: f32, g: f32, b: f32) -> ColorRGBA {
-    ColorRGBA { r, g, b, a: 1.0 }
-}
-
-fn marker(header: &Header, ns: &str, id: i32, kind: i32, scale: f64, c: ColorRGBA) -> Marker {
-    let mut m = Marker {
-        header: header.clone(),
-        ns: ns.into(),
-        id,
-        r#type: kind,
-        action: Marker::ADD,
-        color: c,
-        scale: Vector3 {
-            x: scale,
-            y: scale,
-            z: scale,
-        },
-        ..Default::default()
-    };
-    m.pose.orientation = yaw_quaternion(0.0);
-    m
-}
-
 /// Most points of the predicted path drawn.
 pub const MAX_DRAWN_PATH: usize = 300;
 
@@ -614,66 +588,45 @@ pub const MAX_MARKER_POINTS: usize = 1000;
 /// half of it (its line and dots, a quarter each, downsampled beyond), the predicted path up to
 /// a quarter of the rest, the VFO paths what remains.
 pub fn markers(view: &MarkerView<'_>, stamp: Time, frame: &str) -> MarkerArray {
-    let header = Header {
-        stamp,
-        frame_id: frame.to_owned(),
-    };
-    let mut out = vec![clear_marker(&header)];
+    let mut m = Markers::replacing(stamp, frame);
     let mut budget = MAX_MARKER_POINTS;
     if !view.route.is_empty() {
         let route = downsample(view.route, MAX_MARKER_POINTS / 4);
         budget -= 2 * route.len();
-        let mut line = marker(&header, "route", 0, Marker::LINE_STRIP, 0.02, color(0.2, 0.6, 1.0));
-        line.points = route.iter().map(|p| point(*p)).collect();
-        let mut dots = marker(&header, "route", 1, Marker::SPHERE_LIST, 0.12, color(0.2, 0.6, 1.0));
-        dots.points = line.points.clone();
-        out.push(line);
-        out.push(dots);
+        let blue = rgb(0.2, 0.6, 1.0);
+        m.line_strip("route", 0, route.iter().copied(), 0.02, blue.clone());
+        m.dots("route", 1, route, 0.12, blue);
     }
     if !view.predicted.is_empty() {
-        let mut path = marker(&header, "predicted", 0, Marker::LINE_STRIP, 0.015, color(0.0, 0.8, 0.0));
-        path.points = downsample(view.predicted, MAX_DRAWN_PATH.min(budget / 4))
-            .iter()
-            .map(|p| point(p.position()))
-            .collect();
-        budget -= path.points.len();
-        out.push(path);
+        let path = downsample(view.predicted, MAX_DRAWN_PATH.min(budget / 4));
+        budget -= path.len();
+        m.line_strip(
+            "predicted",
+            0,
+            path.iter().map(|p| p.position()),
+            0.015,
+            rgb(0.0, 0.8, 0.0),
+        );
     }
-    for (i, m) in view.problems.iter().take(MAX_LISTED_PROBLEMS).enumerate() {
+    for (i, p) in view.problems.iter().take(MAX_LISTED_PROBLEMS).enumerate() {
         let id = i32::try_from(i).unwrap_or(i32::MAX);
-        let mut dot = marker(&header, "problems", id, Marker::SPHERE, 0.2, color(0.9, 0.0, 0.0));
-        dot.pose.position = point(m.position);
-        let mut text = marker(
-            &header,
+        m.sphere("problems", id, p.position, 0.2, rgb(0.9, 0.0, 0.0));
+        m.text(
             "problem_text",
             id,
-            Marker::TEXT_VIEW_FACING,
+            (p.position, 0.3),
             0.12,
-            color(1.0, 1.0, 1.0),
+            rgb(1.0, 1.0, 1.0),
+            p.describe(),
         );
-        text.pose.position = Point {
-            x: m.position.x,
-            y: m.position.y,
-            z: 0.3,
-        };
-        text.text = m.describe();
-        out.push(dot);
-        out.push(text);
     }
     if let Some(d) = view.dock {
-        let mut arrow = marker(&header, "dock", 0, Marker::ARROW, 0.0, color(1.0, 0.5, 0.0));
-        arrow.pose = pose_msg(&d);
-        arrow.scale = Vector3 {
-            x: 0.4,
-            y: 0.06,
-            z: 0.06,
-        };
-        out.push(arrow);
+        m.arrow("dock", 0, &d, (0.4, 0.06), rgb(1.0, 0.5, 0.0));
     }
     if let Some(drawing) = view.vfo {
-        vfo_markers(&header, drawing, view.robot, budget, &mut out);
+        vfo_markers(&mut m, drawing, view.robot, budget);
     }
-    MarkerArray { markers: out }
+    m.array()
 }
 
 /// A VFO optimisation's markers: each virtual robot's path a thin LINE_STRIP (`vfo_robots`,
@@ -683,13 +636,7 @@ pub fn markers(view: &MarkerView<'_>, stamp: Time, frame: &str) -> MarkerArray {
 /// one of radius R (`vfo_influence`). The paths share `budget` points: the chosen one up to a
 /// third, the virtual robots the rest, evenly (at least two points each, so the first
 /// `budget / 2` robots at most).
-fn vfo_markers(
-    header: &Header,
-    drawing: &VfoDrawing,
-    robot: Option<Point2<f64>>,
-    budget: usize,
-    out: &mut Vec<Marker>,
-) {
+fn vfo_markers(m: &mut Markers, drawing: &VfoDrawing, robot: Option<Point2<f64>>, budget: usize) {
     let chosen = downsample(&drawing.chosen, budget / 3);
     let rest = budget - chosen.len();
     let robots = &drawing.robots[..drawing.robots.len().min(rest / 2).min(MAX_DRAWN_ROBOTS)];
@@ -697,18 +644,14 @@ fn vfo_markers(
     for (i, r) in robots.iter().enumerate() {
         let id = i32::try_from(i).unwrap_or(i32::MAX);
         let c = if r.dropped {
-            color(1.0, 0.5, 0.0)
+            rgb(1.0, 0.5, 0.0)
         } else {
-            color(0.6, 0.6, 0.6)
+            rgb(0.6, 0.6, 0.6)
         };
-        let mut line = marker(header, "vfo_robots", id, Marker::LINE_STRIP, 0.01, c);
-        line.points = downsample(&r.points, per_robot).iter().map(|p| point(*p)).collect();
-        out.push(line);
+        m.line_strip("vfo_robots", id, downsample(&r.points, per_robot), 0.01, c);
     }
     if !chosen.is_empty() {
-        let mut line = marker(header, "vfo_chosen", 0, Marker::LINE_STRIP, 0.04, color(0.0, 0.9, 0.2));
-        line.points = chosen.iter().map(|p| point(*p)).collect();
-        out.push(line);
+        m.line_strip("vfo_chosen", 0, chosen, 0.04, rgb(0.0, 0.9, 0.2));
     }
     let mut order: Vec<usize> = (0..drawing.obstacles.len()).collect();
     if let Some(at) = robot {
@@ -719,54 +662,19 @@ fn vfo_markers(
         });
     }
     for (k, &i) in order.iter().take(MAX_DRAWN_OBSTACLES).enumerate() {
-        let o = &drawing.obstacles[i];
-        let id = i32::try_from(k).unwrap_or(i32::MAX);
-        for (ns, radius, height, c) in [
-            (
-                "vfo_influence",
-                o.influence_radius(),
-                0.02,
-                ColorRGBA {
-                    r: 1.0,
-                    g: 0.9,
-                    b: 0.2,
-                    a: 0.25,
-                },
-            ),
-            (
-                "vfo_forbidden",
-                o.forbidden_radius(),
-                0.05,
-                ColorRGBA {
-                    r: 0.9,
-                    g: 0.1,
-                    b: 0.1,
-                    a: 0.6,
-                },
-            ),
-        ] {
-            let mut disc = marker(header, ns, id, Marker::CYLINDER, 0.0, c);
-            disc.pose.position = point(o.centre());
-            disc.scale = Vector3 {
-                x: 2.0 * radius,
-                y: 2.0 * radius,
-                z: height,
-            };
-            out.push(disc);
-        }
+        let (o, id) = (&drawing.obstacles[i], i32::try_from(k).unwrap_or(i32::MAX));
+        let zone = (o.influence_radius(), 0.02);
+        m.disc("vfo_influence", id, o.centre(), zone, rgba(1.0, 0.9, 0.2, 0.25));
+        let forbidden = (o.forbidden_radius(), 0.05);
+        m.disc("vfo_forbidden", id, o.centre(), forbidden, rgba(0.9, 0.1, 0.1, 0.6));
     }
-}
-
-fn clear_marker(header: &Header) -> Marker {
-    let mut m = marker(header, "", 0, Marker::SPHERE, 0.0, color(0.0, 0.0, 0.0));
-    m.action = Marker::DELETEALL;
-    m
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
     use approx::assert_relative_eq;
+    use mobil_msgs::visualization_msgs::msg::Marker;
     use mobil_planner::ProblemKind;
     use mobil_ros::geometry::yaw_of;
     use mobil_ros::params::ParamValues;
