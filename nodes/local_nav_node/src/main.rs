@@ -34,13 +34,14 @@ use mobil_msgs::nav_msgs::msg::Odometry;
 use mobil_msgs::sensor_msgs::msg::LaserScan;
 use mobil_msgs::std_msgs::msg::Header;
 use mobil_msgs::visualization_msgs::msg::MarkerArray;
-use mobil_ros::action::{ActionEvent, GoalEnd, GoalRequest, GoalServer, GoalServerConfig};
+use mobil_ros::action::{goal_end, ActionEvent, GoalRequest, GoalServer, GoalServerConfig};
 use mobil_ros::geometry::odom_pose;
 use mobil_ros::input::Inputs;
 use mobil_ros::latest::Latest;
 use mobil_ros::motion::{Applied, CmdVel, EndCause, EndKind, Ended, MotionSession, SessionSettings, Watched};
-use mobil_ros::scan::{scan_from_msg, tf_static_subscription, StaticFrames};
-use mobil_ros::scan::{scan_laser_pose, LaserPoseFrom, ScanRefusal};
+use mobil_ros::scan::{
+    checked_scan, tf_static_subscription, CheckedScan, LaserMount, LaserPoseFrom, ScanRefusal, StaticFrames,
+};
 use mobil_ros::stop::{final_stop, FINAL_STOP_WAIT};
 use mobil_ros::ticker::Ticker;
 use mobil_ros::time::duration_msg;
@@ -162,14 +163,6 @@ async fn serve(node: &mut RosNode) -> anyhow::Result<()> {
 fn result(cause: &EndCause) -> NavigateToPoseResult {
     let (_, error_msg, error_code) = end_answer(cause);
     NavigateToPoseResult { error_code, error_msg }
-}
-
-fn goal_end(cause: &EndCause) -> GoalEnd {
-    match cause.kind() {
-        EndKind::Succeeded => GoalEnd::Succeeded,
-        EndKind::Canceled => GoalEnd::Canceled,
-        EndKind::Aborted => GoalEnd::Aborted,
-    }
 }
 
 /// The loop's outcome, and whether the node's last word must be a zero command.
@@ -586,19 +579,17 @@ impl Shell {
         laser: &StaticFrames,
         m: &LaserScan,
     ) {
-        let checked = scan_laser_pose(
-            laser,
-            &self.config.frames.base_frame,
-            &m.header.frame_id,
-            &self.config.laser_frame,
-            self.config.laser_pose(),
-        )
-        .and_then(|(pose, from)| {
-            scan_from_msg(m, pose)
-                .map(|scan| (scan, pose, from))
-                .map_err(|e| ScanRefusal::Invalid(e.to_string()))
-        });
-        let (scan, base_from_laser, from) = match checked {
+        let mount = LaserMount {
+            base_frame: &self.config.frames.base_frame,
+            laser_frame: &self.config.laser_frame,
+            parameter: self.config.laser_pose(),
+        };
+        let checked = checked_scan(laser, &mount, m, None);
+        let CheckedScan {
+            scan,
+            base_from_laser,
+            from,
+        } = match checked {
             Ok(c) => c,
             Err(e) => {
                 let key = match e {

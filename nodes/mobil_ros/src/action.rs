@@ -77,6 +77,17 @@ use ros2_client::action::{
     ActionServerQosPolicies, AsyncActionServer, CancelHandle, ExecutingGoalHandle, NewGoalHandle,
 };
 pub use ros2_client::action::{GoalEndStatus as GoalEnd, GoalId};
+
+use mobil_motion::{EndCause, EndKind};
+
+/// The action status a motion goal's end gives its client: SUCCEEDED, CANCELED, else ABORTED.
+pub fn goal_end(cause: &EndCause) -> GoalEnd {
+    match cause.kind() {
+        EndKind::Succeeded => GoalEnd::Succeeded,
+        EndKind::Canceled => GoalEnd::Canceled,
+        EndKind::Aborted => GoalEnd::Aborted,
+    }
+}
 use ros2_client::{Name, Node, ServiceMapping};
 use std::sync::{Arc, Mutex};
 use std::time::Duration;

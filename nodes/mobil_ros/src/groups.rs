@@ -29,8 +29,7 @@ use crate::config::Decl;
 use crate::time::seconds;
 use std::time::Duration;
 
-/// The largest `odom_timeout_s` (s).
-pub const MAX_INPUT_TIMEOUT_S: f64 = 60.0;
+pub use mobil_motion::MAX_INPUT_TIMEOUT_S;
 /// The largest `result_timeout_s` (s).
 pub const MAX_RESULT_TIMEOUT_S: f64 = 3600.0;
 

@@ -46,7 +46,8 @@
 
 use crate::log::LogThrottle;
 use crate::time::{DtClock, DtError};
-use mobil_motion::{BodyTwist, End, Outcome, Step};
+use mobil_motion::{BodyTwist, End, Step};
+pub use mobil_motion::{EndCause, EndKind};
 use mobil_msgs::geometry_msgs::msg::Twist;
 use ros2_client::Publisher;
 use std::time::{Duration, Instant};
@@ -115,84 +116,6 @@ impl Default for SessionSettings {
 /// ended (off the event loop) can be recognised and dropped.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
 pub struct GoalId(u64);
-
-/// Why a goal ended.
-#[derive(Debug, Clone, PartialEq)]
-pub enum EndCause {
-    /// The law, or the node on the law's behalf (a pre-check that refuses the route), ended it.
-    Outcome(Outcome),
-    /// Its client canceled it.
-    Canceled,
-    /// A newer goal took its place (named by its source).
-    Preempted(&'static str),
-    /// The law refused its input on this many steps in a row (the last refusal's reason).
-    Refused {
-        /// Steps refused in a row.
-        count: u32,
-        /// The last reason.
-        last: String,
-    },
-    /// An input went stale (named, e.g. `odom`, `scan and odom`).
-    Stale(String),
-    /// The node shut down.
-    Shutdown,
-}
-
-/// How an end counts for the status and an action's result.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum EndKind {
-    /// The goal was reached.
-    Succeeded,
-    /// The client canceled it.
-    Canceled,
-    /// Any other end: failed, pre-empted, stale, refused, shut down.
-    Aborted,
-}
-
-impl From<Outcome> for EndCause {
-    fn from(o: Outcome) -> Self {
-        EndCause::Outcome(o)
-    }
-}
-
-impl EndCause {
-    /// The status reason's code: the outcome's, or `CANCELED`, `PREEMPTED`, `INVALID_INPUT`,
-    /// `STALE_INPUT`, `SHUTDOWN`.
-    pub fn code(&self) -> &str {
-        match self {
-            EndCause::Outcome(Outcome::Succeeded { .. }) => "SUCCEEDED",
-            EndCause::Outcome(Outcome::Failed { code, .. }) => code,
-            EndCause::Canceled => "CANCELED",
-            EndCause::Preempted(_) => "PREEMPTED",
-            EndCause::Refused { .. } => "INVALID_INPUT",
-            EndCause::Stale(_) => "STALE_INPUT",
-            EndCause::Shutdown => "SHUTDOWN",
-        }
-    }
-
-    /// The status reason, "CODE: detail".
-    pub fn reason(&self) -> String {
-        match self {
-            EndCause::Outcome(o) => o.reason(),
-            EndCause::Canceled => "CANCELED: canceled by the client".to_owned(),
-            EndCause::Preempted(by) => format!("PREEMPTED: preempted by a newer goal ({by})"),
-            EndCause::Refused { count, last } => {
-                format!("INVALID_INPUT: the input was refused on {count} steps in a row ({last}): robot stopped")
-            }
-            EndCause::Stale(inputs) => format!("STALE_INPUT: {inputs} stale: robot stopped"),
-            EndCause::Shutdown => "SHUTDOWN: the node is shutting down".to_owned(),
-        }
-    }
-
-    /// How it counts for the status and the action.
-    pub fn kind(&self) -> EndKind {
-        match self {
-            EndCause::Outcome(o) if o.is_success() => EndKind::Succeeded,
-            EndCause::Canceled => EndKind::Canceled,
-            _ => EndKind::Aborted,
-        }
-    }
-}
 
 /// A goal that ended, handed back to the node to tell its client and its status.
 #[derive(Debug, Clone, PartialEq)]
@@ -513,7 +436,7 @@ impl<G, S> MotionSession<G, S> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use mobil_motion::{GoalLaw, Pose2, StepInput};
+    use mobil_motion::{GoalLaw, Outcome, Pose2, StepInput};
 
     /// The goal source of the tests.
     #[derive(Debug, Clone, Copy, PartialEq, Eq)]

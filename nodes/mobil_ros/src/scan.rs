@@ -269,6 +269,68 @@ pub fn scan_laser_pose(
         })
 }
 
+/// Where a node takes a scan's laser pose from: its base frame, the laser frame of a scan whose
+/// header names none, and the `laser_pose` parameter for a frame `tf_static` does not give.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct LaserMount<'a> {
+    /// The robot's base frame.
+    pub base_frame: &'a str,
+    /// The scan's frame when its header has none.
+    pub laser_frame: &'a str,
+    /// The `laser_pose` parameter, if given.
+    pub parameter: Option<Pose2>,
+}
+
+/// A LaserScan read at the edge: the checked scan in the base frame, where the laser is and
+/// whence its pose came.
+#[derive(Debug, Clone, PartialEq)]
+pub struct CheckedScan {
+    /// The scan.
+    pub scan: Scan,
+    /// The laser in the base frame.
+    pub base_from_laser: Pose2,
+    /// Whence that pose.
+    pub from: LaserPoseFrom,
+}
+
+/// `msg` checked, the laser placed by [`scan_laser_pose`]; with `range_limit` (m), echoes
+/// beyond it are no obstacles: it becomes the scan's `range_max` (a scan whose own `range_max`
+/// is not finite is refused, not given the limit in its place).
+pub fn checked_scan(
+    frames: &StaticFrames,
+    mount: &LaserMount<'_>,
+    msg: &LaserScan,
+    range_limit: Option<f64>,
+) -> Result<CheckedScan, ScanRefusal> {
+    let (base_from_laser, from) = scan_laser_pose(
+        frames,
+        mount.base_frame,
+        &msg.header.frame_id,
+        mount.laser_frame,
+        mount.parameter,
+    )?;
+    let invalid = |e: ScanError| ScanRefusal::Invalid(e.to_string());
+    let scan = match range_limit {
+        None => scan_from_msg(msg, base_from_laser).map_err(invalid)?,
+        Some(_) if !msg.range_max.is_finite() => {
+            return Err(ScanRefusal::Invalid(format!(
+                "range_max {} is not finite",
+                msg.range_max
+            )))
+        }
+        Some(limit) => {
+            let mut limited = msg.clone();
+            limited.range_max = limited.range_max.min(limit as f32);
+            scan_from_msg(&limited, base_from_laser).map_err(invalid)?
+        }
+    };
+    Ok(CheckedScan {
+        scan,
+        base_from_laser,
+        from,
+    })
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -392,6 +454,54 @@ mod tests {
         assert_eq!(
             e.to_string(),
             "no laser pose: frame `other` not in tf_static (from `base_link`) and no laser_pose parameter set"
+        );
+    }
+    #[test]
+    fn a_checked_scan_takes_tf_static_then_the_parameter_and_its_range_limit() {
+        let mut frames = StaticFrames::default();
+        frames.add(&TFMessage {
+            transforms: vec![tf("base_link", "laser", 0.3, 0.0, 0.0)],
+        });
+        let mut msg = LaserScan {
+            angle_min: 0.0,
+            angle_max: 0.5,
+            angle_increment: 0.5,
+            range_min: 0.1,
+            range_max: 10.0,
+            ranges: vec![2.0, 6.0],
+            ..Default::default()
+        };
+        msg.header.frame_id = "laser".into();
+        let mut mount = LaserMount {
+            base_frame: "base_link",
+            laser_frame: "laser",
+            parameter: None,
+        };
+        let c = checked_scan(&frames, &mount, &msg, None).unwrap();
+        assert_eq!(
+            (c.base_from_laser, c.from),
+            (Pose2::new(0.3, 0.0, 0.0), LaserPoseFrom::TfStatic)
+        );
+        // The 2 m echo straight ahead is 2.3 m ahead of base_link; with a 4 m limit the 6 m
+        // echo is beyond range_max: no point.
+        assert!((c.scan.points_in_base().next().unwrap().x - 2.3).abs() < 1e-6);
+        assert_eq!(c.scan.points_in_base().count(), 2);
+        let limited = checked_scan(&frames, &mount, &msg, Some(4.0)).unwrap();
+        assert_eq!(limited.scan.points_in_base().count(), 1);
+        msg.header.frame_id = "other".into();
+        assert!(matches!(
+            checked_scan(&frames, &mount, &msg, None),
+            Err(ScanRefusal::NoLaserPose { .. })
+        ));
+        mount.parameter = Some(Pose2::new(0.1, 0.0, 0.0));
+        assert_eq!(
+            checked_scan(&frames, &mount, &msg, None).unwrap().from,
+            LaserPoseFrom::Parameter
+        );
+        msg.range_max = f32::NAN;
+        assert_eq!(
+            checked_scan(&frames, &mount, &msg, Some(4.0)).unwrap_err().to_string(),
+            "scan refused: range_max NaN is not finite"
         );
     }
 }

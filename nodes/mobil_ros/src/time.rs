@@ -21,7 +21,6 @@
 //! ```
 
 use mobil_msgs::builtin_interfaces::msg::{Duration as RosDuration, Time};
-use std::time::Duration;
 use thiserror::Error;
 
 /// Why [`DtClock::step`] yields no `dt`.
@@ -112,12 +111,7 @@ pub fn is_zero(t: &Time) -> bool {
     t.sec == 0 && t.nanosec == 0
 }
 
-/// `s` seconds as a duration, held to [0, `max_s`] (NaN gives `max_s`): never a panic, whatever
-/// the number.
-pub fn seconds(s: f64, max_s: f64) -> Duration {
-    let s = if s.is_nan() { max_s } else { s.clamp(0.0, max_s) };
-    Duration::try_from_secs_f64(s).unwrap_or(Duration::ZERO)
-}
+pub use mobil_motion::seconds;
 
 /// A duration message of `seconds` (navigation time, time remaining): negative (the clock went
 /// backwards), NaN or infinite give zero, and it saturates at 10⁹ s.
@@ -190,14 +184,5 @@ mod tests {
             assert_eq!((d.sec, d.nanosec), (0, 0), "{bad}");
         }
         assert_eq!(duration_msg(5e9).sec, 1_000_000_000);
-    }
-
-    #[test]
-    fn seconds_are_bounded_and_never_panic() {
-        assert_eq!(seconds(1e300, 60.0), Duration::from_secs(60));
-        assert_eq!(seconds(f64::INFINITY, 60.0), Duration::from_secs(60));
-        assert_eq!(seconds(f64::NAN, 60.0), Duration::from_secs(60));
-        assert_eq!(seconds(-1.0, 60.0), Duration::ZERO);
-        assert_eq!(seconds(0.25, 60.0), Duration::from_millis(250));
     }
 }

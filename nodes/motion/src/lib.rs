@@ -232,9 +232,98 @@ pub mod nav2 {
     }
 }
 
+/// Why a goal ended.
+#[derive(Debug, Clone, PartialEq)]
+pub enum EndCause {
+    /// The law, or the node on the law's behalf (a pre-check that refuses the route), ended it.
+    Outcome(Outcome),
+    /// Its client canceled it.
+    Canceled,
+    /// A newer goal took its place (named by its source).
+    Preempted(&'static str),
+    /// The law refused its input on this many steps in a row (the last refusal's reason).
+    Refused {
+        /// Steps refused in a row.
+        count: u32,
+        /// The last reason.
+        last: String,
+    },
+    /// An input went stale (named, e.g. `odom`, `scan and odom`).
+    Stale(String),
+    /// The node shut down.
+    Shutdown,
+}
+
+/// How an end counts for the status and an action's result.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum EndKind {
+    /// The goal was reached.
+    Succeeded,
+    /// The client canceled it.
+    Canceled,
+    /// Any other end: failed, pre-empted, stale, refused, shut down.
+    Aborted,
+}
+
+impl From<Outcome> for EndCause {
+    fn from(o: Outcome) -> Self {
+        EndCause::Outcome(o)
+    }
+}
+
+impl EndCause {
+    /// The status reason's code: the outcome's, or `CANCELED`, `PREEMPTED`, `INVALID_INPUT`,
+    /// `STALE_INPUT`, `SHUTDOWN`.
+    pub fn code(&self) -> &str {
+        match self {
+            EndCause::Outcome(Outcome::Succeeded { .. }) => "SUCCEEDED",
+            EndCause::Outcome(Outcome::Failed { code, .. }) => code,
+            EndCause::Canceled => "CANCELED",
+            EndCause::Preempted(_) => "PREEMPTED",
+            EndCause::Refused { .. } => "INVALID_INPUT",
+            EndCause::Stale(_) => "STALE_INPUT",
+            EndCause::Shutdown => "SHUTDOWN",
+        }
+    }
+
+    /// The status reason, "CODE: detail".
+    pub fn reason(&self) -> String {
+        match self {
+            EndCause::Outcome(o) => o.reason(),
+            EndCause::Canceled => "CANCELED: canceled by the client".to_owned(),
+            EndCause::Preempted(by) => format!("PREEMPTED: preempted by a newer goal ({by})"),
+            EndCause::Refused { count, last } => {
+                format!("INVALID_INPUT: the input was refused on {count} steps in a row ({last}): robot stopped")
+            }
+            EndCause::Stale(inputs) => format!("STALE_INPUT: {inputs} stale: robot stopped"),
+            EndCause::Shutdown => "SHUTDOWN: the node is shutting down".to_owned(),
+        }
+    }
+
+    /// How it counts for the status and the action.
+    pub fn kind(&self) -> EndKind {
+        match self {
+            EndCause::Outcome(o) if o.is_success() => EndKind::Succeeded,
+            EndCause::Canceled => EndKind::Canceled,
+            _ => EndKind::Aborted,
+        }
+    }
+}
+
+/// The largest timeout of an input a goal depends on (`odom_timeout_s`, `scan_timeout_s`), s.
+pub const MAX_INPUT_TIMEOUT_S: f64 = 60.0;
+
+/// `s` seconds as a duration, held to [0, `max_s`] (NaN gives `max_s`): never a panic, whatever
+/// the number.
+pub fn seconds(s: f64, max_s: f64) -> std::time::Duration {
+    let s = if s.is_nan() { max_s } else { s.clamp(0.0, max_s) };
+    std::time::Duration::try_from_secs_f64(s).unwrap_or(std::time::Duration::ZERO)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+    use std::time::Duration;
 
     #[test]
     fn outcomes_give_reasons_and_codes() {
@@ -254,5 +343,58 @@ mod tests {
         let v = BodyTwist::new(0.3, 0.0, 0.1);
         assert_eq!(i.with_velocity(v).velocity, v);
         assert_eq!(i.with_velocity(v).pose, i.pose);
+    }
+
+    #[test]
+    fn an_end_names_its_code_its_reason_and_how_it_counts() {
+        let cases = [
+            (
+                EndCause::Outcome(Outcome::succeeded("at the dock")),
+                "SUCCEEDED",
+                EndKind::Succeeded,
+            ),
+            (
+                EndCause::Outcome(Outcome::failed("BLOCKED", "wall", 106)),
+                "BLOCKED",
+                EndKind::Aborted,
+            ),
+            (EndCause::Canceled, "CANCELED", EndKind::Canceled),
+            (EndCause::Preempted("waypoints"), "PREEMPTED", EndKind::Aborted),
+            (
+                EndCause::Refused {
+                    count: 3,
+                    last: "NaN pose".into(),
+                },
+                "INVALID_INPUT",
+                EndKind::Aborted,
+            ),
+            (EndCause::Stale("odom".into()), "STALE_INPUT", EndKind::Aborted),
+            (EndCause::Shutdown, "SHUTDOWN", EndKind::Aborted),
+        ];
+        for (cause, code, kind) in cases {
+            assert_eq!((cause.code(), cause.kind()), (code, kind), "{cause:?}");
+            assert!(cause.reason().starts_with(code), "{}", cause.reason());
+        }
+        assert_eq!(
+            EndCause::Preempted("waypoints").reason(),
+            "PREEMPTED: preempted by a newer goal (waypoints)"
+        );
+        assert_eq!(
+            EndCause::Refused {
+                count: 3,
+                last: "NaN pose".into()
+            }
+            .reason(),
+            "INVALID_INPUT: the input was refused on 3 steps in a row (NaN pose): robot stopped"
+        );
+    }
+
+    #[test]
+    fn seconds_are_held_to_their_range_and_never_panic() {
+        assert_eq!(seconds(0.25, 60.0), Duration::from_millis(250));
+        assert_eq!(seconds(1e300, 60.0), Duration::from_secs(60));
+        assert_eq!(seconds(-1.0, 60.0), Duration::ZERO);
+        assert_eq!(seconds(f64::NAN, 60.0), Duration::from_secs(60));
+        assert_eq!(seconds(f64::INFINITY, 60.0), Duration::from_secs(60));
     }
 }
