@@ -106,6 +106,7 @@ pub mod follow;
 pub mod goals;
 pub mod route;
 pub mod sim;
+pub mod task;
 pub mod vfo;
 
 pub use approach::{

@@ -13,7 +13,6 @@ use mobil_chassis::model::ChassisConfig;
 use mobil_chassis::{clamp_command, BodyTwist, ChassisParams};
 use mobil_geom::downsample;
 use mobil_geom::Pose2;
-use mobil_motion::{nav2, Outcome};
 use mobil_msgs::builtin_interfaces::msg::Time;
 use mobil_msgs::geometry_msgs::msg::{Point, Pose, PoseStamped, Twist};
 use mobil_msgs::mobil_msgs::msg::{NavStatus, RouteProblem as ProblemMsg};
@@ -39,6 +38,7 @@ use nalgebra::Point2;
 
 pub mod vfo;
 
+pub use mobil_planner::task::{no_dock_database, Action, Figures, Mode};
 pub use vfo::{VfoSettings, WaypointMethod};
 
 /// Everything the node is configured with, each field filled by one declared parameter.
@@ -250,120 +250,6 @@ pub fn clamp_twist(twist: BodyTwist, params: &ChassisParams) -> Twist {
     t
 }
 
-/// What the node is doing.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Mode {
-    /// No goal.
-    Idle,
-    /// A route's pre-check (the virtual robot drives it first; the robot waits).
-    PreCheck,
-    /// Docking by the Lyapunov law.
-    Dock,
-    /// Docking's final in-place rotation.
-    Rotate,
-    /// Following waypoints by the goal approach.
-    Approach,
-    /// Following waypoints by VFO (SPEC §5).
-    Vfo,
-    /// Backing out of the dock.
-    Undock,
-}
-
-impl Mode {
-    /// The status' mode string.
-    pub fn as_str(self) -> &'static str {
-        match self {
-            Mode::Idle => "idle",
-            Mode::PreCheck => "pre_check",
-            Mode::Dock => "dock",
-            Mode::Rotate => "rotate",
-            Mode::Approach => "approach",
-            Mode::Vfo => "vfo",
-            Mode::Undock => "undock",
-        }
-    }
-}
-
-/// The action a goal came from, for Nav2's error codes of the ends the node itself makes.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Action {
-    /// `dock_robot`, and the `dock_pose` topic (no result).
-    Dock,
-    /// `undock_robot`.
-    Undock,
-    /// `follow_waypoints`, and the `waypoints` topic (no result).
-    Follow,
-}
-
-impl Action {
-    /// A goal that lost control (stale or refused input): DockRobot's and UndockRobot's
-    /// FAILED_TO_CONTROL, FollowWaypoints' TASK_EXECUTOR_FAILED.
-    pub fn control_failure(self) -> u16 {
-        match self {
-            Action::Dock | Action::Undock => nav2::docking::FAILED_TO_CONTROL,
-            Action::Follow => nav2::follow_waypoints::TASK_EXECUTOR_FAILED,
-        }
-    }
-
-    /// Shutdown, or a request the action cannot take: UNKNOWN.
-    pub fn unknown(self) -> u16 {
-        match self {
-            Action::Dock | Action::Undock => nav2::docking::UNKNOWN,
-            Action::Follow => nav2::follow_waypoints::UNKNOWN,
-        }
-    }
-}
-
-/// Nav2's error code of a goal from `action` ending with `cause`: the law's own, none for a
-/// cancel or a pre-emption, [`Action::control_failure`] for stale or refused input,
-/// [`Action::unknown`] at shutdown.
-pub fn error_code(cause: &EndCause, action: Action) -> u16 {
-    match cause {
-        EndCause::Outcome(o) => o.nav2_error(),
-        EndCause::Canceled | EndCause::Preempted(_) => nav2::NONE,
-        EndCause::Refused { .. } | EndCause::Stale(_) => action.control_failure(),
-        EndCause::Shutdown => action.unknown(),
-    }
-}
-
-/// An invalid goal, refused before it starts: `INVALID_GOAL` with DockRobot's DOCK_NOT_VALID
-/// or the action's UNKNOWN.
-pub fn invalid_goal(e: &GoalError, action: Action) -> Outcome {
-    let code = match action {
-        Action::Dock => nav2::docking::DOCK_NOT_VALID,
-        Action::Undock | Action::Follow => action.unknown(),
-    };
-    Outcome::failed("INVALID_GOAL", e.to_string(), code)
-}
-
-/// A dock asked for by id: `INVALID_GOAL` with DockRobot's DOCK_NOT_IN_DB (the planner docks
-/// onto a pose; it has no dock database).
-pub fn no_dock_database() -> Outcome {
-    Outcome::failed(
-        "INVALID_GOAL",
-        "use_dock_id is true, but this planner has no dock database (give dock_pose with use_dock_id false)",
-        nav2::docking::DOCK_NOT_IN_DB,
-    )
-}
-
-/// A goal the planner cannot start (its parameters or the law refuse it): `INVALID_INPUT`.
-pub fn refused_goal(e: impl std::fmt::Display, action: Action) -> Outcome {
-    Outcome::failed(
-        "INVALID_INPUT",
-        format!("the planner refused its input: {e}; robot stopped"),
-        action.control_failure(),
-    )
-}
-
-/// A goal that needs an input it has not got fresh (`odom`, `scan`): `STALE_INPUT`.
-pub fn stale_at_start(input: &str, action: Action) -> Outcome {
-    Outcome::failed(
-        "STALE_INPUT",
-        format!("{input} stale: robot stopped"),
-        action.control_failure(),
-    )
-}
-
 /// The NavStatus state an end leaves.
 pub fn end_state(cause: &EndCause) -> u8 {
     match cause.kind() {
@@ -376,7 +262,7 @@ pub fn end_state(cause: &EndCause) -> u8 {
 pub fn dock_result(cause: &EndCause) -> DockRobotResult {
     DockRobotResult {
         success: cause.kind() == EndKind::Succeeded,
-        error_code: error_code(cause, Action::Dock),
+        error_code: Action::Dock.error_code(cause),
         num_retries: 0,
         error_msg: cause.reason(),
     }
@@ -386,7 +272,7 @@ pub fn dock_result(cause: &EndCause) -> DockRobotResult {
 pub fn undock_result(cause: &EndCause) -> UndockRobotResult {
     UndockRobotResult {
         success: cause.kind() == EndKind::Succeeded,
-        error_code: error_code(cause, Action::Undock),
+        error_code: Action::Undock.error_code(cause),
         error_msg: cause.reason(),
     }
 }
@@ -401,7 +287,7 @@ pub fn follow_result(cause: &EndCause, poses: &[PoseStamped], missed: &[Missed])
             .take(MAX_RESULT_MISSED)
             .map(|m| missed_waypoint(m.index, m.error_code(), poses))
             .collect(),
-        error_code: error_code(cause, Action::Follow),
+        error_code: Action::Follow.error_code(cause),
         error_msg: cause.reason(),
     }
 }
@@ -508,6 +394,24 @@ pub struct StatusView {
     pub docking: Option<[f64; 4]>,
     /// A VFO route's current segment: `None` otherwise (Ψ_z and the χ's sent as NaN, counts 0).
     pub vfo: Option<SegmentReport>,
+}
+
+impl StatusView {
+    /// The view in `state` with `reason` of a goal's `figures` (none: idle, or a goal refused
+    /// before it started).
+    pub fn of(state: u8, reason: String, figures: Option<&Figures>) -> Self {
+        let index = |i: usize| i32::try_from(i).unwrap_or(i32::MAX);
+        StatusView {
+            state,
+            mode: figures.map_or(Mode::Idle, |f| f.mode),
+            goal: figures.and_then(|f| f.goal),
+            distance_to_goal: figures.map_or(f64::NAN, |f| f.distance),
+            reason,
+            waypoint_index: figures.and_then(|f| f.waypoint).map_or(-1, index),
+            docking: figures.and_then(|f| f.docking),
+            vfo: figures.and_then(|f| f.vfo),
+        }
+    }
 }
 
 /// The NavStatus message of a view, stamped `stamp`, in `frame`.
@@ -674,6 +578,7 @@ fn vfo_markers(m: &mut Markers, drawing: &VfoDrawing, robot: Option<Point2<f64>>
 mod tests {
     use super::*;
     use approx::assert_relative_eq;
+    use mobil_motion::Outcome;
     use mobil_msgs::visualization_msgs::msg::Marker;
     use mobil_planner::ProblemKind;
     use mobil_ros::geometry::yaw_of;
@@ -776,53 +681,19 @@ mod tests {
             (true, 0, NavStatus::SUCCEEDED)
         );
         assert_eq!(r.error_msg, "SUCCEEDED: docked: e = 0.010 m, heading error 0.020 rad");
-        // The ends the session makes, by action: stale or refused input is a loss of control
-        // (DockRobot/UndockRobot 905, FollowWaypoints 601), a shutdown UNKNOWN (999, 600), a cancel
-        // or a pre-emption no error.
+        // The ends the session makes reach every result with their action's code (the codes
+        // themselves: mobil_planner's task tests).
         let stale = EndCause::Stale("odom".into());
-        assert_eq!(stale.reason(), "STALE_INPUT: odom stale: robot stopped");
-        let refused = EndCause::Refused {
-            count: 20,
-            last: "pose is not finite".into(),
-        };
-        for (cause, codes) in [
-            (&stale, [905, 905, 601]),
-            (&refused, [905, 905, 601]),
-            (&EndCause::Shutdown, [999, 999, 600]),
-            (&EndCause::Canceled, [0, 0, 0]),
-            (&EndCause::Preempted("dock_pose"), [0, 0, 0]),
-        ] {
-            let got = [Action::Dock, Action::Undock, Action::Follow].map(|a| error_code(cause, a));
-            assert_eq!(got, codes, "{cause:?}");
-            assert_eq!(end_state(cause), NavStatus::FAILED);
-        }
+        assert_eq!(end_state(&stale), NavStatus::FAILED);
         assert_eq!(undock_result(&stale).error_code, 905);
+        assert_eq!(dock_result(&EndCause::Shutdown).error_code, 999);
         assert!(undock_result(&EndCause::Outcome(Outcome::succeeded("undocked"))).success);
-        // Refusals before a goal starts, by action.
-        assert_eq!(no_dock_database().nav2_error(), 901);
-        assert!(no_dock_database()
-            .reason()
-            .starts_with("INVALID_GOAL: use_dock_id is true"));
         let nan = GoalError::NotFinite {
             what: "dock pose".into(),
         };
-        assert_eq!(invalid_goal(&nan, Action::Dock).nav2_error(), 902);
-        assert_eq!(invalid_goal(&nan, Action::Follow).nav2_error(), 600);
         assert_eq!(
-            invalid_goal(&nan, Action::Dock).reason(),
+            Action::Dock.invalid_goal(&nan).reason(),
             "INVALID_GOAL: dock pose is not finite"
-        );
-        let r = refused_goal("gamma 0 is not positive", Action::Follow);
-        assert_eq!(
-            (r.reason().as_str(), r.nav2_error()),
-            (
-                "INVALID_INPUT: the planner refused its input: gamma 0 is not positive; robot stopped",
-                601
-            )
-        );
-        assert_eq!(
-            stale_at_start("scan", Action::Dock).reason(),
-            "STALE_INPUT: scan stale: robot stopped"
         );
         // A refused route lists every problem, each with the request's index and its pose.
         let poses = vec![stamped("odom", 2.0, 0.0), stamped("odom", 2.0, 0.3)];

@@ -1,0 +1,416 @@
+//! The planner's goal, whichever law drives it: one type for the node's motion session.
+//!
+//! A goal of the planner node is one of five tasks: a route waiting for its pre-check (the
+//! robot stands meanwhile), a docking, a route by the goal approach, an undocking, or a route by
+//! VFO, whose steps run off the node's event loop (a segment's optimisation takes up to a
+//! second) with the law lent out meanwhile ([`mobil_motion::slot`]). Here is what the node
+//! decides about them without ROS: the status' mode, waypoint and figures, one step of the
+//! laws stepped on the event loop, the turn from a pre-check into a route or a refusal, the
+//! VFO law's lending and return (a late step's command dropped), and Nav2's codes for the ends
+//! the node makes itself ([`Action`]).
+//!
+//! ```
+//! use mobil_chassis::ChassisParams;
+//! use mobil_geom::Pose2;
+//! use mobil_planner::task::{Mode, PreCheck, Task};
+//! use mobil_planner::{FollowConfig, RouteReport};
+//! use nalgebra::Point2;
+//!
+//! let points = vec![Point2::new(3.0, 4.0)];
+//! let mut task = Task::PreCheck(PreCheck::new(Pose2::identity(), points, vec![2]));
+//! assert_eq!((task.mode(), task.waypoint()), (Mode::PreCheck, Some(2)));
+//! let clear = RouteReport { problems: vec![], path: vec![], reached: vec![true] };
+//! let rules = (FollowConfig::default(), &ChassisParams::omr3());
+//! assert_eq!(task.pre_checked(&clear, rules, false), Some(Ok(vec![])));
+//! // Now the goal approach, 5 m from the start to (3, 4).
+//! let figures = task.figures(None);
+//! assert_eq!((figures.mode, figures.distance), (Mode::Approach, 5.0));
+//! ```
+
+use crate::goals::{after_pre_check, DockGoal, Missed, PreChecked, RouteEvent, RouteGoal, UndockGoal};
+use crate::vfo::{ObstacleMap, SegmentReport, VfoGoal, VfoStep, VfoView};
+use crate::{DockingPhase, FollowConfig, RouteReport};
+use mobil_chassis::ChassisParams;
+use mobil_geom::Pose2;
+use mobil_motion::slot::{Handback, LawSlot};
+use mobil_motion::{nav2, BodyTwist, EndCause, GoalLaw, Outcome, Step, StepInput};
+use nalgebra::Point2;
+use std::time::{Duration, Instant};
+
+/// What the node is doing.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Mode {
+    /// No goal.
+    Idle,
+    /// A route's pre-check (the virtual robot drives it first; the robot waits).
+    PreCheck,
+    /// Docking by the Lyapunov law.
+    Dock,
+    /// Docking's final in-place rotation.
+    Rotate,
+    /// Following waypoints by the goal approach.
+    Approach,
+    /// Following waypoints by VFO (SPEC §5).
+    Vfo,
+    /// Backing out of the dock.
+    Undock,
+}
+
+impl Mode {
+    /// The status' mode string.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Mode::Idle => "idle",
+            Mode::PreCheck => "pre_check",
+            Mode::Dock => "dock",
+            Mode::Rotate => "rotate",
+            Mode::Approach => "approach",
+            Mode::Vfo => "vfo",
+            Mode::Undock => "undock",
+        }
+    }
+}
+
+/// A route waiting for its pre-check; the robot stands meanwhile.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PreCheck {
+    /// Where the robot stood when the route came (the pre-check's start).
+    pub start: Pose2,
+    /// The route's waypoints.
+    pub points: Vec<Point2<f64>>,
+    /// The request's index of each.
+    pub request_index: Vec<usize>,
+    /// The problems the pre-check found, kept for the result of a route it refuses.
+    pub problems: Vec<Missed>,
+}
+
+impl PreCheck {
+    /// A route through `points` (the request's index of each alongside) from `start`.
+    pub fn new(start: Pose2, points: Vec<Point2<f64>>, request_index: Vec<usize>) -> Self {
+        PreCheck {
+            start,
+            points,
+            request_index,
+            problems: Vec::new(),
+        }
+    }
+}
+
+/// A VFO route: its law at home or out on a step off the event loop, what the status shows of
+/// it meanwhile, and whether the obstacle map changed since the law last took it.
+#[derive(Debug)]
+pub struct VfoRun {
+    slot: LawSlot<VfoGoal>,
+    view: VfoView,
+    /// `Some(true)`: changed with new obstacles, which re-optimise the segment.
+    map_changed: Option<bool>,
+}
+
+impl VfoRun {
+    /// A route by `law`, whose steps may come back at most `max_delay` after they went out.
+    pub fn new(law: VfoGoal, max_delay: Duration) -> Self {
+        VfoRun {
+            view: law.view(),
+            slot: LawSlot::new(law, max_delay),
+            map_changed: None,
+        }
+    }
+
+    /// The status' figures as the law last came back.
+    pub fn view(&self) -> &VfoView {
+        &self.view
+    }
+
+    /// The law, unless it is out on a step.
+    pub fn law(&self) -> Option<&VfoGoal> {
+        self.slot.law()
+    }
+
+    /// How late a step may come back and still command.
+    pub fn max_delay(&self) -> Duration {
+        self.slot.max_delay()
+    }
+
+    /// The obstacle map changed (`new_obstacles`: with obstacles it had not got); the law takes
+    /// the map at its next step. A change with new obstacles stays one until the law took it.
+    pub fn map_updated(&mut self, new_obstacles: bool) {
+        self.map_changed = Some(new_obstacles || self.map_changed.unwrap_or(false));
+    }
+
+    /// The law lent out at `now` for a step, with `map`'s obstacles if the map changed since
+    /// it last took them; `None` while it is out on a step (the robot is to stand).
+    pub fn lend(&mut self, now: Instant, map: &ObstacleMap) -> Option<Box<VfoGoal>> {
+        let mut law = self.slot.lend(now)?;
+        if let Some(new) = self.map_changed.take() {
+            law.follow_map(map, new);
+        }
+        Some(law)
+    }
+
+    /// The law back at `now` with the step it took: the step, its command dropped (zero) when
+    /// it came back later than [`VfoRun::max_delay`], and whether it did.
+    pub fn give_back(
+        &mut self,
+        law: Box<VfoGoal>,
+        mut step: Step<VfoStep, Vec<usize>>,
+        now: Instant,
+    ) -> (Step<VfoStep, Vec<usize>>, Handback) {
+        self.view = law.view();
+        let handback = self.slot.give_back(law, now);
+        if let (Step::Command { twist, .. }, Handback::Late) = (&mut step, handback) {
+            *twist = BodyTwist::new(0.0, 0.0, 0.0);
+        }
+        (step, handback)
+    }
+}
+
+/// What the active goal does.
+#[derive(Debug)]
+#[allow(clippy::large_enum_variant)]
+pub enum Task {
+    /// A route waiting for its pre-check.
+    PreCheck(PreCheck),
+    /// Docking onto a pose.
+    Dock(DockGoal),
+    /// A route by the goal approach, after its pre-check.
+    Follow(RouteGoal),
+    /// Backing out of a dock.
+    Undock(UndockGoal),
+    /// A route by VFO.
+    Vfo(VfoRun),
+}
+
+/// What the status shows of a goal.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Figures {
+    /// The mode.
+    pub mode: Mode,
+    /// The request's index of the waypoint pursued (a route).
+    pub waypoint: Option<usize>,
+    /// The pose (a dock) or position (a waypoint, yaw 0) pursued, if known.
+    pub goal: Option<Pose2>,
+    /// Distance to it (m; an undocking: left to back out), NaN when unknown.
+    pub distance: f64,
+    /// A docking's (e, α, θ, V), NaN before the first pose.
+    pub docking: Option<[f64; 4]>,
+    /// A VFO route's segment optimisation.
+    pub vfo: Option<SegmentReport>,
+}
+
+/// A step's feedback, whichever law took it on the event loop.
+#[derive(Debug, Clone, PartialEq)]
+pub struct TaskStep {
+    /// The status changed (a docking's phase, a waypoint reached or missed).
+    pub changed: bool,
+    /// A route's waypoints reached or missed at this step.
+    pub events: Vec<RouteEvent>,
+}
+
+/// What one step of the task is.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Stepped {
+    /// The law's step, taken here.
+    Law(Step<TaskStep, ()>),
+    /// A VFO route: its law steps off the event loop ([`VfoRun::lend`]).
+    OffLoop,
+    /// A route waiting for its pre-check: no command yet.
+    Waiting,
+}
+
+fn unified<F, R>(step: Step<F, R>, feedback: impl FnOnce(F) -> TaskStep) -> Step<TaskStep, ()> {
+    match step {
+        Step::Command { twist, feedback: f } => Step::Command {
+            twist,
+            feedback: feedback(f),
+        },
+        Step::End(end) => Step::end(end.outcome, ()),
+        Step::Refused(why) => Step::Refused(why),
+    }
+}
+
+impl Task {
+    /// The status' mode.
+    pub fn mode(&self) -> Mode {
+        match self {
+            Task::Dock(d) => match d.last().map(|o| o.phase) {
+                Some(DockingPhase::Rotate) => Mode::Rotate,
+                _ => Mode::Dock,
+            },
+            Task::PreCheck(_) => Mode::PreCheck,
+            Task::Follow(_) => Mode::Approach,
+            Task::Undock(_) => Mode::Undock,
+            Task::Vfo(_) => Mode::Vfo,
+        }
+    }
+
+    /// The request's index of the waypoint pursued, if a route (a route waiting for its
+    /// pre-check: its first).
+    pub fn waypoint(&self) -> Option<usize> {
+        match self {
+            Task::Follow(goal) => Some(goal.waypoint()),
+            Task::Vfo(v) => Some(v.view.waypoint),
+            Task::PreCheck(p) => Some(p.request_index.first().copied().unwrap_or(0)),
+            Task::Dock(_) | Task::Undock(_) => None,
+        }
+    }
+
+    /// What the status shows; a docking before its first step shows its figures at `latest`,
+    /// the latest pose.
+    pub fn figures(&self, latest: Option<&Pose2>) -> Figures {
+        let at = |p: Option<Point2<f64>>| p.map(|p| Pose2::new(p.x, p.y, 0.0));
+        let mut f = Figures {
+            mode: self.mode(),
+            waypoint: self.waypoint(),
+            goal: None,
+            distance: f64::NAN,
+            docking: None,
+            vfo: None,
+        };
+        match self {
+            Task::Dock(d) => {
+                let figures = d.figures(latest);
+                f.goal = Some(d.target());
+                f.distance = figures.map_or(f64::NAN, |(p, _)| p.e);
+                f.docking = Some(figures.map_or([f64::NAN; 4], |(p, v)| [p.e, p.alpha, p.theta, v]));
+            }
+            Task::Follow(goal) => {
+                f.goal = at(goal.target());
+                f.distance = goal.distance();
+            }
+            Task::Undock(u) => f.distance = u.remaining(),
+            Task::Vfo(v) => {
+                f.goal = at(v.view.target);
+                f.distance = v.view.distance;
+                f.vfo = Some(v.view.report);
+            }
+            Task::PreCheck(p) => f.goal = at(p.points.first().copied()),
+        }
+        f
+    }
+
+    /// One step at `input`: the docking's, the route's or the undocking's law here; a VFO
+    /// route's goes off the loop, a route waiting for its pre-check does not step.
+    pub fn step(&mut self, input: &StepInput) -> Stepped {
+        let step = match self {
+            Task::PreCheck(_) => return Stepped::Waiting,
+            Task::Vfo(_) => return Stepped::OffLoop,
+            Task::Dock(d) => unified(d.step(input, &()), |f| TaskStep {
+                changed: f.phase_changed,
+                events: Vec::new(),
+            }),
+            Task::Follow(goal) => unified(goal.step(input, &()), |f| TaskStep {
+                changed: !f.events.is_empty(),
+                events: f.events,
+            }),
+            Task::Undock(u) => unified(u.step(input, &()), |_| TaskStep {
+                changed: false,
+                events: Vec::new(),
+            }),
+        };
+        Stepped::Law(step)
+    }
+
+    /// A route's pre-check came back with `report`: the route becomes a goal approach from
+    /// where the robot stood (`follow` on `chassis`) and the problems it drives through are
+    /// returned (none unless `execute_infeasible`), or it is refused with the outcome to end
+    /// the goal with (its problems kept for the result). `None` when the task is no pre-check.
+    pub fn pre_checked(
+        &mut self,
+        report: &RouteReport,
+        (follow, chassis): (FollowConfig, &ChassisParams),
+        execute_infeasible: bool,
+    ) -> Option<Result<Vec<Missed>, Outcome>> {
+        let Task::PreCheck(p) = self else { return None };
+        let route = (&p.points[..], &p.request_index[..]);
+        match after_pre_check(report, route, &p.start, (follow, chassis), execute_infeasible) {
+            PreChecked::Refuse { outcome, problems } => {
+                p.problems = problems;
+                Some(Err(outcome))
+            }
+            PreChecked::Drive { goal, problems } => {
+                *self = Task::Follow(*goal);
+                Some(Ok(problems))
+            }
+        }
+    }
+}
+
+/// The action a goal came from, for Nav2's error codes of the ends the node itself makes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Action {
+    /// `dock_robot`, and the `dock_pose` topic (no result).
+    Dock,
+    /// `undock_robot`.
+    Undock,
+    /// `follow_waypoints`, and the `waypoints` topic (no result).
+    Follow,
+}
+
+impl Action {
+    /// A goal that lost control (stale or refused input): DockRobot's and UndockRobot's
+    /// FAILED_TO_CONTROL, FollowWaypoints' TASK_EXECUTOR_FAILED.
+    pub fn control_failure(self) -> u16 {
+        match self {
+            Action::Dock | Action::Undock => nav2::docking::FAILED_TO_CONTROL,
+            Action::Follow => nav2::follow_waypoints::TASK_EXECUTOR_FAILED,
+        }
+    }
+
+    /// Shutdown, or a request the action cannot take: UNKNOWN.
+    pub fn unknown(self) -> u16 {
+        match self {
+            Action::Dock | Action::Undock => nav2::docking::UNKNOWN,
+            Action::Follow => nav2::follow_waypoints::UNKNOWN,
+        }
+    }
+
+    /// Nav2's error code of a goal from this action ending with `cause`: the law's own, none
+    /// for a cancel or a pre-emption, [`Action::control_failure`] for stale or refused input,
+    /// [`Action::unknown`] at shutdown.
+    pub fn error_code(self, cause: &EndCause) -> u16 {
+        match cause {
+            EndCause::Outcome(o) => o.nav2_error(),
+            EndCause::Canceled | EndCause::Preempted(_) => nav2::NONE,
+            EndCause::Refused { .. } | EndCause::Stale(_) => self.control_failure(),
+            EndCause::Shutdown => self.unknown(),
+        }
+    }
+
+    /// An invalid goal (`why`), refused before it starts: `INVALID_GOAL` with DockRobot's
+    /// DOCK_NOT_VALID or the action's UNKNOWN.
+    pub fn invalid_goal(self, why: impl std::fmt::Display) -> Outcome {
+        let code = match self {
+            Action::Dock => nav2::docking::DOCK_NOT_VALID,
+            Action::Undock | Action::Follow => self.unknown(),
+        };
+        Outcome::failed("INVALID_GOAL", why.to_string(), code)
+    }
+
+    /// A goal the planner cannot start (its parameters or the law refuse it): `INVALID_INPUT`.
+    pub fn refused_goal(self, why: impl std::fmt::Display) -> Outcome {
+        Outcome::failed(
+            "INVALID_INPUT",
+            format!("the planner refused its input: {why}; robot stopped"),
+            self.control_failure(),
+        )
+    }
+
+    /// A goal that needs an input it has not got fresh (`odom`, `scan`): `STALE_INPUT`.
+    pub fn stale_at_start(self, input: &str) -> Outcome {
+        Outcome::failed(
+            "STALE_INPUT",
+            format!("{input} stale: robot stopped"),
+            self.control_failure(),
+        )
+    }
+}
+
+/// A dock asked for by id: `INVALID_GOAL` with DockRobot's DOCK_NOT_IN_DB (the planner docks
+/// onto a pose; it has no dock database).
+pub fn no_dock_database() -> Outcome {
+    Outcome::failed(
+        "INVALID_GOAL",
+        "use_dock_id is true, but this planner has no dock database (give dock_pose with use_dock_id false)",
+        nav2::docking::DOCK_NOT_IN_DB,
+    )
+}

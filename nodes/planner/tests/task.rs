@@ -1,0 +1,213 @@
+//! The planner's goal as one type: the status' mode, waypoint and figures of each task, the
+//! steps taken on the loop and those that are not, a pre-check's turn into a route or a
+//! refusal, the VFO law lent out and taken back (a late command dropped), and the Nav2 codes
+//! of the ends the node makes. Figures by hand from the routes and poses given.
+
+use mobil_chassis::ChassisParams;
+use mobil_geom::Pose2;
+use mobil_motion::slot::Handback;
+use mobil_motion::{nav2, BodyTwist, EndCause, Outcome, Step, StepInput};
+use mobil_planner::goals::{DockGoal, UndockGoal};
+use mobil_planner::task::{no_dock_database, Action, Mode, PreCheck, Stepped, Task, VfoRun};
+use mobil_planner::vfo::{
+    ObstacleMap, OptimiseConfig, ScanObstacleConfig, VfoFollower, VfoGains, VfoGoal, VfoStep, VfoWaypoint,
+};
+use mobil_planner::{
+    DockingConfig, DockingController, DockingGains, Finish, FollowConfig, ProblemKind, RouteProblem, RouteReport,
+    VelocityLimits,
+};
+use nalgebra::Point2;
+use std::time::{Duration, Instant};
+
+/// Waypoints (1, 0), (2, 0), (2, 1), the request's poses 4, 5, 6, from the origin.
+fn pre_check() -> Task {
+    let points = vec![Point2::new(1.0, 0.0), Point2::new(2.0, 0.0), Point2::new(2.0, 1.0)];
+    Task::PreCheck(PreCheck::new(Pose2::identity(), points, vec![4, 5, 6]))
+}
+
+/// The pre-check found a collision on the way to the second waypoint (request index 5).
+fn blocked() -> RouteReport {
+    RouteReport {
+        problems: vec![RouteProblem {
+            index: 1,
+            kind: ProblemKind::Collision {
+                at: Point2::new(1.6, 0.1),
+                clearance: -0.1,
+            },
+        }],
+        path: Vec::new(),
+        reached: vec![true, true, true],
+    }
+}
+
+fn at(x: f64, y: f64, yaw: f64) -> StepInput {
+    StepInput::new(0.0, 0.02, Pose2::new(x, y, yaw))
+}
+
+#[test]
+fn a_route_waits_for_its_pre_check_then_is_refused_or_driven() {
+    let omr3 = ChassisParams::omr3();
+    let rules = (FollowConfig::default(), &omr3);
+    let mut task = pre_check();
+    let f = task.figures(None);
+    // Waiting: the first waypoint shown, by its request index, no distance yet, no step.
+    assert_eq!(
+        (f.mode, f.waypoint, f.goal),
+        (Mode::PreCheck, Some(4), Some(Pose2::new(1.0, 0.0, 0.0)))
+    );
+    assert!(f.distance.is_nan());
+    assert_eq!(task.step(&at(0.0, 0.0, 0.0)), Stepped::Waiting);
+    // Refused (execute_infeasible_routes false): ROUTE_INFEASIBLE (FollowWaypoints 601), the
+    // problem kept by its request index for the result; still the pre-check.
+    let refused = task.pre_checked(&blocked(), rules, false).unwrap().unwrap_err();
+    assert!(refused
+        .reason()
+        .starts_with("ROUTE_INFEASIBLE: 1 problem(s): waypoint 5: collision"));
+    assert_eq!(refused.nav2_error(), 601);
+    let Task::PreCheck(p) = &task else { panic!("{task:?}") };
+    assert_eq!(p.problems.iter().map(|m| m.index).collect::<Vec<_>>(), vec![5]);
+    // Driven through (true): the goal approach towards (1, 0), 1 m from the start.
+    let mut task = pre_check();
+    let problems = task.pre_checked(&blocked(), rules, true).unwrap().unwrap();
+    assert_eq!(problems.len(), 1);
+    let f = task.figures(None);
+    assert_eq!((f.mode, f.waypoint, f.distance), (Mode::Approach, Some(4), 1.0));
+    assert!(matches!(
+        task.step(&at(0.0, 0.0, 0.0)),
+        Stepped::Law(Step::Command { .. })
+    ));
+    // A task that is no pre-check takes no report.
+    assert_eq!(task.pre_checked(&blocked(), rules, true), None);
+}
+
+#[test]
+fn a_docking_shows_its_figures_at_the_latest_pose_before_its_first_step() {
+    let controller = DockingController::new(
+        DockingGains::paper(),
+        DockingConfig::default(),
+        VelocityLimits::new(10.0, 10.0).unwrap(),
+        Finish::RotateInPlace,
+        Pose2::new(0.0, 0.0, 0.0),
+    )
+    .unwrap();
+    let task = Task::Dock(DockGoal::new(controller, 0.0));
+    let f = task.figures(None);
+    assert_eq!(
+        (f.mode, f.waypoint, f.goal),
+        (Mode::Dock, None, Some(Pose2::identity()))
+    );
+    assert!(f.distance.is_nan() && f.docking.unwrap().iter().all(|v| v.is_nan()));
+    // 3 m behind the dock, facing it: e = 3 m, Ω = 0 so α = Θ = 0, and (SPEC §3)
+    // V = ½(λe² + α² + hΘ²) = ½·0.55·9 = 2.475 with the paper's λ = 0.55.
+    let f = task.figures(Some(&Pose2::new(-3.0, 0.0, 0.0)));
+    let [e, alpha, theta, v] = f.docking.unwrap();
+    assert_eq!((f.distance, e, alpha, theta), (3.0, 3.0, 0.0, 0.0));
+    assert!((v - 2.475).abs() < 1e-12, "{v}");
+}
+
+#[test]
+fn an_undocking_steps_on_the_loop_and_shows_what_is_left() {
+    let mut task = Task::Undock(UndockGoal::new(0.5, 0.15, 30.0));
+    let f = task.figures(None);
+    assert_eq!((f.mode, f.waypoint, f.distance), (Mode::Undock, None, 0.5));
+    match task.step(&at(0.0, 0.0, 0.0)) {
+        Stepped::Law(Step::Command { twist, feedback }) => {
+            assert!(twist.vx < 0.0, "backs out: {twist:?}");
+            assert!(!feedback.changed && feedback.events.is_empty());
+        }
+        other => panic!("{other:?}"),
+    }
+}
+
+/// A VFO route to (2, 0) (request index 7), no obstacles, from the origin.
+fn vfo() -> VfoRun {
+    let w = vec![VfoWaypoint::new(2.0, 0.0, 0.0, 0.5).unwrap()];
+    let follower = VfoFollower::new(VfoGains::default(), OptimiseConfig::default(), w, Vec::new()).unwrap();
+    let law = VfoGoal::new(follower, vec![7], 0.0, &Pose2::identity(), Vec::new());
+    VfoRun::new(law, Duration::from_millis(40))
+}
+
+fn command(vx: f64, wz: f64) -> Step<VfoStep, Vec<usize>> {
+    Step::Command {
+        twist: BodyTwist::new(vx, 0.0, wz),
+        feedback: VfoStep {
+            events: Vec::new(),
+            settling: false,
+            drawing: None,
+        },
+    }
+}
+
+#[test]
+fn a_vfo_law_is_lent_once_and_a_late_command_is_dropped() {
+    let map = ObstacleMap::new(ScanObstacleConfig::default()).unwrap();
+    let mut task = Task::Vfo(vfo());
+    let f = task.figures(None);
+    assert_eq!(
+        (f.mode, f.waypoint, f.goal, f.distance),
+        (Mode::Vfo, Some(7), Some(Pose2::new(2.0, 0.0, 0.0)), 2.0)
+    );
+    assert_eq!(task.step(&at(0.0, 0.0, 0.0)), Stepped::OffLoop);
+    let Task::Vfo(run) = &mut task else { unreachable!() };
+    let t0 = Instant::now();
+    run.map_updated(true);
+    let law = run.lend(t0, &map).expect("at home");
+    assert!(run.lend(t0, &map).is_none() && run.law().is_none(), "out on its step");
+    // Back within 40 ms: the command stands.
+    let (step, back) = run.give_back(law, command(0.3, 0.1), t0 + Duration::from_millis(10));
+    assert_eq!(back, Handback::Fresh);
+    assert!(matches!(step, Step::Command { twist, .. } if twist == BodyTwist::new(0.3, 0.0, 0.1)));
+    // Back after a second: dropped, zero.
+    let law = run.lend(t0, &map).unwrap();
+    let (step, back) = run.give_back(law, command(0.3, 0.1), t0 + Duration::from_secs(1));
+    assert_eq!(back, Handback::Late);
+    assert!(matches!(step, Step::Command { twist, .. } if twist == BodyTwist::new(0.0, 0.0, 0.0)));
+    assert!(run.law().is_some());
+}
+
+#[test]
+fn the_ends_the_node_makes_carry_each_action_s_nav2_code() {
+    // DockRobot/UndockRobot: FAILED_TO_CONTROL 905, UNKNOWN 999, DOCK_NOT_VALID 902,
+    // DOCK_NOT_IN_DB 901; FollowWaypoints: TASK_EXECUTOR_FAILED 601, UNKNOWN 600.
+    let stale = EndCause::Stale("odom".into());
+    let refused = EndCause::Refused {
+        count: 20,
+        last: "pose is not finite".into(),
+    };
+    for (cause, codes) in [
+        (&stale, [905, 905, 601]),
+        (&refused, [905, 905, 601]),
+        (&EndCause::Shutdown, [999, 999, 600]),
+        (&EndCause::Canceled, [0, 0, 0]),
+        (&EndCause::Preempted("dock_pose"), [0, 0, 0]),
+        (&EndCause::Outcome(Outcome::failed("BLOCKED", "", 106)), [106, 106, 106]),
+    ] {
+        let got = [Action::Dock, Action::Undock, Action::Follow].map(|a| a.error_code(cause));
+        assert_eq!(got, codes, "{cause:?}");
+    }
+    assert_eq!(nav2::NONE, 0);
+    assert_eq!(Action::Dock.invalid_goal("dock pose is not finite").nav2_error(), 902);
+    assert_eq!(Action::Undock.invalid_goal("x").nav2_error(), 999);
+    assert_eq!(Action::Follow.invalid_goal("x").nav2_error(), 600);
+    assert_eq!(
+        Action::Dock.invalid_goal("dock pose is not finite").reason(),
+        "INVALID_GOAL: dock pose is not finite"
+    );
+    let r = Action::Follow.refused_goal("gamma 0 is not positive");
+    assert_eq!(
+        (r.reason().as_str(), r.nav2_error()),
+        (
+            "INVALID_INPUT: the planner refused its input: gamma 0 is not positive; robot stopped",
+            601
+        )
+    );
+    let s = Action::Dock.stale_at_start("scan");
+    assert_eq!(
+        (s.reason().as_str(), s.nav2_error()),
+        ("STALE_INPUT: scan stale: robot stopped", 905)
+    );
+    assert_eq!(no_dock_database().nav2_error(), 901);
+    assert!(no_dock_database()
+        .reason()
+        .starts_with("INVALID_GOAL: use_dock_id is true"));
+}

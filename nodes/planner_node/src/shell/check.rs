@@ -1,0 +1,89 @@
+//! `planner/check_route`: a route's pre-check as a service, computed on the blocking pool.
+
+use crate::*;
+
+impl Shell {
+    /// A `planner/check_route` request: refused at once, answered BUSY when too many are being
+    /// computed, or checked on the blocking pool and answered from there.
+    pub(crate) fn check_in(
+        &mut self,
+        node: &RosNode,
+        jobs: &mut Jobs,
+        check: &Server<CheckRouteRequest, CheckRouteResponse>,
+        id: RmwRequestId,
+        req: &CheckRouteRequest,
+    ) {
+        let (start, route) = match self.check_request(req) {
+            Err(reply) => return respond(check, id, reply, &mut self.throttle),
+            Ok(_) if jobs.pending + 1 >= MAX_CHECKS => {
+                let reply = refused_reply(format!(
+                    "BUSY: {} route checks are already being computed; ask again",
+                    jobs.pending
+                ));
+                return respond(check, id, reply, &mut self.throttle);
+            }
+            Ok(checked) => checked,
+        };
+        jobs.pending += 1;
+        let tx = jobs.replies_tx.clone();
+        let (world, chassis, config) = (self.world.clone(), self.chassis, self.config.route_check());
+        let (stamp, frame, step) = (
+            node.stamp(),
+            self.config.frames.odom_frame.clone(),
+            self.config.follow.check_length,
+        );
+        tokio::task::spawn_blocking(move || {
+            let began = Instant::now();
+            let reply = match check_route_until(&start, &route.points, &chassis, &world, &config, || false) {
+                Ok(report) => check_reply(&report, &route, stamp, &frame, step),
+                Err(e) => refused_reply(Action::Follow.refused_goal(e).reason()),
+            };
+            info!(
+                "planner/check_route: {} waypoints, {} in {:.2} ms",
+                route.points.len(),
+                if reply.feasible {
+                    "feasible".to_owned()
+                } else {
+                    format!("{} problem(s)", reply.problems.len())
+                },
+                began.elapsed().as_secs_f64() * 1e3
+            );
+            // The receiver lives as long as the loop; if it is gone nobody waits.
+            let _ = tx.send((id, reply));
+        });
+    }
+
+    /// The start and route of a `planner/check_route` request, or the reply refusing it.
+    pub(crate) fn check_request(&self, req: &CheckRouteRequest) -> Result<(Pose2, Route), CheckRouteResponse> {
+        let frame = &self.config.frames.odom_frame;
+        let start = if req.use_start {
+            pose_in_frame("start", frame, &req.start, frame)
+                .map_err(|e| refused_reply(Action::Follow.invalid_goal(&e).reason()))?
+        } else {
+            self.fresh_odom().ok_or_else(|| {
+                refused_reply(
+                    "STALE_INPUT: no fresh odometry for the start (set use_start and start to check from a given pose)"
+                        .to_owned(),
+                )
+            })?
+        };
+        let route = route_from_path(&req.route, frame, Some(start.position()), ROUTE_LIMITS)
+            .map_err(|e| refused_reply(Action::Follow.invalid_goal(&e).reason()))?;
+        Ok((start, route))
+    }
+}
+
+pub(crate) fn respond(
+    check: &Server<CheckRouteRequest, CheckRouteResponse>,
+    id: RmwRequestId,
+    reply: CheckRouteResponse,
+    throttle: &mut LogThrottle,
+) {
+    if let Err(e) = check.send_response(id, reply) {
+        warn_throttled!(
+            throttle,
+            "check-reply",
+            "planner/check_route: cannot send the reply: {e:?}"
+        );
+    }
+}

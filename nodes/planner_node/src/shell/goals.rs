@@ -1,0 +1,389 @@
+//! The goal lifecycle of the planner's shell: parameters, status and markers, a goal's
+//! start, end and report, each odometry step through the motion session, the watchdog tick
+//! and the action feedback.
+
+use crate::*;
+
+impl Shell {
+    pub(crate) fn reconfigure(&mut self, c: PlannerConfig) {
+        let scan = c.vfo.scan_config(c.robot_radius);
+        if scan != self.config.vfo.scan_config(self.config.robot_radius) {
+            if let Err(e) = ObstacleMap::new(scan) {
+                return warn!("parameters not applied: {e}");
+            }
+            if self.session.active().is_some() {
+                // The goal keeps the map its parameters built (its obstacles and σ stay valid).
+                info!("vfo obstacle extraction changed: the obstacle map starts afresh once the goal ends");
+                self.map_rebuild = true;
+            } else {
+                info!("vfo obstacle extraction changed: the obstacle map starts afresh");
+                self.map_rebuild = false;
+                if let Ok(map) = ObstacleMap::new(scan) {
+                    self.map = map;
+                }
+            }
+        }
+        match c.chassis_params() {
+            Ok(chassis) => {
+                self.chassis = chassis;
+                self.config = c;
+                if self.session.active().is_some() {
+                    info!("parameters changed: they apply from the next goal");
+                }
+            }
+            Err(e) => warn!("parameters not applied: {e}"),
+        }
+    }
+
+    pub(crate) fn fresh_odom(&self) -> Option<Pose2> {
+        self.odom
+            .get(self.config.timeouts.odom_timeout())
+            .filter(|_| !self.odom_refused)
+            .copied()
+    }
+
+    pub(crate) fn send_status(&mut self, node: &RosNode, out: &Outputs, view: &StatusView) {
+        let msg = status_message(view, node.stamp(), &self.config.frames.odom_frame);
+        if let Err(e) = out.status.publish(msg) {
+            warn_throttled!(self.throttle, "status", "cannot publish planner/status: {e:?}");
+        }
+        self.last_status = Some(Instant::now());
+    }
+
+    pub(crate) fn send_idle_status(&mut self, node: &RosNode, out: &Outputs) {
+        self.send_status(node, out, &self.status_view(None, NavStatus::IDLE, String::new()));
+    }
+
+    /// The status of `goal` (none: idle, or a refusal) in `state` with `reason`.
+    pub(crate) fn status_view(&self, goal: Option<&Goal>, state: u8, reason: String) -> StatusView {
+        let figures = goal.map(|g| g.task.figures(self.odom.value()));
+        StatusView::of(state, reason, figures.as_ref())
+    }
+
+    /// The active goal's status in `state` with `reason`.
+    pub(crate) fn publish_status(&mut self, node: &RosNode, out: &Outputs, state: u8, reason: String) {
+        let view = self.status_view(self.session.active().map(|a| &a.goal), state, reason);
+        self.send_status(node, out, &view);
+    }
+
+    pub(crate) fn publish_markers(&mut self, node: &RosNode, out: &Outputs) {
+        let view = MarkerView {
+            route: &self.drawing.route,
+            predicted: &self.drawing.predicted,
+            problems: &self.drawing.problems,
+            dock: self.drawing.dock,
+            vfo: self.drawing.vfo.as_ref(),
+            robot: self.odom.value().map(|p| p.position()),
+        };
+        let array = markers(&view, node.stamp(), &self.config.frames.odom_frame);
+        if let Err(e) = out.markers.publish(array) {
+            warn_throttled!(self.throttle, "markers", "cannot publish planner/markers: {e:?}");
+        }
+        self.last_markers = Some(Instant::now());
+    }
+
+    /// Ends the active goal with `outcome` (the session sends its zero command, if one is due)
+    /// and reports it.
+    pub(crate) fn end_goal(&mut self, io: &mut Io<'_, '_>, cause: EndCause) {
+        if let Some(ended) = self.session.end(cause, io.sink) {
+            self.report(io, ended, true);
+        }
+    }
+
+    /// Tells an ended goal's end: the action's result (unless the server already ended it:
+    /// a newer goal on the same action server took its place), the log, the status with the
+    /// goal's last figures, the markers; a VFO optimisation under way stops.
+    pub(crate) fn report(&mut self, io: &mut Io<'_, '_>, ended: PlannerEnded, finish_action: bool) {
+        let Ended {
+            goal, source, cause, ..
+        } = ended;
+        goal.stop.cancel();
+        if finish_action {
+            let end = goal_end(&cause);
+            match source {
+                Source::DockAction => {
+                    io.servers.dock.finish(end, dock_result(&cause));
+                }
+                Source::UndockAction => {
+                    io.servers.undock.finish(end, undock_result(&cause));
+                }
+                Source::FollowAction => {
+                    io.servers.follow.finish(end, follow_answer(&goal, &cause));
+                }
+                Source::DockPose | Source::Waypoints => {}
+            }
+        }
+        let reason = cause.reason();
+        match (cause.kind(), &cause) {
+            (EndKind::Succeeded | EndKind::Canceled, _) | (_, EndCause::Preempted(_)) => {
+                info!("goal ({}) ends: {reason}", source.name())
+            }
+            _ => warn!("goal ({}) ends: {reason}", source.name()),
+        }
+        let view = self.status_view(Some(&goal), end_state(&cause), reason);
+        self.send_status(io.node, io.out, &view);
+        if self.session.active().is_none() && std::mem::take(&mut self.map_rebuild) {
+            match ObstacleMap::new(self.config.vfo.scan_config(self.config.robot_radius)) {
+                Ok(map) => {
+                    info!("the obstacle map starts afresh with the new extraction parameters");
+                    self.map = map;
+                }
+                Err(e) => warn!("the obstacle map keeps its old parameters: {e}"),
+            }
+        }
+        self.publish_markers(io.node, io.out);
+    }
+
+    /// Makes `task` (of `route`, if one) from `source` the active goal: the goal it replaces ends PREEMPTED
+    /// (reported; an action goal on the same server was ended by the server's accept).
+    pub(crate) fn begin(&mut self, io: &mut Io<'_, '_>, task: Task, route: Option<Route>, source: Source) -> GoalId {
+        let goal = Goal {
+            task,
+            route,
+            chassis: self.chassis,
+            config: self.config.clone(),
+            stop: CancelToken::new(),
+        };
+        let (id, old) = self.session.start(goal, source, Instant::now());
+        if let Some(old) = old {
+            let by_server = source.is_action() && old.source == source;
+            self.report(io, old, !by_server);
+        }
+        id
+    }
+
+    /// A goal from `source` refused before it started: the goal it was to replace ends
+    /// PREEMPTED (the robot stops with it); an action goal (accepted already) gets its result;
+    /// the status is FAILED with the reason.
+    pub(crate) fn refuse(&mut self, io: &mut Io<'_, '_>, source: Source, refusal: mobil_motion::Outcome) {
+        if let Some(old) = self.session.end(EndCause::Preempted(source.name()), io.sink) {
+            let by_server = source.is_action() && old.source == source;
+            self.report(io, old, !by_server);
+        }
+        let cause = EndCause::Outcome(refusal);
+        warn!("goal ({}) refused: {}", source.name(), cause.reason());
+        match source {
+            Source::DockAction => {
+                io.servers.dock.finish(GoalEnd::Aborted, dock_result(&cause));
+            }
+            Source::UndockAction => {
+                io.servers.undock.finish(GoalEnd::Aborted, undock_result(&cause));
+            }
+            Source::FollowAction => {
+                io.servers
+                    .follow
+                    .finish(GoalEnd::Aborted, follow_result(&cause, &[], &[]));
+            }
+            Source::DockPose | Source::Waypoints => {}
+        }
+        let view = self.status_view(None, NavStatus::FAILED, cause.reason());
+        self.send_status(io.node, io.out, &view);
+    }
+
+    /// Starts a docking onto `target` (or refuses it).
+    pub(crate) fn start_dock(
+        &mut self,
+        io: &mut Io<'_, '_>,
+        target: Result<Pose2, mobil_motion::Outcome>,
+        source: Source,
+    ) {
+        let action = source.action();
+        let built = target.and_then(|dock| {
+            let gains = self.config.gains().map_err(|e| action.refused_goal(e))?;
+            DockGoal::onto(dock, gains, self.config.docking, &self.chassis).map_err(|e| action.refused_goal(e))
+        });
+        let dock = match built {
+            Ok(dock) => dock,
+            Err(refusal) => return self.refuse(io, source, refusal),
+        };
+        let goal = dock.target();
+        info!(
+            "goal ({}): dock at ({:.3}, {:.3}, {:.3} rad) in {}",
+            source.name(),
+            goal.x,
+            goal.y,
+            goal.yaw,
+            self.config.frames.odom_frame
+        );
+        if dock.controller().finish() == Finish::ReportResidual {
+            info!(
+                "a steered chassis cannot turn in place: the law steers its kinematic origin ({:.2} m behind), \
+                 and the heading left at the dock is reported as RESIDUAL",
+                dock.offset()
+            );
+        }
+        self.begin(io, Task::Dock(dock), None, source);
+        self.drawing = Drawing {
+            dock: Some(goal),
+            ..Drawing::default()
+        };
+        self.publish_status(io.node, io.out, NavStatus::ACTIVE, String::new());
+        self.publish_markers(io.node, io.out);
+    }
+
+    pub(crate) fn odom_in(&mut self, io: &mut Io<'_, '_>, jobs: &mut Jobs, m: &Odometry) {
+        match odom_pose(m, &self.config.frames.odom_frame, &self.config.frames.base_frame) {
+            Ok(pose) => {
+                self.odom_refused = false;
+                self.odom_stamp = secs_from_stamp(&m.header.stamp).unwrap_or(f64::NAN);
+                if self.odom_stamp.is_finite() {
+                    self.odom_history.push(self.odom_stamp, pose);
+                }
+                self.odom_period.arrived(Instant::now());
+                self.odom.set(pose, m.header.stamp.clone());
+                if self.session.active().is_some() {
+                    self.step(io, jobs, pose);
+                }
+            }
+            Err(e) => {
+                warn_throttled!(self.throttle, "odom-bad", "odom sample dropped: {e}; robot stopped");
+                self.odom_refused = true;
+                self.odom_history.clear();
+                self.session.hold(io.sink);
+            }
+        }
+    }
+
+    /// One control step at `pose`: the active goal's law, its command out through the session.
+    pub(crate) fn step(&mut self, io: &mut Io<'_, '_>, jobs: &mut Jobs, pose: Pose2) {
+        let dt = match self.session.advance(io.node.now_nanos()) {
+            Some(Ok(dt)) => dt,
+            None | Some(Err(DtError::Zero)) => return,
+            Some(Err(e)) => {
+                return warn_throttled!(
+                    self.throttle,
+                    "time-back",
+                    "{e}; the step is skipped, the goal's time carries on"
+                )
+            }
+        };
+        let Some(active) = self.session.active_mut() else {
+            return;
+        };
+        let input = StepInput::new(active.t(), dt, pose);
+        let chassis = active.goal.chassis;
+        match active.goal.task.step(&input) {
+            Stepped::Waiting => {}
+            Stepped::OffLoop => self.vfo_step(io, jobs, input),
+            Stepped::Law(step) => {
+                if let Step::Command { feedback, .. } = &step {
+                    for event in &feedback.events {
+                        match event {
+                            RouteEvent::Reached(i) => info!("waypoint {i} reached"),
+                            RouteEvent::Missed(m) => warn!("{} (missed; the next one is taken)", m.describe()),
+                        }
+                    }
+                }
+                self.apply(io, step, &chassis, |f| f.changed);
+            }
+        }
+    }
+
+    /// What comes of a law's step: its command held to the chassis limits, a refusal (the robot
+    /// stops; the goal ends after the session's count of them in a row) or the goal's end. The
+    /// status goes out when `changed` says the feedback changed it.
+    pub(crate) fn apply<F, R>(
+        &mut self,
+        io: &mut Io<'_, '_>,
+        step: Step<F, R>,
+        chassis: &ChassisParams,
+        changed: impl FnOnce(&F) -> bool,
+    ) {
+        if let Step::Refused(why) = &step {
+            warn_throttled!(
+                self.throttle,
+                "step",
+                "the planner refused its input: {why}; robot stopped"
+            );
+        }
+        match self.session.apply(step, limited(chassis), io.sink) {
+            Applied::Commanded(f) => {
+                if changed(&f) {
+                    self.publish_status(io.node, io.out, NavStatus::ACTIVE, String::new());
+                }
+            }
+            Applied::Refused(Some(ended)) | Applied::Ended(ended, _) => self.report(io, ended, true),
+            Applied::Refused(None) | Applied::Idle => {}
+        }
+    }
+
+    pub(crate) async fn tick(&mut self, io: &mut Io<'_, '_>) {
+        let Some(active) = self.session.active() else { return };
+        let now = Instant::now();
+        let mut inputs = vec![Watched {
+            name: "odom",
+            age: self.odom.age_at(now),
+            timeout: active.goal.config.timeouts.odom_timeout(),
+        }];
+        if matches!(active.goal.task, Task::Vfo(_)) {
+            inputs.push(Watched {
+                name: "scan",
+                age: self.scan_seen.age_at(now),
+                timeout: active.goal.config.vfo.scan_timeout(),
+            });
+        }
+        if let Some(stale) = self.session.stale(now, &inputs) {
+            return self.end_goal(io, EndCause::Stale(stale));
+        }
+        let status_period = Duration::from_secs_f64(1.0 / self.config.status_rate_hz);
+        if self
+            .last_status
+            .is_none_or(|t| now.saturating_duration_since(t) >= status_period)
+        {
+            self.publish_status(io.node, io.out, NavStatus::ACTIVE, String::new());
+        }
+        let markers_period = Duration::from_secs_f64(1.0 / self.config.markers_rate_hz);
+        if self
+            .last_markers
+            .is_none_or(|t| now.saturating_duration_since(t) >= markers_period)
+        {
+            self.publish_markers(io.node, io.out);
+        }
+        self.feedback(io.servers).await;
+    }
+
+    /// Action feedback, on every watchdog tick (20 Hz) while an action goal is active.
+    pub(crate) async fn feedback(&mut self, servers: &Servers) {
+        let Some(active) = self.session.active() else { return };
+        let sent = match (&active.goal.task, active.source) {
+            // The goal's own time: its steps' dt summed, never running backwards (a step whose
+            // clock went back is skipped), so docking_time never falls on a clock reset.
+            (Task::Dock(_), Source::DockAction) => {
+                servers
+                    .dock
+                    .feedback(DockRobotFeedback {
+                        state: DockRobotFeedback::CONTROLLING,
+                        docking_time: duration_msg(active.t()),
+                        num_retries: 0,
+                    })
+                    .await
+            }
+            (_, Source::FollowAction) => {
+                let index = active.goal.task.waypoint().unwrap_or(0);
+                servers
+                    .follow
+                    .feedback(FollowWaypointsFeedback {
+                        current_waypoint: u32::try_from(index).unwrap_or(u32::MAX),
+                    })
+                    .await
+            }
+            (Task::Undock(_), Source::UndockAction) => {
+                servers
+                    .undock
+                    .feedback(UndockRobotFeedback {
+                        structure_needs_at_least_one_member: 0,
+                    })
+                    .await
+            }
+            _ => Ok(()),
+        };
+        if let Err(e) = sent {
+            warn_throttled!(self.throttle, "feedback", "{e}");
+        }
+    }
+}
+
+/// Holds a law's body twist to the chassis limits, as a `cmd_vel`.
+pub(crate) fn limited(chassis: &ChassisParams) -> impl Fn(BodyTwist) -> Twist + '_ {
+    move |b| clamp_twist(b, chassis)
+}

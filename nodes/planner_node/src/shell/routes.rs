@@ -1,0 +1,298 @@
+//! Routes: a route's pre-check off the event loop and its turn into a goal approach, VFO
+//! routes with their steps off the event loop, and the scans that feed VFO's obstacle map.
+
+use crate::*;
+
+impl Shell {
+    /// Validates a route and starts its pre-check off the event loop (or refuses it).
+    pub(crate) fn start_route(
+        &mut self,
+        io: &mut Io<'_, '_>,
+        jobs: &mut Jobs,
+        route: Result<Route, GoalError>,
+        start: Option<Pose2>,
+        source: Source,
+    ) {
+        let route = match route {
+            Ok(r) => r,
+            Err(e) => return self.refuse(io, source, source.action().invalid_goal(&e)),
+        };
+        if self.config.waypoint_method == WaypointMethod::Vfo {
+            return self.start_vfo(io, route, start, source);
+        }
+        if let Some(i) = route.first_oriented() {
+            info!(
+                "goal ({}): waypoint {i} (and any other) carries an orientation: ignored, the goal approach \
+                 reaches each waypoint's position only",
+                source.name()
+            );
+        }
+        let Some(start) = start else {
+            return self.refuse(io, source, source.action().stale_at_start("odom"));
+        };
+        let (points, world, chassis, config) = (
+            route.points.clone(),
+            self.world.clone(),
+            self.chassis,
+            self.config.route_check(),
+        );
+        info!(
+            "goal ({}): pre-check of {} waypoints (the virtual robot drives them first)",
+            source.name(),
+            route.points.len()
+        );
+        let task = Task::PreCheck(PreCheck::new(start, points.clone(), route.request_index.clone()));
+        let id = self.begin(io, task, Some(route), source);
+        // The robot waits for the pre-check.
+        self.session.hold(io.sink);
+        jobs.goal.start(move |cancel| PreCheckDone {
+            id,
+            report: check_route_until(&start, &points, &chassis, &world, &config, || cancel.is_cancelled())
+                .map_err(|e| e.to_string()),
+        });
+        self.publish_status(io.node, io.out, NavStatus::ACTIVE, String::new());
+    }
+
+    /// A pre-check is done: the route it was for (if still the active goal) starts or is
+    /// refused.
+    pub(crate) fn pre_checked(&mut self, io: &mut Io<'_, '_>, done: PreCheckDone) {
+        let Some(active) = self.session.active_mut().filter(|a| a.id() == done.id) else {
+            return;
+        };
+        let source = active.source;
+        let goal = &mut active.goal;
+        let (follow, execute) = (goal.config.follow, goal.config.execute_infeasible_routes);
+        let points = goal.route.as_ref().map_or_else(Vec::new, |r| r.points.clone());
+        let report = match done.report {
+            Ok(r) => r,
+            Err(e) => return self.end_goal(io, Action::Follow.refused_goal(e).into()),
+        };
+        let Some(checked) = goal.task.pre_checked(&report, (follow, &goal.chassis), execute) else {
+            return;
+        };
+        let found = match (&checked, &goal.task) {
+            (Ok(problems), _) => problems.clone(),
+            (Err(_), Task::PreCheck(p)) => p.problems.clone(),
+            (Err(_), _) => Vec::new(),
+        };
+        self.drawing = Drawing {
+            predicted: report.path.clone(),
+            problems: found.clone(),
+            route: points,
+            ..Drawing::default()
+        };
+        if let Err(outcome) = checked {
+            return self.end_goal(io, outcome.into());
+        }
+        if !found.is_empty() {
+            let reason = route_infeasible(&found).reason();
+            warn!(
+                "goal ({}): driven although execute_infeasible_routes: {reason}",
+                source.name()
+            );
+        }
+        info!(
+            "goal ({}): {} waypoints, pre-check {} ({:.2} m predicted)",
+            source.name(),
+            self.drawing.route.len(),
+            if found.is_empty() {
+                "clear".to_owned()
+            } else {
+                format!("{} problem(s)", found.len())
+            },
+            report.driven_length(follow.check_length)
+        );
+        self.publish_status(io.node, io.out, NavStatus::ACTIVE, String::new());
+        self.publish_markers(io.node, io.out);
+    }
+
+    /// Starts VFO waypoint following of `route` from `start` (or refuses it).
+    pub(crate) fn start_vfo(&mut self, io: &mut Io<'_, '_>, route: Route, start: Option<Pose2>, source: Source) {
+        let Some(start) = start else {
+            return self.refuse(io, source, source.action().stale_at_start("odom"));
+        };
+        // Without a fresh scan the obstacles are unknown: the first tick would optimise the
+        // segment through a map with nothing in it.
+        if self.scan_seen.get(self.config.vfo.scan_timeout()).is_none() {
+            return self.refuse(io, source, source.action().stale_at_start("scan"));
+        }
+        let settings = &self.config.vfo;
+        let setup = settings.setup();
+        let of_route = (&route.points[..], &route.headings()[..], &route.request_index[..]);
+        let law = match VfoGoal::for_route(of_route, &start, &setup, &self.chassis, &self.map) {
+            Ok(law) => law,
+            Err(refusal) => return self.refuse(io, source, refusal),
+        };
+        let gains = vfo_gains(&setup.gains, &self.chassis);
+        info!(
+            "goal ({}): {} waypoints by VFO ({} obstacles known; U_2 {:.2} m/s, |ω| ≤ {:.2} rad/s, T_p {:.3} s)",
+            source.name(),
+            route.points.len(),
+            law.follower().obstacles().len(),
+            gains.speed,
+            gains.omega_max,
+            settings.optimise.time_step
+        );
+        if self.chassis.model().is_nonholonomic() {
+            warn!(
+                "goal ({}): the VFO law is a unicycle's: on this {} chassis the virtual robots turn no \
+                 tighter than at U_2 over R_min, but slower commands are held to R_min too, so the robot may \
+                 turn wider than they did (waypoint_method approach is this chassis' default)",
+                source.name(),
+                self.chassis.model().as_str()
+            );
+        }
+        // A step's command later than the next odometry or two is dropped (the robot stops).
+        let max_delay = late_bound(self.odom_period.period(), settings.optimise.time_step);
+        self.drawing = Drawing {
+            route: route.points.clone(),
+            ..Drawing::default()
+        };
+        self.begin(io, Task::Vfo(VfoRun::new(law, max_delay)), Some(route), source);
+        self.publish_status(io.node, io.out, NavStatus::ACTIVE, String::new());
+        self.publish_markers(io.node, io.out);
+    }
+
+    /// A VFO step: the law goes to the blocking pool with the map's latest obstacles, or,
+    /// while it is still out (optimising), the robot stops.
+    pub(crate) fn vfo_step(&mut self, io: &mut Io<'_, '_>, jobs: &mut Jobs, input: StepInput) {
+        let Some(active) = self.session.active_mut() else {
+            return;
+        };
+        let id = active.id();
+        let budget = active.goal.config.vfo.optimise_budget();
+        let stop = active.goal.stop.clone();
+        let Task::Vfo(v) = &mut active.goal.task else { return };
+        let Some(mut law) = v.lend(Instant::now(), &self.map) else {
+            return self.session.hold(io.sink);
+        };
+        let stamp = self.odom_stamp;
+        jobs.vfo.start(move |cancel| {
+            let (cancel, started) = (cancel.clone(), Instant::now());
+            let interrupt = move || {
+                if cancel.is_cancelled() || stop.is_cancelled() {
+                    Some(Interrupt::Cancel)
+                } else if started.elapsed() > budget {
+                    Some(Interrupt::Budget)
+                } else {
+                    None
+                }
+            };
+            let tick = VfoTick {
+                stamp,
+                interrupt: Box::new(interrupt),
+            };
+            let step = law.step(&input, &tick);
+            VfoTickDone { id, law, step }
+        });
+    }
+
+    /// A VFO step came back: its events are logged, its command goes out (zero when it came
+    /// back late), or the route ends.
+    pub(crate) fn vfo_ticked(&mut self, io: &mut Io<'_, '_>, done: VfoTickDone) {
+        if !self.session.is_current(done.id) {
+            return;
+        }
+        let Some(active) = self.session.active_mut() else {
+            return;
+        };
+        let chassis = active.goal.chassis;
+        let Task::Vfo(v) = &mut active.goal.task else { return };
+        let (mut step, handback) = v.give_back(done.law, done.step, Instant::now());
+        let Some(law) = v.law() else { return };
+        if let Step::Command { feedback, .. } = &mut step {
+            for event in &feedback.events {
+                info!("{}", law.describe(event));
+                if let VfoEvent::Optimised { warnings, .. } = event {
+                    for w in warnings.iter().filter(|w| !matches!(w, OptimiseWarning::NoSafeSigma)) {
+                        warn_throttled!(self.throttle, "vfo-caps", "segment optimisation: {w:?}");
+                    }
+                }
+            }
+            if feedback.settling {
+                warn_throttled!(
+                    self.throttle,
+                    "vfo-settle",
+                    "robot held at zero inside an influence zone until it stands (at most {MAX_SETTLE_S} s), then \
+                     the segment to waypoint {} is optimised from there",
+                    v.view().waypoint
+                );
+            }
+            if let Some(drawing) = feedback.drawing.take() {
+                self.drawing.vfo = Some(drawing);
+            }
+            if handback == Handback::Late {
+                warn_throttled!(
+                    self.throttle,
+                    "vfo-late",
+                    "a tick took longer than {:.0} ms (an optimisation): its command is dropped, the robot stops \
+                     meanwhile",
+                    v.max_delay().as_secs_f64() * 1e3
+                );
+            }
+        }
+        self.apply(io, step, &chassis, |f| !f.events.is_empty());
+    }
+
+    /// A scan: its obstacles go into the map (in odom, with the odometry pose at the scan's
+    /// stamp); a VFO route's follower gets them at its next tick. A goal's scans are read with
+    /// the parameters it began with.
+    pub(crate) fn scan_in(&mut self, m: &LaserScan) {
+        let config = match self.session.active() {
+            Some(a) if matches!(a.goal.task, Task::Vfo(_)) => &a.goal.config,
+            _ if self.config.waypoint_method == WaypointMethod::Vfo => &self.config,
+            _ => return,
+        };
+        let (max_gap, scan_range) = (config.vfo.scan_odom_max_gap_s, config.vfo.scan_range);
+        let mount = LaserMount {
+            base_frame: &config.frames.base_frame,
+            laser_frame: &config.vfo.laser_frame,
+            parameter: config.vfo.laser_pose(),
+        };
+        let scan = match checked_scan(&self.laser, &mount, m, Some(scan_range)) {
+            Ok(c) => c.scan,
+            Err(e) => return warn_throttled!(self.throttle, "scan-bad", "{e}; scan ignored"),
+        };
+        let Some(stamp) = secs_from_stamp(&m.header.stamp) else {
+            return warn_throttled!(
+                self.throttle,
+                "scan-bad",
+                "scan stamp invalid (nanosec ≥ 1e9); scan ignored"
+            );
+        };
+        let history = self.fresh_odom().map(|_| &self.odom_history);
+        let update = match self.map.add_scan(&scan, stamp, history, max_gap) {
+            Ok(u) => u,
+            Err(e @ ScanSkipped::NoPose { .. }) => return warn_throttled!(self.throttle, "scan-odom", "{e}"),
+            Err(e) => return warn_throttled!(self.throttle, "scan-bad", "{e}; scan ignored"),
+        };
+        if !update.cleared.is_empty() {
+            warn_throttled!(
+                self.throttle,
+                "map-reset",
+                "scan at {stamp:.3} s is older than obstacles already seen (clock reset?): the {} obstacles forgotten",
+                update.cleared.len()
+            );
+        }
+        if !update.capped.is_empty() {
+            warn_throttled!(
+                self.throttle,
+                "map-cap",
+                "obstacle map full (vfo.max_obstacles {}): the {} least recently seen dropped",
+                self.map.config().max_obstacles,
+                update.capped.len()
+            );
+        }
+        if self.scan_seen.value().is_none() {
+            info!(
+                "first scan: {} beams, {} obstacles in the map (odom)",
+                scan.len(),
+                self.map.len()
+            );
+        }
+        self.scan_seen.set((), m.header.stamp.clone());
+        if let Some(Task::Vfo(v)) = self.session.active_mut().map(|a| &mut a.goal.task) {
+            v.map_updated(!update.new.is_empty());
+        }
+    }
+}
