@@ -50,7 +50,7 @@ pub use controller::{ChassisController, Command, ControllerConfig, FeedbackOutco
 pub use error::{ChassisError, OdometryError};
 pub use joints::{FeedbackDecoder, FeedbackSample};
 pub use kinematics::{forward, inverse, pre_steer, BodyTwist, Joint, JointKind, WheelState};
-pub use limits::{clamp_command, ClampReason, ClampReasons, Clamped};
+pub use limits::{clamp_at_reference, clamp_command, ClampReason, ClampReasons, Clamped};
 pub use model::{ChassisConfig, ChassisModel, ChassisParams};
 pub use odometry::{Odometry, OdometryNoise};
 pub use watchdog::InputTimeout;

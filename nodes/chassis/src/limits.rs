@@ -23,7 +23,7 @@
 
 use std::fmt;
 
-use crate::kinematics::{inverse, BodyTwist};
+use crate::kinematics::{inverse, twist_at_origin, twist_at_reference, BodyTwist};
 use crate::model::ChassisParams;
 
 /// Relative excess over a limit below which a clamp is applied silently.
@@ -219,5 +219,31 @@ pub fn clamp_command(params: &ChassisParams, requested: BodyTwist) -> Clamped {
         twist: t,
         reasons,
         pre_steer,
+    }
+}
+
+/// A command given at the reference point (a law's), held to the chassis limits as a command
+/// to the chassis is held: on a steered chassis `vx` and `wz` are taken as the kinematic
+/// origin's (the reference point's sideways speed ω·d is implied, and dropped), on the omni
+/// chassis the twist is moved to the origin and back; in between [`clamp_command`] (speed,
+/// turn rate, minimum radius, wheel speeds). Anything non-finite gives zero.
+pub fn clamp_at_reference(params: &ChassisParams, twist: BodyTwist) -> BodyTwist {
+    let d = params.reference_offset();
+    let steered = params.model().is_nonholonomic();
+    let origin = if steered {
+        BodyTwist::new(twist.vx, 0.0, twist.wz)
+    } else {
+        twist_at_origin(twist, d)
+    };
+    let clamped = clamp_command(params, origin).twist;
+    let out = if steered {
+        BodyTwist::new(clamped.vx, 0.0, clamped.wz)
+    } else {
+        twist_at_reference(clamped, d)
+    };
+    if out.is_finite() {
+        out
+    } else {
+        BodyTwist::ZERO
     }
 }

@@ -3,7 +3,8 @@
 use approx::{assert_relative_eq, relative_eq};
 use mobil_chassis::kinematics::ackermann_centre_tan;
 use mobil_chassis::{
-    clamp_command, inverse, BodyTwist, ChassisConfig, ChassisParams, ClampReason, ClampReasons, WheelState,
+    clamp_at_reference, clamp_command, inverse, BodyTwist, ChassisConfig, ChassisParams, ClampReason, ClampReasons,
+    WheelState,
 };
 use nalgebra::Vector3;
 use proptest::prelude::*;
@@ -217,4 +218,52 @@ proptest! {
         prop_assert_eq!(c.twist, t);
         prop_assert!(c.reasons.is_empty());
     }
+}
+
+#[test]
+fn a_law_s_command_at_the_reference_point_is_held_to_the_chassis_limits() {
+    // OMR-III: v_max 0.5. (0.6, 0.8) m/s is 1.0 m/s: scaled to (0.3, 0.4).
+    let omr3 = ChassisParams::omr3();
+    let t = clamp_at_reference(&omr3, BodyTwist::new(0.6, 0.8, 0.0));
+    assert_relative_eq!(t.vx, 0.3, epsilon = 1e-12);
+    assert_relative_eq!(t.vy, 0.4, epsilon = 1e-12);
+    // MOBIL-II with its reference point 0.30 m ahead: at v = 0.3 the tightest turn is
+    // ω = 0.3 / 0.73 = 0.410959 rad/s (linear.x and angular.z are the origin's). A request
+    // for ω = 2 is held to that; a linear.y (the implied ω·d, or any) is never sent.
+    let mobil2 = ChassisParams::new(ChassisConfig {
+        reference_offset: 0.30,
+        ..ChassisConfig::mobil2()
+    })
+    .expect("valid");
+    let t = clamp_at_reference(&mobil2, BodyTwist::new(0.3, 2.0 * 0.3, 2.0));
+    assert_relative_eq!(t.vx, 0.3, epsilon = 1e-12);
+    assert_relative_eq!(t.wz, 0.3 / 0.73, epsilon = 1e-9);
+    assert_eq!(t.vy, 0.0);
+    // A feasible command passes unchanged.
+    let t = clamp_at_reference(&mobil2, BodyTwist::new(0.2, 0.0, 0.1));
+    assert_eq!((t.vx, t.vy, t.wz), (0.2, 0.0, 0.1));
+    // A turn in place is a stop on a car (v = 0 allows no ω).
+    let t = clamp_at_reference(&mobil2, BodyTwist::new(0.0, 0.0, 0.5));
+    assert_eq!((t.vx, t.wz), (0.0, 0.0));
+    // An omni with its reference point 0.2 m ahead: (0.5, 0, 0.25) at the reference point is
+    // (0.5, −0.05, 0.25) at the origin, |v| = 0.502494 > 0.5: the translation is scaled by
+    // s = 0.995037, ω (within 1.5) kept (the fastest wheel, at most (|v| + R·ω) / r =
+    // (0.5 + 0.05) / 0.05 = 11 < 12 rad/s, does not bind); back at the reference point
+    // vy = −0.05·s + 0.2·0.25 = 0.05·(1 − s) = 0.000248.
+    let omni = ChassisParams::new(ChassisConfig {
+        reference_offset: 0.2,
+        ..ChassisConfig::omr3()
+    })
+    .expect("valid");
+    let t = clamp_at_reference(&omni, BodyTwist::new(0.5, 0.0, 0.25));
+    let s = 0.5 / 0.5f64.hypot(0.05);
+    assert_relative_eq!(s, 0.995_037, epsilon = 1e-6);
+    assert_relative_eq!(t.vx, 0.5 * s, epsilon = 1e-9);
+    assert_relative_eq!(t.vy, 0.05 * (1.0 - s), epsilon = 1e-12);
+    assert_relative_eq!(t.wz, 0.25, epsilon = 1e-12);
+    // Non-finite → zero.
+    let t = clamp_at_reference(&omr3, BodyTwist::new(f64::NAN, 0.0, 1.0));
+    assert_eq!((t.vx, t.vy, t.wz), (0.0, 0.0, 0.0));
+    let t = clamp_at_reference(&mobil2, BodyTwist::new(0.1, 0.0, f64::INFINITY));
+    assert_eq!((t.vx, t.vy, t.wz), (0.0, 0.0, 0.0));
 }

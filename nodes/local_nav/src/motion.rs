@@ -113,6 +113,26 @@ impl VelocityCommand {
         c.omega = c.omega.clamp(-limits.omega_max, limits.omega_max);
         c
     }
+
+    /// The command as it goes to the chassis: [`VelocityCommand::limited`], and on a car-like
+    /// chassis |ω| ≤ κ_max·|vx| (a turn no tighter than δ_eff allows: a standing car does not
+    /// turn). Anything non-finite gives the zero command.
+    pub fn for_chassis(self, limits: &MotionLimits) -> VelocityCommand {
+        let mut c = self.limited(limits);
+        if let Drive::CarLike { max_curvature } = limits.drive {
+            let bound = max_curvature * c.vx.abs();
+            c.omega = if bound.is_finite() {
+                c.omega.clamp(-bound, bound)
+            } else {
+                0.0
+            };
+        }
+        if c.is_finite() {
+            c
+        } else {
+            VelocityCommand::ZERO
+        }
+    }
 }
 
 /// What the motion law needs to know about the moment.

@@ -3,7 +3,7 @@
 
 use mobil_chassis::ChassisParams;
 use mobil_geom::{Pose2, Scan};
-use mobil_local_nav::{Drive, MotionLimits, NavConfig, Navigator};
+use mobil_local_nav::{Drive, MotionLimits, NavConfig, Navigator, VelocityCommand};
 use nalgebra::Point2;
 use proptest::prelude::*;
 
@@ -55,4 +55,44 @@ proptest! {
             }
         }
     }
+}
+
+#[test]
+fn commands_go_to_the_chassis_held_to_its_limits() {
+    // OMR-III: v_max 0.5, ω_max 1.5. (0.6, 0.8) is 1.0 m/s: scaled by 0.5 to (0.3, 0.4).
+    let omni = MotionLimits::from_chassis(&ChassisParams::omr3());
+    let t = VelocityCommand {
+        vx: 0.6,
+        vy: 0.8,
+        omega: -3.0,
+    }
+    .for_chassis(&omni);
+    assert!((t.vx - 0.3).abs() < 1e-12 && (t.vy - 0.4).abs() < 1e-12);
+    assert_eq!(t.omega, -1.5);
+    // MOBIL-II: δ_eff = atan(0.60 / 0.73), κ_max = tan δ_eff / L = 1 / 0.73 = 1.36986 1/m.
+    // At vx 0.2 the turn rate is held to 0.2 / 0.73 = 0.273973 rad/s; vy dropped.
+    let car = MotionLimits::from_chassis(&ChassisParams::mobil2());
+    let t = VelocityCommand {
+        vx: 0.2,
+        vy: 0.3,
+        omega: 0.9,
+    }
+    .for_chassis(&car);
+    assert_eq!((t.vx, t.vy), (0.2, 0.0));
+    assert!((t.omega - 0.2 / 0.73).abs() < 1e-9, "{}", t.omega);
+    // A standing car cannot turn; NaN anywhere gives the zero command.
+    let t = VelocityCommand {
+        vx: 0.0,
+        vy: 0.0,
+        omega: 0.5,
+    }
+    .for_chassis(&car);
+    assert_eq!(t.omega, 0.0);
+    let t = VelocityCommand {
+        vx: f64::NAN,
+        vy: 0.0,
+        omega: 0.1,
+    }
+    .for_chassis(&omni);
+    assert_eq!((t.vx, t.vy, t.omega), (0.0, 0.0, 0.0));
 }

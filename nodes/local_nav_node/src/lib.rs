@@ -11,12 +11,11 @@
 use mobil_chassis::model::ChassisConfig;
 use mobil_geom::Pose2;
 use mobil_local_nav::{
-    Drive, Mode, MotionLimits, NavConfig, ProgressChecker, ProgressSettings, Sectors, Side, UnseenSectors,
-    VelocityCommand, WeightProfile,
+    Mode, MotionLimits, NavConfig, ProgressChecker, ProgressSettings, Sectors, Side, UnseenSectors, WeightProfile,
 };
 use mobil_motion::Outcome;
 use mobil_msgs::builtin_interfaces::msg::Time;
-use mobil_msgs::geometry_msgs::msg::{Point, Pose, PoseStamped, Twist};
+use mobil_msgs::geometry_msgs::msg::{Point, Pose, PoseStamped};
 use mobil_msgs::mobil_msgs::msg::NavStatus;
 use mobil_msgs::std_msgs::msg::Header;
 use mobil_msgs::visualization_msgs::msg::{Marker, MarkerArray};
@@ -316,29 +315,6 @@ pub fn goal_in_odom(goal: &PoseStamped, odom_frame: &str) -> Result<Point2<f64>,
     goal_pose("goal", goal, odom_frame).map(|p| p.position())
 }
 
-/// The command as a Twist, held to the chassis limits whatever the navigator asked: speed at
-/// most `v_max`, |ω| at most `omega_max`, and on a car-like chassis no sideways speed and
-/// |ω| ≤ κ_max·|vx| (a turn no tighter than δ_eff allows). Anything non-finite gives zero.
-pub fn twist_from_command(command: VelocityCommand, limits: &MotionLimits) -> Twist {
-    let mut c = command.limited(limits);
-    if let Drive::CarLike { max_curvature } = limits.drive {
-        let bound = max_curvature * c.vx.abs();
-        c.omega = if bound.is_finite() {
-            c.omega.clamp(-bound, bound)
-        } else {
-            0.0
-        };
-    }
-    if !c.is_finite() {
-        c = VelocityCommand::ZERO;
-    }
-    let mut t = Twist::default();
-    t.linear.x = c.vx;
-    t.linear.y = c.vy;
-    t.angular.z = c.omega;
-    t
-}
-
 /// The progress checker after a parameter change: the same one (its window and anchor kept)
 /// unless its own settings changed, so that setting other parameters again and again cannot
 /// keep a stuck goal alive.
@@ -519,57 +495,9 @@ pub fn invalid_goal(e: &GoalError) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use mobil_chassis::ChassisParams;
     use mobil_geom::Scan;
+    use mobil_local_nav::Drive;
     use mobil_ros::params::ParamValues;
-
-    #[test]
-    fn commands_are_held_to_the_chassis_limits() {
-        // OMR-III: v_max 0.5, ω_max 1.5. (0.6, 0.8) is 1.0 m/s: scaled by 0.5 to (0.3, 0.4).
-        let omni = MotionLimits::from_chassis(&ChassisParams::omr3());
-        let t = twist_from_command(
-            VelocityCommand {
-                vx: 0.6,
-                vy: 0.8,
-                omega: -3.0,
-            },
-            &omni,
-        );
-        assert!((t.linear.x - 0.3).abs() < 1e-12 && (t.linear.y - 0.4).abs() < 1e-12);
-        assert_eq!(t.angular.z, -1.5);
-        // MOBIL-II: δ_eff = atan(0.60 / 0.73), κ_max = tan δ_eff / L = 1 / 0.73 = 1.36986 1/m.
-        // At vx 0.2 the turn rate is held to 0.2 / 0.73 = 0.273973 rad/s; vy dropped.
-        let car = MotionLimits::from_chassis(&ChassisParams::mobil2());
-        let t = twist_from_command(
-            VelocityCommand {
-                vx: 0.2,
-                vy: 0.3,
-                omega: 0.9,
-            },
-            &car,
-        );
-        assert_eq!((t.linear.x, t.linear.y), (0.2, 0.0));
-        assert!((t.angular.z - 0.2 / 0.73).abs() < 1e-9, "{}", t.angular.z);
-        // A standing car cannot turn; NaN anywhere gives the zero command.
-        let t = twist_from_command(
-            VelocityCommand {
-                vx: 0.0,
-                vy: 0.0,
-                omega: 0.5,
-            },
-            &car,
-        );
-        assert_eq!(t.angular.z, 0.0);
-        let t = twist_from_command(
-            VelocityCommand {
-                vx: f64::NAN,
-                vy: 0.0,
-                omega: 0.1,
-            },
-            &omni,
-        );
-        assert_eq!((t.linear.x, t.linear.y, t.angular.z), (0.0, 0.0, 0.0));
-    }
 
     #[test]
     fn defaults_build_the_library_defaults_and_bad_weights_are_refused() {

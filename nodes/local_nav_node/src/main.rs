@@ -14,7 +14,7 @@
 //! law: `cmd_vel` only while a goal is active, exactly one zero `cmd_vel` when a goal that moved
 //! the robot ends (reached, no path, no progress, stale input, canceled, refused), none between
 //! a goal and the newer goal that pre-empts it; every command is held to the chassis limits
-//! ([`twist_from_command`]). A refused input while a goal runs (scan, laser pose, odometry)
+//! ([`VelocityCommand::for_chassis`]). A refused input while a goal runs (scan, laser pose, odometry)
 //! stops the robot with one zero command; the navigator refusing its input on 20 scans in a row
 //! ends the goal `INVALID_INPUT`. At shutdown with a goal under way, its zero command is the last
 //! one, waited for ([`final_stop`]); an idle node sends none.
@@ -23,7 +23,7 @@ use mobil_geom::Pose2;
 use mobil_local_nav::{Mode, MotionLimits, Navigator, Progress, ProgressChecker, StepOutput, VelocityCommand};
 use mobil_local_nav_node::{
     clear_markers, end_answer, goal_heading, goal_in_odom, invalid_goal, markers, no_progress, reconfigured_progress,
-    status_message, twist_from_command, LocalNavConfig, MarkerView, StatusView,
+    status_message, LocalNavConfig, MarkerView, StatusView,
 };
 use mobil_motion::{BodyTwist, GoalLaw, Step, StepInput};
 use mobil_msgs::builtin_interfaces::msg::Time;
@@ -35,7 +35,7 @@ use mobil_msgs::sensor_msgs::msg::LaserScan;
 use mobil_msgs::std_msgs::msg::Header;
 use mobil_msgs::visualization_msgs::msg::MarkerArray;
 use mobil_ros::action::{goal_end, ActionEvent, GoalRequest, GoalServer, GoalServerConfig};
-use mobil_ros::geometry::odom_pose;
+use mobil_ros::geometry::{odom_pose, twist_msg};
 use mobil_ros::input::Inputs;
 use mobil_ros::latest::Latest;
 use mobil_ros::motion::{Applied, CmdVel, EndCause, EndKind, Ended, MotionSession, SessionSettings, Watched};
@@ -296,14 +296,13 @@ type TFMessageAlias = mobil_msgs::tf2_msgs::msg::TFMessage;
 /// A command of the navigator (a body twist) held to the chassis limits.
 fn limited(limits: &MotionLimits) -> impl Fn(BodyTwist) -> Twist + '_ {
     move |b| {
-        twist_from_command(
-            VelocityCommand {
-                vx: b.vx,
-                vy: b.vy,
-                omega: b.wz,
-            },
-            limits,
-        )
+        let c = VelocityCommand {
+            vx: b.vx,
+            vy: b.vy,
+            omega: b.wz,
+        }
+        .for_chassis(limits);
+        twist_msg(BodyTwist::new(c.vx, c.vy, c.omega))
     }
 }
 

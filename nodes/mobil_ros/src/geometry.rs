@@ -1,10 +1,21 @@
 //! Planar poses and twists in ROS messages (REP-103: x forward, y left, z up, yaw about z).
 
 use mobil_geom::Pose2;
+use mobil_motion::BodyTwist;
 use mobil_msgs::geometry_msgs::msg::Quaternion;
+use mobil_msgs::geometry_msgs::msg::Twist;
 use mobil_msgs::nav_msgs::msg::Odometry;
 use mobil_msgs::std_msgs::msg::Header;
 use thiserror::Error;
+
+/// A planar body twist as a `cmd_vel` Twist (linear.x, linear.y, angular.z; the rest zero).
+pub fn twist_msg(t: BodyTwist) -> Twist {
+    let mut m = Twist::default();
+    m.linear.x = t.vx;
+    m.linear.y = t.vy;
+    m.angular.z = t.wz;
+    m
+}
 
 /// The quaternion of a rotation by `yaw` about z.
 pub fn yaw_quaternion(yaw: f64) -> Quaternion {

@@ -8,13 +8,12 @@
 
 #![warn(missing_docs)]
 
-use mobil_chassis::kinematics::{twist_at_origin, twist_at_reference};
 use mobil_chassis::model::ChassisConfig;
-use mobil_chassis::{clamp_command, BodyTwist, ChassisParams};
+use mobil_chassis::ChassisParams;
 use mobil_geom::downsample;
 use mobil_geom::Pose2;
 use mobil_msgs::builtin_interfaces::msg::Time;
-use mobil_msgs::geometry_msgs::msg::{Point, Pose, PoseStamped, Twist};
+use mobil_msgs::geometry_msgs::msg::{Point, Pose, PoseStamped};
 use mobil_msgs::mobil_msgs::msg::{NavStatus, RouteProblem as ProblemMsg};
 use mobil_msgs::mobil_msgs::srv::CheckRouteResponse;
 use mobil_msgs::nav2_msgs::action::{DockRobotResult, FollowWaypointsResult, UndockRobotResult};
@@ -221,34 +220,6 @@ pub const ROUTE_LIMITS: RouteLimits = RouteLimits {
     min_length: 1e-3,
     max_waypoints: MAX_WAYPOINTS,
 };
-
-/// The command as a Twist at the reference point, held to the chassis limits as chassis_node
-/// holds them: on a steered chassis `linear.x` and `angular.z` are the kinematic origin's (the
-/// reference point's sideways speed ω·d is implied, never sent: chassis_node drops a `linear.y`
-/// there), on the omni chassis the twist is moved to the origin and back; in between,
-/// [`clamp_command`] (speed, turn rate, minimum radius, wheel speeds). Anything non-finite gives
-/// zero.
-pub fn clamp_twist(twist: BodyTwist, params: &ChassisParams) -> Twist {
-    let d = params.reference_offset();
-    let steered = params.model().is_nonholonomic();
-    let origin = if steered {
-        BodyTwist::new(twist.vx, 0.0, twist.wz)
-    } else {
-        twist_at_origin(twist, d)
-    };
-    let clamped = clamp_command(params, origin).twist;
-    let out = if steered {
-        BodyTwist::new(clamped.vx, 0.0, clamped.wz)
-    } else {
-        twist_at_reference(clamped, d)
-    };
-    let out = if out.is_finite() { out } else { BodyTwist::ZERO };
-    let mut t = Twist::default();
-    t.linear.x = out.vx;
-    t.linear.y = out.vy;
-    t.angular.z = out.wz;
-    t
-}
 
 /// The NavStatus state an end leaves.
 pub fn end_state(cause: &EndCause) -> u8 {
@@ -608,54 +579,6 @@ mod tests {
         bad.set("min_speed", ros2_client::ParameterValue::Double(0.4));
         // min_speed above approach_speed (0.3) is inconsistent.
         assert!(mobil_ros::config::load::<PlannerConfig>(&bad).is_err());
-    }
-
-    #[test]
-    fn commands_are_held_to_the_chassis_limits() {
-        // OMR-III: v_max 0.5. (0.6, 0.8) m/s is 1.0 m/s: scaled to (0.3, 0.4).
-        let omr3 = ChassisParams::omr3();
-        let t = clamp_twist(BodyTwist::new(0.6, 0.8, 0.0), &omr3);
-        assert_relative_eq!(t.linear.x, 0.3, epsilon = 1e-12);
-        assert_relative_eq!(t.linear.y, 0.4, epsilon = 1e-12);
-        // MOBIL-II with its reference point 0.30 m ahead: at v = 0.3 the tightest turn is
-        // ω = 0.3 / 0.73 = 0.410959 rad/s (linear.x and angular.z are the origin's). A request
-        // for ω = 2 is held to that; a linear.y (the implied ω·d, or any) is never sent.
-        let mobil2 = ChassisParams::new(ChassisConfig {
-            reference_offset: 0.30,
-            ..ChassisConfig::mobil2()
-        })
-        .expect("valid");
-        let t = clamp_twist(BodyTwist::new(0.3, 2.0 * 0.3, 2.0), &mobil2);
-        assert_relative_eq!(t.linear.x, 0.3, epsilon = 1e-12);
-        assert_relative_eq!(t.angular.z, 0.3 / 0.73, epsilon = 1e-9);
-        assert_eq!(t.linear.y, 0.0);
-        // A feasible command passes unchanged.
-        let t = clamp_twist(BodyTwist::new(0.2, 0.0, 0.1), &mobil2);
-        assert_eq!((t.linear.x, t.linear.y, t.angular.z), (0.2, 0.0, 0.1));
-        // A turn in place is a stop on a car (v = 0 allows no ω).
-        let t = clamp_twist(BodyTwist::new(0.0, 0.0, 0.5), &mobil2);
-        assert_eq!((t.linear.x, t.angular.z), (0.0, 0.0));
-        // An omni with its reference point 0.2 m ahead: (0.5, 0, 0.25) at the reference point is
-        // (0.5, −0.05, 0.25) at the origin, |v| = 0.502494 > 0.5: the translation is scaled by
-        // s = 0.995037, ω (within 1.5) kept (the fastest wheel, at most (|v| + R·ω) / r =
-        // (0.5 + 0.05) / 0.05 = 11 < 12 rad/s, does not bind); back at the reference point
-        // vy = −0.05·s + 0.2·0.25 = 0.05·(1 − s) = 0.000248.
-        let omni = ChassisParams::new(ChassisConfig {
-            reference_offset: 0.2,
-            ..ChassisConfig::omr3()
-        })
-        .expect("valid");
-        let t = clamp_twist(BodyTwist::new(0.5, 0.0, 0.25), &omni);
-        let s = 0.5 / 0.5f64.hypot(0.05);
-        assert_relative_eq!(s, 0.995_037, epsilon = 1e-6);
-        assert_relative_eq!(t.linear.x, 0.5 * s, epsilon = 1e-9);
-        assert_relative_eq!(t.linear.y, 0.05 * (1.0 - s), epsilon = 1e-12);
-        assert_relative_eq!(t.angular.z, 0.25, epsilon = 1e-12);
-        // Non-finite → zero.
-        let t = clamp_twist(BodyTwist::new(f64::NAN, 0.0, 1.0), &omr3);
-        assert_eq!((t.linear.x, t.linear.y, t.angular.z), (0.0, 0.0, 0.0));
-        let t = clamp_twist(BodyTwist::new(0.1, 0.0, f64::INFINITY), &mobil2);
-        assert_eq!((t.linear.x, t.linear.y, t.angular.z), (0.0, 0.0, 0.0));
     }
 
     #[test]

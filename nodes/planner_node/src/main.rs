@@ -20,12 +20,12 @@
 //! ends, none between a goal and the newer one that replaces it and commands at its next step;
 //! a goal that must wait, a route's pre-check or a VFO segment's optimisation, stops the robot
 //! meanwhile). Every command is held to the chassis limits as chassis_node holds them
-//! ([`clamp_twist`]). A refused odometry message or step stops the robot. At shutdown with a
+//! ([`clamp_at_reference`]). A refused odometry message or step stops the robot. At shutdown with a
 //! goal that moved the robot, its zero command is the last one, waited for ([`final_stop`]);
 //! an idle node sends none.
 
 // The shell's modules (`shell::*`) take every name from here (`use crate::*`).
-use mobil_chassis::ChassisParams;
+use mobil_chassis::{clamp_at_reference, ChassisParams};
 use mobil_geom::Pose2;
 use mobil_motion::slot::{late_bound, ArrivalPeriod, Handback};
 use mobil_motion::{BodyTwist, GoalLaw, Step, StepInput};
@@ -49,12 +49,12 @@ use mobil_planner::vfo::{
 use mobil_planner::{check_route_until, Finish, RouteReport};
 use mobil_planner_node::vfo::WaypointMethod;
 use mobil_planner_node::{
-    check_reply, clamp_twist, dock_result, end_state, follow_result, load_world, markers, no_dock_database,
-    refused_reply, status_message, undock_result, vfo_follow_result, Action, GoalError, MarkerView, Missed,
-    PlannerConfig, Route, StatusView, ROUTE_LIMITS,
+    check_reply, dock_result, end_state, follow_result, load_world, markers, no_dock_database, refused_reply,
+    status_message, undock_result, vfo_follow_result, Action, GoalError, MarkerView, Missed, PlannerConfig, Route,
+    StatusView, ROUTE_LIMITS,
 };
 use mobil_ros::action::{goal_end, ActionEvent, GoalEnd, GoalRequest, GoalServer, GoalServerConfig};
-use mobil_ros::geometry::odom_pose;
+use mobil_ros::geometry::{odom_pose, twist_msg};
 use mobil_ros::goal::{goal_pose, pose_in_frame, route_from_path, route_from_poses};
 use mobil_ros::input::Inputs;
 use mobil_ros::latest::Latest;

@@ -385,5 +385,5 @@ impl Shell {
 
 /// Holds a law's body twist to the chassis limits, as a `cmd_vel`.
 pub(crate) fn limited(chassis: &ChassisParams) -> impl Fn(BodyTwist) -> Twist + '_ {
-    move |b| clamp_twist(b, chassis)
+    move |b| twist_msg(clamp_at_reference(chassis, b))
 }
