@@ -296,11 +296,7 @@ impl LocalNavConfig {
 
     /// The laser pose parameter as a pose; `None` when not set (or not finite).
     pub fn laser_pose(&self) -> Option<Pose2> {
-        let [x, y, yaw] = self.laser_pose.as_slice() else {
-            return None;
-        };
-        let p = Pose2::new(*x, *y, *yaw);
-        p.is_finite().then_some(p)
+        mobil_ros::scan::laser_pose_param(&self.laser_pose)
     }
 
     /// The scan timeout.

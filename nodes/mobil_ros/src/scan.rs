@@ -281,6 +281,15 @@ pub struct LaserMount<'a> {
     pub parameter: Option<Pose2>,
 }
 
+/// The `laser_pose` parameter (x, y, yaw in the base frame) as a pose: `None` unless it holds
+/// three finite values.
+pub fn laser_pose_param(values: &[f64]) -> Option<Pose2> {
+    match values {
+        [x, y, yaw] if x.is_finite() && y.is_finite() && yaw.is_finite() => Some(Pose2::new(*x, *y, *yaw)),
+        _ => None,
+    }
+}
+
 /// A LaserScan read at the edge: the checked scan in the base frame, where the laser is and
 /// whence its pose came.
 #[derive(Debug, Clone, PartialEq)]
@@ -493,7 +502,11 @@ mod tests {
             checked_scan(&frames, &mount, &msg, None),
             Err(ScanRefusal::NoLaserPose { .. })
         ));
-        mount.parameter = Some(Pose2::new(0.1, 0.0, 0.0));
+        assert_eq!(laser_pose_param(&[]), None);
+        assert_eq!(laser_pose_param(&[0.1, 0.0]), None);
+        assert_eq!(laser_pose_param(&[0.1, f64::NAN, 0.0]), None);
+        mount.parameter = laser_pose_param(&[0.1, 0.0, 0.0]);
+        assert_eq!(mount.parameter, Some(Pose2::new(0.1, 0.0, 0.0)));
         assert_eq!(
             checked_scan(&frames, &mount, &msg, None).unwrap().from,
             LaserPoseFrom::Parameter

@@ -120,10 +120,7 @@ impl VfoSettings {
 
     /// The laser's pose from `laser_pose` (`None` when empty or malformed).
     pub fn laser_pose(&self) -> Option<Pose2> {
-        match self.laser_pose.as_slice() {
-            [x, y, yaw] if x.is_finite() && y.is_finite() && yaw.is_finite() => Some(Pose2::new(*x, *y, *yaw)),
-            _ => None,
-        }
+        mobil_ros::scan::laser_pose_param(&self.laser_pose)
     }
 
     /// The scan timeout.
