@@ -115,9 +115,7 @@ impl Markers {
         width: f64,
         color: ColorRGBA,
     ) -> &mut Marker {
-        let m = self.add(ns, id, Marker::LINE_STRIP, [width; 3], color);
-        m.points = points.into_iter().map(point).collect();
-        m
+        self.with_points(ns, id, Marker::LINE_STRIP, [width; 3], color, points)
     }
 
     /// Segments between `points` taken in pairs, `width` wide.
@@ -129,9 +127,7 @@ impl Markers {
         width: f64,
         color: ColorRGBA,
     ) -> &mut Marker {
-        let m = self.add(ns, id, Marker::LINE_LIST, [width; 3], color);
-        m.points = points.into_iter().map(point).collect();
-        m
+        self.with_points(ns, id, Marker::LINE_LIST, [width; 3], color, points)
     }
 
     /// A dot of `diameter` at each of `points`.
@@ -143,7 +139,19 @@ impl Markers {
         diameter: f64,
         color: ColorRGBA,
     ) -> &mut Marker {
-        let m = self.add(ns, id, Marker::SPHERE_LIST, [diameter; 3], color);
+        self.with_points(ns, id, Marker::SPHERE_LIST, [diameter; 3], color, points)
+    }
+
+    fn with_points(
+        &mut self,
+        ns: &str,
+        id: i32,
+        kind: i32,
+        scale: [f64; 3],
+        color: ColorRGBA,
+        points: impl IntoIterator<Item = Point2<f64>>,
+    ) -> &mut Marker {
+        let m = self.add(ns, id, kind, scale, color);
         m.points = points.into_iter().map(point).collect();
         m
     }
