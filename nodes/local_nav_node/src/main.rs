@@ -33,12 +33,11 @@ use mobil_msgs::nav2_msgs::action::{NavigateToPose, NavigateToPoseFeedback, Navi
 use mobil_msgs::nav_msgs::msg::Odometry;
 use mobil_msgs::sensor_msgs::msg::LaserScan;
 use mobil_msgs::std_msgs::msg::Header;
-use mobil_msgs::visualization_msgs::msg::MarkerArray;
 use mobil_ros::action::{goal_end, ActionEvent, GoalRequest, GoalServer, GoalServerConfig};
 use mobil_ros::geometry::{odom_pose, twist_msg};
 use mobil_ros::input::Inputs;
 use mobil_ros::latest::Latest;
-use mobil_ros::motion::{Applied, CmdVel, EndCause, EndKind, Ended, MotionSession, SessionSettings, Watched};
+use mobil_ros::motion::{Applied, CmdVel, EndCause, EndKind, Ended, MotionSession, Outputs, SessionSettings, Watched};
 use mobil_ros::scan::{
     checked_scan, tf_static_subscription, CheckedScan, LaserMount, LaserPoseFrom, ScanRefusal, StaticFrames,
 };
@@ -47,7 +46,7 @@ use mobil_ros::ticker::Ticker;
 use mobil_ros::time::duration_msg;
 use mobil_ros::{qos, run_node, shutdown_signal, warn_throttled, ConfigError, LogThrottle, NodeDecl, RosNode};
 use nalgebra::Point2;
-use ros2_client::{Publisher, Subscription};
+use ros2_client::Subscription;
 use std::process::ExitCode;
 use std::time::{Duration, Instant};
 use tracing::{info, warn};
@@ -109,12 +108,6 @@ struct OdomSample {
     speed: f64,
 }
 
-struct Outputs {
-    cmd: Publisher<Twist>,
-    status: Publisher<NavStatus>,
-    markers: Publisher<MarkerArray>,
-}
-
 /// Everything the loop holds between events.
 struct Shell {
     config: LocalNavConfig,
@@ -146,11 +139,7 @@ enum Event {
 
 async fn serve(node: &mut RosNode) -> anyhow::Result<()> {
     let config: LocalNavConfig = node.config()?;
-    let outputs = Outputs {
-        cmd: node.publisher::<Twist>("cmd_vel", &qos::default_qos())?,
-        status: node.publisher::<NavStatus>("local_nav/status", &qos::latched())?,
-        markers: node.publisher::<MarkerArray>("local_nav/markers", &qos::default_qos())?,
-    };
+    let outputs = Outputs::create(node, "local_nav")?;
     let (outcome, final_zero) = run(node, &outputs, config).await;
     // A goal under way at the end gets its zero command, waited for; an idle node sends none
     // (another node, teleop or a twist_mux input, may be commanding the robot).

@@ -2,11 +2,34 @@
 
 use mobil_geom::Pose2;
 use mobil_motion::BodyTwist;
-use mobil_msgs::geometry_msgs::msg::Quaternion;
-use mobil_msgs::geometry_msgs::msg::Twist;
+use mobil_msgs::geometry_msgs::msg::{Point, Pose, PoseStamped, Quaternion, Twist};
 use mobil_msgs::nav_msgs::msg::Odometry;
 use mobil_msgs::std_msgs::msg::Header;
 use thiserror::Error;
+
+/// A planar pose as a message pose (z 0, the rotation about z).
+pub fn pose_msg(p: &Pose2) -> Pose {
+    Pose {
+        position: Point { x: p.x, y: p.y, z: 0.0 },
+        orientation: yaw_quaternion(p.yaw),
+    }
+}
+
+/// A planar pose with its header (a goal, a dock, a waypoint).
+pub fn pose_stamped(header: Header, p: &Pose2) -> PoseStamped {
+    PoseStamped {
+        header,
+        pose: pose_msg(p),
+    }
+}
+
+/// A header in `frame`, stamped zero (a test's message, a goal whose stamp does not matter).
+pub fn header_in(frame: &str) -> Header {
+    Header {
+        frame_id: frame.to_owned(),
+        ..Default::default()
+    }
+}
 
 /// A planar body twist as a `cmd_vel` Twist (linear.x, linear.y, angular.z; the rest zero).
 pub fn twist_msg(t: BodyTwist) -> Twist {

@@ -272,16 +272,11 @@ pub fn route_from_path(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::geometry::yaw_quaternion;
+    use crate::geometry::{header_in, pose_stamped, yaw_quaternion};
     use mobil_msgs::std_msgs::msg::Header;
 
     fn stamped(frame: &str, x: f64, y: f64) -> PoseStamped {
-        let mut g = PoseStamped::default();
-        g.header.frame_id = frame.into();
-        g.pose.position.x = x;
-        g.pose.position.y = y;
-        g.pose.orientation.w = 1.0;
-        g
+        pose_stamped(header_in(frame), &Pose2::new(x, y, 0.0))
     }
 
     const LIMITS: RouteLimits = RouteLimits {

@@ -49,6 +49,8 @@ use crate::time::{DtClock, DtError};
 use mobil_motion::{BodyTwist, End, Step};
 pub use mobil_motion::{EndCause, EndKind};
 use mobil_msgs::geometry_msgs::msg::Twist;
+use mobil_msgs::mobil_msgs::msg::NavStatus;
+use mobil_msgs::visualization_msgs::msg::MarkerArray;
 use ros2_client::Publisher;
 use std::time::{Duration, Instant};
 
@@ -109,6 +111,28 @@ impl Default for SessionSettings {
             max_dt: 0.1,
             max_refused_steps: 20,
         }
+    }
+}
+
+/// What a navigating motion node publishes: `cmd_vel`, its latched `<name>/status` (the last
+/// one reaches a late subscriber) and `<name>/markers`.
+pub struct Outputs {
+    /// The commands.
+    pub cmd: Publisher<Twist>,
+    /// The status.
+    pub status: Publisher<NavStatus>,
+    /// RViz markers.
+    pub markers: Publisher<MarkerArray>,
+}
+
+impl Outputs {
+    /// The three publishers of node `name` (`planner`, `local_nav`).
+    pub fn create(node: &mut crate::RosNode, name: &str) -> anyhow::Result<Self> {
+        Ok(Outputs {
+            cmd: node.publisher::<Twist>("cmd_vel", &crate::qos::default_qos())?,
+            status: node.publisher::<NavStatus>(&format!("{name}/status"), &crate::qos::latched())?,
+            markers: node.publisher::<MarkerArray>(&format!("{name}/markers"), &crate::qos::default_qos())?,
+        })
     }
 }
 

@@ -26,7 +26,7 @@ use mobil_planner::vfo::{SegmentReport, VfoDrawing, MAX_DRAWN_OBSTACLES, MAX_DRA
 use mobil_planner::{DockingConfig, DockingGains, FollowConfig, RouteCheckConfig, RouteReport};
 use mobil_ros::chassis::{chassis_params, declare_chassis};
 use mobil_ros::config::{Config, ConfigError, Decl};
-use mobil_ros::geometry::yaw_quaternion;
+use mobil_ros::geometry::pose_msg;
 use mobil_ros::goal::RouteLimits;
 pub use mobil_ros::goal::{GoalError, Route};
 use mobil_ros::groups::{Frames, GoalTimeouts};
@@ -282,13 +282,6 @@ fn missed_waypoint(index: usize, error_code: u16, poses: &[PoseStamped]) -> Miss
         index: u32::try_from(index).unwrap_or(u32::MAX),
         goal: poses.get(index).cloned().unwrap_or_default(),
         error_code,
-    }
-}
-
-fn pose_msg(p: &Pose2) -> Pose {
-    Pose {
-        position: point(p.position()),
-        orientation: yaw_quaternion(p.yaw),
     }
 }
 
@@ -552,16 +545,11 @@ mod tests {
     use mobil_motion::Outcome;
     use mobil_msgs::visualization_msgs::msg::Marker;
     use mobil_planner::ProblemKind;
-    use mobil_ros::geometry::yaw_of;
+    use mobil_ros::geometry::{header_in, pose_stamped, yaw_of};
     use mobil_ros::params::ParamValues;
 
     fn stamped(frame: &str, x: f64, y: f64) -> PoseStamped {
-        let mut g = PoseStamped::default();
-        g.header.frame_id = frame.into();
-        g.pose.position.x = x;
-        g.pose.position.y = y;
-        g.pose.orientation.w = 1.0;
-        g
+        pose_stamped(header_in(frame), &Pose2::new(x, y, 0.0))
     }
 
     #[test]

@@ -39,7 +39,6 @@ use mobil_msgs::nav2_msgs::action::{
 use mobil_msgs::nav_msgs::msg::{Odometry, Path};
 use mobil_msgs::sensor_msgs::msg::LaserScan;
 use mobil_msgs::tf2_msgs::msg::TFMessage;
-use mobil_msgs::visualization_msgs::msg::MarkerArray;
 use mobil_planner::goals::{route_infeasible, DockGoal, RouteEvent, UndockGoal};
 use mobil_planner::task::{PreCheck, Stepped, Task, VfoRun};
 use mobil_planner::vfo::{
@@ -58,7 +57,9 @@ use mobil_ros::geometry::{odom_pose, twist_msg};
 use mobil_ros::goal::{goal_pose, pose_in_frame, route_from_path, route_from_poses};
 use mobil_ros::input::Inputs;
 use mobil_ros::latest::Latest;
-use mobil_ros::motion::{Applied, CmdVel, EndCause, EndKind, Ended, GoalId, MotionSession, SessionSettings, Watched};
+use mobil_ros::motion::{
+    Applied, CmdVel, EndCause, EndKind, Ended, GoalId, MotionSession, Outputs, SessionSettings, Watched,
+};
 use mobil_ros::offloop::CancelToken;
 use mobil_ros::scan::{checked_scan, tf_static_subscription, LaserMount, StaticFrames};
 use mobil_ros::stop::{final_stop, FINAL_STOP_WAIT};
@@ -68,7 +69,7 @@ use mobil_ros::OffLoop;
 use mobil_ros::{qos, run_node, shutdown_signal, warn_throttled, ConfigError, LogThrottle, NodeDecl, RosNode};
 use mobil_world::World;
 use nalgebra::Point2;
-use ros2_client::{Publisher, RmwRequestId, Server, Subscription};
+use ros2_client::{RmwRequestId, Server, Subscription};
 use std::process::ExitCode;
 use std::sync::Arc;
 use std::time::{Duration, Instant};
@@ -157,12 +158,6 @@ struct Goal {
 
 type Session = MotionSession<Goal, Source>;
 type PlannerEnded = Ended<Goal, Source>;
-
-struct Outputs {
-    cmd: Publisher<Twist>,
-    status: Publisher<NavStatus>,
-    markers: Publisher<MarkerArray>,
-}
 
 struct Servers {
     dock: GoalServer<DockRobot>,
@@ -271,11 +266,7 @@ enum Event {
 
 async fn serve(node: &mut RosNode) -> anyhow::Result<()> {
     let config: PlannerConfig = node.config()?;
-    let outputs = Outputs {
-        cmd: node.publisher::<Twist>("cmd_vel", &qos::default_qos())?,
-        status: node.publisher::<NavStatus>("planner/status", &qos::latched())?,
-        markers: node.publisher::<MarkerArray>("planner/markers", &qos::default_qos())?,
-    };
+    let outputs = Outputs::create(node, "planner")?;
     start(node, &outputs, config).await?
 }
 

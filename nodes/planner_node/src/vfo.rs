@@ -262,19 +262,14 @@ mod tests {
     use mobil_msgs::visualization_msgs::msg::Marker;
     use mobil_planner::vfo::{DrawnRobot, Obstacle, SegmentReport, VfoDrawing, MAX_DRAWN_OBSTACLES};
     use mobil_ros::config::{load, Decl};
-    use mobil_ros::geometry::yaw_quaternion;
+    use mobil_ros::geometry::{header_in, pose_stamped};
     use mobil_ros::motion::EndCause;
     use mobil_ros::params::ParamValues;
     use nalgebra::Point2;
     use ros2_client::ParameterValue;
 
     fn pose(x: f64, y: f64, yaw: Option<f64>) -> PoseStamped {
-        let mut p = PoseStamped::default();
-        p.header.frame_id = "odom".into();
-        p.pose.position.x = x;
-        p.pose.position.y = y;
-        p.pose.orientation = yaw.map_or_else(|| yaw_quaternion(0.0), yaw_quaternion);
-        p
+        pose_stamped(header_in("odom"), &Pose2::new(x, y, yaw.unwrap_or(0.0)))
     }
 
     #[test]

@@ -14,6 +14,7 @@ use mobil_planner::vfo::{
 use mobil_planner::vfo::{vfo_gains, vfo_waypoints};
 use mobil_planner_node::vfo::VfoSettings;
 use mobil_planner_node::ROUTE_LIMITS;
+use mobil_ros::geometry::{header_in, pose_stamped};
 use mobil_ros::goal::route_from_poses;
 use mobil_sim::lidar::{Lidar, LidarConfig};
 use mobil_world::World;
@@ -43,14 +44,7 @@ fn drive(route: &[(f64, f64)], start: Pose2, scan_phase: usize, hold: usize, lag
     let world = World::builtin();
     let poses: Vec<PoseStamped> = route
         .iter()
-        .map(|&(x, y)| {
-            let mut p = PoseStamped::default();
-            p.header.frame_id = "odom".into();
-            p.pose.position.x = x;
-            p.pose.position.y = y;
-            p.pose.orientation.w = 1.0;
-            p
-        })
+        .map(|&(x, y)| pose_stamped(header_in("odom"), &Pose2::new(x, y, 0.0)))
         .collect();
     let route = route_from_poses(&poses, "odom", "odom", (0, 0), None, ROUTE_LIMITS).expect("valid route");
     let settings = VfoSettings {
@@ -190,10 +184,7 @@ fn an_obstacle_appearing_mid_segment_re_optimises_the_segment_round_it() {
     let mut world = World::builtin();
     let settings = VfoSettings::default();
     let start = Pose2::identity();
-    let mut p = PoseStamped::default();
-    p.header.frame_id = "odom".into();
-    p.pose.position.x = 3.5;
-    p.pose.orientation.w = 1.0;
+    let p = pose_stamped(header_in("odom"), &Pose2::new(3.5, 0.0, 0.0));
     let route =
         route_from_poses(&[p], "odom", "odom", (0, 0), Some(start.position()), ROUTE_LIMITS).expect("valid route");
     let waypoints = vfo_waypoints(&route.points, &route.headings(), &start, settings.guiding).expect("valid");

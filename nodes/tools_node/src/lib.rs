@@ -4,13 +4,14 @@
 //! in `odom` stamped now, a service client, a status read for `mobil_tools`.
 #![warn(missing_docs)]
 
+use mobil_geom::Pose2;
 use mobil_msgs::builtin_interfaces::msg::Time;
 use mobil_msgs::geometry_msgs::msg::PoseStamped;
 use mobil_msgs::mobil_msgs::msg::NavStatus;
 use mobil_msgs::nav_msgs::msg::Path;
 use mobil_msgs::std_msgs::msg::Header;
 use mobil_msgs::RosService;
-use mobil_ros::geometry::yaw_quaternion;
+use mobil_ros::geometry::pose_stamped;
 use mobil_ros::time::{nanos_from_stamp, stamp_from_nanos};
 use mobil_ros::{qos, RosNode};
 use mobil_tools::status::{GoalState, Status};
@@ -29,14 +30,7 @@ pub fn header_now(node: &RosNode) -> Header {
 
 /// The pose (x, y, yaw) in [`FRAME`], stamped now: a goal or a dock.
 pub fn pose_now(node: &RosNode, (x, y, yaw): (f64, f64, f64)) -> PoseStamped {
-    let mut p = PoseStamped {
-        header: header_now(node),
-        ..Default::default()
-    };
-    p.pose.position.x = x;
-    p.pose.position.y = y;
-    p.pose.orientation = yaw_quaternion(yaw);
-    p
+    pose_stamped(header_now(node), &Pose2::new(x, y, yaw))
 }
 
 /// A waypoint route in [`FRAME`], stamped now, every pose with the path's header and yaw 0.
