@@ -35,10 +35,11 @@ use mobil_msgs::builtin_interfaces::msg::Time;
 use mobil_msgs::geometry_msgs::msg::{Point, Pose, Pose2D, PoseStamped};
 use mobil_msgs::mobil_msgs::msg::{GaitPlan, GaitStep, TerrainAssessment};
 use mobil_msgs::mobil_msgs::srv::PlanGaitRequest;
-use mobil_msgs::std_msgs::msg::{ColorRGBA, Header};
+use mobil_msgs::std_msgs::msg::Header;
 use mobil_msgs::visualization_msgs::msg::{Marker, MarkerArray};
 use mobil_ros::config::{Config, ConfigError, Decl};
 use mobil_ros::geometry::yaw_quaternion;
+use mobil_ros::markers::{point, rgb, rgba, Markers};
 use nalgebra::Point2;
 use thiserror::Error;
 
@@ -742,34 +743,8 @@ pub fn goal_from_pose(m: &PoseStamped, frame: &str, unit_length: f64) -> Result<
     Ok(goal)
 }
 
-fn color(r: f32, g: f32, b: f32, a: f32) -> ColorRGBA {
-    ColorRGBA { r, g, b, a }
-}
-
-fn marker(header: &Header, id: i32, kind: i32, scale: f64, c: ColorRGBA) -> Marker {
-    let mut m = Marker {
-        header: header.clone(),
-        ns: "gait".into(),
-        id,
-        r#type: kind,
-        action: Marker::ADD,
-        color: c,
-        ..Marker::default()
-    };
-    m.pose.orientation = yaw_quaternion(0.0);
-    m.scale.x = scale;
-    m.scale.y = scale;
-    m.scale.z = scale;
-    m
-}
-
-fn metres(p: Point2<f64>, unit: f64) -> Point {
-    Point {
-        x: p.x * unit,
-        y: p.y * unit,
-        z: 0.0,
-    }
-}
+/// The namespace of every gait marker.
+const NS: &str = "gait";
 
 /// The body's outline: its four corners (the hips) and the first again, in the world \[j\].
 pub fn body_outline(model: &QuadrupedModel, body: &BodyPose) -> [Point2<f64>; 5] {
@@ -787,9 +762,9 @@ pub fn support_triangle(state: &GaitState, leg: usize) -> Vec<Point2<f64>> {
     t
 }
 
-/// Markers of the walk in `header`'s frame (metres, `unit` m per \[j\]): a DELETEALL, then the
-/// body outline (0), the feet (1), the support triangle of the move just made if it moved a
-/// leg (2), the planned body path (3) and the goal (4).
+/// Markers of the walk in `header`'s frame (metres, `unit` m per \[j\]), all in the namespace
+/// `gait`: a DELETEALL of it, then the body outline (0), the feet (1), the support triangle of
+/// the move just made if it moved a leg (2), the planned body path (3) and the goal (4).
 pub fn markers(
     model: &QuadrupedModel,
     state: &GaitState,
@@ -800,40 +775,25 @@ pub fn markers(
     unit: f64,
 ) -> MarkerArray {
     let line = 0.02 * unit;
-    let mut out = vec![Marker {
-        header: header.clone(),
-        ns: "gait".into(),
-        action: Marker::DELETEALL,
-        ..Marker::default()
-    }];
-    let mut body = marker(header, 0, Marker::LINE_STRIP, line * 2.0, color(0.2, 0.2, 0.2, 1.0));
-    body.points = body_outline(model, &state.body)
-        .iter()
-        .map(|&p| metres(p, unit))
-        .collect();
-    out.push(body);
-    let mut feet = marker(header, 1, Marker::SPHERE_LIST, 0.15 * unit, color(0.0, 0.35, 0.71, 1.0));
-    feet.points = state.feet.iter().map(|&p| metres(p, unit)).collect();
-    out.push(feet);
+    let metres = |p: Point2<f64>| p * unit;
+    let mut m = Markers::new(header.stamp.clone(), &header.frame_id);
+    // A DELETEALL of this namespace only (RViz 2 scopes a DELETEALL that names one).
+    m.add(NS, 0, Marker::ARROW, [0.0; 3], rgba(0.0, 0.0, 0.0, 0.0)).action = Marker::DELETEALL;
+    let outline = body_outline(model, &state.body).map(metres);
+    m.line_strip(NS, 0, outline, line * 2.0, rgb(0.2, 0.2, 0.2));
+    m.dots(NS, 1, state.feet.map(metres), 0.15 * unit, rgb(0.0, 0.35, 0.71));
     if let Some(leg) = current.and_then(|s| s.rule).and_then(|r| r.moving_leg()) {
-        let mut tri = marker(header, 2, Marker::LINE_STRIP, line * 1.5, color(0.9, 0.62, 0.0, 1.0));
-        tri.points = support_triangle(state, leg)
-            .into_iter()
-            .map(|p| metres(p, unit))
-            .collect();
-        out.push(tri);
+        let triangle = support_triangle(state, leg).into_iter().map(metres);
+        m.line_strip(NS, 2, triangle, line * 1.5, rgb(0.9, 0.62, 0.0));
     }
     if plan.len() >= 2 {
-        let mut path = marker(header, 3, Marker::LINE_STRIP, line, color(0.0, 0.6, 0.3, 1.0));
-        path.points = plan.iter().map(|s| metres(s.state.body.centre(), unit)).collect();
-        out.push(path);
+        let path = plan.iter().map(|s| metres(s.state.body.centre()));
+        m.line_strip(NS, 3, path, line, rgb(0.0, 0.6, 0.3));
     }
     if let Some(g) = goal {
-        let mut m = marker(header, 4, Marker::SPHERE, 0.3 * unit, color(0.8, 0.1, 0.1, 1.0));
-        m.pose.position = metres(g, unit);
-        out.push(m);
+        m.sphere(NS, 4, metres(g), 0.3 * unit, rgb(0.8, 0.1, 0.1));
     }
-    MarkerArray { markers: out }
+    m.array()
 }
 
 /// The simulated body as a pose in `header`'s frame (metres; orientation: the body's φ).
@@ -841,7 +801,7 @@ pub fn body_pose(body: &BodyPose, header: Header, unit: f64) -> PoseStamped {
     PoseStamped {
         header,
         pose: Pose {
-            position: metres(body.centre(), unit),
+            position: point(body.centre() * unit),
             orientation: yaw_quaternion(body.phi),
         },
     }

@@ -381,6 +381,36 @@ fn markers_draw_the_body_feet_support_triangle_path_and_goal_in_metres() {
         (-20.0, 20.0)
     );
     assert!(array.markers.iter().all(|m| m.header.frame_id == "odom"));
+    // One namespace, its DELETEALL included; every added marker unrotated.
+    assert!(array.markers.iter().all(|m| m.ns == "gait"));
+    assert!(array.markers[1..]
+        .iter()
+        .all(|m| m.action == Marker::ADD && m.pose.orientation.w == 1.0 && m.pose.orientation.z == 0.0));
+    // Sizes scale with the unit (lines 0.02 m per [j]: the outline twice, the triangle 1.5 times),
+    // each marker in its colour, opaque.
+    let sizes = [0.08, 0.3, 0.06, 0.04, 0.6];
+    let colours = [
+        (0.2, 0.2, 0.2),
+        (0.0, 0.35, 0.71),
+        (0.9, 0.62, 0.0),
+        (0.0, 0.6, 0.3),
+        (0.8, 0.1, 0.1),
+    ];
+    for ((m, size), (r, g, b)) in array.markers[1..].iter().zip(sizes).zip(colours) {
+        let s = &m.scale;
+        assert!(
+            [s.x, s.y, s.z].iter().all(|v| (v - size).abs() < 1e-12),
+            "{}: {s:?}",
+            m.id
+        );
+        assert_eq!((m.color.r, m.color.g, m.color.b, m.color.a), (r, g, b, 1.0), "{}", m.id);
+    }
+    // The feet and the path in metres.
+    let feet: Vec<(f64, f64, f64)> = array.markers[2].points.iter().map(|p| (p.x, p.y, p.z)).collect();
+    let expected: Vec<(f64, f64, f64)> = state.feet.iter().map(|f| (f.x * unit, f.y * unit, 0.0)).collect();
+    assert_eq!(feet, expected);
+    let path: Vec<(f64, f64)> = array.markers[4].points.iter().map(|p| (p.x, p.y)).collect();
+    assert_eq!(path, vec![(2.0, 4.0), (2.0, 4.0)]);
     // A body move draws no support triangle.
     let array = markers(&model, &state, Some(&plan[0]), &plan, None, &h, 1.0);
     assert!(array.markers.iter().all(|m| m.id != 2 || m.action == Marker::DELETEALL));

@@ -30,12 +30,12 @@
 pub mod hexapod_sim;
 
 use mobil_msgs::builtin_interfaces::msg::Time;
-use mobil_msgs::geometry_msgs::msg::{Point, Vector3};
+use mobil_msgs::geometry_msgs::msg::Point;
 use mobil_msgs::mobil_msgs::msg::{FootTouchdown, PlaneTilt as PlaneTiltMsg, TerrainAssessment};
-use mobil_msgs::std_msgs::msg::{ColorRGBA, Header};
+use mobil_msgs::std_msgs::msg::Header;
 use mobil_msgs::visualization_msgs::msg::{Marker, MarkerArray};
 use mobil_ros::config::{Config, ConfigError, Decl};
-use mobil_ros::geometry::yaw_quaternion;
+use mobil_ros::markers::{rgb, rgba, Markers};
 use mobil_terrain::{Assessment, Assessor, FootTracker, Leg, PlaneTilt, TerrainConfig, TerrainError};
 use nalgebra::{Point3, Vector3 as V3};
 use thiserror::Error;
@@ -336,28 +336,8 @@ pub fn assessment_message(a: &Assessment, stamp: Time, frame: &str, rejected: u3
     }
 }
 
-fn color(r: f32, g: f32, b: f32, a: f32) -> ColorRGBA {
-    ColorRGBA { r, g, b, a }
-}
-
-fn marker(header: &Header, id: i32, kind: i32, scale: [f64; 3], c: ColorRGBA) -> Marker {
-    let mut m = Marker {
-        header: header.clone(),
-        ns: "terrain".into(),
-        id,
-        r#type: kind,
-        action: Marker::ADD,
-        color: c,
-        scale: Vector3 {
-            x: scale[0],
-            y: scale[1],
-            z: scale[2],
-        },
-        ..Default::default()
-    };
-    m.pose.orientation = yaw_quaternion(0.0);
-    m
-}
+/// The namespace of every terrain marker.
+const NS: &str = "terrain";
 
 /// Length of the drawn normals (m).
 pub const NORMAL_LENGTH: f64 = 0.08;
@@ -367,50 +347,38 @@ pub const NORMAL_LENGTH: f64 = 0.08;
 /// as arrows of [`NORMAL_LENGTH`] from each triangle's centroid (ids 3–5), and the six feet as
 /// spheres (id 6: tripod A blue, tripod B orange). Seven markers, 21 points: about 2 KB.
 pub fn markers(a: &Assessment, body_points: &[Point3<f64>; 3], stamp: Time, frame: &str) -> MarkerArray {
-    let header = Header {
-        stamp,
-        frame_id: frame.to_owned(),
-    };
+    let mut m = Markers::new(stamp, frame);
     let foot = |leg: Leg| a.feet[leg.index()];
     let triangles = [Leg::PLANE1.map(foot), Leg::PLANE2.map(foot), *body_points];
-    let colors = [
-        color(0.0, 0.35, 0.71, 0.5),
-        color(0.9, 0.62, 0.0, 0.5),
-        color(0.6, 0.6, 0.6, 0.5),
-    ];
-    let mut out = Vec::with_capacity(7);
+    let blue = |alpha| rgba(0.0, 0.35, 0.71, alpha);
+    let orange = |alpha| rgba(0.9, 0.62, 0.0, alpha);
+    let colors = [blue(0.5), orange(0.5), rgba(0.6, 0.6, 0.6, 0.5)];
+    // Markers' line and dot builders take points of the plane; these are in 3D, so each marker
+    // is added bare and given its points.
     for (i, (tri, c)) in triangles.iter().zip(&colors).enumerate() {
-        let mut m = marker(&header, i as i32, Marker::TRIANGLE_LIST, [1.0; 3], c.clone());
-        m.points = tri.iter().map(point).collect();
-        out.push(m);
+        let triangle = m.add(NS, i as i32, Marker::TRIANGLE_LIST, [1.0; 3], c.clone());
+        triangle.points = tri.iter().map(point).collect();
     }
     for (i, (tri, c)) in triangles.iter().zip(colors).enumerate() {
         let centroid = Point3::from((tri[0].coords + tri[1].coords + tri[2].coords) / 3.0);
         let n: V3<f64> = a.planes[i].normal();
-        let mut m = marker(
-            &header,
-            3 + i as i32,
-            Marker::ARROW,
-            [0.006, 0.012, 0.015],
-            color(c.r, c.g, c.b, 1.0),
-        );
-        m.points = vec![point(&centroid), point(&(centroid + n * NORMAL_LENGTH))];
-        out.push(m);
+        let opaque = rgb(c.r, c.g, c.b);
+        let arrow = m.add(NS, 3 + i as i32, Marker::ARROW, [0.006, 0.012, 0.015], opaque);
+        arrow.points = vec![point(&centroid), point(&(centroid + n * NORMAL_LENGTH))];
     }
-    let mut feet = marker(&header, 6, Marker::SPHERE_LIST, [0.02; 3], color(1.0, 1.0, 1.0, 1.0));
+    let feet = m.add(NS, 6, Marker::SPHERE_LIST, [0.02; 3], rgb(1.0, 1.0, 1.0));
     feet.points = a.feet.iter().map(point).collect();
     feet.colors = Leg::ALL
         .iter()
         .map(|l| {
             if Leg::PLANE1.contains(l) {
-                color(0.0, 0.35, 0.71, 1.0)
+                blue(1.0)
             } else {
-                color(0.9, 0.62, 0.0, 1.0)
+                orange(1.0)
             }
         })
         .collect();
-    out.push(feet);
-    MarkerArray { markers: out }
+    m.array()
 }
 
 #[cfg(test)]
@@ -667,6 +635,41 @@ mod tests {
         assert!((n.points[1].z - (-0.10 + NORMAL_LENGTH)).abs() < 1e-15);
         assert_eq!(m.markers[6].points.len(), 6);
         assert!(m.markers.iter().all(|k| k.header.frame_id == "base_link"));
+        // One namespace, ids 0–6 in order, all added unrotated.
+        let ids: Vec<i32> = m.markers.iter().map(|k| k.id).collect();
+        assert_eq!(ids, (0..7).collect::<Vec<_>>());
+        assert!(m.markers.iter().all(|k| k.ns == "terrain"
+            && k.action == Marker::ADD
+            && (k.pose.orientation.z, k.pose.orientation.w) == (0.0, 1.0)));
+        // The triangles half transparent, their normals the same colour opaque.
+        let rgb_of = |k: &Marker| (k.color.r, k.color.g, k.color.b);
+        let colours = [(0.0, 0.35, 0.71), (0.9, 0.62, 0.0), (0.6, 0.6, 0.6)];
+        for (i, c) in colours.into_iter().enumerate() {
+            let (tri, normal) = (&m.markers[i], &m.markers[3 + i]);
+            assert_eq!((rgb_of(tri), tri.color.a, tri.points.len()), (c, 0.5, 3));
+            assert_eq!((rgb_of(normal), normal.color.a, normal.points.len()), (c, 1.0, 2));
+            assert_eq!((tri.scale.x, tri.scale.y, tri.scale.z), (1.0, 1.0, 1.0));
+            assert_eq!((normal.scale.x, normal.scale.y, normal.scale.z), (0.006, 0.012, 0.015));
+        }
+        // Plane 3's triangle is the body points.
+        let third: Vec<Point3<f64>> = m.markers[2].points.iter().map(|p| Point3::new(p.x, p.y, p.z)).collect();
+        assert_eq!(third, body.to_vec());
+        // The feet: 2 cm spheres, where they stand, tripod A blue and tripod B orange.
+        let feet = &m.markers[6];
+        assert_eq!(
+            (feet.r#type, feet.scale.x, feet.scale.z),
+            (Marker::SPHERE_LIST, 0.02, 0.02)
+        );
+        assert_eq!(feet.points, a.feet.map(|p| point(&p)).to_vec());
+        for (leg, c) in Leg::ALL.iter().zip(&feet.colors) {
+            let tripod = if Leg::PLANE1.contains(leg) {
+                (0.0, 0.35, 0.71)
+            } else {
+                (0.9, 0.62, 0.0)
+            };
+            assert_eq!((c.r, c.g, c.b, c.a), (tripod.0, tripod.1, tripod.2, 1.0), "{leg:?}");
+        }
+        assert_eq!(feet.colors.len(), 6);
     }
 
     /// The walker's first touchdowns, turned into messages and fed back: the node's own check
