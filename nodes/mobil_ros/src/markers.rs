@@ -65,7 +65,9 @@ impl Markers {
         }
     }
 
-    /// Markers that replace everything drawn before: a DELETEALL first, so nothing stale stays.
+    /// Markers that replace everything drawn before: a DELETEALL with no namespace first (RViz 2
+    /// then clears every marker its display got from the topic, of any namespace; one with a
+    /// namespace clears only that one), so nothing stale stays.
     pub fn replacing(stamp: Time, frame: &str) -> Self {
         let mut m = Markers::new(stamp, frame);
         m.add("", 0, Marker::SPHERE, [0.0; 3], rgb(0.0, 0.0, 0.0)).action = Marker::DELETEALL;
