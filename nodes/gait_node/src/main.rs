@@ -24,7 +24,9 @@ use mobil_msgs::mobil_msgs::msg::{GaitPlan, TerrainAssessment};
 use mobil_msgs::mobil_msgs::srv::{PlanGait, PlanGaitRequest, PlanGaitResponse};
 use mobil_msgs::visualization_msgs::msg::MarkerArray;
 use mobil_ros::input::Inputs;
-use mobil_ros::{qos, run_node, shutdown_signal, warn_throttled, ConfigError, LogThrottle, NodeDecl, OffLoop, RosNode};
+use mobil_ros::{
+    qos, respond, run_node, shutdown_signal, warn_throttled, ConfigError, LogThrottle, NodeDecl, OffLoop, RosNode,
+};
 use ros2_client::{Publisher, RmwRequestId, Server};
 use std::process::ExitCode;
 use std::time::{Duration, Instant};
@@ -48,6 +50,9 @@ struct Outputs {
     markers: Publisher<MarkerArray>,
     body: Publisher<PoseStamped>,
 }
+
+/// The planning service.
+const COMPUTE_PLAN: &str = "gait/compute_plan";
 
 /// A finished `gait/compute_plan` search, its reply built off the loop (a long plan is
 /// truncated there), the header left to stamp.
@@ -106,7 +111,7 @@ async fn serve(node: &mut RosNode) -> anyhow::Result<()> {
         markers: node.publisher::<MarkerArray>("gait/markers", &qos::default_qos())?,
         body: node.publisher::<PoseStamped>("gait/body", &qos::default_qos())?,
     };
-    let service = node.service::<PlanGait>("gait/compute_plan")?;
+    let service = node.service::<PlanGait>(COMPUTE_PLAN)?;
     let goal_sub = node.subscription::<PoseStamped>("goal_pose", &qos::default_qos())?;
     let terrain_sub = node.subscription::<TerrainAssessment>("terrain/assessment", &qos::latched())?;
     let mut shell = Shell {
@@ -131,7 +136,7 @@ async fn serve(node: &mut RosNode) -> anyhow::Result<()> {
     let mut walk: OffLoop<Chunked> = OffLoop::new();
     let mut inputs = Inputs::new();
     inputs
-        .add_requests(service.receive_request_stream(), "gait/compute_plan", Event::Request)
+        .add_requests(service.receive_request_stream(), COMPUTE_PLAN, Event::Request)
         // An undecodable goal stops the walk where it is, as a refused one does.
         .add_guarded(
             goal_sub.async_stream(),
@@ -201,7 +206,13 @@ async fn serve(node: &mut RosNode) -> anyhow::Result<()> {
     walk.cancel();
     if let Some(r) = shell.running.take() {
         let reply = refused_plan(&r.request, header(node.stamp(), ""), "shutting down".into());
-        respond(&service, r.id, reply, &mut shell.throttle);
+        respond(
+            &service,
+            r.id,
+            PlanGaitResponse { plan: reply },
+            COMPUTE_PLAN,
+            &mut shell.throttle,
+        );
     }
     Ok(())
 }
@@ -211,17 +222,6 @@ async fn sleep_until(at: Option<Instant>) {
     match at {
         Some(t) => tokio::time::sleep_until(t.into()).await,
         None => std::future::pending().await,
-    }
-}
-
-fn respond(
-    service: &Server<PlanGaitRequest, PlanGaitResponse>,
-    id: RmwRequestId,
-    plan: GaitPlan,
-    throttle: &mut LogThrottle,
-) {
-    if let Err(e) = service.send_response(id, PlanGaitResponse { plan }) {
-        warn_throttled!(throttle, "reply", "gait/compute_plan: cannot send the reply: {e:?}");
     }
 }
 
@@ -244,21 +244,19 @@ impl Shell {
             Ok(q) => q,
             Err(why) => {
                 warn_throttled!(self.throttle, "refused", "gait/compute_plan refused: {why}");
-                respond(
-                    service,
-                    id,
-                    refused_plan(&req, header(node.stamp(), ""), why.to_string()),
-                    &mut self.throttle,
-                );
+                let plan = refused_plan(&req, header(node.stamp(), ""), why.to_string());
+                respond(service, id, PlanGaitResponse { plan }, COMPUTE_PLAN, &mut self.throttle);
                 return;
             }
         };
         if let Some(old) = self.running.take() {
             info!("gait/compute_plan: a newer request pre-empts the running search");
+            let plan = refused_plan(&old.request, header(node.stamp(), ""), PREEMPTED.into());
             respond(
                 service,
                 old.id,
-                refused_plan(&old.request, header(node.stamp(), ""), PREEMPTED.into()),
+                PlanGaitResponse { plan },
+                COMPUTE_PLAN,
                 &mut self.throttle,
             );
         }
@@ -319,7 +317,13 @@ impl Shell {
             }
         );
         msg.header = header(node.stamp(), "");
-        respond(service, done.id, msg, &mut self.throttle);
+        respond(
+            service,
+            done.id,
+            PlanGaitResponse { plan: msg },
+            COMPUTE_PLAN,
+            &mut self.throttle,
+        );
     }
 
     fn goal(&mut self, node: &RosNode, out: &Outputs, walk: &mut OffLoop<Chunked>, m: &PoseStamped) {

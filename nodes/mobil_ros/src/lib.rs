@@ -65,7 +65,7 @@ pub use args::RosArgs;
 pub use config::{Config, ConfigError, Decl};
 pub use latest::{Freshness, Latest};
 pub use log::LogThrottle;
-pub use node::{run_node, shutdown_signal, NodeBody, NodeDecl, RosNode};
+pub use node::{respond, run_node, shutdown_signal, NodeBody, NodeDecl, RosNode};
 pub use offloop::{CancelToken, OffLoop};
 pub use params::{ParamSpec, ParamValues};
 pub use ticker::Ticker;

@@ -26,8 +26,8 @@ use mobil_msgs::builtin_interfaces::msg::Time;
 use mobil_msgs::rosgraph_msgs::msg::Clock;
 use mobil_msgs::{RosMessage, RosService};
 use ros2_client::{
-    Context, ContextOptions, Name, Node, NodeName, NodeOptions, ParameterValue, Publisher, QosProfile, Server,
-    ServiceMapping, Subscription,
+    Context, ContextOptions, Name, Node, NodeName, NodeOptions, ParameterValue, Publisher, QosProfile, RmwRequestId,
+    Server, ServiceMapping, Subscription,
 };
 use std::fmt::Write as _;
 use std::sync::atomic::{AtomicI64, Ordering};
@@ -516,5 +516,18 @@ where
             tracing::error!("{e:#}");
             std::process::ExitCode::FAILURE
         }
+    }
+}
+/// Sends `reply` to request `id` of `server` (`service` names it in the log): a reply that
+/// cannot be sent (the client gone) is a rate-limited warning, never an error of the node.
+pub fn respond<Q: ros2_client::Message + 'static, P: ros2_client::Message + 'static>(
+    server: &Server<Q, P>,
+    id: RmwRequestId,
+    reply: P,
+    service: &str,
+    throttle: &mut crate::LogThrottle,
+) {
+    if let Err(e) = server.send_response(id, reply) {
+        crate::warn_throttled!(throttle, "service-reply", "{service}: cannot send the reply: {e:?}");
     }
 }

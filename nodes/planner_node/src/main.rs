@@ -66,7 +66,7 @@ use mobil_ros::stop::{final_stop, FINAL_STOP_WAIT};
 use mobil_ros::ticker::Ticker;
 use mobil_ros::time::{duration_msg, secs_from_stamp, DtError};
 use mobil_ros::OffLoop;
-use mobil_ros::{qos, run_node, shutdown_signal, warn_throttled, ConfigError, LogThrottle, NodeDecl, RosNode};
+use mobil_ros::{qos, respond, run_node, shutdown_signal, warn_throttled, ConfigError, LogThrottle, NodeDecl, RosNode};
 use mobil_world::World;
 use nalgebra::Point2;
 use ros2_client::{RmwRequestId, Server, Subscription};
@@ -75,6 +75,9 @@ use std::sync::Arc;
 use std::time::{Duration, Instant};
 use tokio::sync::mpsc;
 use tracing::{info, warn};
+
+/// The route-check service.
+const CHECK_ROUTE: &str = "planner/check_route";
 
 /// The watchdog tick (steady clock): stale odometry is noticed within 50 ms of its timeout.
 const WATCHDOG_RATE_HZ: f64 = 20.0;
@@ -99,9 +102,8 @@ mod shell {
     mod goals;
     mod routes;
     pub(crate) use actions::follow_answer;
-    pub(crate) use check::respond;
 }
-use shell::{follow_answer, respond};
+use shell::follow_answer;
 
 /// Where the active goal came from.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -286,7 +288,7 @@ async fn start(node: &mut RosNode, out: &Outputs, config: PlannerConfig) -> anyh
     let tf_sub = tf_static_subscription(node)?;
     let map = ObstacleMap::new(config.vfo.scan_config(config.robot_radius))
         .map_err(|e| anyhow::anyhow!("vfo obstacle extraction: {e}"))?;
-    let check = node.service::<CheckRoute>("planner/check_route")?;
+    let check = node.service::<CheckRoute>(CHECK_ROUTE)?;
     let server_config = GoalServerConfig {
         result_timeout: config.timeouts.result_timeout(),
     };
@@ -467,7 +469,7 @@ async fn event_loop(
             Event::Check(id, req) => shell.check_in(io.node, jobs, check, id, &req),
             Event::Checked(id, reply) => {
                 jobs.pending = jobs.pending.saturating_sub(1);
-                respond(check, id, reply, &mut shell.throttle);
+                respond(check, id, reply, CHECK_ROUTE, &mut shell.throttle);
             }
             Event::RouteChecked(done) => shell.pre_checked(&mut io, done),
             Event::Tick => shell.tick(&mut io).await,

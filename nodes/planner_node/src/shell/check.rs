@@ -14,13 +14,13 @@ impl Shell {
         req: &CheckRouteRequest,
     ) {
         let (start, route) = match self.check_request(req) {
-            Err(reply) => return respond(check, id, reply, &mut self.throttle),
+            Err(reply) => return respond(check, id, reply, CHECK_ROUTE, &mut self.throttle),
             Ok(_) if jobs.pending + 1 >= MAX_CHECKS => {
                 let reply = refused_reply(format!(
                     "BUSY: {} route checks are already being computed; ask again",
                     jobs.pending
                 ));
-                return respond(check, id, reply, &mut self.throttle);
+                return respond(check, id, reply, CHECK_ROUTE, &mut self.throttle);
             }
             Ok(checked) => checked,
         };
@@ -70,20 +70,5 @@ impl Shell {
         let route = route_from_path(&req.route, frame, Some(start.position()), ROUTE_LIMITS)
             .map_err(|e| refused_reply(Action::Follow.invalid_goal(&e).reason()))?;
         Ok((start, route))
-    }
-}
-
-pub(crate) fn respond(
-    check: &Server<CheckRouteRequest, CheckRouteResponse>,
-    id: RmwRequestId,
-    reply: CheckRouteResponse,
-    throttle: &mut LogThrottle,
-) {
-    if let Err(e) = check.send_response(id, reply) {
-        warn_throttled!(
-            throttle,
-            "check-reply",
-            "planner/check_route: cannot send the reply: {e:?}"
-        );
     }
 }
