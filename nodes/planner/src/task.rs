@@ -131,6 +131,12 @@ impl VfoRun {
         self.slot.max_delay()
     }
 
+    /// Whether the law has a map change to take at its next step (`Some(true)`: with new
+    /// obstacles, which re-optimise the segment).
+    pub fn map_pending(&self) -> Option<bool> {
+        self.map_changed
+    }
+
     /// The obstacle map changed (`new_obstacles`: with obstacles it had not got); the law takes
     /// the map at its next step. A change with new obstacles stays one until the law took it.
     pub fn map_updated(&mut self, new_obstacles: bool) {

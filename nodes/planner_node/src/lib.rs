@@ -598,6 +598,8 @@ mod tests {
         assert_eq!(end_state(&stale), NavStatus::FAILED);
         assert_eq!(undock_result(&stale).error_code, 905);
         assert_eq!(dock_result(&EndCause::Shutdown).error_code, 999);
+        assert_eq!(follow_result(&EndCause::Shutdown, &[], &[]).error_code, 600);
+        assert_eq!(follow_result(&stale, &[], &[]).error_code, 601);
         assert!(undock_result(&EndCause::Outcome(Outcome::succeeded("undocked"))).success);
         let nan = GoalError::NotFinite {
             what: "dock pose".into(),
