@@ -52,7 +52,7 @@ use mobil_planner_node::{
     status_message, undock_result, vfo_follow_result, Action, GoalError, MarkerView, Missed, PlannerConfig, Route,
     StatusView, ROUTE_LIMITS,
 };
-use mobil_ros::action::{goal_end, ActionEvent, GoalEnd, GoalRequest, GoalServer, GoalServerConfig};
+use mobil_ros::action::{goal_end, ActionEvent, GoalRequest, GoalServer, GoalServerConfig};
 use mobil_ros::geometry::{odom_pose, twist_msg};
 use mobil_ros::goal::{goal_pose, pose_in_frame, route_from_path, route_from_poses};
 use mobil_ros::input::Inputs;
@@ -101,9 +101,7 @@ mod shell {
     mod check;
     mod goals;
     mod routes;
-    pub(crate) use actions::follow_answer;
 }
-use shell::follow_answer;
 
 /// Where the active goal came from.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

@@ -106,7 +106,7 @@ impl Shell {
 /// FollowWaypoints' result for a goal ending with `cause`: the waypoints missed so far (the
 /// pre-check's problems for a route it refused; a VFO route: those not reached), the request's
 /// poses.
-pub(crate) fn follow_answer(goal: &Goal, cause: &EndCause) -> FollowWaypointsResult {
+fn follow_answer(goal: &Goal, cause: &EndCause) -> FollowWaypointsResult {
     let Some(route) = &goal.route else {
         return follow_result(cause, &[], &[]);
     };
@@ -115,5 +115,27 @@ pub(crate) fn follow_answer(goal: &Goal, cause: &EndCause) -> FollowWaypointsRes
         Task::Vfo(v) => vfo_follow_result(cause, &route.poses, &route.unreached_from(v.view().index)),
         Task::PreCheck(p) => follow_result(cause, &route.poses, &p.problems),
         Task::Dock(_) | Task::Undock(_) => follow_result(cause, &[], &[]),
+    }
+}
+
+impl Servers {
+    /// Ends the goal of action `source` (nothing for a topic) with `cause`: its status and
+    /// result; `goal`, the goal that ended (none: refused before it started), lists the
+    /// waypoints a route missed.
+    pub(crate) fn finish(&mut self, source: Source, cause: &EndCause, goal: Option<&Goal>) {
+        let end = goal_end(cause);
+        match source {
+            Source::DockAction => {
+                self.dock.finish(end, dock_result(cause));
+            }
+            Source::UndockAction => {
+                self.undock.finish(end, undock_result(cause));
+            }
+            Source::FollowAction => {
+                let result = goal.map_or_else(|| follow_result(cause, &[], &[]), |g| follow_answer(g, cause));
+                self.follow.finish(end, result);
+            }
+            Source::DockPose | Source::Waypoints => {}
+        }
     }
 }

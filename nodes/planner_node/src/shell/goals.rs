@@ -99,19 +99,7 @@ impl Shell {
         } = ended;
         goal.stop.cancel();
         if finish_action {
-            let end = goal_end(&cause);
-            match source {
-                Source::DockAction => {
-                    io.servers.dock.finish(end, dock_result(&cause));
-                }
-                Source::UndockAction => {
-                    io.servers.undock.finish(end, undock_result(&cause));
-                }
-                Source::FollowAction => {
-                    io.servers.follow.finish(end, follow_answer(&goal, &cause));
-                }
-                Source::DockPose | Source::Waypoints => {}
-            }
+            io.servers.finish(source, &cause, Some(&goal));
         }
         let reason = cause.reason();
         match (cause.kind(), &cause) {
@@ -162,20 +150,7 @@ impl Shell {
         }
         let cause = EndCause::Outcome(refusal);
         warn!("goal ({}) refused: {}", source.name(), cause.reason());
-        match source {
-            Source::DockAction => {
-                io.servers.dock.finish(GoalEnd::Aborted, dock_result(&cause));
-            }
-            Source::UndockAction => {
-                io.servers.undock.finish(GoalEnd::Aborted, undock_result(&cause));
-            }
-            Source::FollowAction => {
-                io.servers
-                    .follow
-                    .finish(GoalEnd::Aborted, follow_result(&cause, &[], &[]));
-            }
-            Source::DockPose | Source::Waypoints => {}
-        }
+        io.servers.finish(source, &cause, None);
         let view = self.status_view(None, NavStatus::FAILED, cause.reason());
         self.send_status(io.node, io.out, &view);
     }
