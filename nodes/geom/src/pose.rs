@@ -28,6 +28,15 @@ impl Pose2 {
         Pose2::default()
     }
 
+    /// The pose of three finite values `[x, y, yaw]` (a parameter's list); `None` for any
+    /// other length or a non-finite value.
+    pub fn from_values(values: &[f64]) -> Option<Self> {
+        match values {
+            [x, y, yaw] if x.is_finite() && y.is_finite() && yaw.is_finite() => Some(Pose2::new(*x, *y, *yaw)),
+            _ => None,
+        }
+    }
+
     /// Whether x, y and yaw are all finite.
     pub fn is_finite(&self) -> bool {
         self.x.is_finite() && self.y.is_finite() && self.yaw.is_finite()

@@ -15,9 +15,8 @@ use mobil_local_nav::{
 };
 use mobil_motion::Outcome;
 use mobil_msgs::builtin_interfaces::msg::Time;
-use mobil_msgs::geometry_msgs::msg::{Point, Pose, PoseStamped};
+use mobil_msgs::geometry_msgs::msg::{Point, PoseStamped};
 use mobil_msgs::mobil_msgs::msg::NavStatus;
-use mobil_msgs::std_msgs::msg::Header;
 use mobil_msgs::visualization_msgs::msg::{Marker, MarkerArray};
 use mobil_ros::chassis::{chassis_params, declare_chassis};
 use mobil_ros::config::{Config, ConfigError, Decl};
@@ -334,61 +333,6 @@ pub fn mode_name(mode: Mode) -> &'static str {
         Mode::Track(Side::Right) => "track_right",
         Mode::Reached => "reached",
         Mode::NoPath(_) => "no_path",
-    }
-}
-
-/// What a status message says.
-#[derive(Debug, Clone, PartialEq)]
-pub struct StatusView {
-    /// NavStatus state (IDLE, ACTIVE, SUCCEEDED, FAILED).
-    pub state: u8,
-    /// The mode.
-    pub mode: Mode,
-    /// The goal (odom), if any.
-    pub goal: Option<Point2<f64>>,
-    /// Distance to the goal (m), NaN when unknown.
-    pub distance_to_goal: f64,
-    /// Reason (empty while active).
-    pub reason: String,
-    /// Hit point H.
-    pub hit_point: Option<Point2<f64>>,
-    /// Leave point L.
-    pub leave_point: Option<Point2<f64>>,
-}
-
-/// The NavStatus message of a view, stamped `stamp`, in `frame` (odom).
-pub fn status_message(view: &StatusView, stamp: Time, frame: &str) -> NavStatus {
-    let mut goal = Pose::default();
-    goal.orientation.w = 1.0;
-    if let Some(g) = view.goal {
-        goal.position = point(g);
-    }
-    NavStatus {
-        header: Header {
-            stamp,
-            frame_id: frame.to_owned(),
-        },
-        state: view.state,
-        mode: mode_name(view.mode).to_owned(),
-        goal,
-        distance_to_goal: view.distance_to_goal,
-        reason: view.reason.clone(),
-        has_hit_point: view.hit_point.is_some(),
-        hit_point: view.hit_point.map(point).unwrap_or_default(),
-        has_leave_point: view.leave_point.is_some(),
-        leave_point: view.leave_point.map(point).unwrap_or_default(),
-        waypoint_index: -1,
-        e: 0.0,
-        alpha: 0.0,
-        theta: 0.0,
-        lyapunov: 0.0,
-        psi_z: f64::NAN,
-        chi_length: f64::NAN,
-        chi_danger: f64::NAN,
-        chi_control: f64::NAN,
-        chi_smoothness: f64::NAN,
-        virtual_robots: 0,
-        candidates: 0,
     }
 }
 

@@ -23,7 +23,7 @@ use mobil_geom::Pose2;
 use mobil_local_nav::{Mode, MotionLimits, Navigator, Progress, ProgressChecker, StepOutput, VelocityCommand};
 use mobil_local_nav_node::{
     clear_markers, end_answer, goal_heading, goal_in_odom, invalid_goal, markers, no_progress, reconfigured_progress,
-    status_message, LocalNavConfig, MarkerView, StatusView,
+    LocalNavConfig, MarkerView,
 };
 use mobil_motion::{BodyTwist, GoalLaw, Step, StepInput};
 use mobil_msgs::builtin_interfaces::msg::Time;
@@ -41,6 +41,7 @@ use mobil_ros::motion::{Applied, CmdVel, EndCause, EndKind, Ended, MotionSession
 use mobil_ros::scan::{
     checked_scan, tf_static_subscription, CheckedScan, LaserMount, LaserPoseFrom, ScanRefusal, StaticFrames,
 };
+use mobil_ros::status::{NavStatusView, RateGate};
 use mobil_ros::stop::{final_stop, FINAL_STOP_WAIT};
 use mobil_ros::ticker::Ticker;
 use mobil_ros::time::duration_msg;
@@ -121,7 +122,7 @@ struct Shell {
     /// valid one still times the watchdog).
     odom_refused: bool,
     last_step: Option<StepOutput>,
-    last_status: Option<Instant>,
+    status_gate: RateGate,
     throttle: LogThrottle,
 }
 
@@ -191,7 +192,7 @@ async fn start(
         odom: Latest::new(),
         odom_refused: false,
         last_step: None,
-        last_status: None,
+        status_gate: RateGate::default(),
         throttle: LogThrottle::new(Duration::from_secs(2)),
     };
     shell.publish_status(node, out, NavStatus::IDLE, String::new());
@@ -347,30 +348,25 @@ impl Shell {
 
     /// What the status says: the last step's distance, H and L (else the distance from the
     /// latest odometry, else NaN).
-    fn status_view(&self, state: u8, reason: String, mode: Mode, goal: Option<Point2<f64>>) -> StatusView {
+    fn status_view(&self, state: u8, reason: String, mode: Mode, goal: Option<Point2<f64>>) -> NavStatusView {
         let last = self.last_step.as_ref();
         let distance = match (last, goal, self.odom.value()) {
             (Some(s), _, _) => s.goal_distance,
             (None, Some(g), Some(o)) => (g - o.pose.position()).norm(),
             _ => f64::NAN,
         };
-        StatusView {
-            state,
-            mode,
-            goal,
+        NavStatusView {
+            goal: goal.map(|g| Pose2::new(g.x, g.y, 0.0)),
             distance_to_goal: distance,
-            reason,
             hit_point: last.and_then(|s| s.hit_point),
             leave_point: last.and_then(|s| s.leave_point),
+            ..NavStatusView::new(state, mobil_local_nav_node::mode_name(mode), reason)
         }
     }
 
-    fn send_status(&mut self, node: &RosNode, out: &Outputs, view: &StatusView) {
-        let msg = status_message(view, node.stamp(), &self.config.frames.odom_frame);
-        if let Err(e) = out.status.publish(msg) {
-            warn_throttled!(self.throttle, "status", "cannot publish local_nav/status: {e:?}");
-        }
-        self.last_status = Some(Instant::now());
+    fn send_status(&mut self, node: &RosNode, out: &Outputs, view: &NavStatusView) {
+        out.send_status(view, node.stamp(), &self.config.frames.odom_frame, &mut self.throttle);
+        self.status_gate.sent(Instant::now());
     }
 
     /// The status of the current goal (or of none).
@@ -436,12 +432,8 @@ impl Shell {
         self.nav.cancel();
         self.progress.reset();
         self.last_step = None;
-        if let Err(e) = out
-            .markers
-            .publish(clear_markers(node.stamp(), &self.config.frames.odom_frame))
-        {
-            warn_throttled!(self.throttle, "markers", "cannot publish local_nav/markers: {e:?}");
-        }
+        let clear = clear_markers(node.stamp(), &self.config.frames.odom_frame);
+        out.send_markers(clear, &mut self.throttle);
     }
 
     /// Starts a validated goal: the goal it replaces, if any, ends PREEMPTED (reported; its
@@ -685,12 +677,8 @@ impl Shell {
         if let Some(stale) = self.session.stale(now, &inputs) {
             return self.end_goal(node, out, sink, server, EndCause::Stale(stale));
         }
-        let period = Duration::from_secs_f64(1.0 / self.config.status_rate_hz);
         let stamp = node.stamp();
-        if self
-            .last_status
-            .is_none_or(|t| now.saturating_duration_since(t) >= period)
-        {
+        if self.status_gate.due(now, self.config.status_rate_hz) {
             self.publish_status(node, out, NavStatus::ACTIVE, String::new());
             self.publish_markers(out, goal.goal, stamp.clone());
         }
@@ -714,9 +702,7 @@ impl Shell {
                 &self.config.frames.odom_frame,
                 &self.config.frames.base_frame,
             );
-            if let Err(e) = out.markers.publish(array) {
-                warn_throttled!(self.throttle, "markers", "cannot publish local_nav/markers: {e:?}");
-            }
+            out.send_markers(array, &mut self.throttle);
         }
     }
 

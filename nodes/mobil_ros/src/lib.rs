@@ -28,7 +28,8 @@
 //!   command at every end, stale input, shutdown), around a [`mobil_motion::GoalLaw`];
 //! - [`goal`]: goal poses and routes from messages, checked in the node's frame (the reasons of
 //!   an `INVALID_GOAL`);
-//! - [`markers`]: RViz markers, built one call per marker;
+//! - [`markers`]: RViz markers, built one call per marker; [`status`]: a navigating node's
+//!   `NavStatus`, and the rate gate of its status and markers;
 //! - [`stop`]: [`stop::final_stop`], the bounded last zero command of a motion node;
 //! - [`scan`]: LaserScan → checked [`mobil_geom::Scan`] at the edge, laser pose from `tf_static`
 //!   ([`scan::tf_static_subscription`] feeding [`scan::LaserPose`]; `tf_static` wins) or a
@@ -57,6 +58,7 @@ pub mod offloop;
 pub mod params;
 pub mod qos;
 pub mod scan;
+pub mod status;
 pub mod stop;
 pub mod ticker;
 pub mod time;

@@ -45,9 +45,11 @@
 //! ```
 
 use crate::log::LogThrottle;
+use crate::status::NavStatusView;
 use crate::time::{DtClock, DtError};
 use mobil_motion::{BodyTwist, End, Step};
 pub use mobil_motion::{EndCause, EndKind};
+use mobil_msgs::builtin_interfaces::msg::Time;
 use mobil_msgs::geometry_msgs::msg::Twist;
 use mobil_msgs::mobil_msgs::msg::NavStatus;
 use mobil_msgs::visualization_msgs::msg::MarkerArray;
@@ -123,6 +125,8 @@ pub struct Outputs {
     pub status: Publisher<NavStatus>,
     /// RViz markers.
     pub markers: Publisher<MarkerArray>,
+    /// The node's name, for the topics' names in warnings.
+    name: String,
 }
 
 impl Outputs {
@@ -132,7 +136,23 @@ impl Outputs {
             cmd: node.publisher::<Twist>("cmd_vel", &crate::qos::default_qos())?,
             status: node.publisher::<NavStatus>(&format!("{name}/status"), &crate::qos::latched())?,
             markers: node.publisher::<MarkerArray>(&format!("{name}/markers"), &crate::qos::default_qos())?,
+            name: name.to_owned(),
         })
+    }
+
+    /// Publishes the status of `view`, stamped `stamp`, in `frame` (a failure: one rate-limited
+    /// warning).
+    pub fn send_status(&self, view: &NavStatusView, stamp: Time, frame: &str, throttle: &mut LogThrottle) {
+        if let Err(e) = self.status.publish(view.message(stamp, frame)) {
+            crate::warn_throttled!(throttle, "status", "cannot publish {}/status: {e:?}", self.name);
+        }
+    }
+
+    /// Publishes `markers` (a failure: one rate-limited warning).
+    pub fn send_markers(&self, markers: MarkerArray, throttle: &mut LogThrottle) {
+        if let Err(e) = self.markers.publish(markers) {
+            crate::warn_throttled!(throttle, "markers", "cannot publish {}/markers: {e:?}", self.name);
+        }
     }
 }
 

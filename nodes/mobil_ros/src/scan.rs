@@ -284,10 +284,7 @@ pub struct LaserMount<'a> {
 /// The `laser_pose` parameter (x, y, yaw in the base frame) as a pose: `None` unless it holds
 /// three finite values.
 pub fn laser_pose_param(values: &[f64]) -> Option<Pose2> {
-    match values {
-        [x, y, yaw] if x.is_finite() && y.is_finite() && yaw.is_finite() => Some(Pose2::new(*x, *y, *yaw)),
-        _ => None,
-    }
+    Pose2::from_values(values)
 }
 
 /// A LaserScan read at the edge: the checked scan in the base frame, where the laser is and

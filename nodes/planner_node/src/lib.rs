@@ -13,7 +13,7 @@ use mobil_chassis::ChassisParams;
 use mobil_geom::downsample;
 use mobil_geom::Pose2;
 use mobil_msgs::builtin_interfaces::msg::Time;
-use mobil_msgs::geometry_msgs::msg::{Point, Pose, PoseStamped};
+use mobil_msgs::geometry_msgs::msg::PoseStamped;
 use mobil_msgs::mobil_msgs::msg::{NavStatus, RouteProblem as ProblemMsg};
 use mobil_msgs::mobil_msgs::srv::CheckRouteResponse;
 use mobil_msgs::nav2_msgs::action::{DockRobotResult, FollowWaypointsResult, UndockRobotResult};
@@ -22,7 +22,7 @@ use mobil_msgs::nav_msgs::msg::Path;
 use mobil_msgs::std_msgs::msg::Header;
 use mobil_msgs::visualization_msgs::msg::MarkerArray;
 pub use mobil_planner::goals::{list_missed, missed_from_report, route_infeasible, Missed, MISSED_BY_THE_RUN};
-use mobil_planner::vfo::{SegmentReport, VfoDrawing, MAX_DRAWN_OBSTACLES, MAX_DRAWN_ROBOTS};
+use mobil_planner::vfo::{VfoDrawing, MAX_DRAWN_OBSTACLES, MAX_DRAWN_ROBOTS};
 use mobil_planner::{DockingConfig, DockingGains, FollowConfig, RouteCheckConfig, RouteReport};
 use mobil_ros::chassis::{chassis_params, declare_chassis};
 use mobil_ros::config::{Config, ConfigError, Decl};
@@ -32,13 +32,14 @@ pub use mobil_ros::goal::{GoalError, Route};
 use mobil_ros::groups::{Frames, GoalTimeouts};
 use mobil_ros::markers::{point, rgb, rgba, Markers};
 use mobil_ros::motion::{EndCause, EndKind};
+use mobil_ros::status::{NavStatusView, VfoFigures};
 use mobil_world::World;
 use nalgebra::Point2;
 
 pub mod vfo;
 
 pub use mobil_planner::task::{no_dock_database, Action, Figures, Mode};
-pub use vfo::{VfoSettings, WaypointMethod};
+pub use mobil_planner::vfo::{VfoSettings, WaypointMethod};
 
 /// Everything the node is configured with, each field filled by one declared parameter.
 #[derive(Debug, Clone, Default, PartialEq)]
@@ -338,85 +339,24 @@ pub fn refused_reply(reason: String) -> CheckRouteResponse {
     }
 }
 
-/// What a status message says.
-#[derive(Debug, Clone, PartialEq)]
-pub struct StatusView {
-    /// NavStatus state.
-    pub state: u8,
-    /// The mode.
-    pub mode: Mode,
-    /// The goal: the dock pose or the waypoint pursued (odom).
-    pub goal: Option<Pose2>,
-    /// Distance to it (m), NaN when unknown.
-    pub distance_to_goal: f64,
-    /// Reason (empty while active).
-    pub reason: String,
-    /// The waypoint pursued (request index), -1 without a route.
-    pub waypoint_index: i32,
-    /// The docking's e, α, Θ and V: `None` when not docking (sent as zeros); NaN while docking
-    /// before the first pose is known.
-    pub docking: Option<[f64; 4]>,
-    /// A VFO route's current segment: `None` otherwise (Ψ_z and the χ's sent as NaN, counts 0).
-    pub vfo: Option<SegmentReport>,
-}
-
-impl StatusView {
-    /// The view in `state` with `reason` of a goal's `figures` (none: idle, or a goal refused
-    /// before it started).
-    pub fn of(state: u8, reason: String, figures: Option<&Figures>) -> Self {
-        let index = |i: usize| i32::try_from(i).unwrap_or(i32::MAX);
-        StatusView {
-            state,
-            mode: figures.map_or(Mode::Idle, |f| f.mode),
-            goal: figures.and_then(|f| f.goal),
-            distance_to_goal: figures.map_or(f64::NAN, |f| f.distance),
-            reason,
-            waypoint_index: figures.and_then(|f| f.waypoint).map_or(-1, index),
-            docking: figures.and_then(|f| f.docking),
-            vfo: figures.and_then(|f| f.vfo),
-        }
-    }
-}
-
-/// The NavStatus message of a view, stamped `stamp`, in `frame`.
-pub fn status_message(view: &StatusView, stamp: Time, frame: &str) -> NavStatus {
-    let goal = view.goal.map_or_else(
-        || {
-            let mut p = Pose::default();
-            p.orientation.w = 1.0;
-            p
-        },
-        |g| pose_msg(&g),
-    );
-    let [e, alpha, theta, lyapunov] = view.docking.unwrap_or_default();
-    let segment = view.vfo.unwrap_or_default();
-    let [chi_length, chi_danger, chi_control, chi_smoothness] = segment.indices;
-    NavStatus {
-        header: Header {
-            stamp,
-            frame_id: frame.to_owned(),
-        },
-        state: view.state,
-        mode: view.mode.as_str().to_owned(),
-        goal,
-        distance_to_goal: view.distance_to_goal,
-        reason: view.reason.clone(),
-        has_hit_point: false,
-        hit_point: Point::default(),
-        has_leave_point: false,
-        leave_point: Point::default(),
-        waypoint_index: view.waypoint_index,
-        e,
-        alpha,
-        theta,
-        lyapunov,
-        psi_z: segment.psi_z,
-        chi_length,
-        chi_danger,
-        chi_control,
-        chi_smoothness,
-        virtual_robots: u32::try_from(segment.virtual_robots).unwrap_or(u32::MAX),
-        candidates: u32::try_from(segment.candidates).unwrap_or(u32::MAX),
+/// The status in `state` with `reason` of a goal's `figures` (none: idle, or a goal refused
+/// before it started).
+pub fn status_view(state: u8, reason: String, figures: Option<&Figures>) -> NavStatusView {
+    let Some(f) = figures else {
+        return NavStatusView::new(state, Mode::Idle.as_str(), reason);
+    };
+    NavStatusView {
+        goal: f.goal,
+        distance_to_goal: f.distance,
+        waypoint_index: f.waypoint,
+        docking: f.docking,
+        vfo: f.vfo.map(|s| VfoFigures {
+            psi_z: s.psi_z,
+            indices: s.indices,
+            virtual_robots: s.virtual_robots,
+            candidates: s.candidates,
+        }),
+        ..NavStatusView::new(state, f.mode.as_str(), reason)
     }
 }
 
@@ -723,35 +663,46 @@ mod tests {
     }
 
     #[test]
-    fn status_carries_the_docking_state_and_the_waypoint() {
-        let view = StatusView {
-            state: NavStatus::ACTIVE,
+    fn status_carries_the_goal_s_figures_and_idle_none() {
+        let figures = Figures {
             mode: Mode::Dock,
+            waypoint: None,
             goal: Some(Pose2::new(1.0, 0.0, 0.0)),
-            distance_to_goal: 1.0,
-            reason: String::new(),
-            waypoint_index: -1,
+            distance: 1.0,
             docking: Some([1.0, 0.5, -0.25, 0.7]),
             vfo: None,
         };
-        let m = status_message(&view, Time::default(), "odom");
+        let m = status_view(NavStatus::ACTIVE, String::new(), Some(&figures)).message(Time::default(), "odom");
         assert_eq!(m.mode, "dock");
         assert_eq!((m.e, m.alpha, m.theta, m.lyapunov), (1.0, 0.5, -0.25, 0.7));
-        assert_eq!(m.waypoint_index, -1);
-        assert_eq!(m.goal.position.x, 1.0);
-        let idle = StatusView {
-            mode: Mode::Approach,
-            goal: None,
-            waypoint_index: 3,
-            docking: None,
-            vfo: None,
-            ..view
-        };
-        let m = status_message(&idle, Time::default(), "odom");
         assert_eq!(
-            (m.mode.as_str(), m.waypoint_index, m.e, m.goal.orientation.w),
-            ("approach", 3, 0.0, 1.0)
+            (m.waypoint_index, m.goal.position.x, m.distance_to_goal),
+            (-1, 1.0, 1.0)
         );
+        let vfo = Figures {
+            mode: Mode::Vfo,
+            waypoint: Some(2),
+            docking: None,
+            vfo: Some(mobil_planner::vfo::SegmentReport {
+                psi_z: 3.25,
+                indices: [4.5, 0.75, 1.5, 0.5],
+                virtual_robots: 9,
+                candidates: 5,
+            }),
+            ..figures
+        };
+        let m = status_view(NavStatus::ACTIVE, String::new(), Some(&vfo)).message(Time::default(), "odom");
+        assert_eq!((m.mode.as_str(), m.waypoint_index, m.e), ("vfo", 2, 0.0));
+        assert_eq!(
+            (m.psi_z, m.chi_danger, m.virtual_robots, m.candidates),
+            (3.25, 0.75, 9, 5)
+        );
+        let idle = status_view(NavStatus::FAILED, "INVALID_GOAL: x".into(), None).message(Time::default(), "odom");
+        assert_eq!(
+            (idle.mode.as_str(), idle.waypoint_index, idle.state),
+            ("idle", -1, NavStatus::FAILED)
+        );
+        assert!(idle.distance_to_goal.is_nan() && idle.psi_z.is_nan());
     }
 
     #[test]

@@ -43,14 +43,13 @@ use mobil_planner::goals::{route_infeasible, DockGoal, RouteEvent, UndockGoal};
 use mobil_planner::task::{PreCheck, Stepped, Task, VfoRun};
 use mobil_planner::vfo::{
     vfo_gains, Interrupt, ObstacleMap, OptimiseWarning, PoseHistory, ScanSkipped, VfoDrawing, VfoEvent, VfoGoal,
-    VfoStep, VfoTick, MAX_SETTLE_S,
+    VfoStep, VfoTick, WaypointMethod, MAX_SETTLE_S,
 };
 use mobil_planner::{check_route_until, Finish, RouteReport};
-use mobil_planner_node::vfo::WaypointMethod;
 use mobil_planner_node::{
     check_reply, dock_result, end_state, follow_result, load_world, markers, no_dock_database, refused_reply,
-    status_message, undock_result, vfo_follow_result, Action, GoalError, MarkerView, Missed, PlannerConfig, Route,
-    StatusView, ROUTE_LIMITS,
+    status_view, undock_result, vfo_follow_result, Action, GoalError, MarkerView, Missed, PlannerConfig, Route,
+    ROUTE_LIMITS,
 };
 use mobil_ros::action::{goal_end, ActionEvent, GoalRequest, GoalServer, GoalServerConfig};
 use mobil_ros::geometry::{odom_pose, twist_msg};
@@ -62,6 +61,7 @@ use mobil_ros::motion::{
 };
 use mobil_ros::offloop::CancelToken;
 use mobil_ros::scan::{checked_scan, tf_static_subscription, LaserMount, StaticFrames};
+use mobil_ros::status::{NavStatusView, RateGate};
 use mobil_ros::stop::{final_stop, FINAL_STOP_WAIT};
 use mobil_ros::ticker::Ticker;
 use mobil_ros::time::{duration_msg, secs_from_stamp, DtError};
@@ -224,8 +224,8 @@ struct Shell {
     session: Session,
     odom: Latest<Pose2>,
     odom_refused: bool,
-    last_status: Option<Instant>,
-    last_markers: Option<Instant>,
+    status_gate: RateGate,
+    markers_gate: RateGate,
     drawing: Drawing,
     throttle: LogThrottle,
     /// Obstacles seen by the LIDAR, in odom (VFO); kept between goals.
@@ -314,8 +314,8 @@ async fn start(node: &mut RosNode, out: &Outputs, config: PlannerConfig) -> anyh
         session: Session::new(SessionSettings::default()),
         odom: Latest::new(),
         odom_refused: false,
-        last_status: None,
-        last_markers: None,
+        status_gate: RateGate::default(),
+        markers_gate: RateGate::default(),
         drawing: Drawing::default(),
         throttle: LogThrottle::new(Duration::from_secs(2)),
         map,

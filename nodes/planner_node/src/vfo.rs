@@ -1,141 +1,15 @@
-//! The shell side of VFO waypoint following ([`mobil_planner::vfo`], SPEC §5): the parameters
-//! and a route's waypoints as VFO waypoints. The law is [`mobil_planner::vfo::VfoGoal`]; the
-//! node runs its steps off the event loop ([`mobil_motion::slot`]) and the robot stops while a
+//! The `waypoint_method` and `vfo.*` parameters of VFO waypoint following
+//! ([`mobil_planner::vfo`], SPEC §5), each bound to a field of
+//! [`mobil_planner::vfo::VfoSettings`]. The law is [`mobil_planner::vfo::VfoGoal`]; the node
+//! runs its steps off the event loop ([`mobil_motion::slot`]) and the robot stops while a
 //! segment is optimised. Nothing here decides where the robot goes.
 
-use std::str::FromStr;
-use std::time::Duration;
-
-use mobil_geom::Pose2;
-use mobil_planner::vfo::{OptimiseConfig, QualityWeights, ScanObstacleConfig, VfoGains, VfoSetup, DEFAULT_GUIDING};
+use mobil_planner::vfo::{
+    OptimiseConfig, QualityWeights, ScanObstacleConfig, VfoGains, VfoSettings, MAX_OPTIMISE_BUDGET_S,
+};
 use mobil_ros::config::Decl;
 
 use crate::PlannerConfig;
-
-/// How `waypoints` and `follow_waypoints` are followed.
-#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
-pub enum WaypointMethod {
-    /// The goal approach after the route pre-check (SPEC §4).
-    #[default]
-    Approach,
-    /// VFO with virtual-robot optimisation round obstacles seen by the LIDAR (SPEC §5).
-    Vfo,
-}
-
-impl WaypointMethod {
-    /// The parameter's spelling: `approach` or `vfo`.
-    pub fn as_str(self) -> &'static str {
-        match self {
-            WaypointMethod::Approach => "approach",
-            WaypointMethod::Vfo => "vfo",
-        }
-    }
-}
-
-impl FromStr for WaypointMethod {
-    type Err = String;
-
-    fn from_str(s: &str) -> Result<Self, Self::Err> {
-        match s {
-            "approach" => Ok(WaypointMethod::Approach),
-            "vfo" => Ok(WaypointMethod::Vfo),
-            other => Err(format!("waypoint_method `{other}`: give approach or vfo")),
-        }
-    }
-}
-
-/// The VFO settings, each filled by one `vfo.*` parameter (defaults: the library's).
-#[derive(Debug, Clone, PartialEq)]
-pub struct VfoSettings {
-    /// The law's gains (U_2 and |ω| are further held to the chassis: [`mobil_planner::vfo::vfo_gains`]).
-    pub gains: VfoGains,
-    /// Algorithm 2's settings (`time_step` = the node's control period).
-    pub optimise: OptimiseConfig,
-    /// Obstacle extraction and merge (`robot_radius` is the node's `robot_radius`).
-    pub scan: ScanObstacleConfig,
-    /// μ of every waypoint (eq. 11).
-    pub guiding: f64,
-    /// Echoes farther than this (m) are not turned into obstacles.
-    pub scan_range: f64,
-    /// A VFO goal fails STALE_INPUT when no valid scan arrived for this long (steady clock), s.
-    pub scan_timeout_s: f64,
-    /// The wall-clock budget of one segment's optimisation (s): when spent, the best Σ found
-    /// so far is taken, with a warning (the robot stands meanwhile).
-    pub optimise_budget_s: f64,
-    /// A scan is placed with the odometry pose at its stamp, interpolated; one with no
-    /// odometry pose within this (s) of its stamp is refused.
-    pub scan_odom_max_gap_s: f64,
-    /// The scan's frame when its header has none.
-    pub laser_frame: String,
-    /// The laser's pose in the base frame (x, y, yaw) for a frame `tf_static` does not give;
-    /// empty: such scans are refused.
-    pub laser_pose: Vec<f64>,
-}
-
-impl Default for VfoSettings {
-    fn default() -> Self {
-        VfoSettings {
-            gains: VfoGains::default(),
-            optimise: OptimiseConfig::default(),
-            scan: ScanObstacleConfig::default(),
-            guiding: DEFAULT_GUIDING,
-            scan_range: 4.0,
-            scan_timeout_s: 0.5,
-            scan_odom_max_gap_s: DEFAULT_SCAN_ODOM_MAX_GAP_S,
-            optimise_budget_s: DEFAULT_OPTIMISE_BUDGET_S,
-            laser_frame: "laser".to_owned(),
-            laser_pose: vec![0.0; 3],
-        }
-    }
-}
-
-/// The default `vfo.scan_odom_max_gap_s` (s): five periods of 50 Hz odometry. Between two
-/// odometry poses a scan's pose is interpolated; beyond the last one it is held for at most
-/// this, where a robot turning at 1.5 rad/s turns 0.15 rad (0.45 m at 3 m) — the worst
-/// misplacement accepted.
-pub const DEFAULT_SCAN_ODOM_MAX_GAP_S: f64 = 0.1;
-
-/// The largest `vfo.optimise_budget_s` (s).
-pub const MAX_OPTIMISE_BUDGET_S: f64 = 30.0;
-
-/// The default `vfo.optimise_budget_s` (s): twice the second Algorithm 2 takes at 30 obstacles
-/// (the bench), so on a loaded machine an optimisation still finishes, while a robot standing
-/// for it never stands longer than this.
-pub const DEFAULT_OPTIMISE_BUDGET_S: f64 = 2.0;
-
-impl VfoSettings {
-    /// What a VFO route is driven with.
-    pub fn setup(&self) -> VfoSetup {
-        VfoSetup {
-            gains: self.gains,
-            optimise: self.optimise,
-            guiding: self.guiding,
-        }
-    }
-
-    /// The optimisation's wall-clock budget.
-    pub fn optimise_budget(&self) -> Duration {
-        mobil_ros::time::seconds(self.optimise_budget_s, MAX_OPTIMISE_BUDGET_S)
-    }
-
-    /// The laser's pose from `laser_pose` (`None` when empty or malformed).
-    pub fn laser_pose(&self) -> Option<Pose2> {
-        mobil_ros::scan::laser_pose_param(&self.laser_pose)
-    }
-
-    /// The scan timeout.
-    pub fn scan_timeout(&self) -> Duration {
-        mobil_ros::time::seconds(self.scan_timeout_s, mobil_ros::groups::MAX_INPUT_TIMEOUT_S)
-    }
-
-    /// The obstacle extraction with the robot's radius.
-    pub fn scan_config(&self, robot_radius: f64) -> ScanObstacleConfig {
-        ScanObstacleConfig {
-            robot_radius,
-            ..self.scan
-        }
-    }
-}
 
 /// Declares `waypoint_method` and the `vfo.*` parameters.
 pub fn declare_vfo(d: &mut Decl<PlannerConfig>) {
@@ -254,13 +128,14 @@ pub fn declare_vfo(d: &mut Decl<PlannerConfig>) {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::{markers, status_message, vfo_follow_result, MarkerView, Mode, StatusView, MISSED_BY_THE_RUN};
+    use crate::{markers, vfo_follow_result, MarkerView, MISSED_BY_THE_RUN};
+    use mobil_geom::Pose2;
     use mobil_msgs::builtin_interfaces::msg::Time;
     use mobil_msgs::geometry_msgs::msg::PoseStamped;
-    use mobil_msgs::mobil_msgs::msg::NavStatus;
     use mobil_msgs::nav2_msgs::action::FollowWaypointsResult;
     use mobil_msgs::visualization_msgs::msg::Marker;
-    use mobil_planner::vfo::{DrawnRobot, Obstacle, SegmentReport, VfoDrawing, MAX_DRAWN_OBSTACLES};
+    use mobil_planner::vfo::WaypointMethod;
+    use mobil_planner::vfo::{DrawnRobot, Obstacle, VfoDrawing, MAX_DRAWN_OBSTACLES};
     use mobil_ros::config::{load, Decl};
     use mobil_ros::geometry::{header_in, pose_stamped};
     use mobil_ros::motion::EndCause;
@@ -270,14 +145,6 @@ mod tests {
 
     fn pose(x: f64, y: f64, yaw: Option<f64>) -> PoseStamped {
         pose_stamped(header_in("odom"), &Pose2::new(x, y, yaw.unwrap_or(0.0)))
-    }
-
-    #[test]
-    fn waypoint_method_parses_its_two_names_only() {
-        assert_eq!("vfo".parse::<WaypointMethod>(), Ok(WaypointMethod::Vfo));
-        assert_eq!("approach".parse::<WaypointMethod>(), Ok(WaypointMethod::Approach));
-        assert!("VFO".parse::<WaypointMethod>().is_err());
-        assert_eq!(WaypointMethod::Vfo.as_str(), "vfo");
     }
 
     #[test]
@@ -366,34 +233,6 @@ mod tests {
         assert_eq!(r[0].r#type, Marker::CYLINDER);
         assert_eq!((r[0].pose.position.x, r[0].scale.x, big[0].scale.x), (1.0, 0.8, 1.6));
         assert_eq!((r[1].pose.position.x, r[1].scale.x, big[1].scale.x), (5.0, 0.6, 1.4));
-    }
-
-    #[test]
-    fn status_carries_the_segment_s_psi_z_and_indices() {
-        let view = StatusView {
-            state: NavStatus::ACTIVE,
-            mode: Mode::Vfo,
-            goal: None,
-            distance_to_goal: 1.0,
-            reason: String::new(),
-            waypoint_index: 2,
-            docking: None,
-            vfo: Some(SegmentReport {
-                psi_z: 3.25,
-                indices: [4.5, 0.75, 1.5, 0.5],
-                virtual_robots: 9,
-                candidates: 5,
-            }),
-        };
-        let m = status_message(&view, Time::default(), "odom");
-        assert_eq!(m.mode, "vfo");
-        assert_eq!(
-            (m.psi_z, m.chi_length, m.chi_danger, m.chi_control, m.chi_smoothness),
-            (3.25, 4.5, 0.75, 1.5, 0.5)
-        );
-        assert_eq!((m.virtual_robots, m.candidates, m.waypoint_index), (9, 5, 2));
-        let m = status_message(&StatusView { vfo: None, ..view }, Time::default(), "odom");
-        assert!(m.psi_z.is_nan() && m.chi_length.is_nan() && m.virtual_robots == 0);
     }
 
     #[test]

@@ -8,11 +8,11 @@
 use mobil_chassis::ChassisParams;
 use mobil_geom::Pose2;
 use mobil_msgs::geometry_msgs::msg::PoseStamped;
+use mobil_planner::vfo::VfoSettings;
 use mobil_planner::vfo::{
     integrate_unicycle, ObstacleMap, OptimiseConfig, PoseHistory, VfoEnd, VfoEvent, VfoFollower, VfoGains,
 };
 use mobil_planner::vfo::{vfo_gains, vfo_waypoints};
-use mobil_planner_node::vfo::VfoSettings;
 use mobil_planner_node::ROUTE_LIMITS;
 use mobil_ros::geometry::{header_in, pose_stamped};
 use mobil_ros::goal::route_from_poses;

@@ -12,6 +12,7 @@
 //!   forgotten when seen through, when not seen for a while, and beyond a cap.
 //! - [`goal`]: [`VfoGoal`], the follower as a goal law (`mobil_motion::GoalLaw`), with the
 //!   reasons and codes of its ends and what the status and markers show of an optimisation.
+//! - [`settings`]: [`VfoSettings`], everything a node configures VFO waypoint following with.
 //! - [`history`]: a short history of odometry poses, to place each scan with the pose at its
 //!   stamp.
 //!
@@ -37,6 +38,7 @@ pub mod obstacles;
 pub mod optimise;
 pub mod quality;
 pub mod scan;
+pub mod settings;
 
 pub use controller::{
     convergence_field, field_rate, integrate_unicycle, ControlStep, Field, StepOutcome, VfoController, VfoGains,
@@ -59,3 +61,6 @@ pub use optimise::{
 };
 pub use quality::{normalise, normalised, path_score, PathIndices, QualityWeights};
 pub use scan::{extract_circles, fit_circle, Circle, MapUpdate, ObstacleMap, ScanObstacleConfig, ScanSkipped};
+pub use settings::{
+    VfoSettings, WaypointMethod, DEFAULT_OPTIMISE_BUDGET_S, DEFAULT_SCAN_ODOM_MAX_GAP_S, MAX_OPTIMISE_BUDGET_S,
+};

@@ -42,12 +42,9 @@ impl Shell {
             .copied()
     }
 
-    pub(crate) fn send_status(&mut self, node: &RosNode, out: &Outputs, view: &StatusView) {
-        let msg = status_message(view, node.stamp(), &self.config.frames.odom_frame);
-        if let Err(e) = out.status.publish(msg) {
-            warn_throttled!(self.throttle, "status", "cannot publish planner/status: {e:?}");
-        }
-        self.last_status = Some(Instant::now());
+    pub(crate) fn send_status(&mut self, node: &RosNode, out: &Outputs, view: &NavStatusView) {
+        out.send_status(view, node.stamp(), &self.config.frames.odom_frame, &mut self.throttle);
+        self.status_gate.sent(Instant::now());
     }
 
     pub(crate) fn send_idle_status(&mut self, node: &RosNode, out: &Outputs) {
@@ -55,9 +52,9 @@ impl Shell {
     }
 
     /// The status of `goal` (none: idle, or a refusal) in `state` with `reason`.
-    pub(crate) fn status_view(&self, goal: Option<&Goal>, state: u8, reason: String) -> StatusView {
+    pub(crate) fn status_view(&self, goal: Option<&Goal>, state: u8, reason: String) -> NavStatusView {
         let figures = goal.map(|g| g.task.figures(self.odom.value()));
-        StatusView::of(state, reason, figures.as_ref())
+        status_view(state, reason, figures.as_ref())
     }
 
     /// The active goal's status in `state` with `reason`.
@@ -76,10 +73,8 @@ impl Shell {
             robot: self.odom.value().map(|p| p.position()),
         };
         let array = markers(&view, node.stamp(), &self.config.frames.odom_frame);
-        if let Err(e) = out.markers.publish(array) {
-            warn_throttled!(self.throttle, "markers", "cannot publish planner/markers: {e:?}");
-        }
-        self.last_markers = Some(Instant::now());
+        out.send_markers(array, &mut self.throttle);
+        self.markers_gate.sent(Instant::now());
     }
 
     /// Ends the active goal with `outcome` (the session sends its zero command, if one is due)
@@ -300,18 +295,10 @@ impl Shell {
         if let Some(stale) = self.session.stale(now, &inputs) {
             return self.end_goal(io, EndCause::Stale(stale));
         }
-        let status_period = Duration::from_secs_f64(1.0 / self.config.status_rate_hz);
-        if self
-            .last_status
-            .is_none_or(|t| now.saturating_duration_since(t) >= status_period)
-        {
+        if self.status_gate.due(now, self.config.status_rate_hz) {
             self.publish_status(io.node, io.out, NavStatus::ACTIVE, String::new());
         }
-        let markers_period = Duration::from_secs_f64(1.0 / self.config.markers_rate_hz);
-        if self
-            .last_markers
-            .is_none_or(|t| now.saturating_duration_since(t) >= markers_period)
-        {
+        if self.markers_gate.due(now, self.config.markers_rate_hz) {
             self.publish_markers(io.node, io.out);
         }
         self.feedback(io.servers).await;
