@@ -85,3 +85,40 @@ def test_every_endpoint_of_late_nodes_is_discovered(start_node):
         finally:
             context.try_shutdown()
     print(f"slowest round: {slowest:.2f} s until every endpoint was in the graph")
+
+
+def _chassis_endpoints(node) -> tuple[int, int]:
+    """(request readers, reply writers) of /chassis/list_parameters in the graph of ``node``."""
+    return (len(node.get_subscriptions_info_by_topic("rq/chassis/list_parametersRequest", no_mangle=True)),
+            len(node.get_publishers_info_by_topic("rr/chassis/list_parametersReply", no_mangle=True)))
+
+
+def test_a_stopped_node_leaves_the_graph_and_a_restarted_one_answers(start_node, ros_node):
+    """A node that stops disposes its endpoints, and Fast DDS removes them at once.
+
+    Before the fix (patches/README.md, "disposes without a key hash") Fast DDS ignored every
+    dispose of a RustDDS participant: a stopped node's endpoints stayed in each peer's graph
+    until the participant's lease ran out (50 s), and rmw_fastrtps calls a service available only
+    while its request readers and reply writers are equal in number, so after a few restarts
+    ``wait_for_service`` could stay false for the whole lease (rclpy tests failed that way when
+    a test's chassis_node followed another's within the lease). Here each of ``RESTARTS``
+    rounds starts chassis_node, waits for one server in the graph, calls a service, stops the
+    node and requires the graph to have no server within ``LEAVE_S``.
+    """
+    from rcl_interfaces.srv import ListParameters
+    RESTARTS = 3
+    LEAVE_S = 2.0
+    for round_ in range(RESTARTS):
+        chassis = start_node("chassis_node", params_file="params/omr3.yaml")
+        assert rosutil.wait_until(lambda: _chassis_endpoints(ros_node) == (1, 1), 10.0, 0.05), (
+            f"round {round_ + 1}: the graph shows {_chassis_endpoints(ros_node)} "
+            "(request readers, reply writers) of /chassis/list_parameters, not one server")
+        reply = rosutil.call_service(ros_node, ListParameters, "/chassis/list_parameters",
+                                     ListParameters.Request(), timeout=10.0)
+        assert "model" in reply.result.names
+        chassis.stop()
+        t0 = time.monotonic()
+        assert rosutil.wait_until(lambda: _chassis_endpoints(ros_node) == (0, 0), LEAVE_S, 0.05), (
+            f"round {round_ + 1}: {LEAVE_S:g} s after chassis_node stopped the graph still shows "
+            f"{_chassis_endpoints(ros_node)} (request readers, reply writers)")
+        print(f"round {round_ + 1}: gone from the graph {time.monotonic() - t0:.2f} s after the stop")

@@ -20,6 +20,11 @@ pub enum DDSData {
   DisposeByKey {
     change_kind: ChangeKind,
     key: SerializedPayload,
+    /// The key's hash, sent as PID_KEY_HASH beside the serialized key when known (a
+    /// local writer's dispose). Fast DDS identifies a key-only DATA by the key hash alone: it
+    /// ignores a serialized key longer than 16 bytes, such as the PL_CDR key of a builtin
+    /// discovery topic, and would then drop the dispose.
+    key_hash: Option<KeyHash>,
   },
   DisposeByKeyHash {
     change_kind: ChangeKind,
@@ -32,7 +37,24 @@ impl DDSData {
     Self::Data { serialized_payload }
   }
   pub fn new_disposed_by_key(change_kind: ChangeKind, key: SerializedPayload) -> Self {
-    Self::DisposeByKey { change_kind, key }
+    Self::DisposeByKey {
+      change_kind,
+      key,
+      key_hash: None,
+    }
+  }
+
+  /// A dispose carrying both the serialized key and its hash (what a writer sends).
+  pub fn new_disposed_by_key_and_hash(
+    change_kind: ChangeKind,
+    key: SerializedPayload,
+    key_hash: KeyHash,
+  ) -> Self {
+    Self::DisposeByKey {
+      change_kind,
+      key,
+      key_hash: Some(key_hash),
+    }
   }
 
   pub fn new_disposed_by_key_hash(change_kind: ChangeKind, key_hash: KeyHash) -> Self {
