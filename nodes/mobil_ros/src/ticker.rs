@@ -87,6 +87,21 @@ impl Ticker {
     pub async fn tick(&mut self) -> Instant {
         self.interval.tick().await
     }
+
+    /// A burst ticker that has fallen more than `max_lag` behind its schedule (the tick
+    /// `scheduled` for then, handled at `now`) forgets the ticks it missed: the next one comes
+    /// one period after `now`. Returns whether it did. A simulator publishing its own clock
+    /// calls it on every tick, so that after a stall simulated time goes on at its rate from
+    /// where it stood instead of racing through the backlog faster than the nodes it drives can
+    /// react; below `max_lag` the burst keeps the rate against timer jitter.
+    pub fn drop_backlog(&mut self, scheduled: Instant, now: Instant, max_lag: Duration) -> bool {
+        if now.saturating_duration_since(scheduled) > max_lag {
+            self.interval.reset();
+            true
+        } else {
+            false
+        }
+    }
 }
 
 #[cfg(test)]
@@ -129,6 +144,32 @@ mod tests {
         let late = Instant::now();
         t.tick().await;
         assert!(Instant::now() - late >= ms(19), "{:?}", Instant::now() - late);
+    }
+
+    // A stall of 60 ms at 1 kHz: a burst ticker owes 60 ticks. Within the allowed lag it pays
+    // them at once; beyond it the backlog is dropped and the next tick is one period away.
+    #[tokio::test(flavor = "current_thread")]
+    async fn a_burst_ticker_drops_a_backlog_beyond_the_allowed_lag() {
+        let ms = Duration::from_millis;
+        let mut t = Ticker::with_missed_tick_behavior(1000.0, MissedTickBehavior::Burst).unwrap();
+        t.tick().await;
+        std::thread::sleep(ms(60));
+        let scheduled = t.tick().await;
+        let now = Instant::now();
+        assert!(now - scheduled >= ms(59), "{:?}", now - scheduled);
+        assert!(!t.drop_backlog(scheduled, now, ms(100)), "60 ms is within 100 ms");
+        // Kept: the next missed tick is due already, long before now.
+        let next = t.tick().await;
+        assert!(next < now, "{:?} after now", next - now);
+        assert!(
+            t.drop_backlog(next, Instant::now(), ms(20)),
+            "about 60 ms behind, over 20 ms"
+        );
+        let after_drop = t.tick().await;
+        assert!(
+            after_drop > now,
+            "after a drop the next tick is one period after the check"
+        );
     }
 
     #[tokio::test(flavor = "current_thread")]

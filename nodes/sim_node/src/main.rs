@@ -48,6 +48,7 @@ struct SimConfig {
     command_timeout_s: f64,
     publish_clock: bool,
     real_time_factor: f64,
+    clock_catch_up_s: f64,
     lidar_enabled: bool,
     lidar: LidarConfig,
     world_frame: String,
@@ -137,6 +138,14 @@ impl Config for SimConfig {
             c.real_time_factor = v
         })
         .within(0.01, 100.0);
+        // The simulated clock's backlog bound: see the tick arm of the loop.
+        d.double(
+            "clock_catch_up_s",
+            0.01,
+            "with publish_clock: a stall longer than this [wall s] slows simulated time instead of being caught up",
+            |c, v| c.clock_catch_up_s = v,
+        )
+        .within(0.0, 1.0);
         d.boolean("lidar.enabled", true, "publish scan", |c, v| c.lidar_enabled = v);
         d.double("lidar.fov", lidar.fov, "field of view [rad]", |c, v| c.lidar.fov = v)
             .within(0.01, std::f64::consts::TAU);
@@ -421,7 +430,19 @@ async fn run(node: &mut RosNode) -> anyhow::Result<()> {
                 // Logged (rate-limited) by the inputs.
                 Command::Undecodable => plant.stop(),
             },
-            _ = tick.tick() => {
+            scheduled = tick.tick() => {
+                // With its own clock the simulation never runs ahead of the nodes it drives by
+                // more than clock_catch_up_s of wall time: after a longer stall (this process,
+                // or a machine short of CPU) it goes on from where it stood, rather than
+                // stepping through the backlog at once while they still act on old samples.
+                // Without it the stamps are wall time, which the catch-up keeps.
+                if config.publish_clock {
+                    let _ = tick.drop_backlog(
+                        scheduled,
+                        tokio::time::Instant::now(),
+                        Duration::from_secs_f64(config.clock_catch_up_s),
+                    );
+                }
                 if watch.check(config.command_timeout_s, Instant::now()) {
                     if watch.newly_stale() {
                         warn_throttled!(throttle, "cmd_timeout", "no wheel_commands for {} s: wheels stopped", config.command_timeout_s);
