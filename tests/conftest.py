@@ -67,6 +67,29 @@ def pytest_report_header(config: pytest.Config) -> list[str]:
             f"mobil: FASTRTPS_DEFAULT_PROFILES_FILE={os.environ.get('FASTRTPS_DEFAULT_PROFILES_FILE')}"]
 
 
+# Closed-loop scenarios: a simulation at several times real time with the nodes under test in
+# its loop (the fixtures that start one, or the ``closed_loop`` marker, tests/pytest.ini). Under pytest-xdist (tests/run_all: two workers, ``--dist loadgroup``) they form one
+# group, run one after another on one worker, first, while the other worker takes every other
+# test: two such loops on two cores each lose the CPU to the other now and then, and at 5x real
+# time a 20 ms stall of the navigator is 0.1 simulated seconds of driving on an old command (a
+# U-trap run touched its wall that way). Every other test is its own unit of work.
+CLOSED_LOOP_FIXTURES = frozenset({"start_scenario", "sim_clock"})
+CLOSED_LOOP_GROUP = "closed_loop"
+
+
+def is_closed_loop(item: pytest.Item) -> bool:
+    return (item.get_closest_marker("closed_loop") is not None
+            or bool(CLOSED_LOOP_FIXTURES.intersection(getattr(item, "fixturenames", ()))))
+
+
+def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item]) -> None:
+    # Stable: within each part the collection order stays (every worker collects the same).
+    items.sort(key=lambda item: not is_closed_loop(item))
+    for item in items:
+        if is_closed_loop(item):
+            item.add_marker(pytest.mark.xdist_group(CLOSED_LOOP_GROUP))
+
+
 @pytest.hookimpl(hookwrapper=True)
 def pytest_runtest_makereport(item: pytest.Item, call: pytest.CallInfo) -> Iterator[None]:
     """On failure, attach the log tail of every node process the test started."""

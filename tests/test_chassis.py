@@ -531,6 +531,7 @@ def test_sim_publishes_the_world_for_rviz(start_node, ros_node):
     assert (pillar.pose.position.x, pillar.pose.position.y, pillar.scale.x) == (1.0, 1.5, pytest.approx(0.6))
 
 
+@pytest.mark.closed_loop
 def test_sim_runs_faster_than_real_time_on_a_simulated_clock(start_node, ros_node):
     from rosgraph_msgs.msg import Clock
     start_node("sim_node", *NO_LIDAR, "-p", "publish_clock:=true", "-p", "real_time_factor:=4.0",
