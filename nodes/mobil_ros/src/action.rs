@@ -117,6 +117,9 @@ pub enum ActionError {
 /// The longest [`GoalServer::close`] waits for queued results.
 pub const CLOSE_WAIT: Duration = Duration::from_secs(2);
 
+/// The longest [`GoalServer::close`] then waits for the clients to acknowledge the results.
+pub const RESULT_ACK_WAIT: Duration = Duration::from_millis(500);
+
 /// Settings of a [`GoalServer`].
 #[derive(Debug, Clone, PartialEq)]
 pub struct GoalServerConfig {
@@ -392,7 +395,11 @@ where
 
     /// Ends the active goal (if any) ABORTED with `result`, then waits until the queued results
     /// are delivered, at most [`CLOSE_WAIT`] (a node shutting down must not hang on a client
-    /// that never asks for its result); what is left then is dropped with a warning.
+    /// that never asks for its result); what is left then is dropped with a warning. Last, it
+    /// waits up to [`RESULT_ACK_WAIT`] for the clients to acknowledge the results sent: the
+    /// server's endpoints are disposed when it is dropped, and a peer that learns of the dispose
+    /// before it has taken a result in flight drops the result (Fast DDS reads discovery and
+    /// data on different threads: an rclpy client's result at shutdown went missing that way).
     pub async fn close(mut self, result: A::Result) {
         if self.active.is_some() {
             self.finish(GoalEnd::Aborted, result);
@@ -407,6 +414,14 @@ where
                 );
                 task.abort();
             }
+        }
+        let server = self.server.clone();
+        let acked = tokio::task::spawn_blocking(move || server.wait_for_result_acknowledgments(RESULT_ACK_WAIT)).await;
+        if !matches!(acked, Ok(Ok(true))) {
+            warn!(
+                "{}: results not acknowledged by every client within {RESULT_ACK_WAIT:?} at close",
+                self.name
+            );
         }
     }
 

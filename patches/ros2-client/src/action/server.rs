@@ -534,6 +534,23 @@ where
   // goal got canceled. But we have to send something in the ResultResponse.
   // And where does it say that result is not significant if cancelled or
   // aborted?
+  /// Waits until the result responses sent so far are acknowledged by every
+  /// matched client, or `max_wait` has passed; see
+  /// [`crate::service::Server::wait_for_acknowledgments`]. Blocks the calling
+  /// thread for at most `max_wait`.
+  pub fn wait_for_result_acknowledgments(
+    &self,
+    max_wait: std::time::Duration,
+  ) -> WriteResult<bool, ()>
+  where
+    R: 'static,
+  {
+    self
+      .actionserver
+      .my_result_server
+      .wait_for_acknowledgments(max_wait)
+  }
+
   pub async fn send_result_response(
     &self,
     handle: ExecutingGoalHandle<G>,

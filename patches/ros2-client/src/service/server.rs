@@ -152,6 +152,19 @@ where
     ))
   }
 
+  /// Waits until every matched reliable reader has acknowledged every response
+  /// sent so far, or `max_wait` has passed (DDS `wait_for_acknowledgments`).
+  /// `Ok(true)`: acknowledged, or no reliable reader is matched; `Ok(false)`:
+  /// timed out. Blocks the calling thread for at most `max_wait`. A server about
+  /// to be dropped calls it so that its last responses are received before its
+  /// endpoints are disposed.
+  pub fn wait_for_acknowledgments(&self, max_wait: std::time::Duration) -> WriteResult<bool, ()> {
+    self
+      .response_sender
+      .wait_for_acknowledgments(max_wait)
+      .map_err(Into::into)
+  }
+
   /// Asynchronous response sending
   pub async fn async_send_response(
     &self,
