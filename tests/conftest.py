@@ -82,6 +82,9 @@ def is_closed_loop(item: pytest.Item) -> bool:
             or bool(CLOSED_LOOP_FIXTURES.intersection(getattr(item, "fixturenames", ()))))
 
 
+# tryfirst: pytest-xdist's own hook (registered later, so called earlier by default) turns the
+# xdist_group markers into the group suffix of each test id; it must find them set.
+@pytest.hookimpl(tryfirst=True)
 def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item]) -> None:
     # Stable: within each part the collection order stays (every worker collects the same).
     items.sort(key=lambda item: not is_closed_loop(item))

@@ -36,7 +36,9 @@ PIP_PACKAGES=(
   ros-jazzy-ament-package ros-jazzy-ament-cmake-include-directories ros-jazzy-rosidl-core-generators
   ros-jazzy-ament-cmake-ros ros-jazzy-ament-cmake-gmock ros-jazzy-ament-cmake-gtest
   ros-jazzy-ament-cmake-pytest ros-jazzy-python-cmake-module
-  pytest pytest-timeout pytest-xdist pyyaml
+  # pytest 9 reads a test's id from Node._id, while pytest-xdist 3.8 marks a test's xdist_group
+  # by rewriting Node._nodeid: under pytest 9 --dist loadgroup groups nothing.
+  "pytest>=8.4,<9" pytest-timeout "pytest-xdist>=3.8,<4" pyyaml
 )
 stamp_pip="$VENV/.mobil-pip-stamp"
 want_pip="$(printf '%s\n' "${PIP_PACKAGES[@]}" | sha256sum | cut -d' ' -f1)"

@@ -73,6 +73,7 @@ def test_robot_script_starts_its_nodes_and_stopping_it_stops_them_all(robot, mod
         log.close()
 
 
+@pytest.mark.closed_loop  # the demo runs sim_node at 3x and 8x with the nodes in its loop
 @pytest.mark.timeout(170)
 def test_demo_drives_the_route_and_plots_it():
     out = subprocess.run([str(ROOT / "launch_scripts" / "demo")], env=_script_env(), capture_output=True,

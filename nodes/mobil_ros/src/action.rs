@@ -416,12 +416,14 @@ where
             }
         }
         let server = self.server.clone();
-        let acked = tokio::task::spawn_blocking(move || server.wait_for_result_acknowledgments(RESULT_ACK_WAIT)).await;
-        if !matches!(acked, Ok(Ok(true))) {
-            warn!(
+        match tokio::task::spawn_blocking(move || server.wait_for_result_acknowledgments(RESULT_ACK_WAIT)).await {
+            Ok(Ok(true)) => {}
+            Ok(Ok(false)) => warn!(
                 "{}: results not acknowledged by every client within {RESULT_ACK_WAIT:?} at close",
                 self.name
-            );
+            ),
+            Ok(Err(e)) => warn!("{}: cannot wait for the results' acknowledgments: {e:?}", self.name),
+            Err(e) => warn!("{}: the wait for the results' acknowledgments failed: {e}", self.name),
         }
     }
 

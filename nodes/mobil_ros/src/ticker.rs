@@ -90,7 +90,7 @@ impl Ticker {
 
     /// A burst ticker that has fallen more than `max_lag` behind its schedule (the tick
     /// `scheduled` for then, handled at `now`) forgets the ticks it missed: the next one comes
-    /// one period after `now`. Returns whether it did. A simulator publishing its own clock
+    /// one period after this call. Returns whether it did. A simulator publishing its own clock
     /// calls it on every tick, so that after a stall simulated time goes on at its rate from
     /// where it stood instead of racing through the backlog faster than the nodes it drives can
     /// react; below `max_lag` the burst keeps the rate against timer jitter.
@@ -147,7 +147,8 @@ mod tests {
     }
 
     // A stall of 60 ms at 1 kHz: a burst ticker owes 60 ticks. Within the allowed lag it pays
-    // them at once; beyond it the backlog is dropped and the next tick is one period away.
+    // them at once; beyond it (20 ms, less than the stall) the backlog is dropped and the next
+    // tick is one period away.
     #[tokio::test(flavor = "current_thread")]
     async fn a_burst_ticker_drops_a_backlog_beyond_the_allowed_lag() {
         let ms = Duration::from_millis;
@@ -157,7 +158,9 @@ mod tests {
         let scheduled = t.tick().await;
         let now = Instant::now();
         assert!(now - scheduled >= ms(59), "{:?}", now - scheduled);
-        assert!(!t.drop_backlog(scheduled, now, ms(100)), "60 ms is within 100 ms");
+        // Only lower bounds of the lag are known on a loaded machine: a bound of 10 s is never
+        // exceeded here.
+        assert!(!t.drop_backlog(scheduled, now, ms(10_000)), "within 10 s");
         // Kept: the next missed tick is due already, long before now.
         let next = t.tick().await;
         assert!(next < now, "{:?} after now", next - now);

@@ -525,15 +525,6 @@ where
     }
   }
 
-  /// Notify Client that a goal end state was reached and
-  /// what was the result of the action.
-  /// This async will not resolve until the action client has requested for the
-  /// result, but the client should request the result as soon as server
-  /// accepts the goal.
-  // TODO: It is a bit silly that we have to supply a "result" even though
-  // goal got canceled. But we have to send something in the ResultResponse.
-  // And where does it say that result is not significant if cancelled or
-  // aborted?
   /// Waits until the result responses sent so far are acknowledged by every
   /// matched client, or `max_wait` has passed; see
   /// [`crate::service::Server::wait_for_acknowledgments`]. Blocks the calling
@@ -551,6 +542,15 @@ where
       .wait_for_acknowledgments(max_wait)
   }
 
+  /// Notify Client that a goal end state was reached and
+  /// what was the result of the action.
+  /// This async will not resolve until the action client has requested for the
+  /// result, but the client should request the result as soon as server
+  /// accepts the goal.
+  // TODO: It is a bit silly that we have to supply a "result" even though
+  // goal got canceled. But we have to send something in the ResultResponse.
+  // And where does it say that result is not significant if cancelled or
+  // aborted?
   pub async fn send_result_response(
     &self,
     handle: ExecutingGoalHandle<G>,
