@@ -68,7 +68,8 @@ def pytest_report_header(config: pytest.Config) -> list[str]:
 
 
 # Closed-loop scenarios: a simulation at several times real time with the nodes under test in
-# its loop (the fixtures that start one, or the ``closed_loop`` marker, tests/pytest.ini). Under pytest-xdist (tests/run_all: two workers, ``--dist loadgroup``) they form one
+# its loop (the fixtures that start one, or the ``closed_loop`` marker, tests/pytest.ini, also on
+# a real-time drive whose legs the test times itself). Under pytest-xdist (tests/run_all: two workers, ``--dist loadgroup``) they form one
 # group, run one after another on one worker, first, while the other worker takes every other
 # test: two such loops on two cores each lose the CPU to the other now and then, and at 5x real
 # time a 20 ms stall of the navigator is 0.1 simulated seconds of driving on an old command (a

@@ -168,6 +168,9 @@ def circle_through(a, b, c) -> tuple[float, float, float]:
     return ux, uy, math.hypot(ax - ux, ay - uy)
 
 
+# Closed loop in real time: the route's legs are timed by this process's sleeps, so a worker
+# beside it that takes the CPU shortens the drive (4.62 m of 5.07 once, beside the fuzz test).
+@pytest.mark.closed_loop
 def test_odometry_within_half_a_percent_of_ground_truth_over_a_5_m_route(start_node, ros_node):
     """An rclpy program drives the simulated MOBIL-II over 5 m with cmd_vel (no noise).
 
