@@ -1,5 +1,6 @@
 //! Planar geometry shared by the mobil suite, ROS-free (nalgebra only): angle wrapping, 2D poses
-//! and frame composition, and the checked laser scan every navigation node reads.
+//! and frame composition, the checked laser scan every navigation node reads, and the sketch
+//! (shapes in the plane) a node draws.
 //!
 //! Frames follow REP-103 (x forward, y left, yaw counter-clockwise about z) and are named rerun
 //! style: `odom_from_base` is the pose of `base` in `odom`, and maps points from `base` to `odom`.
@@ -25,6 +26,7 @@ pub mod angle;
 pub mod pose;
 pub mod sample;
 pub mod scan;
+pub mod sketch;
 
 pub use angle::wrap;
 pub use pose::Pose2;

@@ -19,6 +19,7 @@
 //! ```
 
 use crate::geometry::yaw_quaternion;
+use mobil_geom::sketch::{Rgba, Shape, Sketch};
 use mobil_geom::Pose2;
 use mobil_msgs::builtin_interfaces::msg::Time;
 use mobil_msgs::geometry_msgs::msg::{Point, Vector3};
@@ -34,6 +35,16 @@ pub fn rgb(r: f32, g: f32, b: f32) -> ColorRGBA {
 /// A colour with its opacity.
 pub fn rgba(r: f32, g: f32, b: f32, a: f32) -> ColorRGBA {
     ColorRGBA { r, g, b, a }
+}
+
+/// The message colour of a sketch's colour.
+pub fn colour(c: Rgba) -> ColorRGBA {
+    ColorRGBA {
+        r: c.r,
+        g: c.g,
+        b: c.b,
+        a: c.a,
+    }
 }
 
 /// A point of the plane at height `z`.
@@ -210,6 +221,22 @@ impl Markers {
         m
     }
 
+    /// Adds every shape of `sketch`, in order, one marker each.
+    pub fn sketch(&mut self, sketch: &Sketch) -> &mut Self {
+        for item in &sketch.items {
+            let (ns, id, c) = (item.ns, item.id, colour(item.colour));
+            match &item.shape {
+                Shape::Line { points, width } => self.line_strip(ns, id, points.iter().copied(), *width, c),
+                Shape::Dots { points, diameter } => self.dots(ns, id, points.iter().copied(), *diameter, c),
+                Shape::Sphere { at, diameter } => self.sphere(ns, id, *at, *diameter, c),
+                Shape::Disc { at, radius, height } => self.disc(ns, id, *at, (*radius, *height), c),
+                Shape::Arrow { pose, length, width } => self.arrow(ns, id, pose, (*length, *width), c),
+                Shape::Text { at, z, height, text } => self.text(ns, id, (*at, *z), *height, c, text.clone()),
+            };
+        }
+        self
+    }
+
     /// The markers added so far.
     pub fn len(&self) -> usize {
         self.markers.len()
@@ -277,5 +304,54 @@ mod tests {
         );
         assert_eq!((gone.action, gone.ns.as_str(), gone.id), (Marker::DELETE, "goal", 4));
         assert!(a.markers.iter().take(3).all(|k| k.action == Marker::ADD));
+    }
+
+    #[test]
+    fn a_sketch_draws_the_markers_its_shapes_name() {
+        let (stamp, blue) = (Time { sec: 1, nanosec: 2 }, Rgba::rgb(0.2, 0.6, 1.0));
+        let route = vec![Point2::new(0.0, 0.0), Point2::new(1.0, 0.5)];
+        let mut s = Sketch::default();
+        s.line("route", 0, route.clone(), 0.02, blue);
+        s.dots("route", 1, route.clone(), 0.12, blue);
+        s.sphere("p", 0, Point2::new(1.0, 0.0), 0.2, Rgba::rgb(0.9, 0.0, 0.0));
+        s.disc(
+            "z",
+            4,
+            Point2::new(2.0, 0.0),
+            (0.4, 0.05),
+            Rgba::new(1.0, 0.9, 0.2, 0.25),
+        );
+        s.arrow(
+            "dock",
+            0,
+            Pose2::new(1.0, 2.0, 0.5),
+            (0.4, 0.06),
+            Rgba::rgb(1.0, 0.5, 0.0),
+        );
+        s.text(
+            "t",
+            1,
+            (Point2::new(0.5, 0.5), 0.3),
+            0.12,
+            Rgba::rgb(1.0, 1.0, 1.0),
+            "w".into(),
+        );
+        let mut drawn = Markers::new(stamp.clone(), "odom");
+        drawn.sketch(&s);
+        let mut by_hand = Markers::new(stamp, "odom");
+        by_hand.line_strip("route", 0, route.iter().copied(), 0.02, rgb(0.2, 0.6, 1.0));
+        by_hand.dots("route", 1, route, 0.12, rgb(0.2, 0.6, 1.0));
+        by_hand.sphere("p", 0, Point2::new(1.0, 0.0), 0.2, rgb(0.9, 0.0, 0.0));
+        by_hand.disc("z", 4, Point2::new(2.0, 0.0), (0.4, 0.05), rgba(1.0, 0.9, 0.2, 0.25));
+        by_hand.arrow("dock", 0, &Pose2::new(1.0, 2.0, 0.5), (0.4, 0.06), rgb(1.0, 0.5, 0.0));
+        by_hand.text(
+            "t",
+            1,
+            (Point2::new(0.5, 0.5), 0.3),
+            0.12,
+            rgb(1.0, 1.0, 1.0),
+            "w".into(),
+        );
+        assert_eq!(drawn.array(), by_hand.array());
     }
 }

@@ -19,6 +19,8 @@
 //! - [`route`]: the route pre-check — a virtual robot drives the route on the chassis model
 //!   against a [`mobil_world::World`] and reports every collision, turn below the minimum
 //!   radius and unreachable waypoint with its index.
+//! - [`view`]: what the planner draws (route, prediction, problems, dock, a VFO optimisation)
+//!   as a ROS-free sketch within one budget of points.
 //!
 //! Where the SPEC leaves a choice open, the library chooses as follows (each tested in
 //! `tests/`):
@@ -108,6 +110,7 @@ pub mod route;
 pub mod sim;
 pub mod task;
 pub mod vfo;
+pub mod view;
 
 pub use approach::{
     approach, approach_step, shortest_step, ApproachConfig, ApproachEnd, ApproachOutcome, ApproachRun, ApproachStep,

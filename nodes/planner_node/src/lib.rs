@@ -11,7 +11,6 @@
 use mobil_chassis::model::ChassisConfig;
 use mobil_chassis::ChassisParams;
 use mobil_geom::downsample;
-use mobil_geom::Pose2;
 use mobil_msgs::builtin_interfaces::msg::Time;
 use mobil_msgs::geometry_msgs::msg::PoseStamped;
 use mobil_msgs::mobil_msgs::msg::{NavStatus, RouteProblem as ProblemMsg};
@@ -22,7 +21,6 @@ use mobil_msgs::nav_msgs::msg::Path;
 use mobil_msgs::std_msgs::msg::Header;
 use mobil_msgs::visualization_msgs::msg::MarkerArray;
 pub use mobil_planner::goals::{list_missed, missed_from_report, route_infeasible, Missed, MISSED_BY_THE_RUN};
-use mobil_planner::vfo::{VfoDrawing, MAX_DRAWN_OBSTACLES, MAX_DRAWN_ROBOTS};
 use mobil_planner::{DockingConfig, DockingGains, FollowConfig, RouteCheckConfig, RouteReport};
 use mobil_ros::chassis::{chassis_params, declare_chassis};
 use mobil_ros::config::{Config, ConfigError, Decl};
@@ -30,11 +28,10 @@ use mobil_ros::geometry::pose_msg;
 use mobil_ros::goal::RouteLimits;
 pub use mobil_ros::goal::{GoalError, Route};
 use mobil_ros::groups::{Frames, GoalTimeouts};
-use mobil_ros::markers::{point, rgb, rgba, Markers};
+use mobil_ros::markers::{point, Markers};
 use mobil_ros::motion::{EndCause, EndKind};
 use mobil_ros::status::{NavStatusView, VfoFigures};
 use mobil_world::World;
-use nalgebra::Point2;
 
 pub mod vfo;
 
@@ -360,133 +357,27 @@ pub fn status_view(state: u8, reason: String, figures: Option<&Figures>) -> NavS
     }
 }
 
-/// Most points of the predicted path drawn.
-pub const MAX_DRAWN_PATH: usize = 300;
+pub use mobil_planner::view::{MarkerView, MAX_DRAWN_PATH, MAX_MARKER_POINTS};
 
-/// What the markers show.
-#[derive(Debug, Clone, Default)]
-pub struct MarkerView<'a> {
-    /// The route's waypoints.
-    pub route: &'a [Point2<f64>],
-    /// The virtual robot's predicted path.
-    pub predicted: &'a [Pose2],
-    /// The problems (position and text).
-    pub problems: &'a [Missed],
-    /// The dock pose.
-    pub dock: Option<Pose2>,
-    /// A VFO route's last optimisation.
-    pub vfo: Option<&'a VfoDrawing>,
-    /// The robot's position: the obstacles nearest to it are drawn first.
-    pub robot: Option<Point2<f64>>,
-}
-
-/// Most points over the whole marker array — the route's line and dots, the predicted path,
-/// the virtual robots' paths and the chosen one — shared among them by [`markers`]: 24 bytes
-/// each in CDR, 24 KB. With the markers' own bytes (about 250 each, at most
-/// 2 + 1 + 2·[`MAX_LISTED_PROBLEMS`] + 1 + [`MAX_DRAWN_ROBOTS`] + 1 +
-/// 2·[`MAX_DRAWN_OBSTACLES`] of them) the array stays below the 80 KB a message to rclpy
-/// should stay below (tested on the worst case).
-pub const MAX_MARKER_POINTS: usize = 1000;
-
-/// The marker array: a DELETEALL first (so nothing stale stays), the route as a LINE_STRIP and
-/// a SPHERE_LIST of its waypoints, the predicted path as a LINE_STRIP (at most
-/// [`MAX_DRAWN_PATH`] points), each problem (at most [`MAX_LISTED_PROBLEMS`]) as a red SPHERE
-/// and a TEXT_VIEW_FACING at its place, the dock pose as an ARROW, and a VFO optimisation
-/// (below). The points share one budget, [`MAX_MARKER_POINTS`]: the route takes up to
-/// half of it (its line and dots, a quarter each, downsampled beyond), the predicted path up to
-/// a quarter of the rest, the VFO paths what remains.
+/// The marker array of `view`: a DELETEALL first (so nothing stale stays), then its sketch
+/// ([`MarkerView::sketch`]), one marker per shape.
 pub fn markers(view: &MarkerView<'_>, stamp: Time, frame: &str) -> MarkerArray {
     let mut m = Markers::replacing(stamp, frame);
-    let mut budget = MAX_MARKER_POINTS;
-    if !view.route.is_empty() {
-        let route = downsample(view.route, MAX_MARKER_POINTS / 4);
-        budget -= 2 * route.len();
-        let blue = rgb(0.2, 0.6, 1.0);
-        m.line_strip("route", 0, route.iter().copied(), 0.02, blue.clone());
-        m.dots("route", 1, route, 0.12, blue);
-    }
-    if !view.predicted.is_empty() {
-        let path = downsample(view.predicted, MAX_DRAWN_PATH.min(budget / 4));
-        budget -= path.len();
-        m.line_strip(
-            "predicted",
-            0,
-            path.iter().map(|p| p.position()),
-            0.015,
-            rgb(0.0, 0.8, 0.0),
-        );
-    }
-    for (i, p) in view.problems.iter().take(MAX_LISTED_PROBLEMS).enumerate() {
-        let id = i32::try_from(i).unwrap_or(i32::MAX);
-        m.sphere("problems", id, p.position, 0.2, rgb(0.9, 0.0, 0.0));
-        m.text(
-            "problem_text",
-            id,
-            (p.position, 0.3),
-            0.12,
-            rgb(1.0, 1.0, 1.0),
-            p.describe(),
-        );
-    }
-    if let Some(d) = view.dock {
-        m.arrow("dock", 0, &d, (0.4, 0.06), rgb(1.0, 0.5, 0.0));
-    }
-    if let Some(drawing) = view.vfo {
-        vfo_markers(&mut m, drawing, view.robot, budget);
-    }
+    m.sketch(&view.sketch());
     m.array()
-}
-
-/// A VFO optimisation's markers: each virtual robot's path a thin LINE_STRIP (`vfo_robots`,
-/// grey; orange where the path was dropped on a collision or the time cap), the chosen path a
-/// thick green one (`vfo_chosen`), each obstacle (at most [`MAX_DRAWN_OBSTACLES`], the
-/// nearest to `robot` first) a red CYLINDER of radius r (`vfo_forbidden`) inside a pale yellow
-/// one of radius R (`vfo_influence`). The paths share `budget` points: the chosen one up to a
-/// third, the virtual robots the rest, evenly (at least two points each, so the first
-/// `budget / 2` robots at most).
-fn vfo_markers(m: &mut Markers, drawing: &VfoDrawing, robot: Option<Point2<f64>>, budget: usize) {
-    let chosen = downsample(&drawing.chosen, budget / 3);
-    let rest = budget - chosen.len();
-    let robots = &drawing.robots[..drawing.robots.len().min(rest / 2).min(MAX_DRAWN_ROBOTS)];
-    let per_robot = (rest / robots.len().max(1)).max(2);
-    for (i, r) in robots.iter().enumerate() {
-        let id = i32::try_from(i).unwrap_or(i32::MAX);
-        let c = if r.dropped {
-            rgb(1.0, 0.5, 0.0)
-        } else {
-            rgb(0.6, 0.6, 0.6)
-        };
-        m.line_strip("vfo_robots", id, downsample(&r.points, per_robot), 0.01, c);
-    }
-    if !chosen.is_empty() {
-        m.line_strip("vfo_chosen", 0, chosen, 0.04, rgb(0.0, 0.9, 0.2));
-    }
-    let mut order: Vec<usize> = (0..drawing.obstacles.len()).collect();
-    if let Some(at) = robot {
-        order.sort_by(|&a, &b| {
-            drawing.obstacles[a]
-                .distance(&at)
-                .total_cmp(&drawing.obstacles[b].distance(&at))
-        });
-    }
-    for (k, &i) in order.iter().take(MAX_DRAWN_OBSTACLES).enumerate() {
-        let (o, id) = (&drawing.obstacles[i], i32::try_from(k).unwrap_or(i32::MAX));
-        let zone = (o.influence_radius(), 0.02);
-        m.disc("vfo_influence", id, o.centre(), zone, rgba(1.0, 0.9, 0.2, 0.25));
-        let forbidden = (o.forbidden_radius(), 0.05);
-        m.disc("vfo_forbidden", id, o.centre(), forbidden, rgba(0.9, 0.1, 0.1, 0.6));
-    }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
     use approx::assert_relative_eq;
+    use mobil_geom::Pose2;
     use mobil_motion::Outcome;
     use mobil_msgs::visualization_msgs::msg::Marker;
     use mobil_planner::ProblemKind;
     use mobil_ros::geometry::{header_in, pose_stamped, yaw_of};
     use mobil_ros::params::ParamValues;
+    use nalgebra::Point2;
 
     fn stamped(frame: &str, x: f64, y: f64) -> PoseStamped {
         pose_stamped(header_in(frame), &Pose2::new(x, y, 0.0))
