@@ -135,10 +135,6 @@ impl std::str::FromStr for SetName {
     }
 }
 
-fn count(v: i64) -> u32 {
-    u32::try_from(v).unwrap_or(u32::MAX)
-}
-
 /// Declares the planner's parameters: one per [`GaitConfig`] field, with its name.
 fn declare_gait(d: &mut Decl<GaitConfig>) {
     let c = GaitConfig::default();
@@ -167,11 +163,11 @@ fn declare_gait(d: &mut Decl<GaitConfig>) {
         |c, v| c.goal_tolerance = v,
     )
     .above(0.0);
-    d.integer(
+    d.count(
         "max_expansions",
-        i64::from(c.max_expansions),
+        c.max_expansions,
         "expansion limit of a search (a request's 0 means this)",
-        |c, v| c.max_expansions = count(v),
+        |c, v| c.max_expansions = v,
     )
     .within(1.0, f64::from(u32::MAX));
     d.parsed::<LegAngleReading>(
@@ -213,25 +209,25 @@ fn declare_gait(d: &mut Decl<GaitConfig>) {
 /// Declares the node's own parameters.
 fn declare_node(d: &mut Decl<NodeParams>) {
     let c = NodeParams::default();
-    d.integer(
+    d.count(
         "max_expansions_limit",
-        i64::from(c.max_expansions_limit),
+        c.max_expansions_limit,
         "most expansions a gait/compute_plan request may ask for (larger requests are capped)",
-        |c, v| c.max_expansions_limit = count(v),
+        |c, v| c.max_expansions_limit = v,
     )
     .within(1.0, f64::from(u32::MAX));
-    d.integer(
+    d.count(
         "max_generated_states",
-        i64::from(c.max_generated_states),
+        c.max_generated_states,
         "most states one search may generate, its memory: expansions are capped to this over 2 × the rule count",
-        |c, v| c.max_generated_states = count(v),
+        |c, v| c.max_generated_states = v,
     )
     .within(100.0, f64::from(u32::MAX));
-    d.integer(
+    d.count(
         "max_plan_states",
-        i64::from(c.max_plan_states),
+        c.max_plan_states,
         "most states of a plan sent in a reply or on gait/plan; a longer plan is truncated (success false)",
-        |c, v| c.max_plan_states = count(v),
+        |c, v| c.max_plan_states = v,
     )
     .within(2.0, 100_000.0);
     d.double(
@@ -261,25 +257,25 @@ fn declare_node(d: &mut Decl<NodeParams>) {
         |c, v| c.walk_rule_set = v.0,
     )
     .choices(&["A", "B"]);
-    d.integer(
+    d.count(
         "walk_evaluation",
-        i64::from(c.walk_evaluation),
+        c.walk_evaluation,
         "evaluation function (1, 2 or 3) of the walk's short-time plans",
-        |c, v| c.walk_evaluation = u8::try_from(v).unwrap_or(0),
+        |c, v| c.walk_evaluation = v,
     )
     .within(1.0, 3.0);
-    d.integer(
+    d.count(
         "walk_chunk_expansions",
-        i64::from(c.walk_chunk_expansions),
+        c.walk_chunk_expansions,
         "expansion cap of each short-time plan of the walk",
-        |c, v| c.walk_chunk_expansions = count(v),
+        |c, v| c.walk_chunk_expansions = v,
     )
     .within(1.0, f64::from(u32::MAX));
-    d.integer(
+    d.count(
         "walk_execute_moves",
-        i64::from(c.walk_execute_moves),
+        c.walk_execute_moves,
         "moves executed from each short-time plan before replanning",
-        |c, v| c.walk_execute_moves = count(v),
+        |c, v| c.walk_execute_moves = v,
     )
     .within(1.0, 1000.0);
     d.double(
@@ -289,11 +285,11 @@ fn declare_node(d: &mut Decl<NodeParams>) {
         |c, v| c.walk_move_period_s = v,
     )
     .within(0.001, 60.0);
-    d.integer(
+    d.count(
         "walk_max_chunks",
-        i64::from(c.walk_max_chunks),
+        c.walk_max_chunks,
         "short-time plans after which a walk that has not reached its goal gives up",
-        |c, v| c.walk_max_chunks = count(v),
+        |c, v| c.walk_max_chunks = v,
     )
     .within(1.0, 1e6);
     d.doubles(

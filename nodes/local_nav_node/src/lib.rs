@@ -84,11 +84,11 @@ impl Config for LocalNavConfig {
             |c, v| c.nav.robot_radius = v,
         )
         .min(0.0);
-        d.integer(
+        d.count(
             "sector_count",
-            n.sector_count as i64,
+            n.sector_count,
             "N, the number of sectors the scan is reduced to (eq. 3.50)",
-            |c, v| c.nav.sector_count = usize::try_from(v).unwrap_or(0),
+            |c, v| c.nav.sector_count = v,
         )
         .within(4.0, 360.0);
         d.double_list(
@@ -138,11 +138,11 @@ impl Config for LocalNavConfig {
             |c, v| c.nav.step_length = v,
         )
         .above(0.0);
-        d.integer(
+        d.count(
             "lock_steps",
-            i64::from(n.lock_steps),
+            n.lock_steps,
             "n: L-mode steps over which the progress must reach c1 (eq. 3.58)",
-            |c, v| c.nav.lock_steps = u32::try_from(v).unwrap_or(0),
+            |c, v| c.nav.lock_steps = v,
         )
         .within(1.0, 1e6);
         d.double(
@@ -151,11 +151,11 @@ impl Config for LocalNavConfig {
             "c1: least progress toward G over n steps in L-mode, else hit point H [m]",
             |c, v| c.nav.lock_min_progress = v,
         );
-        d.integer(
+        d.count(
             "track_steps",
-            i64::from(n.track_steps),
+            n.track_steps,
             "m: T-mode steps over which the progress must reach c2 (eq. 3.60)",
-            |c, v| c.nav.track_steps = u32::try_from(v).unwrap_or(0),
+            |c, v| c.nav.track_steps = v,
         )
         .within(1.0, 1e6);
         d.double(

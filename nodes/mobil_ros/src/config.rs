@@ -60,13 +60,14 @@ use thiserror::Error;
 /// #[derive(Debug, Clone, Default)]
 /// struct Limits { v_max: f64 }
 /// #[derive(Debug, Clone, Default)]
-/// struct Teleop { speed: f64, limits: Limits, frame: String }
+/// struct Teleop { speed: f64, limits: Limits, frame: String, retries: usize }
 ///
 /// impl Config for Teleop {
 ///     fn declare(d: &mut Decl<Self>) {
 ///         mobil_ros::params! { d;
 ///             double "speed" = 0.2 => speed, min(0.0); "forward speed [m/s]";
 ///             double "v_max" = 0.5 => limits.v_max, within(0.1, 2.0); "speed limit [m/s]";
+///             count "retries" = 3usize => retries, within(0.0, 10.0); "attempts after the first";
 ///             string "frame" = "base_link" => frame, read_only(); "command frame";
 ///         }
 ///     }
@@ -74,9 +75,11 @@ use thiserror::Error;
 ///
 /// let teleop: Teleop = load(&ParamValues::defaults(&Decl::<Teleop>::of().specs())).unwrap();
 /// assert_eq!((teleop.speed, teleop.limits.v_max, teleop.frame.as_str()), (0.2, 0.5, "base_link"));
+/// assert_eq!(teleop.retries, 3);
 /// ```
 ///
-/// Each row is the method call `d.KIND(NAME, DEFAULT, DESCRIPTION, |c, v| c.FIELD = v)` with
+/// Each row is the method call `d.KIND(NAME, DEFAULT, DESCRIPTION, |c, v| c.FIELD = v)` (KIND
+/// one of `double`, `integer`, `count`, `boolean`, `string`, `parsed`, `double_list`, …) with
 /// its bounds chained; a parameter whose value fills more than one field, or is converted, is
 /// declared with the method itself.
 #[macro_export]
@@ -241,6 +244,34 @@ impl<C: 'static> Decl<C> {
             Arc::new(move |c, v| match v {
                 ParameterValue::Integer(i) => {
                     set(c, *i);
+                    Ok(())
+                }
+                other => Err(wrong_type("integer", other)),
+            }),
+        )
+    }
+
+    /// An integer parameter filling a field of an integer type `T` (`usize`, `u32`, `u8`, …): a
+    /// count or an index. Its bounds should keep it within `T`; a value `T` cannot hold is
+    /// refused (never wrapped, never read as 0) with the range `T` takes.
+    pub fn count<T>(
+        &mut self,
+        name: &str,
+        default: T,
+        description: &str,
+        set: impl Fn(&mut C, T) + Send + Sync + 'static,
+    ) -> Declared<'_>
+    where
+        T: TryFrom<i64> + TryInto<i64> + Copy + Send + Sync + 'static,
+    {
+        let default = default.try_into().unwrap_or(i64::MAX);
+        let type_name = std::any::type_name::<T>();
+        self.push(
+            ParamSpec::integer(name, default, description),
+            Arc::new(move |c, v| match v {
+                ParameterValue::Integer(i) => {
+                    let value = T::try_from(*i).map_err(|_| format!("{i} does not fit a {type_name}"))?;
+                    set(c, value);
                     Ok(())
                 }
                 other => Err(wrong_type("integer", other)),
@@ -456,6 +487,35 @@ mod tests {
             }
             Ok(())
         }
+    }
+
+    #[test]
+    fn a_count_fills_its_type_and_refuses_what_it_cannot_hold() {
+        #[derive(Debug, Clone, Default)]
+        struct Counts {
+            beams: usize,
+            level: u8,
+        }
+        impl Config for Counts {
+            fn declare(d: &mut Decl<Self>) {
+                d.count("beams", 360usize, "beams", |c, v| c.beams = v);
+                d.count("level", 2u8, "level", |c, v| c.level = v);
+            }
+        }
+        let d = Decl::<Counts>::of();
+        let mut values = ParamValues::defaults(&d.specs());
+        let c = d.build(&values).expect("defaults");
+        assert_eq!((c.beams, c.level), (360, 2));
+        values.set("level", ParameterValue::Integer(300));
+        let e = d.build(&values).expect_err("300 is no u8");
+        assert_eq!(e.to_string(), "parameter `level`: 300 does not fit a u8");
+        values.set("level", ParameterValue::Integer(3));
+        values.set("beams", ParameterValue::Integer(-1));
+        assert!(d
+            .build(&values)
+            .expect_err("no negative count")
+            .to_string()
+            .contains("-1 does not fit a usize"));
     }
 
     #[test]

@@ -18,8 +18,6 @@ pub fn declare_vfo(d: &mut Decl<PlannerConfig>) {
     let w = QualityWeights::default();
     let s = ScanObstacleConfig::default();
     let v = VfoSettings::default();
-    // A count: a negative value is refused by the bound, and reads as 0 should one get through.
-    let count = |x: i64| usize::try_from(x).unwrap_or(0);
     mobil_ros::params! { d;
         parsed "waypoint_method" = "approach" => waypoint_method, choices(&["approach", "vfo"]);
             "how waypoints and follow_waypoints are followed: approach (the goal approach after the route \
@@ -47,69 +45,34 @@ pub fn declare_vfo(d: &mut Decl<PlannerConfig>) {
             "K_S, the weight of smoothness in Ψ_z (eq. 22)";
         double "vfo.time_step" = o.time_step => vfo.optimise.time_step, above(0.0), max(0.1);
             "T_p, the virtual robots' integration step; set it to the odometry period the node steps on [s]";
-    }
-    d.integer(
-        "vfo.max_virtual_robots",
-        o.max_virtual_robots as i64,
-        "most virtual robots per optimisation (then the best so far, with a warning)",
-        move |c, x| c.vfo.optimise.max_virtual_robots = count(x),
-    )
-    .min(1.0);
-    mobil_ros::params! { d;
+        count "vfo.max_virtual_robots" = o.max_virtual_robots => vfo.optimise.max_virtual_robots, min(1.0);
+            "most virtual robots per optimisation (then the best so far, with a warning)";
         double "vfo.max_path_time_s" = o.max_path_time_s => vfo.optimise.max_path_time_s, above(0.0);
             "a virtual robot's path longer than this in simulated time is dropped [s]";
         double "vfo.max_total_time_s" = o.max_total_time_s => vfo.optimise.max_total_time_s, above(0.0);
             "most simulated time over all virtual robots of one optimisation [s]";
-    }
-    d.integer(
-        "vfo.threads",
-        o.threads as i64,
-        "threads for a batch of virtual robots (0: every core)",
-        move |c, x| c.vfo.optimise.threads = count(x),
-    )
-    .min(0.0);
-    mobil_ros::params! { d;
+        count "vfo.threads" = o.threads => vfo.optimise.threads, min(0.0);
+            "threads for a batch of virtual robots (0: every core)";
         double "vfo.influence_margin" = s.influence_margin => vfo.scan.influence_margin, above(0.0);
             "R − r of every obstacle seen [m]";
         double "vfo.cluster_gap" = s.cluster_gap => vfo.scan.cluster_gap, above(0.0);
             "largest gap between the echoes of one obstacle (plus two beam spacings) [m]";
-    }
-    d.integer(
-        "vfo.min_points",
-        s.min_points as i64,
-        "fewest echoes of one obstacle",
-        move |c, x| c.vfo.scan.min_points = count(x),
-    )
-    .min(3.0);
-    mobil_ros::params! { d;
+        count "vfo.min_points" = s.min_points => vfo.scan.min_points, min(3.0);
+            "fewest echoes of one obstacle";
         double "vfo.max_radius" = s.max_radius => vfo.scan.max_radius, above(0.0);
             "largest circle fitted to one cluster; larger shapes become chains of circles [m]";
         double "vfo.association_distance" = s.association_distance => vfo.scan.association_distance, above(0.0);
             "circles whose centres lie nearer than this are one obstacle [m]";
-    }
-    d.integer(
-        "vfo.memory",
-        s.memory as i64,
-        "detections an obstacle's running mean remembers",
-        move |c, x| c.vfo.scan.memory = count(x),
-    )
-    .min(1.0);
-    mobil_ros::params! { d;
+        count "vfo.memory" = s.memory => vfo.scan.memory, min(1.0);
+            "detections an obstacle's running mean remembers";
         double "vfo.optimise_budget_s" = v.optimise_budget_s => vfo.optimise_budget_s, above(0.0),
             max(MAX_OPTIMISE_BUDGET_S);
             "wall-clock budget of one optimisation: then the best Σ so far, with a warning (the robot stands \
              meanwhile) [s]";
         double "vfo.decay_s" = s.decay_s => vfo.scan.decay_s, above(0.0);
             "an obstacle not seen again for this long is forgotten [s]";
-    }
-    d.integer(
-        "vfo.max_obstacles",
-        s.max_obstacles as i64,
-        "most obstacles in the map; beyond, the least recently seen are dropped (with a warning)",
-        move |c, x| c.vfo.scan.max_obstacles = count(x),
-    )
-    .min(1.0);
-    mobil_ros::params! { d;
+        count "vfo.max_obstacles" = s.max_obstacles => vfo.scan.max_obstacles, min(1.0);
+            "most obstacles in the map; beyond, the least recently seen are dropped (with a warning)";
         double "vfo.scan_odom_max_gap_s" = v.scan_odom_max_gap_s => vfo.scan_odom_max_gap_s, above(0.0), max(1.0);
             "a scan is placed with the odometry pose at its stamp; refused when no odometry lies within this of it \
              [s]";

@@ -151,11 +151,8 @@ impl Config for SimConfig {
         d.boolean("lidar.enabled", true, "publish scan", |c, v| c.lidar_enabled = v);
         d.double("lidar.fov", lidar.fov, "field of view [rad]", |c, v| c.lidar.fov = v)
             .within(0.01, std::f64::consts::TAU);
-        // The declared range keeps the value in [2, 100000], so the conversion cannot fail.
-        d.integer("lidar.beams", lidar.beams as i64, "beams per scan", |c, v| {
-            c.lidar.beams = usize::try_from(v).unwrap_or_default()
-        })
-        .within(2.0, 100_000.0);
+        d.count("lidar.beams", lidar.beams, "beams per scan", |c, v| c.lidar.beams = v)
+            .within(2.0, 100_000.0);
         d.double("lidar.range_min", lidar.range_min, "[m]", |c, v| c.lidar.range_min = v)
             .min(0.0);
         d.double("lidar.range_max", lidar.range_max, "[m]", |c, v| c.lidar.range_max = v)
