@@ -13,10 +13,9 @@ use mobil_geom::Pose2;
 use mobil_local_nav::{
     Mode, MotionLimits, NavConfig, ProgressChecker, ProgressSettings, Sectors, Side, UnseenSectors, WeightProfile,
 };
-use mobil_motion::Outcome;
+use mobil_motion::{Nav2Codes, Outcome};
 use mobil_msgs::builtin_interfaces::msg::Time;
 use mobil_msgs::geometry_msgs::msg::{Point, PoseStamped};
-use mobil_msgs::mobil_msgs::msg::NavStatus;
 use mobil_msgs::visualization_msgs::msg::{Marker, MarkerArray};
 use mobil_ros::chassis::{chassis_params, declare_chassis};
 use mobil_ros::config::{Config, ConfigError, Decl};
@@ -24,7 +23,8 @@ use mobil_ros::goal::goal_pose;
 pub use mobil_ros::goal::{goal_heading, GoalError};
 use mobil_ros::groups::{Frames, GoalTimeouts, MAX_INPUT_TIMEOUT_S};
 use mobil_ros::markers::{point, rgb, Markers};
-use mobil_ros::motion::{EndCause, EndKind};
+use mobil_ros::motion::EndCause;
+use mobil_ros::status::end_state;
 use mobil_ros::time::seconds;
 use nalgebra::{Point2, Vector2};
 use std::time::Duration;
@@ -414,17 +414,11 @@ pub fn no_progress(since: f64, radius: f64) -> EndCause {
 /// `error_msg`) and `navigate_to_pose`'s error code. Stale or refused input is Nav2's
 /// `NO_VALID_CONTROL`, a shutdown `UNKNOWN`, a cancel or a pre-emption no error.
 pub fn end_answer(cause: &EndCause) -> (u8, String, u16) {
-    let state = match cause.kind() {
-        EndKind::Succeeded => NavStatus::SUCCEEDED,
-        EndKind::Canceled | EndKind::Aborted => NavStatus::FAILED,
-    };
-    let code = match cause {
-        EndCause::Outcome(o) => o.nav2_error(),
-        EndCause::Canceled | EndCause::Preempted(_) => nav2_error::NONE,
-        EndCause::Stale(_) | EndCause::Refused { .. } => nav2_error::NO_VALID_CONTROL,
-        EndCause::Shutdown => nav2_error::UNKNOWN,
-    };
-    (state, cause.reason(), code)
+    (
+        end_state(cause),
+        cause.reason(),
+        cause.nav2_error(Nav2Codes::FOLLOW_PATH),
+    )
 }
 
 /// The status reason of a refused goal.
@@ -435,6 +429,7 @@ pub fn invalid_goal(e: &GoalError) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use mobil_msgs::mobil_msgs::msg::NavStatus;
     use mobil_geom::Scan;
     use mobil_local_nav::Drive;
     use mobil_ros::params::ParamValues;

@@ -25,7 +25,7 @@ use mobil_local_nav_node::{
     clear_markers, end_answer, goal_heading, goal_in_odom, invalid_goal, markers, no_progress, reconfigured_progress,
     LocalNavConfig, MarkerView,
 };
-use mobil_motion::{BodyTwist, GoalLaw, Step, StepInput};
+use mobil_motion::{BodyTwist, GoalLaw, Nav2Codes, Step, StepInput};
 use mobil_msgs::builtin_interfaces::msg::Time;
 use mobil_msgs::geometry_msgs::msg::{Pose, PoseStamped, Twist};
 use mobil_msgs::mobil_msgs::msg::NavStatus;
@@ -33,7 +33,7 @@ use mobil_msgs::nav2_msgs::action::{NavigateToPose, NavigateToPoseFeedback, Navi
 use mobil_msgs::nav_msgs::msg::Odometry;
 use mobil_msgs::sensor_msgs::msg::LaserScan;
 use mobil_msgs::std_msgs::msg::Header;
-use mobil_ros::action::{goal_end, ActionEvent, GoalRequest, GoalServer, GoalServerConfig};
+use mobil_ros::action::{goal_end, nav2_result, ActionEvent, GoalRequest, GoalServer, GoalServerConfig};
 use mobil_ros::geometry::{odom_pose, twist_msg};
 use mobil_ros::input::Inputs;
 use mobil_ros::latest::Latest;
@@ -151,8 +151,7 @@ async fn serve(node: &mut RosNode) -> anyhow::Result<()> {
 }
 
 fn result(cause: &EndCause) -> NavigateToPoseResult {
-    let (_, error_msg, error_code) = end_answer(cause);
-    NavigateToPoseResult { error_code, error_msg }
+    nav2_result(cause, Nav2Codes::FOLLOW_PATH)
 }
 
 /// The loop's outcome, and whether the node's last word must be a zero command.

@@ -78,7 +78,8 @@ use ros2_client::action::{
 };
 pub use ros2_client::action::{GoalEndStatus as GoalEnd, GoalId};
 
-use mobil_motion::{EndCause, EndKind};
+use mobil_motion::{EndCause, EndKind, Nav2Codes};
+use mobil_msgs::nav2_msgs::action::{DockRobotResult, FollowWaypointsResult, NavigateToPoseResult, UndockRobotResult};
 
 /// The action status a motion goal's end gives its client: SUCCEEDED, CANCELED, else ABORTED.
 pub fn goal_end(cause: &EndCause) -> GoalEnd {
@@ -87,6 +88,60 @@ pub fn goal_end(cause: &EndCause) -> GoalEnd {
         EndKind::Canceled => GoalEnd::Canceled,
         EndKind::Aborted => GoalEnd::Aborted,
     }
+}
+
+/// A Nav2 action's result made from a goal's end, the same way by every node: `success` where
+/// the result has one, the error code by [`EndCause::nav2_error`] with the action's `codes`,
+/// the end's reason as `error_msg`; lists (FollowWaypoints' missed waypoints) empty, for the
+/// caller to fill.
+pub trait Nav2Result {
+    /// The result of a goal that ended with `cause`.
+    fn ended(cause: &EndCause, codes: Nav2Codes) -> Self;
+}
+
+impl Nav2Result for NavigateToPoseResult {
+    fn ended(cause: &EndCause, codes: Nav2Codes) -> Self {
+        NavigateToPoseResult {
+            error_code: cause.nav2_error(codes),
+            error_msg: cause.reason(),
+        }
+    }
+}
+
+impl Nav2Result for DockRobotResult {
+    fn ended(cause: &EndCause, codes: Nav2Codes) -> Self {
+        DockRobotResult {
+            success: cause.kind() == EndKind::Succeeded,
+            error_code: cause.nav2_error(codes),
+            num_retries: 0,
+            error_msg: cause.reason(),
+        }
+    }
+}
+
+impl Nav2Result for UndockRobotResult {
+    fn ended(cause: &EndCause, codes: Nav2Codes) -> Self {
+        UndockRobotResult {
+            success: cause.kind() == EndKind::Succeeded,
+            error_code: cause.nav2_error(codes),
+            error_msg: cause.reason(),
+        }
+    }
+}
+
+impl Nav2Result for FollowWaypointsResult {
+    fn ended(cause: &EndCause, codes: Nav2Codes) -> Self {
+        FollowWaypointsResult {
+            missed_waypoints: Vec::new(),
+            error_code: cause.nav2_error(codes),
+            error_msg: cause.reason(),
+        }
+    }
+}
+
+/// The result `R` of a goal that ended with `cause`, for an action with `codes`.
+pub fn nav2_result<R: Nav2Result>(cause: &EndCause, codes: Nav2Codes) -> R {
+    R::ended(cause, codes)
 }
 use ros2_client::{Name, Node, ServiceMapping};
 use std::sync::{Arc, Mutex};
@@ -521,5 +576,31 @@ async fn deliver_one<A: RosAction>(server: Arc<Server<A>>, finished: Finished<A>
         // goal would be reported EXECUTING for ever. A SUCCEEDED or CANCELED goal is left as it
         // was last reported rather than labelled ABORTED, which it is not.
         let _ = server.abort_executing_goal(handle).await;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use mobil_motion::Outcome;
+
+    #[test]
+    fn results_carry_success_the_code_and_the_reason() {
+        let failed = EndCause::Outcome(Outcome::failed("NOT_CONVERGING", "V stalled", 905));
+        let dock: DockRobotResult = nav2_result(&failed, Nav2Codes::DOCKING);
+        assert_eq!((dock.success, dock.error_code, dock.num_retries), (false, 905, 0));
+        assert_eq!(dock.error_msg, "NOT_CONVERGING: V stalled");
+        let undock: UndockRobotResult = nav2_result(&EndCause::Shutdown, Nav2Codes::DOCKING);
+        assert_eq!((undock.success, undock.error_code), (false, 999));
+        let ok = EndCause::Outcome(Outcome::succeeded("arrived"));
+        let nav: NavigateToPoseResult = nav2_result(&ok, Nav2Codes::FOLLOW_PATH);
+        assert_eq!((nav.error_code, nav.error_msg.as_str()), (0, "SUCCEEDED: arrived"));
+        let follow: FollowWaypointsResult = nav2_result(&EndCause::Stale("odom".into()), Nav2Codes::FOLLOW_WAYPOINTS);
+        assert_eq!((follow.error_code, follow.missed_waypoints.len()), (601, 0));
+        assert_eq!(goal_end(&EndCause::Canceled), GoalEnd::Canceled);
+        assert_eq!(
+            crate::status::end_state(&EndCause::Canceled),
+            mobil_msgs::mobil_msgs::msg::NavStatus::FAILED
+        );
     }
 }

@@ -19,6 +19,7 @@
 use crate::geometry::pose_msg;
 use crate::markers::point;
 use mobil_geom::Pose2;
+use mobil_motion::{EndCause, EndKind};
 use mobil_msgs::builtin_interfaces::msg::Time;
 use mobil_msgs::mobil_msgs::msg::NavStatus;
 use mobil_msgs::std_msgs::msg::Header;
@@ -141,6 +142,15 @@ impl RateGate {
     /// One was sent at `at`.
     pub fn sent(&mut self, at: Instant) {
         self.last = Some(at);
+    }
+}
+
+/// The NavStatus state a goal's end leaves: SUCCEEDED, else FAILED (a cancel and a pre-emption
+/// included: the goal was not reached).
+pub fn end_state(cause: &EndCause) -> u8 {
+    match cause.kind() {
+        EndKind::Succeeded => NavStatus::SUCCEEDED,
+        EndKind::Canceled | EndKind::Aborted => NavStatus::FAILED,
     }
 }
 

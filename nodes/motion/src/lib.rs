@@ -232,6 +232,35 @@ pub mod nav2 {
     }
 }
 
+/// The codes an action's result gives for the ends the node makes itself (a law's end carries
+/// its own code): a goal that lost control (stale or refused input), and a shutdown.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Nav2Codes {
+    /// Stale or refused input.
+    pub control_failure: u16,
+    /// The node shut down under the goal.
+    pub unknown: u16,
+}
+
+impl Nav2Codes {
+    /// `FollowPath` (and `NavigateToPose`, whose navigator passes the controller's codes on):
+    /// NO_VALID_CONTROL, UNKNOWN.
+    pub const FOLLOW_PATH: Nav2Codes = Nav2Codes {
+        control_failure: nav2::follow_path::NO_VALID_CONTROL,
+        unknown: nav2::follow_path::UNKNOWN,
+    };
+    /// `DockRobot` and `UndockRobot`: FAILED_TO_CONTROL, UNKNOWN.
+    pub const DOCKING: Nav2Codes = Nav2Codes {
+        control_failure: nav2::docking::FAILED_TO_CONTROL,
+        unknown: nav2::docking::UNKNOWN,
+    };
+    /// `FollowWaypoints`: TASK_EXECUTOR_FAILED, UNKNOWN.
+    pub const FOLLOW_WAYPOINTS: Nav2Codes = Nav2Codes {
+        control_failure: nav2::follow_waypoints::TASK_EXECUTOR_FAILED,
+        unknown: nav2::follow_waypoints::UNKNOWN,
+    };
+}
+
 /// Why a goal ended.
 #[derive(Debug, Clone, PartialEq)]
 pub enum EndCause {
@@ -300,6 +329,18 @@ impl EndCause {
         }
     }
 
+    /// Nav2's error code of this end in the result of an action with `codes`, one rule for
+    /// every node: the law's own, none for a cancel or a pre-emption, the control failure for
+    /// stale or refused input, unknown at shutdown.
+    pub fn nav2_error(&self, codes: Nav2Codes) -> u16 {
+        match self {
+            EndCause::Outcome(o) => o.nav2_error(),
+            EndCause::Canceled | EndCause::Preempted(_) => nav2::NONE,
+            EndCause::Refused { .. } | EndCause::Stale(_) => codes.control_failure,
+            EndCause::Shutdown => codes.unknown,
+        }
+    }
+
     /// How it counts for the status and the action.
     pub fn kind(&self) -> EndKind {
         match self {
@@ -324,6 +365,32 @@ pub fn seconds(s: f64, max_s: f64) -> std::time::Duration {
 mod tests {
     use super::*;
     use std::time::Duration;
+
+    #[test]
+    fn nav2_errors_are_the_law_s_none_the_control_failure_or_unknown() {
+        let c = Nav2Codes::DOCKING;
+        let failed = EndCause::Outcome(Outcome::failed("NOT_CONVERGING", "", 905));
+        let ends = [
+            (failed, 905),
+            (EndCause::Outcome(Outcome::succeeded("docked")), 0),
+            (EndCause::Canceled, 0),
+            (EndCause::Preempted("dock_pose"), 0),
+            (EndCause::Stale("odom".into()), 905),
+            (
+                EndCause::Refused {
+                    count: 20,
+                    last: String::new(),
+                },
+                905,
+            ),
+            (EndCause::Shutdown, 999),
+        ];
+        for (end, code) in ends {
+            assert_eq!(end.nav2_error(c), code, "{end:?}");
+        }
+        assert_eq!(EndCause::Stale("scan".into()).nav2_error(Nav2Codes::FOLLOW_PATH), 106);
+        assert_eq!(EndCause::Shutdown.nav2_error(Nav2Codes::FOLLOW_WAYPOINTS), 600);
+    }
 
     #[test]
     fn outcomes_give_reasons_and_codes() {

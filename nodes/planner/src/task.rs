@@ -33,7 +33,7 @@ use crate::{DockingPhase, FollowConfig, RouteReport};
 use mobil_chassis::ChassisParams;
 use mobil_geom::Pose2;
 use mobil_motion::slot::{Handback, LawSlot};
-use mobil_motion::{nav2, BodyTwist, EndCause, GoalLaw, Outcome, Step, StepInput};
+use mobil_motion::{nav2, BodyTwist, EndCause, GoalLaw, Nav2Codes, Outcome, Step, StepInput};
 use nalgebra::Point2;
 use std::time::{Duration, Instant};
 
@@ -353,33 +353,29 @@ pub enum Action {
 }
 
 impl Action {
-    /// A goal that lost control (stale or refused input): DockRobot's and UndockRobot's
-    /// FAILED_TO_CONTROL, FollowWaypoints' TASK_EXECUTOR_FAILED.
-    pub fn control_failure(self) -> u16 {
+    /// The codes of the ends the node makes: DockRobot's and UndockRobot's FAILED_TO_CONTROL
+    /// and UNKNOWN, FollowWaypoints' TASK_EXECUTOR_FAILED and UNKNOWN.
+    pub fn codes(self) -> Nav2Codes {
         match self {
-            Action::Dock | Action::Undock => nav2::docking::FAILED_TO_CONTROL,
-            Action::Follow => nav2::follow_waypoints::TASK_EXECUTOR_FAILED,
+            Action::Dock | Action::Undock => Nav2Codes::DOCKING,
+            Action::Follow => Nav2Codes::FOLLOW_WAYPOINTS,
         }
+    }
+
+    /// A goal that lost control (stale or refused input).
+    pub fn control_failure(self) -> u16 {
+        self.codes().control_failure
     }
 
     /// Shutdown, or a request the action cannot take: UNKNOWN.
     pub fn unknown(self) -> u16 {
-        match self {
-            Action::Dock | Action::Undock => nav2::docking::UNKNOWN,
-            Action::Follow => nav2::follow_waypoints::UNKNOWN,
-        }
+        self.codes().unknown
     }
 
-    /// Nav2's error code of a goal from this action ending with `cause`: the law's own, none
-    /// for a cancel or a pre-emption, [`Action::control_failure`] for stale or refused input,
-    /// [`Action::unknown`] at shutdown.
+    /// Nav2's error code of a goal from this action ending with `cause`
+    /// ([`EndCause::nav2_error`]).
     pub fn error_code(self, cause: &EndCause) -> u16 {
-        match cause {
-            EndCause::Outcome(o) => o.nav2_error(),
-            EndCause::Canceled | EndCause::Preempted(_) => nav2::NONE,
-            EndCause::Refused { .. } | EndCause::Stale(_) => self.control_failure(),
-            EndCause::Shutdown => self.unknown(),
-        }
+        cause.nav2_error(self.codes())
     }
 
     /// An invalid goal (`why`), refused before it starts: `INVALID_GOAL` with DockRobot's

@@ -13,15 +13,16 @@ use mobil_chassis::ChassisParams;
 use mobil_geom::downsample;
 use mobil_msgs::builtin_interfaces::msg::Time;
 use mobil_msgs::geometry_msgs::msg::PoseStamped;
-use mobil_msgs::mobil_msgs::msg::{NavStatus, RouteProblem as ProblemMsg};
+use mobil_msgs::mobil_msgs::msg::RouteProblem as ProblemMsg;
 use mobil_msgs::mobil_msgs::srv::CheckRouteResponse;
-use mobil_msgs::nav2_msgs::action::{DockRobotResult, FollowWaypointsResult, UndockRobotResult};
+use mobil_msgs::nav2_msgs::action::FollowWaypointsResult;
 use mobil_msgs::nav2_msgs::msg::MissedWaypoint;
 use mobil_msgs::nav_msgs::msg::Path;
 use mobil_msgs::std_msgs::msg::Header;
 use mobil_msgs::visualization_msgs::msg::MarkerArray;
 pub use mobil_planner::goals::{list_missed, missed_from_report, route_infeasible, Missed, MISSED_BY_THE_RUN};
 use mobil_planner::{DockingConfig, DockingGains, FollowConfig, RouteCheckConfig, RouteReport};
+use mobil_ros::action::nav2_result;
 use mobil_ros::chassis::{chassis_params, declare_chassis};
 use mobil_ros::config::{Config, ConfigError, Decl};
 use mobil_ros::geometry::pose_msg;
@@ -219,33 +220,6 @@ pub const ROUTE_LIMITS: RouteLimits = RouteLimits {
     max_waypoints: MAX_WAYPOINTS,
 };
 
-/// The NavStatus state an end leaves.
-pub fn end_state(cause: &EndCause) -> u8 {
-    match cause.kind() {
-        EndKind::Succeeded => NavStatus::SUCCEEDED,
-        EndKind::Canceled | EndKind::Aborted => NavStatus::FAILED,
-    }
-}
-
-/// DockRobot's result of `cause`.
-pub fn dock_result(cause: &EndCause) -> DockRobotResult {
-    DockRobotResult {
-        success: cause.kind() == EndKind::Succeeded,
-        error_code: Action::Dock.error_code(cause),
-        num_retries: 0,
-        error_msg: cause.reason(),
-    }
-}
-
-/// UndockRobot's result of `cause`.
-pub fn undock_result(cause: &EndCause) -> UndockRobotResult {
-    UndockRobotResult {
-        success: cause.kind() == EndKind::Succeeded,
-        error_code: Action::Undock.error_code(cause),
-        error_msg: cause.reason(),
-    }
-}
-
 /// FollowWaypoints' result of `cause`: the waypoints `missed` (the run's, or the pre-check's
 /// problems for a route it refused), up to [`MAX_RESULT_MISSED`], each with its pose from
 /// `poses` and its code; Nav2 lists them on success too.
@@ -256,8 +230,7 @@ pub fn follow_result(cause: &EndCause, poses: &[PoseStamped], missed: &[Missed])
             .take(MAX_RESULT_MISSED)
             .map(|m| missed_waypoint(m.index, m.error_code(), poses))
             .collect(),
-        error_code: Action::Follow.error_code(cause),
-        error_msg: cause.reason(),
+        ..nav2_result(cause, Action::Follow.codes())
     }
 }
 
@@ -370,6 +343,17 @@ pub fn markers(view: &MarkerView<'_>, stamp: Time, frame: &str) -> MarkerArray {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use mobil_msgs::mobil_msgs::msg::NavStatus;
+    use mobil_msgs::nav2_msgs::action::{DockRobotResult, UndockRobotResult};
+    use mobil_ros::status::end_state;
+
+    fn dock_result(cause: &EndCause) -> DockRobotResult {
+        nav2_result(cause, Action::Dock.codes())
+    }
+
+    fn undock_result(cause: &EndCause) -> UndockRobotResult {
+        nav2_result(cause, Action::Undock.codes())
+    }
     use approx::assert_relative_eq;
     use mobil_geom::Pose2;
     use mobil_motion::Outcome;

@@ -47,11 +47,10 @@ use mobil_planner::vfo::{
 };
 use mobil_planner::{check_route_until, Finish, RouteReport};
 use mobil_planner_node::{
-    check_reply, dock_result, end_state, follow_result, load_world, markers, no_dock_database, refused_reply,
-    status_view, undock_result, vfo_follow_result, Action, GoalError, MarkerView, Missed, PlannerConfig, Route,
-    ROUTE_LIMITS,
+    check_reply, follow_result, load_world, markers, no_dock_database, refused_reply, status_view, vfo_follow_result,
+    Action, GoalError, MarkerView, Missed, PlannerConfig, Route, ROUTE_LIMITS,
 };
-use mobil_ros::action::{goal_end, ActionEvent, GoalRequest, GoalServer, GoalServerConfig};
+use mobil_ros::action::{goal_end, nav2_result, ActionEvent, GoalRequest, GoalServer, GoalServerConfig};
 use mobil_ros::geometry::{odom_pose, twist_msg};
 use mobil_ros::goal::{goal_pose, pose_in_frame, route_from_path, route_from_poses};
 use mobil_ros::input::Inputs;
@@ -61,7 +60,7 @@ use mobil_ros::motion::{
 };
 use mobil_ros::offloop::CancelToken;
 use mobil_ros::scan::{checked_scan, tf_static_subscription, LaserMount, StaticFrames};
-use mobil_ros::status::{NavStatusView, RateGate};
+use mobil_ros::status::{end_state, NavStatusView, RateGate};
 use mobil_ros::stop::{final_stop, FINAL_STOP_WAIT};
 use mobil_ros::ticker::Ticker;
 use mobil_ros::time::{duration_msg, secs_from_stamp, DtError};
@@ -369,8 +368,8 @@ async fn start(node: &mut RosNode, out: &Outputs, config: PlannerConfig) -> anyh
     let down = EndCause::Shutdown;
     let Servers { dock, undock, follow } = servers;
     tokio::join!(
-        dock.close(dock_result(&down)),
-        undock.close(undock_result(&down)),
+        dock.close(nav2_result(&down, Action::Dock.codes())),
+        undock.close(nav2_result(&down, Action::Undock.codes())),
         follow.close(follow_result(&down, &[], &[])),
     );
     Ok(outcome)

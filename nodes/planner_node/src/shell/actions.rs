@@ -25,7 +25,7 @@ impl Shell {
                 }
             );
         }
-        let preempted = dock_result(&EndCause::Preempted("dock_robot"));
+        let preempted = nav2_result(&EndCause::Preempted("dock_robot"), Action::Dock.codes());
         let accept = io.servers.dock.accept(request, |_| preempted).await;
         if self.accepted(io, accept, Source::DockAction) {
             self.start_dock(io, target, Source::DockAction);
@@ -60,7 +60,7 @@ impl Shell {
             warn!("undock_robot: max_undocking_time {limit} is not a positive time: 30 s (its default) taken");
             30.0
         };
-        let preempted = undock_result(&EndCause::Preempted("undock_robot"));
+        let preempted = nav2_result(&EndCause::Preempted("undock_robot"), Action::Undock.codes());
         let accept = io.servers.undock.accept(request, |_| preempted).await;
         if !self.accepted(io, accept, Source::UndockAction) {
             return;
@@ -126,10 +126,10 @@ impl Servers {
         let end = goal_end(cause);
         match source {
             Source::DockAction => {
-                self.dock.finish(end, dock_result(cause));
+                self.dock.finish(end, nav2_result(cause, Action::Dock.codes()));
             }
             Source::UndockAction => {
-                self.undock.finish(end, undock_result(cause));
+                self.undock.finish(end, nav2_result(cause, Action::Undock.codes()));
             }
             Source::FollowAction => {
                 let result = goal.map_or_else(|| follow_result(cause, &[], &[]), |g| follow_answer(g, cause));
