@@ -429,9 +429,9 @@ pub fn invalid_goal(e: &GoalError) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use mobil_msgs::mobil_msgs::msg::NavStatus;
     use mobil_geom::Scan;
     use mobil_local_nav::Drive;
+    use mobil_msgs::mobil_msgs::msg::NavStatus;
     use mobil_ros::params::ParamValues;
 
     #[test]

@@ -7,7 +7,9 @@ use std::f64::consts::{FRAC_PI_2, PI};
 
 use approx::assert_relative_eq;
 use mobil_geom::{Pose2, Scan};
-use mobil_planner::vfo::{Circle, ObstacleMap, Placement, PoseHistory, ScanObstacleConfig, ScanSkipped};
+use mobil_planner::vfo::{
+    Circle, KeptMap, MapChange, ObstacleMap, Placement, PoseHistory, ScanObstacleConfig, ScanSkipped,
+};
 use nalgebra::{Point2, Vector2};
 
 /// Ranges of a scan from `odom_from_laser` with `beams` beams over `fov` (centred), seeing
@@ -503,4 +505,33 @@ fn beyond_the_cap_the_least_recently_seen_circles_are_dropped() {
         ..ScanObstacleConfig::default()
     })
     .is_err());
+}
+
+#[test]
+fn new_extraction_parameters_wait_for_the_running_goal_to_end() {
+    let base = ScanObstacleConfig::default();
+    let mut kept = KeptMap::new(base).expect("valid");
+    kept.map_mut().merge_at(&[circle(2.0, 0.0, 0.3)], 0.0);
+    let wider = ScanObstacleConfig {
+        influence_margin: base.influence_margin + 0.2,
+        ..base
+    };
+    // During a goal: the map keeps its obstacle and its parameters until the goal ends.
+    assert_eq!(kept.reconfigure(wider, true), Ok(MapChange::AfterGoal));
+    assert_eq!((kept.map().len(), *kept.map().config()), (1, base));
+    // Invalid parameters are refused and leave the change waiting as it was.
+    let bad = ScanObstacleConfig { memory: 0, ..base };
+    assert!(kept.reconfigure(bad, true).is_err());
+    assert!(kept.goal_ended());
+    assert_eq!((kept.map().len(), *kept.map().config()), (0, wider));
+    assert!(!kept.goal_ended(), "nothing waits any more");
+    // Back to the map's own parameters during a goal: nothing waits, the map is kept.
+    kept.map_mut().merge_at(&[circle(2.0, 0.0, 0.3)], 1.0);
+    assert_eq!(kept.reconfigure(base, true), Ok(MapChange::AfterGoal));
+    assert_eq!(kept.reconfigure(wider, true), Ok(MapChange::Unchanged));
+    assert!(!kept.goal_ended());
+    assert_eq!(kept.map().len(), 1);
+    // With no goal running the map starts afresh at once.
+    assert_eq!(kept.reconfigure(base, false), Ok(MapChange::Restarted));
+    assert_eq!((kept.map().len(), *kept.map().config()), (0, base));
 }

@@ -42,7 +42,7 @@ use mobil_msgs::tf2_msgs::msg::TFMessage;
 use mobil_planner::goals::{route_infeasible, DockGoal, RouteEvent, UndockGoal};
 use mobil_planner::task::{PreCheck, Stepped, Task, VfoRun};
 use mobil_planner::vfo::{
-    vfo_gains, Interrupt, ObstacleMap, OptimiseWarning, PoseHistory, ScanSkipped, VfoDrawing, VfoEvent, VfoGoal,
+    vfo_gains, Interrupt, KeptMap, MapChange, OptimiseWarning, PoseHistory, ScanSkipped, VfoDrawing, VfoEvent, VfoGoal,
     VfoStep, VfoTick, WaypointMethod, MAX_SETTLE_S,
 };
 use mobil_planner::{check_route_until, Finish, RouteReport};
@@ -227,10 +227,9 @@ struct Shell {
     markers_gate: RateGate,
     drawing: Drawing,
     throttle: LogThrottle,
-    /// Obstacles seen by the LIDAR, in odom (VFO); kept between goals.
-    map: ObstacleMap,
-    /// A parameter change asked for a new map while a goal ran: built once none runs.
-    map_rebuild: bool,
+    /// Obstacles seen by the LIDAR, in odom (VFO); kept between goals, new extraction
+    /// parameters applied once no goal runs.
+    map: KeptMap,
     /// The odometry poses of the last seconds by stamp: a scan is placed with the pose at its
     /// own stamp.
     odom_history: PoseHistory,
@@ -283,7 +282,7 @@ async fn start(node: &mut RosNode, out: &Outputs, config: PlannerConfig) -> anyh
     let route_sub = node.subscription::<Path>("waypoints", &qos::default_qos())?;
     let scan_sub = node.subscription::<LaserScan>("scan", &qos::sensor_data())?;
     let tf_sub = tf_static_subscription(node)?;
-    let map = ObstacleMap::new(config.vfo.scan_config(config.robot_radius))
+    let map = KeptMap::new(config.vfo.scan_config(config.robot_radius))
         .map_err(|e| anyhow::anyhow!("vfo obstacle extraction: {e}"))?;
     let check = node.service::<CheckRoute>(CHECK_ROUTE)?;
     let server_config = GoalServerConfig {
@@ -318,7 +317,6 @@ async fn start(node: &mut RosNode, out: &Outputs, config: PlannerConfig) -> anyh
         drawing: Drawing::default(),
         throttle: LogThrottle::new(Duration::from_secs(2)),
         map,
-        map_rebuild: false,
         odom_history: PoseHistory::new(ODOM_HISTORY),
         odom_stamp: f64::NAN,
         scan_seen: Latest::new(),

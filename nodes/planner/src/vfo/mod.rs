@@ -60,7 +60,9 @@ pub use optimise::{
     PARALLEL_MIN_BATCH,
 };
 pub use quality::{normalise, normalised, path_score, PathIndices, QualityWeights};
-pub use scan::{extract_circles, fit_circle, Circle, MapUpdate, ObstacleMap, ScanObstacleConfig, ScanSkipped};
+pub use scan::{
+    extract_circles, fit_circle, Circle, KeptMap, MapChange, MapUpdate, ObstacleMap, ScanObstacleConfig, ScanSkipped,
+};
 pub use settings::{
     VfoSettings, WaypointMethod, DEFAULT_OPTIMISE_BUDGET_S, DEFAULT_SCAN_ODOM_MAX_GAP_S, MAX_OPTIMISE_BUDGET_S,
 };

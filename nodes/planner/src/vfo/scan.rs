@@ -584,3 +584,72 @@ fn sees_through(scan: &Scan, frame_from_laser: &Pose2, circle: &Circle) -> bool 
         _ => false,
     })
 }
+
+/// The obstacle map a node keeps between goals, and a change of its extraction parameters:
+/// applied at once while no goal runs; while one runs, once it ends (the goal keeps the map
+/// its parameters built, so its obstacles and σ stay valid).
+#[derive(Debug, Clone, PartialEq)]
+pub struct KeptMap {
+    map: ObstacleMap,
+    next: Option<ScanObstacleConfig>,
+}
+
+/// What a change of the extraction parameters did to a [`KeptMap`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum MapChange {
+    /// The parameters are the map's own (a change waiting, if any, is dropped).
+    Unchanged,
+    /// The map starts afresh with them.
+    Restarted,
+    /// The map starts afresh with them once the running goal ends.
+    AfterGoal,
+}
+
+impl KeptMap {
+    /// An empty map with `config`.
+    pub fn new(config: ScanObstacleConfig) -> Result<Self, PlannerError> {
+        Ok(KeptMap {
+            map: ObstacleMap::new(config)?,
+            next: None,
+        })
+    }
+
+    /// The map.
+    pub fn map(&self) -> &ObstacleMap {
+        &self.map
+    }
+
+    /// The map, to add scans to.
+    pub fn map_mut(&mut self) -> &mut ObstacleMap {
+        &mut self.map
+    }
+
+    /// New extraction parameters, while a goal runs (`goal_running`) or not. Invalid ones are
+    /// refused, the map and any change waiting left as they were.
+    pub fn reconfigure(&mut self, config: ScanObstacleConfig, goal_running: bool) -> Result<MapChange, PlannerError> {
+        config.validate()?;
+        if config == self.map.config {
+            self.next = None;
+            return Ok(MapChange::Unchanged);
+        }
+        if goal_running {
+            self.next = Some(config);
+            return Ok(MapChange::AfterGoal);
+        }
+        self.map = ObstacleMap::new(config)?;
+        self.next = None;
+        Ok(MapChange::Restarted)
+    }
+
+    /// The goal ended (none runs now): whether a change waiting made the map start afresh.
+    pub fn goal_ended(&mut self) -> bool {
+        match self.next.take().map(ObstacleMap::new) {
+            Some(Ok(map)) => {
+                self.map = map;
+                true
+            }
+            // Validated when it was given; or none waiting.
+            Some(Err(_)) | None => false,
+        }
+    }
+}

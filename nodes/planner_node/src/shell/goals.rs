@@ -6,32 +6,24 @@ use crate::*;
 
 impl Shell {
     pub(crate) fn reconfigure(&mut self, c: PlannerConfig) {
-        let scan = c.vfo.scan_config(c.robot_radius);
-        if scan != self.config.vfo.scan_config(self.config.robot_radius) {
-            if let Err(e) = ObstacleMap::new(scan) {
-                return warn!("parameters not applied: {e}");
+        let chassis = match c.chassis_params() {
+            Ok(chassis) => chassis,
+            Err(e) => return warn!("parameters not applied: {e}"),
+        };
+        let running = self.session.active().is_some();
+        match self.map.reconfigure(c.vfo.scan_config(c.robot_radius), running) {
+            Err(e) => return warn!("parameters not applied: {e}"),
+            Ok(MapChange::Restarted) => info!("vfo obstacle extraction changed: the obstacle map starts afresh"),
+            // The goal keeps the map its parameters built (its obstacles and σ stay valid).
+            Ok(MapChange::AfterGoal) => {
+                info!("vfo obstacle extraction changed: the obstacle map starts afresh once the goal ends")
             }
-            if self.session.active().is_some() {
-                // The goal keeps the map its parameters built (its obstacles and σ stay valid).
-                info!("vfo obstacle extraction changed: the obstacle map starts afresh once the goal ends");
-                self.map_rebuild = true;
-            } else {
-                info!("vfo obstacle extraction changed: the obstacle map starts afresh");
-                self.map_rebuild = false;
-                if let Ok(map) = ObstacleMap::new(scan) {
-                    self.map = map;
-                }
-            }
+            Ok(MapChange::Unchanged) => {}
         }
-        match c.chassis_params() {
-            Ok(chassis) => {
-                self.chassis = chassis;
-                self.config = c;
-                if self.session.active().is_some() {
-                    info!("parameters changed: they apply from the next goal");
-                }
-            }
-            Err(e) => warn!("parameters not applied: {e}"),
+        self.chassis = chassis;
+        self.config = c;
+        if running {
+            info!("parameters changed: they apply from the next goal");
         }
     }
 
@@ -105,14 +97,8 @@ impl Shell {
         }
         let view = self.status_view(Some(&goal), end_state(&cause), reason);
         self.send_status(io.node, io.out, &view);
-        if self.session.active().is_none() && std::mem::take(&mut self.map_rebuild) {
-            match ObstacleMap::new(self.config.vfo.scan_config(self.config.robot_radius)) {
-                Ok(map) => {
-                    info!("the obstacle map starts afresh with the new extraction parameters");
-                    self.map = map;
-                }
-                Err(e) => warn!("the obstacle map keeps its old parameters: {e}"),
-            }
+        if self.session.active().is_none() && self.map.goal_ended() {
+            info!("the obstacle map starts afresh with the new extraction parameters");
         }
         self.publish_markers(io.node, io.out);
     }

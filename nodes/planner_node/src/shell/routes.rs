@@ -119,7 +119,7 @@ impl Shell {
         let settings = &self.config.vfo;
         let setup = settings.setup();
         let of_route = (&route.points[..], &route.headings()[..], &route.request_index[..]);
-        let law = match VfoGoal::for_route(of_route, &start, &setup, &self.chassis, &self.map) {
+        let law = match VfoGoal::for_route(of_route, &start, &setup, &self.chassis, self.map.map()) {
             Ok(law) => law,
             Err(refusal) => return self.refuse(io, source, refusal),
         };
@@ -163,7 +163,7 @@ impl Shell {
         let budget = active.goal.config.vfo.optimise_budget();
         let stop = active.goal.stop.clone();
         let Task::Vfo(v) = &mut active.goal.task else { return };
-        let Some(mut law) = v.lend(Instant::now(), &self.map) else {
+        let Some(mut law) = v.lend(Instant::now(), self.map.map()) else {
             return self.session.hold(io.sink);
         };
         let stamp = self.odom_stamp;
@@ -261,7 +261,7 @@ impl Shell {
             );
         };
         let history = self.fresh_odom().map(|_| &self.odom_history);
-        let update = match self.map.add_scan(&scan, stamp, history, max_gap) {
+        let update = match self.map.map_mut().add_scan(&scan, stamp, history, max_gap) {
             Ok(u) => u,
             Err(e @ ScanSkipped::NoPose { .. }) => return warn_throttled!(self.throttle, "scan-odom", "{e}"),
             Err(e) => return warn_throttled!(self.throttle, "scan-bad", "{e}; scan ignored"),
@@ -279,7 +279,7 @@ impl Shell {
                 self.throttle,
                 "map-cap",
                 "obstacle map full (vfo.max_obstacles {}): the {} least recently seen dropped",
-                self.map.config().max_obstacles,
+                self.map.map().config().max_obstacles,
                 update.capped.len()
             );
         }
@@ -287,7 +287,7 @@ impl Shell {
             info!(
                 "first scan: {} beams, {} obstacles in the map (odom)",
                 scan.len(),
-                self.map.len()
+                self.map.map().len()
             );
         }
         self.scan_seen.set((), m.header.stamp.clone());
