@@ -19,6 +19,36 @@ pub const MAX_DRAWN_PATH: usize = 300;
 /// below (tested on the worst case in `planner_node`).
 pub const MAX_MARKER_POINTS: usize = 1000;
 
+/// What the markers show between goals, owned: the last route, its prediction and problems,
+/// the dock, a VFO route's last optimisation.
+#[derive(Debug, Clone, Default)]
+pub struct Drawing {
+    /// The route's waypoints.
+    pub route: Vec<Point2<f64>>,
+    /// The virtual robot's predicted path.
+    pub predicted: Vec<Pose2>,
+    /// The problems.
+    pub problems: Vec<Missed>,
+    /// The dock pose.
+    pub dock: Option<Pose2>,
+    /// A VFO route's last optimisation.
+    pub vfo: Option<VfoDrawing>,
+}
+
+impl Drawing {
+    /// Its view with the robot at `robot`.
+    pub fn view(&self, robot: Option<Point2<f64>>) -> MarkerView<'_> {
+        MarkerView {
+            route: &self.route,
+            predicted: &self.predicted,
+            problems: &self.problems,
+            dock: self.dock,
+            vfo: self.vfo.as_ref(),
+            robot,
+        }
+    }
+}
+
 /// What the markers show.
 #[derive(Debug, Clone, Default)]
 pub struct MarkerView<'a> {

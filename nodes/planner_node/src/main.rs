@@ -42,13 +42,14 @@ use mobil_msgs::tf2_msgs::msg::TFMessage;
 use mobil_planner::goals::{route_infeasible, DockGoal, RouteEvent, UndockGoal};
 use mobil_planner::task::{PreCheck, Stepped, Task, VfoRun};
 use mobil_planner::vfo::{
-    vfo_gains, Interrupt, KeptMap, MapChange, OptimiseWarning, PoseHistory, ScanSkipped, VfoDrawing, VfoEvent, VfoGoal,
-    VfoStep, VfoTick, WaypointMethod, MAX_SETTLE_S,
+    vfo_gains, Interrupt, KeptMap, MapChange, OptimiseWarning, PoseHistory, ScanSkipped, VfoEvent, VfoGoal, VfoStep,
+    VfoTick, WaypointMethod, MAX_SETTLE_S,
 };
+use mobil_planner::view::Drawing;
 use mobil_planner::{check_route_until, Finish, RouteReport};
 use mobil_planner_node::{
     check_reply, follow_result, load_world, markers, no_dock_database, refused_reply, status_view, vfo_follow_result,
-    Action, GoalError, MarkerView, Missed, PlannerConfig, Route, ROUTE_LIMITS,
+    Action, GoalError, PlannerConfig, Route, ROUTE_LIMITS,
 };
 use mobil_ros::action::{goal_end, nav2_result, ActionEvent, GoalRequest, GoalServer, GoalServerConfig};
 use mobil_ros::geometry::{odom_pose, twist_msg};
@@ -67,7 +68,6 @@ use mobil_ros::time::{duration_msg, secs_from_stamp, DtError};
 use mobil_ros::OffLoop;
 use mobil_ros::{qos, respond, run_node, shutdown_signal, warn_throttled, ConfigError, LogThrottle, NodeDecl, RosNode};
 use mobil_world::World;
-use nalgebra::Point2;
 use ros2_client::{RmwRequestId, Server, Subscription};
 use std::process::ExitCode;
 use std::sync::Arc;
@@ -203,16 +203,6 @@ struct Jobs {
     replies_tx: mpsc::UnboundedSender<(RmwRequestId, CheckRouteResponse)>,
     replies: mpsc::UnboundedReceiver<(RmwRequestId, CheckRouteResponse)>,
     pending: usize,
-}
-
-/// What the markers show between goals: the last route, its prediction and problems, the dock.
-#[derive(Default)]
-struct Drawing {
-    route: Vec<Point2<f64>>,
-    predicted: Vec<Pose2>,
-    problems: Vec<Missed>,
-    dock: Option<Pose2>,
-    vfo: Option<VfoDrawing>,
 }
 
 /// Everything the loop holds between events.

@@ -56,14 +56,7 @@ impl Shell {
     }
 
     pub(crate) fn publish_markers(&mut self, node: &RosNode, out: &Outputs) {
-        let view = MarkerView {
-            route: &self.drawing.route,
-            predicted: &self.drawing.predicted,
-            problems: &self.drawing.problems,
-            dock: self.drawing.dock,
-            vfo: self.drawing.vfo.as_ref(),
-            robot: self.odom.value().map(|p| p.position()),
-        };
+        let view = self.drawing.view(self.odom.value().map(|p| p.position()));
         let array = markers(&view, node.stamp(), &self.config.frames.odom_frame);
         out.send_markers(array, &mut self.throttle);
         self.markers_gate.sent(Instant::now());
@@ -290,40 +283,32 @@ impl Shell {
         self.feedback(io.servers).await;
     }
 
-    /// Action feedback, on every watchdog tick (20 Hz) while an action goal is active.
+    /// Action feedback, on every watchdog tick (20 Hz) while an action goal is active (an
+    /// action's goal is always its own kind of task).
     pub(crate) async fn feedback(&mut self, servers: &Servers) {
         let Some(active) = self.session.active() else { return };
-        let sent = match (&active.goal.task, active.source) {
+        let sent = match active.source {
             // The goal's own time: its steps' dt summed, never running backwards (a step whose
             // clock went back is skipped), so docking_time never falls on a clock reset.
-            (Task::Dock(_), Source::DockAction) => {
-                servers
-                    .dock
-                    .feedback(DockRobotFeedback {
-                        state: DockRobotFeedback::CONTROLLING,
-                        docking_time: duration_msg(active.t()),
-                        num_retries: 0,
-                    })
-                    .await
+            Source::DockAction => {
+                let (state, docking_time) = (DockRobotFeedback::CONTROLLING, duration_msg(active.t()));
+                let feedback = DockRobotFeedback {
+                    state,
+                    docking_time,
+                    num_retries: 0,
+                };
+                servers.dock.feedback(feedback).await
             }
-            (_, Source::FollowAction) => {
+            Source::FollowAction => {
                 let index = active.goal.task.waypoint().unwrap_or(0);
+                let current_waypoint = u32::try_from(index).unwrap_or(u32::MAX);
                 servers
                     .follow
-                    .feedback(FollowWaypointsFeedback {
-                        current_waypoint: u32::try_from(index).unwrap_or(u32::MAX),
-                    })
+                    .feedback(FollowWaypointsFeedback { current_waypoint })
                     .await
             }
-            (Task::Undock(_), Source::UndockAction) => {
-                servers
-                    .undock
-                    .feedback(UndockRobotFeedback {
-                        structure_needs_at_least_one_member: 0,
-                    })
-                    .await
-            }
-            _ => Ok(()),
+            Source::UndockAction => servers.undock.feedback(UndockRobotFeedback::default()).await,
+            Source::DockPose | Source::Waypoints => Ok(()),
         };
         if let Err(e) = sent {
             warn_throttled!(self.throttle, "feedback", "{e}");
