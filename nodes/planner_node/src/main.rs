@@ -439,18 +439,9 @@ async fn event_loop(
             Event::Dock(ActionEvent::Goal(request)) => shell.dock_action(&mut io, request).await,
             Event::Undock(ActionEvent::Goal(request)) => shell.undock_action(&mut io, request).await,
             Event::Follow(ActionEvent::Goal(request)) => shell.follow_action(&mut io, jobs, request).await,
-            Event::Dock(ActionEvent::CancelRequested(id)) => {
-                let is_active = io.servers.dock.active_id() == Some(id);
-                shell.cancel(&mut io, Source::DockAction, is_active)
-            }
-            Event::Undock(ActionEvent::CancelRequested(id)) => {
-                let is_active = io.servers.undock.active_id() == Some(id);
-                shell.cancel(&mut io, Source::UndockAction, is_active)
-            }
-            Event::Follow(ActionEvent::CancelRequested(id)) => {
-                let is_active = io.servers.follow.active_id() == Some(id);
-                shell.cancel(&mut io, Source::FollowAction, is_active)
-            }
+            Event::Dock(ActionEvent::CancelRequested(id)) => shell.cancel(&mut io, Source::DockAction, id),
+            Event::Undock(ActionEvent::CancelRequested(id)) => shell.cancel(&mut io, Source::UndockAction, id),
+            Event::Follow(ActionEvent::CancelRequested(id)) => shell.cancel(&mut io, Source::FollowAction, id),
             Event::Check(id, req) => shell.check_in(io.node, jobs, check, id, &req),
             Event::Checked(id, reply) => {
                 jobs.pending = jobs.pending.saturating_sub(1);

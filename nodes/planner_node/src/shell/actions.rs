@@ -96,8 +96,15 @@ impl Shell {
         }
     }
 
-    pub(crate) fn cancel(&mut self, io: &mut Io<'_, '_>, source: Source, is_active: bool) {
-        if is_active && self.session.active().is_some_and(|a| a.source == source) {
+    /// A cancel of goal `id` of action `source`: the active goal ends CANCELED if it is that one.
+    pub(crate) fn cancel(&mut self, io: &mut Io<'_, '_>, source: Source, id: mobil_ros::action::GoalId) {
+        let active_id = match source {
+            Source::DockAction => io.servers.dock.active_id(),
+            Source::UndockAction => io.servers.undock.active_id(),
+            Source::FollowAction => io.servers.follow.active_id(),
+            Source::DockPose | Source::Waypoints => None,
+        };
+        if active_id == Some(id) && self.session.active().is_some_and(|a| a.source == source) {
             self.end_goal(io, EndCause::Canceled);
         }
     }
