@@ -166,6 +166,63 @@ impl<R: Send + 'static> OffLoop<R> {
     }
 }
 
+/// Requests computed on the blocking pool several at once, up to a limit (a service whose
+/// requests each take up to a second of one core): each reply comes back with its request's
+/// key, in any order; beyond the limit a request is turned away at once, for the caller to
+/// answer BUSY, so a burst of requests never piles up threads.
+pub struct ReplyPool<K, R> {
+    limit: usize,
+    running: usize,
+    tx: mpsc::UnboundedSender<(K, R)>,
+    rx: mpsc::UnboundedReceiver<(K, R)>,
+}
+
+impl<K: Send + 'static, R: Send + 'static> ReplyPool<K, R> {
+    /// A pool of at most `limit` jobs at once.
+    pub fn new(limit: usize) -> Self {
+        let (tx, rx) = mpsc::unbounded_channel();
+        ReplyPool {
+            limit,
+            running: 0,
+            tx,
+            rx,
+        }
+    }
+
+    /// Jobs under way.
+    pub fn running(&self) -> usize {
+        self.running
+    }
+
+    /// Starts `job` for the request `key` on the blocking pool, or, with `limit` jobs under way
+    /// already, gives `key` back with their number. Must be called inside a tokio runtime.
+    pub fn start(&mut self, key: K, job: impl FnOnce() -> R + Send + 'static) -> Result<(), (K, usize)> {
+        if self.running >= self.limit {
+            return Err((key, self.running));
+        }
+        self.running += 1;
+        let tx = self.tx.clone();
+        tokio::task::spawn_blocking(move || {
+            // The receiver lives as long as the pool; if it is gone nobody waits.
+            let _ = tx.send((key, job()));
+        });
+        Ok(())
+    }
+
+    /// The next reply, with its key; pending while none is under way. Cancel-safe (a reply
+    /// not taken stays for the next call), so it sits in the node's `select!`.
+    pub async fn next(&mut self) -> (K, R) {
+        match self.rx.recv().await {
+            Some(reply) => {
+                self.running = self.running.saturating_sub(1);
+                reply
+            }
+            // The pool holds a sender, so the channel never closes.
+            None => std::future::pending().await,
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -292,5 +349,33 @@ mod tests {
             "jobs 1–9 never ran"
         );
         assert_eq!((off.threads(), off.is_running()), (0, false));
+    }
+
+    #[tokio::test(flavor = "current_thread")]
+    async fn a_pool_runs_up_to_its_limit_and_turns_the_next_away() {
+        let (release_tx, release_rx) = std::sync::mpsc::channel::<()>();
+        let release = Arc::new(std::sync::Mutex::new(release_rx));
+        let mut pool = ReplyPool::new(2);
+        for key in [1, 2] {
+            let release = release.clone();
+            let job = move || {
+                // Held until released, so both are under way when the third comes.
+                let _ = release.lock().map(|r| r.recv());
+                key * 10
+            };
+            assert!(pool.start(key, job).is_ok());
+        }
+        assert_eq!(pool.start(3, || 30).unwrap_err(), (3, 2));
+        release_tx.send(()).expect("job waits");
+        let (key, reply) = pool.next().await;
+        assert_eq!(reply, key * 10);
+        assert_eq!(pool.running(), 1);
+        assert!(pool.start(3, || 30).is_ok(), "a place is free again");
+        release_tx.send(()).expect("job waits");
+        let mut rest = [pool.next().await, pool.next().await];
+        rest.sort();
+        assert_eq!(rest.len(), 2);
+        assert!(rest.contains(&(3, 30)));
+        assert_eq!(pool.running(), 0);
     }
 }

@@ -60,6 +60,7 @@ use mobil_ros::motion::{
     Applied, CmdVel, EndCause, EndKind, Ended, GoalId, MotionSession, Outputs, SessionSettings, Watched,
 };
 use mobil_ros::offloop::CancelToken;
+use mobil_ros::offloop::ReplyPool;
 use mobil_ros::scan::{checked_scan, tf_static_subscription, LaserMount, StaticFrames};
 use mobil_ros::status::{end_state, NavStatusView, RateGate};
 use mobil_ros::stop::{final_stop, FINAL_STOP_WAIT};
@@ -72,7 +73,6 @@ use ros2_client::{RmwRequestId, Server, Subscription};
 use std::process::ExitCode;
 use std::sync::Arc;
 use std::time::{Duration, Instant};
-use tokio::sync::mpsc;
 use tracing::{info, warn};
 
 /// The route-check service.
@@ -200,9 +200,7 @@ struct VfoTickDone {
 struct Jobs {
     goal: OffLoop<PreCheckDone>,
     vfo: OffLoop<VfoTickDone>,
-    replies_tx: mpsc::UnboundedSender<(RmwRequestId, CheckRouteResponse)>,
-    replies: mpsc::UnboundedReceiver<(RmwRequestId, CheckRouteResponse)>,
-    pending: usize,
+    checks: ReplyPool<RmwRequestId, CheckRouteResponse>,
 }
 
 /// Everything the loop holds between events.
@@ -314,13 +312,11 @@ async fn start(node: &mut RosNode, out: &Outputs, config: PlannerConfig) -> anyh
         laser: StaticFrames::default(),
     };
     shell.send_idle_status(node, out);
-    let (replies_tx, replies) = mpsc::unbounded_channel();
     let mut jobs = Jobs {
         goal: OffLoop::new(),
         vfo: OffLoop::new(),
-        replies_tx,
-        replies,
-        pending: 0,
+        // The goal's pre-check keeps one of the MAX_CHECKS.
+        checks: ReplyPool::new(MAX_CHECKS - 1),
     };
     let mut sink = CmdVel::new(&out.cmd);
     let outcome = event_loop(
@@ -392,7 +388,7 @@ async fn event_loop(
             e = inputs.next() => e?,
             done = jobs.goal.result() => Event::RouteChecked(done),
             done = jobs.vfo.result() => Event::VfoTicked(done),
-            Some((id, reply)) = jobs.replies.recv() => Event::Checked(id, reply),
+            (id, reply) = jobs.checks.next() => Event::Checked(id, reply),
             e = servers.dock.next_event() => Event::Dock(e),
             e = servers.undock.next_event() => Event::Undock(e),
             e = servers.follow.next_event() => Event::Follow(e),
@@ -443,10 +439,7 @@ async fn event_loop(
             Event::Undock(ActionEvent::CancelRequested(id)) => shell.cancel(&mut io, Source::UndockAction, id),
             Event::Follow(ActionEvent::CancelRequested(id)) => shell.cancel(&mut io, Source::FollowAction, id),
             Event::Check(id, req) => shell.check_in(io.node, jobs, check, id, &req),
-            Event::Checked(id, reply) => {
-                jobs.pending = jobs.pending.saturating_sub(1);
-                respond(check, id, reply, CHECK_ROUTE, &mut shell.throttle);
-            }
+            Event::Checked(id, reply) => respond(check, id, reply, CHECK_ROUTE, &mut shell.throttle),
             Event::RouteChecked(done) => shell.pre_checked(&mut io, done),
             Event::Tick => shell.tick(&mut io).await,
         }

@@ -15,24 +15,15 @@ impl Shell {
     ) {
         let (start, route) = match self.check_request(req) {
             Err(reply) => return respond(check, id, reply, CHECK_ROUTE, &mut self.throttle),
-            Ok(_) if jobs.pending + 1 >= MAX_CHECKS => {
-                let reply = refused_reply(format!(
-                    "BUSY: {} route checks are already being computed; ask again",
-                    jobs.pending
-                ));
-                return respond(check, id, reply, CHECK_ROUTE, &mut self.throttle);
-            }
             Ok(checked) => checked,
         };
-        jobs.pending += 1;
-        let tx = jobs.replies_tx.clone();
         let (world, chassis, config) = (self.world.clone(), self.chassis, self.config.route_check());
         let (stamp, frame, step) = (
             node.stamp(),
             self.config.frames.odom_frame.clone(),
             self.config.follow.check_length,
         );
-        tokio::task::spawn_blocking(move || {
+        let job = move || {
             let began = Instant::now();
             let reply = match check_route_until(&start, &route.points, &chassis, &world, &config, || false) {
                 Ok(report) => check_reply(&report, &route, stamp, &frame, step),
@@ -48,9 +39,14 @@ impl Shell {
                 },
                 began.elapsed().as_secs_f64() * 1e3
             );
-            // The receiver lives as long as the loop; if it is gone nobody waits.
-            let _ = tx.send((id, reply));
-        });
+            reply
+        };
+        if let Err((id, running)) = jobs.checks.start(id, job) {
+            let reply = refused_reply(format!(
+                "BUSY: {running} route checks are already being computed; ask again"
+            ));
+            respond(check, id, reply, CHECK_ROUTE, &mut self.throttle);
+        }
     }
 
     /// The start and route of a `planner/check_route` request, or the reply refusing it.
