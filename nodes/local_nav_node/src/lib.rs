@@ -34,16 +34,8 @@ use std::time::Duration;
 /// the code Nav2's controller (`FollowPath`, 100…) or planner (`ComputePathToPose`, 200…) server
 /// gives the same failure.
 pub mod nav2_error {
-    /// No error (succeeded, canceled, pre-empted).
-    pub const NONE: u16 = 0;
-    /// FollowPath UNKNOWN: the node shut down under the goal.
-    pub const UNKNOWN: u16 = 100;
-    /// FollowPath FAILED_TO_MAKE_PROGRESS: the progress checker fired.
-    pub const FAILED_TO_MAKE_PROGRESS: u16 = 105;
-    /// FollowPath NO_VALID_CONTROL: no command can be computed (scan or odometry stale).
-    pub const NO_VALID_CONTROL: u16 = 106;
-    /// ComputePathToPose NO_VALID_PATH: the method found no path (NO_PATH).
-    pub const NO_VALID_PATH: u16 = 208;
+    pub use mobil_motion::nav2::compute_path::NO_VALID_PATH;
+    pub use mobil_motion::nav2::follow_path::{FAILED_TO_MAKE_PROGRESS, NONE, NO_VALID_CONTROL, UNKNOWN};
 }
 
 /// Everything the node is configured with, each field filled by one declared parameter.

@@ -14,7 +14,7 @@ pub const MAX_DRAWN_PATH: usize = 300;
 /// Most points over the whole sketch — the route's line and dots, the predicted path, the
 /// virtual robots' paths and the chosen one — shared among them by [`MarkerView::sketch`]: 24
 /// bytes each in a marker array's CDR, 24 KB. With the markers' own bytes (about 250 each, at
-/// most 2 + 2·[`MAX_LISTED_MISSED`] + 1 + [`MAX_DRAWN_ROBOTS`] + 1 + 2·[`MAX_DRAWN_OBSTACLES`]
+/// most 2 + 1 + 2·[`MAX_LISTED_MISSED`] + 1 + [`MAX_DRAWN_ROBOTS`] + 1 + 2·[`MAX_DRAWN_OBSTACLES`]
 /// of them, plus the DELETEALL) the array stays below the 80 KB a message to rclpy should stay
 /// below (tested on the worst case in `planner_node`).
 pub const MAX_MARKER_POINTS: usize = 1000;

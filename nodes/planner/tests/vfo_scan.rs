@@ -518,6 +518,11 @@ fn new_extraction_parameters_wait_for_the_running_goal_to_end() {
     };
     // During a goal: the map keeps its obstacle and its parameters until the goal ends.
     assert_eq!(kept.reconfigure(wider, true), Ok(MapChange::AfterGoal));
+    assert_eq!(
+        kept.reconfigure(wider, true),
+        Ok(MapChange::Unchanged),
+        "already waiting"
+    );
     assert_eq!((kept.map().len(), *kept.map().config()), (1, base));
     // Invalid parameters are refused and leave the change waiting as it was.
     let bad = ScanObstacleConfig { memory: 0, ..base };

@@ -343,9 +343,17 @@ pub fn markers(view: &MarkerView<'_>, stamp: Time, frame: &str) -> MarkerArray {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use approx::assert_relative_eq;
+    use mobil_geom::Pose2;
+    use mobil_motion::Outcome;
     use mobil_msgs::mobil_msgs::msg::NavStatus;
     use mobil_msgs::nav2_msgs::action::{DockRobotResult, UndockRobotResult};
+    use mobil_msgs::visualization_msgs::msg::Marker;
+    use mobil_planner::ProblemKind;
+    use mobil_ros::geometry::{header_in, pose_stamped, yaw_of};
+    use mobil_ros::params::ParamValues;
     use mobil_ros::status::end_state;
+    use nalgebra::Point2;
 
     fn dock_result(cause: &EndCause) -> DockRobotResult {
         nav2_result(cause, Action::Dock.codes())
@@ -354,14 +362,6 @@ mod tests {
     fn undock_result(cause: &EndCause) -> UndockRobotResult {
         nav2_result(cause, Action::Undock.codes())
     }
-    use approx::assert_relative_eq;
-    use mobil_geom::Pose2;
-    use mobil_motion::Outcome;
-    use mobil_msgs::visualization_msgs::msg::Marker;
-    use mobil_planner::ProblemKind;
-    use mobil_ros::geometry::{header_in, pose_stamped, yaw_of};
-    use mobil_ros::params::ParamValues;
-    use nalgebra::Point2;
 
     fn stamped(frame: &str, x: f64, y: f64) -> PoseStamped {
         pose_stamped(header_in(frame), &Pose2::new(x, y, 0.0))

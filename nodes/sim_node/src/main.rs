@@ -71,12 +71,9 @@ impl Config for SimConfig {
             c.world_file = v
         })
         .read_only();
-        // The declared range keeps the value ≥ 0, so the conversion cannot fail.
-        d.integer("seed", 1, "random seed (noise)", |c, v| {
-            c.seed = u64::try_from(v).unwrap_or_default()
-        })
-        .min(0.0)
-        .read_only();
+        d.count("seed", 1u64, "random seed (noise)", |c, v| c.seed = v)
+            .min(0.0)
+            .read_only();
         d.doubles(
             "initial_pose",
             [0.0, 0.0, 0.0],

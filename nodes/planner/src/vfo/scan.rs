@@ -597,7 +597,8 @@ pub struct KeptMap {
 /// What a change of the extraction parameters did to a [`KeptMap`].
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum MapChange {
-    /// The parameters are the map's own (a change waiting, if any, is dropped).
+    /// The parameters are the map's own (a change waiting, if any, is dropped), or those
+    /// already waiting.
     Unchanged,
     /// The map starts afresh with them.
     Restarted,
@@ -633,6 +634,9 @@ impl KeptMap {
             return Ok(MapChange::Unchanged);
         }
         if goal_running {
+            if self.next == Some(config) {
+                return Ok(MapChange::Unchanged);
+            }
             self.next = Some(config);
             return Ok(MapChange::AfterGoal);
         }
