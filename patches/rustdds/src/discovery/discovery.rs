@@ -1138,7 +1138,9 @@ impl Discovery {
         let now = std::time::Instant::now();
         let due = now + Self::ENDPOINT_REANNOUNCE_DELAY;
         self.endpoint_reannounce = match self.endpoint_reannounce {
-          Some((first, _)) if now.duration_since(first) < Self::ENDPOINT_REANNOUNCE_MAX_POSTPONE => {
+          Some((first, _))
+            if now.duration_since(first) < Self::ENDPOINT_REANNOUNCE_MAX_POSTPONE =>
+          {
             Some((first, due))
           }
           Some(pending) => Some(pending),
@@ -1935,11 +1937,22 @@ impl Discovery {
 
     // Send the ReaderUpdated notification on any existing readers on the writer's
     // topic This will result in matching the endpoints if possible
-    let existing_readers = db.readers_on_topic(writer_data.publication_topic_data.topic_name());
-    for reader in existing_readers {
-      self.send_discovery_notification(DiscoveryNotificationType::ReaderUpdated {
+    //
+    // The notifications go out after the DB lock is released: their channel is
+    // bounded, and dp_event_loop, which empties it, reads the DB. Sending while
+    // holding the lock deadlocks once a user thread waits to write the DB (a new
+    // reader or writer): the waiting writer blocks dp_event_loop's read, the full
+    // channel blocks this send, and the held read lock blocks the writer.
+    let notifications: Vec<_> = db
+      .readers_on_topic(writer_data.publication_topic_data.topic_name())
+      .into_iter()
+      .map(|reader| DiscoveryNotificationType::ReaderUpdated {
         discovered_reader_data: reader.clone(),
-      });
+      })
+      .collect();
+    drop(db);
+    for notification in notifications {
+      self.send_discovery_notification(notification);
     }
   }
 
@@ -1959,11 +1972,17 @@ impl Discovery {
 
     // Send the WriterUpdated notification on any existing writers on the readers's
     // topic This will result in matching the endpoints if possible
-    let existing_writers = db.writers_on_topic(reader_data.subscription_topic_data.topic_name());
-    for writer in existing_writers {
-      self.send_discovery_notification(DiscoveryNotificationType::WriterUpdated {
+    // (After the DB lock is released, as in add_local_writer.)
+    let notifications: Vec<_> = db
+      .writers_on_topic(reader_data.subscription_topic_data.topic_name())
+      .into_iter()
+      .map(|writer| DiscoveryNotificationType::WriterUpdated {
         discovered_writer_data: writer.clone(),
-      });
+      })
+      .collect();
+    drop(db);
+    for notification in notifications {
+      self.send_discovery_notification(notification);
     }
   }
 
