@@ -28,11 +28,11 @@
 //! ```
 
 use crate::goals::{after_pre_check, DockGoal, Missed, PreChecked, RouteEvent, RouteGoal, UndockGoal};
-use crate::vfo::{ObstacleMap, SegmentReport, VfoGoal, VfoStep, VfoView};
+use crate::vfo::{vfo_gains, ObstacleMap, SegmentReport, VfoGoal, VfoSettings, VfoStep, VfoView};
 use crate::{DockingPhase, FollowConfig, RouteReport};
 use mobil_chassis::ChassisParams;
 use mobil_geom::Pose2;
-use mobil_motion::slot::{Handback, LawSlot};
+use mobil_motion::slot::{late_bound, Handback, LawSlot};
 use mobil_motion::{nav2, BodyTwist, EndCause, GoalLaw, Nav2Codes, Outcome, Step, StepInput};
 use nalgebra::Point2;
 use std::time::{Duration, Instant};
@@ -116,6 +116,51 @@ impl VfoRun {
         }
     }
 
+    /// A VFO route through `route` (points, their headings where given, the request's index
+    /// of each) from `start`, the latest fresh odometry pose, round `map`'s obstacles on
+    /// `chassis` with `settings`; a step's command that comes back later than two periods of
+    /// the odometry (`odom_period`, as measured; else one control step) is dropped
+    /// ([`late_bound`]). Refused STALE_INPUT without fresh odometry, or without a fresh scan
+    /// (`scan_fresh`: the obstacles are unknown, and the first step would optimise the segment
+    /// through a map with nothing in it); else as [`VfoGoal::for_route`] refuses it.
+    pub fn start(
+        route: (&[Point2<f64>], &[Option<f64>], &[usize]),
+        start: Option<Pose2>,
+        scan_fresh: bool,
+        (settings, chassis, map): (&VfoSettings, &ChassisParams, &ObstacleMap),
+        odom_period: Option<Duration>,
+    ) -> Result<VfoStart, Outcome> {
+        let start = start.ok_or_else(|| Action::Follow.stale_at_start("odom"))?;
+        if !scan_fresh {
+            return Err(Action::Follow.stale_at_start("scan"));
+        }
+        let setup = settings.setup();
+        let law = VfoGoal::for_route(route, &start, &setup, chassis, map)?;
+        let gains = vfo_gains(&setup.gains, chassis);
+        let summary = format!(
+            "{} waypoints by VFO ({} obstacles known; U_2 {:.2} m/s, |ω| ≤ {:.2} rad/s, T_p {:.3} s)",
+            route.0.len(),
+            law.follower().obstacles().len(),
+            gains.speed,
+            gains.omega_max,
+            settings.optimise.time_step
+        );
+        let chassis_warning = chassis.model().is_nonholonomic().then(|| {
+            format!(
+                "the VFO law is a unicycle's: on this {} chassis the virtual robots turn no tighter than at \
+                 U_2 over R_min, but slower commands are held to R_min too, so the robot may turn wider than \
+                 they did (waypoint_method approach is this chassis' default)",
+                chassis.model().as_str()
+            )
+        });
+        let max_delay = late_bound(odom_period, settings.optimise.time_step);
+        Ok(VfoStart {
+            run: VfoRun::new(law, max_delay),
+            summary,
+            chassis_warning,
+        })
+    }
+
     /// The status' figures as the law last came back.
     pub fn view(&self) -> &VfoView {
         &self.view
@@ -168,6 +213,17 @@ impl VfoRun {
         }
         (step, handback)
     }
+}
+
+/// A VFO route that starts ([`VfoRun::start`]): the run, and what the node tells of it.
+#[derive(Debug)]
+pub struct VfoStart {
+    /// The route's run.
+    pub run: VfoRun,
+    /// Its waypoints, the obstacles known, the law's speed, turn rate and control step.
+    pub summary: String,
+    /// On a steered chassis: that the robot may turn wider than the virtual robots did.
+    pub chassis_warning: Option<String>,
 }
 
 /// What the active goal does.
@@ -338,6 +394,62 @@ impl Task {
                 Some(Ok(problems))
             }
         }
+    }
+}
+
+/// Where a goal came from: the node's two topics and three action servers.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Source {
+    /// The `dock_pose` topic.
+    DockPose,
+    /// The `waypoints` topic.
+    Waypoints,
+    /// The `dock_robot` action.
+    DockAction,
+    /// The `undock_robot` action.
+    UndockAction,
+    /// The `follow_waypoints` action.
+    FollowAction,
+}
+
+/// The topic's or action's name (the motion session names a goal's source by it).
+impl From<Source> for &'static str {
+    fn from(s: Source) -> &'static str {
+        match s {
+            Source::DockPose => "dock_pose",
+            Source::Waypoints => "waypoints",
+            Source::DockAction => "dock_robot",
+            Source::UndockAction => "undock_robot",
+            Source::FollowAction => "follow_waypoints",
+        }
+    }
+}
+
+impl Source {
+    /// The topic's or action's name.
+    pub fn name(self) -> &'static str {
+        self.into()
+    }
+
+    /// Whether the goal came from an action server (its end is a result).
+    pub fn is_action(self) -> bool {
+        matches!(self, Source::DockAction | Source::UndockAction | Source::FollowAction)
+    }
+
+    /// The action whose codes the goal's ends take (a topic: the action it stands for).
+    pub fn action(self) -> Action {
+        match self {
+            Source::DockPose | Source::DockAction => Action::Dock,
+            Source::UndockAction => Action::Undock,
+            Source::Waypoints | Source::FollowAction => Action::Follow,
+        }
+    }
+
+    /// Whether a goal from `self` that pre-empts one from `old` found it already ended by its
+    /// server: an action server ends its running goal (PREEMPTED) when it accepts the next, so
+    /// only a goal of another source is given its result by the node.
+    pub fn replaced_on_server(self, old: Source) -> bool {
+        self.is_action() && old == self
     }
 }
 

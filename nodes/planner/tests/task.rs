@@ -8,9 +8,9 @@ use mobil_geom::Pose2;
 use mobil_motion::slot::Handback;
 use mobil_motion::{BodyTwist, EndCause, Outcome, Step, StepInput};
 use mobil_planner::goals::{DockGoal, UndockGoal};
-use mobil_planner::task::{no_dock_database, Action, Mode, PreCheck, Stepped, Task, VfoRun};
+use mobil_planner::task::{no_dock_database, Action, Mode, PreCheck, Source, Stepped, Task, VfoRun, VfoStart};
 use mobil_planner::vfo::{
-    ObstacleMap, OptimiseConfig, ScanObstacleConfig, VfoFollower, VfoGains, VfoGoal, VfoStep, VfoWaypoint,
+    ObstacleMap, OptimiseConfig, ScanObstacleConfig, VfoFollower, VfoGains, VfoGoal, VfoSettings, VfoStep, VfoWaypoint,
 };
 use mobil_planner::{
     DockingConfig, DockingController, DockingGains, Finish, FollowConfig, ProblemKind, RouteProblem, RouteReport,
@@ -214,4 +214,79 @@ fn the_ends_the_node_makes_carry_each_action_s_nav2_code() {
     assert!(no_dock_database()
         .reason()
         .starts_with("INVALID_GOAL: use_dock_id is true"));
+}
+
+#[test]
+fn only_an_action_goal_replacing_one_of_its_own_server_finds_it_ended_by_the_server() {
+    use Source::*;
+    let all = [DockPose, Waypoints, DockAction, UndockAction, FollowAction];
+    for new in all {
+        for old in all {
+            let by_server = matches!(
+                (new, old),
+                (DockAction, DockAction) | (UndockAction, UndockAction) | (FollowAction, FollowAction)
+            );
+            assert_eq!(new.replaced_on_server(old), by_server, "{new:?} after {old:?}");
+        }
+    }
+    // Topics stand for the actions whose codes their ends take.
+    let actions: Vec<Action> = all.iter().map(|s| s.action()).collect();
+    use Action::{Dock, Follow, Undock};
+    assert_eq!(actions, vec![Dock, Follow, Dock, Undock, Follow]);
+    let names: Vec<&str> = all.iter().map(|s| s.name()).collect();
+    assert_eq!(
+        names,
+        [
+            "dock_pose",
+            "waypoints",
+            "dock_robot",
+            "undock_robot",
+            "follow_waypoints"
+        ]
+    );
+}
+
+#[test]
+fn a_vfo_route_starts_with_fresh_odometry_and_a_fresh_scan_its_late_bound_from_the_odometry() {
+    let map = ObstacleMap::new(ScanObstacleConfig::default()).unwrap();
+    let settings = VfoSettings::default();
+    let (omr3, mobil2) = (ChassisParams::omr3(), ChassisParams::mobil2());
+    let route = (&[Point2::new(2.0, 0.0)][..], &[None][..], &[7][..]);
+    let start = Some(Pose2::identity());
+    let ms = Duration::from_millis;
+    let reason = |r: Result<VfoStart, Outcome>| r.map(|_| ()).unwrap_err().reason();
+    let rules = (&settings, &omr3, &map);
+    assert_eq!(
+        reason(VfoRun::start(route, None, true, rules, Some(ms(20)))),
+        "STALE_INPUT: odom stale: robot stopped"
+    );
+    assert_eq!(
+        reason(VfoRun::start(route, start, false, rules, Some(ms(20)))),
+        "STALE_INPUT: scan stale: robot stopped"
+    );
+    let bad = (&[Point2::new(f64::NAN, 0.0)][..], &[None][..], &[7][..]);
+    assert_eq!(
+        reason(VfoRun::start(bad, start, true, rules, None)),
+        "INVALID_GOAL: waypoint 7 is not finite"
+    );
+    // OMR-III: U_2 0.3 m/s (under v_max 0.5), |ω| its ω_max 1.5 (under the law's 4); two
+    // odometry periods of 20 ms.
+    let s = VfoRun::start(route, start, true, rules, Some(ms(20))).unwrap();
+    assert_eq!(
+        s.summary,
+        "1 waypoints by VFO (0 obstacles known; U_2 0.30 m/s, |ω| ≤ 1.50 rad/s, T_p 0.010 s)"
+    );
+    assert_eq!((s.chassis_warning, s.run.max_delay()), (None, ms(40)));
+    assert_eq!(s.run.view().waypoint, 7);
+    // MOBIL-II: |ω| ≤ U_2 / R_min = 0.3 / 0.73 = 0.41 rad/s, and the warning; no period measured
+    // yet: one control step of 50 ms.
+    let mut slow = settings.clone();
+    slow.optimise.time_step = 0.05;
+    let s = VfoRun::start(route, start, true, (&slow, &mobil2, &map), None).unwrap();
+    assert!(s.summary.contains("|ω| ≤ 0.41 rad/s, T_p 0.050 s"), "{}", s.summary);
+    assert!(s
+        .chassis_warning
+        .unwrap()
+        .starts_with("the VFO law is a unicycle's: on this car_like chassis"));
+    assert_eq!(s.run.max_delay(), ms(50));
 }

@@ -27,7 +27,7 @@
 // The shell's modules (`shell::*`) take every name from here (`use crate::*`).
 use mobil_chassis::{clamp_at_reference, ChassisParams};
 use mobil_geom::Pose2;
-use mobil_motion::slot::{late_bound, ArrivalPeriod, Handback};
+use mobil_motion::slot::{ArrivalPeriod, Handback};
 use mobil_motion::{BodyTwist, GoalLaw, Step, StepInput};
 use mobil_msgs::geometry_msgs::msg::{PoseStamped, Twist};
 use mobil_msgs::mobil_msgs::msg::NavStatus;
@@ -40,10 +40,10 @@ use mobil_msgs::nav_msgs::msg::{Odometry, Path};
 use mobil_msgs::sensor_msgs::msg::LaserScan;
 use mobil_msgs::tf2_msgs::msg::TFMessage;
 use mobil_planner::goals::{route_infeasible, DockGoal, RouteEvent, UndockGoal};
-use mobil_planner::task::{PreCheck, Stepped, Task, VfoRun};
+use mobil_planner::task::{PreCheck, Source, Stepped, Task, VfoRun};
 use mobil_planner::vfo::{
-    vfo_gains, Interrupt, KeptMap, MapChange, OptimiseWarning, PoseHistory, ScanSkipped, VfoEvent, VfoGoal, VfoStep,
-    VfoTick, WaypointMethod, MAX_SETTLE_S,
+    Interrupt, KeptMap, MapChange, OptimiseWarning, PoseHistory, ScanSkipped, VfoEvent, VfoGoal, VfoStep, VfoTick,
+    WaypointMethod, MAX_SETTLE_S,
 };
 use mobil_planner::view::Drawing;
 use mobil_planner::{check_route_until, Finish, RouteReport};
@@ -100,46 +100,6 @@ mod shell {
     mod check;
     mod goals;
     mod routes;
-}
-
-/// Where the active goal came from.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-enum Source {
-    DockPose,
-    Waypoints,
-    DockAction,
-    UndockAction,
-    FollowAction,
-}
-
-impl From<Source> for &'static str {
-    fn from(s: Source) -> &'static str {
-        match s {
-            Source::DockPose => "dock_pose",
-            Source::Waypoints => "waypoints",
-            Source::DockAction => "dock_robot",
-            Source::UndockAction => "undock_robot",
-            Source::FollowAction => "follow_waypoints",
-        }
-    }
-}
-
-impl Source {
-    fn name(self) -> &'static str {
-        self.into()
-    }
-
-    fn is_action(self) -> bool {
-        matches!(self, Source::DockAction | Source::UndockAction | Source::FollowAction)
-    }
-
-    fn action(self) -> Action {
-        match self {
-            Source::DockPose | Source::DockAction => Action::Dock,
-            Source::UndockAction => Action::Undock,
-            Source::Waypoints | Source::FollowAction => Action::Follow,
-        }
-    }
 }
 
 /// The goal state the session holds.

@@ -108,7 +108,7 @@ impl Shell {
         };
         let (id, old) = self.session.start(goal, source, Instant::now());
         if let Some(old) = old {
-            let by_server = source.is_action() && old.source == source;
+            let by_server = source.replaced_on_server(old.source);
             self.report(io, old, !by_server);
         }
         id
@@ -119,7 +119,7 @@ impl Shell {
     /// the status is FAILED with the reason.
     pub(crate) fn refuse(&mut self, io: &mut Io<'_, '_>, source: Source, refusal: mobil_motion::Outcome) {
         if let Some(old) = self.session.end(EndCause::Preempted(source.name()), io.sink) {
-            let by_server = source.is_action() && old.source == source;
+            let by_server = source.replaced_on_server(old.source);
             self.report(io, old, !by_server);
         }
         let cause = EndCause::Outcome(refusal);

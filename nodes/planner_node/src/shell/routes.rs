@@ -108,47 +108,22 @@ impl Shell {
 
     /// Starts VFO waypoint following of `route` from `start` (or refuses it).
     pub(crate) fn start_vfo(&mut self, io: &mut Io<'_, '_>, route: Route, start: Option<Pose2>, source: Source) {
-        let Some(start) = start else {
-            return self.refuse(io, source, source.action().stale_at_start("odom"));
-        };
-        // Without a fresh scan the obstacles are unknown: the first tick would optimise the
-        // segment through a map with nothing in it.
-        if self.scan_seen.get(self.config.vfo.scan_timeout()).is_none() {
-            return self.refuse(io, source, source.action().stale_at_start("scan"));
-        }
-        let settings = &self.config.vfo;
-        let setup = settings.setup();
+        let scan_fresh = self.scan_seen.get(self.config.vfo.scan_timeout()).is_some();
         let of_route = (&route.points[..], &route.headings()[..], &route.request_index[..]);
-        let law = match VfoGoal::for_route(of_route, &start, &setup, &self.chassis, self.map.map()) {
-            Ok(law) => law,
+        let rules = (&self.config.vfo, &self.chassis, self.map.map());
+        let started = match VfoRun::start(of_route, start, scan_fresh, rules, self.odom_period.period()) {
+            Ok(started) => started,
             Err(refusal) => return self.refuse(io, source, refusal),
         };
-        let gains = vfo_gains(&setup.gains, &self.chassis);
-        info!(
-            "goal ({}): {} waypoints by VFO ({} obstacles known; U_2 {:.2} m/s, |ω| ≤ {:.2} rad/s, T_p {:.3} s)",
-            source.name(),
-            route.points.len(),
-            law.follower().obstacles().len(),
-            gains.speed,
-            gains.omega_max,
-            settings.optimise.time_step
-        );
-        if self.chassis.model().is_nonholonomic() {
-            warn!(
-                "goal ({}): the VFO law is a unicycle's: on this {} chassis the virtual robots turn no \
-                 tighter than at U_2 over R_min, but slower commands are held to R_min too, so the robot may \
-                 turn wider than they did (waypoint_method approach is this chassis' default)",
-                source.name(),
-                self.chassis.model().as_str()
-            );
+        info!("goal ({}): {}", source.name(), started.summary);
+        if let Some(w) = &started.chassis_warning {
+            warn!("goal ({}): {w}", source.name());
         }
-        // A step's command later than the next odometry or two is dropped (the robot stops).
-        let max_delay = late_bound(self.odom_period.period(), settings.optimise.time_step);
         self.drawing = Drawing {
             route: route.points.clone(),
             ..Drawing::default()
         };
-        self.begin(io, Task::Vfo(VfoRun::new(law, max_delay)), Some(route), source);
+        self.begin(io, Task::Vfo(started.run), Some(route), source);
         self.publish_status(io.node, io.out, NavStatus::ACTIVE, String::new());
         self.publish_markers(io.node, io.out);
     }
