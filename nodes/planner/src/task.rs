@@ -27,8 +27,11 @@
 //! assert_eq!((figures.mode, figures.distance), (Mode::Approach, 5.0));
 //! ```
 
-use crate::goals::{after_pre_check, DockGoal, Missed, PreChecked, RouteEvent, RouteGoal, UndockGoal};
+use crate::goals::{
+    after_pre_check, route_infeasible, DockGoal, Missed, PreChecked, RouteEvent, RouteGoal, UndockGoal,
+};
 use crate::vfo::{vfo_gains, ObstacleMap, SegmentReport, VfoGoal, VfoSettings, VfoStep, VfoView};
+use crate::view::Drawing;
 use crate::{DockingPhase, FollowConfig, RouteReport};
 use mobil_chassis::ChassisParams;
 use mobil_geom::Pose2;
@@ -215,6 +218,20 @@ impl VfoRun {
     }
 }
 
+/// A pre-check's turn ([`Task::turn_after_check`]): the route driven (`Ok`) or refused with
+/// the outcome to end the goal with, and what the node shows and tells of it.
+#[derive(Debug)]
+pub struct PreCheckTurn {
+    /// Driven, or refused.
+    pub outcome: Result<(), Outcome>,
+    /// The route, the virtual robot's path and the problems found.
+    pub drawing: Drawing,
+    /// The waypoints, the check's finding, the predicted length.
+    pub summary: String,
+    /// A route driven through problems (`execute_infeasible_routes`): which.
+    pub driven_through: Option<String>,
+}
+
 /// A VFO route that starts ([`VfoRun::start`]): the run, and what the node tells of it.
 #[derive(Debug)]
 pub struct VfoStart {
@@ -394,6 +411,50 @@ impl Task {
                 Some(Ok(problems))
             }
         }
+    }
+
+    /// [`Task::pre_checked`], with what the node shows and tells of it: the drawing (the route,
+    /// the virtual robot's path, the problems found, driven or refusing), one line on the
+    /// check, and a warning when a route is driven through problems.
+    pub fn turn_after_check(
+        &mut self,
+        report: &RouteReport,
+        (follow, chassis): (FollowConfig, &ChassisParams),
+        execute_infeasible: bool,
+    ) -> Option<PreCheckTurn> {
+        let Task::PreCheck(p) = self else { return None };
+        let route = p.points.clone();
+        let checked = self.pre_checked(report, (follow, chassis), execute_infeasible)?;
+        let found = match (&checked, &*self) {
+            (Ok(problems), _) => problems.clone(),
+            (Err(_), Task::PreCheck(p)) => p.problems.clone(),
+            (Err(_), _) => Vec::new(),
+        };
+        let summary = format!(
+            "{} waypoints, pre-check {} ({:.2} m predicted)",
+            route.len(),
+            match found.len() {
+                0 => "clear".to_owned(),
+                n => format!("{n} problem(s)"),
+            },
+            report.driven_length(follow.check_length)
+        );
+        let driven_through = (checked.is_ok() && !found.is_empty()).then(|| {
+            let reason = route_infeasible(&found).reason();
+            format!("driven although execute_infeasible_routes: {reason}")
+        });
+        let drawing = Drawing {
+            predicted: report.path.clone(),
+            problems: found,
+            route,
+            ..Drawing::default()
+        };
+        Some(PreCheckTurn {
+            outcome: checked.map(|_| ()),
+            drawing,
+            summary,
+            driven_through,
+        })
     }
 }
 

@@ -290,3 +290,48 @@ fn a_vfo_route_starts_with_fresh_odometry_and_a_fresh_scan_its_late_bound_from_t
         .starts_with("the VFO law is a unicycle's: on this car_like chassis"));
     assert_eq!(s.run.max_delay(), ms(50));
 }
+
+#[test]
+fn a_pre_check_s_turn_draws_the_route_its_path_and_problems_and_tells_its_length() {
+    let omr3 = ChassisParams::omr3();
+    let rules = (FollowConfig::default(), &omr3);
+    let step = FollowConfig::default().check_length;
+    // A path of moves of one step along x, then a jump of 3 steps (a missed waypoint set down):
+    // 2 steps driven.
+    let mut report = blocked();
+    report.path = [0.0, 1.0, 2.0, 5.0]
+        .iter()
+        .map(|&k| Pose2::new(k * step, 0.0, 0.0))
+        .collect();
+    let driven = format!("{:.2} m predicted", 2.0 * step);
+    // Refused: the drawing holds the three waypoints, the path and the problem (request index 5).
+    let turn = pre_check().turn_after_check(&report, rules, false).unwrap();
+    assert!(turn
+        .outcome
+        .unwrap_err()
+        .reason()
+        .starts_with("ROUTE_INFEASIBLE: 1 problem(s)"));
+    assert_eq!(turn.summary, format!("3 waypoints, pre-check 1 problem(s) ({driven})"));
+    assert_eq!((turn.drawing.route.len(), turn.drawing.predicted.len()), (3, 4));
+    assert_eq!(
+        turn.drawing.problems.iter().map(|m| m.index).collect::<Vec<_>>(),
+        vec![5]
+    );
+    assert_eq!(turn.driven_through, None);
+    // Driven through: the same drawing, and the warning naming the problem.
+    let turn = pre_check().turn_after_check(&report, rules, true).unwrap();
+    assert!(turn.outcome.is_ok());
+    let warning = turn.driven_through.unwrap();
+    assert!(
+        warning.starts_with("driven although execute_infeasible_routes: ROUTE_INFEASIBLE: 1 problem(s): waypoint 5"),
+        "{warning}"
+    );
+    assert_eq!(turn.drawing.problems.len(), 1);
+    // Clear: no problem drawn, no warning.
+    report.problems.clear();
+    let turn = pre_check().turn_after_check(&report, rules, false).unwrap();
+    assert_eq!(turn.summary, format!("3 waypoints, pre-check clear ({driven})"));
+    assert!(turn.outcome.is_ok() && turn.drawing.problems.is_empty() && turn.driven_through.is_none());
+    // A task that is no pre-check takes no report.
+    assert!(Task::Vfo(vfo()).turn_after_check(&report, rules, false).is_none());
+}

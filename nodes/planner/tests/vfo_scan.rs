@@ -427,6 +427,8 @@ fn a_scan_older_than_the_map_empties_it() {
     assert_eq!(u.cleared, vec![0, 1]);
     assert!(u.removed_any());
     assert!(map.is_empty());
+    let reset = "scan at 99.000 s is older than obstacles already seen (clock reset?): the 2 obstacles forgotten";
+    assert_eq!(u.warnings(99.0, 200), vec![("map-reset", reset.to_owned())]);
     map.merge_at(&[circle(3.0, 0.0, 0.3)], 99.5);
     let u = map
         .update_from_ranges(&ranges, -0.1, 0.01, 0.06, 10.0, &away, 129.6)
@@ -437,7 +439,7 @@ fn a_scan_older_than_the_map_empties_it() {
     let u = map
         .update_from_ranges(&ranges, -0.1, 0.01, 0.06, 10.0, &away, 130.0)
         .expect("valid");
-    assert!(u.cleared.is_empty());
+    assert!(u.cleared.is_empty() && u.warnings(130.0, 200).is_empty());
     assert_eq!(map.len(), 1);
 }
 
@@ -486,6 +488,8 @@ fn beyond_the_cap_the_least_recently_seen_circles_are_dropped() {
         .expect("valid");
     assert_eq!(u.capped, vec![1]);
     assert_eq!(map.ids(), vec![0, 2]);
+    let full = "obstacle map full (vfo.max_obstacles 2): the 1 least recently seen dropped";
+    assert_eq!(u.warnings(3.5, 2), vec![("map-cap", full.to_owned())]);
     assert_eq!(map.circles()[1].centre, Point2::new(-3.0, 0.0));
     // Equal ages: the oldest (smallest id) goes first.
     let mut map = circle_map(30.0, 1);

@@ -39,7 +39,7 @@ use mobil_msgs::nav2_msgs::action::{
 use mobil_msgs::nav_msgs::msg::{Odometry, Path};
 use mobil_msgs::sensor_msgs::msg::LaserScan;
 use mobil_msgs::tf2_msgs::msg::TFMessage;
-use mobil_planner::goals::{route_infeasible, DockGoal, RouteEvent, UndockGoal};
+use mobil_planner::goals::{DockGoal, RouteEvent, UndockGoal};
 use mobil_planner::task::{PreCheck, Source, Stepped, Task, VfoRun};
 use mobil_planner::vfo::{
     Interrupt, KeptMap, MapChange, OptimiseWarning, PoseHistory, ScanSkipped, VfoEvent, VfoGoal, VfoStep, VfoTick,

@@ -300,6 +300,27 @@ pub struct MapUpdate {
 }
 
 impl MapUpdate {
+    /// What the node warns of, each with its log key: obstacles forgotten because the scan at
+    /// `stamp` (s) is older than their last detection (`map-reset`), and obstacles dropped by the
+    /// map's cap of `max_obstacles` (`map-cap`).
+    pub fn warnings(&self, stamp: f64, max_obstacles: usize) -> Vec<(&'static str, String)> {
+        let mut w = Vec::new();
+        if !self.cleared.is_empty() {
+            let n = self.cleared.len();
+            let text = format!(
+                "scan at {stamp:.3} s is older than obstacles already seen (clock reset?): the {n} obstacles forgotten"
+            );
+            w.push(("map-reset", text));
+        }
+        if !self.capped.is_empty() {
+            let n = self.capped.len();
+            let text =
+                format!("obstacle map full (vfo.max_obstacles {max_obstacles}): the {n} least recently seen dropped");
+            w.push(("map-cap", text));
+        }
+        w
+    }
+
     /// Whether any obstacle was removed (the indices after it changed).
     pub fn removed_any(&self) -> bool {
         !(self.seen_through.is_empty() && self.decayed.is_empty() && self.capped.is_empty() && self.cleared.is_empty())

@@ -62,46 +62,21 @@ impl Shell {
         let source = active.source;
         let goal = &mut active.goal;
         let (follow, execute) = (goal.config.follow, goal.config.execute_infeasible_routes);
-        let points = goal.route.as_ref().map_or_else(Vec::new, |r| r.points.clone());
         let report = match done.report {
             Ok(r) => r,
             Err(e) => return self.end_goal(io, Action::Follow.refused_goal(e).into()),
         };
-        let Some(checked) = goal.task.pre_checked(&report, (follow, &goal.chassis), execute) else {
+        let Some(turn) = goal.task.turn_after_check(&report, (follow, &goal.chassis), execute) else {
             return;
         };
-        let found = match (&checked, &goal.task) {
-            (Ok(problems), _) => problems.clone(),
-            (Err(_), Task::PreCheck(p)) => p.problems.clone(),
-            (Err(_), _) => Vec::new(),
-        };
-        self.drawing = Drawing {
-            predicted: report.path.clone(),
-            problems: found.clone(),
-            route: points,
-            ..Drawing::default()
-        };
-        if let Err(outcome) = checked {
+        self.drawing = turn.drawing;
+        if let Err(outcome) = turn.outcome {
             return self.end_goal(io, outcome.into());
         }
-        if !found.is_empty() {
-            let reason = route_infeasible(&found).reason();
-            warn!(
-                "goal ({}): driven although execute_infeasible_routes: {reason}",
-                source.name()
-            );
+        if let Some(w) = &turn.driven_through {
+            warn!("goal ({}): {w}", source.name());
         }
-        info!(
-            "goal ({}): {} waypoints, pre-check {} ({:.2} m predicted)",
-            source.name(),
-            self.drawing.route.len(),
-            if found.is_empty() {
-                "clear".to_owned()
-            } else {
-                format!("{} problem(s)", found.len())
-            },
-            report.driven_length(follow.check_length)
-        );
+        info!("goal ({}): {}", source.name(), turn.summary);
         self.publish_status(io.node, io.out, NavStatus::ACTIVE, String::new());
         self.publish_markers(io.node, io.out);
     }
@@ -241,22 +216,8 @@ impl Shell {
             Err(e @ ScanSkipped::NoPose { .. }) => return warn_throttled!(self.throttle, "scan-odom", "{e}"),
             Err(e) => return warn_throttled!(self.throttle, "scan-bad", "{e}; scan ignored"),
         };
-        if !update.cleared.is_empty() {
-            warn_throttled!(
-                self.throttle,
-                "map-reset",
-                "scan at {stamp:.3} s is older than obstacles already seen (clock reset?): the {} obstacles forgotten",
-                update.cleared.len()
-            );
-        }
-        if !update.capped.is_empty() {
-            warn_throttled!(
-                self.throttle,
-                "map-cap",
-                "obstacle map full (vfo.max_obstacles {}): the {} least recently seen dropped",
-                self.map.map().config().max_obstacles,
-                update.capped.len()
-            );
+        for (key, w) in update.warnings(stamp, self.map.map().config().max_obstacles) {
+            warn_throttled!(self.throttle, key, "{w}");
         }
         if self.scan_seen.value().is_none() {
             info!(
