@@ -152,6 +152,16 @@ impl LogThrottle {
         }
     }
 
+    /// Logs `notices`: each info line as it is, each warning rate-limited under its key.
+    pub fn tell(&mut self, notices: impl IntoIterator<Item = mobil_motion::Notice>) {
+        for n in notices {
+            match n {
+                mobil_motion::Notice::Info(text) => tracing::info!("{text}"),
+                mobil_motion::Notice::Warn(key, text) => crate::warn_throttled!(self, key, "{text}"),
+            }
+        }
+    }
+
     /// `Some(n)` when a line for `key` may be written now, `n` being how many were suppressed
     /// since the last one; `None` to stay quiet.
     pub fn allow(&mut self, key: &'static str, now: Instant) -> Option<u64> {

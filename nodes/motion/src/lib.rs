@@ -81,6 +81,16 @@ impl StepInput {
     }
 }
 
+/// What a law, or a goal's turn, has for the node's log: the law decides what is said, the
+/// node only writes it.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Notice {
+    /// An info line.
+    Info(String),
+    /// A warning that may recur at every step: the node rate-limits it under its key.
+    Warn(&'static str, String),
+}
+
 /// How a goal ended: Nav2's view of it.
 #[derive(Debug, Clone, PartialEq)]
 pub enum Outcome {

@@ -30,13 +30,16 @@
 use crate::goals::{
     after_pre_check, route_infeasible, DockGoal, Missed, PreChecked, RouteEvent, RouteGoal, UndockGoal,
 };
-use crate::vfo::{vfo_gains, ObstacleMap, SegmentReport, VfoGoal, VfoSettings, VfoStep, VfoView};
+use crate::vfo::{
+    vfo_gains, ObstacleMap, OptimiseWarning, SegmentReport, VfoEvent, VfoGoal, VfoSettings, VfoStep, VfoView,
+    MAX_SETTLE_S,
+};
 use crate::view::Drawing;
 use crate::{DockingPhase, FollowConfig, RouteReport};
 use mobil_chassis::ChassisParams;
 use mobil_geom::Pose2;
 use mobil_motion::slot::{late_bound, Handback, LawSlot};
-use mobil_motion::{nav2, BodyTwist, EndCause, GoalLaw, Nav2Codes, Outcome, Step, StepInput};
+use mobil_motion::{nav2, BodyTwist, EndCause, GoalLaw, Nav2Codes, Notice, Outcome, Step, StepInput};
 use nalgebra::Point2;
 use std::time::{Duration, Instant};
 
@@ -215,6 +218,39 @@ impl VfoRun {
             *twist = BodyTwist::new(0.0, 0.0, 0.0);
         }
         (step, handback)
+    }
+
+    /// What the node logs of a step given back ([`VfoRun::give_back`]): each event as the law
+    /// describes it, the optimisation's warnings (but that no Σ is safe, which the event says),
+    /// a robot held while it settles inside an influence zone, a command dropped as late.
+    pub fn notices(&self, step: &Step<VfoStep, Vec<usize>>, handback: Handback) -> Vec<Notice> {
+        let (Step::Command { feedback, .. }, Some(law)) = (step, self.law()) else {
+            return Vec::new();
+        };
+        let mut notices = Vec::new();
+        for event in &feedback.events {
+            notices.push(Notice::Info(law.describe(event)));
+            if let VfoEvent::Optimised { warnings, .. } = event {
+                let shown = warnings.iter().filter(|w| !matches!(w, OptimiseWarning::NoSafeSigma));
+                notices.extend(shown.map(|w| Notice::Warn("vfo-caps", format!("segment optimisation: {w:?}"))));
+            }
+        }
+        if feedback.settling {
+            let text = format!(
+                "robot held at zero inside an influence zone until it stands (at most {MAX_SETTLE_S} s), then the \
+                 segment to waypoint {} is optimised from there",
+                self.view.waypoint
+            );
+            notices.push(Notice::Warn("vfo-settle", text));
+        }
+        if handback == Handback::Late {
+            let text = format!(
+                "a tick took longer than {:.0} ms (an optimisation): its command is dropped, the robot stops meanwhile",
+                self.max_delay().as_secs_f64() * 1e3
+            );
+            notices.push(Notice::Warn("vfo-late", text));
+        }
+        notices
     }
 }
 

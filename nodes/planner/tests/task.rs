@@ -6,11 +6,12 @@
 use mobil_chassis::ChassisParams;
 use mobil_geom::Pose2;
 use mobil_motion::slot::Handback;
-use mobil_motion::{BodyTwist, EndCause, Outcome, Step, StepInput};
+use mobil_motion::{BodyTwist, EndCause, Notice, Outcome, Step, StepInput};
 use mobil_planner::goals::{DockGoal, UndockGoal};
 use mobil_planner::task::{no_dock_database, Action, Mode, PreCheck, Source, Stepped, Task, VfoRun, VfoStart};
 use mobil_planner::vfo::{
-    ObstacleMap, OptimiseConfig, ScanObstacleConfig, VfoFollower, VfoGains, VfoGoal, VfoSettings, VfoStep, VfoWaypoint,
+    ObstacleMap, OptimiseConfig, OptimiseWarning, Reoptimised, ScanObstacleConfig, VfoEvent, VfoFollower, VfoGains,
+    VfoGoal, VfoSettings, VfoStep, VfoWaypoint,
 };
 use mobil_planner::{
     DockingConfig, DockingController, DockingGains, Finish, FollowConfig, ProblemKind, RouteProblem, RouteReport,
@@ -334,4 +335,66 @@ fn a_pre_check_s_turn_draws_the_route_its_path_and_problems_and_tells_its_length
     assert!(turn.outcome.is_ok() && turn.drawing.problems.is_empty() && turn.driven_through.is_none());
     // A task that is no pre-check takes no report.
     assert!(Task::Vfo(vfo()).turn_after_check(&report, rules, false).is_none());
+}
+
+#[test]
+fn a_vfo_step_given_back_tells_its_events_its_capped_optimisation_a_settling_and_a_late_command() {
+    let mut run = vfo();
+    let map = ObstacleMap::new(ScanObstacleConfig::default()).unwrap();
+    let law = run.lend(Instant::now(), &map).unwrap();
+    let step = Step::Command {
+        twist: BodyTwist::new(0.1, 0.0, 0.0),
+        feedback: VfoStep {
+            events: vec![
+                VfoEvent::Optimised {
+                    index: 0,
+                    reason: Reoptimised::SegmentStart,
+                    score: None,
+                    warnings: vec![
+                        OptimiseWarning::NoSafeSigma,
+                        OptimiseWarning::VirtualRobotCap { limit: 9, pending: 2 },
+                    ],
+                },
+                VfoEvent::Reached {
+                    index: 0,
+                    vortex: false,
+                },
+            ],
+            settling: true,
+            drawing: None,
+        },
+    };
+    let (step, handback) = run.give_back(law, step, Instant::now() + Duration::from_millis(41));
+    assert_eq!(handback, Handback::Late);
+    let notices = run.notices(&step, handback);
+    // The request's index 7 for waypoint 0; no safe Σ is in the event, not again as a warning;
+    // the bound of 40 ms the run was made with.
+    assert_eq!(
+        notices,
+        vec![
+            Notice::Info(
+                "segment to waypoint 7 optimised (SegmentStart): Ψ_z none, 0 virtual robots, 0 candidates".into()
+            ),
+            Notice::Warn(
+                "vfo-caps",
+                "segment optimisation: VirtualRobotCap { limit: 9, pending: 2 }".into()
+            ),
+            Notice::Info("waypoint 7 reached".into()),
+            Notice::Warn(
+                "vfo-settle",
+                "robot held at zero inside an influence zone until it stands (at most 2 s), then the segment to \
+                 waypoint 7 is optimised from there"
+                    .into()
+            ),
+            Notice::Warn(
+                "vfo-late",
+                "a tick took longer than 40 ms (an optimisation): its command is dropped, the robot stops meanwhile"
+                    .into()
+            ),
+        ]
+    );
+    // A step that ends the route tells nothing here (the end is reported).
+    assert!(run
+        .notices(&Step::end(Outcome::succeeded("done"), vec![]), Handback::Fresh)
+        .is_empty());
 }

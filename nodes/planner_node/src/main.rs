@@ -27,7 +27,7 @@
 // The shell's modules (`shell::*`) take every name from here (`use crate::*`).
 use mobil_chassis::{clamp_at_reference, ChassisParams};
 use mobil_geom::Pose2;
-use mobil_motion::slot::{ArrivalPeriod, Handback};
+use mobil_motion::slot::ArrivalPeriod;
 use mobil_motion::{BodyTwist, GoalLaw, Step, StepInput};
 use mobil_msgs::geometry_msgs::msg::{PoseStamped, Twist};
 use mobil_msgs::mobil_msgs::msg::NavStatus;
@@ -42,8 +42,7 @@ use mobil_msgs::tf2_msgs::msg::TFMessage;
 use mobil_planner::goals::{DockGoal, RouteEvent, UndockGoal};
 use mobil_planner::task::{PreCheck, Source, Stepped, Task, VfoRun};
 use mobil_planner::vfo::{
-    Interrupt, KeptMap, MapChange, OptimiseWarning, PoseHistory, ScanSkipped, VfoEvent, VfoGoal, VfoStep, VfoTick,
-    WaypointMethod, MAX_SETTLE_S,
+    Interrupt, KeptMap, MapChange, PoseHistory, ScanSkipped, VfoGoal, VfoStep, VfoTick, WaypointMethod,
 };
 use mobil_planner::view::Drawing;
 use mobil_planner::{check_route_until, Finish, RouteReport};

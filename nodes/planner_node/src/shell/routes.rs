@@ -149,36 +149,10 @@ impl Shell {
         let chassis = active.goal.chassis;
         let Task::Vfo(v) = &mut active.goal.task else { return };
         let (mut step, handback) = v.give_back(done.law, done.step, Instant::now());
-        let Some(law) = v.law() else { return };
+        self.throttle.tell(v.notices(&step, handback));
         if let Step::Command { feedback, .. } = &mut step {
-            for event in &feedback.events {
-                info!("{}", law.describe(event));
-                if let VfoEvent::Optimised { warnings, .. } = event {
-                    for w in warnings.iter().filter(|w| !matches!(w, OptimiseWarning::NoSafeSigma)) {
-                        warn_throttled!(self.throttle, "vfo-caps", "segment optimisation: {w:?}");
-                    }
-                }
-            }
-            if feedback.settling {
-                warn_throttled!(
-                    self.throttle,
-                    "vfo-settle",
-                    "robot held at zero inside an influence zone until it stands (at most {MAX_SETTLE_S} s), then \
-                     the segment to waypoint {} is optimised from there",
-                    v.view().waypoint
-                );
-            }
             if let Some(drawing) = feedback.drawing.take() {
                 self.drawing.vfo = Some(drawing);
-            }
-            if handback == Handback::Late {
-                warn_throttled!(
-                    self.throttle,
-                    "vfo-late",
-                    "a tick took longer than {:.0} ms (an optimisation): its command is dropped, the robot stops \
-                     meanwhile",
-                    v.max_delay().as_secs_f64() * 1e3
-                );
             }
         }
         self.apply(io, step, &chassis, |f| !f.events.is_empty());
