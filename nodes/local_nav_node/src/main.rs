@@ -37,7 +37,7 @@ use mobil_ros::action::{goal_end, nav2_result, ActionEvent, GoalRequest, GoalSer
 use mobil_ros::geometry::{odom_pose, twist_msg};
 use mobil_ros::input::Inputs;
 use mobil_ros::latest::Latest;
-use mobil_ros::motion::{Applied, CmdVel, EndCause, EndKind, Ended, MotionSession, Outputs, SessionSettings, Watched};
+use mobil_ros::motion::{Applied, CmdVel, EndCause, Ended, MotionSession, Outputs, SessionSettings, Watched};
 use mobil_ros::scan::{
     checked_scan, tf_static_subscription, CheckedScan, LaserMount, LaserPoseFrom, ScanRefusal, StaticFrames,
 };
@@ -419,13 +419,7 @@ impl Shell {
         if ended.source == Source::Action && finish_action {
             server.finish(goal_end(&ended.cause), result(&ended.cause));
         }
-        match ended.cause.kind() {
-            EndKind::Succeeded | EndKind::Canceled => info!("goal ({}) ends: {reason}", ended.source.name()),
-            EndKind::Aborted if matches!(ended.cause, EndCause::Preempted(_)) => {
-                info!("goal ({}) ends: {reason}", ended.source.name())
-            }
-            EndKind::Aborted => warn!("goal ({}) ends: {reason}", ended.source.name()),
-        }
+        self.throttle.tell([ended.cause.notice(ended.source.name())]);
         let mode_before = self.nav.mode();
         self.publish_status_with_mode(node, out, state, reason, mode_before, Some(ended.goal.goal));
         self.nav.cancel();

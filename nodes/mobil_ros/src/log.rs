@@ -152,12 +152,13 @@ impl LogThrottle {
         }
     }
 
-    /// Logs `notices`: each info line as it is, each warning rate-limited under its key.
+    /// Logs `notices`: each line as it is, a recurring warning rate-limited under its key.
     pub fn tell(&mut self, notices: impl IntoIterator<Item = mobil_motion::Notice>) {
         for n in notices {
             match n {
                 mobil_motion::Notice::Info(text) => tracing::info!("{text}"),
-                mobil_motion::Notice::Warn(key, text) => crate::warn_throttled!(self, key, "{text}"),
+                mobil_motion::Notice::Warn(text) => tracing::warn!("{text}"),
+                mobil_motion::Notice::Recurring(key, text) => crate::warn_throttled!(self, key, "{text}"),
             }
         }
     }

@@ -87,8 +87,10 @@ impl StepInput {
 pub enum Notice {
     /// An info line.
     Info(String),
+    /// A warning.
+    Warn(String),
     /// A warning that may recur at every step: the node rate-limits it under its key.
-    Warn(&'static str, String),
+    Recurring(&'static str, String),
 }
 
 /// How a goal ended: Nav2's view of it.
@@ -311,6 +313,16 @@ impl From<Outcome> for EndCause {
 }
 
 impl EndCause {
+    /// The log line of a goal from `source` ending so: a warning unless it succeeded, was
+    /// canceled or was pre-empted by a newer goal.
+    pub fn notice(&self, source: &str) -> Notice {
+        let text = format!("goal ({source}) ends: {}", self.reason());
+        match (self.kind(), self) {
+            (EndKind::Succeeded | EndKind::Canceled, _) | (_, EndCause::Preempted(_)) => Notice::Info(text),
+            _ => Notice::Warn(text),
+        }
+    }
+
     /// The status reason's code: the outcome's, or `CANCELED`, `PREEMPTED`, `INVALID_INPUT`,
     /// `STALE_INPUT`, `SHUTDOWN`.
     pub fn code(&self) -> &str {
@@ -375,6 +387,31 @@ pub fn seconds(s: f64, max_s: f64) -> std::time::Duration {
 mod tests {
     use super::*;
     use std::time::Duration;
+
+    #[test]
+    fn a_goal_s_end_is_a_warning_unless_reached_canceled_or_replaced() {
+        let line = |cause: EndCause| cause.notice("waypoints");
+        let info = |s: &str| Notice::Info(format!("goal (waypoints) ends: {s}"));
+        let warn = |s: &str| Notice::Warn(format!("goal (waypoints) ends: {s}"));
+        assert_eq!(
+            line(EndCause::Outcome(Outcome::succeeded("reached"))),
+            info("SUCCEEDED: reached")
+        );
+        assert_eq!(line(EndCause::Canceled), info("CANCELED: canceled by the client"));
+        assert_eq!(
+            line(EndCause::Preempted("follow_waypoints")),
+            info("PREEMPTED: preempted by a newer goal (follow_waypoints)")
+        );
+        assert_eq!(
+            line(EndCause::Outcome(Outcome::failed("STALLED", "", 1))),
+            warn("STALLED")
+        );
+        assert_eq!(
+            line(EndCause::Stale("odom".into())),
+            warn("STALE_INPUT: odom stale: robot stopped")
+        );
+        assert_eq!(line(EndCause::Shutdown), warn("SHUTDOWN: the node is shutting down"));
+    }
 
     #[test]
     fn nav2_errors_are_the_law_s_none_the_control_failure_or_unknown() {

@@ -14,7 +14,7 @@ use crate::follow::{FollowConfig, FollowEnd, FollowEvent, WaypointFollower};
 use crate::route::{ProblemKind, RouteProblem, RouteReport, UnreachableCause};
 use mobil_chassis::ChassisParams;
 use mobil_geom::Pose2;
-use mobil_motion::{nav2, GoalLaw, Outcome, Step, StepInput};
+use mobil_motion::{nav2, GoalLaw, Notice, Outcome, Step, StepInput};
 use mobil_tools::drive::{DistanceDrive, DriveSettings, Progress};
 use nalgebra::Point2;
 
@@ -343,6 +343,16 @@ pub enum RouteEvent {
     Reached(usize),
     /// Given up, the next one taken.
     Missed(Missed),
+}
+
+impl RouteEvent {
+    /// Its log line: a waypoint reached, or missed (a warning).
+    pub fn notice(&self) -> Notice {
+        match self {
+            RouteEvent::Reached(i) => Notice::Info(format!("waypoint {i} reached")),
+            RouteEvent::Missed(m) => Notice::Warn(format!("{} (missed; the next one is taken)", m.describe())),
+        }
+    }
 }
 
 /// One step of a route.

@@ -232,7 +232,7 @@ impl VfoRun {
             notices.push(Notice::Info(law.describe(event)));
             if let VfoEvent::Optimised { warnings, .. } = event {
                 let shown = warnings.iter().filter(|w| !matches!(w, OptimiseWarning::NoSafeSigma));
-                notices.extend(shown.map(|w| Notice::Warn("vfo-caps", format!("segment optimisation: {w:?}"))));
+                notices.extend(shown.map(|w| Notice::Recurring("vfo-caps", format!("segment optimisation: {w:?}"))));
             }
         }
         if feedback.settling {
@@ -241,14 +241,14 @@ impl VfoRun {
                  segment to waypoint {} is optimised from there",
                 self.view.waypoint
             );
-            notices.push(Notice::Warn("vfo-settle", text));
+            notices.push(Notice::Recurring("vfo-settle", text));
         }
         if handback == Handback::Late {
             let text = format!(
                 "a tick took longer than {:.0} ms (an optimisation): its command is dropped, the robot stops meanwhile",
                 self.max_delay().as_secs_f64() * 1e3
             );
-            notices.push(Notice::Warn("vfo-late", text));
+            notices.push(Notice::Recurring("vfo-late", text));
         }
         notices
     }

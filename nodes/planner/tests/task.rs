@@ -375,18 +375,18 @@ fn a_vfo_step_given_back_tells_its_events_its_capped_optimisation_a_settling_and
             Notice::Info(
                 "segment to waypoint 7 optimised (SegmentStart): Ψ_z none, 0 virtual robots, 0 candidates".into()
             ),
-            Notice::Warn(
+            Notice::Recurring(
                 "vfo-caps",
                 "segment optimisation: VirtualRobotCap { limit: 9, pending: 2 }".into()
             ),
             Notice::Info("waypoint 7 reached".into()),
-            Notice::Warn(
+            Notice::Recurring(
                 "vfo-settle",
                 "robot held at zero inside an influence zone until it stands (at most 2 s), then the segment to \
                  waypoint 7 is optimised from there"
                     .into()
             ),
-            Notice::Warn(
+            Notice::Recurring(
                 "vfo-late",
                 "a tick took longer than 40 ms (an optimisation): its command is dropped, the robot stops meanwhile"
                     .into()

@@ -55,9 +55,7 @@ use mobil_ros::geometry::{odom_pose, twist_msg};
 use mobil_ros::goal::{goal_pose, pose_in_frame, route_from_path, route_from_poses};
 use mobil_ros::input::Inputs;
 use mobil_ros::latest::Latest;
-use mobil_ros::motion::{
-    Applied, CmdVel, EndCause, EndKind, Ended, GoalId, MotionSession, Outputs, SessionSettings, Watched,
-};
+use mobil_ros::motion::{Applied, CmdVel, EndCause, Ended, GoalId, MotionSession, Outputs, SessionSettings, Watched};
 use mobil_ros::offloop::CancelToken;
 use mobil_ros::offloop::ReplyPool;
 use mobil_ros::scan::{checked_scan, tf_static_subscription, LaserMount, StaticFrames};

@@ -81,14 +81,8 @@ impl Shell {
         if finish_action {
             io.servers.finish(source, &cause, Some(&goal));
         }
-        let reason = cause.reason();
-        match (cause.kind(), &cause) {
-            (EndKind::Succeeded | EndKind::Canceled, _) | (_, EndCause::Preempted(_)) => {
-                info!("goal ({}) ends: {reason}", source.name())
-            }
-            _ => warn!("goal ({}) ends: {reason}", source.name()),
-        }
-        let view = self.status_view(Some(&goal), end_state(&cause), reason);
+        self.throttle.tell([cause.notice(source.name())]);
+        let view = self.status_view(Some(&goal), end_state(&cause), cause.reason());
         self.send_status(io.node, io.out, &view);
         if self.session.active().is_none() && self.map.goal_ended() {
             info!("the obstacle map starts afresh with the new extraction parameters");
@@ -216,12 +210,7 @@ impl Shell {
             Stepped::OffLoop => self.vfo_step(io, jobs, input),
             Stepped::Law(step) => {
                 if let Step::Command { feedback, .. } = &step {
-                    for event in &feedback.events {
-                        match event {
-                            RouteEvent::Reached(i) => info!("waypoint {i} reached"),
-                            RouteEvent::Missed(m) => warn!("{} (missed; the next one is taken)", m.describe()),
-                        }
-                    }
+                    self.throttle.tell(feedback.events.iter().map(RouteEvent::notice));
                 }
                 self.apply(io, step, &chassis, |f| f.changed);
             }

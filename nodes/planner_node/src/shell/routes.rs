@@ -150,10 +150,10 @@ impl Shell {
         let Task::Vfo(v) = &mut active.goal.task else { return };
         let (mut step, handback) = v.give_back(done.law, done.step, Instant::now());
         self.throttle.tell(v.notices(&step, handback));
-        if let Step::Command { feedback, .. } = &mut step {
-            if let Some(drawing) = feedback.drawing.take() {
-                self.drawing.vfo = Some(drawing);
-            }
+        if let Step::Command { feedback, .. } = &mut step
+            && let Some(drawing) = feedback.drawing.take()
+        {
+            self.drawing.vfo = Some(drawing);
         }
         self.apply(io, step, &chassis, |f| !f.events.is_empty());
     }
