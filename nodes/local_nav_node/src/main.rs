@@ -214,7 +214,7 @@ async fn start(
     // The zero command, if one is due, is the final, acknowledged one (serve); none here.
     let (ended, final_zero) = shell.session.shutdown();
     if let Some(ended) = ended {
-        shell.report(node, out, &mut server, ended, true);
+        shell.report(node, out, &mut server, ended);
     }
     server.close(result(&EndCause::Shutdown)).await;
     Ok((outcome, final_zero))
@@ -255,14 +255,7 @@ async fn event_loop(
             Event::Config(Err(e)) => warn!("parameters not applied: {e}"),
             Event::Odom(m) => shell.odom_in(&mut sink, &m),
             Event::Scan(m) => {
-                let skipped = laser.take_all(tf_sub);
-                if skipped > 0 {
-                    warn_throttled!(
-                        shell.throttle,
-                        "tf-static",
-                        "{skipped} invalid tf_static transform(s) skipped"
-                    );
-                }
+                laser.refresh(tf_sub, &mut shell.throttle);
                 shell.scan_in(node, out, &mut sink, server, laser, &m);
             }
             Event::GoalPose(m) => shell.goal_pose_in(node, out, &mut sink, server, &m),
@@ -399,7 +392,7 @@ impl Shell {
         cause: EndCause,
     ) {
         if let Some(ended) = self.session.end(cause, sink) {
-            self.report(node, out, server, ended, true);
+            self.report(node, out, server, ended);
         }
     }
 
@@ -407,16 +400,9 @@ impl Shell {
     /// when a newer action goal took its place), the log, the status with the last step's mode,
     /// distance, H and L; the navigator and the progress checker are cleared and the markers
     /// deleted.
-    fn report(
-        &mut self,
-        node: &RosNode,
-        out: &Outputs,
-        server: &mut GoalServer<NavigateToPose>,
-        ended: NavEnded,
-        finish_action: bool,
-    ) {
+    fn report(&mut self, node: &RosNode, out: &Outputs, server: &mut GoalServer<NavigateToPose>, ended: NavEnded) {
         let (state, reason, _) = end_answer(&ended.cause);
-        if ended.source == Source::Action && finish_action {
+        if ended.source == Source::Action && !ended.server_ended {
             server.finish(goal_end(&ended.cause), result(&ended.cause));
         }
         self.throttle.tell([ended.cause.notice(ended.source.name())]);
@@ -429,9 +415,8 @@ impl Shell {
         out.send_markers(clear, &mut self.throttle);
     }
 
-    /// Starts a validated goal: the goal it replaces, if any, ends PREEMPTED (reported; its
-    /// action goal already ended by the server when `old_ended_by_server`).
-    #[allow(clippy::too_many_arguments)]
+    /// Starts a validated goal: the goal it replaces, if any, ends PREEMPTED (reported; an
+    /// action goal replaced by the next one its server accepted was ended by the server).
     fn start_goal(
         &mut self,
         node: &RosNode,
@@ -440,7 +425,6 @@ impl Shell {
         goal: Point2<f64>,
         heading: Option<f64>,
         source: Source,
-        old_ended_by_server: bool,
     ) {
         let new = NavGoal {
             goal,
@@ -448,8 +432,7 @@ impl Shell {
         };
         let (_, old) = self.session.start(new, source, Instant::now());
         if let Some(old) = old {
-            let by_server = old_ended_by_server && old.source == Source::Action;
-            self.report(node, out, server, old, !by_server);
+            self.report(node, out, server, old);
         }
         if let Err(e) = self.nav.set_goal(goal) {
             // goal_in_odom checked it: unreachable in practice, and safe if reached.
@@ -484,7 +467,7 @@ impl Shell {
         m: &PoseStamped,
     ) {
         match goal_in_odom(m, &self.config.frames.odom_frame) {
-            Ok(goal) => self.start_goal(node, out, server, goal, goal_heading(m), Source::Topic, false),
+            Ok(goal) => self.start_goal(node, out, server, goal, goal_heading(m), Source::Topic),
             Err(e) => {
                 // A goal the user meant to replace the old one with: the old one stops too.
                 self.end_goal(node, out, sink, server, EndCause::Preempted("goal_pose, refused"));
@@ -531,13 +514,13 @@ impl Shell {
         // The server ends a running action goal itself on accept, with this result.
         let preempted = result(&EndCause::Preempted("navigate_to_pose"));
         match server.accept(request, |_| preempted).await {
-            Ok(()) => self.start_goal(node, out, server, goal, heading, Source::Action, true),
+            Ok(()) => self.start_goal(node, out, server, goal, heading, Source::Action),
             Err(e) => {
                 warn_throttled!(self.throttle, "accept", "navigate_to_pose goal not started: {e}");
-                // A running action goal was ended by the server: the robot stops with it.
-                if let Some(ended) = self.session.end(EndCause::Preempted("navigate_to_pose"), sink) {
-                    let by_server = ended.source == Source::Action;
-                    self.report(node, out, server, ended, !by_server);
+                // A running action goal was ended by the server: the robot stops with it (and
+                // with a topic's goal, which the action's goal was to replace).
+                if let Some(ended) = self.session.preempt(Source::Action, sink) {
+                    self.report(node, out, server, ended);
                 }
             }
         }
@@ -634,12 +617,12 @@ impl Shell {
             }
             Applied::Refused(ended) => {
                 if let Some(ended) = ended {
-                    self.report(node, out, server, ended, true);
+                    self.report(node, out, server, ended);
                 }
             }
             Applied::Ended(ended, output) => {
                 self.last_step = Some(output);
-                self.report(node, out, server, ended, true);
+                self.report(node, out, server, ended);
             }
             Applied::Idle => {}
         }

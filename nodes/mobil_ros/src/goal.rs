@@ -175,12 +175,6 @@ impl Route {
     pub fn request(&self, i: usize) -> usize {
         self.request_index.get(i).copied().unwrap_or(i)
     }
-
-    /// The request indices of the waypoints from route index `from` on (those not reached
-    /// when the run stops while pursuing `from`).
-    pub fn unreached_from(&self, from: usize) -> Vec<usize> {
-        (from..self.points.len()).map(|i| self.request(i)).collect()
-    }
 }
 
 /// What a route must be beyond its poses.
@@ -380,7 +374,6 @@ mod tests {
         // From index 1, then one more round from 0: 1, 2, 0, 1, 2.
         assert_eq!(r.request_index, vec![1, 2, 0, 1, 2]);
         assert_eq!(r.points[2], Point2::new(1.0, 0.0));
-        assert_eq!(r.unreached_from(3), vec![1, 2]);
         assert_eq!(
             route_from_poses(&poses, "odom", "odom", (3, 0), None, LIMITS),
             Err(GoalError::GoalIndex { index: 3, len: 3 })

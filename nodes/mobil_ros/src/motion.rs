@@ -45,7 +45,7 @@
 //! ```
 
 use crate::log::LogThrottle;
-use crate::status::NavStatusView;
+use crate::status::{NavStatusView, StatusMessage};
 use crate::time::{DtClock, DtError};
 use mobil_motion::{BodyTwist, End, Step};
 pub use mobil_motion::{EndCause, EndKind};
@@ -176,6 +176,10 @@ pub struct Ended<G, S> {
     pub t: f64,
     /// Whether a zero command went out at this end.
     pub zeroed: bool,
+    /// Replaced by a goal from its own source: an action server ended it itself (PREEMPTED)
+    /// when it accepted the newer goal, so the node answers it no more (a topic's goal has no
+    /// client to answer either way).
+    pub server_ended: bool,
 }
 
 /// The active goal.
@@ -303,10 +307,11 @@ impl<G, S> MotionSession<G, S> {
     /// first step, or [`MotionSession::hold`]s.
     pub fn start(&mut self, goal: G, source: S, now: Instant) -> (GoalId, Option<Ended<G, S>>)
     where
-        S: Copy + Into<&'static str>,
+        S: Copy + PartialEq + Into<&'static str>,
     {
         let old = self.active.take().map(|a| Ended {
             id: a.id,
+            server_ended: a.source == source,
             goal: a.goal,
             source: a.source,
             cause: EndCause::Preempted(source.into()),
@@ -401,7 +406,21 @@ impl<G, S> MotionSession<G, S> {
             cause,
             t: a.t,
             zeroed,
+            server_ended: false,
         })
+    }
+
+    /// Ends the active goal `PREEMPTED` by a goal from `by` that does not start (its action
+    /// server accepted it, then the node refused it, or its start failed): one zero command, as
+    /// at any end; [`Ended::server_ended`] when the goal came from `by` too, whose server ended
+    /// it on accepting the newer one. `None` without a goal.
+    pub fn preempt(&mut self, by: S, sink: &mut impl CommandSink) -> Option<Ended<G, S>>
+    where
+        S: Copy + PartialEq + Into<&'static str>,
+    {
+        let mut ended = self.end(EndCause::Preempted(by.into()), sink)?;
+        ended.server_ended = ended.source == by;
+        Some(ended)
     }
 
     /// Ends goal `id` with `cause` if it is still the active one (a cancel, a result computed
@@ -471,6 +490,7 @@ impl<G, S> MotionSession<G, S> {
                 cause: EndCause::Shutdown,
                 t: a.t,
                 zeroed: false,
+                server_ended: false,
             }),
             final_zero,
         )
@@ -638,13 +658,42 @@ mod tests {
         );
         assert_eq!(old.cause.kind(), EndKind::Aborted);
         assert!(!old.zeroed);
+        // Of another source: the node answers it (its server did not).
+        assert!(!old.server_ended);
         // The new goal continues the motion: no zero between the two goals' commands.
         step_at(&mut s, 1.1, &mut sent);
         assert_eq!((sent.len(), zeros(&sent)), (2, 0));
         assert!(s.is_current(second) && !s.is_current(first));
+        // A third from the same action server: that server ended the second on accepting it.
+        let (_, old) = s.start(ToX { to: 12.0 }, Src::Action, Instant::now());
+        assert!(old.unwrap().server_ended);
         // It ends with one zero, as any goal that moved the robot.
-        s.end(EndCause::Canceled, &mut sent);
+        step_at(&mut s, 1.2, &mut sent);
+        let ended = s.end(EndCause::Canceled, &mut sent).unwrap();
         assert_eq!(zeros(&sent), 1);
+        assert!(!ended.server_ended);
+    }
+
+    #[test]
+    fn a_goal_preempted_by_one_that_does_not_start_stops_the_robot_once() {
+        let mut s = session();
+        let mut sent = Vec::new();
+        s.start(ToX { to: 5.0 }, Src::Action, Instant::now());
+        step_at(&mut s, 1.0, &mut sent);
+        // A topic goal refused: the action goal ends PREEMPTED, answered by the node, one zero.
+        let ended = s.preempt(Src::Topic, &mut sent).unwrap();
+        assert_eq!(ended.cause, EndCause::Preempted("goal_pose"));
+        assert!(ended.zeroed && !ended.server_ended && s.active().is_none());
+        assert_eq!((sent.len(), zeros(&sent)), (2, 1));
+        // An action goal whose start failed after its server accepted it: the server ended
+        // the goal it replaced.
+        s.start(ToX { to: 5.0 }, Src::Action, Instant::now());
+        step_at(&mut s, 1.0, &mut sent);
+        let ended = s.preempt(Src::Action, &mut sent).unwrap();
+        assert!(ended.zeroed && ended.server_ended);
+        assert_eq!(zeros(&sent), 2);
+        assert!(s.preempt(Src::Action, &mut sent).is_none());
+        assert_eq!(zeros(&sent), 2, "no goal: nothing sent");
     }
 
     #[test]

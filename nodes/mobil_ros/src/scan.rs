@@ -30,6 +30,7 @@
 //! ```
 
 use crate::geometry::yaw_of;
+use crate::log::LogThrottle;
 use crate::RosNode;
 use mobil_geom::{Pose2, Scan, ScanError};
 use mobil_msgs::sensor_msgs::msg::LaserScan;
@@ -121,6 +122,19 @@ impl StaticFrames {
             }
         }
         skipped
+    }
+
+    /// [`take_all`](Self::take_all), the transforms skipped told in one warning, rate-limited
+    /// by `throttle` (a node calls it before it reads a scan).
+    pub fn refresh(&mut self, sub: &Subscription<TFMessage>, throttle: &mut LogThrottle) {
+        let skipped = self.take_all(sub);
+        if skipped > 0 {
+            crate::warn_throttled!(
+                throttle,
+                "tf-static",
+                "{skipped} invalid tf_static transform(s) skipped"
+            );
+        }
     }
 
     /// The chain from `frame` up to its root: (root, root_from_frame); `None` when the chain

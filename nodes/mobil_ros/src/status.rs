@@ -2,12 +2,13 @@
 //! `planner/status`): one view of what a node says, one message built from it, and the rate
 //! gate both status and markers follow while a goal is active.
 //!
-//! Each node fills the fields it has; the rest take the message's documented "none" values:
-//! `waypoint_index` −1, the docking figures 0, the VFO figures NaN (counts 0), no hit or leave
-//! point, an identity goal orientation when there is no goal.
+//! The view is ROS-free ([`mobil_motion::status`]): each node fills the fields it has; the rest
+//! take the message's documented "none" values: `waypoint_index` −1, the docking figures 0, the
+//! VFO figures NaN (counts 0), no hit or leave point, an identity goal orientation when there
+//! is no goal.
 //!
 //! ```
-//! use mobil_ros::status::NavStatusView;
+//! use mobil_ros::status::{NavStatusView, StatusMessage};
 //! use mobil_msgs::mobil_msgs::msg::NavStatus;
 //!
 //! let view = NavStatusView::new(NavStatus::FAILED, "idle", "INVALID_GOAL: no frame".into());
@@ -18,71 +19,21 @@
 
 use crate::geometry::pose_msg;
 use crate::markers::point;
-use mobil_geom::Pose2;
-use mobil_motion::{EndCause, EndKind};
 use mobil_msgs::builtin_interfaces::msg::Time;
 use mobil_msgs::mobil_msgs::msg::NavStatus;
 use mobil_msgs::std_msgs::msg::Header;
-use nalgebra::Point2;
 use std::time::{Duration, Instant};
 
-/// A VFO segment's last optimisation as the status carries it.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct VfoFigures {
-    /// Ψ_z of the chosen decisions.
-    pub psi_z: f64,
-    /// χ_D, χ_B, χ_E, χ_S of the chosen path.
-    pub indices: [f64; 4],
-    /// Virtual robots simulated.
-    pub virtual_robots: usize,
-    /// Paths that reached the waypoint.
-    pub candidates: usize,
-}
+pub use mobil_motion::status::{end_state, NavStatusView, VfoFigures};
 
-/// What a status message says.
-#[derive(Debug, Clone, PartialEq)]
-pub struct NavStatusView {
-    /// NavStatus state (IDLE, ACTIVE, SUCCEEDED, FAILED).
-    pub state: u8,
-    /// The mode's name.
-    pub mode: &'static str,
-    /// The goal pursued (the node's frame), if any.
-    pub goal: Option<Pose2>,
-    /// Distance to it (m), NaN when unknown.
-    pub distance_to_goal: f64,
-    /// The reason (empty while active).
-    pub reason: String,
-    /// The waypoint pursued (request index), if a route is active.
-    pub waypoint_index: Option<usize>,
-    /// Hit point H (local_nav).
-    pub hit_point: Option<Point2<f64>>,
-    /// Leave point L (local_nav).
-    pub leave_point: Option<Point2<f64>>,
-    /// The docking's e, α, Θ and V (planner, while docking; NaN before the first pose).
-    pub docking: Option<[f64; 4]>,
-    /// A VFO route's current segment (planner).
-    pub vfo: Option<VfoFigures>,
-}
-
-impl NavStatusView {
-    /// A view in `state` and `mode` with `reason`, nothing else known.
-    pub fn new(state: u8, mode: &'static str, reason: String) -> Self {
-        NavStatusView {
-            state,
-            mode,
-            goal: None,
-            distance_to_goal: f64::NAN,
-            reason,
-            waypoint_index: None,
-            hit_point: None,
-            leave_point: None,
-            docking: None,
-            vfo: None,
-        }
-    }
-
+/// The `mobil_msgs/NavStatus` message of a [`NavStatusView`].
+pub trait StatusMessage {
     /// The message, stamped `stamp`, in `frame`.
-    pub fn message(&self, stamp: Time, frame: &str) -> NavStatus {
+    fn message(&self, stamp: Time, frame: &str) -> NavStatus;
+}
+
+impl StatusMessage for NavStatusView {
+    fn message(&self, stamp: Time, frame: &str) -> NavStatus {
         let goal = pose_msg(&self.goal.unwrap_or_default());
         let [e, alpha, theta, lyapunov] = self.docking.unwrap_or_default();
         let vfo = self.vfo.unwrap_or(VfoFigures {
@@ -145,18 +96,25 @@ impl RateGate {
     }
 }
 
-/// The NavStatus state a goal's end leaves: SUCCEEDED, else FAILED (a cancel and a pre-emption
-/// included: the goal was not reached).
-pub fn end_state(cause: &EndCause) -> u8 {
-    match cause.kind() {
-        EndKind::Succeeded => NavStatus::SUCCEEDED,
-        EndKind::Canceled | EndKind::Aborted => NavStatus::FAILED,
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
+    use mobil_geom::Pose2;
+    use mobil_motion::status::state;
+    use nalgebra::Point2;
+
+    #[test]
+    fn the_states_are_numbered_as_the_message_numbers_them() {
+        assert_eq!(
+            [state::IDLE, state::ACTIVE, state::SUCCEEDED, state::FAILED],
+            [
+                NavStatus::IDLE,
+                NavStatus::ACTIVE,
+                NavStatus::SUCCEEDED,
+                NavStatus::FAILED
+            ]
+        );
+    }
 
     #[test]
     fn every_field_a_node_gives_is_carried_and_the_rest_say_none() {

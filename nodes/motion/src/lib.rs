@@ -45,6 +45,7 @@
 #![warn(missing_docs)]
 
 pub mod slot;
+pub mod status;
 
 pub use mobil_chassis::BodyTwist;
 pub use mobil_geom::Pose2;

@@ -271,6 +271,55 @@ pub fn route_infeasible(problems: &[Missed]) -> Outcome {
     )
 }
 
+/// What a route check answers (the node's `planner/check_route` service): the problems found,
+/// each by the request's index, up to [`MAX_LISTED_MISSED`]; ROUTE_INFEASIBLE's reason (empty
+/// when feasible); the first problem's waypoint; the virtual robot's path, downsampled to at
+/// most `max_poses`; and its length without the jumps ([`RouteReport::driven_length`]).
+#[derive(Debug, Clone, PartialEq)]
+pub struct RouteAnswer {
+    /// The problems listed.
+    pub problems: Vec<Missed>,
+    /// Empty when feasible; else the reason, every problem counted.
+    pub reason: String,
+    /// The request's index of the first problem's waypoint.
+    pub failed_waypoint: Option<usize>,
+    /// The predicted path, downsampled.
+    pub path: Vec<Pose2>,
+    /// The predicted path's length (m).
+    pub length: f64,
+}
+
+impl RouteAnswer {
+    /// The answer of `report` for the route through `points` (the request's index of each
+    /// alongside), checked with step length `step`.
+    pub fn of(
+        report: &RouteReport,
+        (points, request_index): (&[Point2<f64>], &[usize]),
+        step: f64,
+        max_poses: usize,
+    ) -> Self {
+        let mut missed = missed_from_report(&report.problems, points, request_index);
+        let reason = if missed.is_empty() {
+            String::new()
+        } else {
+            route_infeasible(&missed).reason()
+        };
+        missed.truncate(MAX_LISTED_MISSED);
+        RouteAnswer {
+            failed_waypoint: missed.first().map(|m| m.index),
+            problems: missed,
+            reason,
+            path: mobil_geom::downsample(&report.path, max_poses),
+            length: report.driven_length(step),
+        }
+    }
+
+    /// Whether the route has no problem.
+    pub fn feasible(&self) -> bool {
+        self.problems.is_empty()
+    }
+}
+
 /// What comes of a route's pre-check ([`after_pre_check`]).
 #[derive(Debug, Clone, PartialEq)]
 pub enum PreChecked {
@@ -480,6 +529,9 @@ pub const UNDOCK_MIN_SPEED: f64 = 0.03;
 /// Undocked when this close to the staging distance (m).
 pub const UNDOCK_TOLERANCE: f64 = 0.005;
 
+/// UndockRobot's `max_undocking_time` default (s), taken for a request's time that is none.
+pub const DEFAULT_UNDOCK_TIME_S: f64 = 30.0;
+
 /// Backing straight out of a dock by `distance` along the heading of the first step, at
 /// `speed`, within a time limit: a [`DistanceDrive`] backwards.
 #[derive(Debug, Clone, PartialEq)]
@@ -500,6 +552,26 @@ impl UndockGoal {
             limit_s,
             drive: None,
         }
+    }
+
+    /// An `undock_robot` request's undocking: back out `distance` at `speed` within the
+    /// request's `max_undocking_time` (s), or [`DEFAULT_UNDOCK_TIME_S`] when that is no positive
+    /// time; with what the node tells of it (the undocking, and a warning for a time not taken).
+    pub fn for_request(distance: f64, speed: f64, max_undocking_time: f32) -> (Self, Vec<Notice>) {
+        let mut notices = Vec::new();
+        let limit_s = if max_undocking_time.is_finite() && max_undocking_time > 0.0 {
+            f64::from(max_undocking_time)
+        } else {
+            notices.push(Notice::Warn(format!(
+                "undock_robot: max_undocking_time {max_undocking_time} is not a positive time: \
+                 {DEFAULT_UNDOCK_TIME_S} s (its default) taken"
+            )));
+            DEFAULT_UNDOCK_TIME_S
+        };
+        notices.push(Notice::Info(format!(
+            "goal (undock_robot): back out {distance:.3} m along the heading, within {limit_s:.1} s"
+        )));
+        (UndockGoal::new(distance, speed, limit_s), notices)
     }
 
     /// How far it has backed out (m).

@@ -29,6 +29,7 @@
 
 use crate::goals::{
     after_pre_check, route_infeasible, DockGoal, Missed, PreChecked, RouteEvent, RouteGoal, UndockGoal,
+    MISSED_BY_THE_RUN,
 };
 use crate::vfo::{
     vfo_gains, ObstacleMap, OptimiseWarning, SegmentReport, VfoEvent, VfoGoal, VfoSettings, VfoStep, VfoView,
@@ -39,6 +40,7 @@ use crate::{DockingPhase, FollowConfig, RouteReport};
 use mobil_chassis::ChassisParams;
 use mobil_geom::Pose2;
 use mobil_motion::slot::{late_bound, Handback, LawSlot};
+use mobil_motion::status::{NavStatusView, VfoFigures};
 use mobil_motion::{nav2, BodyTwist, EndCause, GoalLaw, Nav2Codes, Notice, Outcome, Step, StepInput};
 use nalgebra::Point2;
 use std::time::{Duration, Instant};
@@ -108,6 +110,8 @@ impl PreCheck {
 pub struct VfoRun {
     slot: LawSlot<VfoGoal>,
     view: VfoView,
+    /// The request's index of each waypoint, in driving order.
+    request_index: Vec<usize>,
     /// `Some(true)`: changed with new obstacles, which re-optimise the segment.
     map_changed: Option<bool>,
 }
@@ -117,6 +121,7 @@ impl VfoRun {
     pub fn new(law: VfoGoal, max_delay: Duration) -> Self {
         VfoRun {
             view: law.view(),
+            request_index: law.request_index().to_vec(),
             slot: LawSlot::new(law, max_delay),
             map_changed: None,
         }
@@ -170,6 +175,12 @@ impl VfoRun {
     /// The status' figures as the law last came back.
     pub fn view(&self) -> &VfoView {
         &self.view
+    }
+
+    /// The request's indices of the waypoints not reached: the one pursued as the law last
+    /// came back, and every one after it.
+    pub fn unreached(&self) -> Vec<usize> {
+        self.request_index.iter().skip(self.view.index).copied().collect()
     }
 
     /// The law, unless it is out on a step.
@@ -312,6 +323,34 @@ pub struct Figures {
     pub vfo: Option<SegmentReport>,
 }
 
+impl Figures {
+    /// The status of a goal with these figures, in `state` (NavStatus' numbering) with `reason`.
+    pub fn view(&self, state: u8, reason: String) -> NavStatusView {
+        NavStatusView {
+            goal: self.goal,
+            distance_to_goal: self.distance,
+            waypoint_index: self.waypoint,
+            docking: self.docking,
+            vfo: self.vfo.map(|s| VfoFigures {
+                psi_z: s.psi_z,
+                indices: s.indices,
+                virtual_robots: s.virtual_robots,
+                candidates: s.candidates,
+            }),
+            ..NavStatusView::new(state, self.mode.as_str(), reason)
+        }
+    }
+}
+
+/// The planner's status in `state` with `reason`: of `task`, its figures at `latest`, the
+/// latest pose; with no task (idle, or a goal refused before it started), mode `idle` alone.
+pub fn status_view(task: Option<&Task>, latest: Option<&Pose2>, state: u8, reason: String) -> NavStatusView {
+    match task {
+        Some(task) => task.figures(latest).view(state, reason),
+        None => NavStatusView::new(state, Mode::Idle.as_str(), reason),
+    }
+}
+
 /// A step's feedback, whichever law took it on the event loop.
 #[derive(Debug, Clone, PartialEq)]
 pub struct TaskStep {
@@ -425,6 +464,22 @@ impl Task {
         Stepped::Law(step)
     }
 
+    /// The waypoints a FollowWaypoints result lists when the goal ends (`succeeded` or not),
+    /// each as the request's index and MissedWaypoint's error code: a goal-approach route's
+    /// missed ones (Nav2 lists them on success too), a VFO route's not reached unless it
+    /// succeeded ([`MISSED_BY_THE_RUN`]), a route refused by its pre-check its problems, none for
+    /// a docking or an undocking.
+    pub fn result_missed(&self, succeeded: bool) -> Vec<(usize, u16)> {
+        let listed = |missed: &[Missed]| missed.iter().map(|m| (m.index, m.error_code())).collect();
+        match self {
+            Task::Follow(goal) => listed(goal.missed()),
+            Task::PreCheck(p) => listed(&p.problems),
+            Task::Vfo(_) if succeeded => Vec::new(),
+            Task::Vfo(v) => v.unreached().into_iter().map(|i| (i, MISSED_BY_THE_RUN)).collect(),
+            Task::Dock(_) | Task::Undock(_) => Vec::new(),
+        }
+    }
+
     /// A route's pre-check came back with `report`: the route becomes a goal approach from
     /// where the robot stood (`follow` on `chassis`) and the problems it drives through are
     /// returned (none unless `execute_infeasible`), or it is refused with the outcome to end
@@ -528,11 +583,6 @@ impl Source {
         self.into()
     }
 
-    /// Whether the goal came from an action server (its end is a result).
-    pub fn is_action(self) -> bool {
-        matches!(self, Source::DockAction | Source::UndockAction | Source::FollowAction)
-    }
-
     /// The action whose codes the goal's ends take (a topic: the action it stands for).
     pub fn action(self) -> Action {
         match self {
@@ -540,13 +590,6 @@ impl Source {
             Source::UndockAction => Action::Undock,
             Source::Waypoints | Source::FollowAction => Action::Follow,
         }
-    }
-
-    /// Whether a goal from `self` that pre-empts one from `old` found it already ended by its
-    /// server: an action server ends its running goal (PREEMPTED) when it accepts the next, so
-    /// only a goal of another source is given its result by the node.
-    pub fn replaced_on_server(self, old: Source) -> bool {
-        self.is_action() && old == self
     }
 }
 
@@ -614,6 +657,20 @@ impl Action {
             self.control_failure(),
         )
     }
+}
+
+/// What the node tells of a `dock_robot` request for a pose: the staging it asks for (time
+/// limit, navigating to the staging pose) and a dock type are not used, since the Lyapunov law
+/// docks from wherever the robot is.
+pub fn dock_request_notice(max_staging_time: f32, navigate_to_staging_pose: bool, dock_type: &str) -> Notice {
+    let dock_type = match dock_type {
+        "" => String::new(),
+        t => format!("; dock_type `{t}` ignored"),
+    };
+    Notice::Info(format!(
+        "dock_robot: max_staging_time ({max_staging_time}) and navigate_to_staging_pose \
+         ({navigate_to_staging_pose}) ignored: the Lyapunov law docks from wherever the robot is{dock_type}"
+    ))
 }
 
 /// A dock asked for by id: `INVALID_GOAL` with DockRobot's DOCK_NOT_IN_DB (the planner docks

@@ -6,9 +6,10 @@ use approx::assert_relative_eq;
 use mobil_chassis::model::ChassisConfig;
 use mobil_chassis::ChassisParams;
 use mobil_geom::Pose2;
-use mobil_motion::{GoalLaw, Step, StepInput};
+use mobil_motion::{GoalLaw, Notice, Step, StepInput};
 use mobil_planner::goals::{
-    after_pre_check, docking_failure, docking_offset, DockGoal, PreChecked, RouteEvent, RouteGoal, UndockGoal,
+    after_pre_check, docking_failure, docking_offset, DockGoal, PreChecked, RouteAnswer, RouteEvent, RouteGoal,
+    UndockGoal,
 };
 use mobil_planner::{
     DockingConfig, DockingController, DockingFailure, DockingGains, Finish, FollowConfig, ProblemKind, Residual,
@@ -195,6 +196,29 @@ fn an_undocking_backs_out_on_the_ramp_and_ends_within_tolerance_or_time() {
 }
 
 #[test]
+fn an_undock_request_s_time_limit_is_its_own_or_the_30_s_default_for_none() {
+    // 12 s asked: taken, and the undocking fails TIME_LIMIT past it.
+    let (mut g, notices) = UndockGoal::for_request(0.5, 0.15, 12.0);
+    assert_eq!(
+        notices,
+        vec![Notice::Info(
+            "goal (undock_robot): back out 0.500 m along the heading, within 12.0 s".into()
+        )]
+    );
+    g.step(&at(1.0, 0.0, 0.0, 0.0), &());
+    assert!(matches!(g.step(&at(13.5, -0.1, 0.0, 0.0), &()), Step::End(_)));
+    // Zero, negative, NaN, infinite: Nav2's default of 30 s, with a warning; 13.5 s is in time.
+    for bad in [0.0, -4.0, f32::NAN, f32::INFINITY] {
+        let (mut g, notices) = UndockGoal::for_request(0.5, 0.15, bad);
+        assert_eq!(notices.len(), 2, "{bad}");
+        assert!(matches!(&notices[0], Notice::Warn(w) if w.contains("30 s (its default) taken")));
+        assert!(matches!(&notices[1], Notice::Info(i) if i.ends_with("within 30.0 s")));
+        g.step(&at(1.0, 0.0, 0.0, 0.0), &());
+        assert!(matches!(g.step(&at(13.5, -0.1, 0.0, 0.0), &()), Step::Command { .. }));
+    }
+}
+
+#[test]
 fn a_docking_onto_a_pose_steers_the_kinematic_origin_of_a_steered_chassis() {
     // MOBIL-II with its reference point 0.30 m ahead of the rear axle (params/mobil2.yaml).
     let mobil2 = ChassisParams::new(ChassisConfig {
@@ -281,4 +305,63 @@ fn a_pre_check_with_problems_refuses_the_route_unless_told_to_drive_it() {
         after_pre_check(&clean, (&points, &request), &start, rules, false),
         PreChecked::Drive { problems, .. } if problems.is_empty()
     ));
+}
+
+#[test]
+fn a_route_check_answers_each_problem_by_request_index_a_short_path_and_its_driven_length() {
+    // A straight predicted path of 20 000 poses 2 cm apart, then a 5 m jump (set down on a
+    // missed waypoint), then one more 2 cm step; waypoint 1 of request indices (3, 8) collides at
+    // (300, 0).
+    let mut path: Vec<Pose2> = (0..20_000).map(|i| Pose2::new(i as f64 * 0.02, 0.0, 0.0)).collect();
+    path.push(Pose2::new(404.98, 0.0, 0.0));
+    path.push(Pose2::new(405.0, 0.0, 0.0));
+    let points = [Point2::new(200.0, 0.0), Point2::new(405.0, 0.0)];
+    let collision = RouteProblem {
+        index: 1,
+        kind: ProblemKind::Collision {
+            at: Point2::new(300.0, 0.0),
+            clearance: -0.1,
+        },
+    };
+    let report = RouteReport {
+        problems: vec![collision],
+        path,
+        reached: vec![true, false],
+    };
+    let a = RouteAnswer::of(&report, (&points, &[3, 8]), 0.02, 400);
+    assert!(!a.feasible());
+    assert_eq!(a.failed_waypoint, Some(8));
+    let got: Vec<_> = a.problems.iter().map(|m| (m.index, m.position)).collect();
+    assert_eq!(got, vec![(8, Point2::new(300.0, 0.0))]);
+    assert!(a
+        .reason
+        .starts_with("ROUTE_INFEASIBLE: 1 problem(s): waypoint 8: collision"));
+    // 400 poses, the first and the last kept; the length 19 999 steps of 2 cm and the last
+    // one, the 5 m jump left out.
+    assert_eq!(a.path.len(), 400);
+    assert_eq!((a.path[0].x, a.path[399].x), (0.0, 405.0));
+    assert_relative_eq!(a.length, 20_000.0 * 0.02, epsilon = 1e-6);
+    // 60 problems: 50 listed, the reason counts all 60.
+    let many = RouteReport {
+        problems: vec![collision; 60],
+        path: Vec::new(),
+        reached: vec![true, false],
+    };
+    let a = RouteAnswer::of(&many, (&points, &[3, 8]), 0.02, 400);
+    assert_eq!(a.problems.len(), 50);
+    assert!(
+        a.reason.starts_with("ROUTE_INFEASIBLE: 60 problem(s): "),
+        "{}",
+        a.reason
+    );
+    assert!(a.reason.ends_with("; and 10 more"), "{}", a.reason);
+    // None: feasible, no reason, no failed waypoint.
+    let clear = RouteReport {
+        problems: Vec::new(),
+        path: vec![Pose2::identity()],
+        reached: vec![true, true],
+    };
+    let a = RouteAnswer::of(&clear, (&points, &[3, 8]), 0.02, 400);
+    assert!(a.feasible() && a.reason.is_empty() && a.failed_waypoint.is_none());
+    assert_eq!((a.path.len(), a.length), (1, 0.0));
 }

@@ -82,6 +82,28 @@ fn a_route_waits_for_its_pre_check_then_is_refused_or_driven() {
 }
 
 #[test]
+fn a_result_lists_a_refused_route_s_problems_a_vfo_route_s_unreached_waypoints_a_docking_none() {
+    let omr3 = ChassisParams::omr3();
+    let rules = (FollowConfig::default(), &omr3);
+    // Refused by its pre-check: the collision on the way to request pose 5, as ComputePathToPose's
+    // NO_VALID_PATH (208; a collision is no blocked goal), whether it succeeded or not.
+    let mut task = pre_check();
+    assert!(task.pre_checked(&blocked(), rules, false).unwrap().is_err());
+    assert_eq!(task.result_missed(false), vec![(5, 208)]);
+    // Driven through its problems: the run has missed nothing yet.
+    let mut task = pre_check();
+    assert!(task.pre_checked(&blocked(), rules, true).unwrap().is_ok());
+    assert_eq!(task.result_missed(true), vec![]);
+    // A VFO route ending before its only waypoint (request index 7): FollowPath's
+    // FAILED_TO_MAKE_PROGRESS (105); once done, nothing.
+    let task = Task::Vfo(vfo());
+    assert_eq!(task.result_missed(false), vec![(7, 105)]);
+    assert_eq!(task.result_missed(true), vec![]);
+    let task = Task::Undock(UndockGoal::new(0.5, 0.15, 30.0));
+    assert_eq!(task.result_missed(false), vec![]);
+}
+
+#[test]
 fn a_docking_shows_its_figures_at_the_latest_pose_before_its_first_step() {
     let controller = DockingController::new(
         DockingGains::paper(),
@@ -218,18 +240,9 @@ fn the_ends_the_node_makes_carry_each_action_s_nav2_code() {
 }
 
 #[test]
-fn only_an_action_goal_replacing_one_of_its_own_server_finds_it_ended_by_the_server() {
+fn sources_name_their_topic_or_action_and_stand_for_an_action_s_codes() {
     use Source::*;
     let all = [DockPose, Waypoints, DockAction, UndockAction, FollowAction];
-    for new in all {
-        for old in all {
-            let by_server = matches!(
-                (new, old),
-                (DockAction, DockAction) | (UndockAction, UndockAction) | (FollowAction, FollowAction)
-            );
-            assert_eq!(new.replaced_on_server(old), by_server, "{new:?} after {old:?}");
-        }
-    }
     // Topics stand for the actions whose codes their ends take.
     let actions: Vec<Action> = all.iter().map(|s| s.action()).collect();
     use Action::{Dock, Follow, Undock};
@@ -397,4 +410,71 @@ fn a_vfo_step_given_back_tells_its_events_its_capped_optimisation_a_settling_and
     assert!(run
         .notices(&Step::end(Outcome::succeeded("done"), vec![]), Handback::Fresh)
         .is_empty());
+}
+
+#[test]
+fn the_status_carries_a_task_s_figures_and_with_no_task_the_idle_mode() {
+    use mobil_motion::status::state;
+    use mobil_planner::task::{status_view, Figures};
+    use mobil_planner::vfo::SegmentReport;
+    let figures = Figures {
+        mode: Mode::Dock,
+        waypoint: None,
+        goal: Some(Pose2::new(1.0, 0.0, 0.0)),
+        distance: 1.0,
+        docking: Some([1.0, 0.5, -0.25, 0.7]),
+        vfo: None,
+    };
+    let v = figures.view(state::ACTIVE, String::new());
+    assert_eq!((v.state, v.mode, v.waypoint_index), (state::ACTIVE, "dock", None));
+    assert_eq!((v.goal, v.distance_to_goal), (Some(Pose2::new(1.0, 0.0, 0.0)), 1.0));
+    assert_eq!((v.docking, v.vfo), (Some([1.0, 0.5, -0.25, 0.7]), None));
+    let vfo = Figures {
+        mode: Mode::Vfo,
+        waypoint: Some(2),
+        docking: None,
+        vfo: Some(SegmentReport {
+            psi_z: 3.25,
+            indices: [4.5, 0.75, 1.5, 0.5],
+            virtual_robots: 9,
+            candidates: 5,
+        }),
+        ..figures
+    };
+    let v = vfo.view(state::ACTIVE, String::new());
+    assert_eq!((v.mode, v.waypoint_index, v.docking), ("vfo", Some(2), None));
+    let f = v.vfo.unwrap();
+    assert_eq!(
+        (f.psi_z, f.indices[1], f.virtual_robots, f.candidates),
+        (3.25, 0.75, 9, 5)
+    );
+    // No task: idle, whatever the state and reason; a task: its own figures at the pose.
+    let idle = status_view(None, None, state::FAILED, "INVALID_GOAL: x".into());
+    assert_eq!(
+        (idle.mode, idle.state, idle.reason.as_str()),
+        ("idle", state::FAILED, "INVALID_GOAL: x")
+    );
+    assert!(idle.distance_to_goal.is_nan() && idle.goal.is_none() && idle.vfo.is_none());
+    let v = status_view(Some(&pre_check()), None, state::ACTIVE, String::new());
+    assert_eq!((v.mode, v.waypoint_index), ("pre_check", Some(4)));
+}
+
+#[test]
+fn a_dock_request_s_staging_and_dock_type_are_told_as_not_used() {
+    use mobil_planner::task::dock_request_notice;
+    assert_eq!(
+        dock_request_notice(12.0, true, "charger"),
+        Notice::Info(
+            "dock_robot: max_staging_time (12) and navigate_to_staging_pose (true) ignored: the Lyapunov law \
+             docks from wherever the robot is; dock_type `charger` ignored"
+                .into()
+        )
+    );
+    let Notice::Info(line) = dock_request_notice(1000.0, false, "") else {
+        panic!()
+    };
+    assert!(
+        line.ends_with("(false) ignored: the Lyapunov law docks from wherever the robot is"),
+        "{line}"
+    );
 }

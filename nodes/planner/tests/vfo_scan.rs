@@ -543,4 +543,18 @@ fn new_extraction_parameters_wait_for_the_running_goal_to_end() {
     // With no goal running the map starts afresh at once.
     assert_eq!(kept.reconfigure(base, false), Ok(MapChange::Restarted));
     assert_eq!((kept.map().len(), *kept.map().config()), (0, base));
+    // What the node tells of each.
+    let told = |c: MapChange| match c.notice() {
+        Some(mobil_motion::Notice::Info(line)) => line,
+        other => format!("{other:?}"),
+    };
+    assert_eq!(
+        told(MapChange::Restarted),
+        "vfo obstacle extraction changed: the obstacle map starts afresh"
+    );
+    assert_eq!(
+        told(MapChange::AfterGoal),
+        "vfo obstacle extraction changed: the obstacle map starts afresh once the goal ends"
+    );
+    assert_eq!(MapChange::Unchanged.notice(), None);
 }

@@ -10,7 +10,7 @@
 
 use mobil_chassis::model::ChassisConfig;
 use mobil_chassis::ChassisParams;
-use mobil_geom::downsample;
+use mobil_geom::Pose2;
 use mobil_msgs::builtin_interfaces::msg::Time;
 use mobil_msgs::geometry_msgs::msg::PoseStamped;
 use mobil_msgs::mobil_msgs::msg::RouteProblem as ProblemMsg;
@@ -20,8 +20,10 @@ use mobil_msgs::nav2_msgs::msg::MissedWaypoint;
 use mobil_msgs::nav_msgs::msg::Path;
 use mobil_msgs::std_msgs::msg::Header;
 use mobil_msgs::visualization_msgs::msg::MarkerArray;
-pub use mobil_planner::goals::{list_missed, missed_from_report, route_infeasible, Missed, MISSED_BY_THE_RUN};
-use mobil_planner::{DockingConfig, DockingGains, FollowConfig, RouteCheckConfig, RouteReport};
+pub use mobil_planner::goals::{
+    list_missed, missed_from_report, route_infeasible, Missed, RouteAnswer, MISSED_BY_THE_RUN,
+};
+use mobil_planner::{DockingConfig, DockingGains, FollowConfig, RouteCheckConfig};
 use mobil_ros::action::nav2_result;
 use mobil_ros::chassis::{chassis_params, declare_chassis};
 use mobil_ros::config::{Config, ConfigError, Decl};
@@ -30,8 +32,7 @@ use mobil_ros::goal::RouteLimits;
 pub use mobil_ros::goal::{GoalError, Route};
 use mobil_ros::groups::{Frames, GoalTimeouts};
 use mobil_ros::markers::{point, Markers};
-use mobil_ros::motion::{EndCause, EndKind};
-use mobil_ros::status::{NavStatusView, VfoFigures};
+use mobil_ros::motion::EndCause;
 use mobil_world::World;
 
 pub mod vfo;
@@ -220,82 +221,49 @@ pub const ROUTE_LIMITS: RouteLimits = RouteLimits {
     max_waypoints: MAX_WAYPOINTS,
 };
 
-/// FollowWaypoints' result of `cause`: the waypoints `missed` (the run's, or the pre-check's
-/// problems for a route it refused), up to [`MAX_RESULT_MISSED`], each with its pose from
-/// `poses` and its code; Nav2 lists them on success too.
-pub fn follow_result(cause: &EndCause, poses: &[PoseStamped], missed: &[Missed]) -> FollowWaypointsResult {
+/// FollowWaypoints' result of `cause`, listing the waypoints `missed` (each the request's index
+/// and its error code, as [`mobil_planner::task::Task::result_missed`] chooses them), up to
+/// [`MAX_RESULT_MISSED`], each with its pose from `poses`.
+pub fn follow_result(cause: &EndCause, poses: &[PoseStamped], missed: &[(usize, u16)]) -> FollowWaypointsResult {
+    let listed = |&(index, error_code): &(usize, u16)| MissedWaypoint {
+        index: u32::try_from(index).unwrap_or(u32::MAX),
+        goal: poses.get(index).cloned().unwrap_or_default(),
+        error_code,
+    };
     FollowWaypointsResult {
-        missed_waypoints: missed
-            .iter()
-            .take(MAX_RESULT_MISSED)
-            .map(|m| missed_waypoint(m.index, m.error_code(), poses))
-            .collect(),
+        missed_waypoints: missed.iter().take(MAX_RESULT_MISSED).map(listed).collect(),
         ..nav2_result(cause, Action::Follow.codes())
     }
 }
 
-/// FollowWaypoints' result for a VFO route: every end but success lists the waypoints not
-/// reached, `unreached` (request indices, from the one pursued on), as given up by the run.
-pub fn vfo_follow_result(cause: &EndCause, poses: &[PoseStamped], unreached: &[usize]) -> FollowWaypointsResult {
-    let mut r = follow_result(cause, poses, &[]);
-    if cause.kind() != EndKind::Succeeded {
-        r.missed_waypoints = unreached
-            .iter()
-            .take(MAX_RESULT_MISSED)
-            .map(|&i| missed_waypoint(i, MISSED_BY_THE_RUN, poses))
-            .collect();
-    }
-    r
-}
-
-fn missed_waypoint(index: usize, error_code: u16, poses: &[PoseStamped]) -> MissedWaypoint {
-    MissedWaypoint {
-        index: u32::try_from(index).unwrap_or(u32::MAX),
-        goal: poses.get(index).cloned().unwrap_or_default(),
-        error_code,
-    }
-}
-
-/// The `check_route` reply of a report: every problem (up to [`MAX_LISTED_PROBLEMS`]) with its
-/// index, kind, detail and position; `feasible`, `failed_waypoint`, the simulated path
-/// (downsampled to [`MAX_REPLY_POSES`]) and its length.
-pub fn check_reply(report: &RouteReport, route: &Route, stamp: Time, frame: &str, step: f64) -> CheckRouteResponse {
-    let missed = missed_from_report(&report.problems, &route.points, &route.request_index);
+/// The `check_route` reply of `answer`: each problem with its index, kind, detail and
+/// position; the simulated path stamped `stamp` in `frame`.
+pub fn check_reply(answer: &RouteAnswer, stamp: Time, frame: &str) -> CheckRouteResponse {
     let header = Header {
         stamp,
         frame_id: frame.to_owned(),
     };
-    let problems = missed
-        .iter()
-        .take(MAX_LISTED_PROBLEMS)
-        .map(|m| ProblemMsg {
-            index: i32::try_from(m.index).unwrap_or(i32::MAX),
-            kind: m.kind.as_str().to_owned(),
-            detail: m.kind.to_string(),
-            position: point(m.position),
-        })
-        .collect();
-    let poses = downsample(&report.path, MAX_REPLY_POSES)
-        .iter()
-        .map(|p| PoseStamped {
-            header: header.clone(),
-            pose: pose_msg(p),
-        })
-        .collect();
-    let feasible = missed.is_empty();
+    let index = |i: usize| i32::try_from(i).unwrap_or(i32::MAX);
+    let problem = |m: &Missed| ProblemMsg {
+        index: index(m.index),
+        kind: m.kind.as_str().to_owned(),
+        detail: m.kind.to_string(),
+        position: point(m.position),
+    };
+    let pose = |p: &Pose2| PoseStamped {
+        header: header.clone(),
+        pose: pose_msg(p),
+    };
     CheckRouteResponse {
-        feasible,
-        reason: if feasible {
-            String::new()
-        } else {
-            route_infeasible(&missed).reason()
+        feasible: answer.feasible(),
+        reason: answer.reason.clone(),
+        failed_waypoint: answer.failed_waypoint.map_or(-1, index),
+        problems: answer.problems.iter().map(problem).collect(),
+        simulated_path: Path {
+            poses: answer.path.iter().map(pose).collect(),
+            header,
         },
-        failed_waypoint: missed
-            .first()
-            .map_or(-1, |m| i32::try_from(m.index).unwrap_or(i32::MAX)),
-        problems,
-        simulated_path: Path { header, poses },
-        length: report.driven_length(step),
+        length: answer.length,
     }
 }
 
@@ -306,27 +274,6 @@ pub fn refused_reply(reason: String) -> CheckRouteResponse {
         reason,
         failed_waypoint: -1,
         ..Default::default()
-    }
-}
-
-/// The status in `state` with `reason` of a goal's `figures` (none: idle, or a goal refused
-/// before it started).
-pub fn status_view(state: u8, reason: String, figures: Option<&Figures>) -> NavStatusView {
-    let Some(f) = figures else {
-        return NavStatusView::new(state, Mode::Idle.as_str(), reason);
-    };
-    NavStatusView {
-        goal: f.goal,
-        distance_to_goal: f.distance,
-        waypoint_index: f.waypoint,
-        docking: f.docking,
-        vfo: f.vfo.map(|s| VfoFigures {
-            psi_z: s.psi_z,
-            indices: s.indices,
-            virtual_robots: s.virtual_robots,
-            candidates: s.candidates,
-        }),
-        ..NavStatusView::new(state, f.mode.as_str(), reason)
     }
 }
 
@@ -439,7 +386,7 @@ mod tests {
             infeasible.reason(),
             "ROUTE_INFEASIBLE: 1 problem(s): waypoint 1: turn_radius: turn radius 0.20 m below the chassis minimum 0.73 m"
         );
-        let r = follow_result(&infeasible, &poses, &missed);
+        let r = follow_result(&infeasible, &poses, &[(1, missed[0].error_code())]);
         assert_eq!(r.error_code, 601);
         let listed: Vec<(u32, u16)> = r.missed_waypoints.iter().map(|m| (m.index, m.error_code)).collect();
         assert_eq!(listed, vec![(1, 208)]);
@@ -454,7 +401,7 @@ mod tests {
         assert!(done
             .reason()
             .starts_with("SUCCEEDED: route done: 1 of 2 waypoints missed"));
-        let r = follow_result(&done, &poses, std::slice::from_ref(&ran));
+        let r = follow_result(&done, &poses, &[(ran.index, ran.error_code())]);
         assert_eq!((r.error_code, r.missed_waypoints[0].error_code), (0, 105));
         // More missed than the 50 a reason lists: every one is in the result (60 here).
         let many: Vec<Missed> = (0..60)
@@ -463,6 +410,7 @@ mod tests {
                 ..ran.clone()
             })
             .collect();
+        let many: Vec<(usize, u16)> = many.iter().map(|m| (m.index, m.error_code())).collect();
         let r = follow_result(&done, &poses, &many);
         assert_eq!(r.missed_waypoints.len(), 60);
         assert_eq!(r.missed_waypoints[59].index, 59);
@@ -472,36 +420,46 @@ mod tests {
     }
 
     #[test]
-    fn the_reply_stays_small_and_names_each_problem() {
-        // A long straight report: 20 000 poses are sent as 400; one problem at waypoint 1.
-        let path: Vec<Pose2> = (0..20_000).map(|i| Pose2::new(i as f64 * 0.02, 0.0, 0.0)).collect();
-        let route = Route {
-            points: vec![Point2::new(200.0, 0.0), Point2::new(399.98, 0.0)],
-            request_index: vec![0, 1],
-            poses: vec![],
-        };
-        let report = RouteReport {
-            problems: vec![mobil_planner::RouteProblem {
-                index: 1,
+    fn the_reply_names_each_problem_and_carries_the_answer_s_path() {
+        // The answer's choices (which problems, how many poses): mobil_planner's goals tests.
+        let answer = RouteAnswer {
+            problems: vec![Missed {
+                index: 8,
+                position: Point2::new(300.0, 0.0),
                 kind: ProblemKind::Collision {
                     at: Point2::new(300.0, 0.0),
                     clearance: -0.1,
                 },
+                pre_check: true,
             }],
-            path,
-            reached: vec![true, true],
+            reason: "ROUTE_INFEASIBLE: 1 problem(s): waypoint 8: collision".into(),
+            failed_waypoint: Some(8),
+            path: vec![Pose2::new(0.0, 0.0, 0.0), Pose2::new(1.0, 0.5, 0.25)],
+            length: 1.25,
         };
-        let reply = check_reply(&report, &route, Time::default(), "odom", 0.02);
+        let reply = check_reply(&answer, Time::default(), "odom");
         assert!(!reply.feasible);
-        assert_eq!(reply.failed_waypoint, 1);
-        assert_eq!(reply.problems.len(), 1);
-        assert_eq!(reply.problems[0].kind, "collision");
-        assert_eq!(reply.problems[0].position.x, 300.0);
-        assert_eq!(reply.simulated_path.poses.len(), MAX_REPLY_POSES);
-        assert_relative_eq!(reply.length, 19_999.0 * 0.02, epsilon = 1e-6);
-        assert!(reply
-            .reason
-            .starts_with("ROUTE_INFEASIBLE: 1 problem(s): waypoint 1: collision"));
+        assert_eq!((reply.failed_waypoint, reply.length), (8, 1.25));
+        assert_eq!(reply.reason, answer.reason);
+        let p = &reply.problems[0];
+        assert_eq!((p.index, p.kind.as_str(), p.position.x), (8, "collision", 300.0));
+        assert_eq!(
+            p.detail,
+            "collision at (300.00, 0.00): footprint 0.10 m into an obstacle"
+        );
+        let poses = &reply.simulated_path.poses;
+        assert_eq!((poses.len(), poses[1].pose.position.y), (2, 0.5));
+        assert_eq!(reply.simulated_path.header.frame_id, "odom");
+        assert_relative_eq!(yaw_of(&poses[1].pose.orientation), 0.25, epsilon = 1e-12);
+        let clear = RouteAnswer {
+            problems: Vec::new(),
+            reason: String::new(),
+            failed_waypoint: None,
+            ..answer
+        };
+        let reply = check_reply(&clear, Time::default(), "odom");
+        assert!(reply.feasible && reply.problems.is_empty());
+        assert_eq!(reply.failed_waypoint, -1);
     }
 
     #[test]
@@ -535,49 +493,6 @@ mod tests {
         let arrow = a.markers.last().expect("arrow");
         assert_eq!(arrow.r#type, Marker::ARROW);
         assert_relative_eq!(yaw_of(&arrow.pose.orientation), 0.5, epsilon = 1e-12);
-    }
-
-    #[test]
-    fn status_carries_the_goal_s_figures_and_idle_none() {
-        let figures = Figures {
-            mode: Mode::Dock,
-            waypoint: None,
-            goal: Some(Pose2::new(1.0, 0.0, 0.0)),
-            distance: 1.0,
-            docking: Some([1.0, 0.5, -0.25, 0.7]),
-            vfo: None,
-        };
-        let m = status_view(NavStatus::ACTIVE, String::new(), Some(&figures)).message(Time::default(), "odom");
-        assert_eq!(m.mode, "dock");
-        assert_eq!((m.e, m.alpha, m.theta, m.lyapunov), (1.0, 0.5, -0.25, 0.7));
-        assert_eq!(
-            (m.waypoint_index, m.goal.position.x, m.distance_to_goal),
-            (-1, 1.0, 1.0)
-        );
-        let vfo = Figures {
-            mode: Mode::Vfo,
-            waypoint: Some(2),
-            docking: None,
-            vfo: Some(mobil_planner::vfo::SegmentReport {
-                psi_z: 3.25,
-                indices: [4.5, 0.75, 1.5, 0.5],
-                virtual_robots: 9,
-                candidates: 5,
-            }),
-            ..figures
-        };
-        let m = status_view(NavStatus::ACTIVE, String::new(), Some(&vfo)).message(Time::default(), "odom");
-        assert_eq!((m.mode.as_str(), m.waypoint_index, m.e), ("vfo", 2, 0.0));
-        assert_eq!(
-            (m.psi_z, m.chi_danger, m.virtual_robots, m.candidates),
-            (3.25, 0.75, 9, 5)
-        );
-        let idle = status_view(NavStatus::FAILED, "INVALID_GOAL: x".into(), None).message(Time::default(), "odom");
-        assert_eq!(
-            (idle.mode.as_str(), idle.waypoint_index, idle.state),
-            ("idle", -1, NavStatus::FAILED)
-        );
-        assert!(idle.distance_to_goal.is_nan() && idle.psi_z.is_nan());
     }
 
     #[test]

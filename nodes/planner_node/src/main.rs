@@ -40,22 +40,22 @@ use mobil_msgs::nav_msgs::msg::{Odometry, Path};
 use mobil_msgs::sensor_msgs::msg::LaserScan;
 use mobil_msgs::tf2_msgs::msg::TFMessage;
 use mobil_planner::goals::{DockGoal, RouteEvent, UndockGoal};
-use mobil_planner::task::{PreCheck, Source, Stepped, Task, VfoRun};
-use mobil_planner::vfo::{
-    Interrupt, KeptMap, MapChange, PoseHistory, ScanSkipped, VfoGoal, VfoStep, VfoTick, WaypointMethod,
-};
+use mobil_planner::task::{dock_request_notice, status_view, PreCheck, Source, Stepped, Task, VfoRun};
+use mobil_planner::vfo::{Interrupt, KeptMap, PoseHistory, ScanSkipped, VfoGoal, VfoStep, VfoTick, WaypointMethod};
 use mobil_planner::view::Drawing;
 use mobil_planner::{check_route_until, Finish, RouteReport};
 use mobil_planner_node::{
-    check_reply, follow_result, load_world, markers, no_dock_database, refused_reply, status_view, vfo_follow_result,
-    Action, GoalError, PlannerConfig, Route, ROUTE_LIMITS,
+    check_reply, follow_result, load_world, markers, no_dock_database, refused_reply, Action, GoalError, PlannerConfig,
+    Route, RouteAnswer, MAX_REPLY_POSES, ROUTE_LIMITS,
 };
 use mobil_ros::action::{goal_end, nav2_result, ActionEvent, GoalRequest, GoalServer, GoalServerConfig};
 use mobil_ros::geometry::{odom_pose, twist_msg};
 use mobil_ros::goal::{goal_pose, pose_in_frame, route_from_path, route_from_poses};
 use mobil_ros::input::Inputs;
 use mobil_ros::latest::Latest;
-use mobil_ros::motion::{Applied, CmdVel, EndCause, Ended, GoalId, MotionSession, Outputs, SessionSettings, Watched};
+use mobil_ros::motion::{
+    Applied, CmdVel, EndCause, EndKind, Ended, GoalId, MotionSession, Outputs, SessionSettings, Watched,
+};
 use mobil_ros::offloop::CancelToken;
 use mobil_ros::offloop::ReplyPool;
 use mobil_ros::scan::{checked_scan, tf_static_subscription, LaserMount, StaticFrames};
@@ -301,7 +301,7 @@ async fn start(node: &mut RosNode, out: &Outputs, config: PlannerConfig) -> anyh
             sink: &mut sink,
             servers: &mut servers,
         };
-        shell.report(&mut io, ended, true);
+        shell.report(&mut io, ended);
     }
     if final_zero {
         final_stop(&out.cmd, Twist::default(), FINAL_STOP_WAIT).await;
@@ -363,14 +363,7 @@ async fn event_loop(
             Event::Config(Err(e)) => warn!("parameters not applied: {e}"),
             Event::Odom(m) => shell.odom_in(&mut io, jobs, &m),
             Event::Scan(m) => {
-                let skipped = shell.laser.take_all(tf_sub);
-                if skipped > 0 {
-                    warn_throttled!(
-                        shell.throttle,
-                        "tf-static",
-                        "{skipped} invalid tf_static transform(s) skipped"
-                    );
-                }
+                shell.laser.refresh(tf_sub, &mut shell.throttle);
                 shell.scan_in(&m);
             }
             Event::VfoTicked(done) => shell.vfo_ticked(&mut io, done),

@@ -91,7 +91,7 @@ pub fn declare_vfo(d: &mut Decl<PlannerConfig>) {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::{markers, vfo_follow_result, MarkerView, MISSED_BY_THE_RUN};
+    use crate::{follow_result, markers, MarkerView, MISSED_BY_THE_RUN};
     use mobil_geom::Pose2;
     use mobil_msgs::builtin_interfaces::msg::Time;
     use mobil_msgs::geometry_msgs::msg::PoseStamped;
@@ -199,24 +199,20 @@ mod tests {
     }
 
     #[test]
-    fn an_early_end_lists_the_waypoints_not_reached() {
+    fn an_early_end_lists_the_waypoints_not_reached_with_the_law_s_reason() {
         let poses: Vec<PoseStamped> = (0..4).map(|i| pose(i as f64, 1.0, None)).collect();
-        // The law's failure (its reason and code, as mobil_planner's VfoGoal gives them), a
-        // stale scan, a cancel: each lists what was not reached as given up by the run.
+        // The law's failure (its reason and code, as mobil_planner's VfoGoal gives them) with
+        // the waypoints not reached as the task lists them (mobil_planner's task tests).
         let law = EndCause::Outcome(mobil_motion::Outcome::failed("NO_SAFE_PATH", "no way", 601));
-        for cause in [law.clone(), EndCause::Stale("scan".into()), EndCause::Canceled] {
-            let r = vfo_follow_result(&cause, &poses, &[2, 3]);
-            let listed: Vec<(u32, u16)> = r.missed_waypoints.iter().map(|m| (m.index, m.error_code)).collect();
-            assert_eq!(listed, vec![(2, MISSED_BY_THE_RUN), (3, MISSED_BY_THE_RUN)]);
-            assert_eq!(r.missed_waypoints[1].goal.pose.position.x, 3.0);
-        }
-        let r = vfo_follow_result(&law, &poses, &[3]);
+        let r = follow_result(&law, &poses, &[(2, MISSED_BY_THE_RUN), (3, MISSED_BY_THE_RUN)]);
         assert_eq!(r.error_code, FollowWaypointsResult::TASK_EXECUTOR_FAILED);
         assert_eq!(r.error_msg, "NO_SAFE_PATH: no way");
-        // A route done lists nothing.
-        let done = EndCause::Outcome(mobil_motion::Outcome::succeeded("route done: all 4 waypoints reached"));
-        let r = vfo_follow_result(&done, &poses, &[]);
-        assert!(r.missed_waypoints.is_empty() && r.error_code == 0);
+        let listed: Vec<(u32, u16, f64)> = r
+            .missed_waypoints
+            .iter()
+            .map(|m| (m.index, m.error_code, m.goal.pose.position.x))
+            .collect();
+        assert_eq!(listed, vec![(2, 105, 2.0), (3, 105, 3.0)]);
     }
 
     #[test]

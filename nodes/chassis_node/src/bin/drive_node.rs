@@ -263,7 +263,7 @@ async fn event_loop(
                                 // goes on serving the others; a goal it replaced was ended.
                                 Err(e) => {
                                     warn_throttled!(throttle, "accept", "goal not started: {e}");
-                                    session.end(EndCause::Preempted("drive_distance"), &mut sink);
+                                    session.preempt(DriveAction, &mut sink);
                                 }
                             }
                         }

@@ -42,6 +42,7 @@
 //! - **Obstacle model**: r = r_p + `robot_radius`, R = r + `influence_margin`.
 
 use mobil_geom::{Beam, Pose2, Scan};
+use mobil_motion::Notice;
 use nalgebra::{Matrix3, Point2, Vector3};
 
 use super::history::{Placement, PoseHistory};
@@ -625,6 +626,20 @@ pub enum MapChange {
     Restarted,
     /// The map starts afresh with them once the running goal ends.
     AfterGoal,
+}
+
+impl MapChange {
+    /// What the node tells of it: nothing when unchanged.
+    pub fn notice(self) -> Option<Notice> {
+        let when = match self {
+            MapChange::Unchanged => return None,
+            MapChange::Restarted => "",
+            MapChange::AfterGoal => " once the goal ends",
+        };
+        Some(Notice::Info(format!(
+            "vfo obstacle extraction changed: the obstacle map starts afresh{when}"
+        )))
+    }
 }
 
 impl KeptMap {

@@ -13,17 +13,8 @@ impl Shell {
                 .map_err(|e| Action::Dock.invalid_goal(&e))
         };
         if !g.use_dock_id {
-            info!(
-                "dock_robot: max_staging_time ({}) and navigate_to_staging_pose ({}) ignored: the Lyapunov law \
-                 docks from wherever the robot is{}",
-                g.max_staging_time,
-                g.navigate_to_staging_pose,
-                if g.dock_type.is_empty() {
-                    String::new()
-                } else {
-                    format!("; dock_type `{}` ignored", g.dock_type)
-                }
-            );
+            let notice = dock_request_notice(g.max_staging_time, g.navigate_to_staging_pose, &g.dock_type);
+            self.throttle.tell([notice]);
         }
         let preempted = nav2_result(&EndCause::Preempted("dock_robot"), Action::Dock.codes());
         let accept = io.servers.dock.accept(request, |_| preempted).await;
@@ -42,32 +33,24 @@ impl Shell {
     ) -> bool {
         let Err(e) = accept else { return true };
         warn_throttled!(self.throttle, "accept", "{} goal not started: {e}", source.name());
-        let ours = self.session.active().is_some_and(|a| a.source == source);
-        if let Some(ended) = ours
-            .then(|| self.session.end(EndCause::Preempted(source.name()), io.sink))
-            .flatten()
+        if self.session.active().is_some_and(|a| a.source == source)
+            && let Some(ended) = self.session.preempt(source, io.sink)
         {
-            self.report(io, ended, false);
+            self.report(io, ended);
         }
         false
     }
 
     pub(crate) async fn undock_action(&mut self, io: &mut Io<'_, '_>, request: GoalRequest<UndockRobotGoal>) {
         let limit = request.goal().max_undocking_time;
-        let limit_s = if limit.is_finite() && limit > 0.0 {
-            f64::from(limit)
-        } else {
-            warn!("undock_robot: max_undocking_time {limit} is not a positive time: 30 s (its default) taken");
-            30.0
-        };
         let preempted = nav2_result(&EndCause::Preempted("undock_robot"), Action::Undock.codes());
         let accept = io.servers.undock.accept(request, |_| preempted).await;
         if !self.accepted(io, accept, Source::UndockAction) {
             return;
         }
-        let (distance, speed) = (self.config.staging_distance, self.config.undock_speed);
-        info!("goal (undock_robot): back out {distance:.3} m along the heading, within {limit_s:.1} s");
-        let task = Task::Undock(UndockGoal::new(distance, speed, limit_s));
+        let (undock, notices) = UndockGoal::for_request(self.config.staging_distance, self.config.undock_speed, limit);
+        self.throttle.tell(notices);
+        let task = Task::Undock(undock);
         self.begin(io, task, None, Source::UndockAction);
         self.drawing = Drawing::default();
         self.publish_status(io.node, io.out, NavStatus::ACTIVE, String::new());
@@ -86,10 +69,8 @@ impl Shell {
         let route = route_from_poses(&g.poses, frame, frame, round, at, ROUTE_LIMITS);
         // A follow_waypoints goal pre-empted by this one lists what it had missed.
         let by = EndCause::Preempted("follow_waypoints");
-        let preempted = match self.session.active() {
-            Some(a) if a.source == Source::FollowAction => follow_answer(&a.goal, &by),
-            _ => follow_result(&by, &[], &[]),
-        };
+        let running = self.session.active().filter(|a| a.source == Source::FollowAction);
+        let preempted = follow_answer(running.map(|a| &a.goal), &by);
         let accept = io.servers.follow.accept(request, |_| preempted).await;
         if self.accepted(io, accept, Source::FollowAction) {
             self.start_route(io, jobs, route, start, Source::FollowAction);
@@ -110,18 +91,12 @@ impl Shell {
     }
 }
 
-/// FollowWaypoints' result for a goal ending with `cause`: the waypoints missed so far (the
-/// pre-check's problems for a route it refused; a VFO route: those not reached), the request's
-/// poses.
-fn follow_answer(goal: &Goal, cause: &EndCause) -> FollowWaypointsResult {
-    let Some(route) = &goal.route else {
-        return follow_result(cause, &[], &[]);
-    };
-    match &goal.task {
-        Task::Follow(g) => follow_result(cause, &route.poses, g.missed()),
-        Task::Vfo(v) => vfo_follow_result(cause, &route.poses, &route.unreached_from(v.view().index)),
-        Task::PreCheck(p) => follow_result(cause, &route.poses, &p.problems),
-        Task::Dock(_) | Task::Undock(_) => follow_result(cause, &[], &[]),
+/// FollowWaypoints' result for `goal` (none: refused before it started) ending with `cause`.
+fn follow_answer(goal: Option<&Goal>, cause: &EndCause) -> FollowWaypointsResult {
+    let succeeded = cause.kind() == EndKind::Succeeded;
+    match goal.and_then(|g| Some((g.route.as_ref()?, g.task.result_missed(succeeded)))) {
+        Some((route, missed)) => follow_result(cause, &route.poses, &missed),
+        None => follow_result(cause, &[], &[]),
     }
 }
 
@@ -139,8 +114,7 @@ impl Servers {
                 self.undock.finish(end, nav2_result(cause, Action::Undock.codes()));
             }
             Source::FollowAction => {
-                let result = goal.map_or_else(|| follow_result(cause, &[], &[]), |g| follow_answer(g, cause));
-                self.follow.finish(end, result);
+                self.follow.finish(end, follow_answer(goal, cause));
             }
             Source::DockPose | Source::Waypoints => {}
         }

@@ -26,7 +26,14 @@ impl Shell {
         let job = move || {
             let began = Instant::now();
             let reply = match check_route_until(&start, &route.points, &chassis, &world, &config, || false) {
-                Ok(report) => check_reply(&report, &route, stamp, &frame, step),
+                Ok(report) => {
+                    let of_route = (&route.points[..], &route.request_index[..]);
+                    check_reply(
+                        &RouteAnswer::of(&report, of_route, step, MAX_REPLY_POSES),
+                        stamp,
+                        &frame,
+                    )
+                }
                 Err(e) => refused_reply(Action::Follow.refused_goal(e).reason()),
             };
             info!(

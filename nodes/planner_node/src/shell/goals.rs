@@ -11,14 +11,10 @@ impl Shell {
             Err(e) => return warn!("parameters not applied: {e}"),
         };
         let running = self.session.active().is_some();
+        // A goal keeps the map its parameters built (its obstacles and σ stay valid).
         match self.map.reconfigure(c.vfo.scan_config(c.robot_radius), running) {
             Err(e) => return warn!("parameters not applied: {e}"),
-            Ok(MapChange::Restarted) => info!("vfo obstacle extraction changed: the obstacle map starts afresh"),
-            // The goal keeps the map its parameters built (its obstacles and σ stay valid).
-            Ok(MapChange::AfterGoal) => {
-                info!("vfo obstacle extraction changed: the obstacle map starts afresh once the goal ends")
-            }
-            Ok(MapChange::Unchanged) => {}
+            Ok(change) => self.throttle.tell(change.notice()),
         }
         self.chassis = chassis;
         self.config = c;
@@ -45,8 +41,7 @@ impl Shell {
 
     /// The status of `goal` (none: idle, or a refusal) in `state` with `reason`.
     pub(crate) fn status_view(&self, goal: Option<&Goal>, state: u8, reason: String) -> NavStatusView {
-        let figures = goal.map(|g| g.task.figures(self.odom.value()));
-        status_view(state, reason, figures.as_ref())
+        status_view(goal.map(|g| &g.task), self.odom.value(), state, reason)
     }
 
     /// The active goal's status in `state` with `reason`.
@@ -66,19 +61,23 @@ impl Shell {
     /// and reports it.
     pub(crate) fn end_goal(&mut self, io: &mut Io<'_, '_>, cause: EndCause) {
         if let Some(ended) = self.session.end(cause, io.sink) {
-            self.report(io, ended, true);
+            self.report(io, ended);
         }
     }
 
-    /// Tells an ended goal's end: the action's result (unless the server already ended it:
-    /// a newer goal on the same action server took its place), the log, the status with the
-    /// goal's last figures, the markers; a VFO optimisation under way stops.
-    pub(crate) fn report(&mut self, io: &mut Io<'_, '_>, ended: PlannerEnded, finish_action: bool) {
+    /// Tells an ended goal's end: the action's result (unless its server ended it:
+    /// [`Ended::server_ended`]), the log, the status with the goal's last figures, the markers;
+    /// a VFO optimisation under way stops.
+    pub(crate) fn report(&mut self, io: &mut Io<'_, '_>, ended: PlannerEnded) {
         let Ended {
-            goal, source, cause, ..
+            goal,
+            source,
+            cause,
+            server_ended,
+            ..
         } = ended;
         goal.stop.cancel();
-        if finish_action {
+        if !server_ended {
             io.servers.finish(source, &cause, Some(&goal));
         }
         self.throttle.tell([cause.notice(source.name())]);
@@ -102,8 +101,7 @@ impl Shell {
         };
         let (id, old) = self.session.start(goal, source, Instant::now());
         if let Some(old) = old {
-            let by_server = source.replaced_on_server(old.source);
-            self.report(io, old, !by_server);
+            self.report(io, old);
         }
         id
     }
@@ -112,9 +110,8 @@ impl Shell {
     /// PREEMPTED (the robot stops with it); an action goal (accepted already) gets its result;
     /// the status is FAILED with the reason.
     pub(crate) fn refuse(&mut self, io: &mut Io<'_, '_>, source: Source, refusal: mobil_motion::Outcome) {
-        if let Some(old) = self.session.end(EndCause::Preempted(source.name()), io.sink) {
-            let by_server = source.replaced_on_server(old.source);
-            self.report(io, old, !by_server);
+        if let Some(old) = self.session.preempt(source, io.sink) {
+            self.report(io, old);
         }
         let cause = EndCause::Outcome(refusal);
         warn!("goal ({}) refused: {}", source.name(), cause.reason());
@@ -240,7 +237,7 @@ impl Shell {
                     self.publish_status(io.node, io.out, NavStatus::ACTIVE, String::new());
                 }
             }
-            Applied::Refused(Some(ended)) | Applied::Ended(ended, _) => self.report(io, ended, true),
+            Applied::Refused(Some(ended)) | Applied::Ended(ended, _) => self.report(io, ended),
             Applied::Refused(None) | Applied::Idle => {}
         }
     }
