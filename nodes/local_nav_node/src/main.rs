@@ -405,7 +405,7 @@ impl Shell {
         if ended.source == Source::Action && !ended.server_ended {
             server.finish(goal_end(&ended.cause), result(&ended.cause));
         }
-        self.throttle.tell([ended.cause.notice(ended.source.name())]);
+        mobil_ros::tell!(self.throttle, [ended.cause.notice(ended.source.name())]);
         let mode_before = self.nav.mode();
         self.publish_status_with_mode(node, out, state, reason, mode_before, Some(ended.goal.goal));
         self.nav.cancel();

@@ -67,6 +67,7 @@ pub use args::RosArgs;
 pub use config::{Config, ConfigError, Decl};
 pub use latest::{Freshness, Latest};
 pub use log::LogThrottle;
+pub use mobil_motion::Notice;
 pub use node::{respond, run_node, shutdown_signal, NodeBody, NodeDecl, RosNode};
 pub use offloop::{CancelToken, OffLoop};
 pub use params::{ParamSpec, ParamValues};

@@ -152,17 +152,6 @@ impl LogThrottle {
         }
     }
 
-    /// Logs `notices`: each line as it is, a recurring warning rate-limited under its key.
-    pub fn tell(&mut self, notices: impl IntoIterator<Item = mobil_motion::Notice>) {
-        for n in notices {
-            match n {
-                mobil_motion::Notice::Info(text) => tracing::info!("{text}"),
-                mobil_motion::Notice::Warn(text) => tracing::warn!("{text}"),
-                mobil_motion::Notice::Recurring(key, text) => crate::warn_throttled!(self, key, "{text}"),
-            }
-        }
-    }
-
     /// `Some(n)` when a line for `key` may be written now, `n` being how many were suppressed
     /// since the last one; `None` to stay quiet.
     pub fn allow(&mut self, key: &'static str, now: Instant) -> Option<u64> {
@@ -201,6 +190,22 @@ macro_rules! warn_throttled {
                 ::tracing::warn!("{} ({} similar suppressed)", format_args!($($arg)+), suppressed);
             } else {
                 ::tracing::warn!($($arg)+);
+            }
+        }
+    };
+}
+
+/// Logs notices ([`mobil_motion::Notice`]) where the macro is called, so each line carries the
+/// node's target, file and line: `tell!(throttle, notices)`, each info and warning as it is, a
+/// recurring warning rate-limited under its key by the [`LogThrottle`] `throttle`.
+#[macro_export]
+macro_rules! tell {
+    ($throttle:expr, $notices:expr) => {
+        for notice in ::std::iter::IntoIterator::into_iter($notices) {
+            match notice {
+                $crate::Notice::Info(text) => ::tracing::info!("{text}"),
+                $crate::Notice::Warn(text) => ::tracing::warn!("{text}"),
+                $crate::Notice::Recurring(key, text) => $crate::warn_throttled!($throttle, key, "{text}"),
             }
         }
     };
@@ -257,6 +262,36 @@ mod tests {
             tracing::warn!(target: "cdr_encoding::cdr_deserializer", "shown when asked for");
         });
         assert_eq!(seen_all.lock().map(|s| s.len()).unwrap_or_default(), 1);
+    }
+
+    #[test]
+    fn notices_are_told_at_their_level_and_a_recurring_one_once_per_period() {
+        use mobil_motion::Notice;
+        let seen = Arc::new(Mutex::new(Vec::new()));
+        let subscriber = tracing_subscriber::registry().with(Count(seen.clone()));
+        let mut throttle = LogThrottle::new(Duration::from_secs(60));
+        tracing::subscriber::with_default(subscriber, || {
+            for _ in 0..3 {
+                crate::tell!(
+                    throttle,
+                    [
+                        Notice::Info("reached".into()),
+                        Notice::Warn("missed".into()),
+                        Notice::Recurring("late", "a tick came late".into()),
+                    ]
+                );
+            }
+        });
+        let seen = seen.lock().map(|s| s.clone()).unwrap_or_default();
+        let here = module_path!();
+        let lines = |level: &str| seen.iter().filter(|s| **s == format!("{level} {here}")).count();
+        // Three of each line as it is; the recurring warning once in the minute.
+        assert_eq!((lines("INFO"), lines("WARN")), (3, 3 + 1), "{seen:?}");
+        assert_eq!(
+            throttle.allow("late", Instant::now()),
+            None,
+            "two suppressed, still quiet"
+        );
     }
 
     #[test]

@@ -121,7 +121,7 @@ impl VfoRun {
     pub fn new(law: VfoGoal, max_delay: Duration) -> Self {
         VfoRun {
             view: law.view(),
-            request_index: law.request_index().to_vec(),
+            request_index: (0..law.follower().waypoints().len()).map(|i| law.request(i)).collect(),
             slot: LawSlot::new(law, max_delay),
             map_changed: None,
         }

@@ -206,7 +206,16 @@ fn an_undock_request_s_time_limit_is_its_own_or_the_30_s_default_for_none() {
         )]
     );
     g.step(&at(1.0, 0.0, 0.0, 0.0), &());
-    assert!(matches!(g.step(&at(13.5, -0.1, 0.0, 0.0), &()), Step::End(_)));
+    match g.step(&at(13.5, -0.1, 0.0, 0.0), &()) {
+        Step::End(end) => {
+            assert_eq!(
+                end.outcome.reason(),
+                "TIME_LIMIT: not undocked within max_undocking_time 12.0 s (backed out 0.100 m)"
+            );
+            assert_eq!(end.outcome.nav2_error(), 905);
+        }
+        other => panic!("{other:?}"),
+    }
     // Zero, negative, NaN, infinite: Nav2's default of 30 s, with a warning; 13.5 s is in time.
     for bad in [0.0, -4.0, f32::NAN, f32::INFINITY] {
         let (mut g, notices) = UndockGoal::for_request(0.5, 0.15, bad);

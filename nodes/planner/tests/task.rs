@@ -6,12 +6,12 @@
 use mobil_chassis::ChassisParams;
 use mobil_geom::Pose2;
 use mobil_motion::slot::Handback;
-use mobil_motion::{BodyTwist, EndCause, Notice, Outcome, Step, StepInput};
+use mobil_motion::{BodyTwist, EndCause, GoalLaw, Notice, Outcome, Step, StepInput};
 use mobil_planner::goals::{DockGoal, UndockGoal};
 use mobil_planner::task::{no_dock_database, Action, Mode, PreCheck, Source, Stepped, Task, VfoRun, VfoStart};
 use mobil_planner::vfo::{
     ObstacleMap, OptimiseConfig, OptimiseWarning, Reoptimised, ScanObstacleConfig, VfoEvent, VfoFollower, VfoGains,
-    VfoGoal, VfoSettings, VfoStep, VfoWaypoint,
+    VfoGoal, VfoSettings, VfoStep, VfoTick, VfoWaypoint,
 };
 use mobil_planner::{
     DockingConfig, DockingController, DockingGains, Finish, FollowConfig, ProblemKind, RouteProblem, RouteReport,
@@ -90,6 +90,7 @@ fn a_result_lists_a_refused_route_s_problems_a_vfo_route_s_unreached_waypoints_a
     let mut task = pre_check();
     assert!(task.pre_checked(&blocked(), rules, false).unwrap().is_err());
     assert_eq!(task.result_missed(false), vec![(5, 208)]);
+    assert_eq!(task.result_missed(true), vec![(5, 208)]);
     // Driven through its problems: the run has missed nothing yet.
     let mut task = pre_check();
     assert!(task.pre_checked(&blocked(), rules, true).unwrap().is_ok());
@@ -101,6 +102,28 @@ fn a_result_lists_a_refused_route_s_problems_a_vfo_route_s_unreached_waypoints_a
     assert_eq!(task.result_missed(true), vec![]);
     let task = Task::Undock(UndockGoal::new(0.5, 0.15, 30.0));
     assert_eq!(task.result_missed(false), vec![]);
+}
+
+#[test]
+fn a_vfo_route_past_its_first_waypoint_lists_the_rest_by_request_index() {
+    // A route of request poses 1, 2, 0 (a goal_index 1 with a loop, cut short) through (1, 0),
+    // (2, 0), (3, 0); the robot stands on the first waypoint, so the law's step passes it.
+    let w: Vec<VfoWaypoint> = (1..=3)
+        .map(|x| VfoWaypoint::new(f64::from(x), 0.0, 0.0, 0.5).unwrap())
+        .collect();
+    let follower = VfoFollower::new(VfoGains::default(), OptimiseConfig::default(), w, Vec::new()).unwrap();
+    let law = VfoGoal::new(follower, vec![1, 2, 0], 0.0, &Pose2::identity(), Vec::new());
+    let mut run = VfoRun::new(law, Duration::from_secs(1));
+    assert_eq!(run.unreached(), vec![1, 2, 0]);
+    let map = ObstacleMap::new(ScanObstacleConfig::default()).unwrap();
+    let t0 = Instant::now();
+    let mut law = run.lend(t0, &map).unwrap();
+    let step = law.step(&at(1.0, 0.0, 0.0), &VfoTick::uninterrupted(0.0));
+    run.give_back(law, step, t0);
+    assert_eq!(run.view().index, 1, "the first waypoint passed");
+    assert_eq!(run.unreached(), vec![2, 0]);
+    let task = Task::Vfo(run);
+    assert_eq!(task.result_missed(false), vec![(2, 105), (0, 105)]);
 }
 
 #[test]

@@ -20,9 +20,7 @@ use mobil_msgs::nav2_msgs::msg::MissedWaypoint;
 use mobil_msgs::nav_msgs::msg::Path;
 use mobil_msgs::std_msgs::msg::Header;
 use mobil_msgs::visualization_msgs::msg::MarkerArray;
-pub use mobil_planner::goals::{
-    list_missed, missed_from_report, route_infeasible, Missed, RouteAnswer, MISSED_BY_THE_RUN,
-};
+pub use mobil_planner::goals::{Missed, RouteAnswer};
 use mobil_planner::{DockingConfig, DockingGains, FollowConfig, RouteCheckConfig};
 use mobil_ros::action::nav2_result;
 use mobil_ros::chassis::{chassis_params, declare_chassis};
@@ -89,8 +87,6 @@ pub const MAX_WAYPOINTS: usize = 200;
 /// Most poses of `simulated_path` in a `check_route` reply (about 90 bytes each: 36 KB, well
 /// under the 64 KB a reply should stay below).
 pub const MAX_REPLY_POSES: usize = 400;
-/// Most problems listed in a reply, a reason or the markers (the rest are counted in `reason`).
-pub const MAX_LISTED_PROBLEMS: usize = mobil_planner::goals::MAX_LISTED_MISSED;
 /// Most missed waypoints in a FollowWaypoints result: every one a route of [`MAX_WAYPOINTS`]
 /// can miss while driving, and twice that from a pre-check; about 90 bytes each (index, pose,
 /// code), 36 KB, well under the 64 KB a reply should stay below.
@@ -333,7 +329,7 @@ mod tests {
 
     #[test]
     fn ends_give_status_reasons_and_nav2_codes() {
-        use mobil_planner::goals::{docking_failure, route_done};
+        use mobil_planner::goals::{docking_failure, route_done, route_infeasible};
         use mobil_planner::{DockingFailure, Finish, Residual};
         // A law's end passes through: its reason, its state, its Nav2 code in every result.
         let residual = Residual { e: 0.015, heading: 0.5 };
@@ -483,7 +479,8 @@ mod tests {
         };
         let a = markers(&view, Time::default(), "odom");
         // DELETEALL, route line and dots, predicted path, 50 problems × 2, the dock arrow.
-        assert_eq!(a.markers.len(), 1 + 2 + 1 + 2 * MAX_LISTED_PROBLEMS + 1);
+        // (mobil_planner::goals::MAX_LISTED_MISSED: 50 problems drawn.)
+        assert_eq!(a.markers.len(), 1 + 2 + 1 + 2 * 50 + 1);
         assert_eq!(a.markers[0].action, Marker::DELETEALL);
         let points: usize = a.markers.iter().map(|m| m.points.len()).sum();
         // The route whole (200 ≤ a quarter of the budget each), the predicted path within a

@@ -91,12 +91,13 @@ pub fn declare_vfo(d: &mut Decl<PlannerConfig>) {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::{follow_result, markers, MarkerView, MISSED_BY_THE_RUN};
+    use crate::{follow_result, markers, MarkerView};
     use mobil_geom::Pose2;
     use mobil_msgs::builtin_interfaces::msg::Time;
     use mobil_msgs::geometry_msgs::msg::PoseStamped;
     use mobil_msgs::nav2_msgs::action::FollowWaypointsResult;
     use mobil_msgs::visualization_msgs::msg::Marker;
+    use mobil_planner::goals::MISSED_BY_THE_RUN;
     use mobil_planner::vfo::WaypointMethod;
     use mobil_planner::vfo::{DrawnRobot, Obstacle, VfoDrawing, MAX_DRAWN_OBSTACLES};
     use mobil_ros::config::{load, Decl};

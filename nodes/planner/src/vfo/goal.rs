@@ -277,11 +277,6 @@ impl VfoGoal {
         self.request_index.get(i).copied().unwrap_or(i)
     }
 
-    /// The request's index of each waypoint, in driving order.
-    pub fn request_index(&self) -> &[usize] {
-        &self.request_index
-    }
-
     /// The follower.
     pub fn follower(&self) -> &VfoFollower {
         &self.follower

@@ -14,7 +14,7 @@ impl Shell {
         };
         if !g.use_dock_id {
             let notice = dock_request_notice(g.max_staging_time, g.navigate_to_staging_pose, &g.dock_type);
-            self.throttle.tell([notice]);
+            mobil_ros::tell!(self.throttle, [notice]);
         }
         let preempted = nav2_result(&EndCause::Preempted("dock_robot"), Action::Dock.codes());
         let accept = io.servers.dock.accept(request, |_| preempted).await;
@@ -49,7 +49,7 @@ impl Shell {
             return;
         }
         let (undock, notices) = UndockGoal::for_request(self.config.staging_distance, self.config.undock_speed, limit);
-        self.throttle.tell(notices);
+        mobil_ros::tell!(self.throttle, notices);
         let task = Task::Undock(undock);
         self.begin(io, task, None, Source::UndockAction);
         self.drawing = Drawing::default();

@@ -14,7 +14,7 @@ impl Shell {
         // A goal keeps the map its parameters built (its obstacles and σ stay valid).
         match self.map.reconfigure(c.vfo.scan_config(c.robot_radius), running) {
             Err(e) => return warn!("parameters not applied: {e}"),
-            Ok(change) => self.throttle.tell(change.notice()),
+            Ok(change) => mobil_ros::tell!(self.throttle, change.notice()),
         }
         self.chassis = chassis;
         self.config = c;
@@ -80,7 +80,7 @@ impl Shell {
         if !server_ended {
             io.servers.finish(source, &cause, Some(&goal));
         }
-        self.throttle.tell([cause.notice(source.name())]);
+        mobil_ros::tell!(self.throttle, [cause.notice(source.name())]);
         let view = self.status_view(Some(&goal), end_state(&cause), cause.reason());
         self.send_status(io.node, io.out, &view);
         if self.session.active().is_none() && self.map.goal_ended() {
@@ -207,7 +207,7 @@ impl Shell {
             Stepped::OffLoop => self.vfo_step(io, jobs, input),
             Stepped::Law(step) => {
                 if let Step::Command { feedback, .. } = &step {
-                    self.throttle.tell(feedback.events.iter().map(RouteEvent::notice));
+                    mobil_ros::tell!(self.throttle, feedback.events.iter().map(RouteEvent::notice));
                 }
                 self.apply(io, step, &chassis, |f| f.changed);
             }

@@ -149,7 +149,7 @@ impl Shell {
         let chassis = active.goal.chassis;
         let Task::Vfo(v) = &mut active.goal.task else { return };
         let (mut step, handback) = v.give_back(done.law, done.step, Instant::now());
-        self.throttle.tell(v.notices(&step, handback));
+        mobil_ros::tell!(self.throttle, v.notices(&step, handback));
         if let Step::Command { feedback, .. } = &mut step
             && let Some(drawing) = feedback.drawing.take()
         {

@@ -26,7 +26,7 @@ use rustdds::{
   TopicDescription, TopicKind,
 };
 use rustdds::policy::{Deadline, Durability, History, Reliability}; /* import all QoS
-                                                                    * policies directly */
+                                                                     * policies directly */
 use serde::{Deserialize, Serialize};
 use clap::{Arg, ArgMatches, Command}; // command line argument processing
 use mio1::{Events, Interest, Poll, Token}; // non-blocking i/o polling

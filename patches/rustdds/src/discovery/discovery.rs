@@ -1138,9 +1138,7 @@ impl Discovery {
         let now = std::time::Instant::now();
         let due = now + Self::ENDPOINT_REANNOUNCE_DELAY;
         self.endpoint_reannounce = match self.endpoint_reannounce {
-          Some((first, _))
-            if now.duration_since(first) < Self::ENDPOINT_REANNOUNCE_MAX_POSTPONE =>
-          {
+          Some((first, _)) if now.duration_since(first) < Self::ENDPOINT_REANNOUNCE_MAX_POSTPONE => {
             Some((first, due))
           }
           Some(pending) => Some(pending),
