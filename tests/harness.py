@@ -49,7 +49,7 @@ __all__ = [
     "launch_node", "launch_scenario", "make_qos", "message_to_yaml", "param_get", "param_list",
     "param_set", "publish_on_sim_time", "publish_until", "qos_default", "qos_latched",
     "qos_sensor", "resolve_executable", "run_ros2cli", "set_message_fields", "subscribe",
-    "wait_for_message", "wait_for_node", "wait_until",
+    "wait_for_message", "wait_for_node", "wait_until", "OdomFeed", "OpenSpaceScan", "odom_at",
 ]
 
 BIN_DIR = Path(os.environ.get("MOBIL_BIN_DIR", str(ROOT / "target" / "release")))
@@ -540,3 +540,98 @@ def publish_on_sim_time(pub: Any, msg: Union[Any, Callable[[float], Any]], clock
             if t >= next_sim:
                 next_sim = (math.floor(t / period + 1e-9) + 1) * period
         time.sleep(0.002)
+
+
+# Feeds for a node run without a simulator
+# --------------------------------------------------------------------------------------------
+
+class OpenSpaceScan:
+    """Publishes an empty 270° scan (541 beams, all +inf: nothing in range) on ``scan`` at 20
+    wall Hz from a thread, until stopped: a scan whose end the test controls."""
+
+    def __init__(self, node: Any) -> None:
+        from sensor_msgs.msg import LaserScan
+        self.pub = node.create_publisher(LaserScan, "scan", qos_sensor())
+        self.msg = LaserScan()
+        self.msg.header.frame_id = "laser"
+        fov = 1.5 * math.pi
+        self.msg.angle_min, self.msg.angle_max = -fov / 2, fov / 2
+        self.msg.angle_increment = fov / 540
+        self.msg.range_min, self.msg.range_max = 0.06, 10.0
+        self.msg.ranges = [math.inf] * 541
+        self.last_sent = math.nan
+        self.defects: list = []
+        self.defects_sent = 0
+        self._broken = threading.Event()
+        self._stop = threading.Event()
+        self._thread = threading.Thread(target=self._run, daemon=True)
+        self._thread.start()
+
+    def _run(self) -> None:
+        n = 0
+        while not self._stop.wait(0.05):
+            if self._broken.is_set():
+                self.pub.publish(self.defects[n % len(self.defects)])
+                n += 1
+                self.defects_sent = n
+                continue
+            self.pub.publish(self.msg)
+            self.last_sent = time.monotonic()
+
+    def break_scans(self) -> float:
+        """From now on, only defective scans, each a defect the checked Scan refuses (no beams;
+        a negative, a NaN increment; NaN angles; more beams than the angles span; range_min
+        above range_max; three intensities for 541 ranges); returns the monotonic time of the
+        last valid scan."""
+        from sensor_msgs.msg import LaserScan
+
+        def bad(**fields: Any) -> Any:
+            m = LaserScan()
+            for name in ("header", "angle_min", "angle_max", "angle_increment", "range_min",
+                         "range_max", "ranges"):
+                setattr(m, name, getattr(self.msg, name))
+            for name, value in fields.items():
+                setattr(m, name, value)
+            return m
+        self.defects = [bad(ranges=[]), bad(angle_increment=-0.01), bad(angle_increment=math.nan),
+                        bad(angle_min=math.nan), bad(ranges=[1.0] * 900),
+                        bad(range_min=20.0), bad(intensities=[1.0, 2.0, 3.0])]
+        self._broken.set()
+        assert wait_until(lambda: self.defects_sent > 0, 5.0), "no defective scan sent"
+        return self.last_sent
+
+    def stop(self) -> float:
+        """Stops; returns the monotonic time of the last scan sent."""
+        self._stop.set()
+        self._thread.join(timeout=5)
+        return self.last_sent
+
+
+class OdomFeed:
+    """Publishes ``msg`` on ``odom`` at 20 wall Hz from a thread until stopped; the test swaps
+    ``msg`` to feed bad odometry."""
+
+    def __init__(self, node: Any, msg: Any) -> None:
+        from nav_msgs.msg import Odometry
+        self.pub = node.create_publisher(Odometry, "odom", 10)
+        self.msg = msg
+        self._stop = threading.Event()
+        self._thread = threading.Thread(target=self._run, daemon=True)
+        self._thread.start()
+
+    def _run(self) -> None:
+        while not self._stop.wait(0.05):
+            self.pub.publish(self.msg)
+
+    def stop(self) -> None:
+        self._stop.set()
+        self._thread.join(timeout=5)
+
+
+def odom_at(x: float = 0.0, frame: str = "odom") -> Any:
+    from nav_msgs.msg import Odometry
+    m = Odometry()
+    m.header.frame_id, m.child_frame_id = frame, "base_link"
+    m.pose.pose.position.x = x
+    m.pose.pose.orientation.w = 1.0
+    return m

@@ -28,8 +28,8 @@ import pytest
 
 from foreign_lidar import WorldRaycaster
 
-from harness import (TESTS_DIR as TESTS, make_qos, param_set, qos_latched, qos_sensor, subscribe,
-                     wait_until)
+from harness import (TESTS_DIR as TESTS, OdomFeed, OpenSpaceScan, make_qos, odom_at, param_set,
+                     qos_latched, qos_sensor, subscribe, wait_until)
 
 from action_msgs.msg import GoalStatus
 from geometry_msgs.msg import PoseStamped, Twist
@@ -199,65 +199,6 @@ def test_goal_pose_in_open_space(start_scenario, start_node, sim_clock, ros_node
 # A foreign LIDAR: tests/foreign_lidar.py, its own raycaster over the world file, fed by
 # sim_node's ground truth, in its own process; sim_node's LIDAR off
 # --------------------------------------------------------------------------------------------
-
-class OpenSpaceScan:
-    """Publishes an empty 270° scan (541 beams, all +inf: nothing in range) on ``scan`` at 20
-    wall Hz from a thread, until stopped: a scan whose end the test controls."""
-
-    def __init__(self, node) -> None:
-        self.pub = node.create_publisher(LaserScan, "scan", qos_sensor())
-        self.msg = LaserScan()
-        self.msg.header.frame_id = "laser"
-        fov = 1.5 * math.pi
-        self.msg.angle_min, self.msg.angle_max = -fov / 2, fov / 2
-        self.msg.angle_increment = fov / 540
-        self.msg.range_min, self.msg.range_max = 0.06, 10.0
-        self.msg.ranges = [math.inf] * 541
-        self.last_sent = math.nan
-        self.defects: list = []
-        self.defects_sent = 0
-        self._broken = threading.Event()
-        self._stop = threading.Event()
-        self._thread = threading.Thread(target=self._run, daemon=True)
-        self._thread.start()
-
-    def _run(self) -> None:
-        n = 0
-        while not self._stop.wait(0.05):
-            if self._broken.is_set():
-                self.pub.publish(self.defects[n % len(self.defects)])
-                n += 1
-                self.defects_sent = n
-                continue
-            self.pub.publish(self.msg)
-            self.last_sent = time.monotonic()
-
-    def break_scans(self) -> float:
-        """From now on, only defective scans, each a defect the checked Scan refuses (no beams;
-        a negative, a NaN increment; NaN angles; more beams than the angles span; range_min
-        above range_max; three intensities for 541 ranges); returns the monotonic time of the
-        last valid scan."""
-        def bad(**fields) -> LaserScan:
-            m = LaserScan()
-            for name in ("header", "angle_min", "angle_max", "angle_increment", "range_min",
-                         "range_max", "ranges"):
-                setattr(m, name, getattr(self.msg, name))
-            for name, value in fields.items():
-                setattr(m, name, value)
-            return m
-        self.defects = [bad(ranges=[]), bad(angle_increment=-0.01), bad(angle_increment=math.nan),
-                        bad(angle_min=math.nan), bad(ranges=[1.0] * 900),
-                        bad(range_min=20.0), bad(intensities=[1.0, 2.0, 3.0])]
-        self._broken.set()
-        assert wait_until(lambda: self.defects_sent > 0, 5.0), "no defective scan sent"
-        return self.last_sent
-
-    def stop(self) -> float:
-        """Stops; returns the monotonic time of the last scan sent."""
-        self._stop.set()
-        self._thread.join(timeout=5)
-        return self.last_sent
-
 
 def start_foreign_lidar(start_node, tmp_path: Path, world: Path):
     """tests/foreign_lidar.py as a node process (stopped like the Rust nodes)."""
@@ -582,34 +523,6 @@ def test_refusals_preemption_and_stale_scan(start_scenario, start_node, sim_cloc
     check_commands(cmds, started - 2 + 1)
 
 
-class OdomFeed:
-    """Publishes ``msg`` on ``odom`` at 20 wall Hz from a thread until stopped; the test swaps
-    ``msg`` to feed bad odometry."""
-
-    def __init__(self, node, msg: Odometry) -> None:
-        self.pub = node.create_publisher(Odometry, "odom", 10)
-        self.msg = msg
-        self._stop = threading.Event()
-        self._thread = threading.Thread(target=self._run, daemon=True)
-        self._thread.start()
-
-    def _run(self) -> None:
-        while not self._stop.wait(0.05):
-            self.pub.publish(self.msg)
-
-    def stop(self) -> None:
-        self._stop.set()
-        self._thread.join(timeout=5)
-
-
-def odom_at_origin(frame: str = "odom", x: float = 0.0) -> Odometry:
-    m = Odometry()
-    m.header.frame_id, m.child_frame_id = frame, "base_link"
-    m.pose.pose.position.x = x
-    m.pose.pose.orientation.w = 1.0
-    return m
-
-
 def test_refused_odometry_stops_the_robot(start_node, ros_node):
     """No simulator: this test feeds ``scan`` (open space) and ``odom`` (the robot standing at the
     origin) and sends a goal 3 m ahead. Odometry with a NaN position, and later odometry in
@@ -617,16 +530,16 @@ def test_refused_odometry_stops_the_robot(start_node, ros_node):
     command after it, and the goal ends STALE_INPUT (odom) with its own zero."""
     nav = start_node("local_nav_node", params_file=PARAMS)
     lidar = OpenSpaceScan(ros_node)
-    feed = OdomFeed(ros_node, odom_at_origin())
+    feed = OdomFeed(ros_node, odom_at())
     pub = ros_node.create_publisher(PoseStamped, "goal_pose", 10)
-    bad_odoms = [odom_at_origin(x=math.nan), odom_at_origin(frame="map")]
+    bad_odoms = [odom_at(x=math.nan), odom_at(frame="map")]
     logs = ["odom with a non-finite pose", "odom in frames `map` → `base_link`"]
     with subscribe(ros_node, NavStatus, "local_nav/status", qos=qos_latched()) as status, \
             subscribe(ros_node, Twist, "cmd_vel", qos=DEEP) as cmd:
         status.wait_for(lambda s: s.state == NavStatus.IDLE, REPLY_TIMEOUT)
         nav.wait_for_log("first scan", timeout=REPLY_TIMEOUT)
         for bad, log in zip(bad_odoms, logs):
-            feed.msg = odom_at_origin()
+            feed.msg = odom_at()
             publish_until_taken(pub, nav, goal_pose(3.0, 0.0))
             cmd.wait_for(lambda t: not is_zero(t), REPLY_TIMEOUT, start=len(cmd))
             mark, mark_status = len(cmd), len(status)

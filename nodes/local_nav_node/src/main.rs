@@ -513,7 +513,7 @@ impl Shell {
         let heading = goal_heading(&request.goal().pose);
         // The server ends a running action goal itself on accept, with this result.
         let preempted = result(&EndCause::Preempted("navigate_to_pose"));
-        match server.accept(request, |_| preempted).await {
+        match server.accept(request, |_| preempted, node.now_nanos()).await {
             Ok(()) => self.start_goal(node, out, server, goal, heading, Source::Action),
             Err(e) => {
                 warn_throttled!(self.throttle, "accept", "navigate_to_pose goal not started: {e}");

@@ -64,7 +64,7 @@ impl Frames {
 pub struct GoalTimeouts {
     /// A goal ends `STALE_INPUT` when no valid odometry arrived for this long (s, steady clock).
     pub odom_timeout_s: f64,
-    /// How long a finished action goal's result waits for the client to ask for it (s).
+    /// How long an ended action goal's result is kept for its clients (s).
     pub result_timeout_s: f64,
 }
 
@@ -83,7 +83,8 @@ impl GoalTimeouts {
         d.double(
             "result_timeout_s",
             10.0,
-            "how long a finished action goal's result waits for the client to ask for it [s]",
+            "how long an ended action goal's result is kept for its clients' get_result requests (Nav2's \
+             action_server_result_timeout) [s]",
             |c, v| c.result_timeout_s = v,
         )
         .above(0.0)
@@ -96,7 +97,7 @@ impl GoalTimeouts {
         seconds(self.odom_timeout_s, MAX_INPUT_TIMEOUT_S)
     }
 
-    /// How long a finished action goal's result waits for the client.
+    /// How long an ended action goal's result is kept for its clients.
     pub fn result_timeout(&self) -> Duration {
         seconds(self.result_timeout_s, MAX_RESULT_TIMEOUT_S)
     }

@@ -1,6 +1,7 @@
 //! `GoalServer` against ros2-client's own action client, two DDS participants in one process:
 //! reject, accept, feedback, pre-emption (the old goal ends ABORTED with the result built from
-//! it), cancel (CANCELED) and results delivered after the client asks for them.
+//! it), cancel (CANCELED), results kept and asked for again, and the answers for ids the server
+//! does not know (rcl_action's; the wire-level comparison with rclpy is tests/test_actions.py).
 
 use futures::StreamExt;
 use mobil_msgs::mobil_msgs::action::{DriveDistance, DriveDistanceFeedback, DriveDistanceGoal, DriveDistanceResult};
@@ -44,13 +45,11 @@ async fn serve(mut server: GoalServer<DriveDistance>) {
                 server.reject(request, "distance must be above zero").await;
             }
             ActionEvent::Goal(request) => {
-                server
-                    .accept(request, |old| DriveDistanceResult {
-                        travelled: old.distance,
-                        reason: "preempted by a newer goal".into(),
-                    })
-                    .await
-                    .unwrap();
+                let preempted = |old: &DriveDistanceGoal| DriveDistanceResult {
+                    travelled: old.distance,
+                    reason: "preempted by a newer goal".into(),
+                };
+                server.accept(request, preempted, Time::now().to_nanos()).await.unwrap();
             }
             ActionEvent::CancelRequested(id) => {
                 assert_eq!(server.active_id(), Some(id));
@@ -178,14 +177,34 @@ async fn reject_accept_feedback_preempt_cancel_and_results() {
     assert_eq!(status, GoalStatusEnum::Canceled);
     assert_eq!((result.travelled, result.reason.as_str()), (1.5, "canceled"));
 
-    // Nothing is active now: a cancel of the finished goal is refused.
+    // Its result is kept: asked again, the same answer.
+    let (status, result) = within(client.async_request_result(second)).await;
+    assert_eq!((status, result.travelled), (GoalStatusEnum::Canceled, 1.5));
+    // Nothing is active now: a cancel of the finished goal is refused as rcl_action refuses it
+    // (ERROR_GOAL_TERMINATED), and one of an id never seen as unknown.
     let cancel = within(client.async_cancel_goal(second, Time::ZERO)).await;
     assert!(cancel.goals_canceling.is_empty());
-    assert_eq!(cancel.return_code, CancelGoalResponseEnum::Rejected);
+    assert_eq!(cancel.return_code, CancelGoalResponseEnum::GoalTerminated);
+    let unknown = ros2_client::action::GoalId::new_random();
+    let cancel = within(client.async_cancel_goal(unknown, Time::ZERO)).await;
+    assert_eq!(cancel.return_code, CancelGoalResponseEnum::UnknownGoal);
+    // A result for an id never seen: STATUS_UNKNOWN with a default result, at once.
+    let asked = std::time::Instant::now();
+    let (status, result) = within(client.async_request_result(unknown)).await;
+    assert_eq!(
+        (status, result.travelled, result.reason.as_str()),
+        (GoalStatusEnum::Unknown, 0.0, "")
+    );
+    assert!(
+        asked.elapsed() < Duration::from_secs(2),
+        "answered in {:?}",
+        asked.elapsed()
+    );
 
     // A goal the server is slow to cancel (distance 5): canceled once (agreed, the goal listed),
     // then again while it is CANCELING, which is refused as rcl_action refuses a goal that cannot
-    // move to CANCELING, and not reported to the node a second time (`serve` would panic).
+    // move to CANCELING (ERROR_GOAL_TERMINATED), and not reported to the node a second time
+    // (`serve` would panic).
     let (third, accepted) = send(&client, goal(5.0)).await;
     assert!(accepted);
     let cancel = within(client.async_cancel_goal(third, Time::ZERO)).await;
@@ -193,7 +212,7 @@ async fn reject_accept_feedback_preempt_cancel_and_results() {
     assert_eq!(cancel.goals_canceling.len(), 1);
     assert_eq!(cancel.goals_canceling[0].goal_id, third);
     let again = within(client.async_cancel_goal(third, Time::ZERO)).await;
-    assert_eq!(again.return_code, CancelGoalResponseEnum::Rejected);
+    assert_eq!(again.return_code, CancelGoalResponseEnum::GoalTerminated);
     assert!(again.goals_canceling.is_empty());
     // Pre-empted while CANCELING, it ends CANCELED with the result built from it (5.0).
     let (_, accepted) = send(&client, goal(1.0)).await;

@@ -59,6 +59,15 @@ pub struct CancelGoalRequest {
 }
 impl Message for CancelGoalRequest {}
 
+impl CancelGoalRequest {
+  /// The goals to cancel: one by id (stamp zero), all accepted up to the
+  /// stamp (id zero), both, or all (both zero). A server that answers the
+  /// request itself needs it.
+  pub fn goal_info(&self) -> &GoalInfo {
+    &self.goal_info
+  }
+}
+
 /// From [CancelGoal](https://docs.ros2.org/foxy/api/action_msgs/srv/CancelGoal.html)
 #[derive(Clone, Copy, Serialize_repr, Deserialize_repr, PartialEq, Debug)]
 #[repr(i8)]

@@ -254,7 +254,8 @@ async fn event_loop(
                         Ok(new) => {
                             let travelled = session.active().map_or(0.0, |a| a.goal.progress().travelled);
                             // The server ends the goal it replaces itself, with this result.
-                            match server.accept(request, |_| result(travelled, "preempted by a newer goal")).await {
+                            let preempted = |_: &_| result(travelled, "preempted by a newer goal");
+                            match server.accept(request, preempted, node.now_nanos()).await {
                                 Ok(()) => {
                                     info!("driving {} m at {} m/s", goal.distance, goal.speed);
                                     session.start(new, DriveAction, Instant::now());

@@ -17,7 +17,11 @@ impl Shell {
             mobil_ros::tell!(self.throttle, [notice]);
         }
         let preempted = nav2_result(&EndCause::Preempted("dock_robot"), Action::Dock.codes());
-        let accept = io.servers.dock.accept(request, |_| preempted).await;
+        let accept = io
+            .servers
+            .dock
+            .accept(request, |_| preempted, io.node.now_nanos())
+            .await;
         if self.accepted(io, accept, Source::DockAction) {
             self.start_dock(io, target, Source::DockAction);
         }
@@ -44,7 +48,11 @@ impl Shell {
     pub(crate) async fn undock_action(&mut self, io: &mut Io<'_, '_>, request: GoalRequest<UndockRobotGoal>) {
         let limit = request.goal().max_undocking_time;
         let preempted = nav2_result(&EndCause::Preempted("undock_robot"), Action::Undock.codes());
-        let accept = io.servers.undock.accept(request, |_| preempted).await;
+        let accept = io
+            .servers
+            .undock
+            .accept(request, |_| preempted, io.node.now_nanos())
+            .await;
         if !self.accepted(io, accept, Source::UndockAction) {
             return;
         }
@@ -71,7 +79,11 @@ impl Shell {
         let by = EndCause::Preempted("follow_waypoints");
         let running = self.session.active().filter(|a| a.source == Source::FollowAction);
         let preempted = follow_answer(running.map(|a| &a.goal), &by);
-        let accept = io.servers.follow.accept(request, |_| preempted).await;
+        let accept = io
+            .servers
+            .follow
+            .accept(request, |_| preempted, io.node.now_nanos())
+            .await;
         if self.accepted(io, accept, Source::FollowAction) {
             self.start_route(io, jobs, route, start, Source::FollowAction);
         }

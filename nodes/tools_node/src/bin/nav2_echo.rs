@@ -115,6 +115,7 @@ async fn answer<A: RosAction + 'static>(
     server: &mut GoalServer<A>,
     event: ActionEvent<A::Goal>,
     respond: fn(&A::Goal) -> Response<A>,
+    now_nanos: i64,
 ) -> anyhow::Result<()> {
     let ActionEvent::Goal(request) = event else {
         // Goals end as soon as they are accepted; nothing is left to cancel.
@@ -122,7 +123,7 @@ async fn answer<A: RosAction + 'static>(
     };
     let (feedback, result) = respond(request.goal());
     info!("{}: goal {:?}", A::NAME, request.id());
-    server.accept(request, |_| A::Result::default()).await?;
+    server.accept(request, |_| A::Result::default(), now_nanos).await?;
     if let Err(e) = server.feedback(feedback).await {
         warn!("{}: {e}", A::NAME);
     }
@@ -142,10 +143,10 @@ async fn serve(node: &mut RosNode) -> anyhow::Result<()> {
     loop {
         tokio::select! {
             _ = &mut shutdown => break,
-            e = navigate_s.next_event() => answer(&mut navigate_s, e, navigate).await?,
-            e = dock_s.next_event() => answer(&mut dock_s, e, dock).await?,
-            e = undock_s.next_event() => answer(&mut undock_s, e, undock).await?,
-            e = follow_s.next_event() => answer(&mut follow_s, e, follow).await?,
+            e = navigate_s.next_event() => answer(&mut navigate_s, e, navigate, node.now_nanos()).await?,
+            e = dock_s.next_event() => answer(&mut dock_s, e, dock, node.now_nanos()).await?,
+            e = undock_s.next_event() => answer(&mut undock_s, e, undock, node.now_nanos()).await?,
+            e = follow_s.next_event() => answer(&mut follow_s, e, follow, node.now_nanos()).await?,
         }
     }
     navigate_s.close(NavigateToPoseResult::default()).await;

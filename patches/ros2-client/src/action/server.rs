@@ -71,6 +71,24 @@ where
     &mut self.my_status_publisher
   }
 
+  /// The goal, cancel and result services, borrowed together: an async server
+  /// can await a request on all three at once (`goal_server()` and its
+  /// siblings borrow the server mutably, one at a time).
+  #[allow(clippy::type_complexity)]
+  pub fn services(
+    &self,
+  ) -> (
+    &Server<SendGoalRequest<G>, SendGoalResponse>,
+    &Server<action_msgs::CancelGoalRequest, action_msgs::CancelGoalResponse>,
+    &Server<GetResultRequest, GetResultResponse<R>>,
+  ) {
+    (
+      &self.my_goal_server,
+      &self.my_cancel_server,
+      &self.my_result_server,
+    )
+  }
+
   /// Receive a new goal, if available.
   pub fn receive_goal(&self) -> ReadResult<Option<(RmwRequestId, SendGoalRequest<G>)>>
   where
