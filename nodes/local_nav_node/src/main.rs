@@ -37,7 +37,9 @@ use mobil_ros::action::{goal_end, nav2_result, ActionEvent, GoalRequest, GoalSer
 use mobil_ros::geometry::{odom_pose, twist_msg};
 use mobil_ros::input::Inputs;
 use mobil_ros::latest::Latest;
-use mobil_ros::motion::{Applied, CmdVel, EndCause, Ended, MotionSession, Outputs, SessionSettings, Watched};
+use mobil_ros::motion::{
+    Applied, ClockCheck, CmdVel, EndCause, Ended, MotionSession, Outputs, SessionSettings, Watched,
+};
 use mobil_ros::scan::{
     checked_scan, tf_static_subscription, CheckedScan, LaserMount, LaserPoseFrom, ScanRefusal, StaticFrames,
 };
@@ -361,8 +363,13 @@ impl Shell {
         self.status_gate.sent(Instant::now());
     }
 
-    /// The status of the current goal (or of none).
+    /// The status of the current goal (or of none); with no reason given, the stopped clock's if
+    /// the robot is held for it.
     fn publish_status(&mut self, node: &RosNode, out: &Outputs, state: u8, reason: String) {
+        let reason = match reason.is_empty() {
+            true => self.session.clock_hold_reason().unwrap_or_default(),
+            false => reason,
+        };
         let goal = self.session.active().map(|a| a.goal.goal).or(self.nav.goal());
         let view = self.status_view(state, reason, self.nav.mode(), goal);
         self.send_status(node, out, &view);
@@ -635,9 +642,22 @@ impl Shell {
         sink: &mut CmdVel<'_>,
         server: &mut GoalServer<NavigateToPose>,
     ) {
+        let now = Instant::now();
+        if self.session.active().is_none() {
+            return;
+        }
+        let timeout = self.config.timeouts.clock_timeout();
+        let clock = self.session.watch_clock(node.now_nanos(), now, timeout, sink);
+        mobil_ros::tell!(self.throttle, clock.notice());
+        match clock {
+            ClockCheck::Back(ended) => return self.report(node, out, server, ended),
+            ClockCheck::Held { newly: true, .. } | ClockCheck::Resumed => {
+                self.publish_status(node, out, NavStatus::ACTIVE, String::new())
+            }
+            ClockCheck::Held { .. } | ClockCheck::Running => {}
+        }
         let Some(active) = self.session.active() else { return };
         let (goal, source) = (active.goal.clone(), active.source);
-        let now = Instant::now();
         let inputs = [
             Watched {
                 name: "scan",

@@ -73,7 +73,7 @@ pub fn planar_odometry(header: Header, child_frame_id: &str, pose: [f64; 3], twi
 }
 
 /// Why an odometry message is refused.
-#[derive(Debug, Clone, PartialEq, Eq, Error)]
+#[derive(Debug, Clone, PartialEq, Error)]
 pub enum OdomError {
     /// `header.frame_id` or `child_frame_id` is not the configured frame (a leading `/` and an
     /// empty frame are accepted, as many drivers leave it empty).
@@ -91,10 +91,49 @@ pub enum OdomError {
     /// NaN or infinity in the pose.
     #[error("odom with a non-finite pose")]
     NotFinite,
+    /// A position beyond ±[`MAX_ODOM_COORD`]: what follows from it (a distance, a time to
+    /// go) could not be represented.
+    #[error("odom position ({}, {}) beyond ±{MAX_ODOM_COORD:e} m", short(*x), short(*y))]
+    TooFar {
+        /// x (m).
+        x: f64,
+        /// y (m).
+        y: f64,
+    },
+}
+
+/// A number for a log line: as it is when short, else in scientific notation (1e308 has 309
+/// digits written out).
+fn short(v: f64) -> String {
+    if v.abs() < 1e7 {
+        format!("{v}")
+    } else {
+        format!("{v:e}")
+    }
+}
+
+/// The largest |x| and |y| of an odometry position the nodes take (m): 1000 km, far beyond any
+/// drive (mobil_planner's own coordinate limit), and far below where a distance, its square or
+/// a time computed from it overflows, even as an `f32` in a Nav2 feedback.
+pub const MAX_ODOM_COORD: f64 = 1e6;
+
+/// The planar robot pose of an odometry pose, or why it is refused: NaN or infinity in it (the
+/// quaternion included), or a position beyond ±[`MAX_ODOM_COORD`].
+pub fn planar_pose(p: &Pose) -> Result<Pose2, OdomError> {
+    let q = &p.orientation;
+    let pose = Pose2::new(p.position.x, p.position.y, yaw_of(q));
+    // The yaw of a quaternion with an infinity in it can come out finite: each part is checked.
+    if !(pose.is_finite() && [q.x, q.y, q.z, q.w].iter().all(|v| v.is_finite())) {
+        return Err(OdomError::NotFinite);
+    }
+    if pose.x.abs() > MAX_ODOM_COORD || pose.y.abs() > MAX_ODOM_COORD {
+        return Err(OdomError::TooFar { x: pose.x, y: pose.y });
+    }
+    Ok(pose)
 }
 
 /// The robot pose of an odometry message, or why it is refused: frames other than
-/// `odom_frame` → `base_frame` (an empty frame passes), or a non-finite pose.
+/// `odom_frame` → `base_frame` (an empty frame passes), or a pose [`planar_pose`] refuses.
 pub fn odom_pose(m: &Odometry, odom_frame: &str, base_frame: &str) -> Result<Pose2, OdomError> {
     let same = |got: &str, want: &str| {
         let got = got.trim_start_matches('/');
@@ -108,15 +147,7 @@ pub fn odom_pose(m: &Odometry, odom_frame: &str, base_frame: &str) -> Result<Pos
             want_child: base_frame.to_owned(),
         });
     }
-    let p = &m.pose.pose;
-    let q = &p.orientation;
-    let pose = Pose2::new(p.position.x, p.position.y, yaw_of(q));
-    // The yaw of a quaternion with an infinity in it can come out finite: each part is checked.
-    if pose.is_finite() && [q.x, q.y, q.z, q.w].iter().all(|v| v.is_finite()) {
-        Ok(pose)
-    } else {
-        Err(OdomError::NotFinite)
-    }
+    planar_pose(&m.pose.pose)
 }
 
 #[cfg(test)]
@@ -167,5 +198,16 @@ mod tests {
         let mut q_inf = odom("odom", "base_link", 0.0);
         q_inf.pose.pose.orientation.z = f64::INFINITY;
         assert_eq!(odom_pose(&q_inf, "odom", "base_link"), Err(OdomError::NotFinite));
+        // Finite, but so far that a distance from it overflows an f32 (1e308 m), or beyond the
+        // 1000 km bound: refused; the bound itself is taken.
+        for x in [1e308, -1e308, 1.0000001e6] {
+            assert_eq!(
+                odom_pose(&odom("odom", "base_link", x), "odom", "base_link"),
+                Err(OdomError::TooFar { x, y: 0.0 })
+            );
+        }
+        assert!(odom_pose(&odom("odom", "base_link", -1e6), "odom", "base_link").is_ok());
+        let far = OdomError::TooFar { x: 1e308, y: -2.5 };
+        assert_eq!(far.to_string(), "odom position (1e308, -2.5) beyond ±1e6 m");
     }
 }

@@ -22,7 +22,7 @@
 //!
 //! let specs = Decl::<NavConfig>::of().specs();
 //! let names: Vec<&str> = specs.iter().map(|s| s.name.as_str()).collect();
-//! assert_eq!(names, ["odom_frame", "base_frame", "odom_timeout_s", "result_timeout_s"]);
+//! assert_eq!(names, ["odom_frame", "base_frame", "odom_timeout_s", "clock_timeout_s", "result_timeout_s"]);
 //! ```
 
 use crate::config::Decl;
@@ -64,12 +64,15 @@ impl Frames {
 pub struct GoalTimeouts {
     /// A goal ends `STALE_INPUT` when no valid odometry arrived for this long (s, steady clock).
     pub odom_timeout_s: f64,
+    /// A goal's robot is held while ROS time has not advanced for this long (s, steady clock).
+    pub clock_timeout_s: f64,
     /// How long an ended action goal's result is kept for its clients (s).
     pub result_timeout_s: f64,
 }
 
 impl GoalTimeouts {
-    /// Declares `odom_timeout_s` (0.5 s, up to [`MAX_INPUT_TIMEOUT_S`]) and `result_timeout_s`
+    /// Declares `odom_timeout_s` and `clock_timeout_s` (0.5 s, up to [`MAX_INPUT_TIMEOUT_S`])
+    /// and `result_timeout_s`
     /// (10 s, up to [`MAX_RESULT_TIMEOUT_S`], read-only: the action servers take it at start).
     pub fn declare(d: &mut Decl<GoalTimeouts>) {
         d.double(
@@ -77,6 +80,15 @@ impl GoalTimeouts {
             0.5,
             "a goal is aborted when no valid odom arrived for this long (steady clock) [s]",
             |c, v| c.odom_timeout_s = v,
+        )
+        .above(0.0)
+        .max(MAX_INPUT_TIMEOUT_S);
+        d.double(
+            "clock_timeout_s",
+            0.5,
+            "a goal's robot is held (zero cmd_vel, STALE_INPUT) while ROS time has not advanced for this long \
+             (a paused or stalled /clock; steady clock) [s]",
+            |c, v| c.clock_timeout_s = v,
         )
         .above(0.0)
         .max(MAX_INPUT_TIMEOUT_S);
@@ -95,6 +107,11 @@ impl GoalTimeouts {
     /// How long odometry may be missing.
     pub fn odom_timeout(&self) -> Duration {
         seconds(self.odom_timeout_s, MAX_INPUT_TIMEOUT_S)
+    }
+
+    /// How long ROS time may stand still before a goal's robot is held.
+    pub fn clock_timeout(&self) -> Duration {
+        seconds(self.clock_timeout_s, MAX_INPUT_TIMEOUT_S)
     }
 
     /// How long an ended action goal's result is kept for its clients.
@@ -133,19 +150,25 @@ mod tests {
             ("odom", "base_link")
         );
         assert_eq!(c.timeouts.odom_timeout(), Duration::from_millis(500));
+        assert_eq!(c.timeouts.clock_timeout(), Duration::from_millis(500));
         assert_eq!(c.timeouts.result_timeout(), Duration::from_secs(10));
         for name in ["odom_frame", "base_frame", "result_timeout_s"] {
             assert!(spec(name).read_only, "{name}");
         }
-        assert!(!spec("odom_timeout_s").read_only);
+        assert!(!spec("odom_timeout_s").read_only && !spec("clock_timeout_s").read_only);
         // 1e300 s is finite and positive, and would panic in Duration::from_secs_f64.
-        for (name, max) in [("odom_timeout_s", 60.0), ("result_timeout_s", 3600.0)] {
+        for (name, max) in [
+            ("odom_timeout_s", 60.0),
+            ("clock_timeout_s", 60.0),
+            ("result_timeout_s", 3600.0),
+        ] {
             let check = |v: f64| spec(name).check(&ParameterValue::Double(v));
             assert!(check(1e300).is_err() && check(0.0).is_err(), "{name}");
             assert!(check(max).is_ok() && check(max * 1.001).is_err(), "{name}");
         }
         let t = GoalTimeouts {
             odom_timeout_s: f64::NAN,
+            clock_timeout_s: 0.5,
             result_timeout_s: 1e300,
         };
         assert_eq!(

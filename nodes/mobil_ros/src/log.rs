@@ -2,6 +2,12 @@
 //! records on stderr), with
 //! the level from `--log-level` or `RUST_LOG`, and a throttle so that a flood of bad input
 //! produces one clear line per period, with a count of what was suppressed.
+//!
+//! Besides the throttles a node sets on purpose ([`LogThrottle`], [`crate::warn_throttled!`]),
+//! every line at info and above has a budget per call site ([`LineBudget`]): a burst of
+//! [`BURST_LINES`], then one line per [`LINE_PERIOD`]; the next line let through says how many
+//! were suppressed. A storm of goals, a `/clock` at 100 Hz with bad stamps (ros2-client warns of
+//! each), any line a node writes per message: none floods stderr or `/rosout`.
 
 use ros2_client::log::LogLevel;
 use ros2_client::{NodeLoggingHandle, RosoutRaw};
@@ -35,12 +41,113 @@ pub fn init(level: Option<&str>) {
         .with_writer(std::io::stderr)
         .with_ansi(std::io::IsTerminal::is_terminal(&std::io::stderr()))
         .with_target(false)
+        .fmt_fields(NotedFields)
         .with_filter(not_an_echo);
     let _ = tracing_subscriber::registry()
         .with(filter)
+        .with(LineBudgetLayer(Mutex::new(LineBudget::default())))
         .with(fmt)
         .with(RosoutLayer)
         .try_init();
+}
+
+/// Lines one call site may write at once before its budget holds it back.
+pub const BURST_LINES: u32 = 10;
+
+/// Once its burst is spent, a call site may write one line per this period.
+pub const LINE_PERIOD: Duration = Duration::from_secs(1);
+
+/// The budget of log lines per call site (module docs), with the clock as an input.
+#[derive(Debug, Default)]
+pub struct LineBudget {
+    sites: HashMap<u64, Site>,
+}
+
+/// One call site's budget: its tokens at `at`, and the lines it was refused since it last wrote.
+#[derive(Debug, Clone, Copy)]
+struct Site {
+    tokens: f64,
+    at: Instant,
+    suppressed: u64,
+}
+
+impl LineBudget {
+    /// Whether a line of call site `site` may be written at `now`: `Some(n)`, `n` lines of it
+    /// having been suppressed since the last one written; `None` to suppress this one.
+    pub fn allow(&mut self, site: u64, now: Instant) -> Option<u64> {
+        let burst = f64::from(BURST_LINES);
+        let s = self.sites.entry(site).or_insert(Site {
+            tokens: burst,
+            at: now,
+            suppressed: 0,
+        });
+        let refill = now.saturating_duration_since(s.at).as_secs_f64() / LINE_PERIOD.as_secs_f64();
+        s.tokens = (s.tokens + refill).min(burst);
+        s.at = now;
+        if s.tokens < 1.0 {
+            s.suppressed += 1;
+            return None;
+        }
+        s.tokens -= 1.0;
+        Some(std::mem::take(&mut s.suppressed))
+    }
+}
+
+thread_local! {
+    /// Lines suppressed before the event being written now, from its call site (0: none).
+    static SUPPRESSED: std::cell::Cell<u64> = const { std::cell::Cell::new(0) };
+}
+
+/// The call site of an event: its level, target, file and line (a `log` record's own, not the
+/// one `tracing-log` forwards every record of a level through; the level tells apart the lines
+/// one macro call writes at different levels, as `tell!` does).
+fn site_of(event: &Event<'_>) -> u64 {
+    use std::hash::{Hash, Hasher};
+    use tracing_log::NormalizeEvent;
+    let normalized = event.normalized_metadata();
+    let meta = normalized.as_ref().unwrap_or_else(|| event.metadata());
+    let mut h = std::collections::hash_map::DefaultHasher::new();
+    (meta.level().as_str(), meta.target(), meta.file(), meta.line()).hash(&mut h);
+    h.finish()
+}
+
+/// Holds every event at info and above to its call site's [`LineBudget`]; the count of what it
+/// suppressed goes with the next line it lets through ([`NotedFields`], `/rosout`).
+struct LineBudgetLayer(Mutex<LineBudget>);
+
+impl<S: Subscriber> Layer<S> for LineBudgetLayer {
+    fn event_enabled(&self, event: &Event<'_>, _: layer::Context<'_, S>) -> bool {
+        SUPPRESSED.with(|c| c.set(0));
+        if *event.metadata().level() > Level::INFO {
+            return true;
+        }
+        let Ok(mut budget) = self.0.lock() else { return true };
+        match budget.allow(site_of(event), Instant::now()) {
+            Some(n) => {
+                SUPPRESSED.with(|c| c.set(n));
+                true
+            }
+            None => false,
+        }
+    }
+}
+
+/// The fields of an event as `tracing-subscriber` writes them, then the count of lines its call
+/// site had suppressed before it, if any.
+struct NotedFields;
+
+impl<'w> tracing_subscriber::fmt::FormatFields<'w> for NotedFields {
+    fn format_fields<R: tracing_subscriber::field::RecordFields>(
+        &self,
+        mut writer: tracing_subscriber::fmt::format::Writer<'w>,
+        fields: R,
+    ) -> std::fmt::Result {
+        tracing_subscriber::fmt::format::DefaultFields::new().format_fields(writer.by_ref(), fields)?;
+        match SUPPRESSED.with(|c| c.get()) {
+            0 => Ok(()),
+            n => write!(writer, " ({n} similar lines suppressed)"),
+        }
+    }
 }
 
 /// The filter for a base level (`info`, …), or exactly the directives given when `base` holds
@@ -84,11 +191,15 @@ pub fn detach_rosout() {
     }
 }
 
-/// Forwards the suite's own events (info and above) to `/rosout`.
+/// Forwards the suite's own events (info and above) to `/rosout`. The outermost layer: it sees
+/// each event last.
 struct RosoutLayer;
 
 impl<S: Subscriber + for<'a> LookupSpan<'a>> Layer<S> for RosoutLayer {
     fn on_event(&self, event: &Event<'_>, cx: layer::Context<'_, S>) {
+        // The last layer to see the event: the count goes with it and no further (a span's
+        // fields formatted later must not carry it).
+        let suppressed = SUPPRESSED.with(|c| c.replace(0));
         let meta = event.metadata();
         let level = match *meta.level() {
             Level::ERROR => LogLevel::Error,
@@ -107,6 +218,9 @@ impl<S: Subscriber + for<'a> LookupSpan<'a>> Layer<S> for RosoutLayer {
         let Some(handle) = slot.as_ref() else { return };
         let mut text = MessageText(String::new());
         event.record(&mut text);
+        if suppressed > 0 {
+            text.0 += &format!(" ({suppressed} similar lines suppressed)");
+        }
         handle.rosout_raw(
             ros2_client::builtin_interfaces::Time::now(),
             level,
@@ -292,6 +406,94 @@ mod tests {
             None,
             "two suppressed, still quiet"
         );
+    }
+
+    #[test]
+    fn a_call_site_writes_its_burst_then_one_line_per_period_and_tells_what_it_held_back() {
+        let mut b = LineBudget::default();
+        let t0 = Instant::now();
+        let ms = Duration::from_millis;
+        for _ in 0..BURST_LINES {
+            assert_eq!(b.allow(1, t0), Some(0));
+        }
+        for _ in 0..5 {
+            assert_eq!(b.allow(1, t0), None);
+        }
+        // Another call site has a budget of its own.
+        assert_eq!(b.allow(2, t0), Some(0));
+        // Half a period later half a line has come back: still held.
+        assert_eq!(b.allow(1, t0 + ms(500)), None);
+        // A period: one line, telling the six held back.
+        assert_eq!(b.allow(1, t0 + ms(1000)), Some(6));
+        assert_eq!(b.allow(1, t0 + ms(1000)), None);
+        // A quiet minute refills the burst, and no more than the burst.
+        let t1 = t0 + Duration::from_secs(61);
+        assert_eq!(b.allow(1, t1), Some(1));
+        for _ in 1..BURST_LINES {
+            assert_eq!(b.allow(1, t1), Some(0));
+        }
+        assert_eq!(b.allow(1, t1), None);
+    }
+
+    #[test]
+    fn the_budget_holds_back_a_flood_from_one_site_and_the_next_line_tells_the_count() {
+        let seen = Arc::new(Mutex::new(Vec::new()));
+        let subscriber = tracing_subscriber::registry()
+            .with(LineBudgetLayer(Mutex::new(LineBudget::default())))
+            .with(Count(seen.clone()));
+        tracing::subscriber::with_default(subscriber, || {
+            for _ in 0..100 {
+                tracing::warn!("goal refused");
+            }
+            tracing::info!("another site");
+            for _ in 0..100 {
+                tracing::debug!("debug lines are not held back");
+            }
+        });
+        let seen = seen.lock().map(|s| s.clone()).unwrap_or_default();
+        let count = |level: &str| seen.iter().filter(|s| s.starts_with(level)).count();
+        assert_eq!((count("WARN"), count("INFO"), count("DEBUG")), (10, 1, 100));
+
+        // The line that follows a suppression carries its count.
+        let out = Arc::new(Mutex::new(Vec::<u8>::new()));
+        let sink = out.clone();
+        let writer = move || Buffer(sink.clone());
+        let subscriber = tracing_subscriber::registry().with(
+            tracing_subscriber::fmt::layer()
+                .with_writer(writer)
+                .with_ansi(false)
+                .fmt_fields(NotedFields),
+        );
+        tracing::subscriber::with_default(subscriber, || {
+            SUPPRESSED.with(|c| c.set(4));
+            tracing::warn!("goal refused");
+            SUPPRESSED.with(|c| c.set(0));
+            tracing::warn!("goal refused");
+        });
+        let text = String::from_utf8(out.lock().map(|o| o.clone()).unwrap_or_default()).unwrap_or_default();
+        let lines: Vec<&str> = text.lines().collect();
+        assert_eq!(lines.len(), 2, "{text}");
+        assert!(
+            lines[0].ends_with("goal refused (4 similar lines suppressed)"),
+            "{text}"
+        );
+        assert!(lines[1].ends_with("goal refused"), "{text}");
+    }
+
+    /// A writer into a shared buffer.
+    struct Buffer(Arc<Mutex<Vec<u8>>>);
+
+    impl std::io::Write for Buffer {
+        fn write(&mut self, buf: &[u8]) -> std::io::Result<usize> {
+            if let Ok(mut out) = self.0.lock() {
+                out.extend_from_slice(buf);
+            }
+            Ok(buf.len())
+        }
+
+        fn flush(&mut self) -> std::io::Result<()> {
+            Ok(())
+        }
     }
 
     #[test]

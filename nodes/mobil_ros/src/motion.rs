@@ -19,6 +19,10 @@
 //!   ([`MotionSession::hold`]: a pre-check, a first optimisation) stops the robot;
 //! - **stale input**: [`MotionSession::stale`] names the inputs older than their timeout, a
 //!   goal getting one timeout from its start for them to arrive;
+//! - **a stopped clock**: [`MotionSession::watch_clock`], at every watchdog tick, holds the
+//!   robot (one zero command, no command until it moves again) while ROS time has not advanced
+//!   for longer than the node's `clock_timeout_s` (steady clock: a paused or stalled `/clock`),
+//!   and ends the goal `CLOCK_BACKWARDS` when ROS time goes back;
 //! - **shutdown**: [`MotionSession::shutdown`] ends the goal `SHUTDOWN` and says whether the
 //!   node's last word must be a zero command ([`crate::stop::final_stop`], waited for).
 //!
@@ -46,7 +50,7 @@
 
 use crate::log::LogThrottle;
 use crate::status::{NavStatusView, StatusMessage};
-use crate::time::{DtClock, DtError};
+use crate::time::{ClockState, ClockWatch, DtClock, DtError};
 use mobil_motion::{BodyTwist, End, Step};
 pub use mobil_motion::{EndCause, EndKind};
 use mobil_msgs::builtin_interfaces::msg::Time;
@@ -246,6 +250,45 @@ pub struct MotionSession<G, S> {
     /// The last command sent moved the robot (not zero).
     moving: bool,
     next_id: u64,
+    clock: ClockWatch,
+    /// How long ROS time had stood still when last looked at, while the robot is held for it.
+    clock_held: Option<Duration>,
+}
+
+/// What [`MotionSession::watch_clock`] found.
+#[derive(Debug, Clone, PartialEq)]
+pub enum ClockCheck<G, S> {
+    /// ROS time runs, or has stood still for no longer than the timeout, or no goal runs.
+    Running,
+    /// ROS time moved again after the robot was held: the goal commands again.
+    Resumed,
+    /// ROS time has not advanced for `stopped` (beyond the timeout): the robot is held until it
+    /// moves again; `newly` at the first look of the hold (the one that stopped the robot).
+    Held {
+        /// How long ROS time has stood still.
+        stopped: Duration,
+        /// This look began the hold.
+        newly: bool,
+    },
+    /// ROS time went back: the active goal ended `CLOCK_BACKWARDS`.
+    Back(Ended<G, S>),
+}
+
+impl<G, S> ClockCheck<G, S> {
+    /// What the node tells of it: a warning when the hold begins, a line when time moves again
+    /// (a goal that ended is told by its end).
+    pub fn notice(&self) -> Option<mobil_motion::Notice> {
+        match self {
+            ClockCheck::Held { stopped, newly: true } => Some(mobil_motion::Notice::Warn(format!(
+                "ROS time has not advanced for {:.2} s (clock paused or stalled): robot held until it moves again",
+                stopped.as_secs_f64()
+            ))),
+            ClockCheck::Resumed => Some(mobil_motion::Notice::Info(
+                "ROS time moves again: the goal goes on".to_owned(),
+            )),
+            ClockCheck::Held { newly: false, .. } | ClockCheck::Running | ClockCheck::Back(_) => None,
+        }
+    }
 }
 
 fn is_zero(t: &Twist) -> bool {
@@ -269,6 +312,8 @@ impl<G, S> MotionSession<G, S> {
             active: None,
             moving: false,
             next_id: 0,
+            clock: ClockWatch::new(),
+            clock_held: None,
         }
     }
 
@@ -350,8 +395,12 @@ impl<G, S> MotionSession<G, S> {
         Some(Ok(dt))
     }
 
-    /// Sends a command for the active goal (none without one).
+    /// Sends a command for the active goal (none without one; while ROS time stands still, the
+    /// robot is held instead: [`MotionSession::watch_clock`]).
     pub fn command(&mut self, twist: Twist, sink: &mut impl CommandSink) {
+        if self.clock_held.is_some() {
+            return self.hold(sink);
+        }
         let Some(active) = self.active.as_mut() else { return };
         active.commanded = true;
         active.refused = 0;
@@ -470,6 +519,48 @@ impl<G, S> MotionSession<G, S> {
             .map(|w| w.name)
             .collect();
         (!stale.is_empty()).then(|| stale.join(" and "))
+    }
+
+    /// ROS time is `ros_nanos` at steady instant `now`, looked at on every watchdog tick: with a
+    /// goal active, time that has not advanced for longer than `timeout` holds the robot (one
+    /// zero command if it moves, no command until time moves again), and time gone back ends
+    /// the goal `CLOCK_BACKWARDS` (with its zero command).
+    pub fn watch_clock(
+        &mut self,
+        ros_nanos: i64,
+        now: Instant,
+        timeout: Duration,
+        sink: &mut impl CommandSink,
+    ) -> ClockCheck<G, S> {
+        match self.clock.observe(ros_nanos, now) {
+            ClockState::Back(by) => {
+                self.clock_held = None;
+                self.end(EndCause::ClockBack(by), sink)
+                    .map_or(ClockCheck::Running, ClockCheck::Back)
+            }
+            ClockState::Stopped(stopped) if stopped > timeout && self.active.is_some() => {
+                let newly = self.clock_held.is_none();
+                if newly {
+                    self.hold(sink);
+                }
+                self.clock_held = Some(stopped);
+                ClockCheck::Held { stopped, newly }
+            }
+            ClockState::Stopped(_) | ClockState::Running => match self.clock_held.take() {
+                Some(_) if self.active.is_some() => ClockCheck::Resumed,
+                _ => ClockCheck::Running,
+            },
+        }
+    }
+
+    /// While the robot is held for a stopped clock: the status reason that says so.
+    pub fn clock_hold_reason(&self) -> Option<String> {
+        self.clock_held.map(|d| {
+            format!(
+                "STALE_INPUT: ROS time has not advanced for {:.1} s (clock paused or stalled): robot stopped",
+                d.as_secs_f64()
+            )
+        })
     }
 
     /// The node shuts down: the active goal ends `SHUTDOWN` without a zero command here, and
@@ -829,6 +920,87 @@ mod tests {
         assert_eq!(old.unwrap().id, second);
         assert!(s.end_if_current(second, EndCause::Canceled, &mut sent).is_none());
         assert_eq!((sent.len(), zeros(&sent)), (2, 1));
+    }
+
+    #[test]
+    fn a_stopped_clock_holds_the_robot_once_until_time_moves_and_time_gone_back_ends_the_goal() {
+        let mut s = session();
+        let mut sent = Vec::new();
+        let t0 = Instant::now();
+        let (ms, timeout) = (Duration::from_millis, Duration::from_millis(500));
+        let at = |k: u64| t0 + ms(50 * k);
+        s.start(ToX { to: 5.0 }, Src::Topic, t0);
+        // Ticks every 50 ms, ROS time running: the goal commands.
+        for k in 0..4 {
+            assert_eq!(
+                s.watch_clock(1_000_000_000 + 50_000_000 * k as i64, at(k), timeout, &mut sent),
+                ClockCheck::Running
+            );
+            step_at(&mut s, 1.0, &mut sent);
+        }
+        assert_eq!((sent.len(), zeros(&sent)), (4, 0));
+        // ROS time stands at 1.15 s from tick 3 on: still commanding for 500 ms of it (ticks
+        // 4..=13), held from the first tick beyond it (tick 14: 550 ms), with one zero.
+        let frozen = 1_150_000_000;
+        for k in 4..=13 {
+            assert_eq!(
+                s.watch_clock(frozen, at(k), timeout, &mut sent),
+                ClockCheck::Running,
+                "tick {k}"
+            );
+        }
+        assert_eq!(
+            s.watch_clock(frozen, at(14), timeout, &mut sent),
+            ClockCheck::Held {
+                stopped: ms(550),
+                newly: true
+            }
+        );
+        assert_eq!(zeros(&sent), 1);
+        assert!(s
+            .clock_hold_reason()
+            .unwrap()
+            .starts_with("STALE_INPUT: ROS time has not advanced for 0.6 s"));
+        let held: ClockCheck<ToX, Src> = ClockCheck::Held {
+            stopped: ms(550),
+            newly: true,
+        };
+        let told = held.notice();
+        assert!(
+            matches!(&told, Some(mobil_motion::Notice::Warn(w)) if w.starts_with("ROS time has not advanced for 0.55 s")),
+            "{told:?}"
+        );
+        // Held: a law's command is not sent, no second zero, and the goal goes on.
+        let before = sent.len();
+        step_at(&mut s, 1.0, &mut sent);
+        assert_eq!(
+            s.watch_clock(frozen, at(15), timeout, &mut sent),
+            ClockCheck::Held {
+                stopped: ms(600),
+                newly: false
+            }
+        );
+        assert_eq!(sent.len(), before, "nothing sent while held");
+        assert!(s.active().is_some());
+        // Time moves: resumed, commanding again.
+        assert_eq!(
+            s.watch_clock(frozen + 1, at(16), timeout, &mut sent),
+            ClockCheck::Resumed
+        );
+        assert_eq!(s.clock_hold_reason(), None);
+        step_at(&mut s, 1.0, &mut sent);
+        assert_eq!((sent.len(), zeros(&sent)), (before + 1, 1));
+        // Time back by 0.5 s: the goal ends CLOCK_BACKWARDS with its one zero.
+        let ClockCheck::Back(ended) = s.watch_clock(frozen - 499_999_999, at(17), timeout, &mut sent) else {
+            panic!("not ended")
+        };
+        assert_eq!(ended.cause, EndCause::ClockBack(0.5));
+        assert!(ended.zeroed && s.active().is_none());
+        assert_eq!(zeros(&sent), 2);
+        // No goal: a stopped clock holds nothing and sends nothing.
+        let n = sent.len();
+        assert_eq!(s.watch_clock(frozen, at(40), timeout, &mut sent), ClockCheck::Running);
+        assert_eq!(sent.len(), n);
     }
 
     #[test]

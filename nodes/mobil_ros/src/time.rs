@@ -79,6 +79,50 @@ impl DtClock {
     }
 }
 
+/// What ROS time did since a node last looked ([`ClockWatch::observe`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum ClockState {
+    /// It advanced (or this is the first look).
+    Running,
+    /// It has not advanced for this long (steady clock): a paused or stalled `/clock`.
+    Stopped(std::time::Duration),
+    /// It went back by this many seconds (a restarted simulation, a clock reset); the watch
+    /// restarts at the new time.
+    Back(f64),
+}
+
+/// Watches ROS time on the steady clock: how long it has stood still, and whether it went back.
+/// A motion node looks at every watchdog tick (the time rule: a stopped `/clock` must not keep
+/// a robot moving, and the node can tell only by the steady clock).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct ClockWatch {
+    last: Option<(i64, std::time::Instant)>,
+}
+
+impl ClockWatch {
+    /// A watch that has not looked yet.
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    /// ROS time is `ros_nanos` at steady instant `now`.
+    pub fn observe(&mut self, ros_nanos: i64, now: std::time::Instant) -> ClockState {
+        let Some((last, moved_at)) = self.last else {
+            self.last = Some((ros_nanos, now));
+            return ClockState::Running;
+        };
+        if ros_nanos == last {
+            return ClockState::Stopped(now.saturating_duration_since(moved_at));
+        }
+        self.last = Some((ros_nanos, now));
+        if ros_nanos > last {
+            ClockState::Running
+        } else {
+            ClockState::Back((last - ros_nanos) as f64 * 1e-9)
+        }
+    }
+}
+
 /// A stamp from nanoseconds since the epoch (negative values clamp to 0, as ROS time cannot be).
 pub fn stamp_from_nanos(nanos: i64) -> Time {
     let nanos = nanos.max(0);
@@ -150,6 +194,23 @@ mod tests {
         assert_eq!(c.step(1_001_000_000), Ok(Some(0.001)));
         c.reset();
         assert_eq!(c.step(5), Ok(None));
+    }
+
+    #[test]
+    fn a_clock_watch_tells_a_stand_still_by_the_steady_clock_and_a_jump_back() {
+        use std::time::{Duration, Instant};
+        let mut w = ClockWatch::new();
+        let t0 = Instant::now();
+        let ms = Duration::from_millis;
+        assert_eq!(w.observe(5_000_000_000, t0), ClockState::Running);
+        assert_eq!(w.observe(5_000_000_000, t0 + ms(300)), ClockState::Stopped(ms(300)));
+        // Still, measured from the last time it moved.
+        assert_eq!(w.observe(5_000_000_000, t0 + ms(700)), ClockState::Stopped(ms(700)));
+        assert_eq!(w.observe(5_000_000_001, t0 + ms(750)), ClockState::Running);
+        assert_eq!(w.observe(5_000_000_001, t0 + ms(800)), ClockState::Stopped(ms(50)));
+        // Back 4.5 s: told once, then the watch runs from there.
+        assert_eq!(w.observe(500_000_001, t0 + ms(850)), ClockState::Back(4.5));
+        assert_eq!(w.observe(600_000_001, t0 + ms(900)), ClockState::Running);
     }
 
     #[test]

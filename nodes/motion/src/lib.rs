@@ -292,6 +292,9 @@ pub enum EndCause {
     },
     /// An input went stale (named, e.g. `odom`, `scan and odom`).
     Stale(String),
+    /// ROS time went back by this many seconds while the goal ran (a restarted simulation, a
+    /// clock reset): the goal's time cannot go on.
+    ClockBack(f64),
     /// The node shut down.
     Shutdown,
 }
@@ -325,7 +328,7 @@ impl EndCause {
     }
 
     /// The status reason's code: the outcome's, or `CANCELED`, `PREEMPTED`, `INVALID_INPUT`,
-    /// `STALE_INPUT`, `SHUTDOWN`.
+    /// `STALE_INPUT`, `CLOCK_BACKWARDS`, `SHUTDOWN`.
     pub fn code(&self) -> &str {
         match self {
             EndCause::Outcome(Outcome::Succeeded { .. }) => "SUCCEEDED",
@@ -334,6 +337,7 @@ impl EndCause {
             EndCause::Preempted(_) => "PREEMPTED",
             EndCause::Refused { .. } => "INVALID_INPUT",
             EndCause::Stale(_) => "STALE_INPUT",
+            EndCause::ClockBack(_) => "CLOCK_BACKWARDS",
             EndCause::Shutdown => "SHUTDOWN",
         }
     }
@@ -348,18 +352,22 @@ impl EndCause {
                 format!("INVALID_INPUT: the input was refused on {count} steps in a row ({last}): robot stopped")
             }
             EndCause::Stale(inputs) => format!("STALE_INPUT: {inputs} stale: robot stopped"),
+            EndCause::ClockBack(by) => format!(
+                "CLOCK_BACKWARDS: ROS time went back by {by:.3} s (a restarted simulation or a clock reset): \
+                 robot stopped"
+            ),
             EndCause::Shutdown => "SHUTDOWN: the node is shutting down".to_owned(),
         }
     }
 
     /// Nav2's error code of this end in the result of an action with `codes`, one rule for
     /// every node: the law's own, none for a cancel or a pre-emption, the control failure for
-    /// stale or refused input, unknown at shutdown.
+    /// stale or refused input or a clock gone back, unknown at shutdown.
     pub fn nav2_error(&self, codes: Nav2Codes) -> u16 {
         match self {
             EndCause::Outcome(o) => o.nav2_error(),
             EndCause::Canceled | EndCause::Preempted(_) => nav2::NONE,
-            EndCause::Refused { .. } | EndCause::Stale(_) => codes.control_failure,
+            EndCause::Refused { .. } | EndCause::Stale(_) | EndCause::ClockBack(_) => codes.control_failure,
             EndCause::Shutdown => codes.unknown,
         }
     }
@@ -431,11 +439,21 @@ mod tests {
                 },
                 905,
             ),
+            (EndCause::ClockBack(4.5), 905),
             (EndCause::Shutdown, 999),
         ];
         for (end, code) in ends {
             assert_eq!(end.nav2_error(c), code, "{end:?}");
         }
+        let back = EndCause::ClockBack(4.5);
+        assert_eq!(
+            (back.code(), back.kind(), back.reason().as_str()),
+            (
+                "CLOCK_BACKWARDS",
+                EndKind::Aborted,
+                "CLOCK_BACKWARDS: ROS time went back by 4.500 s (a restarted simulation or a clock reset): robot stopped"
+            )
+        );
         assert_eq!(EndCause::Stale("scan".into()).nav2_error(Nav2Codes::FOLLOW_PATH), 106);
         assert_eq!(EndCause::Shutdown.nav2_error(Nav2Codes::FOLLOW_WAYPOINTS), 600);
     }

@@ -54,7 +54,7 @@ use mobil_ros::goal::{goal_pose, pose_in_frame, route_from_path, route_from_pose
 use mobil_ros::input::Inputs;
 use mobil_ros::latest::Latest;
 use mobil_ros::motion::{
-    Applied, CmdVel, EndCause, EndKind, Ended, GoalId, MotionSession, Outputs, SessionSettings, Watched,
+    Applied, ClockCheck, CmdVel, EndCause, EndKind, Ended, GoalId, MotionSession, Outputs, SessionSettings, Watched,
 };
 use mobil_ros::offloop::CancelToken;
 use mobil_ros::offloop::ReplyPool;

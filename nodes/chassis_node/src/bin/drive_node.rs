@@ -17,11 +17,11 @@ use mobil_msgs::mobil_msgs::action::{DriveDistance, DriveDistanceFeedback, Drive
 use mobil_msgs::nav_msgs::msg::Odometry;
 use mobil_ros::action::{ActionEvent, GoalEnd, GoalServer, GoalServerConfig};
 use mobil_ros::config::{Config, ConfigError, Decl};
-use mobil_ros::geometry::yaw_of;
+use mobil_ros::geometry::planar_pose;
 use mobil_ros::groups::GoalTimeouts;
 use mobil_ros::input::Inputs;
 use mobil_ros::latest::Latest;
-use mobil_ros::motion::{Applied, CmdVel, EndCause, EndKind, Ended, MotionSession, SessionSettings};
+use mobil_ros::motion::{Applied, ClockCheck, CmdVel, EndCause, EndKind, Ended, MotionSession, SessionSettings};
 use mobil_ros::stop::{final_stop, FINAL_STOP_WAIT};
 use mobil_ros::ticker::Ticker;
 use mobil_ros::{qos, run_node, shutdown_signal, warn_throttled, LogThrottle, NodeDecl, RosNode};
@@ -234,12 +234,9 @@ async fn event_loop(
             },
             m = inputs.next() => {
                 let m = m?;
-                let p = &m.pose.pose;
-                let pose = Pose2::new(p.position.x, p.position.y, yaw_of(&p.orientation));
-                if pose.is_finite() {
-                    latest.set(pose, m.header.stamp);
-                } else {
-                    warn_throttled!(throttle, "odom-nan", "odom with a non-finite pose dropped");
+                match planar_pose(&m.pose.pose) {
+                    Ok(pose) => latest.set(pose, m.header.stamp),
+                    Err(e) => warn_throttled!(throttle, "odom-bad", "{e}: sample dropped"),
                 }
             }
             event = server.next_event() => match event {
@@ -285,6 +282,12 @@ async fn event_loop(
                     finish(server, ended);
                     continue;
                 };
+                let clock = session.watch_clock(node.now_nanos(), Instant::now(), config.timeouts.clock_timeout(), &mut sink);
+                mobil_ros::tell!(throttle, clock.notice());
+                if let ClockCheck::Back(ended) = clock {
+                    finish(server, Some(ended));
+                    continue;
+                }
                 // The law reads no time; the goal's own time is kept for the record.
                 let dt = session.advance(node.now_nanos()).and_then(Result::ok).unwrap_or(0.0);
                 let t = session.active().map_or(0.0, |a| a.t());

@@ -44,8 +44,13 @@ impl Shell {
         status_view(goal.map(|g| &g.task), self.odom.value(), state, reason)
     }
 
-    /// The active goal's status in `state` with `reason`.
+    /// The active goal's status in `state` with `reason` (none given: the stopped clock's, if the
+    /// robot is held for it).
     pub(crate) fn publish_status(&mut self, node: &RosNode, out: &Outputs, state: u8, reason: String) {
+        let reason = match reason.is_empty() {
+            true => self.session.clock_hold_reason().unwrap_or_default(),
+            false => reason,
+        };
         let view = self.status_view(self.session.active().map(|a| &a.goal), state, reason);
         self.send_status(node, out, &view);
     }
@@ -189,12 +194,8 @@ impl Shell {
         let dt = match self.session.advance(io.node.now_nanos()) {
             Some(Ok(dt)) => dt,
             None | Some(Err(DtError::Zero)) => return,
-            Some(Err(e)) => {
-                return warn_throttled!(
-                    self.throttle,
-                    "time-back",
-                    "{e}; the step is skipped, the goal's time carries on"
-                )
+            Some(Err(DtError::Backwards { by_nanos })) => {
+                return self.end_goal(io, EndCause::ClockBack(by_nanos as f64 * 1e-9));
             }
         };
         let Some(active) = self.session.active_mut() else {
@@ -245,6 +246,17 @@ impl Shell {
     pub(crate) async fn tick(&mut self, io: &mut Io<'_, '_>) {
         let Some(active) = self.session.active() else { return };
         let now = Instant::now();
+        let timeout = active.goal.config.timeouts.clock_timeout();
+        let clock = self.session.watch_clock(io.node.now_nanos(), now, timeout, io.sink);
+        mobil_ros::tell!(self.throttle, clock.notice());
+        match clock {
+            ClockCheck::Back(ended) => return self.report(io, ended),
+            ClockCheck::Held { newly: true, .. } | ClockCheck::Resumed => {
+                self.publish_status(io.node, io.out, NavStatus::ACTIVE, String::new())
+            }
+            ClockCheck::Held { .. } | ClockCheck::Running => {}
+        }
+        let Some(active) = self.session.active() else { return };
         let mut inputs = vec![Watched {
             name: "odom",
             age: self.odom.age_at(now),
