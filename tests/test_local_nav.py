@@ -19,7 +19,6 @@ from __future__ import annotations
 import math
 import re
 import sys
-import threading
 import time
 from pathlib import Path
 
@@ -29,13 +28,12 @@ import pytest
 from foreign_lidar import WorldRaycaster
 
 from harness import (TESTS_DIR as TESTS, OdomFeed, OpenSpaceScan, make_qos, odom_at, param_set,
-                     qos_latched, qos_sensor, subscribe, wait_until)
+                     qos_latched, subscribe, wait_until)
 
 from action_msgs.msg import GoalStatus
 from geometry_msgs.msg import PoseStamped, Twist
 from nav_msgs.msg import Odometry
 from rclpy.action import ActionClient
-from sensor_msgs.msg import LaserScan
 from visualization_msgs.msg import Marker, MarkerArray
 
 from mobil_msgs.msg import NavStatus
