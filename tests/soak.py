@@ -9,7 +9,7 @@ result does not come within its allowance.
     .venv/bin/python tests/soak.py --sim-minutes 30          # the long soak (6 min at 5×)
     .venv/bin/python tests/soak.py --sim-minutes 30 --json soak.json
 
-tests/test_soak.py runs a short one (5 simulated minutes) in the suite. The long soak's figures
+tests/test_soak.py runs a short one (4 simulated minutes after 1 of warm-up) in the suite. The long soak's figures
 are in docs/performance.md.
 """
 

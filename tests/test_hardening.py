@@ -15,7 +15,6 @@ simulator: the test owns ``/clock``, odometry and the scan.
 from __future__ import annotations
 
 import math
-import re
 import threading
 import time
 from typing import Any
@@ -37,8 +36,8 @@ PARAMS = "params/omr3.yaml"
 REPLY_TIMEOUT = 10.0
 CLOCK_TIMEOUT_S = 0.5  # clock_timeout_s's default
 WATCHDOG_PERIOD_S = 0.05  # both nodes' 20 Hz watchdog tick
-# What a loaded 2-core machine adds to the bound: a DDS hop and a late tick.
-SCHEDULING_S = 0.15
+# What a loaded 2-core machine adds to the bound: DDS hops and a late tick or callback.
+SCHEDULING_S = 0.25
 DEEP = make_qos("reliable", "volatile", 1000)
 # NavStatus fields documented as NaN while unknown (msgs/msg/NavStatus.msg): the distance with no
 # goal or odometry, a docking's figures before its first odometry, the VFO figures outside VFO.
@@ -128,6 +127,7 @@ def start_goals(ros_node, nav, plan) -> None:
         assert wait_until(sent, REPLY_TIMEOUT, interval=0.2), f"{proc.name} took no goal"
 
 
+@pytest.mark.closed_loop  # timed in wall time: never beside a simulation at 5×
 @pytest.mark.timeout(120)
 def test_a_stopped_clock_stops_the_robot_and_a_clock_gone_back_ends_the_goal(start_node, ros_node):
     clock = ClockFeed(ros_node)
@@ -298,11 +298,10 @@ def test_a_goal_storm_and_a_clock_with_bad_stamps_leave_few_log_lines(start_node
             storm = time.monotonic() - began
             for proc in (nav, plan):
                 lines = log_lines(proc, marks[proc.name])
-                kinds = {re.sub(r"[-\d.]+", "#", line.split(" ", 2)[-1]) for line in lines}
-                bound = len(kinds) * (BURST + PER_SECOND * storm)
-                print(f"{proc.name}: {len(lines)} lines in {storm:.2f} s from {len(kinds)} kinds")
-                assert len(lines) <= bound, "\n".join(lines[-20:])
-                assert len(lines) < 300, "one line per goal or more"
+                print(f"{proc.name}: {len(lines)} lines in {storm:.2f} s")
+                # Two lines per goal (taken, the one before ended) from two call sites, 600 lines
+                # without a budget: at most 2 · (10 + a line a second) with it.
+                assert len(lines) <= 2 * (BURST + PER_SECOND * storm) + 2, "\n".join(lines[-20:])
             # /clock at 100 Hz with nanosec 1.5e9 (invalid) for 3 s.
             marks = {p.name: len(p.log_text()) for p in (nav, plan)}
             clock.bad_nanosec = True

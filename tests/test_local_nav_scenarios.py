@@ -63,7 +63,8 @@ ODOM_DRIFT_PER_M = 0.01
 # Its scan and odom watchdogs (steady clock, 0.5 s) get 2 s, as chassis_node's feedback watchdog
 # does: with other builds holding the 2-core machine at a load average of 20, odom once stopped
 # for over half a wall second mid-run (a stalled machine is not what these scenarios check).
-NAV_ARGS = ("-p", "status_rate_hz:=20.0", "-p", "odom_timeout_s:=2.0", "-p", "scan_timeout_s:=2.0")
+NAV_ARGS = ("-p", "status_rate_hz:=20.0", "-p", "odom_timeout_s:=2.0", "-p", "scan_timeout_s:=2.0",
+            "-p", "clock_timeout_s:=2.0")
 # NavStatus states.
 IDLE, ACTIVE, SUCCEEDED, FAILED = 0, 1, 2, 3
 

@@ -34,11 +34,11 @@ from nav2_msgs.action import DockRobot, FollowWaypoints, UndockRobot
 REAL_TIME_FACTOR = 5.0
 MIN_FACTOR = 4.0
 CHASSIS_ARGS = ("-p", "feedback_timeout_s:=2.0")
-# planner_node's odometry watchdog gets the same 2 s: a simulation starved of CPU for a moment
-# (other builds on the machine) must not end a goal STALE_INPUT.
+# planner_node's odometry and clock watchdogs get the same 2 s: a simulation starved of CPU for a
+# moment (other builds on the machine) must not end a goal STALE_INPUT nor hold the robot.
 # The approach is what these tests drive (params/omr3.yaml follows waypoints by VFO: see
 # test_planner_vfo.py).
-PLANNER_ARGS = ("-p", "odom_timeout_s:=2.0", "-p", "waypoint_method:=approach")
+PLANNER_ARGS = ("-p", "odom_timeout_s:=2.0", "-p", "clock_timeout_s:=2.0", "-p", "waypoint_method:=approach")
 REPLY_TIMEOUT = 10.0
 DEEP = make_qos("reliable", "volatile", 2000)
 # A U-turn of radius 0.5 m round (1, 0.5) from (0, 0) facing east: the third waypoint needs a

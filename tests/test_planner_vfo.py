@@ -51,7 +51,8 @@ PARAMS = "params/omr3.yaml"
 # Watchdogs (steady clock) at 2 s: a machine busy with other builds stalls /clock for a moment
 # now and then (test_scenario.py).
 CHASSIS_ARGS = ("-p", "feedback_timeout_s:=2.0")
-PLANNER_ARGS = ("-p", "use_sim_time:=true", "-p", "odom_timeout_s:=2.0", "-p", "vfo.scan_timeout_s:=2.0",
+PLANNER_ARGS = ("-p", "use_sim_time:=true", "-p", "odom_timeout_s:=2.0", "-p", "clock_timeout_s:=2.0",
+                "-p", "vfo.scan_timeout_s:=2.0",
                 "-p", "status_rate_hz:=20.0", "-p", "markers_rate_hz:=2.0")
 SIM_COLLISION_RADIUS = 0.05
 # Through the clutter of the built-in world from (0, 0) facing east (see the module docstring).
@@ -210,6 +211,7 @@ def test_vfo_goal_needs_a_fresh_scan_and_ends_stale_when_scans_stop(start_scenar
     start_scenario(PARAMS, real_time_factor=REAL_TIME_FACTOR, lidar=True,
                    sim_args=("-p", f"robot_radius:={SIM_COLLISION_RADIUS}"), node_args=CHASSIS_ARGS)
     planner = start_node("planner_node", "-p", "use_sim_time:=true", "-p", "odom_timeout_s:=2.0",
+                         "-p", "clock_timeout_s:=2.0",
                          "-p", "vfo.scan_timeout_s:=0.5", "-r", "scan:=scan_relay", params_file=PARAMS)
     relay_on = [False]
     relay_pub = ros_node.create_publisher(LaserScan, "scan_relay", qos_profile_sensor_data)

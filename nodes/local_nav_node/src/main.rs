@@ -643,18 +643,17 @@ impl Shell {
         server: &mut GoalServer<NavigateToPose>,
     ) {
         let now = Instant::now();
-        if self.session.active().is_none() {
-            return;
-        }
-        let timeout = self.config.timeouts.clock_timeout();
-        let clock = self.session.watch_clock(node.now_nanos(), now, timeout, sink);
-        mobil_ros::tell!(self.throttle, clock.notice());
-        match clock {
-            ClockCheck::Back(ended) => return self.report(node, out, server, ended),
-            ClockCheck::Held { newly: true, .. } | ClockCheck::Resumed => {
-                self.publish_status(node, out, NavStatus::ACTIVE, String::new())
+        if node.uses_sim_time() {
+            let timeout = self.config.timeouts.clock_timeout();
+            let clock = self.session.watch_clock(node.now_nanos(), now, timeout, sink);
+            mobil_ros::tell!(self.throttle, clock.notice());
+            match clock {
+                ClockCheck::Back(ended) => return self.report(node, out, server, ended),
+                ClockCheck::Held { newly: true, .. } | ClockCheck::Resumed => {
+                    self.publish_status(node, out, NavStatus::ACTIVE, String::new())
+                }
+                ClockCheck::Held { .. } | ClockCheck::Running => {}
             }
-            ClockCheck::Held { .. } | ClockCheck::Running => {}
         }
         let Some(active) = self.session.active() else { return };
         let (goal, source) = (active.goal.clone(), active.source);

@@ -389,7 +389,14 @@ impl<G, S> MotionSession<G, S> {
         let dt = match active.clock.step(now_nanos) {
             Ok(None) => settings.first_dt,
             Ok(Some(dt)) => dt.min(settings.max_dt),
-            Err(e) => return Some(Err(e)),
+            Err(e) => {
+                if let DtError::Backwards { .. } = e {
+                    // Seen here first: the watch starts again from the new time, so the jump is
+                    // not told again, to this goal's end or to the next goal.
+                    self.clock = ClockWatch::new();
+                }
+                return Some(Err(e));
+            }
         };
         active.t += dt;
         Some(Ok(dt))
@@ -521,10 +528,11 @@ impl<G, S> MotionSession<G, S> {
         (!stale.is_empty()).then(|| stale.join(" and "))
     }
 
-    /// ROS time is `ros_nanos` at steady instant `now`, looked at on every watchdog tick: with a
-    /// goal active, time that has not advanced for longer than `timeout` holds the robot (one
-    /// zero command if it moves, no command until time moves again), and time gone back ends
-    /// the goal `CLOCK_BACKWARDS` (with its zero command).
+    /// ROS time is `ros_nanos` at steady instant `now`, looked at on every watchdog tick, with a
+    /// goal or without (a node on `/clock`: a system clock neither stops nor, but for a step,
+    /// goes back): with a goal active, time that has not advanced for longer than `timeout`
+    /// holds the robot (one zero command if it moves, no command until time moves again), and
+    /// time gone back ends the goal `CLOCK_BACKWARDS` (with its zero command).
     pub fn watch_clock(
         &mut self,
         ros_nanos: i64,
@@ -1001,6 +1009,44 @@ mod tests {
         let n = sent.len();
         assert_eq!(s.watch_clock(frozen, at(40), timeout, &mut sent), ClockCheck::Running);
         assert_eq!(sent.len(), n);
+    }
+
+    #[test]
+    fn a_clock_reset_between_goals_or_seen_first_by_a_step_ends_no_later_goal() {
+        let mut s = session();
+        let mut sent = Vec::new();
+        let t0 = Instant::now();
+        let (ms, timeout) = (Duration::from_millis, Duration::from_millis(500));
+        // A goal runs to 130 s of ROS time and ends; idle ticks go on watching.
+        s.start(ToX { to: 5.0 }, Src::Topic, t0);
+        assert_eq!(
+            s.watch_clock(130_000_000_000, t0, timeout, &mut sent),
+            ClockCheck::Running
+        );
+        s.end(EndCause::Canceled, &mut sent);
+        // The simulation restarts at 20 s while no goal runs: told to nobody.
+        assert_eq!(
+            s.watch_clock(20_000_000_000, t0 + ms(50), timeout, &mut sent),
+            ClockCheck::Running
+        );
+        // The next goal runs on.
+        s.start(ToX { to: 5.0 }, Src::Topic, t0 + ms(60));
+        assert_eq!(
+            s.watch_clock(20_050_000_000, t0 + ms(100), timeout, &mut sent),
+            ClockCheck::Running
+        );
+        assert!(s.active().is_some());
+        // A jump back seen first by a step: the step reports it, and the watch does not tell it
+        // again (the node ends the goal; a new goal is not ended for it).
+        assert_eq!(s.advance(20_100_000_000), Some(Ok(0.02)));
+        assert!(matches!(s.advance(1_000_000_000), Some(Err(DtError::Backwards { .. }))));
+        s.end(EndCause::ClockBack(19.1), &mut sent);
+        s.start(ToX { to: 5.0 }, Src::Topic, t0 + ms(120));
+        assert_eq!(
+            s.watch_clock(1_000_000_000, t0 + ms(150), timeout, &mut sent),
+            ClockCheck::Running
+        );
+        assert!(s.active().is_some());
     }
 
     #[test]

@@ -404,6 +404,15 @@ impl RosNode {
         }
     }
 
+    /// Whether the node's clock is `/clock` (`use_sim_time`): a clock that can stop or go back,
+    /// which a motion node watches ([`crate::motion::MotionSession::watch_clock`]).
+    pub fn uses_sim_time(&self) -> bool {
+        matches!(
+            self.node.get_parameter("use_sim_time"),
+            Some(ParameterValue::Boolean(true))
+        )
+    }
+
     /// The node's clock as a message stamp.
     pub fn stamp(&self) -> Time {
         crate::time::stamp_from_nanos(self.now_nanos())

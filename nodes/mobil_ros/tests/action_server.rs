@@ -1,7 +1,7 @@
 //! `GoalServer` against ros2-client's own action client, two DDS participants in one process:
 //! reject, accept, feedback, pre-emption (the old goal ends ABORTED with the result built from
 //! it), cancel (CANCELED), results kept and asked for again, and the answers for ids the server
-//! does not know (rcl_action's; the wire-level comparison with rclpy is tests/test_actions.py).
+//! does not know (rcl_action's; the wire-level comparison with rclpy is tests/test_action_protocol.py).
 
 use futures::StreamExt;
 use mobil_msgs::mobil_msgs::action::{DriveDistance, DriveDistanceFeedback, DriveDistanceGoal, DriveDistanceResult};

@@ -273,6 +273,15 @@ async fn event_loop(
                 }
             },
             _ = ticker.tick() => {
+                if node.uses_sim_time() {
+                    let timeout = config.timeouts.clock_timeout();
+                    let clock = session.watch_clock(node.now_nanos(), Instant::now(), timeout, &mut sink);
+                    mobil_ros::tell!(throttle, clock.notice());
+                    if let ClockCheck::Back(ended) = clock {
+                        finish(server, Some(ended));
+                        continue;
+                    }
+                }
                 if session.active().is_none() {
                     continue;
                 }
@@ -282,12 +291,6 @@ async fn event_loop(
                     finish(server, ended);
                     continue;
                 };
-                let clock = session.watch_clock(node.now_nanos(), Instant::now(), config.timeouts.clock_timeout(), &mut sink);
-                mobil_ros::tell!(throttle, clock.notice());
-                if let ClockCheck::Back(ended) = clock {
-                    finish(server, Some(ended));
-                    continue;
-                }
                 // The law reads no time; the goal's own time is kept for the record.
                 let dt = session.advance(node.now_nanos()).and_then(Result::ok).unwrap_or(0.0);
                 let t = session.active().map_or(0.0, |a| a.t());

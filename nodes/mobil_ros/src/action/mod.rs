@@ -262,6 +262,20 @@ fn status_of(end: GoalEnd) -> GoalStatusEnum {
     }
 }
 
+/// A warning of `$server`, rate-limited under `$key` by its throttle, written where it is called
+/// (so that each place has its own line budget, `crate::log`).
+macro_rules! warn_at {
+    ($server:expr, $key:expr, $($arg:tt)+) => {
+        if let Ok(mut throttle) = $server.throttle.lock() {
+            crate::warn_throttled!(throttle, $key, $($arg)+);
+        }
+    };
+}
+
+/// Requests [`GoalServer::next_event`] answers in a row before it lets the node's other work in
+/// (a flood of `get_result` requests must not starve the node's loop).
+const ANSWERED_IN_A_ROW: u32 = 64;
+
 /// An action server owning at most one active goal (see the module docs).
 pub struct GoalServer<A: RosAction> {
     server: Arc<Server<A>>,
@@ -325,20 +339,20 @@ where
         self.active.as_ref().is_some_and(|a| a.canceling)
     }
 
-    /// How many goals the server knows (running, or ended with their results kept).
-    pub fn known_goals(&self) -> usize {
-        self.table.len()
-    }
-
     /// Waits for the next goal or cancel request; answers what needs no decision of the node on
     /// the way (module docs). Cancel-safe: a request is never half taken, so this can be one
     /// branch of a `tokio::select!` that other branches win.
     pub async fn next_event(&mut self) -> ActionEvent<A::Goal> {
+        let mut answered = 0u32;
         loop {
             if let Some(id) = self.unreported_cancel.take()
                 && self.active_id() == Some(id)
             {
                 return ActionEvent::CancelRequested(id);
+            }
+            answered += 1;
+            if answered.is_multiple_of(ANSWERED_IN_A_ROW) {
+                tokio::task::yield_now().await;
             }
             let incoming = self.receive().await;
             self.table.expire(Instant::now());
@@ -352,10 +366,7 @@ where
                         });
                     }
                     // rcl_action refuses a goal id it knows without asking the server.
-                    self.info(
-                        "duplicate",
-                        format_args!("{}: goal {goal_id:?} refused: its id is in use", self.name),
-                    );
+                    info!("{}: goal {goal_id:?} refused: its id is in use", self.name);
                     self.send_goal_response(request, false, RosTime::ZERO, goal_id);
                 }
                 Incoming::Cancel(request, cancel) => self.cancel(request, cancel.goal_info()),
@@ -365,9 +376,11 @@ where
                     }
                 }
                 Incoming::Undecodable(service, e) => {
-                    self.warn(
+                    warn_at!(
+                        self,
                         "undecodable",
-                        format_args!("{}: undecodable {service} request dropped: {e}", self.name),
+                        "{}: undecodable {service} request dropped: {e}",
+                        self.name
                     );
                 }
             }
@@ -407,13 +420,10 @@ where
         if !answer.canceling().is_empty() {
             self.publish_statuses();
         } else {
-            self.info(
-                "cancel-refused",
-                format_args!(
-                    "{}: cancel request answered {:?}: no goal canceling",
-                    self.name,
-                    answer.code()
-                ),
+            info!(
+                "{}: cancel request answered {:?}: no goal canceling",
+                self.name,
+                answer.code()
             );
         }
         let response = CancelGoalResponse {
@@ -421,9 +431,11 @@ where
             goals_canceling: answer.canceling().to_vec(),
         };
         if let Err(e) = self.server.send_cancel_response(request, response) {
-            self.warn(
+            warn_at!(
+                self,
                 "cancel-response",
-                format_args!("{}: cannot answer a cancel request: {e:?}", self.name),
+                "{}: cannot answer a cancel request: {e:?}",
+                self.name
             );
         }
     }
@@ -438,6 +450,11 @@ where
         now_nanos: i64,
     ) -> Result<(), ActionError> {
         let id = request.id;
+        if self.table.knows(&id) {
+            // Another request with this id was accepted since this one came (the node held two).
+            self.send_goal_response(request.request, false, RosTime::ZERO, id);
+            return Err(ActionError::Goal(id, "its id is in use".to_owned()));
+        }
         if let Some(old) = self.active.take() {
             let status = if old.canceling {
                 GoalEnd::Canceled
@@ -474,7 +491,7 @@ where
     /// Rejects a goal; the reason is logged (a ROS 2 goal response cannot carry it).
     pub async fn reject(&mut self, request: GoalRequest<A::Goal>, reason: &str) {
         let id = request.id;
-        self.info("reject", format_args!("{}: goal {id:?} rejected: {reason}", self.name));
+        info!("{}: goal {id:?} rejected: {reason}", self.name);
         self.send_goal_response(request.request, false, RosTime::ZERO, id);
     }
 
@@ -508,7 +525,7 @@ where
             self.finish(GoalEnd::Aborted, result);
         }
         let deadline = tokio::time::Instant::now() + CLOSE_WAIT.min(self.result_timeout);
-        while self.table.has_unasked() {
+        while self.table.unasked() > 0 {
             let next = {
                 let (_, _, results) = self.server.services();
                 tokio::time::timeout_at(deadline, results.async_receive_request()).await
@@ -518,7 +535,7 @@ where
                     warn!(
                         "{}: at close, no client asked for the result of {} ended goal(s)",
                         self.name,
-                        self.table.statuses().len()
+                        self.table.unasked()
                     );
                     break;
                 }
@@ -527,7 +544,16 @@ where
                         self.send_result(request, goal_id, status, result);
                     }
                 }
-                Ok(Err(e)) => warn!("{}: undecodable get_result request dropped: {e:?}", self.name),
+                Ok(Err(e)) => {
+                    warn_at!(
+                        self,
+                        "undecodable",
+                        "{}: undecodable get_result request dropped: {e:?}",
+                        self.name
+                    );
+                    // A reader that keeps failing must not spin the close.
+                    tokio::time::sleep(Duration::from_millis(10)).await;
+                }
             }
         }
         let name = self.name.clone();
@@ -565,18 +591,22 @@ where
             .server
             .send_goal_response(request, SendGoalResponse { accepted, stamp })
         {
-            self.warn(
+            warn_at!(
+                self,
                 "goal-response",
-                format_args!("{}: cannot answer goal request {id:?}: {e:?}", self.name),
+                "{}: cannot answer goal request {id:?}: {e:?}",
+                self.name
             );
         }
     }
 
     fn send_result(&self, request: RmwRequestId, id: GoalId, status: GoalStatusEnum, result: A::Result) {
         if let Err(e) = self.server.send_result(request, GetResultResponse { status, result }) {
-            self.warn(
+            warn_at!(
+                self,
                 "result",
-                format_args!("{}: cannot send the result of goal {id:?}: {e:?}", self.name),
+                "{}: cannot send the result of goal {id:?}: {e:?}",
+                self.name
             );
         }
     }
@@ -586,27 +616,7 @@ where
             status_list: self.table.statuses(),
         };
         if let Err(e) = self.server.send_goal_statuses(statuses) {
-            self.warn(
-                "status",
-                format_args!("{}: cannot publish the goal status: {e:?}", self.name),
-            );
-        }
-    }
-
-    fn warn(&self, key: &'static str, message: std::fmt::Arguments<'_>) {
-        if let Ok(mut throttle) = self.throttle.lock() {
-            crate::warn_throttled!(throttle, key, "{message}");
-        }
-    }
-
-    fn info(&self, key: &'static str, message: std::fmt::Arguments<'_>) {
-        if let Ok(mut throttle) = self.throttle.lock()
-            && let Some(suppressed) = throttle.allow(key, Instant::now())
-        {
-            match suppressed {
-                0 => info!("{message}"),
-                n => info!("{message} ({n} similar suppressed)"),
-            }
+            warn_at!(self, "status", "{}: cannot publish the goal status: {e:?}", self.name);
         }
     }
 }

@@ -253,9 +253,9 @@ impl<R: Clone + Default, K> GoalTable<R, K> {
         }
     }
 
-    /// Whether some goal ended with its result kept, which no client has asked for yet.
-    pub fn has_unasked(&self) -> bool {
-        self.goals.values().any(|g| g.ended.is_some() && !g.asked)
+    /// How many goals ended with their results kept that no client has asked for yet.
+    pub fn unasked(&self) -> usize {
+        self.goals.values().filter(|g| g.ended.is_some() && !g.asked).count()
     }
 
     /// The status of every known goal, by acceptance (`action_msgs/GoalStatusArray`).
@@ -453,8 +453,8 @@ mod tests {
             .collect();
         assert_eq!(listed, vec![(id(3), 100, Succeeded), (id(7), 300, Executing)]);
         // Nobody asked for the ended goal's result yet.
-        assert!(t.has_unasked());
+        assert_eq!(t.unasked(), 1);
         assert_eq!(t.result(id(3), 0), ResultAnswer::Now(Succeeded, 0));
-        assert!(!t.has_unasked());
+        assert_eq!(t.unasked(), 0);
     }
 }

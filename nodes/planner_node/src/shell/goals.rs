@@ -194,8 +194,15 @@ impl Shell {
         let dt = match self.session.advance(io.node.now_nanos()) {
             Some(Ok(dt)) => dt,
             None | Some(Err(DtError::Zero)) => return,
-            Some(Err(DtError::Backwards { by_nanos })) => {
+            Some(Err(DtError::Backwards { by_nanos })) if io.node.uses_sim_time() => {
                 return self.end_goal(io, EndCause::ClockBack(by_nanos as f64 * 1e-9));
+            }
+            Some(Err(e)) => {
+                return warn_throttled!(
+                    self.throttle,
+                    "time-back",
+                    "{e}; the step is skipped, the goal's time carries on"
+                );
             }
         };
         let Some(active) = self.session.active_mut() else {
@@ -244,17 +251,20 @@ impl Shell {
     }
 
     pub(crate) async fn tick(&mut self, io: &mut Io<'_, '_>) {
-        let Some(active) = self.session.active() else { return };
         let now = Instant::now();
-        let timeout = active.goal.config.timeouts.clock_timeout();
-        let clock = self.session.watch_clock(io.node.now_nanos(), now, timeout, io.sink);
-        mobil_ros::tell!(self.throttle, clock.notice());
-        match clock {
-            ClockCheck::Back(ended) => return self.report(io, ended),
-            ClockCheck::Held { newly: true, .. } | ClockCheck::Resumed => {
-                self.publish_status(io.node, io.out, NavStatus::ACTIVE, String::new())
+        if io.node.uses_sim_time() {
+            let timeout = self.session.active().map_or(self.config.timeouts.clock_timeout(), |a| {
+                a.goal.config.timeouts.clock_timeout()
+            });
+            let clock = self.session.watch_clock(io.node.now_nanos(), now, timeout, io.sink);
+            mobil_ros::tell!(self.throttle, clock.notice());
+            match clock {
+                ClockCheck::Back(ended) => return self.report(io, ended),
+                ClockCheck::Held { newly: true, .. } | ClockCheck::Resumed => {
+                    self.publish_status(io.node, io.out, NavStatus::ACTIVE, String::new())
+                }
+                ClockCheck::Held { .. } | ClockCheck::Running => {}
             }
-            ClockCheck::Held { .. } | ClockCheck::Running => {}
         }
         let Some(active) = self.session.active() else { return };
         let mut inputs = vec![Watched {
@@ -286,8 +296,9 @@ impl Shell {
     pub(crate) async fn feedback(&mut self, servers: &Servers) {
         let Some(active) = self.session.active() else { return };
         let sent = match active.source {
-            // The goal's own time: its steps' dt summed, never running backwards (a step whose
-            // clock went back is skipped), so docking_time never falls on a clock reset.
+            // The goal's own time: its steps' dt summed, never running backwards (a clock that
+            // goes back ends the goal, or on the system clock skips the step), so docking_time
+            // never falls.
             Source::DockAction => {
                 let (state, docking_time) = (DockRobotFeedback::CONTROLLING, duration_msg(active.t()));
                 let feedback = DockRobotFeedback {

@@ -149,9 +149,12 @@ async fn serve(node: &mut RosNode) -> anyhow::Result<()> {
             e = follow_s.next_event() => answer(&mut follow_s, e, follow, node.now_nanos()).await?,
         }
     }
-    navigate_s.close(NavigateToPoseResult::default()).await;
-    dock_s.close(DockRobotResult::default()).await;
-    undock_s.close(UndockRobotResult::default()).await;
-    follow_s.close(FollowWaypointsResult::default()).await;
+    // Closed together: each may wait for its clients (GoalServer::close).
+    tokio::join!(
+        navigate_s.close(NavigateToPoseResult::default()),
+        dock_s.close(DockRobotResult::default()),
+        undock_s.close(UndockRobotResult::default()),
+        follow_s.close(FollowWaypointsResult::default()),
+    );
     Ok(())
 }
