@@ -50,6 +50,7 @@ __all__ = [
     "param_set", "publish_on_sim_time", "publish_until", "qos_default", "qos_latched",
     "qos_sensor", "resolve_executable", "run_ros2cli", "set_message_fields", "subscribe",
     "wait_for_message", "wait_for_node", "wait_until", "OdomFeed", "OpenSpaceScan", "odom_at",
+    "stamped_pose",
 ]
 
 BIN_DIR = Path(os.environ.get("MOBIL_BIN_DIR", str(ROOT / "target" / "release")))
@@ -635,3 +636,13 @@ def odom_at(x: float = 0.0, frame: str = "odom") -> Any:
     m.pose.pose.position.x = x
     m.pose.pose.orientation.w = 1.0
     return m
+
+
+def stamped_pose(x: float, y: float, frame: str = "odom", yaw: float = 0.0) -> Any:
+    """A PoseStamped at (x, y) facing ``yaw`` in ``frame`` (a goal, a dock, a waypoint)."""
+    from geometry_msgs.msg import PoseStamped
+    p = PoseStamped()
+    p.header.frame_id = frame
+    p.pose.position.x, p.pose.position.y = float(x), float(y)
+    p.pose.orientation.z, p.pose.orientation.w = math.sin(yaw / 2), math.cos(yaw / 2)
+    return p

@@ -26,7 +26,7 @@ import pytest
 import harness
 from fuzzing import (INF, NAN, PER_CALL_TIMEOUT, WRONG_TYPES, Fuzz, answers_parameter_get, mutate,
                      number, rng_for, same_type)
-from harness import OdomFeed, OpenSpaceScan, odom_at, subscribe, wait_until
+from harness import OdomFeed, OpenSpaceScan, odom_at, stamped_pose as pose, subscribe, wait_until
 from rosutil import get_parameters, parameter_value_from_python, set_parameters
 
 from action_msgs.msg import GoalInfo
@@ -51,14 +51,6 @@ REACTION = 0.4
 # NavStatus fields documented as NaN while unknown (msgs/msg/NavStatus.msg).
 NAN_WHEN_NONE = frozenset({"distance_to_goal", "e", "alpha", "theta", "lyapunov", "psi_z",
                            "chi_length", "chi_danger", "chi_control", "chi_smoothness"})
-
-
-def pose(x: float, y: float, frame: str = "odom", yaw: float = 0.0) -> PoseStamped:
-    p = PoseStamped()
-    p.header.frame_id = frame
-    p.pose.position.x, p.pose.position.y = float(x), float(y)
-    p.pose.orientation.z, p.pose.orientation.w = math.sin(yaw / 2), math.cos(yaw / 2)
-    return p
 
 
 def hostile_pose(rng: random.Random) -> PoseStamped:
@@ -259,6 +251,16 @@ def stops_on_refusals(fuzz: Fuzz, rng: random.Random, cmd: Any, restart_goal, ba
             fuzz.fail(f"no zero command within {REACTION} s of a refused input ({kind})")
 
 
+def moves_on(fuzz: Fuzz, node: Any, pub: Any, goal: Any, cmd: Any, what: str) -> None:
+    """After the fuzz: ``goal`` on ``pub`` still moves the robot."""
+    fuzz.case = f"{what} after the fuzz"
+    try:
+        harness.publish_until(node, pub, goal, lambda: cmd.latest is not None and not is_zero(cmd.latest),
+                              rate_hz=2, timeout=10)
+    except TimeoutError as exc:
+        fuzz.fail(f"{what} no longer moves the robot: {exc}")
+
+
 @pytest.mark.timeout(150)
 def test_fuzz_local_nav(start_node, ros_node):
     rng = rng_for("local_nav")
@@ -288,13 +290,7 @@ def test_fuzz_local_nav(start_node, ros_node):
             nav_goals.append(NavigateToPose.Goal(pose=pose(3.0, 0.0)))
             abuse_actions(fuzz, rng, ros_node, "navigate_to_pose", NavigateToPose, nav_goals, 60)
             fuzz_parameters(fuzz, rng, ros_node, "/local_nav", 25)
-            fuzz.case = "a valid goal after the fuzz"
-            try:
-                harness.publish_until(ros_node, goal_pub, pose(3.0, 0.0),
-                                      lambda: cmd.latest is not None and not is_zero(cmd.latest),
-                                      rate_hz=2, timeout=10)
-            except TimeoutError as exc:
-                fuzz.fail(f"a valid goal no longer moves the robot: {exc}")
+            moves_on(fuzz, ros_node, goal_pub, pose(3.0, 0.0), cmd, "a valid goal")
     finally:
         lidar.stop()
         feed.stop()
@@ -354,13 +350,7 @@ def test_fuzz_planner(start_node, ros_node):
                       for _ in range(5)]
             abuse_actions(fuzz, rng, ros_node, "follow_waypoints", FollowWaypoints, routes, 30)
             fuzz_parameters(fuzz, rng, ros_node, "/planner", 25)
-            fuzz.case = "a valid dock after the fuzz"
-            try:
-                harness.publish_until(ros_node, dock_pub, pose(2.0, 0.0),
-                                      lambda: cmd.latest is not None and not is_zero(cmd.latest),
-                                      rate_hz=2, timeout=10)
-            except TimeoutError as exc:
-                fuzz.fail(f"a valid dock no longer moves the robot: {exc}")
+            moves_on(fuzz, ros_node, dock_pub, pose(2.0, 0.0), cmd, "a valid dock")
     finally:
         lidar.stop()
         feed.stop()

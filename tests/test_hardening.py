@@ -14,15 +14,18 @@ simulator: the test owns ``/clock``, odometry and the scan.
 
 from __future__ import annotations
 
+import contextlib
+import dataclasses
 import math
 import threading
 import time
+from collections.abc import Iterator
 from typing import Any
 
 import pytest
 
 from harness import (OdomFeed, OpenSpaceScan, make_qos, odom_at, qos_latched, qos_sensor,
-                     subscribe, wait_until)
+                     stamped_pose as pose, subscribe, wait_until)
 
 from geometry_msgs.msg import PoseStamped, Twist
 from rosgraph_msgs.msg import Clock
@@ -93,16 +96,28 @@ class ClockFeed:
         self._thread.join(timeout=5)
 
 
-def pose(x: float, y: float, frame: str = "odom") -> PoseStamped:
-    p = PoseStamped()
-    p.header.frame_id = frame
-    p.pose.position.x, p.pose.position.y = x, y
-    p.pose.orientation.w = 1.0
-    return p
-
-
 def is_zero(t: Twist) -> bool:
     return (t.linear.x, t.linear.y, t.linear.z, t.angular.x, t.angular.y, t.angular.z) == (0,) * 6
+
+
+@dataclasses.dataclass
+class Feeds:
+    clock: ClockFeed
+    odom: OdomFeed
+    scan: OpenSpaceScan
+
+
+@contextlib.contextmanager
+def fed(ros_node: Any) -> Iterator[Feeds]:
+    """The test's ``/clock``, odometry of a robot standing at the origin and an empty scan, for
+    as long as the block runs."""
+    feeds = Feeds(ClockFeed(ros_node), OdomFeed(ros_node, odom_at(0.0)), OpenSpaceScan(ros_node))
+    try:
+        yield feeds
+    finally:
+        feeds.scan.stop()
+        feeds.odom.stop()
+        feeds.clock.stop()
 
 
 def start_pair(start_node, *args: str):
@@ -130,55 +145,47 @@ def start_goals(ros_node, nav, plan) -> None:
 @pytest.mark.closed_loop  # timed in wall time: never beside a simulation at 5×
 @pytest.mark.timeout(120)
 def test_a_stopped_clock_stops_the_robot_and_a_clock_gone_back_ends_the_goal(start_node, ros_node):
-    clock = ClockFeed(ros_node)
-    feed = OdomFeed(ros_node, odom_at(0.0))
-    lidar = OpenSpaceScan(ros_node)
     nav, plan = start_pair(start_node)
-    try:
-        with subscribe(ros_node, Twist, "nav_cmd", qos=DEEP) as nav_cmd, \
-                subscribe(ros_node, Twist, "plan_cmd", qos=DEEP) as plan_cmd, \
-                subscribe(ros_node, NavStatus, "local_nav/status", qos=qos_latched()) as nav_status, \
-                subscribe(ros_node, NavStatus, "planner/status", qos=qos_latched()) as plan_status:
-            nav.wait_for_log("first scan", timeout=REPLY_TIMEOUT)
-            start_goals(ros_node, nav, plan)
-            for cmd in (nav_cmd, plan_cmd):
-                cmd.wait_for(lambda t: not is_zero(t), REPLY_TIMEOUT)
-            marks = (len(nav_cmd), len(plan_cmd))
-            frozen_at = clock.freeze()
-            for cmd, mark in zip((nav_cmd, plan_cmd), marks):
-                cmd.wait_for(is_zero, REPLY_TIMEOUT, start=mark)
-                zero_at = cmd.times[next(i for i in range(mark, len(cmd)) if is_zero(cmd.messages[i]))]
-                delay = zero_at - frozen_at
-                assert delay <= CLOCK_TIMEOUT_S + WATCHDOG_PERIOD_S + SCHEDULING_S, \
-                    f"{cmd.topic}: zero {delay:.3f} s after the clock stopped"
-                assert delay >= CLOCK_TIMEOUT_S - 0.1, f"{cmd.topic}: held after only {delay:.3f} s"
-            time.sleep(0.5)
-            for cmd, mark in zip((nav_cmd, plan_cmd), marks):
-                held = cmd.snapshot()[mark:]
-                first_zero = next(i for i, t in enumerate(held) if is_zero(t))
-                assert all(is_zero(t) for t in held[first_zero:]), f"{cmd.topic} moved while held"
-            for status in (nav_status, plan_status):
-                s = status.wait_for(lambda s: "ROS time has not advanced" in s.reason, REPLY_TIMEOUT)
-                assert s.state == NavStatus.ACTIVE and s.reason.startswith("STALE_INPUT: "), s.reason
-            # Time moves again: both command again.
-            marks = (len(nav_cmd), len(plan_cmd))
-            clock.resume()
-            for cmd, mark in zip((nav_cmd, plan_cmd), marks):
-                cmd.wait_for(lambda t: not is_zero(t), REPLY_TIMEOUT, start=mark)
-            for proc in (nav, plan):
-                proc.wait_for_log("ROS time moves again")
-            # Back 5 s: each goal ends CLOCK_BACKWARDS, with its zero.
-            marks = (len(nav_status), len(plan_status))
-            clock.back(5.0)
-            for status, mark in zip((nav_status, plan_status), marks):
-                s = status.wait_for(lambda s: s.state == NavStatus.FAILED, REPLY_TIMEOUT, start=mark)
-                assert s.reason.startswith("CLOCK_BACKWARDS: ROS time went back by "), s.reason
-            for cmd in (nav_cmd, plan_cmd):
-                assert wait_until(lambda: is_zero(cmd.latest), REPLY_TIMEOUT), f"{cmd.topic} left moving"
-    finally:
-        lidar.stop()
-        feed.stop()
-        clock.stop()
+    with fed(ros_node) as feeds, subscribe(ros_node, Twist, "nav_cmd", qos=DEEP) as nav_cmd, \
+            subscribe(ros_node, Twist, "plan_cmd", qos=DEEP) as plan_cmd, \
+            subscribe(ros_node, NavStatus, "local_nav/status", qos=qos_latched()) as nav_status, \
+            subscribe(ros_node, NavStatus, "planner/status", qos=qos_latched()) as plan_status:
+        nav.wait_for_log("first scan", timeout=REPLY_TIMEOUT)
+        start_goals(ros_node, nav, plan)
+        for cmd in (nav_cmd, plan_cmd):
+            cmd.wait_for(lambda t: not is_zero(t), REPLY_TIMEOUT)
+        marks = (len(nav_cmd), len(plan_cmd))
+        frozen_at = feeds.clock.freeze()
+        for cmd, mark in zip((nav_cmd, plan_cmd), marks):
+            cmd.wait_for(is_zero, REPLY_TIMEOUT, start=mark)
+            zero_at = cmd.times[next(i for i in range(mark, len(cmd)) if is_zero(cmd.messages[i]))]
+            delay = zero_at - frozen_at
+            assert delay <= CLOCK_TIMEOUT_S + WATCHDOG_PERIOD_S + SCHEDULING_S, \
+                f"{cmd.topic}: zero {delay:.3f} s after the clock stopped"
+            assert delay >= CLOCK_TIMEOUT_S - 0.1, f"{cmd.topic}: held after only {delay:.3f} s"
+        time.sleep(0.5)
+        for cmd, mark in zip((nav_cmd, plan_cmd), marks):
+            held = cmd.snapshot()[mark:]
+            first_zero = next(i for i, t in enumerate(held) if is_zero(t))
+            assert all(is_zero(t) for t in held[first_zero:]), f"{cmd.topic} moved while held"
+        for status in (nav_status, plan_status):
+            s = status.wait_for(lambda s: "ROS time has not advanced" in s.reason, REPLY_TIMEOUT)
+            assert s.state == NavStatus.ACTIVE and s.reason.startswith("STALE_INPUT: "), s.reason
+        # Time moves again: both command again.
+        marks = (len(nav_cmd), len(plan_cmd))
+        feeds.clock.resume()
+        for cmd, mark in zip((nav_cmd, plan_cmd), marks):
+            cmd.wait_for(lambda t: not is_zero(t), REPLY_TIMEOUT, start=mark)
+        for proc in (nav, plan):
+            proc.wait_for_log("ROS time moves again")
+        # Back 5 s: each goal ends CLOCK_BACKWARDS, with its zero.
+        marks = (len(nav_status), len(plan_status))
+        feeds.clock.back(5.0)
+        for status, mark in zip((nav_status, plan_status), marks):
+            s = status.wait_for(lambda s: s.state == NavStatus.FAILED, REPLY_TIMEOUT, start=mark)
+            assert s.reason.startswith("CLOCK_BACKWARDS: ROS time went back by "), s.reason
+        for cmd in (nav_cmd, plan_cmd):
+            assert wait_until(lambda: is_zero(cmd.latest), REPLY_TIMEOUT), f"{cmd.topic} left moving"
 
 
 def send_action(node: Any, action_type: Any, name: str, goal: Any, feedback: list) -> None:
@@ -219,38 +226,30 @@ def not_finite(messages: list[Any], nan_allowed: frozenset[str] = frozenset()) -
 @pytest.mark.timeout(120)
 def test_odometry_too_far_to_compute_with_stops_the_robot_and_nothing_non_finite_goes_out(
         start_node, ros_node):
-    clock = ClockFeed(ros_node)
-    feed = OdomFeed(ros_node, odom_at(0.0))
-    lidar = OpenSpaceScan(ros_node)
     nav, plan = start_pair(start_node)
-    try:
-        with subscribe(ros_node, Twist, "nav_cmd", qos=DEEP) as nav_cmd, \
-                subscribe(ros_node, Twist, "plan_cmd", qos=DEEP) as plan_cmd, \
-                subscribe(ros_node, NavStatus, "local_nav/status", qos=DEEP) as nav_status, \
-                subscribe(ros_node, NavStatus, "planner/status", qos=DEEP) as plan_status, \
-                subscribe(ros_node, MarkerArray, "local_nav/markers", qos=DEEP) as nav_markers, \
-                subscribe(ros_node, MarkerArray, "planner/markers", qos=DEEP) as plan_markers:
-            nav.wait_for_log("first scan", timeout=REPLY_TIMEOUT)
-            feedback: list[Any] = []
-            send_action(ros_node, NavigateToPose, "navigate_to_pose",
-                        NavigateToPose.Goal(pose=pose(3.0, 0.0)), feedback)
-            send_action(ros_node, DockRobot, "dock_robot",
-                        DockRobot.Goal(use_dock_id=False, dock_pose=pose(2.0, 0.0)), feedback)
-            for cmd in (nav_cmd, plan_cmd):
-                cmd.wait_for(lambda t: not is_zero(t), REPLY_TIMEOUT)
-            assert wait_until(lambda: len(feedback) > 10, REPLY_TIMEOUT), "no feedback"
-            marks = (len(nav_cmd), len(plan_cmd))
-            feed.msg = odom_at(1e308)
-            for cmd, mark in zip((nav_cmd, plan_cmd), marks):
-                cmd.wait_for(is_zero, REPLY_TIMEOUT, start=mark)
-            for proc in (nav, plan):
-                proc.wait_for_log(r"odom position \(1e308, 0\) beyond")
-            time.sleep(1.0)  # the goals end STALE_INPUT; outputs keep coming meanwhile
-            feed.msg = odom_at(0.0)
-    finally:
-        lidar.stop()
-        feed.stop()
-        clock.stop()
+    with fed(ros_node) as feeds, subscribe(ros_node, Twist, "nav_cmd", qos=DEEP) as nav_cmd, \
+            subscribe(ros_node, Twist, "plan_cmd", qos=DEEP) as plan_cmd, \
+            subscribe(ros_node, NavStatus, "local_nav/status", qos=DEEP) as nav_status, \
+            subscribe(ros_node, NavStatus, "planner/status", qos=DEEP) as plan_status, \
+            subscribe(ros_node, MarkerArray, "local_nav/markers", qos=DEEP) as nav_markers, \
+            subscribe(ros_node, MarkerArray, "planner/markers", qos=DEEP) as plan_markers:
+        nav.wait_for_log("first scan", timeout=REPLY_TIMEOUT)
+        feedback: list[Any] = []
+        send_action(ros_node, NavigateToPose, "navigate_to_pose",
+                    NavigateToPose.Goal(pose=pose(3.0, 0.0)), feedback)
+        send_action(ros_node, DockRobot, "dock_robot",
+                    DockRobot.Goal(use_dock_id=False, dock_pose=pose(2.0, 0.0)), feedback)
+        for cmd in (nav_cmd, plan_cmd):
+            cmd.wait_for(lambda t: not is_zero(t), REPLY_TIMEOUT)
+        assert wait_until(lambda: len(feedback) > 10, REPLY_TIMEOUT), "no feedback"
+        marks = (len(nav_cmd), len(plan_cmd))
+        feeds.odom.msg = odom_at(1e308)
+        for cmd, mark in zip((nav_cmd, plan_cmd), marks):
+            cmd.wait_for(is_zero, REPLY_TIMEOUT, start=mark)
+        for proc in (nav, plan):
+            proc.wait_for_log(r"odom position \(1e308, 0\) beyond")
+        time.sleep(1.0)  # the goals end STALE_INPUT; outputs keep coming meanwhile
+        feeds.odom.msg = odom_at(0.0)
     outputs = {
         "cmd_vel": not_finite(nav_cmd.snapshot() + plan_cmd.snapshot()),
         "status": not_finite(nav_status.snapshot() + plan_status.snapshot(), NAN_WHEN_NONE),
@@ -273,45 +272,37 @@ BURST, PER_SECOND = 10, 1.0
 
 @pytest.mark.timeout(120)
 def test_a_goal_storm_and_a_clock_with_bad_stamps_leave_few_log_lines(start_node, ros_node):
-    clock = ClockFeed(ros_node)
-    feed = OdomFeed(ros_node, odom_at(0.0))
-    lidar = OpenSpaceScan(ros_node)
     nav, plan = start_pair(start_node)
-    try:
-        with subscribe(ros_node, NavStatus, "local_nav/status", qos=DEEP) as nav_status, \
-                subscribe(ros_node, NavStatus, "planner/status", qos=DEEP) as plan_status:
-            nav.wait_for_log("first scan", timeout=REPLY_TIMEOUT)
-            start_goals(ros_node, nav, plan)
-            goal_pub = ros_node.create_publisher(PoseStamped, "goal_pose", DEEP)
-            dock_pub = ros_node.create_publisher(PoseStamped, "dock_pose", DEEP)
-            marks = {p.name: len(p.log_text()) for p in (nav, plan)}
-            began = time.monotonic()
-            # 300 goals each, as fast as rclpy sends them; the last ones 3.299 m and 2.299 m ahead.
-            for k in range(300):
-                goal_pub.publish(pose(3.0 + 0.001 * k, 0.0))
-                dock_pub.publish(pose(2.0 + 0.001 * k, 0.0))
-                if k % 50 == 49:
-                    time.sleep(0.05)  # within the nodes' reader depth (10): most goals arrive
-            for status, x in ((nav_status, 3.299), (plan_status, 2.299)):
-                status.wait_for(lambda s: abs(s.goal.position.x - x) < 1e-9, REPLY_TIMEOUT)
-            time.sleep(0.5)
-            storm = time.monotonic() - began
-            for proc in (nav, plan):
-                lines = log_lines(proc, marks[proc.name])
-                print(f"{proc.name}: {len(lines)} lines in {storm:.2f} s")
-                # Two lines per goal (taken, the one before ended) from two call sites, 600 lines
-                # without a budget: at most 2 · (10 + a line a second) with it.
-                assert len(lines) <= 2 * (BURST + PER_SECOND * storm) + 2, "\n".join(lines[-20:])
-            # /clock at 100 Hz with nanosec 1.5e9 (invalid) for 3 s.
-            marks = {p.name: len(p.log_text()) for p in (nav, plan)}
-            clock.bad_nanosec = True
-            time.sleep(3.0)
-            clock.bad_nanosec = False
-            for proc in (nav, plan):
-                lines = log_lines(proc, marks[proc.name])
-                print(f"{proc.name}, bad clock: {len(lines)} lines")
-                assert len(lines) <= 2 * (BURST + 3), "\n".join(lines[-20:])
-    finally:
-        lidar.stop()
-        feed.stop()
-        clock.stop()
+    with fed(ros_node) as feeds, subscribe(ros_node, NavStatus, "local_nav/status", qos=DEEP) as nav_status, \
+            subscribe(ros_node, NavStatus, "planner/status", qos=DEEP) as plan_status:
+        nav.wait_for_log("first scan", timeout=REPLY_TIMEOUT)
+        start_goals(ros_node, nav, plan)
+        goal_pub = ros_node.create_publisher(PoseStamped, "goal_pose", DEEP)
+        dock_pub = ros_node.create_publisher(PoseStamped, "dock_pose", DEEP)
+        marks = {p.name: len(p.log_text()) for p in (nav, plan)}
+        began = time.monotonic()
+        # 300 goals each, as fast as rclpy sends them; the last ones 3.299 m and 2.299 m ahead.
+        for k in range(300):
+            goal_pub.publish(pose(3.0 + 0.001 * k, 0.0))
+            dock_pub.publish(pose(2.0 + 0.001 * k, 0.0))
+            if k % 50 == 49:
+                time.sleep(0.05)  # within the nodes' reader depth (10): most goals arrive
+        for status, x in ((nav_status, 3.299), (plan_status, 2.299)):
+            status.wait_for(lambda s: abs(s.goal.position.x - x) < 1e-9, REPLY_TIMEOUT)
+        time.sleep(0.5)
+        storm = time.monotonic() - began
+        for proc in (nav, plan):
+            lines = log_lines(proc, marks[proc.name])
+            print(f"{proc.name}: {len(lines)} lines in {storm:.2f} s")
+            # Two lines per goal (taken, the one before ended) from two call sites, 600 lines
+            # without a budget: at most 2 · (10 + a line a second) with it.
+            assert len(lines) <= 2 * (BURST + PER_SECOND * storm) + 2, "\n".join(lines[-20:])
+        # /clock at 100 Hz with nanosec 1.5e9 (invalid) for 3 s.
+        marks = {p.name: len(p.log_text()) for p in (nav, plan)}
+        feeds.clock.bad_nanosec = True
+        time.sleep(3.0)
+        feeds.clock.bad_nanosec = False
+        for proc in (nav, plan):
+            lines = log_lines(proc, marks[proc.name])
+            print(f"{proc.name}, bad clock: {len(lines)} lines")
+            assert len(lines) <= 2 * (BURST + 3), "\n".join(lines[-20:])
