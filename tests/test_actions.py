@@ -37,6 +37,10 @@ DISCOVERY_TIMEOUT = 20.0
 # 5 mm short (the tolerance) and about 10 mm long; 20 mm leaves margin for scheduling on a
 # loaded 2-core machine.
 STOP_TOLERANCE = 0.02
+# RUNNING_ALONE: the drives below run in real time against 0.5 s watchdogs and a 2 cm stop, so
+# they join the closed-loop group (conftest.py): beside the demo or the soak a stall of half a
+# second starved sim, chassis and drive_node at once (seen: 26 mm past the stop, a goal ended
+# "odometry stale").
 
 
 def start_robot(start_node):
@@ -107,6 +111,7 @@ def settled(truth) -> Odometry | None:
     return None
 
 
+@pytest.mark.closed_loop  # a real-time drive: never beside the demo or the soak (RUNNING_ALONE)
 def test_drive_distance_succeeds_with_feedback_and_matches_ground_truth(start_node, ros_node):
     start_robot(start_node)
     with subscribe(ros_node, Odometry, "ground_truth") as truth, \
@@ -138,6 +143,7 @@ def test_drive_distance_succeeds_with_feedback_and_matches_ground_truth(start_no
         assert planar_distance(start, end) == pytest.approx(distance, abs=STOP_TOLERANCE)
 
 
+@pytest.mark.closed_loop  # a real-time drive: never beside the demo or the soak (RUNNING_ALONE)
 def test_cancel_ends_the_goal_canceled_and_stops_the_wheels(start_node, ros_node):
     start_robot(start_node)
     with subscribe(ros_node, Odometry, "ground_truth") as truth, \
@@ -171,6 +177,7 @@ def test_cancel_ends_the_goal_canceled_and_stops_the_wheels(start_node, ros_node
         assert (last.linear.x, last.linear.y, last.angular.z) == (0.0, 0.0, 0.0)
 
 
+@pytest.mark.closed_loop  # a real-time drive: never beside the demo or the soak (RUNNING_ALONE)
 def test_a_new_goal_preempts_the_running_one_which_ends_aborted(start_node, ros_node):
     start_robot(start_node)
     with subscribe(ros_node, Odometry, "odom") as odom:
@@ -239,6 +246,7 @@ def test_nav2_action_types_round_trip_through_a_rust_server(start_node, ros_node
     assert (result.error_code, result.error_msg) == (600, "2 of 4 missed, 2 loops from 1")
 
 
+@pytest.mark.closed_loop  # a real-time drive: never beside the demo or the soak (RUNNING_ALONE)
 def test_stale_odometry_aborts_the_goal_and_stops(start_node, ros_node):
     params = "params/omr3.yaml"
     start_node("sim_node", *NO_LIDAR, params_file=params)

@@ -141,6 +141,7 @@ def test_cmd_vel_moves_odom_as_the_kinematics_predict(robot, start_node, ros_nod
     assert truth_step == pytest.approx(chord, rel=0.001)
 
 
+@pytest.mark.closed_loop  # a real-time drive against 0.5 s watchdogs (test_actions.py, RUNNING_ALONE)
 def test_car_like_turn_tighter_than_the_minimum_radius_is_clamped(start_node, ros_node):
     start_robot(start_node, "mobil2")
     cmd = ros_node.create_publisher(Twist, "cmd_vel", 10)
