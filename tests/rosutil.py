@@ -87,9 +87,11 @@ def setup_process_environment() -> None:
     if str(MSGS_PYTHONPATH) not in sys.path and MSGS_PYTHONPATH.is_dir():
         sys.path.append(str(MSGS_PYTHONPATH))
     if MSGS_LIB.is_dir():
-        # mobil_msgs, and nav2_msgs (Nav2's action types), which setup_env.sh installs beside it.
+        # mobil_msgs, and nav2_msgs (Nav2's action types) and bond, which setup_env.sh installs
+        # beside it.
         _msgs_preload_error = _preload_libraries(
-            sorted(MSGS_LIB.glob("libmobil_msgs__*.so")) + sorted(MSGS_LIB.glob("libnav2_msgs__*.so")))
+            [lib for package in ("mobil_msgs", "nav2_msgs", "bond")
+             for lib in sorted(MSGS_LIB.glob(f"lib{package}__*.so"))])
 
 
 def _preload_libraries(libs: Sequence[Path]) -> Optional[str]:

@@ -72,10 +72,10 @@ fi
 
 # mobil_msgs Python type support, from the same CMakeLists.txt colcon uses, with its C type
 # supports only (MOBIL_MSGS_C_ONLY: rclpy loads no C++ type support; that halves the build).
-# The hash of an interface package's inputs (msgs/rust and the nested nav2_msgs are not part of
+# The hash of an interface package's inputs (msgs/rust and the nested nav2_msgs and bond are not part of
 # mobil_msgs).
 package_hash() {
-  (cd "$1" && find . \( -path ./rust -o -path ./nav2_msgs \) -prune -o -type f \( -name '*.msg' -o -name '*.srv' -o -name '*.action' -o -name CMakeLists.txt -o -name package.xml \) -print | sort | xargs sha256sum | sha256sum | cut -d' ' -f1)
+  (cd "$1" && find . \( -path ./rust -o -path ./nav2_msgs -o -path ./bond \) -prune -o -type f \( -name '*.msg' -o -name '*.srv' -o -name '*.action' -o -name CMakeLists.txt -o -name package.xml \) -print | sort | xargs sha256sum | sha256sum | cut -d' ' -f1)
 }
 want_msgs="$want_ver $(package_hash "$ROOT/msgs")"
 stamp_msgs="$INSTALL/.mobil-msgs-stamp"
@@ -92,20 +92,24 @@ if [ "$(cat "$stamp_msgs" 2>/dev/null)" != "$want_msgs" ]; then
   echo "$want_msgs" > "$stamp_msgs"
 fi
 
-# nav2_msgs (Nav2's Jazzy action types, msgs/nav2_msgs; no wheel exists on PyPI), installed into
-# the same prefix, so the PYTHONPATH / LD_LIBRARY_PATH above serve both. A rebuild of mobil_msgs
-# empties the prefix and its stamp with it, so this one follows.
-NAV2_BUILD="$ROOT/target/nav2-msgs-build-py$want_ver"
-want_nav2="$want_ver $(package_hash "$ROOT/msgs/nav2_msgs")"
-stamp_nav2="$INSTALL/.mobil-nav2-msgs-stamp"
-if [ "$(cat "$stamp_nav2" 2>/dev/null)" != "$want_nav2" ]; then
-  echo "setup_env: building nav2_msgs Python type support (about 1 CPU-minute)" >&2
-  rm -rf "$NAV2_BUILD"
-  PATH="$VENV/bin:$PATH" AMENT_PREFIX_PATH="$VENV" CMAKE_PREFIX_PATH="$VENV" \
-    "$VENV/bin/cmake" -S "$ROOT/msgs/nav2_msgs" -B "$NAV2_BUILD" -DPython3_EXECUTABLE="$VENV/bin/python" \
-      -DBUILD_TESTING=OFF -DMOBIL_MSGS_C_ONLY=ON -DCMAKE_INSTALL_PREFIX="$INSTALL" >"$ROOT/target/nav2-msgs-cmake.log" 2>&1 \
-    && PATH="$VENV/bin:$PATH" "$VENV/bin/cmake" --build "$NAV2_BUILD" -j2 >>"$ROOT/target/nav2-msgs-cmake.log" 2>&1 \
-    && "$VENV/bin/cmake" --install "$NAV2_BUILD" >>"$ROOT/target/nav2-msgs-cmake.log" 2>&1 \
-    || { echo "setup_env: nav2_msgs build failed, see target/nav2-msgs-cmake.log" >&2; tail -30 "$ROOT/target/nav2-msgs-cmake.log" >&2; exit 1; }
-  echo "$want_nav2" > "$stamp_nav2"
-fi
+# The nested interface packages that have no wheel on PyPI: nav2_msgs (Nav2's Jazzy action types,
+# msgs/nav2_msgs) and bond (msgs/bond), installed into the same prefix, so the PYTHONPATH /
+# LD_LIBRARY_PATH above serve them too. A rebuild of mobil_msgs empties the prefix and their
+# stamps with it, so these follow.
+for nested in nav2_msgs bond; do
+  nested_build="$ROOT/target/$nested-build-py$want_ver"
+  want_nested="$want_ver $(package_hash "$ROOT/msgs/$nested")"
+  stamp_nested="$INSTALL/.mobil-$nested-stamp"
+  if [ "$(cat "$stamp_nested" 2>/dev/null)" != "$want_nested" ]; then
+    echo "setup_env: building $nested Python type support (about 1 CPU-minute)" >&2
+    rm -rf "$nested_build"
+    log="$ROOT/target/$nested-cmake.log"
+    PATH="$VENV/bin:$PATH" AMENT_PREFIX_PATH="$VENV" CMAKE_PREFIX_PATH="$VENV" \
+      "$VENV/bin/cmake" -S "$ROOT/msgs/$nested" -B "$nested_build" -DPython3_EXECUTABLE="$VENV/bin/python" \
+        -DBUILD_TESTING=OFF -DMOBIL_MSGS_C_ONLY=ON -DCMAKE_INSTALL_PREFIX="$INSTALL" >"$log" 2>&1 \
+      && PATH="$VENV/bin:$PATH" "$VENV/bin/cmake" --build "$nested_build" -j2 >>"$log" 2>&1 \
+      && "$VENV/bin/cmake" --install "$nested_build" >>"$log" 2>&1 \
+      || { echo "setup_env: $nested build failed, see $log" >&2; tail -30 "$log" >&2; exit 1; }
+    echo "$want_nested" > "$stamp_nested"
+  fi
+done

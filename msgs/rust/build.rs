@@ -1,7 +1,8 @@
 //! Generates the Rust message types from `.msg` / `.srv` / `.action` files at build time.
 //!
 //! Inputs: the suite's own interface package (`msgs/msg`, `msgs/srv`, `msgs/action`, package
-//! `mobil_msgs`), Nav2's Jazzy action types (`msgs/nav2_msgs`, package `nav2_msgs`) and the
+//! `mobil_msgs`), Nav2's Jazzy action types (`msgs/nav2_msgs`, package `nav2_msgs`), bond's
+//! messages (`msgs/bond`, package `bond`) and the
 //! standard ROS 2 Jazzy definitions the suite uses, vendored unchanged under `msgs/rust/ros`.
 //! Output: `$OUT_DIR/generated.rs`, one module per package (`geometry_msgs::msg::Twist`, …),
 //! with serde layouts that match the CDR encoding rmw implementations use (field order, fixed
@@ -23,6 +24,7 @@ fn main() {
     let mut sources: Vec<(String, PathBuf)> = Vec::new();
     collect(&own_package, "mobil_msgs", &mut sources);
     collect(&own_package.join("nav2_msgs"), "nav2_msgs", &mut sources);
+    collect(&own_package.join("bond"), "bond", &mut sources);
     let mut std_packages: Vec<_> = std::fs::read_dir(&vendored)
         .expect("msgs/rust/ros exists")
         .filter_map(|e| e.ok())
@@ -64,6 +66,7 @@ fn main() {
     println!("cargo:rerun-if-changed=../srv");
     println!("cargo:rerun-if-changed=../action");
     println!("cargo:rerun-if-changed=../nav2_msgs");
+    println!("cargo:rerun-if-changed=../bond");
 }
 
 fn collect(package_dir: &Path, pkg: &str, out: &mut Vec<(String, PathBuf)>) {

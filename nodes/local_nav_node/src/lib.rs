@@ -22,6 +22,7 @@ use mobil_ros::config::{Config, ConfigError, Decl};
 use mobil_ros::goal::goal_pose;
 pub use mobil_ros::goal::{goal_heading, GoalError};
 use mobil_ros::groups::{Frames, GoalTimeouts, MAX_INPUT_TIMEOUT_S};
+use mobil_ros::lifecycle::Managed;
 use mobil_ros::markers::{point, rgb, Markers};
 use mobil_ros::motion::EndCause;
 use mobil_ros::status::end_state;
@@ -62,6 +63,8 @@ pub struct LocalNavConfig {
     /// Laser pose (x, y, yaw) in the base frame, for scans whose frame `tf_static` does not
     /// give; empty when not set (such scans are then refused).
     pub laser_pose: Vec<f64>,
+    /// The managed-node parameters (`autostart`, `bond_heartbeat_period`).
+    pub managed: Managed,
 }
 
 impl Config for LocalNavConfig {
@@ -235,6 +238,7 @@ impl Config for LocalNavConfig {
         )
         .within(0.1, 50.0);
         d.nest(|c: &mut LocalNavConfig| &mut c.timeouts, GoalTimeouts::declare);
+        d.nest(|c: &mut LocalNavConfig| &mut c.managed, Managed::declare);
         d.nest(|c: &mut LocalNavConfig| &mut c.frames, Frames::declare);
         d.string(
             "laser_frame",

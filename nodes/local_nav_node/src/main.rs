@@ -37,6 +37,7 @@ use mobil_ros::action::{goal_end, nav2_result, ActionEvent, GoalRequest, GoalSer
 use mobil_ros::geometry::{odom_pose, twist_msg};
 use mobil_ros::input::Inputs;
 use mobil_ros::latest::Latest;
+use mobil_ros::lifecycle::{CallbackReturn, Lifecycle, Transition};
 use mobil_ros::motion::{
     Applied, ClockCheck, CmdVel, EndCause, Ended, MotionSession, Outputs, SessionSettings, Watched,
 };
@@ -137,6 +138,7 @@ enum Event {
     Odom(Odometry),
     GoalPose(PoseStamped),
     Action(ActionEvent<NavigateToPoseGoal>),
+    Lifecycle(Transition),
     Tick,
 }
 
@@ -175,13 +177,15 @@ async fn start(
     let odom_sub = node.subscription::<Odometry>("odom", &qos::default_qos())?;
     let goal_sub = node.subscription::<PoseStamped>("goal_pose", &qos::default_qos())?;
     let tf_sub = tf_static_subscription(node)?;
+    let mut lifecycle = Lifecycle::serve(node, &config.managed)?;
     let mut server = GoalServer::<NavigateToPose>::create(
         node,
         "navigate_to_pose",
         GoalServerConfig {
             result_timeout: config.timeouts.result_timeout(),
         },
-    )?;
+    )?
+    .gate(lifecycle.gate());
     let mut laser = StaticFrames::default();
     let mut shell = Shell {
         progress: ProgressChecker::new(config.progress),
@@ -206,6 +210,7 @@ async fn start(
         out,
         &mut shell,
         &mut server,
+        &mut lifecycle,
         &mut laser,
         &scan_sub,
         &odom_sub,
@@ -219,6 +224,7 @@ async fn start(
         shell.report(node, out, &mut server, ended);
     }
     server.close(result(&EndCause::Shutdown)).await;
+    lifecycle.close();
     Ok((outcome, final_zero))
 }
 
@@ -228,6 +234,7 @@ async fn event_loop(
     out: &Outputs,
     shell: &mut Shell,
     server: &mut GoalServer<NavigateToPose>,
+    lifecycle: &mut Lifecycle,
     laser: &mut StaticFrames,
     scan_sub: &Subscription<LaserScan>,
     odom_sub: &Subscription<Odometry>,
@@ -248,19 +255,36 @@ async fn event_loop(
             Some(changed) = node.config_changed::<LocalNavConfig>() => Event::Config(changed),
             e = inputs.next() => e?,
             e = server.next_event() => Event::Action(e),
+            t = lifecycle.next() => Event::Lifecycle(t),
             _ = ticker.tick() => Event::Tick,
         };
         let mut sink = CmdVel::new(&out.cmd);
         match event {
             Event::Shutdown => return Ok(()),
-            Event::Config(Ok(c)) => shell.reconfigure(c),
+            Event::Config(Ok(c)) => {
+                lifecycle.set_managed(&c.managed);
+                shell.reconfigure(c);
+            }
             Event::Config(Err(e)) => warn!("parameters not applied: {e}"),
             Event::Odom(m) => shell.odom_in(&mut sink, &m),
             Event::Scan(m) => {
                 laser.refresh(tf_sub, &mut shell.throttle);
                 shell.scan_in(node, out, &mut sink, server, laser, &m);
             }
+            Event::GoalPose(_) if !lifecycle.is_active() => warn_throttled!(
+                shell.throttle,
+                "inactive",
+                "goal_pose refused: the node is {} (lifecycle): activate it first",
+                lifecycle.state()
+            ),
             Event::GoalPose(m) => shell.goal_pose_in(node, out, &mut sink, server, &m),
+            Event::Lifecycle(transition) => {
+                // Leaving active (deactivate, shutdown): the goal under way ends, with its zero.
+                if transition.leaves_active() {
+                    shell.end_goal(node, out, &mut sink, server, EndCause::Deactivated);
+                }
+                lifecycle.complete(transition, CallbackReturn::Success);
+            }
             Event::Action(ActionEvent::Goal(request)) => {
                 shell.action_goal_in(node, out, &mut sink, server, request).await
             }

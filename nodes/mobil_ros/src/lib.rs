@@ -21,6 +21,8 @@
 //!   watchdogs, freshness and tick periods on the steady clock;
 //! - [`offloop`]: [`OffLoop`], searches of 10–500 ms off the event loop, pre-empted by newer
 //!   requests;
+//! - [`lifecycle`]: the managed-node interface (`lifecycle_msgs` services, transition events,
+//!   `autostart`) and Nav2's bond, around [`mobil_lifecycle`];
 //! - [`action`]: [`action::GoalServer`], an action server with one active goal for a node's
 //!   select loop (accept/reject, feedback, result, cancel, pre-emption);
 //! - [`motion`]: [`motion::MotionSession`], the motion server every node that moves the robot
@@ -49,6 +51,7 @@ pub mod goal;
 pub mod groups;
 pub mod input;
 pub mod latest;
+pub mod lifecycle;
 pub mod log;
 pub mod markers;
 pub mod motion;

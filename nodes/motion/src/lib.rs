@@ -297,6 +297,8 @@ pub enum EndCause {
     ClockBack(f64),
     /// The node shut down.
     Shutdown,
+    /// The node left the active state (its lifecycle manager deactivated or shut it down).
+    Deactivated,
 }
 
 /// How an end counts for the status and an action's result.
@@ -328,7 +330,7 @@ impl EndCause {
     }
 
     /// The status reason's code: the outcome's, or `CANCELED`, `PREEMPTED`, `INVALID_INPUT`,
-    /// `STALE_INPUT`, `CLOCK_BACKWARDS`, `SHUTDOWN`.
+    /// `STALE_INPUT`, `CLOCK_BACKWARDS`, `SHUTDOWN`, `DEACTIVATED`.
     pub fn code(&self) -> &str {
         match self {
             EndCause::Outcome(Outcome::Succeeded { .. }) => "SUCCEEDED",
@@ -339,6 +341,7 @@ impl EndCause {
             EndCause::Stale(_) => "STALE_INPUT",
             EndCause::ClockBack(_) => "CLOCK_BACKWARDS",
             EndCause::Shutdown => "SHUTDOWN",
+            EndCause::Deactivated => "DEACTIVATED",
         }
     }
 
@@ -357,18 +360,19 @@ impl EndCause {
                  robot stopped"
             ),
             EndCause::Shutdown => "SHUTDOWN: the node is shutting down".to_owned(),
+            EndCause::Deactivated => "DEACTIVATED: the node was deactivated (lifecycle): robot stopped".to_owned(),
         }
     }
 
     /// Nav2's error code of this end in the result of an action with `codes`, one rule for
     /// every node: the law's own, none for a cancel or a pre-emption, the control failure for
-    /// stale or refused input or a clock gone back, unknown at shutdown.
+    /// stale or refused input or a clock gone back, unknown at shutdown or deactivation.
     pub fn nav2_error(&self, codes: Nav2Codes) -> u16 {
         match self {
             EndCause::Outcome(o) => o.nav2_error(),
             EndCause::Canceled | EndCause::Preempted(_) => nav2::NONE,
             EndCause::Refused { .. } | EndCause::Stale(_) | EndCause::ClockBack(_) => codes.control_failure,
-            EndCause::Shutdown => codes.unknown,
+            EndCause::Shutdown | EndCause::Deactivated => codes.unknown,
         }
     }
 
@@ -420,6 +424,10 @@ mod tests {
             warn("STALE_INPUT: odom stale: robot stopped")
         );
         assert_eq!(line(EndCause::Shutdown), warn("SHUTDOWN: the node is shutting down"));
+        assert_eq!(
+            line(EndCause::Deactivated),
+            warn("DEACTIVATED: the node was deactivated (lifecycle): robot stopped")
+        );
     }
 
     #[test]
@@ -441,6 +449,7 @@ mod tests {
             ),
             (EndCause::ClockBack(4.5), 905),
             (EndCause::Shutdown, 999),
+            (EndCause::Deactivated, 999),
         ];
         for (end, code) in ends {
             assert_eq!(end.nav2_error(c), code, "{end:?}");
@@ -503,6 +512,7 @@ mod tests {
             ),
             (EndCause::Stale("odom".into()), "STALE_INPUT", EndKind::Aborted),
             (EndCause::Shutdown, "SHUTDOWN", EndKind::Aborted),
+            (EndCause::Deactivated, "DEACTIVATED", EndKind::Aborted),
         ];
         for (cause, code, kind) in cases {
             assert_eq!((cause.code(), cause.kind()), (code, kind), "{cause:?}");

@@ -29,6 +29,7 @@ use mobil_ros::geometry::pose_msg;
 use mobil_ros::goal::RouteLimits;
 pub use mobil_ros::goal::{GoalError, Route};
 use mobil_ros::groups::{Frames, GoalTimeouts};
+use mobil_ros::lifecycle::Managed;
 use mobil_ros::markers::{point, Markers};
 use mobil_ros::motion::EndCause;
 use mobil_world::World;
@@ -71,6 +72,8 @@ pub struct PlannerConfig {
     pub markers_rate_hz: f64,
     /// How long a goal waits for odometry, and its result for the client.
     pub timeouts: GoalTimeouts,
+    /// The managed-node parameters (`autostart`, `bond_heartbeat_period`).
+    pub managed: Managed,
     /// The frames of odometry, goals and the robot.
     pub frames: Frames,
     /// How `waypoints` and `follow_waypoints` are followed.
@@ -151,6 +154,7 @@ impl Config for PlannerConfig {
                 "planner/markers rate while a goal is active [Hz]";
         }
         d.nest(|c: &mut PlannerConfig| &mut c.timeouts, GoalTimeouts::declare);
+        d.nest(|c: &mut PlannerConfig| &mut c.managed, Managed::declare);
         d.nest(|c: &mut PlannerConfig| &mut c.frames, Frames::declare);
         vfo::declare_vfo(d);
     }

@@ -53,6 +53,7 @@ use mobil_ros::geometry::{odom_pose, twist_msg};
 use mobil_ros::goal::{goal_pose, pose_in_frame, route_from_path, route_from_poses};
 use mobil_ros::input::Inputs;
 use mobil_ros::latest::Latest;
+use mobil_ros::lifecycle::{CallbackReturn, Lifecycle, Transition};
 use mobil_ros::motion::{
     Applied, ClockCheck, CmdVel, EndCause, EndKind, Ended, GoalId, MotionSession, Outputs, SessionSettings, Watched,
 };
@@ -201,6 +202,7 @@ enum Event {
     Dock(ActionEvent<DockRobotGoal>),
     Undock(ActionEvent<UndockRobotGoal>),
     Follow(ActionEvent<FollowWaypointsGoal>),
+    Lifecycle(Transition),
     Check(RmwRequestId, CheckRouteRequest),
     Checked(RmwRequestId, CheckRouteResponse),
     RouteChecked(PreCheckDone),
@@ -233,10 +235,11 @@ async fn start(node: &mut RosNode, out: &Outputs, config: PlannerConfig) -> anyh
     let server_config = GoalServerConfig {
         result_timeout: config.timeouts.result_timeout(),
     };
+    let mut lifecycle = Lifecycle::serve(node, &config.managed)?;
     let mut servers = Servers {
-        dock: GoalServer::create(node, "dock_robot", server_config.clone())?,
-        undock: GoalServer::create(node, "undock_robot", server_config.clone())?,
-        follow: GoalServer::create(node, "follow_waypoints", server_config)?,
+        dock: GoalServer::create(node, "dock_robot", server_config.clone())?.gate(lifecycle.gate()),
+        undock: GoalServer::create(node, "undock_robot", server_config.clone())?.gate(lifecycle.gate()),
+        follow: GoalServer::create(node, "follow_waypoints", server_config)?.gate(lifecycle.gate()),
     };
     info!(
         "{} chassis, pre-check world: {} ({} obstacles); waiting for dock_pose, waypoints, dock_robot, \
@@ -283,6 +286,7 @@ async fn start(node: &mut RosNode, out: &Outputs, config: PlannerConfig) -> anyh
         &mut shell,
         &mut servers,
         &mut jobs,
+        &mut lifecycle,
         (&odom_sub, &dock_sub, &route_sub),
         (&scan_sub, &tf_sub),
         &check,
@@ -313,6 +317,7 @@ async fn start(node: &mut RosNode, out: &Outputs, config: PlannerConfig) -> anyh
         undock.close(nav2_result(&down, Action::Undock.codes())),
         follow.close(follow_result(&down, &[], &[])),
     );
+    lifecycle.close();
     Ok(outcome)
 }
 
@@ -324,6 +329,7 @@ async fn event_loop(
     shell: &mut Shell,
     servers: &mut Servers,
     jobs: &mut Jobs,
+    lifecycle: &mut Lifecycle,
     (odom_sub, dock_sub, route_sub): (&Subscription<Odometry>, &Subscription<PoseStamped>, &Subscription<Path>),
     (scan_sub, tf_sub): (&Subscription<LaserScan>, &Subscription<TFMessage>),
     check: &Server<CheckRouteRequest, CheckRouteResponse>,
@@ -349,6 +355,7 @@ async fn event_loop(
             e = servers.dock.next_event() => Event::Dock(e),
             e = servers.undock.next_event() => Event::Undock(e),
             e = servers.follow.next_event() => Event::Follow(e),
+            t = lifecycle.next() => Event::Lifecycle(t),
             _ = ticker.tick() => Event::Tick,
         };
         let mut io = Io {
@@ -359,7 +366,23 @@ async fn event_loop(
         };
         match event {
             Event::Shutdown => return Ok(()),
-            Event::Config(Ok(c)) => shell.reconfigure(c),
+            Event::Config(Ok(c)) => {
+                lifecycle.set_managed(&c.managed);
+                shell.reconfigure(c);
+            }
+            Event::Lifecycle(transition) => {
+                // Leaving active (deactivate, shutdown): the goal under way ends, with its zero.
+                if transition.leaves_active() {
+                    shell.end_goal(&mut io, EndCause::Deactivated);
+                }
+                lifecycle.complete(transition, CallbackReturn::Success);
+            }
+            Event::DockPose(_) | Event::Waypoints(_) if !lifecycle.is_active() => warn_throttled!(
+                shell.throttle,
+                "inactive",
+                "topic goal refused: the node is {} (lifecycle): activate it first",
+                lifecycle.state()
+            ),
             Event::Config(Err(e)) => warn!("parameters not applied: {e}"),
             Event::Odom(m) => shell.odom_in(&mut io, jobs, &m),
             Event::Scan(m) => {

@@ -21,6 +21,7 @@ use mobil_ros::geometry::planar_pose;
 use mobil_ros::groups::GoalTimeouts;
 use mobil_ros::input::Inputs;
 use mobil_ros::latest::Latest;
+use mobil_ros::lifecycle::{CallbackReturn, Lifecycle, Managed};
 use mobil_ros::motion::{Applied, ClockCheck, CmdVel, EndCause, EndKind, Ended, MotionSession, SessionSettings};
 use mobil_ros::stop::{final_stop, FINAL_STOP_WAIT};
 use mobil_ros::ticker::Ticker;
@@ -40,6 +41,7 @@ struct DriveConfig {
     tolerance: f64,
     rate_hz: f64,
     timeouts: GoalTimeouts,
+    managed: Managed,
 }
 
 impl Config for DriveConfig {
@@ -74,6 +76,7 @@ impl Config for DriveConfig {
         )
         .within(1.0, 200.0);
         d.nest(|c: &mut DriveConfig| &mut c.timeouts, GoalTimeouts::declare);
+        d.nest(|c: &mut DriveConfig| &mut c.managed, Managed::declare);
     }
 
     fn validate(&self) -> Result<(), ConfigError> {
@@ -184,14 +187,22 @@ async fn drive_loop(
     mut config: DriveConfig,
 ) -> anyhow::Result<()> {
     let odom_sub = node.subscription::<Odometry>("odom", &qos::default_qos())?;
+    let mut lifecycle = Lifecycle::serve(node, &config.managed)?;
     let mut server = GoalServer::<DriveDistance>::create(
         node,
         "drive_distance",
         GoalServerConfig {
             result_timeout: config.timeouts.result_timeout(),
         },
-    )?;
-    let outcome = event_loop(node, cmd, &odom_sub, &mut server, session, &mut config).await;
+    )?
+    .gate(lifecycle.gate());
+    let io = Io {
+        cmd,
+        odom_sub: &odom_sub,
+        server: &mut server,
+        lifecycle: &mut lifecycle,
+    };
+    let outcome = event_loop(node, io, session, &mut config).await;
     let travelled = session.active().map_or(0.0, |a| a.goal.progress().travelled);
     let reason = if outcome.is_ok() {
         "shutting down"
@@ -199,17 +210,30 @@ async fn drive_loop(
         "node failed"
     };
     server.close(result(travelled, reason)).await;
+    lifecycle.close();
     outcome
+}
+
+/// The node's interfaces, for its loop.
+struct Io<'a> {
+    cmd: &'a Publisher<Twist>,
+    odom_sub: &'a Subscription<Odometry>,
+    server: &'a mut GoalServer<DriveDistance>,
+    lifecycle: &'a mut Lifecycle,
 }
 
 async fn event_loop(
     node: &mut RosNode,
-    cmd: &Publisher<Twist>,
-    odom_sub: &Subscription<Odometry>,
-    server: &mut GoalServer<DriveDistance>,
+    io: Io<'_>,
     session: &mut Session,
     config: &mut DriveConfig,
 ) -> anyhow::Result<()> {
+    let Io {
+        cmd,
+        odom_sub,
+        server,
+        lifecycle,
+    } = io;
     let mut inputs = Inputs::new();
     inputs.add(odom_sub.async_stream(), "odom", "sample ignored", |m: Odometry| m);
     let shutdown = shutdown_signal();
@@ -227,11 +251,22 @@ async fn event_loop(
             _ = &mut shutdown => return Ok(()),
             Some(changed) = node.config_changed::<DriveConfig>() => match changed {
                 Ok(c) => match ticker.set_rate(c.rate_hz) {
-                    Ok(()) => *config = c,
+                    Ok(()) => {
+                        lifecycle.set_managed(&c.managed);
+                        *config = c;
+                    }
                     Err(e) => warn!("parameters not applied: {e}"),
                 },
                 Err(e) => warn!("parameters not applied: {e}"),
             },
+            transition = lifecycle.next() => {
+                // Leaving active (deactivate, shutdown): the goal under way ends, with its zero.
+                if transition.leaves_active() {
+                    let ended = session.end(EndCause::Deactivated, &mut sink);
+                    finish(server, ended);
+                }
+                lifecycle.complete(transition, CallbackReturn::Success);
+            }
             m = inputs.next() => {
                 let m = m?;
                 match planar_pose(&m.pose.pose) {

@@ -72,6 +72,7 @@
 //! # }
 //! ```
 
+use crate::lifecycle::ActiveGate;
 use crate::RosNode;
 use mobil_msgs::RosAction;
 use ros2_client::action::ActionServerQosPolicies;
@@ -286,6 +287,8 @@ pub struct GoalServer<A: RosAction> {
     /// dropped [`GoalServer::next_event`] future reports it on the next call).
     unreported_cancel: Option<GoalId>,
     result_timeout: Duration,
+    /// Goals are refused while it is closed (the node is not active: [`crate::lifecycle`]).
+    gate: ActiveGate,
     throttle: Mutex<crate::LogThrottle>,
 }
 
@@ -320,8 +323,16 @@ where
             active: None,
             unreported_cancel: None,
             result_timeout: config.result_timeout,
+            gate: ActiveGate::open(),
             throttle: Mutex::new(crate::LogThrottle::new(Duration::from_secs(2))),
         })
+    }
+
+    /// Refuses goals while `gate` is closed: a managed node's server takes goals only while the
+    /// node is active ([`crate::lifecycle::Lifecycle::gate`]).
+    pub fn gate(mut self, gate: ActiveGate) -> Self {
+        self.gate = gate;
+        self
     }
 
     /// The active goal, if any (also while it is being canceled).
@@ -358,16 +369,23 @@ where
             self.table.expire(Instant::now());
             match incoming {
                 Incoming::Goal(request, SendGoalRequest { goal_id, goal }) => {
-                    if !self.table.knows(&goal_id) {
+                    if !self.gate.is_open() {
+                        info!(
+                            "{}: goal {goal_id:?} rejected: the node is not active (lifecycle: activate it first)",
+                            self.name
+                        );
+                        self.send_goal_response(request, false, RosTime::ZERO, goal_id);
+                    } else if !self.table.knows(&goal_id) {
                         return ActionEvent::Goal(GoalRequest {
                             request,
                             id: goal_id,
                             goal,
                         });
+                    } else {
+                        // rcl_action refuses a goal id it knows without asking the server.
+                        info!("{}: goal {goal_id:?} refused: its id is in use", self.name);
+                        self.send_goal_response(request, false, RosTime::ZERO, goal_id);
                     }
-                    // rcl_action refuses a goal id it knows without asking the server.
-                    info!("{}: goal {goal_id:?} refused: its id is in use", self.name);
-                    self.send_goal_response(request, false, RosTime::ZERO, goal_id);
                 }
                 Incoming::Cancel(request, cancel) => self.cancel(request, cancel.goal_info()),
                 Incoming::Result(request, GetResultRequest { goal_id }) => {
