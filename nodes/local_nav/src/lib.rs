@@ -11,6 +11,7 @@
 //!   free distance ahead (along the arc driven, for a car-like chassis) and near the goal, hard
 //!   stop.
 //! - [`config`]: [`NavConfig`], every default justified.
+//! - [`path`]: a path (Nav2's `FollowPath`) as sub-goals for the navigator.
 //! - [`progress`]: Nav2's progress checker (`required_movement_radius` within
 //!   `movement_time_allowance`), time as an input.
 //!
@@ -79,6 +80,7 @@ pub mod config;
 pub mod field;
 pub mod motion;
 pub mod navigator;
+pub mod path;
 pub mod progress;
 pub mod sectors;
 

@@ -10,12 +10,14 @@
 
 use mobil_chassis::model::ChassisConfig;
 use mobil_geom::Pose2;
+use mobil_local_nav::path::PathGoals;
 use mobil_local_nav::{
     Mode, MotionLimits, NavConfig, ProgressChecker, ProgressSettings, Sectors, Side, UnseenSectors, WeightProfile,
 };
 use mobil_motion::{Nav2Codes, Outcome};
 use mobil_msgs::builtin_interfaces::msg::Time;
 use mobil_msgs::geometry_msgs::msg::{Point, PoseStamped};
+use mobil_msgs::nav2_msgs::action::FollowPathGoal;
 use mobil_msgs::visualization_msgs::msg::{Marker, MarkerArray};
 use mobil_ros::chassis::{chassis_params, declare_chassis};
 use mobil_ros::config::{Config, ConfigError, Decl};
@@ -36,7 +38,9 @@ use std::time::Duration;
 /// gives the same failure.
 pub mod nav2_error {
     pub use mobil_motion::nav2::compute_path::NO_VALID_PATH;
-    pub use mobil_motion::nav2::follow_path::{FAILED_TO_MAKE_PROGRESS, NONE, NO_VALID_CONTROL, UNKNOWN};
+    pub use mobil_motion::nav2::follow_path::{
+        FAILED_TO_MAKE_PROGRESS, INVALID_CONTROLLER, INVALID_PATH, NONE, NO_VALID_CONTROL, TF_ERROR, UNKNOWN,
+    };
 }
 
 /// Everything the node is configured with, each field filled by one declared parameter.
@@ -65,6 +69,8 @@ pub struct LocalNavConfig {
     pub laser_pose: Vec<f64>,
     /// The managed-node parameters (`autostart`, `bond_heartbeat_period`).
     pub managed: Managed,
+    /// `follow_path`: the spacing of the sub-goals along a path (m).
+    pub path_lookahead: f64,
 }
 
 impl Config for LocalNavConfig {
@@ -223,6 +229,15 @@ impl Config for LocalNavConfig {
         )
         .above(0.0);
         d.double(
+            "path_lookahead",
+            1.0,
+            "follow_path: the navigator heads for a point this far along the path, the next one once \
+             within half of it; the path's end last [m]",
+            |c, v| c.path_lookahead = v,
+        )
+        .above(0.0)
+        .max(100.0);
+        d.double(
             "scan_timeout_s",
             0.5,
             "a goal fails STALE_INPUT when no valid scan arrived for this long (steady clock) [s]",
@@ -266,6 +281,13 @@ impl Config for LocalNavConfig {
         }
         self.motion_limits()?;
         self.nav_config()?;
+        if self.path_lookahead / 2.0 <= self.nav.goal_tolerance {
+            return Err(ConfigError::inconsistent(format!(
+                "path_lookahead {} m: half of it must be above xy_goal_tolerance {} m (a sub-goal \
+                 would be reached before the next is taken)",
+                self.path_lookahead, self.nav.goal_tolerance
+            )));
+        }
         Ok(())
     }
 }
@@ -417,6 +439,47 @@ pub fn end_answer(cause: &EndCause) -> (u8, String, u16) {
     )
 }
 
+/// The `controller_id`s `follow_path` takes: the node's one law.
+pub const CONTROLLERS: [&str; 2] = ["", "vector_distance"];
+
+/// A `follow_path` goal as sub-goals for a robot at `from`, or the end Nav2's controller
+/// server gives such a goal at once: INVALID_CONTROLLER for a `controller_id` not in
+/// [`CONTROLLERS`], TF_ERROR for a path in another frame than `odom_frame` (empty passes),
+/// INVALID_PATH for an empty path or a non-finite pose.
+pub fn follow_path_goal(
+    goal: &FollowPathGoal,
+    odom_frame: &str,
+    from: Point2<f64>,
+    lookahead: f64,
+) -> Result<PathGoals, Outcome> {
+    if !CONTROLLERS.contains(&goal.controller_id.as_str()) {
+        return Err(Outcome::failed(
+            "INVALID_CONTROLLER",
+            format!(
+                "controller_id `{}`: this node's controller is `vector_distance` (or empty)",
+                goal.controller_id
+            ),
+            nav2_error::INVALID_CONTROLLER,
+        ));
+    }
+    let frame = &goal.path.header.frame_id;
+    if !frame.is_empty() && frame != odom_frame {
+        return Err(Outcome::failed(
+            "TF_ERROR",
+            format!("path in frame `{frame}`: only `{odom_frame}` is followed"),
+            nav2_error::TF_ERROR,
+        ));
+    }
+    let points: Vec<Point2<f64>> = goal
+        .path
+        .poses
+        .iter()
+        .map(|p| Point2::new(p.pose.position.x, p.pose.position.y))
+        .collect();
+    PathGoals::new(&points, from, lookahead)
+        .map_err(|e| Outcome::failed("INVALID_PATH", e.to_string(), nav2_error::INVALID_PATH))
+}
+
 /// The status reason of a refused goal.
 pub fn invalid_goal(e: &GoalError) -> String {
     format!("INVALID_GOAL: {e}")
@@ -429,6 +492,40 @@ mod tests {
     use mobil_local_nav::Drive;
     use mobil_msgs::mobil_msgs::msg::NavStatus;
     use mobil_ros::params::ParamValues;
+
+    fn path_goal(points: &[(f64, f64)], frame: &str, controller: &str) -> FollowPathGoal {
+        let mut g = FollowPathGoal::default();
+        g.path.header.frame_id = frame.to_owned();
+        g.controller_id = controller.to_owned();
+        for &(x, y) in points {
+            let mut p = PoseStamped::default();
+            (p.pose.position.x, p.pose.position.y) = (x, y);
+            g.path.poses.push(p);
+        }
+        g
+    }
+
+    /// Nav2's codes for goals that cannot be followed; a good one gives sub-goals a lookahead
+    /// apart from the robot's nearest point.
+    #[test]
+    fn follow_path_goals_are_checked_with_nav2_codes() {
+        let from = Point2::new(0.0, 0.0);
+        let code = |g: &FollowPathGoal| follow_path_goal(g, "odom", from, 1.0).unwrap_err().nav2_error();
+        assert_eq!(code(&path_goal(&[(1.0, 0.0)], "odom", "dwb")), 101);
+        assert_eq!(code(&path_goal(&[(1.0, 0.0)], "map", "")), 102);
+        assert_eq!(code(&path_goal(&[], "odom", "")), 103);
+        assert_eq!(code(&path_goal(&[(0.0, 0.0), (f64::NAN, 1.0)], "odom", "")), 103);
+        let ok = follow_path_goal(
+            &path_goal(&[(0.0, 0.0), (2.5, 0.0)], "", "vector_distance"),
+            "odom",
+            from,
+            1.0,
+        );
+        assert_eq!(
+            ok.unwrap().goals(),
+            &[Point2::new(1.0, 0.0), Point2::new(2.0, 0.0), Point2::new(2.5, 0.0)]
+        );
+    }
 
     #[test]
     fn defaults_build_the_library_defaults_and_bad_weights_are_refused() {

@@ -20,6 +20,7 @@
 //! one, waited for ([`final_stop`]); an idle node sends none.
 
 use mobil_geom::Pose2;
+use mobil_local_nav::path::PathGoals;
 use mobil_local_nav::{Mode, MotionLimits, Navigator, Progress, ProgressChecker, StepOutput, VelocityCommand};
 use mobil_local_nav_node::{
     clear_markers, end_answer, goal_heading, goal_in_odom, invalid_goal, markers, no_progress, reconfigured_progress,
@@ -29,7 +30,10 @@ use mobil_motion::{BodyTwist, GoalLaw, Nav2Codes, Step, StepInput};
 use mobil_msgs::builtin_interfaces::msg::Time;
 use mobil_msgs::geometry_msgs::msg::{Pose, PoseStamped, Twist};
 use mobil_msgs::mobil_msgs::msg::NavStatus;
-use mobil_msgs::nav2_msgs::action::{NavigateToPose, NavigateToPoseFeedback, NavigateToPoseGoal, NavigateToPoseResult};
+use mobil_msgs::nav2_msgs::action::{
+    FollowPath, FollowPathGoal, FollowPathResult, NavigateToPose, NavigateToPoseFeedback, NavigateToPoseGoal,
+    NavigateToPoseResult,
+};
 use mobil_msgs::nav_msgs::msg::Odometry;
 use mobil_msgs::sensor_msgs::msg::LaserScan;
 use mobil_msgs::std_msgs::msg::Header;
@@ -58,6 +62,8 @@ use tracing::{info, warn};
 /// The watchdog tick (steady clock): stale inputs are noticed within 50 ms of their timeout.
 const WATCHDOG_RATE_HZ: f64 = 20.0;
 
+mod follow;
+
 fn decl() -> NodeDecl {
     NodeDecl::for_config::<LocalNavConfig>(
         "local_nav",
@@ -75,6 +81,7 @@ fn main() -> ExitCode {
 enum Source {
     Topic,
     Action,
+    Path,
 }
 
 impl From<Source> for &'static str {
@@ -82,6 +89,7 @@ impl From<Source> for &'static str {
         match s {
             Source::Topic => "goal_pose",
             Source::Action => "navigate_to_pose",
+            Source::Path => "follow_path",
         }
     }
 }
@@ -98,6 +106,14 @@ impl Source {
 struct NavGoal {
     goal: Point2<f64>,
     started_ros_nanos: i64,
+    /// A `follow_path` goal's path, as sub-goals: `goal` is the current one.
+    path: Option<PathGoals>,
+}
+
+/// What a goal drives to: a point (its heading, if given, is not kept), or a path's sub-goals.
+enum Target {
+    Point { goal: Point2<f64>, heading: Option<f64> },
+    Path(PathGoals),
 }
 
 type Session = MotionSession<NavGoal, Source>;
@@ -138,6 +154,7 @@ enum Event {
     Odom(Odometry),
     GoalPose(PoseStamped),
     Action(ActionEvent<NavigateToPoseGoal>),
+    Path(ActionEvent<FollowPathGoal>),
     Lifecycle(Transition),
     Tick,
 }
@@ -156,6 +173,16 @@ async fn serve(node: &mut RosNode) -> anyhow::Result<()> {
 
 fn result(cause: &EndCause) -> NavigateToPoseResult {
     nav2_result(cause, Nav2Codes::FOLLOW_PATH)
+}
+
+fn path_result(cause: &EndCause) -> FollowPathResult {
+    nav2_result(cause, Nav2Codes::FOLLOW_PATH)
+}
+
+/// The node's action servers.
+struct Servers {
+    nav: GoalServer<NavigateToPose>,
+    path: GoalServer<FollowPath>,
 }
 
 /// The loop's outcome, and whether the node's last word must be a zero command.
@@ -178,14 +205,13 @@ async fn start(
     let goal_sub = node.subscription::<PoseStamped>("goal_pose", &qos::default_qos())?;
     let tf_sub = tf_static_subscription(node)?;
     let mut lifecycle = Lifecycle::serve(node, &config.managed)?;
-    let mut server = GoalServer::<NavigateToPose>::create(
-        node,
-        "navigate_to_pose",
-        GoalServerConfig {
-            result_timeout: config.timeouts.result_timeout(),
-        },
-    )?
-    .gate(lifecycle.gate());
+    let server_config = GoalServerConfig {
+        result_timeout: config.timeouts.result_timeout(),
+    };
+    let mut servers = Servers {
+        nav: GoalServer::create(node, "navigate_to_pose", server_config.clone())?.gate(lifecycle.gate()),
+        path: GoalServer::create(node, "follow_path", server_config)?.gate(lifecycle.gate()),
+    };
     let mut laser = StaticFrames::default();
     let mut shell = Shell {
         progress: ProgressChecker::new(config.progress),
@@ -209,7 +235,7 @@ async fn start(
         node,
         out,
         &mut shell,
-        &mut server,
+        &mut servers,
         &mut lifecycle,
         &mut laser,
         &scan_sub,
@@ -221,9 +247,13 @@ async fn start(
     // The zero command, if one is due, is the final, acknowledged one (serve); none here.
     let (ended, final_zero) = shell.session.shutdown();
     if let Some(ended) = ended {
-        shell.report(node, out, &mut server, ended);
+        shell.report(node, out, &mut servers, ended);
     }
-    server.close(result(&EndCause::Shutdown)).await;
+    let Servers { nav, path } = servers;
+    tokio::join!(
+        nav.close(result(&EndCause::Shutdown)),
+        path.close(path_result(&EndCause::Shutdown))
+    );
     lifecycle.close();
     Ok((outcome, final_zero))
 }
@@ -233,7 +263,7 @@ async fn event_loop(
     node: &mut RosNode,
     out: &Outputs,
     shell: &mut Shell,
-    server: &mut GoalServer<NavigateToPose>,
+    servers: &mut Servers,
     lifecycle: &mut Lifecycle,
     laser: &mut StaticFrames,
     scan_sub: &Subscription<LaserScan>,
@@ -254,7 +284,8 @@ async fn event_loop(
             _ = &mut shutdown => Event::Shutdown,
             Some(changed) = node.config_changed::<LocalNavConfig>() => Event::Config(changed),
             e = inputs.next() => e?,
-            e = server.next_event() => Event::Action(e),
+            e = servers.nav.next_event() => Event::Action(e),
+            e = servers.path.next_event() => Event::Path(e),
             t = lifecycle.next() => Event::Lifecycle(t),
             _ = ticker.tick() => Event::Tick,
         };
@@ -269,7 +300,7 @@ async fn event_loop(
             Event::Odom(m) => shell.odom_in(&mut sink, &m),
             Event::Scan(m) => {
                 laser.refresh(tf_sub, &mut shell.throttle);
-                shell.scan_in(node, out, &mut sink, server, laser, &m);
+                shell.scan_in(node, out, &mut sink, servers, laser, &m);
             }
             Event::GoalPose(_) if !lifecycle.is_active() => warn_throttled!(
                 shell.throttle,
@@ -277,24 +308,25 @@ async fn event_loop(
                 "goal_pose refused: the node is {} (lifecycle): activate it first",
                 lifecycle.state()
             ),
-            Event::GoalPose(m) => shell.goal_pose_in(node, out, &mut sink, server, &m),
+            Event::GoalPose(m) => shell.goal_pose_in(node, out, &mut sink, servers, &m),
             Event::Lifecycle(transition) => {
                 // Leaving active (deactivate, shutdown): the goal under way ends, with its zero.
                 if transition.leaves_active() {
-                    shell.end_goal(node, out, &mut sink, server, EndCause::Deactivated);
+                    shell.end_goal(node, out, &mut sink, servers, EndCause::Deactivated);
                 }
                 lifecycle.complete(transition, CallbackReturn::Success);
             }
             Event::Action(ActionEvent::Goal(request)) => {
-                shell.action_goal_in(node, out, &mut sink, server, request).await
+                shell.action_goal_in(node, out, &mut sink, servers, request).await
             }
+            Event::Path(ActionEvent::Goal(request)) => shell.path_goal_in(node, out, &mut sink, servers, request).await,
             Event::Action(ActionEvent::CancelRequested(id)) => {
-                let ours = shell.session.active().is_some_and(|a| a.source == Source::Action);
-                if ours && server.active_id() == Some(id) {
-                    shell.end_goal(node, out, &mut sink, server, EndCause::Canceled);
-                }
+                shell.cancel(node, out, &mut sink, servers, Source::Action, id)
             }
-            Event::Tick => shell.tick(node, out, &mut sink, server).await,
+            Event::Path(ActionEvent::CancelRequested(id)) => {
+                shell.cancel(node, out, &mut sink, servers, Source::Path, id)
+            }
+            Event::Tick => shell.tick(node, out, &mut sink, servers).await,
         }
     }
 }
@@ -419,11 +451,11 @@ impl Shell {
         node: &RosNode,
         out: &Outputs,
         sink: &mut CmdVel<'_>,
-        server: &mut GoalServer<NavigateToPose>,
+        servers: &mut Servers,
         cause: EndCause,
     ) {
         if let Some(ended) = self.session.end(cause, sink) {
-            self.report(node, out, server, ended);
+            self.report(node, out, servers, ended);
         }
     }
 
@@ -431,10 +463,18 @@ impl Shell {
     /// when a newer action goal took its place), the log, the status with the last step's mode,
     /// distance, H and L; the navigator and the progress checker are cleared and the markers
     /// deleted.
-    fn report(&mut self, node: &RosNode, out: &Outputs, server: &mut GoalServer<NavigateToPose>, ended: NavEnded) {
+    fn report(&mut self, node: &RosNode, out: &Outputs, servers: &mut Servers, ended: NavEnded) {
         let (state, reason, _) = end_answer(&ended.cause);
-        if ended.source == Source::Action && !ended.server_ended {
-            server.finish(goal_end(&ended.cause), result(&ended.cause));
+        if !ended.server_ended {
+            match ended.source {
+                Source::Action => {
+                    servers.nav.finish(goal_end(&ended.cause), result(&ended.cause));
+                }
+                Source::Path => {
+                    servers.path.finish(goal_end(&ended.cause), path_result(&ended.cause));
+                }
+                Source::Topic => {}
+            }
         }
         mobil_ros::tell!(self.throttle, [ended.cause.notice(ended.source.name())]);
         let mode_before = self.nav.mode();
@@ -448,22 +488,19 @@ impl Shell {
 
     /// Starts a validated goal: the goal it replaces, if any, ends PREEMPTED (reported; an
     /// action goal replaced by the next one its server accepted was ended by the server).
-    fn start_goal(
-        &mut self,
-        node: &RosNode,
-        out: &Outputs,
-        server: &mut GoalServer<NavigateToPose>,
-        goal: Point2<f64>,
-        heading: Option<f64>,
-        source: Source,
-    ) {
+    fn start_goal(&mut self, node: &RosNode, out: &Outputs, servers: &mut Servers, source: Source, target: Target) {
+        let (goal, heading, path) = match target {
+            Target::Point { goal, heading } => (goal, heading, None),
+            Target::Path(path) => (path.goal(), None, Some(path)),
+        };
         let new = NavGoal {
             goal,
             started_ros_nanos: node.now_nanos(),
+            path,
         };
         let (_, old) = self.session.start(new, source, Instant::now());
         if let Some(old) = old {
-            self.report(node, out, server, old);
+            self.report(node, out, servers, old);
         }
         if let Err(e) = self.nav.set_goal(goal) {
             // goal_in_odom checked it: unreachable in practice, and safe if reached.
@@ -494,14 +531,17 @@ impl Shell {
         node: &RosNode,
         out: &Outputs,
         sink: &mut CmdVel<'_>,
-        server: &mut GoalServer<NavigateToPose>,
+        servers: &mut Servers,
         m: &PoseStamped,
     ) {
         match goal_in_odom(m, &self.config.frames.odom_frame) {
-            Ok(goal) => self.start_goal(node, out, server, goal, goal_heading(m), Source::Topic),
+            Ok(goal) => {
+                let heading = goal_heading(m);
+                self.start_goal(node, out, servers, Source::Topic, Target::Point { goal, heading })
+            }
             Err(e) => {
                 // A goal the user meant to replace the old one with: the old one stops too.
-                self.end_goal(node, out, sink, server, EndCause::Preempted("goal_pose, refused"));
+                self.end_goal(node, out, sink, servers, EndCause::Preempted("goal_pose, refused"));
                 let reason = invalid_goal(&e);
                 warn!("goal_pose refused: {reason}");
                 self.publish_status_with_mode(node, out, NavStatus::FAILED, reason, Mode::Idle, None);
@@ -514,7 +554,7 @@ impl Shell {
         node: &RosNode,
         out: &Outputs,
         sink: &mut CmdVel<'_>,
-        server: &mut GoalServer<NavigateToPose>,
+        servers: &mut Servers,
         request: GoalRequest<NavigateToPoseGoal>,
     ) {
         let goal = match goal_in_odom(&request.goal().pose, &self.config.frames.odom_frame) {
@@ -522,7 +562,7 @@ impl Shell {
             Err(e) => {
                 let reason = invalid_goal(&e);
                 warn!("navigate_to_pose goal rejected: {reason}");
-                server.reject(request, &reason).await;
+                servers.nav.reject(request, &reason).await;
                 // The status says so too; a running goal keeps running (unlike a refused
                 // goal_pose, a rejected action goal never replaces the active one), and its
                 // ACTIVE status follows, so that the latched status is the running goal's.
@@ -544,14 +584,14 @@ impl Shell {
         let heading = goal_heading(&request.goal().pose);
         // The server ends a running action goal itself on accept, with this result.
         let preempted = result(&EndCause::Preempted("navigate_to_pose"));
-        match server.accept(request, |_| preempted, node.now_nanos()).await {
-            Ok(()) => self.start_goal(node, out, server, goal, heading, Source::Action),
+        match servers.nav.accept(request, |_| preempted, node.now_nanos()).await {
+            Ok(()) => self.start_goal(node, out, servers, Source::Action, Target::Point { goal, heading }),
             Err(e) => {
                 warn_throttled!(self.throttle, "accept", "navigate_to_pose goal not started: {e}");
                 // A running action goal was ended by the server: the robot stops with it (and
                 // with a topic's goal, which the action's goal was to replace).
                 if let Some(ended) = self.session.preempt(Source::Action, sink) {
-                    self.report(node, out, server, ended);
+                    self.report(node, out, servers, ended);
                 }
             }
         }
@@ -562,7 +602,7 @@ impl Shell {
         node: &RosNode,
         out: &Outputs,
         sink: &mut CmdVel<'_>,
-        server: &mut GoalServer<NavigateToPose>,
+        servers: &mut Servers,
         laser: &StaticFrames,
         m: &LaserScan,
     ) {
@@ -620,6 +660,7 @@ impl Shell {
             );
             return self.session.hold(sink);
         };
+        self.next_subgoal(odom.pose.position());
         // The method counts path, not time: the step's time is the progress checker's.
         let now = node.now_nanos() as f64 * 1e-9;
         let step = GoalLaw::step(&mut self.nav, &StepInput::new(now, 0.0, odom.pose), &scan);
@@ -627,7 +668,7 @@ impl Shell {
             && let Progress::Stuck { since } = self.progress.check(odom.pose.position(), now)
         {
             let radius = self.progress.settings().required_movement_radius;
-            return self.end_goal(node, out, sink, server, no_progress(since, radius));
+            return self.end_goal(node, out, sink, servers, no_progress(since, radius));
         }
         if let Step::Refused(why) = &step {
             warn_throttled!(
@@ -648,31 +689,25 @@ impl Shell {
             }
             Applied::Refused(ended) => {
                 if let Some(ended) = ended {
-                    self.report(node, out, server, ended);
+                    self.report(node, out, servers, ended);
                 }
             }
             Applied::Ended(ended, output) => {
                 self.last_step = Some(output);
-                self.report(node, out, server, ended);
+                self.report(node, out, servers, ended);
             }
             Applied::Idle => {}
         }
     }
 
-    async fn tick(
-        &mut self,
-        node: &RosNode,
-        out: &Outputs,
-        sink: &mut CmdVel<'_>,
-        server: &mut GoalServer<NavigateToPose>,
-    ) {
+    async fn tick(&mut self, node: &RosNode, out: &Outputs, sink: &mut CmdVel<'_>, servers: &mut Servers) {
         let now = Instant::now();
         if node.uses_sim_time() {
             let timeout = self.config.timeouts.clock_timeout();
             let clock = self.session.watch_clock(node.now_nanos(), now, timeout, sink);
             mobil_ros::tell!(self.throttle, clock.notice());
             match clock {
-                ClockCheck::Back(ended) => return self.report(node, out, server, ended),
+                ClockCheck::Back(ended) => return self.report(node, out, servers, ended),
                 ClockCheck::Held { newly: true, .. } | ClockCheck::Resumed => {
                     self.publish_status(node, out, NavStatus::ACTIVE, String::new())
                 }
@@ -694,15 +729,17 @@ impl Shell {
             },
         ];
         if let Some(stale) = self.session.stale(now, &inputs) {
-            return self.end_goal(node, out, sink, server, EndCause::Stale(stale));
+            return self.end_goal(node, out, sink, servers, EndCause::Stale(stale));
         }
         let stamp = node.stamp();
         if self.status_gate.due(now, self.config.status_rate_hz) {
             self.publish_status(node, out, NavStatus::ACTIVE, String::new());
             self.publish_markers(out, goal.goal, stamp.clone());
         }
-        if source == Source::Action {
-            self.feedback(node, server, &goal, stamp).await;
+        match source {
+            Source::Action => self.feedback(node, servers, &goal, stamp).await,
+            Source::Path => self.path_feedback(servers, &goal).await,
+            Source::Topic => {}
         }
     }
 
@@ -726,7 +763,7 @@ impl Shell {
     }
 
     /// Action feedback, on every watchdog tick (20 Hz) while an action goal is active.
-    async fn feedback(&mut self, node: &RosNode, server: &mut GoalServer<NavigateToPose>, goal: &NavGoal, stamp: Time) {
+    async fn feedback(&mut self, node: &RosNode, servers: &mut Servers, goal: &NavGoal, stamp: Time) {
         let Some(odom) = self.odom.value() else { return };
         let distance = (goal.goal - odom.pose.position()).norm();
         let elapsed = (node.now_nanos().saturating_sub(goal.started_ros_nanos)) as f64 * 1e-9;
@@ -744,7 +781,7 @@ impl Shell {
             number_of_recoveries: 0,
             distance_remaining: distance as f32,
         };
-        if let Err(e) = server.feedback(feedback).await {
+        if let Err(e) = servers.nav.feedback(feedback).await {
             warn_throttled!(self.throttle, "feedback", "{e}");
         }
     }

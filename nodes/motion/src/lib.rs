@@ -213,6 +213,12 @@ pub mod nav2 {
         pub const NONE: u16 = 0;
         /// Unknown.
         pub const UNKNOWN: u16 = 100;
+        /// `controller_id` names no controller of the node.
+        pub const INVALID_CONTROLLER: u16 = 101;
+        /// The path's frame cannot be used.
+        pub const TF_ERROR: u16 = 102;
+        /// The path is empty or not finite.
+        pub const INVALID_PATH: u16 = 103;
         /// The robot did not move enough within the progress checker's time.
         pub const FAILED_TO_MAKE_PROGRESS: u16 = 105;
         /// No valid control could be computed.

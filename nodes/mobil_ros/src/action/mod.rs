@@ -79,7 +79,9 @@ use ros2_client::action::ActionServerQosPolicies;
 pub use ros2_client::action::{GoalEndStatus as GoalEnd, GoalId};
 
 use mobil_motion::{EndCause, EndKind, Nav2Codes};
-use mobil_msgs::nav2_msgs::action::{DockRobotResult, FollowWaypointsResult, NavigateToPoseResult, UndockRobotResult};
+use mobil_msgs::nav2_msgs::action::{
+    DockRobotResult, FollowPathResult, FollowWaypointsResult, NavigateToPoseResult, UndockRobotResult,
+};
 
 /// The action status a motion goal's end gives its client: SUCCEEDED, CANCELED, else ABORTED.
 pub fn goal_end(cause: &EndCause) -> GoalEnd {
@@ -133,6 +135,16 @@ impl Nav2Result for FollowWaypointsResult {
     fn ended(cause: &EndCause, codes: Nav2Codes) -> Self {
         FollowWaypointsResult {
             missed_waypoints: Vec::new(),
+            error_code: cause.nav2_error(codes),
+            error_msg: cause.reason(),
+        }
+    }
+}
+
+impl Nav2Result for FollowPathResult {
+    fn ended(cause: &EndCause, codes: Nav2Codes) -> Self {
+        FollowPathResult {
+            result: Default::default(),
             error_code: cause.nav2_error(codes),
             error_msg: cause.reason(),
         }

@@ -1,0 +1,180 @@
+"""Nav2's controller role from real rclpy (ROS 2 Jazzy, Fast DDS): ``follow_path``
+(nav2_msgs/action/FollowPath) driven as Nav2's navigator drives a controller server, a new path
+about every second, on the simulated OMR-III and MOBIL-II in the built-in world.
+
+The navigator stand-in re-plans as a global planner would: every simulated second a path from
+the robot's odometry pose straight to the next corner of the route not yet passed, then along
+the rest, poses 5 cm apart (as Nav2's planners space them).
+"""
+
+from __future__ import annotations
+
+import math
+import threading
+
+import pytest
+
+from harness import make_qos, subscribe, wait_until
+from rosutil import wait_for_future
+
+from action_msgs.msg import GoalStatus
+from geometry_msgs.msg import PoseStamped, Twist
+from nav2_msgs.action import FollowPath
+from nav_msgs.msg import Odometry, Path
+from rclpy.action import ActionClient
+
+REAL_TIME_FACTOR = 3.0
+CHASSIS_ARGS = ("-p", "feedback_timeout_s:=2.0")
+NODE_ARGS = ("-p", "use_sim_time:=true", "-p", "odom_timeout_s:=2.0", "-p", "clock_timeout_s:=2.0")
+REPLY_TIMEOUT = 10.0
+# Around the pillar at (1, 1.5) of the built-in world (sim_node's): 3 m east, 3 m north. The
+# box east starts at x = 4.5, the triangle south below y = -1.2.
+ROUTE = [(0.0, 0.0), (3.0, 0.0), (3.0, 3.0)]
+# A corner is passed once the robot is this near it.
+CORNER_PASSED = 0.6
+
+
+def path_msg(points, frame: str = "odom", spacing: float = 0.05) -> Path:
+    """A path through ``points``, poses every ``spacing`` metres (the corners included)."""
+    msg = Path()
+    msg.header.frame_id = frame
+    dense = []
+    for (x0, y0), (x1, y1) in zip(points, points[1:]):
+        n = max(1, int(math.dist((x0, y0), (x1, y1)) / spacing))
+        dense += [(x0 + (x1 - x0) * k / n, y0 + (y1 - y0) * k / n) for k in range(n)]
+    dense.append(points[-1])
+    for x, y in dense:
+        pose = PoseStamped()
+        pose.header.frame_id = frame
+        pose.pose.position.x, pose.pose.position.y = float(x), float(y)
+        pose.pose.orientation.w = 1.0
+        msg.poses.append(pose)
+    return msg
+
+
+def follow_goal(points, controller: str = "") -> FollowPath.Goal:
+    goal = FollowPath.Goal()
+    goal.path = path_msg(points) if points else Path()
+    goal.path.header.frame_id = "odom"
+    goal.controller_id = controller
+    return goal
+
+
+def accepted(client: ActionClient, goal, attempts: int = 4):
+    for _ in range(attempts):
+        future = client.send_goal_async(goal)
+        if wait_until(future.done, 3.0):
+            handle = future.result()
+            assert handle.accepted, "follow_path goal rejected"
+            return handle
+    raise AssertionError("no answer to a follow_path goal")
+
+
+def result_of(handle, timeout: float = REPLY_TIMEOUT):
+    future = handle.get_result_async()
+    assert wait_for_future(future, timeout), "no follow_path result"
+    return future.result()
+
+
+def is_zero(t: Twist) -> bool:
+    return t.linear.x == 0.0 and t.linear.y == 0.0 and t.angular.z == 0.0
+
+
+class Navigator:
+    """Nav2's navigator as a controller server sees it: a FollowPath goal along the rest of
+    ``route`` every simulated second, from the robot's odometry pose."""
+
+    def __init__(self, client: ActionClient, odom, sim_clock, route) -> None:
+        self.client, self.odom, self.clock, self.route = client, odom, sim_clock, route
+        self.handles: list = []
+        self.next_corner = 1
+        self._stop = threading.Event()
+        self.failure: BaseException | None = None
+        self._thread = threading.Thread(target=self._run, daemon=True)
+
+    def path_from(self, x: float, y: float) -> list:
+        while (self.next_corner < len(self.route) - 1
+               and math.dist((x, y), self.route[self.next_corner]) < CORNER_PASSED):
+            self.next_corner += 1
+        return [(x, y), *self.route[self.next_corner:]]
+
+    def send(self) -> None:
+        p = self.odom.latest.pose.pose.position
+        self.handles.append(accepted(self.client, follow_goal(self.path_from(p.x, p.y))))
+
+    def _run(self) -> None:
+        try:
+            while not self._stop.is_set():
+                t = self.clock.now()
+                self.clock.wait_until(t + 1.0)
+                if not self._stop.is_set():
+                    self.send()
+        except BaseException as e:  # noqa: BLE001 (reported by the test)
+            self.failure = e
+
+    def start(self) -> "Navigator":
+        self.send()
+        self._thread.start()
+        return self
+
+    def stop(self) -> None:
+        self._stop.set()
+        self._thread.join(timeout=10)
+
+
+@pytest.mark.timeout(150)
+@pytest.mark.parametrize("robot", ["omr3", "mobil2"])
+def test_follow_path_replanned_every_second_reaches_the_end_without_a_stop(
+        robot, start_scenario, start_node, sim_clock, ros_node):
+    params = f"params/{robot}.yaml"
+    start_scenario(params, real_time_factor=REAL_TIME_FACTOR, lidar=True, node_args=CHASSIS_ARGS)
+    nav = start_node("local_nav_node", *NODE_ARGS, params_file=params)
+    client = ActionClient(ros_node, FollowPath, "follow_path")
+    deep = make_qos("reliable", "volatile", 5000)
+    with subscribe(ros_node, Odometry, "odom", qos=deep) as odom, \
+            subscribe(ros_node, Odometry, "ground_truth", qos=deep) as truth, \
+            subscribe(ros_node, Twist, "cmd_vel", qos=deep) as cmd:
+        sim_clock.wait_started()
+        odom.wait_for(None, REPLY_TIMEOUT)
+        assert client.wait_for_server(timeout_sec=20.0)
+        # Goals that cannot be followed: accepted, ended at once with Nav2's codes.
+        for goal, code in ((follow_goal([]), FollowPath.Result.INVALID_PATH),
+                           (follow_goal([(1.0, 0.0)], controller="dwb"), FollowPath.Result.INVALID_CONTROLLER)):
+            res = result_of(accepted(client, goal))
+            assert res.status == GoalStatus.STATUS_ABORTED and res.result.error_code == code, \
+                (res.status, res.result.error_code, res.result.error_msg)
+        # local_nav steps on scans: wait for its first one before the route starts.
+        nav.wait_for_log(r"first scan", REPLY_TIMEOUT)
+        assert len(cmd) == 0, "cmd_vel before a goal that can be followed"
+
+        navigator = Navigator(client, odom, sim_clock, ROUTE).start()
+        t0 = sim_clock.now()
+        final = None
+        try:
+            # About 6 m at up to 0.5 m/s, with the corners: 20 simulated seconds at most. The
+            # last goal sent ends the route; one replaced meanwhile ends PREEMPTED.
+            while final is None:
+                assert sim_clock.now() - t0 < 40.0, "the route did not end within 40 simulated s"
+                assert navigator.failure is None, navigator.failure
+                future = navigator.handles[-1].get_result_async()
+                if wait_until(future.done, 0.5) and not future.result().result.error_msg.startswith("PREEMPTED"):
+                    final = future.result()
+        finally:
+            navigator.stop()
+        handles = list(navigator.handles)
+        sim_clock.wait_until(sim_clock.now() + 1.0)
+        commands = cmd.snapshot()
+        end = truth.latest.pose.pose.position
+
+    assert final.status == GoalStatus.STATUS_SUCCEEDED, (final.status, final.result.error_msg)
+    assert final.result.error_code == FollowPath.Result.NONE
+    assert len(handles) >= 8, f"only {len(handles)} paths sent: the stand-in did not re-plan every second"
+    # Every replaced goal ended ABORTED with no error, as controller_server ends a preempted one.
+    for h in handles[:-2]:
+        r = result_of(h)
+        assert r.status == GoalStatus.STATUS_ABORTED and r.result.error_code == FollowPath.Result.NONE
+    # No zero command while the paths came: only the last one, at the end.
+    zeros = [i for i, c in enumerate(commands) if is_zero(c)]
+    assert zeros == [len(commands) - 1], f"zero commands at {zeros} of {len(commands)}"
+    xg, yg = ROUTE[-1]
+    assert math.hypot(end.x - xg, end.y - yg) < 0.25, (end.x, end.y)
