@@ -178,3 +178,116 @@ def test_follow_path_replanned_every_second_reaches_the_end_without_a_stop(
     assert zeros == [len(commands) - 1], f"zero commands at {zeros} of {len(commands)}"
     xg, yg = ROUTE[-1]
     assert math.hypot(end.x - xg, end.y - yg) < 0.25, (end.x, end.y)
+
+
+# ---------------------------------------------------------------------------------------------
+# Nav2's behavior role: drive_node's backup, drive_on_heading and spin
+# ---------------------------------------------------------------------------------------------
+
+# A wall behind the robot: 0.1 m thick, its face at x = -0.45, from y = -1 to 1.
+WALL_BEHIND = "obstacles:\n  - polygon: { points: [[-0.55, -1.0], [-0.45, -1.0], [-0.45, 1.0], [-0.55, 1.0]] }\n"
+
+
+def duration(seconds: float):
+    from builtin_interfaces.msg import Duration
+    d = Duration()
+    d.sec = int(seconds)
+    d.nanosec = int(round((seconds - int(seconds)) * 1e9))
+    return d
+
+
+def yaw_of(m: Odometry) -> float:
+    q = m.pose.pose.orientation
+    return math.atan2(2.0 * (q.w * q.z + q.x * q.y), 1.0 - 2.0 * (q.y * q.y + q.z * q.z))
+
+
+def run_goal(client: ActionClient, goal, timeout: float = 30.0, feedback=None):
+    handle = None
+    for _ in range(4):
+        future = client.send_goal_async(goal, feedback_callback=feedback)
+        if wait_until(future.done, 3.0):
+            handle = future.result()
+            break
+    assert handle is not None and handle.accepted, f"{client._action_name}: goal not accepted"
+    return result_of(handle, timeout)
+
+
+@pytest.mark.timeout(120)
+def test_backup_drive_on_heading_and_spin_reach_their_targets_collide_and_time_out(
+        start_scenario, start_node, sim_clock, ros_node, tmp_path):
+    """OMR-III with a wall 0.45 m behind: DriveOnHeading 0.5 m, BackUp 0.3 m and Spin π/2 reach
+    their targets by ground truth; a BackUp of 1 m toward the wall at 0.2 m/s gives
+    COLLISION_AHEAD at once (the 2 s horizon reaches 0.4 m, the footprint 0.25 m more); a 0.3 s
+    time_allowance for a 1 m drive gives TIMEOUT."""
+    from nav2_msgs.action import BackUp, DriveOnHeading, Spin
+
+    world = tmp_path / "wall_behind.yaml"
+    world.write_text(WALL_BEHIND)
+    params = "params/omr3.yaml"
+    start_scenario(params, real_time_factor=2.0, lidar=True, node_args=CHASSIS_ARGS,
+                   sim_args=("-p", f"world_file:={world}"))
+    start_node("drive_node", *NODE_ARGS, params_file=params)
+    clients = {name: ActionClient(ros_node, kind, name)
+               for name, kind in (("backup", BackUp), ("drive_on_heading", DriveOnHeading), ("spin", Spin))}
+    deep = make_qos("reliable", "volatile", 5000)
+    with subscribe(ros_node, Odometry, "ground_truth", qos=deep) as truth:
+        sim_clock.wait_started()
+        truth.wait_for(None, REPLY_TIMEOUT)
+        for name, client in clients.items():
+            assert client.wait_for_server(timeout_sec=20.0), name
+
+        def settled() -> Odometry:
+            sim_clock.wait_until(sim_clock.now() + 1.0)
+            return truth.latest
+
+        start = settled()
+        goal = DriveOnHeading.Goal()
+        goal.target.x, goal.speed = 0.5, 0.2
+        feedback = []
+        res = run_goal(clients["drive_on_heading"], goal, feedback=lambda f: feedback.append(f.feedback))
+        assert res.status == GoalStatus.STATUS_SUCCEEDED, res.result.error_msg
+        assert res.result.error_code == DriveOnHeading.Result.NONE
+        assert feedback and 0.0 <= feedback[-1].distance_traveled <= 0.5
+        ahead = settled()
+        moved = ahead.pose.pose.position.x - start.pose.pose.position.x
+        assert abs(moved - 0.5) < 0.03, moved
+        # 2.5 s of driving at 0.2 m/s, and the ramp-down: between 2.5 and 5 simulated seconds.
+        elapsed = res.result.total_elapsed_time.sec + res.result.total_elapsed_time.nanosec * 1e-9
+        assert 2.5 <= elapsed <= 5.0, elapsed
+
+        goal = BackUp.Goal()
+        goal.target.x, goal.speed = 0.3, 0.1
+        res = run_goal(clients["backup"], goal)
+        assert res.status == GoalStatus.STATUS_SUCCEEDED, res.result.error_msg
+        back = settled()
+        moved = back.pose.pose.position.x - ahead.pose.pose.position.x
+        assert abs(moved + 0.3) < 0.03, moved
+
+        goal = Spin.Goal()
+        goal.target_yaw = math.pi / 2
+        res = run_goal(clients["spin"], goal)
+        assert res.status == GoalStatus.STATUS_SUCCEEDED, res.result.error_msg
+        turned = settled()
+        dyaw = math.remainder(yaw_of(turned) - yaw_of(back), math.tau)
+        assert abs(dyaw - math.pi / 2) < 0.05, dyaw
+        # Face east again: the wall is behind.
+        goal.target_yaw = -math.pi / 2
+        assert run_goal(clients["spin"], goal).status == GoalStatus.STATUS_SUCCEEDED
+        settled()
+
+        goal = BackUp.Goal()
+        goal.target.x, goal.speed = 1.0, 0.2
+        res = run_goal(clients["backup"], goal)
+        assert res.status == GoalStatus.STATUS_ABORTED
+        assert res.result.error_code == BackUp.Result.COLLISION_AHEAD, res.result.error_msg
+
+        goal = DriveOnHeading.Goal()
+        goal.target.x, goal.speed, goal.time_allowance = 1.0, 0.1, duration(0.3)
+        res = run_goal(clients["drive_on_heading"], goal)
+        assert res.status == GoalStatus.STATUS_ABORTED
+        assert res.result.error_code == DriveOnHeading.Result.TIMEOUT, res.result.error_msg
+        # Nav2's rules: a y component is INVALID_INPUT.
+        goal = DriveOnHeading.Goal()
+        goal.target.x, goal.target.y, goal.speed = 0.5, 0.1, 0.1
+        res = run_goal(clients["drive_on_heading"], goal)
+        assert res.result.error_code == DriveOnHeading.Result.INVALID_INPUT

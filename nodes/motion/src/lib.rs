@@ -249,6 +249,49 @@ pub mod nav2 {
         /// The task executor (the law following the route) failed.
         pub const TASK_EXECUTOR_FAILED: u16 = 601;
     }
+    /// The behavior server's codes: one block per action (`Spin` 70x, `BackUp` 71x,
+    /// `DriveOnHeading` 72x), each with its own UNKNOWN, TIMEOUT, TF_ERROR, COLLISION_AHEAD and
+    /// (not Spin) INVALID_INPUT.
+    pub mod behavior {
+        /// A behavior's codes.
+        #[derive(Debug, Clone, Copy, PartialEq, Eq)]
+        pub struct Codes {
+            /// Unknown.
+            pub unknown: u16,
+            /// `time_allowance` exceeded.
+            pub timeout: u16,
+            /// The robot's pose is not available (stale or refused odometry).
+            pub tf_error: u16,
+            /// An obstacle in the way of the motion.
+            pub collision_ahead: u16,
+            /// A goal the behavior cannot run (Spin has none: 0).
+            pub invalid_input: u16,
+        }
+        /// `Spin`.
+        pub const SPIN: Codes = Codes {
+            unknown: 700,
+            timeout: 701,
+            tf_error: 702,
+            collision_ahead: 703,
+            invalid_input: 0,
+        };
+        /// `BackUp`.
+        pub const BACK_UP: Codes = Codes {
+            unknown: 710,
+            timeout: 711,
+            tf_error: 712,
+            collision_ahead: 714,
+            invalid_input: 713,
+        };
+        /// `DriveOnHeading`.
+        pub const DRIVE_ON_HEADING: Codes = Codes {
+            unknown: 720,
+            timeout: 721,
+            tf_error: 722,
+            collision_ahead: 723,
+            invalid_input: 724,
+        };
+    }
 }
 
 /// The codes an action's result gives for the ends the node makes itself (a law's end carries
@@ -278,6 +321,15 @@ impl Nav2Codes {
         control_failure: nav2::follow_waypoints::TASK_EXECUTOR_FAILED,
         unknown: nav2::follow_waypoints::UNKNOWN,
     };
+
+    /// A behavior (`Spin`, `BackUp`, `DriveOnHeading`): its TF_ERROR (the pose lost) and
+    /// UNKNOWN.
+    pub const fn behavior(codes: nav2::behavior::Codes) -> Nav2Codes {
+        Nav2Codes {
+            control_failure: codes.tf_error,
+            unknown: codes.unknown,
+        }
+    }
 }
 
 /// Why a goal ended.

@@ -11,6 +11,7 @@
 //! the fifth act's planned walk; [`vfo`], the sixth act's VFO waypoint following. [`status`]:
 //! a navigation node's status as the acts read it.
 
+pub mod behavior;
 pub mod drive;
 pub mod gait;
 pub mod nav;

@@ -1,33 +1,47 @@
-//! `drive_node`: serves the `mobil_msgs/action/DriveDistance` action `drive_distance` — drive
-//! straight ahead or back by a distance, following `odom` and commanding `cmd_vel`, like Nav2's
-//! DriveOnHeading / BackUp behaviours. The logic is `mobil_tools::drive`; this is its shell.
+//! `drive_node`: short motions on request, following `odom` and commanding `cmd_vel`:
+//! - `drive_distance` (`mobil_msgs/action/DriveDistance`): straight ahead or back by a distance;
+//! - Nav2's behavior server's actions (Jazzy): `backup` (BackUp), `drive_on_heading`
+//!   (DriveOnHeading) and `spin` (Spin), with `time_allowance` and, when a scan is fresh, the
+//!   check for an obstacle in the robot's way (COLLISION_AHEAD).
 //!
-//! Its goals run through the kit's motion server ([`MotionSession`]): `cmd_vel` only while a
-//! goal runs, one zero `cmd_vel` when it ends — reached, canceled, odometry stale for
-//! `odom_timeout_s` (steady clock; ABORTED) — and none between a goal and the newer goal that
-//! pre-empts it (the old one ends ABORTED; the new one commands at once). A node leaving
-//! (shutdown or a failure) with a goal under way sends a last zero `cmd_vel`, waited for until
-//! the readers acknowledge it (at most `mobil_ros::stop::FINAL_STOP_WAIT`); an idle one sends
-//! none. A goal that cannot be started (a DDS send to that client failed) is logged and the
-//! node goes on serving.
+//! The laws are `mobil_tools::drive` and `mobil_tools::behavior`; this is their shell. Every
+//! goal runs through the kit's motion server ([`MotionSession`]): `cmd_vel` only while a goal
+//! runs, one zero `cmd_vel` when it ends — reached, canceled, odometry stale for
+//! `odom_timeout_s` (steady clock; ABORTED), timed out, blocked — and none between a goal and
+//! the newer goal (of any of the four actions) that pre-empts it. A node leaving (shutdown or a
+//! failure) with a goal under way sends a last zero `cmd_vel`, waited for until the readers
+//! acknowledge it (at most `mobil_ros::stop::FINAL_STOP_WAIT`); an idle one sends none. The
+//! node is a managed node ([`Lifecycle`]): goals only while active.
 
-use mobil_motion::{BodyTwist, GoalLaw, StepInput};
+use mobil_motion::nav2::behavior::{Codes, BACK_UP, DRIVE_ON_HEADING, SPIN};
+use mobil_motion::{BodyTwist, GoalLaw, Nav2Codes, Outcome, StepInput};
+use mobil_msgs::builtin_interfaces::msg::Duration as DurationMsg;
 use mobil_msgs::geometry_msgs::msg::Twist;
 use mobil_msgs::mobil_msgs::action::{DriveDistance, DriveDistanceFeedback, DriveDistanceResult};
+use mobil_msgs::nav2_msgs::action::{
+    BackUp, BackUpFeedback, BackUpResult, DriveOnHeading, DriveOnHeadingFeedback, DriveOnHeadingResult, Spin,
+    SpinFeedback, SpinResult,
+};
 use mobil_msgs::nav_msgs::msg::Odometry;
-use mobil_ros::action::{ActionEvent, GoalEnd, GoalServer, GoalServerConfig};
+use mobil_msgs::sensor_msgs::msg::LaserScan;
+use mobil_ros::action::{goal_end, ActionEvent, GoalEnd, GoalRequest, GoalServer, GoalServerConfig};
 use mobil_ros::config::{Config, ConfigError, Decl};
 use mobil_ros::geometry::planar_pose;
-use mobil_ros::groups::GoalTimeouts;
+use mobil_ros::groups::{GoalTimeouts, MAX_INPUT_TIMEOUT_S};
 use mobil_ros::input::Inputs;
 use mobil_ros::latest::Latest;
 use mobil_ros::lifecycle::{CallbackReturn, Lifecycle, Managed};
 use mobil_ros::motion::{Applied, ClockCheck, CmdVel, EndCause, EndKind, Ended, MotionSession, SessionSettings};
+use mobil_ros::scan::{checked_scan, tf_static_subscription, LaserMount, StaticFrames};
 use mobil_ros::stop::{final_stop, FINAL_STOP_WAIT};
 use mobil_ros::ticker::Ticker;
+use mobil_ros::time::{duration_msg, seconds};
 use mobil_ros::{qos, run_node, shutdown_signal, warn_throttled, LogThrottle, NodeDecl, RosNode};
-use mobil_tools::drive::{DistanceDrive, DriveSettings, Pose2};
-use ros2_client::{Publisher, Subscription};
+use mobil_tools::behavior::{Behavior, Guard, SpinSettings};
+use mobil_tools::drive::Pose2;
+use mobil_tools::drive::{DistanceDrive, DriveSettings};
+use nalgebra::Point2;
+use ros2_client::Publisher;
 use std::process::ExitCode;
 use std::time::{Duration, Instant};
 use tracing::{info, warn};
@@ -40,8 +54,52 @@ struct DriveConfig {
     decel: f64,
     tolerance: f64,
     rate_hz: f64,
+    spin: SpinSettings,
+    robot_radius: f64,
+    simulate_ahead_time: f64,
+    scan_timeout_s: f64,
+    base_frame: String,
+    laser_frame: String,
+    laser_pose: Vec<f64>,
     timeouts: GoalTimeouts,
     managed: Managed,
+}
+
+/// The spin parameters' declarations (Nav2's names).
+struct SpinSettingsParams;
+
+impl SpinSettingsParams {
+    fn declare(d: &mut Decl<SpinSettings>) {
+        let s = SpinSettings::default();
+        d.double(
+            "max_rotational_vel",
+            s.max_speed,
+            "spin: highest turn rate (Nav2's parameter) [rad/s]",
+            |c, v| c.max_speed = v,
+        )
+        .above(0.0);
+        d.double(
+            "min_rotational_vel",
+            s.min_speed,
+            "spin: slowest turn rate before arrival [rad/s]",
+            |c, v| c.min_speed = v,
+        )
+        .above(0.0);
+        d.double(
+            "rotational_acc_lim",
+            s.decel,
+            "spin: deceleration of the ramp-down before arrival [rad/s²]",
+            |c, v| c.decel = v,
+        )
+        .above(0.0);
+        d.double(
+            "yaw_tolerance",
+            s.tolerance,
+            "spin: arrived when this close to target_yaw [rad]",
+            |c, v| c.tolerance = v,
+        )
+        .above(0.0);
+    }
 }
 
 impl Config for DriveConfig {
@@ -75,6 +133,50 @@ impl Config for DriveConfig {
             |c, v| c.rate_hz = v,
         )
         .within(1.0, 200.0);
+        d.nest(|c: &mut DriveConfig| &mut c.spin, SpinSettingsParams::declare);
+        d.double(
+            "robot_radius",
+            0.25,
+            "radius of the round footprint the collision check sweeps (as the params files' /** section gives it) [m]",
+            |c, v| c.robot_radius = v,
+        )
+        .above(0.0);
+        d.double(
+            "simulate_ahead_time",
+            2.0,
+            "backup, drive_on_heading: the motion of the next this many seconds is checked against the scan \
+             (Nav2's parameter) [s]",
+            |c, v| c.simulate_ahead_time = v,
+        )
+        .min(0.0)
+        .max(60.0);
+        d.double(
+            "scan_timeout_s",
+            0.5,
+            "the collision check uses a scan no older than this (steady clock); without one it is off [s]",
+            |c, v| c.scan_timeout_s = v,
+        )
+        .above(0.0)
+        .max(MAX_INPUT_TIMEOUT_S);
+        d.string("base_frame", "base_link", "robot frame (reference point)", |c, v| {
+            c.base_frame = v
+        })
+        .read_only();
+        d.string(
+            "laser_frame",
+            "laser",
+            "the scan's frame: its pose in base_frame comes from tf_static",
+            |c, v| c.laser_frame = v,
+        )
+        .read_only();
+        d.double_list(
+            "laser_pose",
+            &[],
+            "x, y, yaw of the laser in the base frame for scans whose frame tf_static does not give; \
+             empty (default): such scans are not used",
+            |c, v| c.laser_pose = v,
+        )
+        .read_only();
         d.nest(|c: &mut DriveConfig| &mut c.timeouts, GoalTimeouts::declare);
         d.nest(|c: &mut DriveConfig| &mut c.managed, Managed::declare);
     }
@@ -84,6 +186,18 @@ impl Config for DriveConfig {
             return Err(ConfigError::inconsistent(format!(
                 "min_speed {} is above max_speed {}",
                 self.min_speed, self.max_speed
+            )));
+        }
+        if self.spin.min_speed > self.spin.max_speed {
+            return Err(ConfigError::inconsistent(format!(
+                "min_rotational_vel {} is above max_rotational_vel {}",
+                self.spin.min_speed, self.spin.max_speed
+            )));
+        }
+        if !matches!(self.laser_pose.len(), 0 | 3) {
+            return Err(ConfigError::inconsistent(format!(
+                "laser_pose has {} values: give x, y, yaw (3) or none",
+                self.laser_pose.len()
             )));
         }
         Ok(())
@@ -99,12 +213,20 @@ impl DriveConfig {
             tolerance: self.tolerance,
         }
     }
+
+    fn guard(&self) -> Guard {
+        Guard {
+            robot_radius: self.robot_radius,
+            simulate_ahead_time: self.simulate_ahead_time,
+        }
+    }
 }
 
 fn decl() -> NodeDecl {
     NodeDecl::for_config::<DriveConfig>(
         "drive",
-        "Serves the DriveDistance action: drives straight by a distance, following odom, commanding cmd_vel",
+        "Short motions on request: DriveDistance, and Nav2's BackUp, DriveOnHeading and Spin; follows odom, \
+         commands cmd_vel",
     )
 }
 
@@ -112,58 +234,199 @@ fn main() -> ExitCode {
     run_node(&decl(), |node| Box::pin(serve(node)))
 }
 
-fn result(travelled: f64, reason: &str) -> DriveDistanceResult {
+/// The action a goal came from.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Kind {
+    Distance,
+    BackUp,
+    Heading,
+    Spin,
+}
+
+impl From<Kind> for &'static str {
+    fn from(k: Kind) -> &'static str {
+        match k {
+            Kind::Distance => "drive_distance",
+            Kind::BackUp => "backup",
+            Kind::Heading => "drive_on_heading",
+            Kind::Spin => "spin",
+        }
+    }
+}
+
+impl Kind {
+    /// The Nav2 behavior's codes (none for DriveDistance).
+    fn codes(self) -> Option<Codes> {
+        match self {
+            Kind::Distance => None,
+            Kind::BackUp => Some(BACK_UP),
+            Kind::Heading => Some(DRIVE_ON_HEADING),
+            Kind::Spin => Some(SPIN),
+        }
+    }
+}
+
+type Session = MotionSession<Behavior, Kind>;
+type DriveEnded = Ended<Behavior, Kind>;
+
+/// The node's action servers.
+struct Servers {
+    distance: GoalServer<DriveDistance>,
+    backup: GoalServer<BackUp>,
+    heading: GoalServer<DriveOnHeading>,
+    spin: GoalServer<Spin>,
+}
+
+fn distance_result(travelled: f64, reason: &str) -> DriveDistanceResult {
     DriveDistanceResult {
         travelled,
         reason: reason.to_owned(),
     }
 }
 
-/// The one goal source: the action.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-struct DriveAction;
-
-impl From<DriveAction> for &'static str {
-    fn from(_: DriveAction) -> &'static str {
-        "drive_distance"
-    }
-}
-
-type Session = MotionSession<DistanceDrive, DriveAction>;
-
-/// The action's answer for an ended goal: its status and result (the reason as the action has
-/// always given it).
-fn answer(ended: &Ended<DistanceDrive, DriveAction>) -> (GoalEnd, DriveDistanceResult) {
-    let reason = match &ended.cause {
+/// The reason DriveDistance's result has always given.
+fn distance_reason(cause: &EndCause) -> String {
+    match cause {
         EndCause::Outcome(o) if o.is_success() => "reached".to_owned(),
         EndCause::Canceled => "canceled".to_owned(),
         EndCause::Preempted(_) => "preempted by a newer goal".to_owned(),
         EndCause::Stale(_) => "odometry stale".to_owned(),
         EndCause::Shutdown => "shutting down".to_owned(),
         other => other.reason(),
-    };
-    let status = match ended.cause.kind() {
-        EndKind::Succeeded => GoalEnd::Succeeded,
-        EndKind::Canceled => GoalEnd::Canceled,
-        EndKind::Aborted => GoalEnd::Aborted,
-    };
-    (status, result(ended.goal.progress().travelled, &reason))
+    }
 }
 
-fn finish(server: &mut GoalServer<DriveDistance>, ended: Option<Ended<DistanceDrive, DriveAction>>) {
-    if let Some(ended) = ended {
-        let (status, result) = answer(&ended);
-        match status {
-            GoalEnd::Succeeded | GoalEnd::Canceled => info!("goal ends: {}", result.reason),
-            GoalEnd::Aborted => warn!("goal ends: {}", result.reason),
+/// A behavior's result fields: elapsed time, Nav2's code, the reason.
+fn behavior_answer(kind: Kind, cause: &EndCause, elapsed: f64) -> (DurationMsg, u16, String) {
+    let codes = kind.codes().map_or(Nav2Codes::FOLLOW_PATH, Nav2Codes::behavior);
+    (duration_msg(elapsed), cause.nav2_error(codes), cause.reason())
+}
+
+impl Servers {
+    /// The ended goal's action result, unless its server ended it already.
+    fn finish(&mut self, ended: &DriveEnded) {
+        let cause = &ended.cause;
+        match cause.kind() {
+            EndKind::Succeeded | EndKind::Canceled => {
+                info!("goal ({}) ends: {}", <&str>::from(ended.source), cause.reason())
+            }
+            EndKind::Aborted => warn!("goal ({}) ends: {}", <&str>::from(ended.source), cause.reason()),
         }
-        server.finish(status, result);
+        if ended.server_ended {
+            return;
+        }
+        let status = goal_end(cause);
+        let (elapsed, code, msg) = behavior_answer(ended.source, cause, ended.t);
+        let travelled = ended.goal.progress().travelled;
+        match ended.source {
+            Kind::Distance => {
+                self.distance
+                    .finish(status, distance_result(travelled, &distance_reason(cause)));
+            }
+            Kind::BackUp => {
+                let r = BackUpResult {
+                    total_elapsed_time: elapsed,
+                    error_code: code,
+                    error_msg: msg,
+                };
+                self.backup.finish(status, r);
+            }
+            Kind::Heading => {
+                let r = DriveOnHeadingResult {
+                    total_elapsed_time: elapsed,
+                    error_code: code,
+                    error_msg: msg,
+                };
+                self.heading.finish(status, r);
+            }
+            Kind::Spin => {
+                let r = SpinResult {
+                    total_elapsed_time: elapsed,
+                    error_code: code,
+                    error_msg: msg,
+                };
+                self.spin.finish(status, r);
+            }
+        };
+    }
+
+    /// The active goal's feedback.
+    async fn feedback(&self, kind: Kind, goal: &Behavior) -> Result<(), mobil_ros::action::ActionError> {
+        let p = goal.progress();
+        let done = p.travelled.abs() as f32;
+        match kind {
+            Kind::Distance => {
+                let f = DriveDistanceFeedback {
+                    travelled: p.travelled,
+                    remaining: p.remaining,
+                };
+                self.distance.feedback(f).await
+            }
+            Kind::BackUp => {
+                self.backup
+                    .feedback(BackUpFeedback {
+                        distance_traveled: done,
+                    })
+                    .await
+            }
+            Kind::Heading => {
+                let f = DriveOnHeadingFeedback {
+                    distance_traveled: done,
+                };
+                self.heading.feedback(f).await
+            }
+            Kind::Spin => {
+                let f = SpinFeedback {
+                    angular_distance_traveled: done,
+                };
+                self.spin.feedback(f).await
+            }
+        }
+    }
+
+    fn active_id(&self, kind: Kind) -> Option<mobil_ros::action::GoalId> {
+        match kind {
+            Kind::Distance => self.distance.active_id(),
+            Kind::BackUp => self.backup.active_id(),
+            Kind::Heading => self.heading.active_id(),
+            Kind::Spin => self.spin.active_id(),
+        }
+    }
+
+    async fn close(self, travelled: f64, reason: &str) {
+        let cause = EndCause::Shutdown;
+        let answer = |k: Kind| behavior_answer(k, &cause, 0.0);
+        let (t, c, m) = answer(Kind::BackUp);
+        let backup = BackUpResult {
+            total_elapsed_time: t,
+            error_code: c,
+            error_msg: m,
+        };
+        let (t, c, m) = answer(Kind::Heading);
+        let heading = DriveOnHeadingResult {
+            total_elapsed_time: t,
+            error_code: c,
+            error_msg: m,
+        };
+        let (t, c, m) = answer(Kind::Spin);
+        let spin = SpinResult {
+            total_elapsed_time: t,
+            error_code: c,
+            error_msg: m,
+        };
+        tokio::join!(
+            self.distance.close(distance_result(travelled, reason)),
+            self.backup.close(backup),
+            self.heading.close(heading),
+            self.spin.close(spin),
+        );
     }
 }
 
 fn twist(b: BodyTwist) -> Twist {
     let mut t = Twist::default();
     t.linear.x = b.vx;
+    t.angular.z = b.wz;
     t
 }
 
@@ -184,165 +447,413 @@ async fn drive_loop(
     node: &mut RosNode,
     cmd: &Publisher<Twist>,
     session: &mut Session,
-    mut config: DriveConfig,
+    config: DriveConfig,
 ) -> anyhow::Result<()> {
-    let odom_sub = node.subscription::<Odometry>("odom", &qos::default_qos())?;
     let mut lifecycle = Lifecycle::serve(node, &config.managed)?;
-    let mut server = GoalServer::<DriveDistance>::create(
-        node,
-        "drive_distance",
-        GoalServerConfig {
-            result_timeout: config.timeouts.result_timeout(),
-        },
-    )?
-    .gate(lifecycle.gate());
-    let io = Io {
-        cmd,
-        odom_sub: &odom_sub,
-        server: &mut server,
-        lifecycle: &mut lifecycle,
+    let server_config = GoalServerConfig {
+        result_timeout: config.timeouts.result_timeout(),
     };
-    let outcome = event_loop(node, io, session, &mut config).await;
+    let gate = lifecycle.gate();
+    let mut servers = Servers {
+        distance: GoalServer::create(node, "drive_distance", server_config.clone())?.gate(gate.clone()),
+        backup: GoalServer::create(node, "backup", server_config.clone())?.gate(gate.clone()),
+        heading: GoalServer::create(node, "drive_on_heading", server_config.clone())?.gate(gate.clone()),
+        spin: GoalServer::create(node, "spin", server_config)?.gate(gate),
+    };
+    let mut shell = Shell {
+        config,
+        latest: Latest::new(),
+        echoes: Latest::new(),
+        laser: StaticFrames::default(),
+        throttle: LogThrottle::new(Duration::from_secs(2)),
+    };
+    let outcome = shell.event_loop(node, cmd, &mut servers, &mut lifecycle, session).await;
     let travelled = session.active().map_or(0.0, |a| a.goal.progress().travelled);
     let reason = if outcome.is_ok() {
         "shutting down"
     } else {
         "node failed"
     };
-    server.close(result(travelled, reason)).await;
+    servers.close(travelled, reason).await;
     lifecycle.close();
     outcome
 }
 
-/// The node's interfaces, for its loop.
-struct Io<'a> {
-    cmd: &'a Publisher<Twist>,
-    odom_sub: &'a Subscription<Odometry>,
-    server: &'a mut GoalServer<DriveDistance>,
-    lifecycle: &'a mut Lifecycle,
+/// What woke the loop.
+#[allow(clippy::large_enum_variant)]
+enum Event {
+    Shutdown,
+    Config(Result<DriveConfig, ConfigError>),
+    Odom(Odometry),
+    Scan(LaserScan),
+    Lifecycle(mobil_ros::lifecycle::Transition),
+    Distance(ActionEvent<mobil_msgs::mobil_msgs::action::DriveDistanceGoal>),
+    BackUp(ActionEvent<mobil_msgs::nav2_msgs::action::BackUpGoal>),
+    Heading(ActionEvent<mobil_msgs::nav2_msgs::action::DriveOnHeadingGoal>),
+    Spin(ActionEvent<mobil_msgs::nav2_msgs::action::SpinGoal>),
+    Tick,
 }
 
-async fn event_loop(
-    node: &mut RosNode,
-    io: Io<'_>,
-    session: &mut Session,
-    config: &mut DriveConfig,
-) -> anyhow::Result<()> {
-    let Io {
-        cmd,
-        odom_sub,
-        server,
-        lifecycle,
-    } = io;
-    let mut inputs = Inputs::new();
-    inputs.add(odom_sub.async_stream(), "odom", "sample ignored", |m: Odometry| m);
-    let shutdown = shutdown_signal();
-    tokio::pin!(shutdown);
-    let mut ticker = Ticker::new(config.rate_hz)?;
-    let mut throttle = LogThrottle::new(Duration::from_secs(2));
-    let mut sink = CmdVel::new(cmd);
+/// What the loop keeps between events.
+struct Shell {
+    config: DriveConfig,
+    /// The latest valid odometry pose, with its stamp and steady receive instant: the one
+    /// place odom freshness is judged.
+    latest: Latest<Pose2>,
+    /// The latest scan's echoes in the base frame (the collision check's input).
+    echoes: Latest<Vec<Point2<f64>>>,
+    laser: StaticFrames,
+    throttle: LogThrottle,
+}
 
-    // The latest valid odometry pose, with its stamp and steady receive instant: the one
-    // place odom freshness is judged.
-    let mut latest: Latest<Pose2> = Latest::new();
-    info!("serving drive_distance");
-    loop {
-        tokio::select! {
-            _ = &mut shutdown => return Ok(()),
-            Some(changed) = node.config_changed::<DriveConfig>() => match changed {
-                Ok(c) => match ticker.set_rate(c.rate_hz) {
+/// A Nav2 behavior's goal: the law, or the end Nav2's behavior server gives it at once.
+type Built = Result<Behavior, Outcome>;
+
+impl Shell {
+    async fn event_loop(
+        &mut self,
+        node: &mut RosNode,
+        cmd: &Publisher<Twist>,
+        servers: &mut Servers,
+        lifecycle: &mut Lifecycle,
+        session: &mut Session,
+    ) -> anyhow::Result<()> {
+        let odom_sub = node.subscription::<Odometry>("odom", &qos::default_qos())?;
+        let scan_sub = node.subscription::<LaserScan>("scan", &qos::sensor_data())?;
+        let tf_sub = tf_static_subscription(node)?;
+        let mut inputs = Inputs::new();
+        inputs
+            .add(odom_sub.async_stream(), "odom", "sample ignored", Event::Odom)
+            .add(scan_sub.async_stream(), "scan", "scan ignored", Event::Scan);
+        let shutdown = shutdown_signal();
+        tokio::pin!(shutdown);
+        let mut ticker = Ticker::new(self.config.rate_hz)?;
+        let mut sink = CmdVel::new(cmd);
+        info!("serving drive_distance, backup, drive_on_heading, spin");
+        loop {
+            let event = tokio::select! {
+                _ = &mut shutdown => Event::Shutdown,
+                Some(changed) = node.config_changed::<DriveConfig>() => Event::Config(changed),
+                e = inputs.next() => e?,
+                t = lifecycle.next() => Event::Lifecycle(t),
+                e = servers.distance.next_event() => Event::Distance(e),
+                e = servers.backup.next_event() => Event::BackUp(e),
+                e = servers.heading.next_event() => Event::Heading(e),
+                e = servers.spin.next_event() => Event::Spin(e),
+                _ = ticker.tick() => Event::Tick,
+            };
+            match event {
+                Event::Shutdown => return Ok(()),
+                Event::Config(Ok(c)) => match ticker.set_rate(c.rate_hz) {
                     Ok(()) => {
                         lifecycle.set_managed(&c.managed);
-                        *config = c;
+                        self.config = c;
                     }
                     Err(e) => warn!("parameters not applied: {e}"),
                 },
-                Err(e) => warn!("parameters not applied: {e}"),
-            },
-            transition = lifecycle.next() => {
-                // Leaving active (deactivate, shutdown): the goal under way ends, with its zero.
-                if transition.leaves_active() {
-                    let ended = session.end(EndCause::Deactivated, &mut sink);
-                    finish(server, ended);
+                Event::Config(Err(e)) => warn!("parameters not applied: {e}"),
+                Event::Odom(m) => match planar_pose(&m.pose.pose) {
+                    Ok(pose) => self.latest.set(pose, m.header.stamp),
+                    Err(e) => warn_throttled!(self.throttle, "odom-bad", "{e}: sample dropped"),
+                },
+                Event::Scan(m) => {
+                    self.laser.refresh(&tf_sub, &mut self.throttle);
+                    self.scan_in(&m);
                 }
-                lifecycle.complete(transition, CallbackReturn::Success);
-            }
-            m = inputs.next() => {
-                let m = m?;
-                match planar_pose(&m.pose.pose) {
-                    Ok(pose) => latest.set(pose, m.header.stamp),
-                    Err(e) => warn_throttled!(throttle, "odom-bad", "{e}: sample dropped"),
+                Event::Lifecycle(transition) => {
+                    // Leaving active (deactivate, shutdown): the goal under way ends, with its zero.
+                    if transition.leaves_active()
+                        && let Some(ended) = session.end(EndCause::Deactivated, &mut sink)
+                    {
+                        servers.finish(&ended);
+                    }
+                    lifecycle.complete(transition, CallbackReturn::Success);
                 }
-            }
-            event = server.next_event() => match event {
-                ActionEvent::Goal(request) => {
-                    let goal = request.goal().clone();
-                    let Some(&start) = latest.get(config.timeouts.odom_timeout()) else {
-                        server.reject(request, "no recent odom: is the chassis running?").await;
-                        continue;
+                Event::Distance(ActionEvent::Goal(request)) => {
+                    self.distance_goal(node, servers, session, &mut sink, request).await
+                }
+                Event::BackUp(ActionEvent::Goal(request)) => {
+                    let g = request.goal();
+                    let (target, speed, allowance) =
+                        ([g.target.x, g.target.y, g.target.z], g.speed, g.time_allowance.clone());
+                    let (settings, guard) = (self.config.settings(), self.config.guard());
+                    let build =
+                        |start| Behavior::back_up(start, target, f64::from(speed), settings, secs(&allowance), guard);
+                    let start = self.nav2_start(Kind::BackUp);
+                    let built = start.and_then(build);
+                    let accepted = servers
+                        .backup
+                        .accept(request, |_| preempted_backup(), node.now_nanos())
+                        .await;
+                    self.begin(servers, session, &mut sink, Kind::BackUp, accepted, built);
+                }
+                Event::Heading(ActionEvent::Goal(request)) => {
+                    let g = request.goal();
+                    let (target, speed, allowance) =
+                        ([g.target.x, g.target.y, g.target.z], g.speed, g.time_allowance.clone());
+                    let (settings, guard) = (self.config.settings(), self.config.guard());
+                    let build = |start| {
+                        Behavior::drive_on_heading(start, target, f64::from(speed), settings, secs(&allowance), guard)
                     };
-                    match DistanceDrive::new(start, goal.distance, goal.speed, config.settings()) {
-                        Err(e) => server.reject(request, &e.to_string()).await,
-                        Ok(new) => {
-                            let travelled = session.active().map_or(0.0, |a| a.goal.progress().travelled);
-                            // The server ends the goal it replaces itself, with this result.
-                            let preempted = |_: &_| result(travelled, "preempted by a newer goal");
-                            match server.accept(request, preempted, node.now_nanos()).await {
-                                Ok(()) => {
-                                    info!("driving {} m at {} m/s", goal.distance, goal.speed);
-                                    session.start(new, DriveAction, Instant::now());
-                                }
-                                // One client's goal (a DDS send failed): logged, and the node
-                                // goes on serving the others; a goal it replaced was ended.
-                                Err(e) => {
-                                    warn_throttled!(throttle, "accept", "goal not started: {e}");
-                                    session.preempt(DriveAction, &mut sink);
-                                }
-                            }
-                        }
-                    }
+                    let built = self.nav2_start(Kind::Heading).and_then(build);
+                    let accepted = servers
+                        .heading
+                        .accept(request, |_| preempted_heading(), node.now_nanos())
+                        .await;
+                    self.begin(servers, session, &mut sink, Kind::Heading, accepted, built);
                 }
-                ActionEvent::CancelRequested(_) => {
-                    let ended = session.end(EndCause::Canceled, &mut sink);
-                    finish(server, ended);
+                Event::Spin(ActionEvent::Goal(request)) => {
+                    let g = request.goal();
+                    let (target, allowance) = (f64::from(g.target_yaw), g.time_allowance.clone());
+                    let (settings, guard) = (self.config.spin, self.config.guard());
+                    let build = |start| Behavior::spin(start, target, secs(&allowance), settings, guard);
+                    let built = self.nav2_start(Kind::Spin).and_then(build);
+                    let accepted = servers
+                        .spin
+                        .accept(request, |_| preempted_spin(), node.now_nanos())
+                        .await;
+                    self.begin(servers, session, &mut sink, Kind::Spin, accepted, built);
                 }
-            },
-            _ = ticker.tick() => {
-                if node.uses_sim_time() {
-                    let timeout = config.timeouts.clock_timeout();
-                    let clock = session.watch_clock(node.now_nanos(), Instant::now(), timeout, &mut sink);
-                    mobil_ros::tell!(throttle, clock.notice());
-                    if let ClockCheck::Back(ended) = clock {
-                        finish(server, Some(ended));
-                        continue;
-                    }
+                Event::Distance(ActionEvent::CancelRequested(id)) => {
+                    cancel(servers, session, &mut sink, Kind::Distance, id)
                 }
-                if session.active().is_none() {
-                    continue;
+                Event::BackUp(ActionEvent::CancelRequested(id)) => {
+                    cancel(servers, session, &mut sink, Kind::BackUp, id)
                 }
-                let Some(&pose) = latest.get(config.timeouts.odom_timeout()) else {
-                    warn!("no odom for {:?}: goal aborted", config.timeouts.odom_timeout());
-                    let ended = session.end(EndCause::Stale("odom".into()), &mut sink);
-                    finish(server, ended);
-                    continue;
+                Event::Heading(ActionEvent::CancelRequested(id)) => {
+                    cancel(servers, session, &mut sink, Kind::Heading, id)
+                }
+                Event::Spin(ActionEvent::CancelRequested(id)) => cancel(servers, session, &mut sink, Kind::Spin, id),
+                Event::Tick => self.tick(node, servers, session, &mut sink).await,
+            }
+        }
+    }
+
+    /// A scan's echoes in the base frame, kept for the collision check; a scan that cannot be
+    /// placed is dropped (the check then goes off once the last one is older than the timeout).
+    fn scan_in(&mut self, m: &LaserScan) {
+        let mount = LaserMount {
+            base_frame: &self.config.base_frame,
+            laser_frame: &self.config.laser_frame,
+            parameter: mobil_ros::scan::laser_pose_param(&self.config.laser_pose),
+        };
+        match checked_scan(&self.laser, &mount, m, None) {
+            Ok(c) => self
+                .echoes
+                .set(c.scan.points_in_base().collect(), m.header.stamp.clone()),
+            Err(e) => warn_throttled!(self.throttle, "scan-bad", "{e}; scan not used for the collision check"),
+        }
+    }
+
+    /// The pose a Nav2 behavior starts from, or TF_ERROR (Nav2: "current robot pose is not
+    /// available").
+    fn nav2_start(&self, kind: Kind) -> Result<Pose2, Outcome> {
+        let codes = kind.codes().unwrap_or(BACK_UP);
+        self.latest
+            .get(self.config.timeouts.odom_timeout())
+            .copied()
+            .ok_or_else(|| Outcome::failed("TF_ERROR", "no recent odom: is the chassis running?", codes.tf_error))
+    }
+
+    async fn distance_goal(
+        &mut self,
+        node: &RosNode,
+        servers: &mut Servers,
+        session: &mut Session,
+        sink: &mut CmdVel<'_>,
+        request: GoalRequest<mobil_msgs::mobil_msgs::action::DriveDistanceGoal>,
+    ) {
+        let goal = request.goal().clone();
+        let Some(&start) = self.latest.get(self.config.timeouts.odom_timeout()) else {
+            servers
+                .distance
+                .reject(request, "no recent odom: is the chassis running?")
+                .await;
+            return;
+        };
+        match DistanceDrive::new(start, goal.distance, goal.speed, self.config.settings()) {
+            Err(e) => servers.distance.reject(request, &e.to_string()).await,
+            Ok(drive) => {
+                let travelled = session.active().map_or(0.0, |a| a.goal.progress().travelled);
+                // The server ends the goal it replaces itself, with this result.
+                let preempted = |_: &_| distance_result(travelled, "preempted by a newer goal");
+                let accepted = servers.distance.accept(request, preempted, node.now_nanos()).await;
+                if accepted.is_ok() {
+                    info!("driving {} m at {} m/s", goal.distance, goal.speed);
+                }
+                self.begin(
+                    servers,
+                    session,
+                    sink,
+                    Kind::Distance,
+                    accepted,
+                    Ok(Behavior::distance(drive)),
+                );
+            }
+        }
+    }
+
+    /// After an accept: the goal starts, or ends at once with Nav2's code (accepted first, as
+    /// the behavior server does); a failed accept stops the goal it was to replace.
+    fn begin(
+        &mut self,
+        servers: &mut Servers,
+        session: &mut Session,
+        sink: &mut CmdVel<'_>,
+        kind: Kind,
+        accepted: Result<(), mobil_ros::action::ActionError>,
+        built: Built,
+    ) {
+        if let Err(e) = accepted {
+            // One client's goal (a DDS send failed): logged, and the node goes on serving the
+            // others; a goal it replaced was ended.
+            warn_throttled!(self.throttle, "accept", "goal not started: {e}");
+            if let Some(ended) = session.preempt(kind, sink) {
+                servers.finish(&ended);
+            }
+            return;
+        }
+        match built {
+            Ok(law) => {
+                if let (_, Some(old)) = session.start(law, kind, Instant::now()) {
+                    servers.finish(&old);
+                }
+            }
+            Err(outcome) => {
+                let cause = EndCause::Outcome(outcome);
+                warn!("goal ({}) ends at once: {}", <&str>::from(kind), cause.reason());
+                let (elapsed, code, msg) = behavior_answer(kind, &cause, 0.0);
+                match kind {
+                    Kind::BackUp => servers.backup.finish(
+                        GoalEnd::Aborted,
+                        BackUpResult {
+                            total_elapsed_time: elapsed,
+                            error_code: code,
+                            error_msg: msg,
+                        },
+                    ),
+                    Kind::Heading => servers.heading.finish(
+                        GoalEnd::Aborted,
+                        DriveOnHeadingResult {
+                            total_elapsed_time: elapsed,
+                            error_code: code,
+                            error_msg: msg,
+                        },
+                    ),
+                    Kind::Spin => servers.spin.finish(
+                        GoalEnd::Aborted,
+                        SpinResult {
+                            total_elapsed_time: elapsed,
+                            error_code: code,
+                            error_msg: msg,
+                        },
+                    ),
+                    Kind::Distance => servers.distance.finish(GoalEnd::Aborted, distance_result(0.0, &msg)),
                 };
-                // The law reads no time; the goal's own time is kept for the record.
-                let dt = session.advance(node.now_nanos()).and_then(Result::ok).unwrap_or(0.0);
-                let t = session.active().map_or(0.0, |a| a.t());
-                let Some(active) = session.active_mut() else { continue };
-                let step = active.goal.step(&StepInput::new(t, dt, pose), &());
-                match session.apply(step, twist, &mut sink) {
-                    Applied::Commanded(progress) => {
-                        let feedback = DriveDistanceFeedback { travelled: progress.travelled, remaining: progress.remaining };
-                        if let Err(e) = server.feedback(feedback).await {
-                            warn_throttled!(throttle, "feedback", "{e}");
-                        }
-                    }
-                    Applied::Ended(ended, _) => finish(server, Some(ended)),
-                    Applied::Refused(ended) => finish(server, ended),
-                    Applied::Idle => {}
+                // The goal it was to replace stops (its robot would otherwise drive on).
+                if let Some(ended) = session.preempt(kind, sink) {
+                    servers.finish(&ended);
                 }
             }
         }
+    }
+
+    async fn tick(&mut self, node: &RosNode, servers: &mut Servers, session: &mut Session, sink: &mut CmdVel<'_>) {
+        if node.uses_sim_time() {
+            let timeout = self.config.timeouts.clock_timeout();
+            let clock = session.watch_clock(node.now_nanos(), Instant::now(), timeout, sink);
+            mobil_ros::tell!(self.throttle, clock.notice());
+            if let ClockCheck::Back(ended) = clock {
+                servers.finish(&ended);
+                return;
+            }
+        }
+        let Some(kind) = session.active().map(|a| a.source) else {
+            return;
+        };
+        let Some(&pose) = self.latest.get(self.config.timeouts.odom_timeout()) else {
+            warn!("no odom for {:?}: goal aborted", self.config.timeouts.odom_timeout());
+            if let Some(ended) = session.end(EndCause::Stale("odom".into()), sink) {
+                servers.finish(&ended);
+            }
+            return;
+        };
+        let echoes = self
+            .echoes
+            .get(seconds(self.config.scan_timeout_s, MAX_INPUT_TIMEOUT_S))
+            .cloned();
+        let dt = session.advance(node.now_nanos()).and_then(Result::ok).unwrap_or(0.0);
+        let t = session.active().map_or(0.0, |a| a.t());
+        let Some(active) = session.active_mut() else { return };
+        let step = active.goal.step(&StepInput::new(t, dt, pose), &echoes);
+        match session.apply(step, twist, sink) {
+            Applied::Commanded(_) => {
+                if let Some(active) = session.active()
+                    && let Err(e) = servers.feedback(kind, &active.goal).await
+                {
+                    warn_throttled!(self.throttle, "feedback", "{e}");
+                }
+            }
+            Applied::Ended(ended, _) => servers.finish(&ended),
+            Applied::Refused(ended) => {
+                if let Some(ended) = ended {
+                    servers.finish(&ended);
+                }
+            }
+            Applied::Idle => {}
+        }
+    }
+}
+
+/// A cancel request for the active goal of `kind`'s server.
+fn cancel(
+    servers: &mut Servers,
+    session: &mut Session,
+    sink: &mut CmdVel<'_>,
+    kind: Kind,
+    id: mobil_ros::action::GoalId,
+) {
+    let ours = session.active().is_some_and(|a| a.source == kind);
+    if ours
+        && servers.active_id(kind) == Some(id)
+        && let Some(ended) = session.end(EndCause::Canceled, sink)
+    {
+        servers.finish(&ended);
+    }
+}
+
+/// `time_allowance` in seconds (negative or non-finite: none, as zero).
+fn secs(d: &DurationMsg) -> f64 {
+    f64::from(d.sec) + f64::from(d.nanosec) * 1e-9
+}
+
+fn preempted_result(kind: Kind) -> (DurationMsg, u16, String) {
+    behavior_answer(kind, &EndCause::Preempted(kind.into()), 0.0)
+}
+
+fn preempted_backup() -> BackUpResult {
+    let (total_elapsed_time, error_code, error_msg) = preempted_result(Kind::BackUp);
+    BackUpResult {
+        total_elapsed_time,
+        error_code,
+        error_msg,
+    }
+}
+
+fn preempted_heading() -> DriveOnHeadingResult {
+    let (total_elapsed_time, error_code, error_msg) = preempted_result(Kind::Heading);
+    DriveOnHeadingResult {
+        total_elapsed_time,
+        error_code,
+        error_msg,
+    }
+}
+
+fn preempted_spin() -> SpinResult {
+    let (total_elapsed_time, error_code, error_msg) = preempted_result(Kind::Spin);
+    SpinResult {
+        total_elapsed_time,
+        error_code,
+        error_msg,
     }
 }
