@@ -14,7 +14,7 @@ import threading
 
 import pytest
 
-from harness import make_qos, subscribe, wait_until
+from harness import make_qos, run_ros2cli, subscribe, wait_until
 from rosutil import wait_for_future
 
 from action_msgs.msg import GoalStatus
@@ -291,3 +291,68 @@ def test_backup_drive_on_heading_and_spin_reach_their_targets_collide_and_time_o
         goal.target.x, goal.target.y, goal.speed = 0.5, 0.1, 0.1
         res = run_goal(clients["drive_on_heading"], goal)
         assert res.result.error_code == DriveOnHeading.Result.INVALID_INPUT
+
+
+# ---------------------------------------------------------------------------------------------
+# enable_stamped_cmd_vel: the robot driven on TwistStamped only
+# ---------------------------------------------------------------------------------------------
+
+STAMPED = ("-p", "enable_stamped_cmd_vel:=true")
+
+
+@pytest.mark.timeout(120)
+def test_stamped_cmd_vel_drives_the_robot_and_a_twist_publisher_is_told(
+        start_scenario, start_node, sim_clock, ros_node):
+    """With enable_stamped_cmd_vel:=true on chassis_node, drive_node, local_nav_node and
+    planner_node, cmd_vel is TwistStamped only (stamped with ROS time, in base_link), and each
+    of the three moves the simulated OMR-III to its goal: a drive of 0.3 m, a path to
+    (1.2, 0), a docking at (2, 0). A Twist publisher on cmd_vel is then told in chassis_node's
+    log, with what to set."""
+    from geometry_msgs.msg import TwistStamped
+    from nav2_msgs.action import DockRobot, DriveOnHeading
+
+    params = "params/omr3.yaml"
+    sim, chassis = start_scenario(params, real_time_factor=2.0, lidar=True,
+                                  node_args=(*CHASSIS_ARGS, *STAMPED))
+    for exe in ("drive_node", "local_nav_node", "planner_node"):
+        start_node(exe, *NODE_ARGS, *STAMPED, params_file=params)
+    drive = ActionClient(ros_node, DriveOnHeading, "drive_on_heading")
+    follow = ActionClient(ros_node, FollowPath, "follow_path")
+    dock = ActionClient(ros_node, DockRobot, "dock_robot")
+    deep = make_qos("reliable", "volatile", 5000)
+    with subscribe(ros_node, Odometry, "ground_truth", qos=deep) as truth, \
+            subscribe(ros_node, TwistStamped, "cmd_vel", qos=deep) as cmd:
+        sim_clock.wait_started()
+        truth.wait_for(None, REPLY_TIMEOUT)
+        for client in (drive, follow, dock):
+            assert client.wait_for_server(timeout_sec=20.0)
+
+        goal = DriveOnHeading.Goal()
+        goal.target.x, goal.speed = 0.3, 0.2
+        res = run_goal(drive, goal)
+        assert res.status == GoalStatus.STATUS_SUCCEEDED, res.result.error_msg
+        res = run_goal(follow, follow_goal([(0.3, 0.0), (1.2, 0.0)]))
+        assert res.status == GoalStatus.STATUS_SUCCEEDED, res.result.error_msg
+        goal = DockRobot.Goal()
+        goal.use_dock_id = False
+        goal.dock_pose.header.frame_id = "odom"
+        goal.dock_pose.pose.position.x = 2.0
+        goal.dock_pose.pose.orientation.w = 1.0
+        res = run_goal(dock, goal, timeout=40.0)
+        assert res.status == GoalStatus.STATUS_SUCCEEDED, res.result.error_msg
+        sim_clock.wait_until(sim_clock.now() + 1.0)
+        end = truth.latest.pose.pose.position
+        types = dict(ros_node.get_topic_names_and_types()).get("/cmd_vel")
+        commands = cmd.snapshot()
+
+        # A Twist publisher (another process: one participant cannot have both types).
+        run_ros2cli("topic", "pub", "/cmd_vel", "geometry_msgs/msg/Twist", "{}",
+                    "--times", "4", "-w", "0", "--rate", "1", timeout=30.0)
+        chassis.wait_for_log(r"cmd_vel: a publisher of geometry_msgs/msg/Twist is on the topic.*"
+                             r"enable_stamped_cmd_vel:=false", 15.0)
+
+    assert types == ["geometry_msgs/msg/TwistStamped"], types
+    assert math.hypot(end.x - 2.0, end.y) < 0.1, (end.x, end.y)
+    assert len(commands) > 50
+    assert {c.header.frame_id for c in commands} == {"base_link"}
+    assert all(c.header.stamp.sec > 0 or c.header.stamp.nanosec > 0 for c in commands)

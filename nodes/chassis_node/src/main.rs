@@ -20,13 +20,14 @@ use mobil_chassis::model::ChassisConfig;
 use mobil_chassis::model::ChassisModel;
 use mobil_chassis::odometry::OdometryNoise;
 use mobil_msgs::builtin_interfaces::msg::Time;
-use mobil_msgs::geometry_msgs::msg::{Transform, TransformStamped, Twist, Vector3};
+use mobil_msgs::geometry_msgs::msg::{Transform, TransformStamped, Twist, TwistStamped, Vector3};
 use mobil_msgs::mobil_msgs::msg::ChassisStatus;
 use mobil_msgs::nav_msgs::msg::Odometry;
 use mobil_msgs::sensor_msgs::msg::JointState;
 use mobil_msgs::std_msgs::msg::Header;
 use mobil_msgs::tf2_msgs::msg::TFMessage;
 use mobil_ros::chassis::{chassis_params, declare_chassis};
+use mobil_ros::cmd_vel::{stamped_twist, CmdVelType, TypeWatch};
 use mobil_ros::config::{Config, ConfigError, Decl};
 use mobil_ros::geometry::{planar_odometry, yaw_quaternion};
 use mobil_ros::input::Inputs as Streams;
@@ -51,6 +52,7 @@ struct NodeConfig {
     odom_frame: String,
     base_frame: String,
     publish_tf: bool,
+    cmd_vel: CmdVelType,
 }
 
 impl Config for NodeConfig {
@@ -98,6 +100,7 @@ impl Config for NodeConfig {
         d.boolean("publish_tf", true, "publish odom → base_link on tf", |c, v| {
             c.publish_tf = v
         });
+        d.nest(|c: &mut NodeConfig| &mut c.cmd_vel, CmdVelType::declare);
         d.double(
             "odom.along_track_var_per_m",
             noise.along_track_var_per_m,
@@ -212,7 +215,15 @@ async fn run(node: &mut RosNode) -> anyhow::Result<()> {
     );
 
     let q = qos::default_qos();
-    let cmd_sub = node.subscription::<Twist>("cmd_vel", &q)?;
+    // cmd_vel as Twist or TwistStamped: the twist is taken, the header never read (the
+    // watchdog judges arrival on the steady clock).
+    let stamped = config.cmd_vel.enable_stamped_cmd_vel;
+    let cmd_sub = (!stamped)
+        .then(|| node.subscription::<Twist>("cmd_vel", &q))
+        .transpose()?;
+    let cmd_stamped_sub = stamped
+        .then(|| node.subscription::<TwistStamped>("cmd_vel", &q))
+        .transpose()?;
     let joints_sub = node.subscription::<JointState>("joint_states", &q)?;
     let wheel_pub = node.publisher::<JointState>("wheel_commands", &q)?;
     let odom_pub = node.publisher::<Odometry>("odom", &q)?;
@@ -221,17 +232,25 @@ async fn run(node: &mut RosNode) -> anyhow::Result<()> {
 
     // An undecodable cmd_vel stops the wheels at once; an undecodable joint_states is counted.
     let mut streams = Streams::new();
-    streams
-        .add_guarded(cmd_sub.async_stream(), "cmd_vel", "wheels stopped", In::Cmd, || {
+    if let Some(sub) = &cmd_sub {
+        streams.add_guarded(sub.async_stream(), "cmd_vel", "wheels stopped", In::Cmd, || {
             Some(In::BadCmd)
-        })
-        .add_guarded(
-            joints_sub.async_stream(),
-            "joint_states",
-            "sample ignored",
-            In::Joints,
-            || Some(In::BadJoints),
-        );
+        });
+    }
+    if let Some(sub) = &cmd_stamped_sub {
+        let event = |m: TwistStamped| In::Cmd(stamped_twist(m));
+        streams.add_guarded(sub.async_stream(), "cmd_vel", "wheels stopped", event, || {
+            Some(In::BadCmd)
+        });
+    }
+    let mut types = TypeWatch::default();
+    streams.add_guarded(
+        joints_sub.async_stream(),
+        "joint_states",
+        "sample ignored",
+        In::Joints,
+        || Some(In::BadJoints),
+    );
     let shutdown = shutdown_signal();
     let mut tick = Ticker::new(config.control_rate_hz)?;
     tokio::pin!(shutdown);
@@ -350,6 +369,9 @@ async fn run(node: &mut RosNode) -> anyhow::Result<()> {
                 In::BadJoints => rejected += 1,
             },
             _ = tick.tick() => {
+                if let Some(line) = types.check(node, stamped, "cmd_vel", std::time::Instant::now()) {
+                    warn_throttled!(throttle, "cmd-type", "{line}");
+                }
                 let cmd = controller.gate(inputs.ages());
                 let safety = cmd.safety();
                 // A refused (NaN) cmd_vel stops the wheels too, but was logged as what it is.

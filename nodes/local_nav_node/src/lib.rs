@@ -20,6 +20,7 @@ use mobil_msgs::geometry_msgs::msg::{Point, PoseStamped};
 use mobil_msgs::nav2_msgs::action::FollowPathGoal;
 use mobil_msgs::visualization_msgs::msg::{Marker, MarkerArray};
 use mobil_ros::chassis::{chassis_params, declare_chassis};
+use mobil_ros::cmd_vel::CmdVelType;
 use mobil_ros::config::{Config, ConfigError, Decl};
 use mobil_ros::goal::goal_pose;
 pub use mobil_ros::goal::{goal_heading, GoalError};
@@ -71,6 +72,8 @@ pub struct LocalNavConfig {
     pub managed: Managed,
     /// `follow_path`: the spacing of the sub-goals along a path (m).
     pub path_lookahead: f64,
+    /// `cmd_vel`'s type (`enable_stamped_cmd_vel`).
+    pub cmd_vel: CmdVelType,
 }
 
 impl Config for LocalNavConfig {
@@ -254,6 +257,7 @@ impl Config for LocalNavConfig {
         .within(0.1, 50.0);
         d.nest(|c: &mut LocalNavConfig| &mut c.timeouts, GoalTimeouts::declare);
         d.nest(|c: &mut LocalNavConfig| &mut c.managed, Managed::declare);
+        d.nest(|c: &mut LocalNavConfig| &mut c.cmd_vel, CmdVelType::declare);
         d.nest(|c: &mut LocalNavConfig| &mut c.frames, Frames::declare);
         d.string(
             "laser_frame",

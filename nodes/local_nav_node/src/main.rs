@@ -49,7 +49,7 @@ use mobil_ros::scan::{
     checked_scan, tf_static_subscription, CheckedScan, LaserMount, LaserPoseFrom, ScanRefusal, StaticFrames,
 };
 use mobil_ros::status::{NavStatusView, RateGate};
-use mobil_ros::stop::{final_stop, FINAL_STOP_WAIT};
+use mobil_ros::stop::FINAL_STOP_WAIT;
 use mobil_ros::ticker::Ticker;
 use mobil_ros::time::duration_msg;
 use mobil_ros::{qos, run_node, shutdown_signal, warn_throttled, ConfigError, LogThrottle, NodeDecl, RosNode};
@@ -143,6 +143,8 @@ struct Shell {
     last_step: Option<StepOutput>,
     status_gate: RateGate,
     throttle: LogThrottle,
+    /// Looks for a `cmd_vel` endpoint of the other type.
+    types: mobil_ros::cmd_vel::TypeWatch,
 }
 
 /// What woke the loop. One lives at a time, on the stack, so its size does not matter.
@@ -161,12 +163,13 @@ enum Event {
 
 async fn serve(node: &mut RosNode) -> anyhow::Result<()> {
     let config: LocalNavConfig = node.config()?;
-    let outputs = Outputs::create(node, "local_nav")?;
+    let stamped = config.cmd_vel.enable_stamped_cmd_vel;
+    let outputs = Outputs::create(node, "local_nav", stamped, &config.frames.base_frame)?;
     let (outcome, final_zero) = run(node, &outputs, config).await;
     // A goal under way at the end gets its zero command, waited for; an idle node sends none
     // (another node, teleop or a twist_mux input, may be commanding the robot).
     if final_zero {
-        final_stop(&outputs.cmd, Twist::default(), FINAL_STOP_WAIT).await;
+        outputs.cmd.final_stop(FINAL_STOP_WAIT).await;
     }
     outcome
 }
@@ -225,6 +228,7 @@ async fn start(
         last_step: None,
         status_gate: RateGate::default(),
         throttle: LogThrottle::new(Duration::from_secs(2)),
+        types: Default::default(),
     };
     shell.publish_status(node, out, NavStatus::IDLE, String::new());
     info!(
@@ -702,6 +706,10 @@ impl Shell {
 
     async fn tick(&mut self, node: &RosNode, out: &Outputs, sink: &mut CmdVel<'_>, servers: &mut Servers) {
         let now = Instant::now();
+        let stamped = self.config.cmd_vel.enable_stamped_cmd_vel;
+        if let Some(line) = self.types.check(node, stamped, "cmd_vel", now) {
+            warn_throttled!(self.throttle, "cmd-type", "{line}");
+        }
         if node.uses_sim_time() {
             let timeout = self.config.timeouts.clock_timeout();
             let clock = self.session.watch_clock(node.now_nanos(), now, timeout, sink);

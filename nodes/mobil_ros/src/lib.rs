@@ -32,6 +32,8 @@
 //!   an `INVALID_GOAL`);
 //! - [`markers`]: RViz markers, built one call per marker; [`status`]: a navigating node's
 //!   `NavStatus`, and the rate gate of its status and markers;
+//! - [`cmd_vel`]: `cmd_vel` as Twist or TwistStamped (`enable_stamped_cmd_vel`), and a peer of
+//!   the other type told;
 //! - [`stop`]: [`stop::final_stop`], the bounded last zero command of a motion node;
 //! - [`scan`]: LaserScan → checked [`mobil_geom::Scan`] at the edge, laser pose from `tf_static`
 //!   ([`scan::tf_static_subscription`] feeding [`scan::LaserPose`]; `tf_static` wins) or a
@@ -44,6 +46,7 @@
 pub mod action;
 pub mod args;
 pub mod chassis;
+pub mod cmd_vel;
 pub mod config;
 pub mod docs;
 pub mod geometry;

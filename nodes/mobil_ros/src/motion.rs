@@ -48,6 +48,7 @@
 //! assert_eq!(sent[1], Twist::default());
 //! ```
 
+use crate::cmd_vel::CmdVelOut;
 use crate::log::LogThrottle;
 use crate::status::{NavStatusView, StatusMessage};
 use crate::time::{ClockState, ClockWatch, DtClock, DtError};
@@ -75,13 +76,13 @@ impl CommandSink for Vec<Twist> {
 
 /// `cmd_vel` as the session's sink: each command published, a failure logged (rate-limited).
 pub struct CmdVel<'a> {
-    publisher: &'a Publisher<Twist>,
+    publisher: &'a CmdVelOut,
     throttle: LogThrottle,
 }
 
 impl<'a> CmdVel<'a> {
     /// Commands go to `publisher`.
-    pub fn new(publisher: &'a Publisher<Twist>) -> Self {
+    pub fn new(publisher: &'a CmdVelOut) -> Self {
         CmdVel {
             publisher,
             throttle: LogThrottle::new(Duration::from_secs(2)),
@@ -92,7 +93,7 @@ impl<'a> CmdVel<'a> {
 impl CommandSink for CmdVel<'_> {
     fn send(&mut self, twist: &Twist) {
         if let Err(e) = self.publisher.publish(twist.clone()) {
-            crate::warn_throttled!(self.throttle, "cmd", "cannot publish cmd_vel: {e:?}");
+            crate::warn_throttled!(self.throttle, "cmd", "cannot publish cmd_vel: {e}");
         }
     }
 }
@@ -123,8 +124,8 @@ impl Default for SessionSettings {
 /// What a navigating motion node publishes: `cmd_vel`, its latched `<name>/status` (the last
 /// one reaches a late subscriber) and `<name>/markers`.
 pub struct Outputs {
-    /// The commands.
-    pub cmd: Publisher<Twist>,
+    /// The commands (Twist or TwistStamped).
+    pub cmd: CmdVelOut,
     /// The status.
     pub status: Publisher<NavStatus>,
     /// RViz markers.
@@ -134,10 +135,11 @@ pub struct Outputs {
 }
 
 impl Outputs {
-    /// The three publishers of node `name` (`planner`, `local_nav`).
-    pub fn create(node: &mut crate::RosNode, name: &str) -> anyhow::Result<Self> {
+    /// The three publishers of node `name` (`planner`, `local_nav`); `cmd_vel` stamped in
+    /// `base_frame` when `stamped` ([`crate::cmd_vel`]).
+    pub fn create(node: &mut crate::RosNode, name: &str, stamped: bool, base_frame: &str) -> anyhow::Result<Self> {
         Ok(Outputs {
-            cmd: node.publisher::<Twist>("cmd_vel", &crate::qos::default_qos())?,
+            cmd: CmdVelOut::create(node, "cmd_vel", stamped, base_frame)?,
             status: node.publisher::<NavStatus>(&format!("{name}/status"), &crate::qos::latched())?,
             markers: node.publisher::<MarkerArray>(&format!("{name}/markers"), &crate::qos::default_qos())?,
             name: name.to_owned(),

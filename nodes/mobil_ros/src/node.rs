@@ -193,8 +193,33 @@ pub struct RosNode {
     spinner: Option<tokio::task::JoinHandle<()>>,
     /// `/clock`, read when the time is asked for (see [`RosNode::now_nanos`]).
     clock: Option<Subscription<Clock>>,
-    /// Latest `/clock` (ns).
-    sim_clock: AtomicI64,
+    /// Latest `/clock` (ns), shared with the node's [`NodeClock`]s.
+    sim_clock: Arc<AtomicI64>,
+}
+
+/// The node's clock for a part of it that stamps messages away from the node itself (a
+/// command publisher): the system clock, or under `use_sim_time` the latest `/clock` the node
+/// has read ([`RosNode::now_nanos`], which every node calls at least once per tick).
+#[derive(Debug, Clone)]
+pub struct NodeClock {
+    sim: Option<Arc<AtomicI64>>,
+}
+
+impl NodeClock {
+    /// The system clock (a node without `use_sim_time`, or a test).
+    pub fn system() -> Self {
+        NodeClock { sim: None }
+    }
+
+    /// Nanoseconds now.
+    pub fn now_nanos(&self) -> i64 {
+        match &self.sim {
+            Some(sim) => sim.load(Ordering::Relaxed),
+            None => std::time::SystemTime::now()
+                .duration_since(std::time::UNIX_EPOCH)
+                .map_or(0, |d| i64::try_from(d.as_nanos()).unwrap_or(i64::MAX)),
+        }
+    }
 }
 
 fn lock(values: &Mutex<ParamValues>) -> std::sync::MutexGuard<'_, ParamValues> {
@@ -302,7 +327,7 @@ impl RosNode {
             changes,
             spinner: Some(handle),
             clock: None,
-            sim_clock: AtomicI64::new(0),
+            sim_clock: Arc::new(AtomicI64::new(0)),
         };
         ros_node.clock = Some(ros_node.subscription::<Clock>("/clock", &crate::qos::sensor_data())?);
         crate::log::attach_rosout(ros_node.node.logging_handle());
@@ -411,6 +436,37 @@ impl RosNode {
             self.node.get_parameter("use_sim_time"),
             Some(ParameterValue::Boolean(true))
         )
+    }
+
+    /// A handle on the node's clock (see [`NodeClock`]).
+    pub fn clock(&self) -> NodeClock {
+        NodeClock {
+            sim: self.uses_sim_time().then(|| self.sim_clock.clone()),
+        }
+    }
+
+    /// The DDS type names of the other endpoints discovered on `topic` (resolved and
+    /// remapped): `(is_writer, type name)`, e.g. `(true, "geometry_msgs::msg::dds_::Twist_")`.
+    pub fn endpoint_types(&self, topic: &str) -> Vec<(bool, String)> {
+        let Ok(full) = self.names.resolve(topic) else {
+            return Vec::new();
+        };
+        let dds = format!("rt{full}");
+        let participant = self.context.domain_participant();
+        let mut out: Vec<(bool, String)> = participant
+            .discovered_writers()
+            .iter()
+            .filter(|w| w.publication_topic_data.topic_name == dds)
+            .map(|w| (true, w.publication_topic_data.type_name.clone()))
+            .collect();
+        out.extend(
+            participant
+                .discovered_readers()
+                .iter()
+                .filter(|r| r.subscription_topic_data.topic_name() == &dds)
+                .map(|r| (false, r.subscription_topic_data.type_name().clone())),
+        );
+        out
     }
 
     /// The node's clock as a message stamp.

@@ -24,6 +24,7 @@ pub use mobil_planner::goals::{Missed, RouteAnswer};
 use mobil_planner::{DockingConfig, DockingGains, FollowConfig, RouteCheckConfig};
 use mobil_ros::action::nav2_result;
 use mobil_ros::chassis::{chassis_params, declare_chassis};
+use mobil_ros::cmd_vel::CmdVelType;
 use mobil_ros::config::{Config, ConfigError, Decl};
 use mobil_ros::geometry::pose_msg;
 use mobil_ros::goal::RouteLimits;
@@ -74,6 +75,8 @@ pub struct PlannerConfig {
     pub timeouts: GoalTimeouts,
     /// The managed-node parameters (`autostart`, `bond_heartbeat_period`).
     pub managed: Managed,
+    /// `cmd_vel`'s type (`enable_stamped_cmd_vel`).
+    pub cmd_vel: CmdVelType,
     /// The frames of odometry, goals and the robot.
     pub frames: Frames,
     /// How `waypoints` and `follow_waypoints` are followed.
@@ -155,6 +158,7 @@ impl Config for PlannerConfig {
         }
         d.nest(|c: &mut PlannerConfig| &mut c.timeouts, GoalTimeouts::declare);
         d.nest(|c: &mut PlannerConfig| &mut c.managed, Managed::declare);
+        d.nest(|c: &mut PlannerConfig| &mut c.cmd_vel, CmdVelType::declare);
         d.nest(|c: &mut PlannerConfig| &mut c.frames, Frames::declare);
         vfo::declare_vfo(d);
     }

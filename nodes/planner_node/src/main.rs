@@ -61,7 +61,7 @@ use mobil_ros::offloop::CancelToken;
 use mobil_ros::offloop::ReplyPool;
 use mobil_ros::scan::{checked_scan, tf_static_subscription, LaserMount, StaticFrames};
 use mobil_ros::status::{end_state, NavStatusView, RateGate};
-use mobil_ros::stop::{final_stop, FINAL_STOP_WAIT};
+use mobil_ros::stop::FINAL_STOP_WAIT;
 use mobil_ros::ticker::Ticker;
 use mobil_ros::time::{duration_msg, secs_from_stamp, DtError};
 use mobil_ros::OffLoop;
@@ -173,6 +173,8 @@ struct Shell {
     markers_gate: RateGate,
     drawing: Drawing,
     throttle: LogThrottle,
+    /// Looks for a `cmd_vel` endpoint of the other type.
+    types: mobil_ros::cmd_vel::TypeWatch,
     /// Obstacles seen by the LIDAR, in odom (VFO); kept between goals, new extraction
     /// parameters applied once no goal runs.
     map: KeptMap,
@@ -211,7 +213,8 @@ enum Event {
 
 async fn serve(node: &mut RosNode) -> anyhow::Result<()> {
     let config: PlannerConfig = node.config()?;
-    let outputs = Outputs::create(node, "planner")?;
+    let stamped = config.cmd_vel.enable_stamped_cmd_vel;
+    let outputs = Outputs::create(node, "planner", stamped, &config.frames.base_frame)?;
     start(node, &outputs, config).await?
 }
 
@@ -264,6 +267,7 @@ async fn start(node: &mut RosNode, out: &Outputs, config: PlannerConfig) -> anyh
         markers_gate: RateGate::default(),
         drawing: Drawing::default(),
         throttle: LogThrottle::new(Duration::from_secs(2)),
+        types: Default::default(),
         map,
         odom_history: PoseHistory::new(ODOM_HISTORY),
         odom_stamp: f64::NAN,
@@ -308,7 +312,7 @@ async fn start(node: &mut RosNode, out: &Outputs, config: PlannerConfig) -> anyh
         shell.report(&mut io, ended);
     }
     if final_zero {
-        final_stop(&out.cmd, Twist::default(), FINAL_STOP_WAIT).await;
+        out.cmd.final_stop(FINAL_STOP_WAIT).await;
     }
     let down = EndCause::Shutdown;
     let Servers { dock, undock, follow } = servers;

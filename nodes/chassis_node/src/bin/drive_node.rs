@@ -25,6 +25,7 @@ use mobil_msgs::nav2_msgs::action::{
 use mobil_msgs::nav_msgs::msg::Odometry;
 use mobil_msgs::sensor_msgs::msg::LaserScan;
 use mobil_ros::action::{goal_end, ActionEvent, GoalEnd, GoalRequest, GoalServer, GoalServerConfig};
+use mobil_ros::cmd_vel::{CmdVelOut, CmdVelType, TypeWatch};
 use mobil_ros::config::{Config, ConfigError, Decl};
 use mobil_ros::geometry::planar_pose;
 use mobil_ros::groups::{GoalTimeouts, MAX_INPUT_TIMEOUT_S};
@@ -33,7 +34,7 @@ use mobil_ros::latest::Latest;
 use mobil_ros::lifecycle::{CallbackReturn, Lifecycle, Managed};
 use mobil_ros::motion::{Applied, ClockCheck, CmdVel, EndCause, EndKind, Ended, MotionSession, SessionSettings};
 use mobil_ros::scan::{checked_scan, tf_static_subscription, LaserMount, StaticFrames};
-use mobil_ros::stop::{final_stop, FINAL_STOP_WAIT};
+use mobil_ros::stop::FINAL_STOP_WAIT;
 use mobil_ros::ticker::Ticker;
 use mobil_ros::time::{duration_msg, seconds};
 use mobil_ros::{qos, run_node, shutdown_signal, warn_throttled, LogThrottle, NodeDecl, RosNode};
@@ -41,7 +42,6 @@ use mobil_tools::behavior::{Behavior, Guard, SpinSettings};
 use mobil_tools::drive::Pose2;
 use mobil_tools::drive::{DistanceDrive, DriveSettings};
 use nalgebra::Point2;
-use ros2_client::Publisher;
 use std::process::ExitCode;
 use std::time::{Duration, Instant};
 use tracing::{info, warn};
@@ -63,6 +63,7 @@ struct DriveConfig {
     laser_pose: Vec<f64>,
     timeouts: GoalTimeouts,
     managed: Managed,
+    cmd_vel: CmdVelType,
 }
 
 /// The spin parameters' declarations (Nav2's names).
@@ -179,6 +180,7 @@ impl Config for DriveConfig {
         .read_only();
         d.nest(|c: &mut DriveConfig| &mut c.timeouts, GoalTimeouts::declare);
         d.nest(|c: &mut DriveConfig| &mut c.managed, Managed::declare);
+        d.nest(|c: &mut DriveConfig| &mut c.cmd_vel, CmdVelType::declare);
     }
 
     fn validate(&self) -> Result<(), ConfigError> {
@@ -432,20 +434,21 @@ fn twist(b: BodyTwist) -> Twist {
 
 async fn serve(node: &mut RosNode) -> anyhow::Result<()> {
     let config: DriveConfig = node.config()?;
-    let cmd = node.publisher::<Twist>("cmd_vel", &qos::default_qos())?;
+    let stamped = config.cmd_vel.enable_stamped_cmd_vel;
+    let cmd = CmdVelOut::create(node, "cmd_vel", stamped, &config.base_frame)?;
     let mut session = Session::new(SessionSettings::default());
     let outcome = drive_loop(node, &cmd, &mut session, config).await;
     // Whatever ends the loop (shutdown or a failure), a goal under way gets its zero command,
     // waited for, so the chassis does not keep the last speed until its own watchdog fires.
     if session.shutdown().1 {
-        final_stop(&cmd, Twist::default(), FINAL_STOP_WAIT).await;
+        cmd.final_stop(FINAL_STOP_WAIT).await;
     }
     outcome
 }
 
 async fn drive_loop(
     node: &mut RosNode,
-    cmd: &Publisher<Twist>,
+    cmd: &CmdVelOut,
     session: &mut Session,
     config: DriveConfig,
 ) -> anyhow::Result<()> {
@@ -465,6 +468,7 @@ async fn drive_loop(
         latest: Latest::new(),
         echoes: Latest::new(),
         laser: StaticFrames::default(),
+        types: TypeWatch::default(),
         throttle: LogThrottle::new(Duration::from_secs(2)),
     };
     let outcome = shell.event_loop(node, cmd, &mut servers, &mut lifecycle, session).await;
@@ -503,6 +507,7 @@ struct Shell {
     /// The latest scan's echoes in the base frame (the collision check's input).
     echoes: Latest<Vec<Point2<f64>>>,
     laser: StaticFrames,
+    types: TypeWatch,
     throttle: LogThrottle,
 }
 
@@ -513,7 +518,7 @@ impl Shell {
     async fn event_loop(
         &mut self,
         node: &mut RosNode,
-        cmd: &Publisher<Twist>,
+        cmd: &CmdVelOut,
         servers: &mut Servers,
         lifecycle: &mut Lifecycle,
         session: &mut Session,
@@ -759,6 +764,10 @@ impl Shell {
     }
 
     async fn tick(&mut self, node: &RosNode, servers: &mut Servers, session: &mut Session, sink: &mut CmdVel<'_>) {
+        let stamped = self.config.cmd_vel.enable_stamped_cmd_vel;
+        if let Some(line) = self.types.check(node, stamped, "cmd_vel", Instant::now()) {
+            warn_throttled!(self.throttle, "cmd-type", "{line}");
+        }
         if node.uses_sim_time() {
             let timeout = self.config.timeouts.clock_timeout();
             let clock = session.watch_clock(node.now_nanos(), Instant::now(), timeout, sink);

@@ -252,6 +252,10 @@ impl Shell {
 
     pub(crate) async fn tick(&mut self, io: &mut Io<'_, '_>) {
         let now = Instant::now();
+        let stamped = self.config.cmd_vel.enable_stamped_cmd_vel;
+        if let Some(line) = self.types.check(io.node, stamped, "cmd_vel", now) {
+            warn_throttled!(self.throttle, "cmd-type", "{line}");
+        }
         if io.node.uses_sim_time() {
             let timeout = self.session.active().map_or(self.config.timeouts.clock_timeout(), |a| {
                 a.goal.config.timeouts.clock_timeout()
