@@ -184,8 +184,11 @@ def test_follow_path_replanned_every_second_reaches_the_end_without_a_stop(
 # Nav2's behavior role: drive_node's backup, drive_on_heading and spin
 # ---------------------------------------------------------------------------------------------
 
-# A wall behind the robot: 0.1 m thick, its face at x = -0.45, from y = -1 to 1.
-WALL_BEHIND = "obstacles:\n  - polygon: { points: [[-0.55, -1.0], [-0.45, -1.0], [-0.45, 1.0], [-0.55, 1.0]] }\n"
+# A wall behind the robot: 0.1 m thick, its face at x = -0.35, from y = -1 to 1.
+WALL_BEHIND = "obstacles:\n  - polygon: { points: [[-0.45, -1.0], [-0.35, -1.0], [-0.35, 1.0], [-0.45, 1.0]] }\n"
+# The collision check sees what the scan sees: a LIDAR all round (the default 270° one is blind
+# straight behind, where a wall 0.55 m back lies outside its view).
+LIDAR_ALL_ROUND = ("-p", "lidar.fov:=6.283185307179586", "-p", "lidar.beams:=720")
 
 
 def duration(seconds: float):
@@ -215,17 +218,17 @@ def run_goal(client: ActionClient, goal, timeout: float = 30.0, feedback=None):
 @pytest.mark.timeout(120)
 def test_backup_drive_on_heading_and_spin_reach_their_targets_collide_and_time_out(
         start_scenario, start_node, sim_clock, ros_node, tmp_path):
-    """OMR-III with a wall 0.45 m behind: DriveOnHeading 0.5 m, BackUp 0.3 m and Spin π/2 reach
-    their targets by ground truth; a BackUp of 1 m toward the wall at 0.2 m/s gives
-    COLLISION_AHEAD at once (the 2 s horizon reaches 0.4 m, the footprint 0.25 m more); a 0.3 s
-    time_allowance for a 1 m drive gives TIMEOUT."""
+    """OMR-III with a LIDAR all round and a wall 0.35 m behind: DriveOnHeading 0.5 m, BackUp 0.3 m
+    and Spin π/2 reach their targets by ground truth; then, 0.55 m from the wall, a BackUp of 1 m
+    at 0.2 m/s gives COLLISION_AHEAD at once (the 2 s horizon reaches 0.4 m, the footprint 0.25 m
+    more: 0.65 m); a 0.3 s time_allowance for a 1 m drive gives TIMEOUT."""
     from nav2_msgs.action import BackUp, DriveOnHeading, Spin
 
     world = tmp_path / "wall_behind.yaml"
     world.write_text(WALL_BEHIND)
     params = "params/omr3.yaml"
     start_scenario(params, real_time_factor=2.0, lidar=True, node_args=CHASSIS_ARGS,
-                   sim_args=("-p", f"world_file:={world}"))
+                   sim_args=("-p", f"world_file:={world}", *LIDAR_ALL_ROUND))
     start_node("drive_node", *NODE_ARGS, params_file=params)
     clients = {name: ActionClient(ros_node, kind, name)
                for name, kind in (("backup", BackUp), ("drive_on_heading", DriveOnHeading), ("spin", Spin))}
@@ -356,3 +359,60 @@ def test_stamped_cmd_vel_drives_the_robot_and_a_twist_publisher_is_told(
     assert len(commands) > 50
     assert {c.header.frame_id for c in commands} == {"base_link"}
     assert all(c.header.stamp.sec > 0 or c.header.stamp.nanosec > 0 for c in commands)
+
+
+# ---------------------------------------------------------------------------------------------
+# The dock database: dock_robot by dock_id
+# ---------------------------------------------------------------------------------------------
+
+DOCKS = """planner:
+  ros__parameters:
+    docks: ["dock1", "in_map"]
+    dock1:
+      type: charging_dock
+      frame: odom
+      pose: [1.0, 0.5, 1.0]
+      id: "c67f50cb"
+    in_map:
+      pose: [0.0, 0.0, 0.0]
+"""
+
+
+@pytest.mark.timeout(120)
+def test_dock_id_goals_dock_at_the_databases_pose(start_scenario, start_node, sim_clock, ros_node, tmp_path):
+    """Docks named in the planner's parameters, as opennav_docking takes them: a goal naming
+    dock1 docks at its pose (ground truth within 0.05 m and 0.1 rad, as the planner's docking
+    tests ask); an unknown name gives DOCK_NOT_IN_DB, a dock in `map` DOCK_NOT_VALID."""
+    from nav2_msgs.action import DockRobot
+
+    docks = tmp_path / "docks.yaml"
+    docks.write_text(DOCKS)
+    params = "params/omr3.yaml"
+    start_scenario(params, real_time_factor=3.0, node_args=CHASSIS_ARGS)
+    planner = start_node("planner_node", *NODE_ARGS, "--params-file", str(docks), params_file=params)
+    planner.wait_for_log(r"dock `dock1` \(charging_dock\) at \(1\.000, 0\.500, 1\.000 rad\) in odom")
+    planner.wait_for_log(r"dock `in_map` is in frame `map`")
+    client = ActionClient(ros_node, DockRobot, "dock_robot")
+    deep = make_qos("reliable", "volatile", 5000)
+    with subscribe(ros_node, Odometry, "ground_truth", qos=deep) as truth:
+        sim_clock.wait_started()
+        truth.wait_for(None, REPLY_TIMEOUT)
+        assert client.wait_for_server(timeout_sec=20.0)
+
+        def by_id(name: str) -> DockRobot.Goal:
+            goal = DockRobot.Goal()
+            goal.use_dock_id, goal.dock_id = True, name
+            return goal
+
+        for name, code in (("nowhere", DockRobot.Result.DOCK_NOT_IN_DB),
+                           ("in_map", DockRobot.Result.DOCK_NOT_VALID)):
+            res = run_goal(client, by_id(name))
+            assert res.status == GoalStatus.STATUS_ABORTED and res.result.error_code == code, \
+                (name, res.result.error_code, res.result.error_msg)
+        res = run_goal(client, by_id("dock1"), timeout=40.0)
+        assert res.status == GoalStatus.STATUS_SUCCEEDED and res.result.success, res.result.error_msg
+        sim_clock.wait_until(sim_clock.now() + 1.0)
+        end = truth.latest
+    p = end.pose.pose.position
+    assert math.hypot(p.x - 1.0, p.y - 0.5) < 0.05, (p.x, p.y)
+    assert abs(math.remainder(yaw_of(end) - 1.0, math.tau)) < 0.1, yaw_of(end)

@@ -17,7 +17,7 @@
 //! ([`VelocityCommand::for_chassis`]). A refused input while a goal runs (scan, laser pose, odometry)
 //! stops the robot with one zero command; the navigator refusing its input on 20 scans in a row
 //! ends the goal `INVALID_INPUT`. At shutdown with a goal under way, its zero command is the last
-//! one, waited for ([`final_stop`]); an idle node sends none.
+//! one, waited for ([`mobil_ros::stop::final_stop`]); an idle node sends none.
 
 use mobil_geom::Pose2;
 use mobil_local_nav::path::PathGoals;

@@ -390,6 +390,26 @@ impl<C: 'static> Decl<C> {
         )
     }
 
+    /// An array of strings filling a field (names of instances, as Nav2's `docks`).
+    pub fn strings(
+        &mut self,
+        name: &str,
+        default: &[&str],
+        description: &str,
+        set: impl Fn(&mut C, Vec<String>) + Send + Sync + 'static,
+    ) -> Declared<'_> {
+        self.push(
+            ParamSpec::strings(name, default, description),
+            Arc::new(move |c, v| match v {
+                ParameterValue::StringArray(a) => {
+                    set(c, a.clone());
+                    Ok(())
+                }
+                other => Err(wrong_type("string array", other)),
+            }),
+        )
+    }
+
     /// Declares a group of parameters (its own [`Decl`]) that fills one part of `C`, e.g. the
     /// chassis geometry shared by every node that models the chassis.
     pub fn nest<S: 'static>(

@@ -47,6 +47,9 @@ pub struct NodeDecl {
     pub about: String,
     pub params: Vec<ParamSpec>,
     pub check: ConfigCheck,
+    /// Which undeclared parameters the node takes as they come ([`RosNode::extra_params`]):
+    /// instances named in a list, as Nav2's `docks: [dock1]` with `dock1.pose`.
+    pub extra: Arc<dyn Fn(&str) -> bool + Send + Sync>,
 }
 
 impl NodeDecl {
@@ -57,6 +60,7 @@ impl NodeDecl {
             about: about.to_owned(),
             params: Vec::new(),
             check: Arc::new(|_| Ok(())),
+            extra: Arc::new(|_| false),
         }
     }
 
@@ -78,6 +82,14 @@ impl NodeDecl {
     /// Declares several parameters.
     pub fn params(mut self, specs: impl IntoIterator<Item = ParamSpec>) -> Self {
         self.params.extend(specs);
+        self
+    }
+
+    /// Takes the undeclared parameters `accepts` names from files and `-p` (not from `/**`), as
+    /// they come, without the warning an unknown parameter gets: the node reads them once at
+    /// start ([`RosNode::extra_params`]); they are not served by the parameter services.
+    pub fn extra(mut self, accepts: impl Fn(&str) -> bool + Send + Sync + 'static) -> Self {
+        self.extra = Arc::new(accepts);
         self
     }
 
@@ -195,6 +207,8 @@ pub struct RosNode {
     clock: Option<Subscription<Clock>>,
     /// Latest `/clock` (ns), shared with the node's [`NodeClock`]s.
     sim_clock: Arc<AtomicI64>,
+    /// The undeclared parameters the node takes ([`NodeDecl::extra`]).
+    extra: Vec<(String, ParameterValue)>,
 }
 
 /// The node's clock for a part of it that stamps messages away from the node itself (a
@@ -244,8 +258,13 @@ impl RosNode {
             files.push((path.clone(), text));
         }
         let initial = initial_params(&decl.params, &files, &args.params, &fqn, &node_name)?;
-        for w in &initial.warnings {
-            warn!("{w}");
+        let mut extra = Vec::new();
+        for (name, value, origin) in &initial.unknown {
+            if (decl.extra)(name) {
+                extra.push((name.clone(), value.clone()));
+            } else {
+                warn!("unknown parameter `{name}` from {origin} ignored");
+            }
         }
         (decl.check)(&initial.values).map_err(|e| anyhow!("parameters of {fqn} are inconsistent: {e}"))?;
 
@@ -328,6 +347,7 @@ impl RosNode {
             spinner: Some(handle),
             clock: None,
             sim_clock: Arc::new(AtomicI64::new(0)),
+            extra,
         };
         ros_node.clock = Some(ros_node.subscription::<Clock>("/clock", &crate::qos::sensor_data())?);
         crate::log::attach_rosout(ros_node.node.logging_handle());
@@ -436,6 +456,12 @@ impl RosNode {
             self.node.get_parameter("use_sim_time"),
             Some(ParameterValue::Boolean(true))
         )
+    }
+
+    /// The undeclared parameters the node takes ([`NodeDecl::extra`]), in the order given (a
+    /// later value of a name after an earlier one).
+    pub fn extra_params(&self) -> &[(String, ParameterValue)] {
+        &self.extra
     }
 
     /// A handle on the node's clock (see [`NodeClock`]).

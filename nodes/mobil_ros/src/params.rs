@@ -131,6 +131,12 @@ impl ParamSpec {
         Self::new(name, ParameterValue::DoubleArray(default.to_vec()), description)
     }
 
+    /// A string array parameter.
+    pub fn strings(name: &str, default: &[&str], description: &str) -> Self {
+        let default = default.iter().map(|s| (*s).to_owned()).collect();
+        Self::new(name, ParameterValue::StringArray(default), description)
+    }
+
     /// Accept only values ≥ `min`.
     pub fn min(self, min: f64) -> Self {
         self.range(Some((min, true)), None)
@@ -550,6 +556,8 @@ pub struct InitialParams {
     pub use_sim_time: bool,
     /// Things worth a warning (unknown parameters), already formatted.
     pub warnings: Vec<String>,
+    /// The unknown parameters given to this node by name (not by `/**`): name, value, origin.
+    pub unknown: Vec<(String, ParameterValue, String)>,
 }
 
 /// Computes the start-up values of a node's parameters.
@@ -563,6 +571,7 @@ pub fn initial_params(
     let mut values = ParamValues::defaults(specs);
     let mut use_sim_time = false;
     let mut warnings = Vec::new();
+    let mut unknown = Vec::new();
     let mut apply = |name: &str, value: ParameterValue, origin: &str, shared: bool| -> Result<(), ParamError> {
         let invalid = |reason: String| ParamError::Invalid {
             name: name.to_owned(),
@@ -579,7 +588,10 @@ pub fn initial_params(
         match specs.iter().find(|s| s.name == name) {
             Some(spec) => values.set(name, spec.check(&value).map_err(invalid)?),
             None if shared => {}
-            None => warnings.push(format!("unknown parameter `{name}` from {origin} ignored")),
+            None => {
+                warnings.push(format!("unknown parameter `{name}` from {origin} ignored"));
+                unknown.push((name.to_owned(), value, origin.to_owned()));
+            }
         }
         Ok(())
     };
@@ -608,6 +620,7 @@ pub fn initial_params(
         values,
         use_sim_time,
         warnings,
+        unknown,
     })
 }
 

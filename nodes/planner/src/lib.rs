@@ -103,6 +103,7 @@
 
 pub mod approach;
 pub mod docking;
+pub mod docks;
 pub mod error;
 pub mod follow;
 pub mod goals;

@@ -672,13 +672,3 @@ pub fn dock_request_notice(max_staging_time: f32, navigate_to_staging_pose: bool
          ({navigate_to_staging_pose}) ignored: the Lyapunov law docks from wherever the robot is{dock_type}"
     ))
 }
-
-/// A dock asked for by id: `INVALID_GOAL` with DockRobot's DOCK_NOT_IN_DB (the planner docks
-/// onto a pose; it has no dock database).
-pub fn no_dock_database() -> Outcome {
-    Outcome::failed(
-        "INVALID_GOAL",
-        "use_dock_id is true, but this planner has no dock database (give dock_pose with use_dock_id false)",
-        nav2::docking::DOCK_NOT_IN_DB,
-    )
-}

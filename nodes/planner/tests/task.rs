@@ -8,7 +8,7 @@ use mobil_geom::Pose2;
 use mobil_motion::slot::Handback;
 use mobil_motion::{BodyTwist, EndCause, GoalLaw, Notice, Outcome, Step, StepInput};
 use mobil_planner::goals::{DockGoal, UndockGoal};
-use mobil_planner::task::{no_dock_database, Action, Mode, PreCheck, Source, Stepped, Task, VfoRun, VfoStart};
+use mobil_planner::task::{Action, Mode, PreCheck, Source, Stepped, Task, VfoRun, VfoStart};
 use mobil_planner::vfo::{
     ObstacleMap, OptimiseConfig, OptimiseWarning, Reoptimised, ScanObstacleConfig, VfoEvent, VfoFollower, VfoGains,
     VfoGoal, VfoSettings, VfoStep, VfoTick, VfoWaypoint,
@@ -256,10 +256,6 @@ fn the_ends_the_node_makes_carry_each_action_s_nav2_code() {
         (s.reason().as_str(), s.nav2_error()),
         ("STALE_INPUT: scan stale: robot stopped", 905)
     );
-    assert_eq!(no_dock_database().nav2_error(), 901);
-    assert!(no_dock_database()
-        .reason()
-        .starts_with("INVALID_GOAL: use_dock_id is true"));
 }
 
 #[test]

@@ -20,6 +20,7 @@ use mobil_msgs::nav2_msgs::msg::MissedWaypoint;
 use mobil_msgs::nav_msgs::msg::Path;
 use mobil_msgs::std_msgs::msg::Header;
 use mobil_msgs::visualization_msgs::msg::MarkerArray;
+use mobil_planner::docks::{DockDatabase, DockFields};
 pub use mobil_planner::goals::{Missed, RouteAnswer};
 use mobil_planner::{DockingConfig, DockingGains, FollowConfig, RouteCheckConfig};
 use mobil_ros::action::nav2_result;
@@ -34,10 +35,11 @@ use mobil_ros::lifecycle::Managed;
 use mobil_ros::markers::{point, Markers};
 use mobil_ros::motion::EndCause;
 use mobil_world::World;
+use ros2_client::ParameterValue;
 
 pub mod vfo;
 
-pub use mobil_planner::task::{no_dock_database, Action, Figures, Mode};
+pub use mobil_planner::task::{Action, Figures, Mode};
 pub use mobil_planner::vfo::{VfoSettings, WaypointMethod};
 
 /// Everything the node is configured with, each field filled by one declared parameter.
@@ -61,6 +63,11 @@ pub struct PlannerConfig {
     pub follow: FollowConfig,
     /// The world file of the pre-check: empty = the sim's built-in world, `none` = no obstacles.
     pub world_file: String,
+    /// The dock instances' names (`docks`; each one's `type`, `frame`, `pose`, `id` come as
+    /// `<name>.pose` … parameters).
+    pub docks: Vec<String>,
+    /// A dock database file in opennav_docking's form (`dock_database`); empty: `docks`.
+    pub dock_database: String,
     /// Drive a route the pre-check found problems on (default false: refused).
     pub execute_infeasible_routes: bool,
     /// How far `undock_robot` backs out (m).
@@ -156,6 +163,22 @@ impl Config for PlannerConfig {
             double "markers_rate_hz" = 1.0 => markers_rate_hz, within(0.1, 10.0);
                 "planner/markers rate while a goal is active [Hz]";
         }
+        d.strings(
+            "docks",
+            &[],
+            "dock_robot's dock database (opennav_docking's form): the names of the dock instances, each \
+             with NAME.pose [x, y, yaw], NAME.frame (default map), NAME.type, NAME.id",
+            |c, v| c.docks = v,
+        )
+        .read_only();
+        d.string(
+            "dock_database",
+            "",
+            "a dock database YAML file (opennav_docking's: docks: {NAME: {type, frame, pose, id}}) read \
+             instead of docks; empty: docks",
+            |c, v| c.dock_database = v,
+        )
+        .read_only();
         d.nest(|c: &mut PlannerConfig| &mut c.timeouts, GoalTimeouts::declare);
         d.nest(|c: &mut PlannerConfig| &mut c.managed, Managed::declare);
         d.nest(|c: &mut PlannerConfig| &mut c.cmd_vel, CmdVelType::declare);
@@ -289,6 +312,100 @@ pub fn markers(view: &MarkerView<'_>, stamp: Time, frame: &str) -> MarkerArray {
     let mut m = Markers::replacing(stamp, frame);
     m.sketch(&view.sketch());
     m.array()
+}
+
+/// The fields a dock instance's parameters fill (`NAME.type` …): what [`NodeDecl::extra`]
+/// takes for the planner.
+///
+/// [`NodeDecl::extra`]: mobil_ros::NodeDecl::extra
+pub const DOCK_FIELDS: [&str; 4] = ["type", "frame", "pose", "id"];
+
+/// Whether an undeclared parameter is a dock instance's field (`NAME.pose`, …).
+pub fn is_dock_field(name: &str) -> bool {
+    name.rsplit_once('.')
+        .is_some_and(|(dock, field)| !dock.is_empty() && DOCK_FIELDS.contains(&field))
+}
+
+/// The dock database from `docks` and the instances' parameters (`extra`: name, value), or
+/// from the `dock_database` file's text when one is given.
+pub fn dock_database(
+    config: &PlannerConfig,
+    extra: &[(String, ParameterValue)],
+    file_text: Option<&str>,
+) -> Result<DockDatabase, String> {
+    let instances = match file_text {
+        Some(text) => docks_from_yaml(text)?,
+        None => config
+            .docks
+            .iter()
+            .map(|name| dock_from_params(name, extra))
+            .collect::<Result<Vec<_>, String>>()?,
+    };
+    DockDatabase::new(instances).map_err(|e| e.to_string())
+}
+
+/// One dock instance from its parameters (the last value of a name wins).
+fn dock_from_params(name: &str, extra: &[(String, ParameterValue)]) -> Result<(String, DockFields), String> {
+    let field = |f: &str| {
+        let key = format!("{name}.{f}");
+        extra.iter().rev().find(|(n, _)| *n == key).map(|(_, v)| v.clone())
+    };
+    let text = |f: &str| -> Result<Option<String>, String> {
+        match field(f) {
+            None => Ok(None),
+            Some(ParameterValue::String(s)) => Ok(Some(s)),
+            Some(other) => Err(format!("{name}.{f} must be a string, not {other:?}")),
+        }
+    };
+    let pose = match field("pose") {
+        None => None,
+        Some(ParameterValue::DoubleArray(a)) => Some(a),
+        Some(ParameterValue::IntegerArray(a)) => Some(a.iter().map(|i| *i as f64).collect()),
+        Some(other) => return Err(format!("{name}.pose must be [x, y, yaw], not {other:?}")),
+    };
+    let fields = DockFields {
+        dock_type: text("type")?,
+        frame: text("frame")?,
+        pose,
+        id: text("id")?,
+    };
+    Ok((name.to_owned(), fields))
+}
+
+/// The instances of a dock database file: `docks:` mapping each name to its fields.
+pub fn docks_from_yaml(text: &str) -> Result<Vec<(String, DockFields)>, String> {
+    use serde_norway::Value;
+    let root: Value = serde_norway::from_str(text).map_err(|e| format!("not YAML: {e}"))?;
+    let Some(Value::Mapping(docks)) = root.get("docks") else {
+        return Err("no `docks:` mapping each dock's name to its fields".to_owned());
+    };
+    docks
+        .iter()
+        .map(|(name, fields)| {
+            let name = name.as_str().ok_or("a dock's name is not a string")?.to_owned();
+            let text = |f: &str| fields.get(f).and_then(Value::as_str).map(str::to_owned);
+            let pose = match fields.get("pose") {
+                None => None,
+                Some(Value::Sequence(items)) => Some(
+                    items
+                        .iter()
+                        .map(|v| {
+                            v.as_f64()
+                                .ok_or_else(|| format!("dock `{name}`: pose holds a non-number"))
+                        })
+                        .collect::<Result<Vec<f64>, String>>()?,
+                ),
+                Some(_) => return Err(format!("dock `{name}`: pose must be [x, y, yaw]")),
+            };
+            let fields = DockFields {
+                dock_type: text("type"),
+                frame: text("frame"),
+                pose,
+                id: text("id"),
+            };
+            Ok((name, fields))
+        })
+        .collect()
 }
 
 #[cfg(test)]
@@ -505,5 +622,49 @@ mod tests {
         assert_eq!(load_world("").expect("builtin"), World::builtin());
         assert!(load_world("none").expect("empty").obstacles.is_empty());
         assert!(load_world("/nonexistent/world.yaml").is_err());
+    }
+
+    /// Docks from parameters (Nav2's form) and from a file; refusals say what is wrong.
+    #[test]
+    fn the_dock_database_comes_from_parameters_or_a_file() {
+        let mut config: PlannerConfig =
+            mobil_ros::config::load(&ParamValues::defaults(&Decl::<PlannerConfig>::of().specs())).unwrap();
+        config.docks = vec!["dock1".into(), "dock2".into()];
+        let extra = vec![
+            ("dock1.type".to_owned(), ParameterValue::String("charging_dock".into())),
+            ("dock1.frame".to_owned(), ParameterValue::String("odom".into())),
+            (
+                "dock1.pose".to_owned(),
+                ParameterValue::DoubleArray(vec![1.0, 0.5, 1.0]),
+            ),
+            ("dock2.pose".to_owned(), ParameterValue::IntegerArray(vec![2, 0, 0])),
+        ];
+        let db = dock_database(&config, &extra, None).unwrap();
+        assert_eq!(
+            db.pose_in("dock1", "odom").unwrap(),
+            mobil_geom::Pose2::new(1.0, 0.5, 1.0)
+        );
+        assert_eq!((db.docks()[1].frame.as_str(), db.docks()[1].pose.x), ("map", 2.0));
+        assert!(is_dock_field("dock1.pose") && is_dock_field("a.b.id"));
+        assert!(!is_dock_field("pose") && !is_dock_field(".pose") && !is_dock_field("dock1.colour"));
+        let missing = dock_database(&config, &extra[..3], None).unwrap_err();
+        assert_eq!(missing, "dock `dock2` has no pose: give `dock2.pose: [x, y, yaw]`");
+        let bad_frame = [("dock1.frame".to_owned(), ParameterValue::Double(1.0))];
+        assert!(dock_database(&config, &bad_frame, None)
+            .unwrap_err()
+            .contains("dock1.frame must be a string"));
+        let file =
+            "docks:\n  home:\n    type: charging_dock\n    frame: odom\n    pose: [0.3, -0.2, 3.0]\n    id: c67f\n";
+        let db = dock_database(&config, &[], Some(file)).unwrap();
+        assert_eq!(db.docks()[0].name, "home");
+        assert_eq!(db.docks()[0].id, "c67f");
+        assert_eq!(db.pose_in("home", "odom").unwrap().yaw, 3.0);
+        assert!(dock_database(&config, &[], Some("docks: 3"))
+            .unwrap_err()
+            .starts_with("no `docks:`"));
+        assert!(dock_database(&config, &[], Some("docks: {a: {pose: [1, x, 0]}}")).is_err());
+        assert!(dock_database(&config, &[], Some(": : :"))
+            .unwrap_err()
+            .starts_with("not YAML"));
     }
 }

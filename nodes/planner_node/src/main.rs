@@ -21,7 +21,7 @@
 //! a goal that must wait, a route's pre-check or a VFO segment's optimisation, stops the robot
 //! meanwhile). Every command is held to the chassis limits as chassis_node holds them
 //! ([`clamp_at_reference`]). A refused odometry message or step stops the robot. At shutdown with a
-//! goal that moved the robot, its zero command is the last one, waited for ([`final_stop`]);
+//! goal that moved the robot, its zero command is the last one, waited for ([`mobil_ros::stop::final_stop`]);
 //! an idle node sends none.
 
 // The shell's modules (`shell::*`) take every name from here (`use crate::*`).
@@ -39,14 +39,15 @@ use mobil_msgs::nav2_msgs::action::{
 use mobil_msgs::nav_msgs::msg::{Odometry, Path};
 use mobil_msgs::sensor_msgs::msg::LaserScan;
 use mobil_msgs::tf2_msgs::msg::TFMessage;
+use mobil_planner::docks::DockDatabase;
 use mobil_planner::goals::{DockGoal, RouteEvent, UndockGoal};
 use mobil_planner::task::{dock_request_notice, status_view, PreCheck, Source, Stepped, Task, VfoRun};
 use mobil_planner::vfo::{Interrupt, KeptMap, PoseHistory, ScanSkipped, VfoGoal, VfoStep, VfoTick, WaypointMethod};
 use mobil_planner::view::Drawing;
 use mobil_planner::{check_route_until, Finish, RouteReport};
 use mobil_planner_node::{
-    check_reply, follow_result, load_world, markers, no_dock_database, refused_reply, Action, GoalError, PlannerConfig,
-    Route, RouteAnswer, MAX_REPLY_POSES, ROUTE_LIMITS,
+    check_reply, follow_result, load_world, markers, refused_reply, Action, GoalError, PlannerConfig, Route,
+    RouteAnswer, MAX_REPLY_POSES, ROUTE_LIMITS,
 };
 use mobil_ros::action::{goal_end, nav2_result, ActionEvent, GoalRequest, GoalServer, GoalServerConfig};
 use mobil_ros::geometry::{odom_pose, twist_msg};
@@ -86,6 +87,8 @@ fn decl() -> NodeDecl {
          following by the goal approach after a route pre-check or by VFO round the obstacles in scan \
          (waypoint_method; waypoints, follow_waypoints, planner/check_route); cmd_vel out",
     )
+    // The dock instances' fields (docks: [dock1] with dock1.pose …), as opennav_docking takes them.
+    .extra(mobil_planner_node::is_dock_field)
 }
 
 fn main() -> ExitCode {
@@ -190,6 +193,8 @@ struct Shell {
     odom_period: ArrivalPeriod,
     /// The laser's pose from `tf_static`.
     laser: StaticFrames,
+    /// dock_robot's dock database.
+    docks: DockDatabase,
 }
 
 #[allow(clippy::large_enum_variant)]
@@ -227,6 +232,7 @@ async fn start(node: &mut RosNode, out: &Outputs, config: PlannerConfig) -> anyh
     for w in config.gains()?.warnings() {
         warn!("{w} (accepted: stability needs only positive gains)");
     }
+    let docks = load_docks(node, &config)?;
     let odom_sub = node.subscription::<Odometry>("odom", &qos::default_qos())?;
     let dock_sub = node.subscription::<PoseStamped>("dock_pose", &qos::default_qos())?;
     let route_sub = node.subscription::<Path>("waypoints", &qos::default_qos())?;
@@ -274,6 +280,7 @@ async fn start(node: &mut RosNode, out: &Outputs, config: PlannerConfig) -> anyh
         scan_seen: Latest::new(),
         odom_period: ArrivalPeriod::default(),
         laser: StaticFrames::default(),
+        docks,
     };
     shell.send_idle_status(node, out);
     let mut jobs = Jobs {
@@ -323,6 +330,30 @@ async fn start(node: &mut RosNode, out: &Outputs, config: PlannerConfig) -> anyh
     );
     lifecycle.close();
     Ok(outcome)
+}
+
+/// The dock database (`dock_database` file, else `docks`), each dock logged; a dock in another
+/// frame than odometry's is told (goals to it fail DOCK_NOT_VALID).
+fn load_docks(node: &RosNode, config: &PlannerConfig) -> anyhow::Result<DockDatabase> {
+    let text = match config.dock_database.as_str() {
+        "" => None,
+        path => Some(std::fs::read_to_string(path).map_err(|e| anyhow::anyhow!("dock_database `{path}`: {e}"))?),
+    };
+    let docks = mobil_planner_node::dock_database(config, node.extra_params(), text.as_deref())
+        .map_err(|e| anyhow::anyhow!("dock database: {e}"))?;
+    for d in docks.docks() {
+        info!(
+            "dock `{}` ({}) at ({:.3}, {:.3}, {:.3} rad) in {}",
+            d.name, d.dock_type, d.pose.x, d.pose.y, d.pose.yaw, d.frame
+        );
+        if d.frame != config.frames.odom_frame {
+            warn!(
+                "dock `{}` is in frame `{}`: this planner docks in `{}` only; goals to it fail DOCK_NOT_VALID",
+                d.name, d.frame, config.frames.odom_frame
+            );
+        }
+    }
+    Ok(docks)
 }
 
 #[allow(clippy::too_many_arguments)]

@@ -7,7 +7,7 @@ impl Shell {
     pub(crate) async fn dock_action(&mut self, io: &mut Io<'_, '_>, request: GoalRequest<DockRobotGoal>) {
         let g = request.goal();
         let target = if g.use_dock_id {
-            Err(no_dock_database())
+            self.docks.pose_in(&g.dock_id, &self.config.frames.odom_frame)
         } else {
             goal_pose("dock pose", &g.dock_pose, &self.config.frames.odom_frame)
                 .map_err(|e| Action::Dock.invalid_goal(&e))
