@@ -62,18 +62,23 @@ def descriptions(reply) -> list:
              d.goal_state.id, d.goal_state.label) for d in reply.available_transitions]
 
 
+_change_clients: dict = {}
+
+
 def change(ros_node, name: str, transition: int = 0, label: str = "") -> bool:
-    """One ChangeState, sent once and waited for (Nav2's manager never re-sends it)."""
-    client = ros_node.create_client(ChangeState, srv(name, "change_state"))
-    try:
-        assert client.wait_for_service(timeout_sec=REPLY_TIMEOUT), f"{name}/change_state not found"
-        request = ChangeState.Request()
-        request.transition.id, request.transition.label = transition, label
-        future = client.call_async(request)
-        assert wait_for_future(future, REPLY_TIMEOUT), f"{name}: no answer to change_state {transition}"
-        return future.result().success
-    finally:
-        ros_node.destroy_client(client)
+    """One ChangeState, sent once and waited for (Nav2's manager never re-sends it), on one
+    client per node kept for the test's node, as the manager keeps one: a new client's first
+    request can wait for discovery to match it."""
+    key = (id(ros_node), name)
+    if key not in _change_clients:
+        _change_clients[key] = ros_node.create_client(ChangeState, srv(name, "change_state"))
+    client = _change_clients[key]
+    assert client.wait_for_service(timeout_sec=REPLY_TIMEOUT), f"{name}/change_state not found"
+    request = ChangeState.Request()
+    request.transition.id, request.transition.label = transition, label
+    future = client.call_async(request)
+    assert wait_for_future(future, REPLY_TIMEOUT), f"{name}: no answer to change_state {transition}"
+    return future.result().success
 
 
 class Events:

@@ -100,6 +100,8 @@ class Navigator:
 
     def send(self) -> None:
         p = self.odom.latest.pose.pose.position
+        if self.handles and math.dist((p.x, p.y), self.route[-1]) < CORNER_PASSED:
+            return  # at the end: a navigator re-plans no more (the last goal finishes the route)
         self.handles.append(accepted(self.client, follow_goal(self.path_from(p.x, p.y))))
 
     def _run(self) -> None:
@@ -317,8 +319,11 @@ def test_stamped_cmd_vel_drives_the_robot_and_a_twist_publisher_is_told(
     params = "params/omr3.yaml"
     sim, chassis = start_scenario(params, real_time_factor=2.0, lidar=True,
                                   node_args=(*CHASSIS_ARGS, *STAMPED))
-    for exe in ("drive_node", "local_nav_node", "planner_node"):
-        start_node(exe, *NODE_ARGS, *STAMPED, params_file=params)
+    # Names of their own: a node of an earlier test in this domain (one killed, say) can linger
+    # in the graph for a while under its name.
+    names = ("stamped_drive", "stamped_local_nav", "stamped_planner")
+    for exe, name in zip(("drive_node", "local_nav_node", "planner_node"), names):
+        start_node(exe, *NODE_ARGS, *STAMPED, params_file=params, name=name)
     drive = ActionClient(ros_node, DriveOnHeading, "drive_on_heading")
     follow = ActionClient(ros_node, FollowPath, "follow_path")
     dock = ActionClient(ros_node, DockRobot, "dock_robot")
@@ -345,7 +350,10 @@ def test_stamped_cmd_vel_drives_the_robot_and_a_twist_publisher_is_told(
         assert res.status == GoalStatus.STATUS_SUCCEEDED, res.result.error_msg
         sim_clock.wait_until(sim_clock.now() + 1.0)
         end = truth.latest.pose.pose.position
-        types = dict(ros_node.get_topic_names_and_types()).get("/cmd_vel")
+        publishers = {(i.node_name, i.topic_type) for i in ros_node.get_publishers_info_by_topic("/cmd_vel")
+                      if i.node_name in names}
+        readers = {(i.node_name, i.topic_type) for i in ros_node.get_subscriptions_info_by_topic("/cmd_vel")
+                   if i.node_name == "chassis"}
         commands = cmd.snapshot()
 
         # A Twist publisher (another process: one participant cannot have both types).
@@ -354,7 +362,8 @@ def test_stamped_cmd_vel_drives_the_robot_and_a_twist_publisher_is_told(
         chassis.wait_for_log(r"cmd_vel: a publisher of geometry_msgs/msg/Twist is on the topic.*"
                              r"enable_stamped_cmd_vel:=false", 15.0)
 
-    assert types == ["geometry_msgs/msg/TwistStamped"], types
+    assert publishers == {(n, "geometry_msgs/msg/TwistStamped") for n in names}, publishers
+    assert readers == {("chassis", "geometry_msgs/msg/TwistStamped")}, readers
     assert math.hypot(end.x - 2.0, end.y) < 0.1, (end.x, end.y)
     assert len(commands) > 50
     assert {c.header.frame_id for c in commands} == {"base_link"}

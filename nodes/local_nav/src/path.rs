@@ -130,21 +130,22 @@ impl PathGoals {
     }
 
     /// Keeps `current` (the sub-goal the navigator heads for, from an earlier path) as the goal
-    /// when one of these sub-goals lies within `lookahead / 2` of it: that sub-goal becomes
-    /// `current` and the ones before it are dropped. A path re-planned along the same way then
-    /// leaves the navigator's goal, and its mode, as they were. False (nothing changed) when
-    /// none is that near.
+    /// when one of these sub-goals, not the end, lies within `lookahead / 2` of it: that
+    /// sub-goal becomes `current` and the ones before it are dropped. A path re-planned along
+    /// the same way then leaves the navigator's goal, and its mode, as they were. False
+    /// (nothing changed) when none is that near, or only the end (which is never moved).
     pub fn keep(&mut self, current: Point2<f64>) -> bool {
         let near = self.goals[self.next..]
             .iter()
             .position(|g| (g - current).norm() <= self.switch_radius);
         match near {
-            Some(i) => {
+            // The path's end is never moved: only it ends the goal.
+            Some(i) if self.next + i + 1 < self.goals.len() => {
                 self.next += i;
                 self.goals[self.next] = current;
                 true
             }
-            None => false,
+            _ => false,
         }
     }
 
@@ -237,6 +238,10 @@ mod tests {
         let before = other.clone();
         assert!(!other.keep(p(1.0, 0.0)));
         assert_eq!(other, before);
+        // Near the end: a new end 0.4 m from the old one is not replaced by it.
+        let mut end = PathGoals::new(&[p(2.6, 0.0), p(3.4, 0.0)], p(2.6, 0.0), 1.0).unwrap();
+        assert!(!end.keep(p(3.0, 0.0)));
+        assert_eq!(end.goal(), p(3.4, 0.0));
     }
 
     #[test]

@@ -49,7 +49,9 @@ impl Shell {
         let preempted = path_result(&EndCause::Preempted("follow_path"));
         if let Err(e) = servers.path.accept(request, |_| preempted, node.now_nanos()).await {
             warn_throttled!(self.throttle, "accept", "follow_path goal not started: {e}");
-            if let Some(ended) = self.session.preempt(Source::Path, sink) {
+            if e.ended_active()
+                && let Some(ended) = self.session.preempt(Source::Path, sink)
+            {
                 self.report(node, out, servers, ended);
             }
             return;
@@ -79,18 +81,18 @@ impl Shell {
     }
 
     /// A new path for the running `follow_path` goal: no stop, the sub-goal kept when the new
-    /// path passes near it, the progress checker kept.
+    /// path passes near it (the navigator's mode with it), the progress checker kept; any other
+    /// goal, the end included, goes to the navigator as it is.
     fn replace_path(&mut self, mut path: PathGoals) {
-        let tolerance = self.config.nav.goal_tolerance;
         let Some(active) = self.session.active_mut() else {
             return;
         };
         let kept = path.keep(active.goal.goal);
         let goal = path.goal();
-        let moved = (goal - active.goal.goal).norm() > tolerance;
+        let moved = goal != active.goal.goal;
         active.goal.goal = goal;
         active.goal.path = Some(path);
-        if !kept && moved {
+        if moved {
             if let Err(e) = self.nav.set_goal(goal) {
                 warn!("sub-goal refused by the navigator: {e}");
             }

@@ -166,8 +166,9 @@ async fn serve(node: &mut RosNode) -> anyhow::Result<()> {
     let stamped = config.cmd_vel.enable_stamped_cmd_vel;
     let outputs = Outputs::create(node, "local_nav", stamped, &config.frames.base_frame)?;
     let (outcome, final_zero) = run(node, &outputs, config).await;
-    // A goal under way at the end gets its zero command, waited for; an idle node sends none
-    // (another node, teleop or a twist_mux input, may be commanding the robot).
+    // A goal under way at the end gets its zero command, waited for (the loop sends it; this
+    // one for a loop that failed with a goal under way); an idle node sends none (another node,
+    // teleop or a twist_mux input, may be commanding the robot).
     if final_zero {
         outputs.cmd.final_stop(FINAL_STOP_WAIT).await;
     }
@@ -248,18 +249,23 @@ async fn start(
         &tf_sub,
     )
     .await;
-    // The zero command, if one is due, is the final, acknowledged one (serve); none here.
+    // A goal under way ends, and its zero command, waited for, goes out before anything that
+    // may take time; then the bond breaks and the servers close (each waits up to 2 s for its
+    // results).
     let (ended, final_zero) = shell.session.shutdown();
     if let Some(ended) = ended {
         shell.report(node, out, &mut servers, ended);
     }
+    if final_zero {
+        out.cmd.final_stop(FINAL_STOP_WAIT).await;
+    }
+    lifecycle.close().await;
     let Servers { nav, path } = servers;
     tokio::join!(
         nav.close(result(&EndCause::Shutdown)),
         path.close(path_result(&EndCause::Shutdown))
     );
-    lifecycle.close();
-    Ok((outcome, final_zero))
+    Ok((outcome, false))
 }
 
 #[allow(clippy::too_many_arguments)]
@@ -296,10 +302,7 @@ async fn event_loop(
         let mut sink = CmdVel::new(&out.cmd);
         match event {
             Event::Shutdown => return Ok(()),
-            Event::Config(Ok(c)) => {
-                lifecycle.set_managed(&c.managed);
-                shell.reconfigure(c);
-            }
+            Event::Config(Ok(c)) => shell.reconfigure(c),
             Event::Config(Err(e)) => warn!("parameters not applied: {e}"),
             Event::Odom(m) => shell.odom_in(&mut sink, &m),
             Event::Scan(m) => {
@@ -593,8 +596,11 @@ impl Shell {
             Err(e) => {
                 warn_throttled!(self.throttle, "accept", "navigate_to_pose goal not started: {e}");
                 // A running action goal was ended by the server: the robot stops with it (and
-                // with a topic's goal, which the action's goal was to replace).
-                if let Some(ended) = self.session.preempt(Source::Action, sink) {
+                // with a topic's goal, which the action's goal was to replace); a request refused
+                // for its id leaves the running goal alone.
+                if e.ended_active()
+                    && let Some(ended) = self.session.preempt(Source::Action, sink)
+                {
                     self.report(node, out, servers, ended);
                 }
             }

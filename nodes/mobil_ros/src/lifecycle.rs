@@ -45,6 +45,9 @@ use tracing::{info, warn};
 pub const BOND_TIMEOUT: Duration = Duration::from_secs(4);
 /// The largest `bond_heartbeat_period` (s): a heartbeat rarer than the timeout breaks the bond.
 pub const MAX_HEARTBEAT_PERIOD_S: f64 = 2.0;
+/// The shortest heartbeat period (s): a smaller positive value is taken as this, so that no
+/// setting makes the node flood `bond`.
+pub const MIN_HEARTBEAT_PERIOD_S: f64 = 0.01;
 
 /// The parameters of a managed node, nested by each node's configuration.
 #[derive(Debug, Clone, Default, PartialEq)]
@@ -57,7 +60,7 @@ pub struct Managed {
 
 impl Managed {
     /// Declares `autostart` (true, read-only) and `bond_heartbeat_period` (0.1 s, Nav2's name
-    /// and default; 0 disables the bond).
+    /// and default; 0 disables the bond; read-only, as Nav2 reads it once).
     pub fn declare(d: &mut Decl<Managed>) {
         d.boolean(
             "autostart",
@@ -71,16 +74,19 @@ impl Managed {
             "bond_heartbeat_period",
             0.1,
             "period of the bond heartbeats to the lifecycle manager while active after its activate \
-             (Nav2's parameter); 0 disables the bond [s]",
+             (Nav2's parameter); 0 disables the bond; a positive value below 0.01 is taken as 0.01 [s]",
             |c, v| c.bond_heartbeat_period = v,
         )
         .min(0.0)
-        .max(MAX_HEARTBEAT_PERIOD_S);
+        .max(MAX_HEARTBEAT_PERIOD_S)
+        .read_only();
     }
 
-    /// The heartbeat period.
+    /// The heartbeat period: zero (no bond), or at least [`MIN_HEARTBEAT_PERIOD_S`].
     pub fn heartbeat_period(&self) -> Duration {
-        crate::time::seconds(self.bond_heartbeat_period.max(0.0), MAX_HEARTBEAT_PERIOD_S)
+        let p = self.bond_heartbeat_period;
+        let p = if p > 0.0 { p.max(MIN_HEARTBEAT_PERIOD_S) } else { 0.0 };
+        crate::time::seconds(p, MAX_HEARTBEAT_PERIOD_S)
     }
 }
 
@@ -175,6 +181,8 @@ pub struct Lifecycle {
     bond_in: Subscription<Status>,
     heart: Heart,
     gate: ActiveGate,
+    /// A manager activated the node (its bond runs while active).
+    bonded: bool,
     fqn: String,
     throttle: LogThrottle,
 }
@@ -202,6 +210,7 @@ impl Lifecycle {
                 timeout: BOND_TIMEOUT,
             }),
             gate: ActiveGate::default(),
+            bonded: false,
             fqn,
             throttle: LogThrottle::new(Duration::from_secs(2)),
         };
@@ -239,13 +248,6 @@ impl Lifecycle {
     /// The current state.
     pub fn state(&self) -> State {
         self.machine.state()
-    }
-
-    /// A new heartbeat period, for the next activation.
-    pub fn set_managed(&mut self, managed: &Managed) {
-        let mut settings = self.heart.settings().clone();
-        settings.period = managed.heartbeat_period();
-        self.heart.set_settings(settings);
     }
 
     /// Waits for a transition that needs the node's callback, answering the queries, the bond
@@ -334,6 +336,7 @@ impl Lifecycle {
             next = after;
         }
         if transition.step == Step::Activate && self.machine.state() == State::Active {
+            self.bonded = true;
             self.heart.start(Instant::now(), new_instance_id());
             self.beat(Instant::now());
             if self.heart.is_beating() {
@@ -349,12 +352,18 @@ impl Lifecycle {
         self.reply_change(transition.request, answer == CallbackReturn::Success);
     }
 
-    /// Breaks a running bond as the node leaves (its `active = false`, once: the process goes).
-    pub fn close(mut self) {
-        if self.heart.is_beating() {
-            self.heart.stop(Instant::now());
+    /// Breaks a running bond as the node leaves: its `active = false` three times over 100 ms,
+    /// as at a deactivation (call it first at shutdown, before anything that may take time).
+    pub async fn close(mut self) {
+        if !self.heart.is_beating() {
+            return;
+        }
+        self.heart.stop(Instant::now());
+        while let Some(due) = self.heart.due() {
+            tokio::time::sleep_until(tokio::time::Instant::from_std(due)).await;
             self.beat(Instant::now());
         }
+        info!("{}: bond to the lifecycle manager broken (shutting down)", self.fqn);
     }
 
     fn reply_change(&mut self, request: RmwRequestId, success: bool) {
@@ -367,7 +376,8 @@ impl Lifecycle {
         );
     }
 
-    /// A move of the machine: its event, the gate, and the bond broken when leaving active.
+    /// A move of the machine: its event, the gate, and the bond broken when leaving active
+    /// (and started again when a failed deactivation goes back to active).
     fn moved(&mut self, event: Event) {
         self.publish(event);
         self.gate.set(self.machine.state() == State::Active);
@@ -375,6 +385,10 @@ impl Lifecycle {
             self.heart.stop(Instant::now());
             self.beat(Instant::now());
             info!("{}: bond to the lifecycle manager broken (leaving active)", self.fqn);
+        }
+        if event.start == State::Deactivating && event.goal == State::Active && self.bonded {
+            self.heart.start(Instant::now(), new_instance_id());
+            self.beat(Instant::now());
         }
     }
 

@@ -321,6 +321,7 @@ async fn start(node: &mut RosNode, out: &Outputs, config: PlannerConfig) -> anyh
     if final_zero {
         out.cmd.final_stop(FINAL_STOP_WAIT).await;
     }
+    lifecycle.close().await;
     let down = EndCause::Shutdown;
     let Servers { dock, undock, follow } = servers;
     tokio::join!(
@@ -328,7 +329,6 @@ async fn start(node: &mut RosNode, out: &Outputs, config: PlannerConfig) -> anyh
         undock.close(nav2_result(&down, Action::Undock.codes())),
         follow.close(follow_result(&down, &[], &[])),
     );
-    lifecycle.close();
     Ok(outcome)
 }
 
@@ -401,10 +401,7 @@ async fn event_loop(
         };
         match event {
             Event::Shutdown => return Ok(()),
-            Event::Config(Ok(c)) => {
-                lifecycle.set_managed(&c.managed);
-                shell.reconfigure(c);
-            }
+            Event::Config(Ok(c)) => shell.reconfigure(c),
             Event::Lifecycle(transition) => {
                 // Leaving active (deactivate, shutdown): the goal under way ends, with its zero.
                 if transition.leaves_active() {

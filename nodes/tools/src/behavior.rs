@@ -111,9 +111,11 @@ impl SpinTurn {
             return 0.0;
         }
         let s = &self.settings;
+        // max then min, not clamp: settings with min above max give max, never a panic.
         let w = (2.0 * s.decel * self.progress().1)
             .sqrt()
-            .clamp(s.min_speed, s.max_speed);
+            .max(s.min_speed)
+            .min(s.max_speed);
         w * self.target.signum()
     }
 }
@@ -246,11 +248,18 @@ impl Behavior {
         guard: Guard,
     ) -> Result<Self, Outcome> {
         let codes = mobil_motion::nav2::behavior::SPIN;
-        if !target_yaw.is_finite() || !start.yaw.is_finite() {
+        if !target_yaw.is_finite() {
             return Err(Outcome::failed(
                 "INVALID_INPUT",
                 format!("target_yaw {target_yaw} is not finite"),
                 codes.unknown,
+            ));
+        }
+        if !start.yaw.is_finite() {
+            return Err(Outcome::failed(
+                "TF_ERROR",
+                "the start heading is not finite",
+                codes.tf_error,
             ));
         }
         Ok(Behavior {

@@ -33,6 +33,7 @@ use mobil_ros::input::Inputs;
 use mobil_ros::latest::Latest;
 use mobil_ros::lifecycle::{CallbackReturn, Lifecycle, Managed};
 use mobil_ros::motion::{Applied, ClockCheck, CmdVel, EndCause, EndKind, Ended, MotionSession, SessionSettings};
+use mobil_ros::node::NodeClock;
 use mobil_ros::scan::{checked_scan, tf_static_subscription, LaserMount, StaticFrames};
 use mobil_ros::stop::FINAL_STOP_WAIT;
 use mobil_ros::ticker::Ticker;
@@ -277,6 +278,10 @@ struct Servers {
     backup: GoalServer<BackUp>,
     heading: GoalServer<DriveOnHeading>,
     spin: GoalServer<Spin>,
+    /// The node's clock, and the ROS time the running goal started at: its elapsed time, for
+    /// `time_allowance` and `total_elapsed_time` (Nav2's, in ROS time).
+    clock: NodeClock,
+    started_nanos: i64,
 }
 
 fn distance_result(travelled: f64, reason: &str) -> DriveDistanceResult {
@@ -305,6 +310,11 @@ fn behavior_answer(kind: Kind, cause: &EndCause, elapsed: f64) -> (DurationMsg, 
 }
 
 impl Servers {
+    /// ROS time since the running goal started (s, never negative).
+    fn elapsed(&self) -> f64 {
+        (self.clock.now_nanos().saturating_sub(self.started_nanos)).max(0) as f64 * 1e-9
+    }
+
     /// The ended goal's action result, unless its server ended it already.
     fn finish(&mut self, ended: &DriveEnded) {
         let cause = &ended.cause;
@@ -318,7 +328,7 @@ impl Servers {
             return;
         }
         let status = goal_end(cause);
-        let (elapsed, code, msg) = behavior_answer(ended.source, cause, ended.t);
+        let (elapsed, code, msg) = behavior_answer(ended.source, cause, self.elapsed());
         let travelled = ended.goal.progress().travelled;
         match ended.source {
             Kind::Distance => {
@@ -462,6 +472,8 @@ async fn drive_loop(
         backup: GoalServer::create(node, "backup", server_config.clone())?.gate(gate.clone()),
         heading: GoalServer::create(node, "drive_on_heading", server_config.clone())?.gate(gate.clone()),
         spin: GoalServer::create(node, "spin", server_config)?.gate(gate),
+        clock: node.clock(),
+        started_nanos: 0,
     };
     let mut shell = Shell {
         config,
@@ -478,8 +490,13 @@ async fn drive_loop(
     } else {
         "node failed"
     };
+    // A goal under way gets its zero command first, waited for; then the bond breaks and the
+    // servers close (each waits up to 2 s for its results, the running goal's among them).
+    if session.shutdown().1 {
+        cmd.final_stop(FINAL_STOP_WAIT).await;
+    }
+    lifecycle.close().await;
     servers.close(travelled, reason).await;
-    lifecycle.close();
     outcome
 }
 
@@ -550,10 +567,7 @@ impl Shell {
             match event {
                 Event::Shutdown => return Ok(()),
                 Event::Config(Ok(c)) => match ticker.set_rate(c.rate_hz) {
-                    Ok(()) => {
-                        lifecycle.set_managed(&c.managed);
-                        self.config = c;
-                    }
+                    Ok(()) => self.config = c,
                     Err(e) => warn!("parameters not applied: {e}"),
                 },
                 Event::Config(Err(e)) => warn!("parameters not applied: {e}"),
@@ -713,7 +727,9 @@ impl Shell {
             // One client's goal (a DDS send failed): logged, and the node goes on serving the
             // others; a goal it replaced was ended.
             warn_throttled!(self.throttle, "accept", "goal not started: {e}");
-            if let Some(ended) = session.preempt(kind, sink) {
+            if e.ended_active()
+                && let Some(ended) = session.preempt(kind, sink)
+            {
                 servers.finish(&ended);
             }
             return;
@@ -723,6 +739,7 @@ impl Shell {
                 if let (_, Some(old)) = session.start(law, kind, Instant::now()) {
                     servers.finish(&old);
                 }
+                servers.started_nanos = servers.clock.now_nanos();
             }
             Err(outcome) => {
                 let cause = EndCause::Outcome(outcome);
@@ -791,8 +808,19 @@ impl Shell {
             .echoes
             .get(seconds(self.config.scan_timeout_s, MAX_INPUT_TIMEOUT_S))
             .cloned();
+        if echoes.is_none() && matches!(kind, Kind::BackUp | Kind::Heading) {
+            warn_throttled!(
+                self.throttle,
+                "no-scan",
+                "{}: no scan placed in {} within scan_timeout_s: the collision check is off",
+                <&str>::from(kind),
+                self.config.base_frame
+            );
+        }
         let dt = session.advance(node.now_nanos()).and_then(Result::ok).unwrap_or(0.0);
-        let t = session.active().map_or(0.0, |a| a.t());
+        // The goal's ROS time, not the session's sum of steps (each held to 0.1 s): a time
+        // allowance is ROS time whatever the tick rate or the simulation's speed.
+        let t = servers.elapsed();
         let Some(active) = session.active_mut() else { return };
         let step = active.goal.step(&StepInput::new(t, dt, pose), &echoes);
         match session.apply(step, twist, sink) {

@@ -188,6 +188,18 @@ pub enum ActionError {
     /// DDS failed to send.
     #[error("goal {0:?}: {1}")]
     Goal(GoalId, String),
+    /// Another request with this goal's id was accepted first: this one is refused, and the
+    /// goal that was running runs on.
+    #[error("goal {0:?}: its id is in use")]
+    IdInUse(GoalId),
+}
+
+impl ActionError {
+    /// Whether a failed [`GoalServer::accept`] ended the goal that was running (it did unless
+    /// the id was in use): the node then stops that goal's robot.
+    pub fn ended_active(&self) -> bool {
+        !matches!(self, ActionError::IdInUse(_))
+    }
 }
 
 /// The longest [`GoalServer::close`] waits for the results no client has asked for yet.
@@ -483,7 +495,7 @@ where
         if self.table.knows(&id) {
             // Another request with this id was accepted since this one came (the node held two).
             self.send_goal_response(request.request, false, RosTime::ZERO, id);
-            return Err(ActionError::Goal(id, "its id is in use".to_owned()));
+            return Err(ActionError::IdInUse(id));
         }
         if let Some(old) = self.active.take() {
             let status = if old.canceling {

@@ -37,7 +37,8 @@ impl Shell {
     ) -> bool {
         let Err(e) = accept else { return true };
         warn_throttled!(self.throttle, "accept", "{} goal not started: {e}", source.name());
-        if self.session.active().is_some_and(|a| a.source == source)
+        if e.ended_active()
+            && self.session.active().is_some_and(|a| a.source == source)
             && let Some(ended) = self.session.preempt(source, io.sink)
         {
             self.report(io, ended);
