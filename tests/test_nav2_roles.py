@@ -60,9 +60,9 @@ def follow_goal(points, controller: str = "") -> FollowPath.Goal:
     return goal
 
 
-def accepted(client: ActionClient, goal, attempts: int = 4):
+def accepted(client: ActionClient, goal, attempts: int = 4, feedback=None):
     for _ in range(attempts):
-        future = client.send_goal_async(goal)
+        future = client.send_goal_async(goal, feedback_callback=feedback)
         if wait_until(future.done, 3.0):
             handle = future.result()
             assert handle.accepted, "follow_path goal rejected"
@@ -87,6 +87,7 @@ class Navigator:
     def __init__(self, client: ActionClient, odom, sim_clock, route) -> None:
         self.client, self.odom, self.clock, self.route = client, odom, sim_clock, route
         self.handles: list = []
+        self.feedback: list = []  # (distance_to_goal, speed) of every goal
         self.next_corner = 1
         self._stop = threading.Event()
         self.failure: BaseException | None = None
@@ -102,7 +103,9 @@ class Navigator:
         p = self.odom.latest.pose.pose.position
         if self.handles and math.dist((p.x, p.y), self.route[-1]) < CORNER_PASSED:
             return  # at the end: a navigator re-plans no more (the last goal finishes the route)
-        self.handles.append(accepted(self.client, follow_goal(self.path_from(p.x, p.y))))
+        path = follow_goal(self.path_from(p.x, p.y))
+        keep = lambda f: self.feedback.append((f.feedback.distance_to_goal, f.feedback.speed))  # noqa: E731
+        self.handles.append(accepted(self.client, path, feedback=keep))
 
     def _run(self) -> None:
         try:
@@ -170,6 +173,11 @@ def test_follow_path_replanned_every_second_reaches_the_end_without_a_stop(
 
     assert final.status == GoalStatus.STATUS_SUCCEEDED, (final.status, final.result.error_msg)
     assert final.result.error_code == FollowPath.Result.NONE
+    # Feedback: the distance along the route to its end (6 m at the start) and the speed.
+    feedback = list(navigator.feedback)
+    assert len(feedback) > 20, len(feedback)
+    assert 5.0 < feedback[0][0] <= 6.1 and feedback[-1][0] < 0.5, (feedback[0], feedback[-1])
+    assert max(v for _, v in feedback) > 0.2 and all(v >= 0.0 for _, v in feedback)
     assert len(handles) >= 8, f"only {len(handles)} paths sent: the stand-in did not re-plan every second"
     # Every replaced goal ended ABORTED with no error, as controller_server ends a preempted one.
     for h in handles[:-2]:
@@ -401,6 +409,14 @@ def test_dock_id_goals_dock_at_the_databases_pose(start_scenario, start_node, si
     planner = start_node("planner_node", *NODE_ARGS, "--params-file", str(docks), params_file=params)
     planner.wait_for_log(r"dock `dock1` \(charging_dock\) at \(1\.000, 0\.500, 1\.000 rad\) in odom")
     planner.wait_for_log(r"dock `in_map` is in frame `map`")
+    # The other form: a dock_database file (opennav_docking's), read at start by a second planner.
+    database = tmp_path / "dock_database.yaml"
+    database.write_text("docks:\n  home:\n    type: charging_dock\n    frame: odom\n    pose: [0.3, -0.2, 3.0]\n")
+    # (In a namespace of its own, so that its actions are not this test's.)
+    other = start_node("planner_node", "-r", "__ns:=/from_file", "-p", f"dock_database:={database}",
+                       params_file=params, name="planner_from_file")
+    other.wait_for_log(r"dock `home` \(charging_dock\) at \(0\.300, -0\.200, 3\.000 rad\) in odom")
+    other.stop()
     client = ActionClient(ros_node, DockRobot, "dock_robot")
     deep = make_qos("reliable", "volatile", 5000)
     with subscribe(ros_node, Odometry, "ground_truth", qos=deep) as truth:

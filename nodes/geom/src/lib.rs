@@ -26,6 +26,7 @@ pub mod angle;
 pub mod pose;
 pub mod sample;
 pub mod scan;
+pub mod segment;
 pub mod sketch;
 
 pub use angle::wrap;

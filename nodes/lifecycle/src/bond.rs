@@ -110,11 +110,6 @@ impl Heart {
         &self.settings
     }
 
-    /// Changes the period and timeout for the next start (a running bond keeps its own).
-    pub fn set_settings(&mut self, settings: BondSettings) {
-        self.settings = settings;
-    }
-
     /// This activation's instance id (empty before the first start).
     pub fn instance_id(&self) -> &str {
         &self.instance_id

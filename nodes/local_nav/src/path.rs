@@ -19,6 +19,7 @@
 //! assert!((goals.remaining(Point2::new(0.6, 0.0)) - 4.4).abs() < 1e-12);
 //! ```
 
+use mobil_geom::segment::nearest_on_segment;
 use nalgebra::Point2;
 use thiserror::Error;
 
@@ -42,18 +43,6 @@ pub struct PathGoals {
     goals: Vec<Point2<f64>>,
     next: usize,
     switch_radius: f64,
-}
-
-/// The point of segment ab nearest p, and its parameter in [0, 1].
-fn nearest_on_segment(a: Point2<f64>, b: Point2<f64>, p: Point2<f64>) -> (Point2<f64>, f64) {
-    let ab = b - a;
-    let len2 = ab.norm_squared();
-    let t = if len2 > 0.0 {
-        ((p - a).dot(&ab) / len2).clamp(0.0, 1.0)
-    } else {
-        0.0
-    };
-    (a + ab * t, t)
 }
 
 impl PathGoals {

@@ -28,6 +28,7 @@ use mobil_ros::groups::{Frames, GoalTimeouts, MAX_INPUT_TIMEOUT_S};
 use mobil_ros::lifecycle::Managed;
 use mobil_ros::markers::{point, rgb, Markers};
 use mobil_ros::motion::EndCause;
+use mobil_ros::scan::LaserParams;
 use mobil_ros::status::end_state;
 use mobil_ros::time::seconds;
 use nalgebra::{Point2, Vector2};
@@ -63,11 +64,8 @@ pub struct LocalNavConfig {
     pub timeouts: GoalTimeouts,
     /// The frames of odometry, goals and the robot.
     pub frames: Frames,
-    /// The scan's frame, looked up in `tf_static`.
-    pub laser_frame: String,
-    /// Laser pose (x, y, yaw) in the base frame, for scans whose frame `tf_static` does not
-    /// give; empty when not set (such scans are then refused).
-    pub laser_pose: Vec<f64>,
+    /// The laser's frame and `laser_pose` parameter.
+    pub laser: LaserParams,
     /// The managed-node parameters (`autostart`, `bond_heartbeat_period`).
     pub managed: Managed,
     /// `follow_path`: the spacing of the sub-goals along a path (m).
@@ -259,30 +257,11 @@ impl Config for LocalNavConfig {
         d.nest(|c: &mut LocalNavConfig| &mut c.managed, Managed::declare);
         d.nest(|c: &mut LocalNavConfig| &mut c.cmd_vel, CmdVelType::declare);
         d.nest(|c: &mut LocalNavConfig| &mut c.frames, Frames::declare);
-        d.string(
-            "laser_frame",
-            "laser",
-            "the scan's frame: its pose in base_frame comes from tf_static",
-            |c, v| c.laser_frame = v,
-        )
-        .read_only();
-        d.double_list(
-            "laser_pose",
-            &[],
-            "x, y, yaw of the laser in the base frame for scans whose frame tf_static does not give; \
-             empty (default): such scans are refused",
-            |c, v| c.laser_pose = v,
-        )
-        .read_only();
+        d.nest(|c: &mut LocalNavConfig| &mut c.laser, LaserParams::declare);
     }
 
     fn validate(&self) -> Result<(), ConfigError> {
-        if !matches!(self.laser_pose.len(), 0 | 3) {
-            return Err(ConfigError::inconsistent(format!(
-                "laser_pose has {} values: give x, y, yaw (3) or none",
-                self.laser_pose.len()
-            )));
-        }
+        self.laser.validate()?;
         self.motion_limits()?;
         self.nav_config()?;
         if self.path_lookahead / 2.0 <= self.nav.goal_tolerance {
@@ -317,7 +296,7 @@ impl LocalNavConfig {
 
     /// The laser pose parameter as a pose; `None` when not set (or not finite).
     pub fn laser_pose(&self) -> Option<Pose2> {
-        mobil_ros::scan::laser_pose_param(&self.laser_pose)
+        self.laser.pose()
     }
 
     /// The scan timeout.

@@ -45,9 +45,7 @@ use mobil_ros::lifecycle::{CallbackReturn, Lifecycle, Transition};
 use mobil_ros::motion::{
     Applied, ClockCheck, CmdVel, EndCause, Ended, MotionSession, Outputs, SessionSettings, Watched,
 };
-use mobil_ros::scan::{
-    checked_scan, tf_static_subscription, CheckedScan, LaserMount, LaserPoseFrom, ScanRefusal, StaticFrames,
-};
+use mobil_ros::scan::{checked_scan, tf_static_subscription, CheckedScan, LaserPoseFrom, ScanRefusal, StaticFrames};
 use mobil_ros::status::{NavStatusView, RateGate};
 use mobil_ros::stop::FINAL_STOP_WAIT;
 use mobil_ros::ticker::Ticker;
@@ -616,11 +614,7 @@ impl Shell {
         laser: &StaticFrames,
         m: &LaserScan,
     ) {
-        let mount = LaserMount {
-            base_frame: &self.config.frames.base_frame,
-            laser_frame: &self.config.laser_frame,
-            parameter: self.config.laser_pose(),
-        };
+        let mount = self.config.laser.mount(&self.config.frames.base_frame);
         let checked = checked_scan(laser, &mount, m, None);
         let CheckedScan {
             scan,

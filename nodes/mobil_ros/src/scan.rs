@@ -295,6 +295,61 @@ pub struct LaserMount<'a> {
     pub parameter: Option<Pose2>,
 }
 
+/// The laser's parameters every node that reads scans declares: `laser_frame` and
+/// `laser_pose` (the pose for scans whose frame `tf_static` does not give).
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct LaserParams {
+    /// The scan's frame when its header has none (`laser_frame`).
+    pub laser_frame: String,
+    /// x, y, yaw in the base frame, or empty (`laser_pose`).
+    pub laser_pose: Vec<f64>,
+}
+
+impl LaserParams {
+    /// Declares `laser_frame` (`laser`) and `laser_pose` (empty), both read-only.
+    pub fn declare(d: &mut crate::config::Decl<LaserParams>) {
+        d.string(
+            "laser_frame",
+            "laser",
+            "the scan's frame: its pose in base_frame comes from tf_static",
+            |c, v| c.laser_frame = v,
+        )
+        .read_only();
+        d.double_list(
+            "laser_pose",
+            &[],
+            "x, y, yaw of the laser in the base frame for scans whose frame tf_static does not give; \
+             empty (default): such scans are refused",
+            |c, v| c.laser_pose = v,
+        )
+        .read_only();
+    }
+
+    /// `laser_pose` holds three values or none.
+    pub fn validate(&self) -> Result<(), crate::config::ConfigError> {
+        match self.laser_pose.len() {
+            0 | 3 => Ok(()),
+            n => Err(crate::config::ConfigError::inconsistent(format!(
+                "laser_pose has {n} values: give x, y, yaw (3) or none"
+            ))),
+        }
+    }
+
+    /// The `laser_pose` parameter as a pose, if set.
+    pub fn pose(&self) -> Option<Pose2> {
+        laser_pose_param(&self.laser_pose)
+    }
+
+    /// How the laser sits on a robot whose base frame is `base_frame`.
+    pub fn mount<'a>(&'a self, base_frame: &'a str) -> LaserMount<'a> {
+        LaserMount {
+            base_frame,
+            laser_frame: &self.laser_frame,
+            parameter: self.pose(),
+        }
+    }
+}
+
 /// The `laser_pose` parameter (x, y, yaw in the base frame) as a pose: `None` unless it holds
 /// three finite values.
 pub fn laser_pose_param(values: &[f64]) -> Option<Pose2> {

@@ -172,6 +172,12 @@ pub fn duration_msg(seconds: f64) -> RosDuration {
     }
 }
 
+/// The seconds of a duration message (a goal's `time_allowance`): `sec + nanosec·10⁻⁹`, as
+/// rclcpp reads one (negative when `sec` is).
+pub fn secs_from_duration(d: &RosDuration) -> f64 {
+    f64::from(d.sec) + f64::from(d.nanosec) * 1e-9
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -245,5 +251,15 @@ mod tests {
             assert_eq!((d.sec, d.nanosec), (0, 0), "{bad}");
         }
         assert_eq!(duration_msg(5e9).sec, 1_000_000_000);
+    }
+
+    #[test]
+    fn durations_read_back_as_seconds() {
+        assert_eq!(secs_from_duration(&duration_msg(2.5)), 2.5);
+        let d = RosDuration {
+            sec: -1,
+            nanosec: 500_000_000,
+        };
+        assert_eq!(secs_from_duration(&d), -0.5);
     }
 }

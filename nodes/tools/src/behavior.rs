@@ -28,6 +28,7 @@
 //! ```
 
 use crate::drive::{DistanceDrive, DriveSettings, Pose2};
+use mobil_geom::segment::segment_distance;
 use mobil_geom::wrap;
 use mobil_motion::nav2::behavior::Codes;
 use mobil_motion::{BodyTwist, GoalLaw, Outcome, Step, StepInput};
@@ -153,6 +154,14 @@ fn invalid(codes: Codes, detail: String) -> Outcome {
     Outcome::failed("INVALID_INPUT", detail, codes.invalid_input)
 }
 
+/// A straight behavior's target moves along x only (Nav2: y or z is INVALID_INPUT).
+fn x_only(codes: Codes, target: [f64; 3], what: &str) -> Result<(), Outcome> {
+    if target[1] != 0.0 || target[2] != 0.0 {
+        return Err(invalid(codes, format!("{what} in y and z is not supported")));
+    }
+    Ok(())
+}
+
 fn allowance(time_allowance: f64) -> Option<f64> {
     (time_allowance.is_finite() && time_allowance > 0.0).then_some(time_allowance)
 }
@@ -194,9 +203,7 @@ impl Behavior {
         guard: Guard,
     ) -> Result<Self, Outcome> {
         let codes = mobil_motion::nav2::behavior::BACK_UP;
-        if target[1] != 0.0 || target[2] != 0.0 {
-            return Err(invalid(codes, "backing up in y and z is not supported".to_owned()));
-        }
+        x_only(codes, target, "backing up")?;
         Self::straight(
             start,
             (-target[0].abs(), speed.abs()),
@@ -217,12 +224,7 @@ impl Behavior {
         guard: Guard,
     ) -> Result<Self, Outcome> {
         let codes = mobil_motion::nav2::behavior::DRIVE_ON_HEADING;
-        if target[1] != 0.0 || target[2] != 0.0 {
-            return Err(invalid(
-                codes,
-                "driving on heading in y and z is not supported".to_owned(),
-            ));
-        }
+        x_only(codes, target, "driving on heading")?;
         if (target[0] > 0.0) != (speed > 0.0) {
             return Err(invalid(
                 codes,
@@ -307,10 +309,11 @@ impl Behavior {
 /// The first echo (base frame) inside the capsule a round footprint of `radius` sweeps moving
 /// `reach` metres along x (negative: backwards) from the origin.
 pub fn echo_in_sweep(echoes: &[Point2<f64>], radius: f64, reach: f64) -> Option<Point2<f64>> {
-    echoes.iter().copied().find(|p| {
-        let along = p.x.clamp(reach.min(0.0), reach.max(0.0));
-        (p - Point2::new(along, 0.0)).norm() < radius
-    })
+    let (start, end) = (Point2::origin(), Point2::new(reach, 0.0));
+    echoes
+        .iter()
+        .copied()
+        .find(|p| segment_distance(*p, start, end) < radius)
 }
 
 /// The behavior as a goal law: the command with the progress as feedback; the end at arrival

@@ -10,6 +10,7 @@
 //! measured to the nearest surface. Coordinates are metres in the world frame.
 #![warn(missing_docs)]
 
+use mobil_geom::segment::segment_distance;
 use nalgebra::{Point2, Vector2};
 use serde::{Deserialize, Serialize};
 use thiserror::Error;
@@ -76,17 +77,6 @@ pub enum WorldError {
 
 fn point(p: [f64; 2]) -> Point2<f64> {
     Point2::new(p[0], p[1])
-}
-
-fn segment_distance(p: Point2<f64>, a: Point2<f64>, b: Point2<f64>) -> f64 {
-    let ab = b - a;
-    let len2 = ab.norm_squared();
-    let t = if len2 > 0.0 {
-        ((p - a).dot(&ab) / len2).clamp(0.0, 1.0)
-    } else {
-        0.0
-    };
-    (p - (a + ab * t)).norm()
 }
 
 /// Distance along a ray (origin o, unit direction d) to segment ab, if it hits.

@@ -16,7 +16,7 @@
 use mobil_motion::nav2::behavior::{Codes, BACK_UP, DRIVE_ON_HEADING, SPIN};
 use mobil_motion::{BodyTwist, GoalLaw, Nav2Codes, Outcome, StepInput};
 use mobil_msgs::builtin_interfaces::msg::Duration as DurationMsg;
-use mobil_msgs::geometry_msgs::msg::Twist;
+use mobil_msgs::geometry_msgs::msg::{Point, Twist};
 use mobil_msgs::mobil_msgs::action::{DriveDistance, DriveDistanceFeedback, DriveDistanceResult};
 use mobil_msgs::nav2_msgs::action::{
     BackUp, BackUpFeedback, BackUpResult, DriveOnHeading, DriveOnHeadingFeedback, DriveOnHeadingResult, Spin,
@@ -34,10 +34,10 @@ use mobil_ros::latest::Latest;
 use mobil_ros::lifecycle::{CallbackReturn, Lifecycle, Managed};
 use mobil_ros::motion::{Applied, ClockCheck, CmdVel, EndCause, EndKind, Ended, MotionSession, SessionSettings};
 use mobil_ros::node::NodeClock;
-use mobil_ros::scan::{checked_scan, tf_static_subscription, LaserMount, StaticFrames};
+use mobil_ros::scan::{checked_scan, tf_static_subscription, LaserParams, StaticFrames};
 use mobil_ros::stop::FINAL_STOP_WAIT;
 use mobil_ros::ticker::Ticker;
-use mobil_ros::time::{duration_msg, seconds};
+use mobil_ros::time::{duration_msg, seconds, secs_from_duration};
 use mobil_ros::{qos, run_node, shutdown_signal, warn_throttled, LogThrottle, NodeDecl, RosNode};
 use mobil_tools::behavior::{Behavior, Guard, SpinSettings};
 use mobil_tools::drive::Pose2;
@@ -60,8 +60,7 @@ struct DriveConfig {
     simulate_ahead_time: f64,
     scan_timeout_s: f64,
     base_frame: String,
-    laser_frame: String,
-    laser_pose: Vec<f64>,
+    laser: LaserParams,
     timeouts: GoalTimeouts,
     managed: Managed,
     cmd_vel: CmdVelType,
@@ -164,21 +163,7 @@ impl Config for DriveConfig {
             c.base_frame = v
         })
         .read_only();
-        d.string(
-            "laser_frame",
-            "laser",
-            "the scan's frame: its pose in base_frame comes from tf_static",
-            |c, v| c.laser_frame = v,
-        )
-        .read_only();
-        d.double_list(
-            "laser_pose",
-            &[],
-            "x, y, yaw of the laser in the base frame for scans whose frame tf_static does not give; \
-             empty (default): such scans are not used",
-            |c, v| c.laser_pose = v,
-        )
-        .read_only();
+        d.nest(|c: &mut DriveConfig| &mut c.laser, LaserParams::declare);
         d.nest(|c: &mut DriveConfig| &mut c.timeouts, GoalTimeouts::declare);
         d.nest(|c: &mut DriveConfig| &mut c.managed, Managed::declare);
         d.nest(|c: &mut DriveConfig| &mut c.cmd_vel, CmdVelType::declare);
@@ -197,13 +182,7 @@ impl Config for DriveConfig {
                 self.spin.min_speed, self.spin.max_speed
             )));
         }
-        if !matches!(self.laser_pose.len(), 0 | 3) {
-            return Err(ConfigError::inconsistent(format!(
-                "laser_pose has {} values: give x, y, yaw (3) or none",
-                self.laser_pose.len()
-            )));
-        }
-        Ok(())
+        self.laser.validate()
     }
 }
 
@@ -303,10 +282,28 @@ fn distance_reason(cause: &EndCause) -> String {
     }
 }
 
-/// A behavior's result fields: elapsed time, Nav2's code, the reason.
-fn behavior_answer(kind: Kind, cause: &EndCause, elapsed: f64) -> (DurationMsg, u16, String) {
+/// The result of a Nav2 behavior: BackUp, DriveOnHeading and Spin share its fields.
+trait BehaviorResult {
+    fn of(total_elapsed_time: DurationMsg, error_code: u16, error_msg: String) -> Self;
+}
+
+macro_rules! behavior_results {
+    ($($result:ty),*) => {$(
+        impl BehaviorResult for $result {
+            fn of(total_elapsed_time: DurationMsg, error_code: u16, error_msg: String) -> Self {
+                Self { total_elapsed_time, error_code, error_msg }
+            }
+        }
+    )*};
+}
+
+behavior_results!(BackUpResult, DriveOnHeadingResult, SpinResult);
+
+/// `kind`'s result for a goal that ended with `cause` after `elapsed` seconds of ROS time:
+/// Nav2's code of the behavior, the reason as `error_msg`.
+fn behavior_result<R: BehaviorResult>(kind: Kind, cause: &EndCause, elapsed: f64) -> R {
     let codes = kind.codes().map_or(Nav2Codes::FOLLOW_PATH, Nav2Codes::behavior);
-    (duration_msg(elapsed), cause.nav2_error(codes), cause.reason())
+    R::of(duration_msg(elapsed), cause.nav2_error(codes), cause.reason())
 }
 
 impl Servers {
@@ -327,38 +324,19 @@ impl Servers {
         if ended.server_ended {
             return;
         }
-        let status = goal_end(cause);
-        let (elapsed, code, msg) = behavior_answer(ended.source, cause, self.elapsed());
         let travelled = ended.goal.progress().travelled;
-        match ended.source {
-            Kind::Distance => {
-                self.distance
-                    .finish(status, distance_result(travelled, &distance_reason(cause)));
-            }
-            Kind::BackUp => {
-                let r = BackUpResult {
-                    total_elapsed_time: elapsed,
-                    error_code: code,
-                    error_msg: msg,
-                };
-                self.backup.finish(status, r);
-            }
-            Kind::Heading => {
-                let r = DriveOnHeadingResult {
-                    total_elapsed_time: elapsed,
-                    error_code: code,
-                    error_msg: msg,
-                };
-                self.heading.finish(status, r);
-            }
-            Kind::Spin => {
-                let r = SpinResult {
-                    total_elapsed_time: elapsed,
-                    error_code: code,
-                    error_msg: msg,
-                };
-                self.spin.finish(status, r);
-            }
+        self.end(ended.source, goal_end(cause), cause, self.elapsed(), travelled);
+    }
+
+    /// Ends `kind`'s active goal with `status` and the result of `cause`.
+    fn end(&mut self, kind: Kind, status: GoalEnd, cause: &EndCause, elapsed: f64, travelled: f64) {
+        match kind {
+            Kind::Distance => self
+                .distance
+                .finish(status, distance_result(travelled, &distance_reason(cause))),
+            Kind::BackUp => self.backup.finish(status, behavior_result(kind, cause, elapsed)),
+            Kind::Heading => self.heading.finish(status, behavior_result(kind, cause, elapsed)),
+            Kind::Spin => self.spin.finish(status, behavior_result(kind, cause, elapsed)),
         };
     }
 
@@ -406,31 +384,12 @@ impl Servers {
     }
 
     async fn close(self, travelled: f64, reason: &str) {
-        let cause = EndCause::Shutdown;
-        let answer = |k: Kind| behavior_answer(k, &cause, 0.0);
-        let (t, c, m) = answer(Kind::BackUp);
-        let backup = BackUpResult {
-            total_elapsed_time: t,
-            error_code: c,
-            error_msg: m,
-        };
-        let (t, c, m) = answer(Kind::Heading);
-        let heading = DriveOnHeadingResult {
-            total_elapsed_time: t,
-            error_code: c,
-            error_msg: m,
-        };
-        let (t, c, m) = answer(Kind::Spin);
-        let spin = SpinResult {
-            total_elapsed_time: t,
-            error_code: c,
-            error_msg: m,
-        };
+        let (cause, elapsed) = (EndCause::Shutdown, self.elapsed());
         tokio::join!(
             self.distance.close(distance_result(travelled, reason)),
-            self.backup.close(backup),
-            self.heading.close(heading),
-            self.spin.close(spin),
+            self.backup.close(behavior_result(Kind::BackUp, &cause, elapsed)),
+            self.heading.close(behavior_result(Kind::Heading, &cause, elapsed)),
+            self.spin.close(behavior_result(Kind::Spin, &cause, elapsed)),
         );
     }
 }
@@ -593,31 +552,21 @@ impl Shell {
                 }
                 Event::BackUp(ActionEvent::Goal(request)) => {
                     let g = request.goal();
-                    let (target, speed, allowance) =
-                        ([g.target.x, g.target.y, g.target.z], g.speed, g.time_allowance.clone());
-                    let (settings, guard) = (self.config.settings(), self.config.guard());
-                    let build =
-                        |start| Behavior::back_up(start, target, f64::from(speed), settings, secs(&allowance), guard);
-                    let start = self.nav2_start(Kind::BackUp);
-                    let built = start.and_then(build);
+                    let built = self.straight(Kind::BackUp, &g.target, g.speed, &g.time_allowance);
+                    let elapsed = servers.elapsed();
                     let accepted = servers
                         .backup
-                        .accept(request, |_| preempted_backup(), node.now_nanos())
+                        .accept(request, |_| preempted(Kind::BackUp, elapsed), node.now_nanos())
                         .await;
                     self.begin(servers, session, &mut sink, Kind::BackUp, accepted, built);
                 }
                 Event::Heading(ActionEvent::Goal(request)) => {
                     let g = request.goal();
-                    let (target, speed, allowance) =
-                        ([g.target.x, g.target.y, g.target.z], g.speed, g.time_allowance.clone());
-                    let (settings, guard) = (self.config.settings(), self.config.guard());
-                    let build = |start| {
-                        Behavior::drive_on_heading(start, target, f64::from(speed), settings, secs(&allowance), guard)
-                    };
-                    let built = self.nav2_start(Kind::Heading).and_then(build);
+                    let built = self.straight(Kind::Heading, &g.target, g.speed, &g.time_allowance);
+                    let elapsed = servers.elapsed();
                     let accepted = servers
                         .heading
-                        .accept(request, |_| preempted_heading(), node.now_nanos())
+                        .accept(request, |_| preempted(Kind::Heading, elapsed), node.now_nanos())
                         .await;
                     self.begin(servers, session, &mut sink, Kind::Heading, accepted, built);
                 }
@@ -625,11 +574,12 @@ impl Shell {
                     let g = request.goal();
                     let (target, allowance) = (f64::from(g.target_yaw), g.time_allowance.clone());
                     let (settings, guard) = (self.config.spin, self.config.guard());
-                    let build = |start| Behavior::spin(start, target, secs(&allowance), settings, guard);
+                    let build = |start| Behavior::spin(start, target, secs_from_duration(&allowance), settings, guard);
                     let built = self.nav2_start(Kind::Spin).and_then(build);
+                    let elapsed = servers.elapsed();
                     let accepted = servers
                         .spin
-                        .accept(request, |_| preempted_spin(), node.now_nanos())
+                        .accept(request, |_| preempted(Kind::Spin, elapsed), node.now_nanos())
                         .await;
                     self.begin(servers, session, &mut sink, Kind::Spin, accepted, built);
                 }
@@ -651,16 +601,24 @@ impl Shell {
     /// A scan's echoes in the base frame, kept for the collision check; a scan that cannot be
     /// placed is dropped (the check then goes off once the last one is older than the timeout).
     fn scan_in(&mut self, m: &LaserScan) {
-        let mount = LaserMount {
-            base_frame: &self.config.base_frame,
-            laser_frame: &self.config.laser_frame,
-            parameter: mobil_ros::scan::laser_pose_param(&self.config.laser_pose),
-        };
+        let mount = self.config.laser.mount(&self.config.base_frame);
         match checked_scan(&self.laser, &mount, m, None) {
             Ok(c) => self
                 .echoes
                 .set(c.scan.points_in_base().collect(), m.header.stamp.clone()),
             Err(e) => warn_throttled!(self.throttle, "scan-bad", "{e}; scan not used for the collision check"),
+        }
+    }
+
+    /// A BackUp or DriveOnHeading goal (the two share their fields) as the law, or its end.
+    fn straight(&self, kind: Kind, target: &Point, speed: f32, allowance: &DurationMsg) -> Built {
+        let target = [target.x, target.y, target.z];
+        let (settings, guard) = (self.config.settings(), self.config.guard());
+        let (speed, allowance) = (f64::from(speed), secs_from_duration(allowance));
+        let start = self.nav2_start(kind)?;
+        match kind {
+            Kind::BackUp => Behavior::back_up(start, target, speed, settings, allowance, guard),
+            _ => Behavior::drive_on_heading(start, target, speed, settings, allowance, guard),
         }
     }
 
@@ -744,34 +702,7 @@ impl Shell {
             Err(outcome) => {
                 let cause = EndCause::Outcome(outcome);
                 warn!("goal ({}) ends at once: {}", <&str>::from(kind), cause.reason());
-                let (elapsed, code, msg) = behavior_answer(kind, &cause, 0.0);
-                match kind {
-                    Kind::BackUp => servers.backup.finish(
-                        GoalEnd::Aborted,
-                        BackUpResult {
-                            total_elapsed_time: elapsed,
-                            error_code: code,
-                            error_msg: msg,
-                        },
-                    ),
-                    Kind::Heading => servers.heading.finish(
-                        GoalEnd::Aborted,
-                        DriveOnHeadingResult {
-                            total_elapsed_time: elapsed,
-                            error_code: code,
-                            error_msg: msg,
-                        },
-                    ),
-                    Kind::Spin => servers.spin.finish(
-                        GoalEnd::Aborted,
-                        SpinResult {
-                            total_elapsed_time: elapsed,
-                            error_code: code,
-                            error_msg: msg,
-                        },
-                    ),
-                    Kind::Distance => servers.distance.finish(GoalEnd::Aborted, distance_result(0.0, &msg)),
-                };
+                servers.end(kind, GoalEnd::Aborted, &cause, 0.0, 0.0);
                 // The goal it was to replace stops (its robot would otherwise drive on).
                 if let Some(ended) = session.preempt(kind, sink) {
                     servers.finish(&ended);
@@ -804,9 +735,13 @@ impl Shell {
             }
             return;
         };
-        let echoes = self
-            .echoes
-            .get(seconds(self.config.scan_timeout_s, MAX_INPUT_TIMEOUT_S))
+        // Only a Nav2 behavior checks for collisions: a drive_distance goal copies no echoes.
+        let echoes = kind
+            .codes()
+            .and_then(|_| {
+                self.echoes
+                    .get(seconds(self.config.scan_timeout_s, MAX_INPUT_TIMEOUT_S))
+            })
             .cloned();
         if echoes.is_none() && matches!(kind, Kind::BackUp | Kind::Heading) {
             warn_throttled!(
@@ -859,38 +794,7 @@ fn cancel(
     }
 }
 
-/// `time_allowance` in seconds (negative or non-finite: none, as zero).
-fn secs(d: &DurationMsg) -> f64 {
-    f64::from(d.sec) + f64::from(d.nanosec) * 1e-9
-}
-
-fn preempted_result(kind: Kind) -> (DurationMsg, u16, String) {
-    behavior_answer(kind, &EndCause::Preempted(kind.into()), 0.0)
-}
-
-fn preempted_backup() -> BackUpResult {
-    let (total_elapsed_time, error_code, error_msg) = preempted_result(Kind::BackUp);
-    BackUpResult {
-        total_elapsed_time,
-        error_code,
-        error_msg,
-    }
-}
-
-fn preempted_heading() -> DriveOnHeadingResult {
-    let (total_elapsed_time, error_code, error_msg) = preempted_result(Kind::Heading);
-    DriveOnHeadingResult {
-        total_elapsed_time,
-        error_code,
-        error_msg,
-    }
-}
-
-fn preempted_spin() -> SpinResult {
-    let (total_elapsed_time, error_code, error_msg) = preempted_result(Kind::Spin);
-    SpinResult {
-        total_elapsed_time,
-        error_code,
-        error_msg,
-    }
+/// The result of `kind`'s goal replaced by a newer one after `elapsed` seconds.
+fn preempted<R: BehaviorResult>(kind: Kind, elapsed: f64) -> R {
+    behavior_result(kind, &EndCause::Preempted(kind.into()), elapsed)
 }
