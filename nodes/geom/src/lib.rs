@@ -23,6 +23,7 @@
 #![warn(missing_docs)]
 
 pub mod angle;
+pub mod path;
 pub mod pose;
 pub mod sample;
 pub mod scan;

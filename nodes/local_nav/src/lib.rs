@@ -80,15 +80,13 @@ pub mod config;
 pub mod field;
 pub mod motion;
 pub mod navigator;
-pub mod path;
-pub mod progress;
 pub mod sectors;
 
 pub use config::{ConfigError, NavConfig};
 pub use field::{vector_distance, Side, WeightProfile};
+pub use mobil_motion::progress::{Progress, ProgressChecker, ProgressSettings};
 pub use motion::{
     arc_free_distance, car_arc, command_along, CarArc, Drive, MotionInput, MotionLimits, SpeedProfile, VelocityCommand,
 };
 pub use navigator::{InputError, Mode, Navigator, NoPathReason, StepOutput};
-pub use progress::{Progress, ProgressChecker, ProgressSettings};
 pub use sectors::{Sector, Sectors, UnseenSectors};

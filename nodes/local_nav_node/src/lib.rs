@@ -9,8 +9,8 @@
 #![warn(missing_docs)]
 
 use mobil_chassis::model::ChassisConfig;
+use mobil_geom::path::PathGoals;
 use mobil_geom::Pose2;
-use mobil_local_nav::path::PathGoals;
 use mobil_local_nav::{
     Mode, MotionLimits, NavConfig, ProgressChecker, ProgressSettings, Sectors, Side, UnseenSectors, WeightProfile,
 };

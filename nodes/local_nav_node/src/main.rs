@@ -19,8 +19,8 @@
 //! ends the goal `INVALID_INPUT`. At shutdown with a goal under way, its zero command is the last
 //! one, waited for ([`mobil_ros::stop::final_stop`]); an idle node sends none.
 
+use mobil_geom::path::PathGoals;
 use mobil_geom::Pose2;
-use mobil_local_nav::path::PathGoals;
 use mobil_local_nav::{Mode, MotionLimits, Navigator, Progress, ProgressChecker, StepOutput, VelocityCommand};
 use mobil_local_nav_node::{
     clear_markers, end_answer, goal_heading, goal_in_odom, invalid_goal, markers, no_progress, reconfigured_progress,

@@ -1,15 +1,15 @@
-//! A path to follow as a sequence of goals for the navigator (Nav2's controller role,
-//! `FollowPath`).
+//! A path to follow as a sequence of sub-goals (Nav2's controller role, `FollowPath`).
 //!
-//! The vector-distance function drives to one goal point (SPEC §2). A path is followed by
-//! giving it sub-goals along the path, `lookahead` apart in arc length from the point of the
-//! path nearest the robot, the path's end last. The navigator takes the next sub-goal when the
-//! robot comes within `lookahead / 2` of the current one, so it never stops at an intermediate
-//! sub-goal; only the end is reached (within the goal tolerance) and ends the goal. Between two
-//! sub-goals the method itself avoids obstacles, as it does between a start and a goal.
+//! A controller that drives to one point at a time follows a path by its sub-goals along the
+//! path, `lookahead` apart in arc length from the point of the path nearest the robot, the
+//! path's end last. The controller takes the next sub-goal when the robot comes within
+//! `lookahead / 2` of the current one, so it never stops at an intermediate sub-goal; only the
+//! end is reached (within the controller's goal tolerance) and ends the goal. Between two
+//! sub-goals the controller's own law drives (and avoids obstacles, if it does). The path's
+//! poses (Nav2's planners give one every few centimetres) need no other resampling.
 //!
 //! ```
-//! use mobil_local_nav::path::PathGoals;
+//! use mobil_geom::path::PathGoals;
 //! use nalgebra::Point2;
 //! let path = [Point2::new(0.0, 0.0), Point2::new(3.0, 0.0), Point2::new(3.0, 2.0)];
 //! let mut goals = PathGoals::new(&path, Point2::new(0.0, 0.0), 1.0).unwrap();
@@ -19,7 +19,7 @@
 //! assert!((goals.remaining(Point2::new(0.6, 0.0)) - 4.4).abs() < 1e-12);
 //! ```
 
-use mobil_geom::segment::nearest_on_segment;
+use crate::segment::nearest_on_segment;
 use nalgebra::Point2;
 use thiserror::Error;
 
@@ -138,6 +138,20 @@ impl PathGoals {
         }
     }
 
+    /// Heads for sub-goal `index` when it lies ahead of the current one (a controller that gave
+    /// up a sub-goal itself, or passed it); never past the end, never back. True when the goal
+    /// changed.
+    pub fn pursue(&mut self, index: usize) -> bool {
+        let before = self.next;
+        self.next = self.next.max(index.min(self.goals.len() - 1));
+        self.next != before
+    }
+
+    /// The index of the sub-goal the controller heads for.
+    pub fn index(&self) -> usize {
+        self.next
+    }
+
     /// Distance still to go: to the current sub-goal, then along the rest.
     pub fn remaining(&self, position: Point2<f64>) -> f64 {
         let rest: f64 = self.goals[self.next..].windows(2).map(|w| (w[1] - w[0]).norm()).sum();
@@ -231,6 +245,17 @@ mod tests {
         let mut end = PathGoals::new(&[p(2.6, 0.0), p(3.4, 0.0)], p(2.6, 0.0), 1.0).unwrap();
         assert!(!end.keep(p(3.0, 0.0)));
         assert_eq!(end.goal(), p(3.4, 0.0));
+    }
+
+    /// Pursuing: forward only, never past the end.
+    #[test]
+    fn pursue_moves_forward_only() {
+        let mut goals = PathGoals::new(&[p(0.0, 0.0), p(3.0, 0.0)], p(0.0, 0.0), 1.0).unwrap();
+        assert!(goals.pursue(1));
+        assert_eq!((goals.index(), goals.goal()), (1, p(2.0, 0.0)));
+        assert!(!goals.pursue(0), "never back");
+        assert!(goals.pursue(7) && goals.is_last(), "never past the end");
+        assert_eq!(goals.goal(), p(3.0, 0.0));
     }
 
     #[test]
