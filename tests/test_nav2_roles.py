@@ -1,6 +1,8 @@
-"""Nav2's controller role from real rclpy (ROS 2 Jazzy, Fast DDS): ``follow_path``
+"""Nav2's roles from real rclpy (ROS 2 Jazzy, Fast DDS). The controller role: ``follow_path``
 (nav2_msgs/action/FollowPath) driven as Nav2's navigator drives a controller server, a new path
-about every second, on the simulated OMR-III and MOBIL-II in the built-in world.
+about every second, on the simulated OMR-III and MOBIL-II in the built-in world, by
+local_nav_node (the vector-distance function) and planner_node (the goal approach, and VFO on
+OMR-III). The behavior role (drive_node), stamped commands and the dock database follow.
 
 The navigator stand-in re-plans as a global planner would: every simulated second a path from
 the robot's odometry pose straight to the next corner of the route not yet passed, then along
@@ -84,8 +86,9 @@ class Navigator:
     """Nav2's navigator as a controller server sees it: a FollowPath goal along the rest of
     ``route`` every simulated second, from the robot's odometry pose."""
 
-    def __init__(self, client: ActionClient, odom, sim_clock, route) -> None:
+    def __init__(self, client: ActionClient, odom, sim_clock, route, controller: str = "") -> None:
         self.client, self.odom, self.clock, self.route = client, odom, sim_clock, route
+        self.controller = controller
         self.handles: list = []
         self.feedback: list = []  # (distance_to_goal, speed) of every goal
         self.next_corner = 1
@@ -93,9 +96,15 @@ class Navigator:
         self.failure: BaseException | None = None
         self._thread = threading.Thread(target=self._run, daemon=True)
 
+    def passed(self, x: float, y: float) -> bool:
+        """Whether the robot at (x, y) has passed the next corner: near it, or beyond it along
+        the leg after it (a controller may cut a corner by up to half its lookahead)."""
+        (cx, cy), (nx, ny) = self.route[self.next_corner], self.route[self.next_corner + 1]
+        beyond = (x - cx) * (nx - cx) + (y - cy) * (ny - cy) > 0.0
+        return beyond or math.dist((x, y), (cx, cy)) < CORNER_PASSED
+
     def path_from(self, x: float, y: float) -> list:
-        while (self.next_corner < len(self.route) - 1
-               and math.dist((x, y), self.route[self.next_corner]) < CORNER_PASSED):
+        while self.next_corner < len(self.route) - 1 and self.passed(x, y):
             self.next_corner += 1
         return [(x, y), *self.route[self.next_corner:]]
 
@@ -103,7 +112,7 @@ class Navigator:
         p = self.odom.latest.pose.pose.position
         if self.handles and math.dist((p.x, p.y), self.route[-1]) < CORNER_PASSED:
             return  # at the end: a navigator re-plans no more (the last goal finishes the route)
-        path = follow_goal(self.path_from(p.x, p.y))
+        path = follow_goal(self.path_from(p.x, p.y), controller=self.controller)
         keep = lambda f: self.feedback.append((f.feedback.distance_to_goal, f.feedback.speed))  # noqa: E731
         self.handles.append(accepted(self.client, path, feedback=keep))
 
@@ -128,12 +137,18 @@ class Navigator:
 
 
 @pytest.mark.timeout(150)
-@pytest.mark.parametrize("robot", ["omr3", "mobil2"])
+@pytest.mark.parametrize("node,robot,controller", [
+    ("local_nav_node", "omr3", ""),
+    ("local_nav_node", "mobil2", ""),
+    ("planner_node", "omr3", "approach"),
+    ("planner_node", "mobil2", ""),  # its waypoint_method: the goal approach
+    ("planner_node", "omr3", ""),  # its waypoint_method: VFO
+])
 def test_follow_path_replanned_every_second_reaches_the_end_without_a_stop(
-        robot, start_scenario, start_node, sim_clock, ros_node):
+        node, robot, controller, start_scenario, start_node, sim_clock, ros_node):
     params = f"params/{robot}.yaml"
     start_scenario(params, real_time_factor=REAL_TIME_FACTOR, lidar=True, node_args=CHASSIS_ARGS)
-    nav = start_node("local_nav_node", *NODE_ARGS, params_file=params)
+    nav = start_node(node, *NODE_ARGS, params_file=params)
     client = ActionClient(ros_node, FollowPath, "follow_path")
     deep = make_qos("reliable", "volatile", 5000)
     with subscribe(ros_node, Odometry, "odom", qos=deep) as odom, \
@@ -148,11 +163,11 @@ def test_follow_path_replanned_every_second_reaches_the_end_without_a_stop(
             res = result_of(accepted(client, goal))
             assert res.status == GoalStatus.STATUS_ABORTED and res.result.error_code == code, \
                 (res.status, res.result.error_code, res.result.error_msg)
-        # local_nav steps on scans: wait for its first one before the route starts.
+        # local_nav steps on scans, VFO needs one: wait for the first one before the route starts.
         nav.wait_for_log(r"first scan", REPLY_TIMEOUT)
         assert len(cmd) == 0, "cmd_vel before a goal that can be followed"
 
-        navigator = Navigator(client, odom, sim_clock, ROUTE).start()
+        navigator = Navigator(client, odom, sim_clock, ROUTE, controller).start()
         t0 = sim_clock.now()
         final = None
         try:
@@ -183,9 +198,15 @@ def test_follow_path_replanned_every_second_reaches_the_end_without_a_stop(
     for h in handles[:-2]:
         r = result_of(h)
         assert r.status == GoalStatus.STATUS_ABORTED and r.result.error_code == FollowPath.Result.NONE
-    # No zero command while the paths came: only the last one, at the end.
     zeros = [i for i, c in enumerate(commands) if is_zero(c)]
-    assert zeros == [len(commands) - 1], f"zero commands at {zeros} of {len(commands)}"
+    if node == "planner_node" and controller == "" and robot == "omr3":
+        # VFO keeps its law across paths to the same end, and holds the robot only while a
+        # segment's optimisation outlasts an odometry period (a machine under load).
+        assert "starts anew" not in nav.log_text(), nav.log_tail()
+        assert zeros[-1] == len(commands) - 1, f"zero commands at {zeros} of {len(commands)}"
+    else:
+        # No zero command while the paths came: only the last one, at the end.
+        assert zeros == [len(commands) - 1], f"zero commands at {zeros} of {len(commands)}"
     xg, yg = ROUTE[-1]
     assert math.hypot(end.x - xg, end.y - yg) < 0.25, (end.x, end.y)
 

@@ -19,7 +19,7 @@
 //! assert!((goals.remaining(Point2::new(0.6, 0.0)) - 4.4).abs() < 1e-12);
 //! ```
 
-use crate::segment::nearest_on_segment;
+use crate::segment::{nearest_on_segment, segment_distance};
 use nalgebra::Point2;
 use thiserror::Error;
 
@@ -40,6 +40,8 @@ pub enum PathError {
 /// Sub-goals along a path, and which one the navigator is heading for.
 #[derive(Debug, Clone, PartialEq)]
 pub struct PathGoals {
+    /// The path's point nearest the robot when the path came: the sub-goals follow from it.
+    start: Point2<f64>,
     goals: Vec<Point2<f64>>,
     next: usize,
     switch_radius: f64,
@@ -87,6 +89,7 @@ impl PathGoals {
             goals.push(end);
         }
         Ok(PathGoals {
+            start,
             goals,
             next: 0,
             switch_radius: lookahead / 2.0,
@@ -150,6 +153,18 @@ impl PathGoals {
     /// The index of the sub-goal the controller heads for.
     pub fn index(&self) -> usize {
         self.next
+    }
+
+    /// Whether `point` lies within `lookahead / 2` of the path ahead (from its point nearest
+    /// the robot when it came, through the sub-goals).
+    pub fn passes_near(&self, point: Point2<f64>) -> bool {
+        let mut from = self.start;
+        let mut nearest = (point - from).norm();
+        for &g in &self.goals {
+            nearest = nearest.min(segment_distance(point, from, g));
+            from = g;
+        }
+        nearest <= self.switch_radius
     }
 
     /// Distance still to go: to the current sub-goal, then along the rest.
@@ -245,6 +260,17 @@ mod tests {
         let mut end = PathGoals::new(&[p(2.6, 0.0), p(3.4, 0.0)], p(2.6, 0.0), 1.0).unwrap();
         assert!(!end.keep(p(3.0, 0.0)));
         assert_eq!(end.goal(), p(3.4, 0.0));
+    }
+
+    /// Near the path ahead: within half a lookahead of it, from its point nearest the robot
+    /// on; not behind that point.
+    #[test]
+    fn passes_near_measures_to_the_path_ahead() {
+        let goals = PathGoals::new(&[p(0.0, 0.0), p(3.0, 0.0), p(3.0, 2.0)], p(1.0, 0.2), 1.0).unwrap();
+        assert!(goals.passes_near(p(1.5, 0.5)), "0.5 from (1.5, 0)");
+        assert!(!goals.passes_near(p(1.5, 0.51)));
+        assert!(goals.passes_near(p(3.4, 1.0)), "0.4 from the second leg");
+        assert!(!goals.passes_near(p(0.3, 0.0)), "0.7 behind the start (1, 0)");
     }
 
     /// Pursuing: forward only, never past the end.

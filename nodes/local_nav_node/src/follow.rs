@@ -43,7 +43,12 @@ impl Shell {
             (None, Some(p)) => Point2::new(p.pose.position.x, p.pose.position.y),
             (None, None) => Point2::origin(),
         };
-        let checked = follow_path_goal(goal, &self.config.frames.odom_frame, from, self.config.path_lookahead);
+        let checked = follow_path_goal(
+            goal,
+            &self.config.frames.odom_frame,
+            from,
+            self.config.controller.path_lookahead,
+        );
         let continuing = self.session.active().is_some_and(|a| a.source == Source::Path);
         // The server ends a running follow_path goal itself on accept, as controller_server.
         let preempted = path_result(&EndCause::Preempted("follow_path"));

@@ -24,7 +24,7 @@ use mobil_ros::cmd_vel::CmdVelType;
 use mobil_ros::config::{Config, ConfigError, Decl};
 use mobil_ros::goal::goal_pose;
 pub use mobil_ros::goal::{goal_heading, GoalError};
-use mobil_ros::groups::{Frames, GoalTimeouts, MAX_INPUT_TIMEOUT_S};
+use mobil_ros::groups::{Controller, Frames, GoalTimeouts, MAX_INPUT_TIMEOUT_S};
 use mobil_ros::lifecycle::Managed;
 use mobil_ros::markers::{point, rgb, Markers};
 use mobil_ros::motion::EndCause;
@@ -41,7 +41,8 @@ use std::time::Duration;
 pub mod nav2_error {
     pub use mobil_motion::nav2::compute_path::NO_VALID_PATH;
     pub use mobil_motion::nav2::follow_path::{
-        FAILED_TO_MAKE_PROGRESS, INVALID_CONTROLLER, INVALID_PATH, NONE, NO_VALID_CONTROL, TF_ERROR, UNKNOWN,
+        DEFAULT_CONTROLLER_ID, FAILED_TO_MAKE_PROGRESS, INVALID_CONTROLLER, INVALID_PATH, NONE, NO_VALID_CONTROL,
+        TF_ERROR, UNKNOWN,
     };
 }
 
@@ -54,8 +55,8 @@ pub struct LocalNavConfig {
     pub nav: NavConfig,
     /// The weight profile as given (empty: the default profile for `sector_count`).
     pub weights: Vec<f64>,
-    /// Nav2's progress checker.
-    pub progress: ProgressSettings,
+    /// Nav2's controller role: the progress checker, `follow_path`'s sub-goal spacing.
+    pub controller: Controller,
     /// A goal fails STALE_INPUT when no scan arrived for this long (steady clock), in seconds.
     pub scan_timeout_s: f64,
     /// Status and markers rate while a goal is active, in Hz.
@@ -68,8 +69,6 @@ pub struct LocalNavConfig {
     pub laser: LaserParams,
     /// The managed-node parameters (`autostart`, `bond_heartbeat_period`).
     pub managed: Managed,
-    /// `follow_path`: the spacing of the sub-goals along a path (m).
-    pub path_lookahead: f64,
     /// `cmd_vel`'s type (`enable_stamped_cmd_vel`).
     pub cmd_vel: CmdVelType,
 }
@@ -77,7 +76,6 @@ pub struct LocalNavConfig {
 impl Config for LocalNavConfig {
     fn declare(d: &mut Decl<Self>) {
         let n = NavConfig::default();
-        let p = ProgressSettings::default();
         d.nest(|c: &mut LocalNavConfig| &mut c.chassis, declare_chassis);
         d.double(
             "robot_radius",
@@ -216,29 +214,6 @@ impl Config for LocalNavConfig {
         )
         .above(0.0);
         d.double(
-            "required_movement_radius",
-            p.required_movement_radius,
-            "progress checker: the robot must move this far … [m]",
-            |c, v| c.progress.required_movement_radius = v,
-        )
-        .above(0.0);
-        d.double(
-            "movement_time_allowance",
-            p.movement_time_allowance,
-            "… within this time (ROS time), else the goal fails ABORTED [s]",
-            |c, v| c.progress.movement_time_allowance = v,
-        )
-        .above(0.0);
-        d.double(
-            "path_lookahead",
-            1.0,
-            "follow_path: the navigator heads for a point this far along the path, the next one once \
-             within half of it; the path's end last [m]",
-            |c, v| c.path_lookahead = v,
-        )
-        .above(0.0)
-        .max(100.0);
-        d.double(
             "scan_timeout_s",
             0.5,
             "a goal fails STALE_INPUT when no valid scan arrived for this long (steady clock) [s]",
@@ -253,6 +228,7 @@ impl Config for LocalNavConfig {
             |c, v| c.status_rate_hz = v,
         )
         .within(0.1, 50.0);
+        d.nest(|c: &mut LocalNavConfig| &mut c.controller, Controller::declare);
         d.nest(|c: &mut LocalNavConfig| &mut c.timeouts, GoalTimeouts::declare);
         d.nest(|c: &mut LocalNavConfig| &mut c.managed, Managed::declare);
         d.nest(|c: &mut LocalNavConfig| &mut c.cmd_vel, CmdVelType::declare);
@@ -264,11 +240,11 @@ impl Config for LocalNavConfig {
         self.laser.validate()?;
         self.motion_limits()?;
         self.nav_config()?;
-        if self.path_lookahead / 2.0 <= self.nav.goal_tolerance {
+        if self.controller.path_lookahead / 2.0 <= self.nav.goal_tolerance {
             return Err(ConfigError::inconsistent(format!(
                 "path_lookahead {} m: half of it must be above xy_goal_tolerance {} m (a sub-goal \
                  would be reached before the next is taken)",
-                self.path_lookahead, self.nav.goal_tolerance
+                self.controller.path_lookahead, self.nav.goal_tolerance
             )));
         }
         Ok(())
@@ -401,14 +377,9 @@ pub fn clear_markers(stamp: Time, frame: &str) -> MarkerArray {
     Markers::replacing(stamp, frame).array()
 }
 
-/// How the progress checker ends a goal: `ABORTED` with Nav2's `FAILED_TO_MAKE_PROGRESS`
-/// (two decimals, so 1.04 s against an allowance of 1 s does not print "1.0 s").
+/// How the progress checker ends a goal ([`mobil_motion::progress::no_progress`]).
 pub fn no_progress(since: f64, radius: f64) -> EndCause {
-    EndCause::Outcome(Outcome::failed(
-        "ABORTED",
-        format!("no progress: moved less than {radius} m in {since:.2} s"),
-        nav2_error::FAILED_TO_MAKE_PROGRESS,
-    ))
+    EndCause::Outcome(mobil_motion::progress::no_progress(since, radius))
 }
 
 /// How a goal's end is told: the status state, the status reason (also the action's
@@ -422,8 +393,9 @@ pub fn end_answer(cause: &EndCause) -> (u8, String, u16) {
     )
 }
 
-/// The `controller_id`s `follow_path` takes: the node's one law.
-pub const CONTROLLERS: [&str; 2] = ["", "vector_distance"];
+/// The `controller_id`s `follow_path` takes: the node's one law, by its name, by none, or by the
+/// name of Nav2's default controller plugin (`FollowPath`, what Nav2's default trees send).
+pub const CONTROLLERS: [&str; 3] = ["", "vector_distance", nav2_error::DEFAULT_CONTROLLER_ID];
 
 /// A `follow_path` goal as sub-goals for a robot at `from`, or the end Nav2's controller
 /// server gives such a goal at once: INVALID_CONTROLLER for a `controller_id` not in
@@ -439,28 +411,13 @@ pub fn follow_path_goal(
         return Err(Outcome::failed(
             "INVALID_CONTROLLER",
             format!(
-                "controller_id `{}`: this node's controller is `vector_distance` (or empty)",
+                "controller_id `{}`: this node's controller is `vector_distance` (or empty, or `FollowPath`)",
                 goal.controller_id
             ),
             nav2_error::INVALID_CONTROLLER,
         ));
     }
-    let frame = &goal.path.header.frame_id;
-    if !frame.is_empty() && frame != odom_frame {
-        return Err(Outcome::failed(
-            "TF_ERROR",
-            format!("path in frame `{frame}`: only `{odom_frame}` is followed"),
-            nav2_error::TF_ERROR,
-        ));
-    }
-    let points: Vec<Point2<f64>> = goal
-        .path
-        .poses
-        .iter()
-        .map(|p| Point2::new(p.pose.position.x, p.pose.position.y))
-        .collect();
-    PathGoals::new(&points, from, lookahead)
-        .map_err(|e| Outcome::failed("INVALID_PATH", e.to_string(), nav2_error::INVALID_PATH))
+    mobil_ros::goal::path_goals(&goal.path, odom_frame, from, lookahead)
 }
 
 /// The status reason of a refused goal.
@@ -498,6 +455,7 @@ mod tests {
         assert_eq!(code(&path_goal(&[(1.0, 0.0)], "map", "")), 102);
         assert_eq!(code(&path_goal(&[], "odom", "")), 103);
         assert_eq!(code(&path_goal(&[(0.0, 0.0), (f64::NAN, 1.0)], "odom", "")), 103);
+        assert!(follow_path_goal(&path_goal(&[(1.0, 0.0)], "odom", "FollowPath"), "odom", from, 1.0).is_ok());
         let ok = follow_path_goal(
             &path_goal(&[(0.0, 0.0), (2.5, 0.0)], "", "vector_distance"),
             "odom",
@@ -515,7 +473,7 @@ mod tests {
         let mut values = ParamValues::defaults(&Decl::<LocalNavConfig>::of().specs());
         let c: LocalNavConfig = mobil_ros::config::load(&values).unwrap();
         assert_eq!(c.nav_config().unwrap(), NavConfig::default());
-        assert_eq!(c.progress, ProgressSettings::default());
+        assert_eq!(c.controller.progress, ProgressSettings::default());
         // MOBIL-II chassis defaults: car-like, κ_max = 1 / 0.73.
         match c.motion_limits().unwrap().drive {
             Drive::CarLike { max_curvature } => assert!((max_curvature - 1.0 / 0.73).abs() < 1e-9),

@@ -216,7 +216,7 @@ async fn start(
     };
     let mut laser = StaticFrames::default();
     let mut shell = Shell {
-        progress: ProgressChecker::new(config.progress),
+        progress: ProgressChecker::new(config.controller.progress),
         config,
         limits,
         nav,
@@ -369,8 +369,8 @@ impl Shell {
                 }
                 self.limits = limits;
                 self.nav = nav;
-                let old = std::mem::replace(&mut self.progress, ProgressChecker::new(c.progress));
-                self.progress = reconfigured_progress(old, c.progress);
+                let old = std::mem::replace(&mut self.progress, ProgressChecker::new(c.controller.progress));
+                self.progress = reconfigured_progress(old, c.controller.progress);
                 self.config = c;
             }
             Err(e) => warn!("parameters not applied: {e}"),

@@ -18,7 +18,9 @@
 //! ```
 
 use crate::geometry::yaw_of;
+use mobil_geom::path::PathGoals;
 use mobil_geom::Pose2;
+use mobil_motion::{nav2::follow_path, Outcome};
 use mobil_msgs::geometry_msgs::msg::{Pose, PoseStamped, Quaternion};
 use mobil_msgs::nav_msgs::msg::Path;
 use nalgebra::Point2;
@@ -79,6 +81,28 @@ pub enum GoalError {
         /// How many poses there are.
         len: usize,
     },
+}
+
+/// A `follow_path` goal's path as sub-goals `lookahead` apart for a robot at `from`, or the
+/// end Nav2's controller server gives such a goal at once: TF_ERROR for a path in another frame
+/// than `frame` (empty passes, as for any goal here), INVALID_PATH for an empty path or a
+/// non-finite pose. The `controller_id` is the node's to check.
+pub fn path_goals(path: &Path, frame: &str, from: Point2<f64>, lookahead: f64) -> Result<PathGoals, Outcome> {
+    let got = &path.header.frame_id;
+    if !got.is_empty() && !same_frame(got, frame) {
+        return Err(Outcome::failed(
+            "TF_ERROR",
+            format!("path in frame `{got}`: only `{frame}` is followed"),
+            follow_path::TF_ERROR,
+        ));
+    }
+    let points: Vec<Point2<f64>> = path
+        .poses
+        .iter()
+        .map(|p| Point2::new(p.pose.position.x, p.pose.position.y))
+        .collect();
+    PathGoals::new(&points, from, lookahead)
+        .map_err(|e| Outcome::failed("INVALID_PATH", e.to_string(), follow_path::INVALID_PATH))
 }
 
 /// Whether frame `got` names frame `want` (a leading `/` ignored on either).

@@ -1,7 +1,7 @@
 //! Parameter groups every motion node shares, declared once here and nested by each node
 //! ([`crate::config::Decl::nest`]), so a name, its default, range and description are the same
-//! wherever they appear: the frames a node reads odometry and goals in ([`Frames`]) and the
-//! timeouts of its goals ([`GoalTimeouts`]). The chassis group is [`crate::chassis`].
+//! wherever they appear: the frames a node reads odometry and goals in ([`Frames`]), the
+//! timeouts of its goals ([`GoalTimeouts`]) and Nav2's controller role ([`Controller`]). The chassis group is [`crate::chassis`].
 //!
 //! ```
 //! use mobil_ros::config::{Config, Decl};
@@ -27,11 +27,53 @@
 
 use crate::config::Decl;
 use crate::time::seconds;
+use mobil_motion::progress::ProgressSettings;
 use std::time::Duration;
 
 pub use mobil_motion::MAX_INPUT_TIMEOUT_S;
 /// The largest `result_timeout_s` (s).
 pub const MAX_RESULT_TIMEOUT_S: f64 = 3600.0;
+
+/// Nav2's controller role (`follow_path`): its progress checker, and the spacing of the
+/// sub-goals a path becomes ([`mobil_geom::path::PathGoals`]).
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Controller {
+    /// Nav2's progress checker (`required_movement_radius`, `movement_time_allowance`).
+    pub progress: ProgressSettings,
+    /// The sub-goals' spacing along a path (`path_lookahead`, m).
+    pub path_lookahead: f64,
+}
+
+impl Controller {
+    /// Declares Nav2's `required_movement_radius` (0.5 m) and `movement_time_allowance`
+    /// (10 s, ROS time), and `path_lookahead` (1 m, up to 100 m).
+    pub fn declare(d: &mut Decl<Controller>) {
+        let p = ProgressSettings::default();
+        d.double(
+            "required_movement_radius",
+            p.required_movement_radius,
+            "progress checker: the robot must move this far … [m]",
+            |c, v| c.progress.required_movement_radius = v,
+        )
+        .above(0.0);
+        d.double(
+            "movement_time_allowance",
+            p.movement_time_allowance,
+            "… within this time (ROS time), else the goal fails ABORTED (FAILED_TO_MAKE_PROGRESS) [s]",
+            |c, v| c.progress.movement_time_allowance = v,
+        )
+        .above(0.0);
+        d.double(
+            "path_lookahead",
+            1.0,
+            "follow_path: the controller heads for a point this far along the path, the next one once \
+             within half of it; the path's end last [m]",
+            |c, v| c.path_lookahead = v,
+        )
+        .above(0.0)
+        .max(100.0);
+    }
+}
 
 /// The frames of odometry and goals.
 #[derive(Debug, Clone, Default, PartialEq)]

@@ -224,6 +224,9 @@ pub mod nav2 {
         pub const FAILED_TO_MAKE_PROGRESS: u16 = 105;
         /// No valid control could be computed.
         pub const NO_VALID_CONTROL: u16 = 106;
+        /// The `controller_id` Nav2's default configuration and behavior trees send (the name of
+        /// controller_server's one default plugin): a node with a default law takes it as that.
+        pub const DEFAULT_CONTROLLER_ID: &str = "FollowPath";
     }
     /// `ComputePathToPose`'s (the planner server's) codes.
     pub mod compute_path {

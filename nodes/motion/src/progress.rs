@@ -5,6 +5,8 @@
 
 use nalgebra::Point2;
 
+use crate::{nav2, Outcome};
+
 /// Nav2's two progress parameters.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ProgressSettings {
@@ -84,6 +86,17 @@ impl ProgressChecker {
             }
         }
     }
+}
+
+/// How the progress checker ends a goal: `ABORTED` with Nav2's `FAILED_TO_MAKE_PROGRESS`,
+/// after `since` seconds within `radius` metres (two decimals, so 1.04 s against an allowance
+/// of 1 s does not print "1.0 s").
+pub fn no_progress(since: f64, radius: f64) -> Outcome {
+    Outcome::failed(
+        "ABORTED",
+        format!("no progress: moved less than {radius} m in {since:.2} s"),
+        nav2::follow_path::FAILED_TO_MAKE_PROGRESS,
+    )
 }
 
 #[cfg(test)]

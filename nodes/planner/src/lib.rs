@@ -107,6 +107,7 @@ pub mod docks;
 pub mod error;
 pub mod follow;
 pub mod goals;
+pub mod path;
 pub mod route;
 pub mod sim;
 pub mod task;

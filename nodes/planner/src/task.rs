@@ -31,6 +31,7 @@ use crate::goals::{
     after_pre_check, route_infeasible, DockGoal, Missed, PreChecked, RouteEvent, RouteGoal, UndockGoal,
     MISSED_BY_THE_RUN,
 };
+use crate::path::{PathLaw, PathTask};
 use crate::vfo::{
     vfo_gains, ObstacleMap, OptimiseWarning, SegmentReport, VfoEvent, VfoGoal, VfoSettings, VfoStep, VfoView,
     MAX_SETTLE_S,
@@ -304,6 +305,8 @@ pub enum Task {
     Undock(UndockGoal),
     /// A route by VFO.
     Vfo(VfoRun),
+    /// A path (Nav2's `follow_path`) by the goal approach or VFO.
+    Path(PathTask),
 }
 
 /// What the status shows of a goal.
@@ -394,16 +397,21 @@ impl Task {
             Task::Follow(_) => Mode::Approach,
             Task::Undock(_) => Mode::Undock,
             Task::Vfo(_) => Mode::Vfo,
+            Task::Path(p) => match p.law() {
+                PathLaw::Approach { .. } => Mode::Approach,
+                PathLaw::Vfo(_) => Mode::Vfo,
+            },
         }
     }
 
     /// The request's index of the waypoint pursued, if a route (a route waiting for its
-    /// pre-check: its first).
+    /// pre-check: its first; a path: its sub-goal).
     pub fn waypoint(&self) -> Option<usize> {
         match self {
             Task::Follow(goal) => Some(goal.waypoint()),
             Task::Vfo(v) => Some(v.view.waypoint),
             Task::PreCheck(p) => Some(p.request_index.first().copied().unwrap_or(0)),
+            Task::Path(p) => Some(p.goals().index()),
             Task::Dock(_) | Task::Undock(_) => None,
         }
     }
@@ -438,16 +446,36 @@ impl Task {
                 f.vfo = Some(v.view.report);
             }
             Task::PreCheck(p) => f.goal = at(p.points.first().copied()),
+            Task::Path(p) => {
+                f.goal = at(Some(p.goals().goal()));
+                f.distance = p.distance();
+                if let PathLaw::Vfo(v) = p.law() {
+                    f.vfo = Some(v.view.report);
+                }
+            }
         }
         f
     }
 
     /// One step at `input`: the docking's, the route's or the undocking's law here; a VFO
-    /// route's goes off the loop, a route waiting for its pre-check does not step.
+    /// route's goes off the loop, a route waiting for its pre-check does not step. A path is
+    /// first checked for progress (either law), then stepped as its law is.
     pub fn step(&mut self, input: &StepInput) -> Stepped {
         let step = match self {
             Task::PreCheck(_) => return Stepped::Waiting,
             Task::Vfo(_) => return Stepped::OffLoop,
+            Task::Path(p) => {
+                if let Some(stuck) = p.check_progress(input.pose.position(), input.t) {
+                    return Stepped::Law(Step::end(stuck, ()));
+                }
+                if matches!(p.law(), PathLaw::Vfo(_)) {
+                    return Stepped::OffLoop;
+                }
+                unified(p.step_approach(input), |f| TaskStep {
+                    changed: f.changed,
+                    events: Vec::new(),
+                })
+            }
             Task::Dock(d) => unified(d.step(input, &()), |f| TaskStep {
                 changed: f.phase_changed,
                 events: Vec::new(),
@@ -476,8 +504,22 @@ impl Task {
             Task::PreCheck(p) => listed(&p.problems),
             Task::Vfo(_) if succeeded => Vec::new(),
             Task::Vfo(v) => v.unreached().into_iter().map(|i| (i, MISSED_BY_THE_RUN)).collect(),
-            Task::Dock(_) | Task::Undock(_) => Vec::new(),
+            Task::Dock(_) | Task::Undock(_) | Task::Path(_) => Vec::new(),
         }
+    }
+
+    /// The VFO law's run: a VFO route's, or a path's followed by VFO.
+    pub fn vfo_mut(&mut self) -> Option<&mut VfoRun> {
+        match self {
+            Task::Vfo(v) => Some(v),
+            Task::Path(p) => p.vfo_run(),
+            _ => None,
+        }
+    }
+
+    /// Whether the law is VFO's (it needs the scan).
+    pub fn is_vfo(&self) -> bool {
+        self.mode() == Mode::Vfo
     }
 
     /// A route's pre-check came back with `report`: the route becomes a goal approach from
@@ -549,7 +591,7 @@ impl Task {
     }
 }
 
-/// Where a goal came from: the node's two topics and three action servers.
+/// Where a goal came from: the node's two topics and four action servers.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Source {
     /// The `dock_pose` topic.
@@ -562,6 +604,8 @@ pub enum Source {
     UndockAction,
     /// The `follow_waypoints` action.
     FollowAction,
+    /// The `follow_path` action.
+    PathAction,
 }
 
 /// The topic's or action's name (the motion session names a goal's source by it).
@@ -573,6 +617,7 @@ impl From<Source> for &'static str {
             Source::DockAction => "dock_robot",
             Source::UndockAction => "undock_robot",
             Source::FollowAction => "follow_waypoints",
+            Source::PathAction => "follow_path",
         }
     }
 }
@@ -589,6 +634,7 @@ impl Source {
             Source::DockPose | Source::DockAction => Action::Dock,
             Source::UndockAction => Action::Undock,
             Source::Waypoints | Source::FollowAction => Action::Follow,
+            Source::PathAction => Action::Path,
         }
     }
 }
@@ -602,15 +648,19 @@ pub enum Action {
     Undock,
     /// `follow_waypoints`, and the `waypoints` topic (no result).
     Follow,
+    /// `follow_path`.
+    Path,
 }
 
 impl Action {
     /// The codes of the ends the node makes: DockRobot's and UndockRobot's FAILED_TO_CONTROL
-    /// and UNKNOWN, FollowWaypoints' TASK_EXECUTOR_FAILED and UNKNOWN.
+    /// and UNKNOWN, FollowWaypoints' TASK_EXECUTOR_FAILED and UNKNOWN, FollowPath's
+    /// NO_VALID_CONTROL and UNKNOWN.
     pub fn codes(self) -> Nav2Codes {
         match self {
             Action::Dock | Action::Undock => Nav2Codes::DOCKING,
             Action::Follow => Nav2Codes::FOLLOW_WAYPOINTS,
+            Action::Path => Nav2Codes::FOLLOW_PATH,
         }
     }
 
@@ -631,10 +681,11 @@ impl Action {
     }
 
     /// An invalid goal (`why`), refused before it starts: `INVALID_GOAL` with DockRobot's
-    /// DOCK_NOT_VALID or the action's UNKNOWN.
+    /// DOCK_NOT_VALID, FollowPath's INVALID_PATH or the action's UNKNOWN.
     pub fn invalid_goal(self, why: impl std::fmt::Display) -> Outcome {
         let code = match self {
             Action::Dock => nav2::docking::DOCK_NOT_VALID,
+            Action::Path => nav2::follow_path::INVALID_PATH,
             Action::Undock | Action::Follow => self.unknown(),
         };
         Outcome::failed("INVALID_GOAL", why.to_string(), code)

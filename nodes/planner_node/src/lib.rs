@@ -30,7 +30,7 @@ use mobil_ros::config::{Config, ConfigError, Decl};
 use mobil_ros::geometry::pose_msg;
 use mobil_ros::goal::RouteLimits;
 pub use mobil_ros::goal::{GoalError, Route};
-use mobil_ros::groups::{Frames, GoalTimeouts};
+use mobil_ros::groups::{Controller, Frames, GoalTimeouts};
 use mobil_ros::lifecycle::Managed;
 use mobil_ros::markers::{point, Markers};
 use mobil_ros::motion::EndCause;
@@ -86,8 +86,10 @@ pub struct PlannerConfig {
     pub cmd_vel: CmdVelType,
     /// The frames of odometry, goals and the robot.
     pub frames: Frames,
-    /// How `waypoints` and `follow_waypoints` are followed.
+    /// How `waypoints` and `follow_waypoints` are followed, and `follow_path` by default.
     pub waypoint_method: WaypointMethod,
+    /// Nav2's controller role (`follow_path`): the progress checker, the sub-goal spacing.
+    pub controller: Controller,
     /// VFO waypoint following's settings.
     pub vfo: VfoSettings,
 }
@@ -179,6 +181,7 @@ impl Config for PlannerConfig {
             |c, v| c.dock_database = v,
         )
         .read_only();
+        d.nest(|c: &mut PlannerConfig| &mut c.controller, Controller::declare);
         d.nest(|c: &mut PlannerConfig| &mut c.timeouts, GoalTimeouts::declare);
         d.nest(|c: &mut PlannerConfig| &mut c.managed, Managed::declare);
         d.nest(|c: &mut PlannerConfig| &mut c.cmd_vel, CmdVelType::declare);
@@ -191,6 +194,13 @@ impl Config for PlannerConfig {
         self.gains()?;
         self.docking.validate().map_err(ConfigError::inconsistent)?;
         self.follow.validate().map_err(ConfigError::inconsistent)?;
+        if self.controller.path_lookahead / 2.0 <= self.follow.critical_distance {
+            return Err(ConfigError::inconsistent(format!(
+                "path_lookahead {} m: half of it must be above critical_distance {} m (a sub-goal would \
+                 be reached before the next is taken)",
+                self.controller.path_lookahead, self.follow.critical_distance
+            )));
+        }
         self.route_check().validate().map_err(ConfigError::inconsistent)?;
         self.vfo.gains.validate().map_err(ConfigError::inconsistent)?;
         mobil_planner::vfo::VfoWaypoint::new(0.0, 0.0, 0.0, self.vfo.guiding).map_err(ConfigError::inconsistent)?;
@@ -446,10 +456,16 @@ mod tests {
         let mut bad = values.clone();
         bad.set("gamma", ros2_client::ParameterValue::Double(0.0));
         assert!(mobil_ros::config::load::<PlannerConfig>(&bad).is_err());
-        let mut bad = values;
+        let mut bad = values.clone();
         bad.set("min_speed", ros2_client::ParameterValue::Double(0.4));
         // min_speed above approach_speed (0.3) is inconsistent.
         assert!(mobil_ros::config::load::<PlannerConfig>(&bad).is_err());
+        // follow_path: half the lookahead must exceed Z_crit (0.16 m): 0.32 m is refused, 0.34 m taken.
+        let mut lookahead = values;
+        lookahead.set("path_lookahead", ros2_client::ParameterValue::Double(0.32));
+        assert!(mobil_ros::config::load::<PlannerConfig>(&lookahead).is_err());
+        lookahead.set("path_lookahead", ros2_client::ParameterValue::Double(0.34));
+        assert!(mobil_ros::config::load::<PlannerConfig>(&lookahead).is_ok());
     }
 
     #[test]

@@ -5,8 +5,9 @@
 //! `planner/check_route`), or with `waypoint_method: vfo` by VFO round the obstacles the LIDAR
 //! sees (`scan`), each segment's left/right decisions optimised by virtual robots
 //! ([`mobil_planner_node::vfo`]: the ticks run off the event loop and the robot stops while a
-//! segment is optimised). Every source feeds one session: a new goal from any of them
-//! pre-empts the running one.
+//! segment is optimised). Nav2's controller role, `follow_path`, follows a path by either law
+//! (`shell/path.rs`). Every source feeds one session: a new goal from any of them pre-empts the
+//! running one.
 //!
 //! **One step per odometry message**: each valid `odom` (50 Hz from chassis_node) is one
 //! control step and one `cmd_vel`; the law's time and `dt` are ROS time (simulated under
@@ -26,6 +27,7 @@
 
 // The shell's modules (`shell::*`) take every name from here (`use crate::*`).
 use mobil_chassis::{clamp_at_reference, ChassisParams};
+use mobil_geom::path::PathGoals;
 use mobil_geom::Pose2;
 use mobil_motion::slot::ArrivalPeriod;
 use mobil_motion::{BodyTwist, GoalLaw, Step, StepInput};
@@ -33,8 +35,8 @@ use mobil_msgs::geometry_msgs::msg::{PoseStamped, Twist};
 use mobil_msgs::mobil_msgs::msg::NavStatus;
 use mobil_msgs::mobil_msgs::srv::{CheckRoute, CheckRouteRequest, CheckRouteResponse};
 use mobil_msgs::nav2_msgs::action::{
-    DockRobot, DockRobotFeedback, DockRobotGoal, FollowWaypoints, FollowWaypointsFeedback, FollowWaypointsGoal,
-    FollowWaypointsResult, UndockRobot, UndockRobotFeedback, UndockRobotGoal,
+    DockRobot, DockRobotFeedback, DockRobotGoal, FollowPath, FollowPathGoal, FollowWaypoints, FollowWaypointsFeedback,
+    FollowWaypointsGoal, FollowWaypointsResult, UndockRobot, UndockRobotFeedback, UndockRobotGoal,
 };
 use mobil_msgs::nav_msgs::msg::{Odometry, Path};
 use mobil_msgs::sensor_msgs::msg::LaserScan;
@@ -100,6 +102,7 @@ mod shell {
     mod actions;
     mod check;
     mod goals;
+    mod path;
     mod routes;
 }
 
@@ -123,6 +126,7 @@ struct Servers {
     dock: GoalServer<DockRobot>,
     undock: GoalServer<UndockRobot>,
     follow: GoalServer<FollowWaypoints>,
+    path: GoalServer<FollowPath>,
 }
 
 /// What a handler reaches of the node: its clock, its outputs and commands, its action servers.
@@ -171,6 +175,8 @@ struct Shell {
     world: Arc<World>,
     session: Session,
     odom: Latest<Pose2>,
+    /// The robot's speed (m/s) in the latest odometry, for `follow_path`'s feedback.
+    odom_speed: f64,
     odom_refused: bool,
     status_gate: RateGate,
     markers_gate: RateGate,
@@ -209,6 +215,7 @@ enum Event {
     Dock(ActionEvent<DockRobotGoal>),
     Undock(ActionEvent<UndockRobotGoal>),
     Follow(ActionEvent<FollowWaypointsGoal>),
+    Path(ActionEvent<FollowPathGoal>),
     Lifecycle(Transition),
     Check(RmwRequestId, CheckRouteRequest),
     Checked(RmwRequestId, CheckRouteResponse),
@@ -248,11 +255,12 @@ async fn start(node: &mut RosNode, out: &Outputs, config: PlannerConfig) -> anyh
     let mut servers = Servers {
         dock: GoalServer::create(node, "dock_robot", server_config.clone())?.gate(lifecycle.gate()),
         undock: GoalServer::create(node, "undock_robot", server_config.clone())?.gate(lifecycle.gate()),
-        follow: GoalServer::create(node, "follow_waypoints", server_config)?.gate(lifecycle.gate()),
+        follow: GoalServer::create(node, "follow_waypoints", server_config.clone())?.gate(lifecycle.gate()),
+        path: GoalServer::create(node, "follow_path", server_config)?.gate(lifecycle.gate()),
     };
     info!(
         "{} chassis, pre-check world: {} ({} obstacles); waiting for dock_pose, waypoints, dock_robot, \
-         undock_robot, follow_waypoints (frame `{}`)",
+         undock_robot, follow_waypoints, follow_path (frame `{}`)",
         chassis.model().as_str(),
         match config.world_file.as_str() {
             "" => "the sim's built-in world",
@@ -268,6 +276,7 @@ async fn start(node: &mut RosNode, out: &Outputs, config: PlannerConfig) -> anyh
         world: Arc::new(world),
         session: Session::new(SessionSettings::default()),
         odom: Latest::new(),
+        odom_speed: 0.0,
         odom_refused: false,
         status_gate: RateGate::default(),
         markers_gate: RateGate::default(),
@@ -305,7 +314,7 @@ async fn start(node: &mut RosNode, out: &Outputs, config: PlannerConfig) -> anyh
     .await;
     // A goal under way (a pre-check included: it stopped a robot a goal before it moved) ends,
     // and its zero command, waited for, goes out before anything that may take time; then the
-    // three servers close at once (each waits up to 2 s for its results).
+    // four servers close at once (each waits up to 2 s for its results).
     jobs.vfo.cancel();
     jobs.goal.cancel();
     let (ended, final_zero) = shell.session.shutdown();
@@ -323,11 +332,17 @@ async fn start(node: &mut RosNode, out: &Outputs, config: PlannerConfig) -> anyh
     }
     lifecycle.close().await;
     let down = EndCause::Shutdown;
-    let Servers { dock, undock, follow } = servers;
+    let Servers {
+        dock,
+        undock,
+        follow,
+        path,
+    } = servers;
     tokio::join!(
         dock.close(nav2_result(&down, Action::Dock.codes())),
         undock.close(nav2_result(&down, Action::Undock.codes())),
         follow.close(follow_result(&down, &[], &[])),
+        path.close(nav2_result(&down, Action::Path.codes())),
     );
     Ok(outcome)
 }
@@ -390,6 +405,7 @@ async fn event_loop(
             e = servers.dock.next_event() => Event::Dock(e),
             e = servers.undock.next_event() => Event::Undock(e),
             e = servers.follow.next_event() => Event::Follow(e),
+            e = servers.path.next_event() => Event::Path(e),
             t = lifecycle.next() => Event::Lifecycle(t),
             _ = ticker.tick() => Event::Tick,
         };
@@ -440,9 +456,11 @@ async fn event_loop(
             Event::Dock(ActionEvent::Goal(request)) => shell.dock_action(&mut io, request).await,
             Event::Undock(ActionEvent::Goal(request)) => shell.undock_action(&mut io, request).await,
             Event::Follow(ActionEvent::Goal(request)) => shell.follow_action(&mut io, jobs, request).await,
+            Event::Path(ActionEvent::Goal(request)) => shell.path_action(&mut io, request).await,
             Event::Dock(ActionEvent::CancelRequested(id)) => shell.cancel(&mut io, Source::DockAction, id),
             Event::Undock(ActionEvent::CancelRequested(id)) => shell.cancel(&mut io, Source::UndockAction, id),
             Event::Follow(ActionEvent::CancelRequested(id)) => shell.cancel(&mut io, Source::FollowAction, id),
+            Event::Path(ActionEvent::CancelRequested(id)) => shell.cancel(&mut io, Source::PathAction, id),
             Event::Check(id, req) => shell.check_in(io.node, jobs, check, id, &req),
             Event::Checked(id, reply) => respond(check, id, reply, CHECK_ROUTE, &mut shell.throttle),
             Event::RouteChecked(done) => shell.pre_checked(&mut io, done),

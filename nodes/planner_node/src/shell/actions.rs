@@ -1,5 +1,5 @@
-//! The three action servers' goals and cancels: `dock_robot`, `undock_robot`,
-//! `follow_waypoints`.
+//! The action servers' goals and cancels: `dock_robot`, `undock_robot`, `follow_waypoints`
+//! (`follow_path`'s are in `path.rs`).
 
 use crate::*;
 
@@ -96,6 +96,7 @@ impl Shell {
             Source::DockAction => io.servers.dock.active_id(),
             Source::UndockAction => io.servers.undock.active_id(),
             Source::FollowAction => io.servers.follow.active_id(),
+            Source::PathAction => io.servers.path.active_id(),
             Source::DockPose | Source::Waypoints => None,
         };
         if active_id == Some(id) && self.session.active().is_some_and(|a| a.source == source) {
@@ -128,6 +129,9 @@ impl Servers {
             }
             Source::FollowAction => {
                 self.follow.finish(end, follow_answer(goal, cause));
+            }
+            Source::PathAction => {
+                self.path.finish(end, nav2_result(cause, Action::Path.codes()));
             }
             Source::DockPose | Source::Waypoints => {}
         }

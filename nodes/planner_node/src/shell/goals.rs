@@ -170,6 +170,12 @@ impl Shell {
         match odom_pose(m, &self.config.frames.odom_frame, &self.config.frames.base_frame) {
             Ok(pose) => {
                 self.odom_refused = false;
+                let v = &m.twist.twist.linear;
+                self.odom_speed = if v.x.is_finite() && v.y.is_finite() {
+                    v.x.hypot(v.y)
+                } else {
+                    0.0
+                };
                 self.odom_stamp = secs_from_stamp(&m.header.stamp).unwrap_or(f64::NAN);
                 if self.odom_stamp.is_finite() {
                     self.odom_history.push(self.odom_stamp, pose);
@@ -276,7 +282,7 @@ impl Shell {
             age: self.odom.age_at(now),
             timeout: active.goal.config.timeouts.odom_timeout(),
         }];
-        if matches!(active.goal.task, Task::Vfo(_)) {
+        if active.goal.task.is_vfo() {
             inputs.push(Watched {
                 name: "scan",
                 age: self.scan_seen.age_at(now),
@@ -321,6 +327,10 @@ impl Shell {
                     .await
             }
             Source::UndockAction => servers.undock.feedback(UndockRobotFeedback::default()).await,
+            Source::PathAction => match self.path_feedback(&active.goal) {
+                Some(feedback) => servers.path.feedback(feedback).await,
+                None => Ok(()),
+            },
             Source::DockPose | Source::Waypoints => Ok(()),
         };
         if let Err(e) = sent {

@@ -106,13 +106,15 @@ impl Shell {
     /// A VFO step: the law goes to the blocking pool with the map's latest obstacles, or,
     /// while it is still out (optimising), the robot stops.
     pub(crate) fn vfo_step(&mut self, io: &mut Io<'_, '_>, jobs: &mut Jobs, input: StepInput) {
+        // A path whose new sub-goals wait for the law: it is built now, while the law is home.
+        self.rebuild_path_vfo(io);
         let Some(active) = self.session.active_mut() else {
             return;
         };
         let id = active.id();
         let budget = active.goal.config.vfo.optimise_budget();
         let stop = active.goal.stop.clone();
-        let Task::Vfo(v) = &mut active.goal.task else { return };
+        let Some(v) = active.goal.task.vfo_mut() else { return };
         let Some(mut law) = v.lend(Instant::now(), self.map.map()) else {
             return self.session.hold(io.sink);
         };
@@ -147,9 +149,17 @@ impl Shell {
             return;
         };
         let chassis = active.goal.chassis;
-        let Task::Vfo(v) = &mut active.goal.task else { return };
+        let Some(v) = active.goal.task.vfo_mut() else { return };
         let (mut step, handback) = v.give_back(done.law, done.step, Instant::now());
         mobil_ros::tell!(self.throttle, v.notices(&step, handback));
+        // A path: the sub-goal pursued follows the law's waypoint, and its ends take
+        // FollowPath's codes.
+        if let Task::Path(path) = &mut active.goal.task {
+            path.vfo_returned();
+            if let Step::End(end) = &mut step {
+                end.outcome = mobil_planner::path::as_follow_path(end.outcome.clone());
+            }
+        }
         if let Step::Command { feedback, .. } = &mut step
             && let Some(drawing) = feedback.drawing.take()
         {
@@ -160,12 +170,12 @@ impl Shell {
 
     /// A scan: its obstacles go into the map (in odom, with the odometry pose at the scan's
     /// stamp); a VFO route's follower gets them at its next tick. A goal's scans are read with
-    /// the parameters it began with.
+    /// the parameters it began with. The map is kept whatever `waypoint_method` is: a
+    /// `follow_path` goal may name VFO.
     pub(crate) fn scan_in(&mut self, m: &LaserScan) {
         let config = match self.session.active() {
-            Some(a) if matches!(a.goal.task, Task::Vfo(_)) => &a.goal.config,
-            _ if self.config.waypoint_method == WaypointMethod::Vfo => &self.config,
-            _ => return,
+            Some(a) if a.goal.task.is_vfo() => &a.goal.config,
+            _ => &self.config,
         };
         let (max_gap, scan_range) = (config.vfo.scan_odom_max_gap_s, config.vfo.scan_range);
         let mount = LaserMount {
@@ -201,7 +211,7 @@ impl Shell {
             );
         }
         self.scan_seen.set((), m.header.stamp.clone());
-        if let Some(Task::Vfo(v)) = self.session.active_mut().map(|a| &mut a.goal.task) {
+        if let Some(v) = self.session.active_mut().and_then(|a| a.goal.task.vfo_mut()) {
             v.map_updated(!update.new.is_empty());
         }
     }

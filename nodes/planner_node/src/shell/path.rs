@@ -1,0 +1,166 @@
+//! Nav2's controller role: `follow_path` (nav2_msgs/action/FollowPath) by the goal approach or
+//! VFO, as `controller_id` names them ([`mobil_planner::path`]).
+//!
+//! A new `follow_path` goal while one runs is taken as controller_server takes it: the running
+//! goal's action ends ABORTED (error NONE) and the new path goes on from where the robot is,
+//! with no zero command between them and the progress checker kept ([`PathTask::replace`]). A
+//! goal that cannot be followed is accepted and ended at once with Nav2's code
+//! (INVALID_CONTROLLER, TF_ERROR, INVALID_PATH), as controller_server ends it. The path is
+//! followed without the route pre-check: Nav2's planner has placed it in free space already.
+
+use crate::*;
+use mobil_msgs::nav2_msgs::action::FollowPathFeedback;
+use mobil_planner::path::{as_follow_path, controller, PathTask, Replaced};
+use mobil_planner::vfo::WaypointMethod;
+use mobil_ros::goal::path_goals;
+use nalgebra::Point2;
+use tracing::debug;
+
+impl Shell {
+    pub(crate) async fn path_action(&mut self, io: &mut Io<'_, '_>, request: GoalRequest<FollowPathGoal>) {
+        let goal = request.goal();
+        for (what, id) in [
+            ("goal_checker_id", &goal.goal_checker_id),
+            ("progress_checker_id", &goal.progress_checker_id),
+        ] {
+            if !id.is_empty() {
+                warn_throttled!(
+                    self.throttle,
+                    "checker-id",
+                    "follow_path: {what} `{id}` ignored: the node has one goal checker (critical_distance) and \
+                     one progress checker"
+                );
+            }
+        }
+        let from = match (self.odom.value(), goal.path.poses.first()) {
+            (Some(o), _) => o.position(),
+            (None, Some(p)) => Point2::new(p.pose.position.x, p.pose.position.y),
+            (None, None) => Point2::origin(),
+        };
+        let (frame, lookahead) = (&self.config.frames.odom_frame, self.config.controller.path_lookahead);
+        let checked = controller(&goal.controller_id, self.config.waypoint_method)
+            .and_then(|method| Ok((method, path_goals(&goal.path, frame, from, lookahead)?)));
+        // A running path by the same law goes on with the new one.
+        let running = self.session.active().filter(|a| a.source == Source::PathAction);
+        let continuing = running.and_then(|a| match &a.goal.task {
+            Task::Path(p) => Some(p.method()),
+            _ => None,
+        });
+        // The server ends a running follow_path goal itself on accept, as controller_server.
+        let preempted = nav2_result(&EndCause::Preempted("follow_path"), Action::Path.codes());
+        let accept = io
+            .servers
+            .path
+            .accept(request, |_| preempted, io.node.now_nanos())
+            .await;
+        if !self.accepted(io, accept, Source::PathAction) {
+            return;
+        }
+        match checked {
+            Err(outcome) => self.refuse(io, Source::PathAction, outcome),
+            Ok((method, goals)) if continuing == Some(method) => self.replace_path(io, goals),
+            Ok((method, goals)) => self.start_path(io, method, goals),
+        }
+    }
+
+    /// Starts following `goals` by `method` (or refuses it).
+    fn start_path(&mut self, io: &mut Io<'_, '_>, method: WaypointMethod, goals: PathGoals) {
+        let progress = self.config.controller.progress;
+        let task = match method {
+            WaypointMethod::Approach => PathTask::approach(goals, (self.config.follow, &self.chassis, progress)),
+            WaypointMethod::Vfo => {
+                let scan_fresh = self.scan_seen.get(self.config.vfo.scan_timeout()).is_some();
+                let (points, headings, index) = PathTask::vfo_route(&goals);
+                let rules = (&self.config.vfo, &self.chassis, self.map.map());
+                let start = self.fresh_odom();
+                VfoRun::start(
+                    (&points, &headings, &index),
+                    start,
+                    scan_fresh,
+                    rules,
+                    self.odom_period.period(),
+                )
+                .map(|started| PathTask::vfo(goals, started.run, progress))
+                .map_err(as_follow_path)
+            }
+        };
+        let task = match task {
+            Ok(task) => task,
+            Err(refusal) => return self.refuse(io, Source::PathAction, refusal),
+        };
+        let end = *task.goals().goals().last().unwrap_or(&task.goals().goal());
+        info!(
+            "goal (follow_path): {} sub-goals to ({:.3}, {:.3}) by {}",
+            task.goals().goals().len(),
+            end.x,
+            end.y,
+            method.as_str()
+        );
+        self.drawing = Drawing {
+            route: task.goals().goals().to_vec(),
+            ..Drawing::default()
+        };
+        self.begin(io, Task::Path(task), None, Source::PathAction);
+        self.publish_status(io.node, io.out, NavStatus::ACTIVE, String::new());
+        self.publish_markers(io.node, io.out);
+    }
+
+    /// A new path for the running `follow_path` goal: no stop, the progress checker kept; the
+    /// goal approach takes it at once, VFO keeps its law or rebuilds it ([`PathTask::replace`]).
+    fn replace_path(&mut self, io: &mut Io<'_, '_>, goals: PathGoals) {
+        let Some(Task::Path(task)) = self.session.active_mut().map(|a| &mut a.goal.task) else {
+            return;
+        };
+        let route = goals.goals().to_vec();
+        match task.replace(goals) {
+            Err(outcome) => self.end_goal(io, outcome.into()),
+            Ok(Replaced::Swapped { kept }) => {
+                self.drawing.route = route;
+                debug!("follow_path: new path, sub-goal {}", if kept { "kept" } else { "new" });
+            }
+            Ok(Replaced::LawKept) => debug!("follow_path: new path to the same end; the VFO law goes on"),
+            Ok(Replaced::Pending) => {
+                self.drawing.route = route;
+                self.rebuild_path_vfo(io);
+            }
+        }
+    }
+
+    /// A `follow_path` goal by VFO whose new path waits for its law: the law built on it, once
+    /// the old one is home (no step off the event loop); the goal ends if it cannot be.
+    pub(crate) fn rebuild_path_vfo(&mut self, io: &mut Io<'_, '_>) {
+        let start = self.fresh_odom();
+        let scan_fresh = self.scan_seen.get(self.config.vfo.scan_timeout()).is_some();
+        let period = self.odom_period.period();
+        let Some(active) = self.session.active_mut() else {
+            return;
+        };
+        let Task::Path(task) = &mut active.goal.task else {
+            return;
+        };
+        let Some(goals) = task.take_pending() else { return };
+        let (points, headings, index) = PathTask::vfo_route(&goals);
+        let rules = (&active.goal.config.vfo, &active.goal.chassis, self.map.map());
+        match VfoRun::start((&points, &headings, &index), start, scan_fresh, rules, period) {
+            Ok(started) => {
+                info!(
+                    "follow_path: a new path to another end; VFO starts anew: {}",
+                    started.summary
+                );
+                task.rebuilt(goals, started.run);
+            }
+            Err(refusal) => self.end_goal(io, as_follow_path(refusal).into()),
+        }
+    }
+
+    /// `follow_path` feedback: the distance along the sub-goals to the end, and the speed.
+    pub(crate) fn path_feedback(&self, goal: &Goal) -> Option<FollowPathFeedback> {
+        let (Some(odom), Task::Path(task)) = (self.odom.value(), &goal.task) else {
+            return None;
+        };
+        Some(FollowPathFeedback {
+            distance_to_goal: task.remaining(odom.position()) as f32,
+            speed: self.odom_speed as f32,
+        })
+    }
+}
