@@ -199,6 +199,9 @@ def test_follow_path_replanned_every_second_reaches_the_end_without_a_stop(
         r = result_of(h)
         assert r.status == GoalStatus.STATUS_ABORTED and r.result.error_code == FollowPath.Result.NONE
     zeros = [i for i, c in enumerate(commands) if is_zero(c)]
+    if node == "planner_node":
+        law = "vfo" if controller == "" and robot == "omr3" else "approach"
+        assert f"by {law}" in nav.log_text(), nav.log_tail()
     if node == "planner_node" and controller == "" and robot == "omr3":
         # VFO keeps its law across paths to the same end, and holds the robot only while a
         # segment's optimisation outlasts an odometry period (a machine under load).

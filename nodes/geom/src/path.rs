@@ -32,10 +32,23 @@ pub enum PathError {
     /// A pose (its index) with NaN or infinity.
     #[error("pose {0} of the path is not finite")]
     NotFinite(usize),
+    /// A pose (its index) farther than [`MAX_PATH_COORD`] from the origin on an axis.
+    #[error("pose {0} of the path lies beyond ±{MAX_PATH_COORD} m")]
+    TooFar(usize),
+    /// More sub-goals than [`MAX_SUB_GOALS`] (the path's length over the lookahead).
+    #[error("the path would make {0} sub-goals, more than {MAX_SUB_GOALS}")]
+    TooLong(usize),
     /// A lookahead not above zero, or not finite.
     #[error("the lookahead must be finite and above zero")]
     Lookahead,
 }
+
+/// The largest |x| and |y| of a path's pose (m): as for any goal of the suite.
+pub const MAX_PATH_COORD: f64 = 1e4;
+
+/// The most sub-goals one path makes: 100 km at a 1 m lookahead, far beyond any path a
+/// planner sends, and 1.6 MB of points.
+pub const MAX_SUB_GOALS: usize = 100_000;
 
 /// Sub-goals along a path, and which one the navigator is heading for.
 #[derive(Debug, Clone, PartialEq)]
@@ -59,6 +72,17 @@ impl PathGoals {
         };
         if let Some(i) = path.iter().position(|p| !(p.x.is_finite() && p.y.is_finite())) {
             return Err(PathError::NotFinite(i));
+        }
+        if let Some(i) = path
+            .iter()
+            .position(|p| p.x.abs() > MAX_PATH_COORD || p.y.abs() > MAX_PATH_COORD)
+        {
+            return Err(PathError::TooFar(i));
+        }
+        let length: f64 = path.windows(2).map(|w| (w[1] - w[0]).norm()).sum();
+        let count = (length / lookahead).ceil();
+        if count > MAX_SUB_GOALS as f64 {
+            return Err(PathError::TooLong(count.min(usize::MAX as f64) as usize));
         }
         // The nearest point of the polyline: segment index and point.
         let (mut segment, mut start) = (0, path[0]);
@@ -123,7 +147,7 @@ impl PathGoals {
 
     /// Keeps `current` (the sub-goal the navigator heads for, from an earlier path) as the goal
     /// when one of these sub-goals, not the end, lies within `lookahead / 2` of it: that
-    /// sub-goal becomes `current` and the ones before it are dropped. A path re-planned along
+    /// sub-goal becomes `current` and the ones before it are skipped. A path re-planned along
     /// the same way then leaves the navigator's goal, and its mode, as they were. False
     /// (nothing changed) when none is that near, or only the end (which is never moved).
     pub fn keep(&mut self, current: Point2<f64>) -> bool {
@@ -295,6 +319,22 @@ mod tests {
             PathGoals::new(&[p(0.0, 0.0)], p(0.0, 0.0), 0.0),
             Err(PathError::Lookahead)
         );
+        // Far poses: refused before any arithmetic can overflow (±1e308 apart is infinite).
+        assert_eq!(
+            PathGoals::new(&[p(-1e308, 0.0), p(1e308, 0.0)], p(0.0, 0.0), 1.0),
+            Err(PathError::TooFar(0))
+        );
+        assert_eq!(
+            PathGoals::new(&[p(0.0, 0.0), p(0.0, 10_000.5)], p(0.0, 0.0), 1.0),
+            Err(PathError::TooFar(1))
+        );
+        // 2 × 10 km there and back at 0.1 m: 200 000 sub-goals, refused; at 1 m, 20 000 taken.
+        let long = [p(0.0, 0.0), p(1e4, 0.0), p(0.0, 0.0)];
+        assert_eq!(
+            PathGoals::new(&long, p(0.0, 0.0), 0.1),
+            Err(PathError::TooLong(200_000))
+        );
+        assert_eq!(PathGoals::new(&long, p(0.0, 0.0), 1.0).unwrap().goals().len(), 20_000);
         assert_eq!(
             PathGoals::new(&[p(0.0, 0.0)], p(0.0, 0.0), f64::INFINITY),
             Err(PathError::Lookahead)

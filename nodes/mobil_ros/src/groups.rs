@@ -36,12 +36,22 @@ pub const MAX_RESULT_TIMEOUT_S: f64 = 3600.0;
 
 /// Nav2's controller role (`follow_path`): its progress checker, and the spacing of the
 /// sub-goals a path becomes ([`mobil_geom::path::PathGoals`]).
-#[derive(Debug, Clone, Default, PartialEq)]
+#[derive(Debug, Clone, PartialEq)]
 pub struct Controller {
     /// Nav2's progress checker (`required_movement_radius`, `movement_time_allowance`).
     pub progress: ProgressSettings,
     /// The sub-goals' spacing along a path (`path_lookahead`, m).
     pub path_lookahead: f64,
+}
+
+/// Nav2's progress checker defaults, sub-goals 1 m apart (the declared defaults).
+impl Default for Controller {
+    fn default() -> Self {
+        Controller {
+            progress: ProgressSettings::default(),
+            path_lookahead: 1.0,
+        }
+    }
 }
 
 impl Controller {
@@ -65,9 +75,9 @@ impl Controller {
         .above(0.0);
         d.double(
             "path_lookahead",
-            1.0,
-            "follow_path: the controller heads for a point this far along the path, the next one once \
-             within half of it; the path's end last [m]",
+            Controller::default().path_lookahead,
+            "follow_path: the path becomes sub-goals this far apart along it, the path's end last; the \
+             controller takes the next one within half of it (VFO: at its switch radius) [m]",
             |c, v| c.path_lookahead = v,
         )
         .above(0.0)

@@ -459,13 +459,15 @@ impl Task {
 
     /// One step at `input`: the docking's, the route's or the undocking's law here; a VFO
     /// route's goes off the loop, a route waiting for its pre-check does not step. A path is
-    /// first checked for progress (either law), then stepped as its law is.
-    pub fn step(&mut self, input: &StepInput) -> Stepped {
+    /// first checked for progress (either law) at ROS time `now` (s: Nav2's progress checker
+    /// runs on ROS time, not on the goal's own time, whose steps are capped), then stepped as
+    /// its law is.
+    pub fn step(&mut self, input: &StepInput, now: f64) -> Stepped {
         let step = match self {
             Task::PreCheck(_) => return Stepped::Waiting,
             Task::Vfo(_) => return Stepped::OffLoop,
             Task::Path(p) => {
-                if let Some(stuck) = p.check_progress(input.pose.position(), input.t) {
+                if let Some(stuck) = p.check_progress(input.pose.position(), now) {
                     return Stepped::Law(Step::end(stuck, ()));
                 }
                 if matches!(p.law(), PathLaw::Vfo(_)) {

@@ -57,7 +57,7 @@ fn a_route_waits_for_its_pre_check_then_is_refused_or_driven() {
         (Mode::PreCheck, Some(4), Some(Pose2::new(1.0, 0.0, 0.0)))
     );
     assert!(f.distance.is_nan());
-    assert_eq!(task.step(&at(0.0, 0.0, 0.0)), Stepped::Waiting);
+    assert_eq!(task.step(&at(0.0, 0.0, 0.0), 0.0), Stepped::Waiting);
     // Refused (execute_infeasible_routes false): ROUTE_INFEASIBLE (FollowWaypoints 601), the
     // problem kept by its request index for the result; still the pre-check.
     let refused = task.pre_checked(&blocked(), rules, false).unwrap().unwrap_err();
@@ -74,7 +74,7 @@ fn a_route_waits_for_its_pre_check_then_is_refused_or_driven() {
     let f = task.figures(None);
     assert_eq!((f.mode, f.waypoint, f.distance), (Mode::Approach, Some(4), 1.0));
     assert!(matches!(
-        task.step(&at(0.0, 0.0, 0.0)),
+        task.step(&at(0.0, 0.0, 0.0), 0.0),
         Stepped::Law(Step::Command { .. })
     ));
     // A task that is no pre-check takes no report.
@@ -156,7 +156,7 @@ fn an_undocking_steps_on_the_loop_and_shows_what_is_left() {
     let mut task = Task::Undock(UndockGoal::new(0.5, 0.15, 30.0));
     let f = task.figures(None);
     assert_eq!((f.mode, f.waypoint, f.distance), (Mode::Undock, None, 0.5));
-    match task.step(&at(0.0, 0.0, 0.0)) {
+    match task.step(&at(0.0, 0.0, 0.0), 0.0) {
         Stepped::Law(Step::Command { twist, feedback }) => {
             assert!(twist.vx < 0.0, "backs out: {twist:?}");
             assert!(!feedback.changed && feedback.events.is_empty());
@@ -193,7 +193,7 @@ fn a_vfo_law_is_lent_once_and_a_late_command_is_dropped() {
         (f.mode, f.waypoint, f.goal, f.distance),
         (Mode::Vfo, Some(7), Some(Pose2::new(2.0, 0.0, 0.0)), 2.0)
     );
-    assert_eq!(task.step(&at(0.0, 0.0, 0.0)), Stepped::OffLoop);
+    assert_eq!(task.step(&at(0.0, 0.0, 0.0), 0.0), Stepped::OffLoop);
     let Task::Vfo(run) = &mut task else { unreachable!() };
     let t0 = Instant::now();
     // A change with new obstacles stays one until the law takes it, at its next lending.

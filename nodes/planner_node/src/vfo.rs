@@ -22,7 +22,7 @@ pub fn declare_vfo(d: &mut Decl<PlannerConfig>) {
         parsed "waypoint_method" = "approach" => waypoint_method, choices(&["approach", "vfo"]);
             "how waypoints and follow_waypoints are followed: approach (the goal approach after the route \
              pre-check) or vfo (VFO round the obstacles the LIDAR sees, left/right decisions optimised by \
-             virtual robots), and follow_path when its controller_id is empty; applies from the next goal";
+             virtual robots), and follow_path when its controller_id is empty or FollowPath; applies from the next goal";
         double "vfo.k_p" = g.k_p => vfo.gains.k_p, above(0.0); "k_p, the position gain of h* (eq. 10) [1/s]";
         double "vfo.k_a" = g.k_a => vfo.gains.k_a, above(0.0); "k_a, the orienting gain (eq. 13) [1/s]";
         double "vfo.speed" = g.speed => vfo.gains.speed, above(0.0);

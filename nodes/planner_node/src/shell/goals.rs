@@ -189,6 +189,7 @@ impl Shell {
             Err(e) => {
                 warn_throttled!(self.throttle, "odom-bad", "odom sample dropped: {e}; robot stopped");
                 self.odom_refused = true;
+                self.odom_speed = 0.0;
                 self.odom_history.clear();
                 self.session.hold(io.sink);
             }
@@ -216,7 +217,8 @@ impl Shell {
         };
         let input = StepInput::new(active.t(), dt, pose);
         let chassis = active.goal.chassis;
-        match active.goal.task.step(&input) {
+        let now = io.node.now_nanos() as f64 * 1e-9;
+        match active.goal.task.step(&input, now) {
             Stepped::Waiting => {}
             Stepped::OffLoop => self.vfo_step(io, jobs, input),
             Stepped::Law(step) => {

@@ -9,6 +9,7 @@
 //! followed without the route pre-check: Nav2's planner has placed it in free space already.
 
 use crate::*;
+use mobil_motion::progress::ProgressChecker;
 use mobil_msgs::nav2_msgs::action::FollowPathFeedback;
 use mobil_planner::path::{as_follow_path, controller, PathTask, Replaced};
 use mobil_planner::vfo::WaypointMethod;
@@ -32,7 +33,7 @@ impl Shell {
                 );
             }
         }
-        let from = match (self.odom.value(), goal.path.poses.first()) {
+        let from = match (self.fresh_odom(), goal.path.poses.first()) {
             (Some(o), _) => o.position(),
             (None, Some(p)) => Point2::new(p.pose.position.x, p.pose.position.y),
             (None, None) => Point2::origin(),
@@ -40,12 +41,13 @@ impl Shell {
         let (frame, lookahead) = (&self.config.frames.odom_frame, self.config.controller.path_lookahead);
         let checked = controller(&goal.controller_id, self.config.waypoint_method)
             .and_then(|method| Ok((method, path_goals(&goal.path, frame, from, lookahead)?)));
-        // A running path by the same law goes on with the new one.
+        // A running path by the same law goes on with the new one; by the other law, its
+        // progress checker goes on.
         let running = self.session.active().filter(|a| a.source == Source::PathAction);
-        let continuing = running.and_then(|a| match &a.goal.task {
-            Task::Path(p) => Some(p.method()),
-            _ => None,
-        });
+        let (continuing, progress) = match running.map(|a| &a.goal.task) {
+            Some(Task::Path(p)) => (Some(p.method()), Some(p.progress().clone())),
+            _ => (None, None),
+        };
         // The server ends a running follow_path goal itself on accept, as controller_server.
         let preempted = nav2_result(&EndCause::Preempted("follow_path"), Action::Path.codes());
         let accept = io
@@ -59,34 +61,43 @@ impl Shell {
         match checked {
             Err(outcome) => self.refuse(io, Source::PathAction, outcome),
             Ok((method, goals)) if continuing == Some(method) => self.replace_path(io, goals),
-            Ok((method, goals)) => self.start_path(io, method, goals),
+            Ok((method, goals)) => self.start_path(io, method, goals, progress),
         }
     }
 
-    /// Starts following `goals` by `method` (or refuses it).
-    fn start_path(&mut self, io: &mut Io<'_, '_>, method: WaypointMethod, goals: PathGoals) {
-        let progress = self.config.controller.progress;
+    /// Starts following `goals` by `method` (or refuses it), watched by `progress` when a path
+    /// by the other law ran until now.
+    fn start_path(
+        &mut self,
+        io: &mut Io<'_, '_>,
+        method: WaypointMethod,
+        goals: PathGoals,
+        progress: Option<ProgressChecker>,
+    ) {
+        let settings = self.config.controller.progress;
+        let start = self.fresh_odom();
         let task = match method {
-            WaypointMethod::Approach => PathTask::approach(goals, (self.config.follow, &self.chassis, progress)),
+            WaypointMethod::Approach if start.is_none() => Err(Action::Path.stale_at_start("odom")),
+            WaypointMethod::Approach => PathTask::approach(goals, (self.config.follow, &self.chassis, settings)),
             WaypointMethod::Vfo => {
                 let scan_fresh = self.scan_seen.get(self.config.vfo.scan_timeout()).is_some();
                 let (points, headings, index) = PathTask::vfo_route(&goals);
                 let rules = (&self.config.vfo, &self.chassis, self.map.map());
-                let start = self.fresh_odom();
-                VfoRun::start(
-                    (&points, &headings, &index),
-                    start,
-                    scan_fresh,
-                    rules,
-                    self.odom_period.period(),
-                )
-                .map(|started| PathTask::vfo(goals, started.run, progress))
-                .map_err(as_follow_path)
+                let period = self.odom_period.period();
+                VfoRun::start((&points, &headings, &index), start, scan_fresh, rules, period)
+                    .map(|started| {
+                        if let Some(w) = &started.chassis_warning {
+                            warn!("goal (follow_path): {w}");
+                        }
+                        PathTask::vfo(goals, started.run, settings)
+                    })
+                    .map_err(as_follow_path)
             }
         };
-        let task = match task {
-            Ok(task) => task,
-            Err(refusal) => return self.refuse(io, Source::PathAction, refusal),
+        let task = match (task, progress) {
+            (Ok(task), Some(progress)) => task.with_progress(progress),
+            (Ok(task), None) => task,
+            (Err(refusal), _) => return self.refuse(io, Source::PathAction, refusal),
         };
         let end = *task.goals().goals().last().unwrap_or(&task.goals().goal());
         info!(
@@ -144,7 +155,7 @@ impl Shell {
         match VfoRun::start((&points, &headings, &index), start, scan_fresh, rules, period) {
             Ok(started) => {
                 info!(
-                    "follow_path: a new path to another end; VFO starts anew: {}",
+                    "follow_path: a new path to another end, or away from the sub-goal pursued; VFO starts anew: {}",
                     started.summary
                 );
                 task.rebuilt(goals, started.run);
@@ -155,7 +166,7 @@ impl Shell {
 
     /// `follow_path` feedback: the distance along the sub-goals to the end, and the speed.
     pub(crate) fn path_feedback(&self, goal: &Goal) -> Option<FollowPathFeedback> {
-        let (Some(odom), Task::Path(task)) = (self.odom.value(), &goal.task) else {
+        let (Some(odom), Task::Path(task)) = (self.fresh_odom(), &goal.task) else {
             return None;
         };
         Some(FollowPathFeedback {

@@ -152,12 +152,13 @@ impl Shell {
         let Some(v) = active.goal.task.vfo_mut() else { return };
         let (mut step, handback) = v.give_back(done.law, done.step, Instant::now());
         mobil_ros::tell!(self.throttle, v.notices(&step, handback));
-        // A path: the sub-goal pursued follows the law's waypoint, and its ends take
-        // FollowPath's codes.
+        // A path: the sub-goal pursued follows the law's waypoint, its ends take FollowPath's
+        // codes, and an end made on a path a newer one replaces is dropped (the robot held until
+        // the law is built on the new one, at the next step).
         if let Task::Path(path) = &mut active.goal.task {
-            path.vfo_returned();
-            if let Step::End(end) = &mut step {
-                end.outcome = mobil_planner::path::as_follow_path(end.outcome.clone());
+            match path.vfo_returned(step) {
+                Some(s) => step = s,
+                None => return self.session.hold(io.sink),
             }
         }
         if let Step::Command { feedback, .. } = &mut step
