@@ -6,7 +6,7 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
-CRATES=(mobil_geom mobil_world mobil_chassis mobil_motion mobil_lifecycle mobil_sim mobil_local_nav mobil_tools mobil_planner mobil_terrain mobil_gait mobil_ga_step mobil_ga_step_sim)
+CRATES=(mobil_geom mobil_world mobil_chassis mobil_motion mobil_lifecycle mobil_tf mobil_sim mobil_local_nav mobil_tools mobil_planner mobil_terrain mobil_gait mobil_ga_step mobil_ga_step_sim)
 FORBIDDEN='^(ros2-client|rustdds|tokio) '
 
 status=0

@@ -66,6 +66,7 @@ pub mod qos;
 pub mod scan;
 pub mod status;
 pub mod stop;
+pub mod tf;
 pub mod ticker;
 pub mod time;
 

@@ -1,0 +1,177 @@
+//! The transform buffer on `tf` and `tf_static` ([`mobil_tf::FrameTree`]), as tf2_ros'
+//! `TransformListener` fills a `Buffer`: `tf` reliable and volatile (depth 100), `tf_static`
+//! reliable and transient local (a node started after the publishers still gets their
+//! transforms). Both names are relative, so `-r __ns:=/robot1` moves them with the publishers.
+//!
+//! A node drains both subscriptions before it looks a transform up ([`TfListener::poll`]);
+//! a transform refused (non-finite, a frame given a second parent, a stamp with `nanosec` out
+//! of range or before the epoch) is dropped and told in one rate-limited warning.
+//!
+//! ```
+//! use mobil_msgs::geometry_msgs::msg::TransformStamped;
+//! use mobil_msgs::tf2_msgs::msg::TFMessage;
+//! use mobil_ros::tf::add_message;
+//! use mobil_tf::{At, FrameTree};
+//! use std::time::Duration;
+//!
+//! let mut t = TransformStamped::default();
+//! (t.header.frame_id, t.child_frame_id) = ("map".into(), "odom".into());
+//! t.header.stamp.sec = 3;
+//! t.transform.translation.x = 1.5;
+//! t.transform.rotation.w = 1.0;
+//! let mut tree = FrameTree::new(Duration::from_secs(10));
+//! let refused = add_message(&mut tree, &TFMessage { transforms: vec![t] }, false);
+//! assert!(refused.is_empty());
+//! assert_eq!(tree.planar("map", "odom", At::Latest).unwrap().x, 1.5);
+//! ```
+
+use crate::log::LogThrottle;
+use crate::node::RosNode;
+use crate::time::nanos_from_stamp;
+use crate::warn_throttled;
+use mobil_msgs::tf2_msgs::msg::TFMessage;
+use mobil_tf::{FrameTree, TfError};
+use nalgebra::{Isometry3, Quaternion, Translation3, UnitQuaternion};
+use ros2_client::Subscription;
+use std::time::Duration;
+
+/// `tf`'s QoS, tf2_ros' dynamic listener's: reliable, volatile, depth 100.
+pub fn tf_qos() -> ros2_client::QosProfile {
+    crate::qos::reliable(100)
+}
+
+/// Adds every transform of `msg` to `tree` (`is_static`: from `tf_static`, valid at every
+/// instant); the ones refused, with why.
+pub fn add_message(tree: &mut FrameTree, msg: &TFMessage, is_static: bool) -> Vec<TfError> {
+    let mut refused = Vec::new();
+    for t in &msg.transforms {
+        let (parent, child) = (&t.header.frame_id, &t.child_frame_id);
+        let stamp = match (is_static, nanos_from_stamp(&t.header.stamp)) {
+            (true, _) => None,
+            (false, Some(ns)) if ns >= 0 => Some(ns as u64),
+            (false, _) => {
+                refused.push(TfError::Rejected {
+                    parent: parent.clone(),
+                    child: child.clone(),
+                    why: "its stamp is invalid (nanosec ≥ 1e9) or before the epoch".into(),
+                });
+                continue;
+            }
+        };
+        let (v, q) = (&t.transform.translation, &t.transform.rotation);
+        // Normalised here (tf2 takes a quaternion off by rounding); a zero or non-finite one is
+        // refused by the tree, whose check sees it unchanged.
+        let raw = Quaternion::new(q.w, q.x, q.y, q.z);
+        let rotation = if raw.norm() > 1e-6 && raw.norm().is_finite() {
+            UnitQuaternion::from_quaternion(raw)
+        } else {
+            UnitQuaternion::new_unchecked(raw)
+        };
+        let iso = Isometry3::from_parts(Translation3::new(v.x, v.y, v.z), rotation);
+        if let Err(e) = tree.insert(parent, child, &iso, stamp) {
+            refused.push(e);
+        }
+    }
+    refused
+}
+
+/// `tf` and `tf_static` into one frame tree.
+pub struct TfListener {
+    tree: FrameTree,
+    tf: Subscription<TFMessage>,
+    tf_static: Subscription<TFMessage>,
+}
+
+impl TfListener {
+    /// Subscribes `tf` and `tf_static`; the tree keeps `cache` of each dynamic edge's history.
+    pub fn create(node: &mut RosNode, cache: Duration) -> anyhow::Result<Self> {
+        Ok(TfListener {
+            tree: FrameTree::new(cache),
+            tf: node.subscription::<TFMessage>("tf", &tf_qos())?,
+            tf_static: crate::scan::tf_static_subscription(node)?,
+        })
+    }
+
+    /// Takes every message waiting on both topics (non-blocking) into the tree; the transforms
+    /// refused are told in one warning at most every throttle period. Returns how many
+    /// transforms were taken.
+    pub fn poll(&mut self, throttle: &mut LogThrottle) -> usize {
+        let mut taken = 0;
+        let mut refused = Vec::new();
+        for (sub, is_static) in [(&self.tf_static, true), (&self.tf, false)] {
+            loop {
+                match sub.take() {
+                    Ok(Some((msg, _))) => {
+                        taken += msg.transforms.len();
+                        refused.extend(add_message(&mut self.tree, &msg, is_static));
+                    }
+                    Ok(None) => break,
+                    Err(e) => {
+                        warn_throttled!(throttle, "tf-read", "a tf message could not be read: {e:?}");
+                        break;
+                    }
+                }
+            }
+        }
+        if let Some(first) = refused.first() {
+            warn_throttled!(
+                throttle,
+                "tf-refused",
+                "{} transform(s) refused, e.g. {first}",
+                refused.len()
+            );
+        }
+        taken - refused.len().min(taken)
+    }
+
+    /// The frame tree.
+    pub fn tree(&self) -> &FrameTree {
+        &self.tree
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use mobil_msgs::geometry_msgs::msg::TransformStamped;
+    use mobil_tf::At;
+
+    fn tf(parent: &str, child: &str, sec: i32, x: f64, yaw: f64) -> TransformStamped {
+        let mut t = TransformStamped::default();
+        (t.header.frame_id, t.child_frame_id) = (parent.into(), child.into());
+        t.header.stamp.sec = sec;
+        t.transform.translation.x = x;
+        (t.transform.rotation.z, t.transform.rotation.w) = ((yaw / 2.0).sin(), (yaw / 2.0).cos());
+        t
+    }
+
+    /// A message's transforms go in; a bad stamp, a NaN, a zero quaternion are refused one by
+    /// one while the rest are taken; a static message is valid at any instant.
+    #[test]
+    fn messages_fill_the_tree_and_bad_transforms_are_refused() {
+        let mut tree = FrameTree::new(Duration::from_secs(10));
+        let mut bad_stamp = tf("map", "a", 1, 0.0, 0.0);
+        bad_stamp.header.stamp.nanosec = 1_000_000_000;
+        let nan = tf("map", "b", 1, f64::NAN, 0.0);
+        let mut zero_q = tf("map", "c", 1, 0.0, 0.0);
+        zero_q.transform.rotation.w = 0.0;
+        // A quaternion off by rounding (norm 1.0001) is taken, normalised.
+        let mut rounded = tf("map", "odom", 2, 1.0, 0.0);
+        rounded.transform.rotation.w = 1.0001;
+        let msg = TFMessage {
+            transforms: vec![bad_stamp, nan, zero_q, rounded],
+        };
+        let refused = add_message(&mut tree, &msg, false);
+        assert_eq!(refused.len(), 3, "{refused:?}");
+        assert_eq!(tree.planar("map", "odom", At::Latest).unwrap().x, 1.0);
+        let laser = TFMessage {
+            transforms: vec![tf("odom", "laser", 0, 0.2, std::f64::consts::PI)],
+        };
+        assert!(add_message(&mut tree, &laser, true).is_empty());
+        let p = tree.planar("map", "laser", At::Nanos(2_000_000_000)).unwrap();
+        assert!(
+            (p.x - 1.2).abs() < 1e-12 && (p.yaw.abs() - std::f64::consts::PI).abs() < 1e-9,
+            "{p:?}"
+        );
+    }
+}

@@ -1,0 +1,218 @@
+//! ROS-free transform buffer of the mobil suite: the frame tree `/tf` and `/tf_static` build,
+//! looked up as tf2's `Buffer` looks it up.
+//!
+//! The storage, the interpolation and the chaining are the `transforms` crate's
+//! ([`transforms::Registry`]): a tree keyed by child frame, each edge a time-ordered history
+//! (or one static transform), a lookup walking both frames up to their common ancestor and
+//! composing the edges sampled at one instant. It was chosen over writing one because it does
+//! what tf2 does where it matters here, and is tested for it: linear interpolation of the
+//! translation and slerp of the rotation between the two samples around the instant, static
+//! edges valid at every instant, no extrapolation either way, a history kept for a cache
+//! length behind each edge's newest sample, and errors that tell an unknown frame from a
+//! disconnected tree from a time outside the history. What this crate adds is tf2's
+//! conventions on top: frame names without their leading `/`, "time 0" as the latest instant
+//! every edge of the chain covers (tf2's `TimePointZero`), ROS time in nanoseconds, and the
+//! planar pose a wheeled robot's goal needs ([`FrameTree::planar`]).
+//!
+//! Where it differs from tf2: a child frame keeps the parent its first transform gave it (tf2
+//! takes a new parent from the latest message; here the transform is refused with
+//! [`TfError::Rejected`], so two publishers that disagree cannot wipe each other's history),
+//! and a frame is static or dynamic for good.
+//!
+//! ```
+//! use mobil_tf::{At, FrameTree};
+//! use nalgebra::{Isometry3, Translation3, UnitQuaternion};
+//! use std::time::Duration;
+//!
+//! let mut tree = FrameTree::new(Duration::from_secs(10));
+//! let odom_in_map = Isometry3::from_parts(Translation3::new(1.0, 2.0, 0.0), UnitQuaternion::identity());
+//! tree.insert("map", "odom", &odom_in_map, Some(1_000_000_000)).unwrap();
+//! let pose = tree.planar("map", "odom", At::Latest).unwrap();
+//! assert_eq!((pose.x, pose.y), (1.0, 2.0));
+//! ```
+
+#![warn(missing_docs)]
+
+use mobil_geom::Pose2;
+use nalgebra::{Isometry3, Quaternion as NaQuaternion, Translation3, UnitQuaternion};
+use std::time::Duration;
+use thiserror::Error;
+use transforms::errors::RegistryError;
+use transforms::geometry::{Quaternion, Transform, Vector3};
+use transforms::time::{Stamp, Timestamp};
+use transforms::Registry;
+
+/// tf2's default cache length (s).
+pub const DEFAULT_CACHE_S: f64 = 10.0;
+
+/// The instant of a lookup.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum At {
+    /// The latest instant every edge of the chain covers (tf2's time 0); any instant for a
+    /// chain of static edges.
+    Latest,
+    /// ROS time in nanoseconds.
+    Nanos(u64),
+}
+
+/// Why a transform is refused or a lookup fails.
+#[derive(Debug, Clone, PartialEq, Error)]
+pub enum TfError {
+    /// A frame no transform names.
+    #[error("frame `{0}` does not exist")]
+    UnknownFrame(String),
+    /// Both frames exist, in trees no transform joins.
+    #[error("`{target}` and `{from}` are not connected (two unconnected trees)")]
+    Disconnected {
+        /// The lookup's target frame.
+        target: String,
+        /// The lookup's source frame.
+        from: String,
+    },
+    /// The instant lies outside an edge's history (extrapolation into the future or the past).
+    #[error("no transform from `{from}` to `{target}` at {requested_s:.3} s: {detail}")]
+    Extrapolation {
+        /// The lookup's target frame.
+        target: String,
+        /// The lookup's source frame.
+        from: String,
+        /// The instant asked for (s).
+        requested_s: f64,
+        /// The edge whose history does not cover it, and what it covers.
+        detail: String,
+    },
+    /// No instant is covered by every edge of the chain (a [`At::Latest`] lookup).
+    #[error("no instant common to every transform between `{target}` and `{from}`")]
+    NoCommonTime {
+        /// The lookup's target frame.
+        target: String,
+        /// The lookup's source frame.
+        from: String,
+    },
+    /// A transform refused: not finite, not a rotation, a frame its own parent, a loop, a new
+    /// parent for a frame, a static transform for a dynamic frame or the reverse.
+    #[error("transform `{parent}` → `{child}` refused: {why}")]
+    Rejected {
+        /// Its parent frame.
+        parent: String,
+        /// Its child frame.
+        child: String,
+        /// Why.
+        why: String,
+    },
+}
+
+/// A frame name as tf2 takes it: without a leading `/`.
+pub fn frame_name(name: &str) -> &str {
+    name.strip_prefix('/').unwrap_or(name)
+}
+
+/// The transform tree: every frame's transform into its parent, over a cache length of time.
+#[derive(Debug)]
+pub struct FrameTree {
+    registry: Registry<Timestamp>,
+}
+
+impl FrameTree {
+    /// An empty tree keeping each dynamic edge's history `cache` behind its newest sample.
+    pub fn new(cache: Duration) -> Self {
+        FrameTree {
+            registry: Registry::with_max_age(cache),
+        }
+    }
+
+    /// Adds `child`'s pose in `parent`, `transform`, at ROS time `stamp` (ns; `None`: static,
+    /// valid at every instant, as on `/tf_static`). A frame keeps its first parent and its
+    /// kind (static or dynamic); a sample older than the cache behind the newest is dropped.
+    pub fn insert(
+        &mut self,
+        parent: &str,
+        child: &str,
+        transform: &Isometry3<f64>,
+        stamp: Option<u64>,
+    ) -> Result<(), TfError> {
+        let (parent, child) = (frame_name(parent), frame_name(child));
+        let rejected = |why: String| TfError::Rejected {
+            parent: parent.to_owned(),
+            child: child.to_owned(),
+            why,
+        };
+        let t = transform.translation.vector;
+        let q = transform.rotation.quaternion();
+        let stamp = stamp.map_or(Stamp::Static, |ns| Stamp::At(Timestamp::from_nanos(ns)));
+        let sample = Transform::new(
+            parent,
+            child,
+            Vector3::new(t.x, t.y, t.z),
+            Quaternion::from_wxyz(q.w, q.i, q.j, q.k),
+            stamp,
+        )
+        .map_err(|e| rejected(e.to_string()))?;
+        self.registry.add_transform(sample).map_err(|e| rejected(e.to_string()))
+    }
+
+    /// The pose of `source` in `target` at `at`: the transform that takes a point in `source`
+    /// into `target` (tf2's `lookupTransform(target, source, time)`).
+    pub fn lookup(&self, target: &str, source: &str, at: At) -> Result<Isometry3<f64>, TfError> {
+        let (target, source) = (frame_name(target), frame_name(source));
+        let time = match at {
+            At::Nanos(ns) => Timestamp::from_nanos(ns),
+            At::Latest => match self.registry.latest_common_time(target, source) {
+                Ok(Stamp::At(t)) => t,
+                // Static all the way (or the same frame): any instant.
+                Ok(Stamp::Static) => Timestamp::zero(),
+                Err(e) => return Err(tf_error(e, target, source)),
+            },
+        };
+        let found = self
+            .registry
+            .get_transform(target, source, time)
+            .map_err(|e| tf_error(e, target, source))?;
+        let (t, q) = (found.translation(), found.rotation());
+        let rotation = UnitQuaternion::from_quaternion(NaQuaternion::new(q.w, q.x, q.y, q.z));
+        Ok(Isometry3::from_parts(Translation3::new(t.x, t.y, t.z), rotation))
+    }
+
+    /// The latest instant (ns) every edge between the frames covers; `None` when they are
+    /// joined by static edges only (or are one frame).
+    pub fn latest_time(&self, target: &str, source: &str) -> Result<Option<u64>, TfError> {
+        let (target, source) = (frame_name(target), frame_name(source));
+        match self.registry.latest_common_time(target, source) {
+            Ok(Stamp::At(t)) => Ok(Some(t.as_nanos())),
+            Ok(Stamp::Static) => Ok(None),
+            Err(e) => Err(tf_error(e, target, source)),
+        }
+    }
+
+    /// [`FrameTree::lookup`] in the plane: x, y and the yaw of `source` in `target` (the yaw
+    /// of the rotation's x axis seen from above; any roll or pitch is dropped, as a wheeled
+    /// robot's goal has none).
+    pub fn planar(&self, target: &str, source: &str, at: At) -> Result<Pose2, TfError> {
+        let iso = self.lookup(target, source, at)?;
+        let x_axis = iso.rotation * nalgebra::Vector3::x();
+        let t = iso.translation.vector;
+        Ok(Pose2::new(t.x, t.y, x_axis.y.atan2(x_axis.x)))
+    }
+}
+
+/// The crate's error as this one's, with the lookup's frames.
+fn tf_error(e: RegistryError<Timestamp>, target: &str, source: &str) -> TfError {
+    let text = e.to_string();
+    let (target, source) = (target.to_owned(), source.to_owned());
+    match e {
+        RegistryError::UnknownFrame(f) => TfError::UnknownFrame(f),
+        RegistryError::Disconnected { .. } => TfError::Disconnected { target, from: source },
+        RegistryError::NotFoundAt { requested, .. } => TfError::Extrapolation {
+            requested_s: requested.as_seconds_lossy(),
+            detail: text,
+            target,
+            from: source,
+        },
+        RegistryError::NoCommonTime { .. } => TfError::NoCommonTime { target, from: source },
+        _ => TfError::Rejected {
+            parent: target,
+            child: source,
+            why: text,
+        },
+    }
+}

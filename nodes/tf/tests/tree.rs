@@ -1,0 +1,139 @@
+//! The frame tree against hand-worked transforms and tf2's behaviour at the edges.
+
+use approx::assert_relative_eq;
+use mobil_tf::{At, FrameTree, TfError};
+use nalgebra::{Isometry3, Point3, Translation3, UnitQuaternion};
+use std::f64::consts::{FRAC_PI_2, FRAC_PI_4, PI};
+use std::time::Duration;
+
+const S: u64 = 1_000_000_000;
+
+/// A planar transform: (x, y) and a yaw.
+fn planar(x: f64, y: f64, yaw: f64) -> Isometry3<f64> {
+    Isometry3::from_parts(
+        Translation3::new(x, y, 0.0),
+        UnitQuaternion::from_axis_angle(&nalgebra::Vector3::z_axis(), yaw),
+    )
+}
+
+fn tree() -> FrameTree {
+    FrameTree::new(Duration::from_secs(10))
+}
+
+/// Between two samples, as tf2: the translation linearly, the rotation by slerp. odom → base at
+/// 1 s (0, 0, 0) and 3 s (2, 0, π/2): at 2 s half of each, (1, 0, π/4); at 1.5 s a quarter.
+#[test]
+fn interpolates_between_samples() {
+    let mut t = tree();
+    t.insert("odom", "base_link", &planar(0.0, 0.0, 0.0), Some(S)).unwrap();
+    t.insert("odom", "base_link", &planar(2.0, 0.0, FRAC_PI_2), Some(3 * S))
+        .unwrap();
+    let half = t.planar("odom", "base_link", At::Nanos(2 * S)).unwrap();
+    assert_relative_eq!(half.x, 1.0, epsilon = 1e-12);
+    assert_relative_eq!(half.y, 0.0, epsilon = 1e-12);
+    assert_relative_eq!(half.yaw, FRAC_PI_4, epsilon = 1e-12);
+    let quarter = t.planar("odom", "base_link", At::Nanos(3 * S / 2)).unwrap();
+    assert_relative_eq!(quarter.x, 0.5, epsilon = 1e-12);
+    assert_relative_eq!(quarter.yaw, FRAC_PI_4 / 2.0, epsilon = 1e-12);
+    // At a sample, the sample; the latest is the newest.
+    let latest = t.planar("odom", "base_link", At::Latest).unwrap();
+    assert_relative_eq!(latest.x, 2.0, epsilon = 1e-12);
+    assert_relative_eq!(latest.yaw, FRAC_PI_2, epsilon = 1e-12);
+}
+
+/// No extrapolation, either way: after the newest sample and before the oldest, refused.
+#[test]
+fn refuses_to_extrapolate() {
+    let mut t = tree();
+    t.insert("odom", "base_link", &planar(0.0, 0.0, 0.0), Some(S)).unwrap();
+    t.insert("odom", "base_link", &planar(2.0, 0.0, 0.0), Some(3 * S))
+        .unwrap();
+    for at in [7 * S / 2, S / 2] {
+        match t.lookup("odom", "base_link", At::Nanos(at)) {
+            Err(TfError::Extrapolation { requested_s, .. }) => assert_relative_eq!(requested_s, at as f64 * 1e-9),
+            other => panic!("{at}: {other:?}"),
+        }
+    }
+}
+
+/// Four frames, map → odom (dynamic) → base_link (dynamic) → laser (static), worked by hand:
+/// odom in map (1, 2, π/2); base_link in odom (3, 0, 0), so in map R(π/2)·(3, 0) + (1, 2) =
+/// (1, 5), yaw π/2; laser in base_link (0.2, 0, π), so in map (1, 5) + R(π/2)·(0.2, 0) =
+/// (1, 5.2), yaw π/2 + π = −π/2. A point 1 m ahead of the laser is at (1, 4.2) in map; the
+/// reverse lookup takes it back.
+#[test]
+fn chains_four_frames() {
+    let mut t = tree();
+    t.insert("map", "odom", &planar(1.0, 2.0, FRAC_PI_2), Some(10 * S))
+        .unwrap();
+    t.insert("odom", "base_link", &planar(3.0, 0.0, 0.0), Some(10 * S))
+        .unwrap();
+    t.insert("base_link", "laser", &planar(0.2, 0.0, PI), None).unwrap();
+    let laser = t.planar("map", "laser", At::Nanos(10 * S)).unwrap();
+    assert_relative_eq!(laser.x, 1.0, epsilon = 1e-12);
+    assert_relative_eq!(laser.y, 5.2, epsilon = 1e-12);
+    assert_relative_eq!(laser.yaw.abs(), FRAC_PI_2, epsilon = 1e-12);
+    assert!(laser.yaw < 0.0, "{}", laser.yaw);
+    let ahead = t.lookup("map", "laser", At::Latest).unwrap() * Point3::new(1.0, 0.0, 0.0);
+    assert_relative_eq!(ahead, Point3::new(1.0, 4.2, 0.0), epsilon = 1e-12);
+    let back = t.lookup("laser", "map", At::Latest).unwrap() * ahead;
+    assert_relative_eq!(back, Point3::new(1.0, 0.0, 0.0), epsilon = 1e-12);
+    // Leading slashes are ignored, as tf2 ignores them.
+    assert!(t.lookup("/map", "/laser", At::Latest).is_ok());
+}
+
+/// A static edge is valid at any instant; a dynamic one in the same chain bounds the chain: the
+/// latest common instant is the dynamic edge's newest, and beyond it the chain extrapolates.
+#[test]
+fn static_and_dynamic_in_one_chain() {
+    let mut t = tree();
+    t.insert("base_link", "laser", &planar(0.2, 0.0, 0.0), None).unwrap();
+    assert_eq!(t.latest_time("base_link", "laser"), Ok(None));
+    assert!(t.lookup("base_link", "laser", At::Nanos(123 * S)).is_ok());
+    t.insert("odom", "base_link", &planar(1.0, 0.0, 0.0), Some(4 * S))
+        .unwrap();
+    t.insert("odom", "base_link", &planar(2.0, 0.0, 0.0), Some(5 * S))
+        .unwrap();
+    assert_eq!(t.latest_time("odom", "laser"), Ok(Some(5 * S)));
+    let at = t.planar("odom", "laser", At::Nanos(9 * S / 2)).unwrap();
+    assert_relative_eq!(at.x, 1.7, epsilon = 1e-12);
+    assert!(matches!(
+        t.lookup("odom", "laser", At::Nanos(6 * S)),
+        Err(TfError::Extrapolation { .. })
+    ));
+}
+
+/// tf2's other failures: an unknown frame, two unconnected trees, a sample older than the
+/// cache behind the newest (dropped), a frame given a second parent (refused), a non-finite
+/// transform (refused).
+#[test]
+fn unknown_disconnected_cached_and_refused() {
+    let mut t = tree();
+    t.insert("odom", "base_link", &planar(0.0, 0.0, 0.0), Some(20 * S))
+        .unwrap();
+    t.insert("map2", "other", &planar(0.0, 0.0, 0.0), Some(20 * S)).unwrap();
+    assert_eq!(
+        t.lookup("odom", "nowhere", At::Latest),
+        Err(TfError::UnknownFrame("nowhere".into()))
+    );
+    assert!(matches!(
+        t.lookup("odom", "other", At::Latest),
+        Err(TfError::Disconnected { .. })
+    ));
+    // 10 s of cache behind the newest sample (20 s): a sample at 5 s is dropped, so 5 s
+    // cannot be looked up.
+    let _ = t.insert("odom", "base_link", &planar(0.0, 0.0, 0.0), Some(5 * S));
+    assert!(matches!(
+        t.lookup("odom", "base_link", At::Nanos(5 * S)),
+        Err(TfError::Extrapolation { .. })
+    ));
+    assert!(matches!(
+        t.insert("map", "base_link", &planar(0.0, 0.0, 0.0), Some(21 * S)),
+        Err(TfError::Rejected { .. })
+    ));
+    let bad = Isometry3::from_parts(Translation3::new(f64::NAN, 0.0, 0.0), UnitQuaternion::identity());
+    assert!(matches!(
+        t.insert("odom", "base_link", &bad, Some(21 * S)),
+        Err(TfError::Rejected { .. })
+    ));
+}
