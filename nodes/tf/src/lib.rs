@@ -89,6 +89,21 @@ pub enum TfError {
         /// The lookup's source frame.
         from: String,
     },
+    /// The latest transform between the frames is older than the tolerance allows (a localiser
+    /// that stopped, a publisher gone).
+    #[error(
+        "the transform from `{from}` to `{target}` is {age_s:.3} s old, more than transform_tolerance {tolerance_s} s"
+    )]
+    Stale {
+        /// The lookup's target frame.
+        target: String,
+        /// The lookup's source frame.
+        from: String,
+        /// How old its latest instant is (s).
+        age_s: f64,
+        /// The tolerance (s).
+        tolerance_s: f64,
+    },
     /// A transform refused: not finite, not a rotation, a frame its own parent, a loop, a new
     /// parent for a frame, a static transform for a dynamic frame or the reverse.
     #[error("transform `{parent}` → `{child}` refused: {why}")]
@@ -182,6 +197,45 @@ impl FrameTree {
             Ok(Stamp::Static) => Ok(None),
             Err(e) => Err(tf_error(e, target, source)),
         }
+    }
+
+    /// The planar pose of `source` in `target` at the latest instant, refused ([`TfError::Stale`])
+    /// when that instant is more than `tolerance` before ROS time `now` (ns), as Nav2's
+    /// `transform_tolerance` refuses it; a chain of static edges (and one frame) is never stale.
+    /// A latest instant after `now` (a localiser dating its transform ahead, as AMCL does) is
+    /// fresh.
+    pub fn planar_fresh(&self, target: &str, source: &str, now: u64, tolerance: Duration) -> Result<Pose2, TfError> {
+        if frame_name(target) == frame_name(source) {
+            return Ok(Pose2::identity());
+        }
+        if let Some(latest) = self.latest_time(target, source)? {
+            let age = Duration::from_nanos(now.saturating_sub(latest));
+            if age > tolerance {
+                return Err(TfError::Stale {
+                    target: frame_name(target).to_owned(),
+                    from: frame_name(source).to_owned(),
+                    age_s: age.as_secs_f64(),
+                    tolerance_s: tolerance.as_secs_f64(),
+                });
+            }
+        }
+        self.planar(target, source, At::Latest)
+    }
+
+    /// `pose`, known in `source` (the robot's odometry pose in `odom`), in `target` (a goal's
+    /// frame) through the latest transform, refused as [`FrameTree::planar_fresh`] refuses it.
+    /// A law that steers the robot to a goal in `target` is given this pose at every step, so a
+    /// localiser's correction of `target → source` moves the robot relative to the goal, as it
+    /// moves a Nav2 controller's goal.
+    pub fn pose_in(
+        &self,
+        target: &str,
+        source: &str,
+        pose: &Pose2,
+        now: u64,
+        tolerance: Duration,
+    ) -> Result<Pose2, TfError> {
+        Ok(self.planar_fresh(target, source, now, tolerance)?.compose(pose))
     }
 
     /// [`FrameTree::lookup`] in the plane: x, y and the yaw of `source` in `target` (the yaw

@@ -137,3 +137,33 @@ fn unknown_disconnected_cached_and_refused() {
         Err(TfError::Rejected { .. })
     ));
 }
+
+/// A robot's odometry pose in a goal's frame: odom in map (1, 2, π/2) at 10 s, the robot at
+/// (3, 0, 0) in odom is at (1, 5, π/2) in map. Fresh within the tolerance (0.1 s) of now, a
+/// transform dated ahead of now too; stale beyond it; a static one never; the odometry frame
+/// itself needs no transform at all.
+#[test]
+fn a_pose_in_the_goal_frame_needs_a_fresh_transform() {
+    let mut t = tree();
+    t.insert("map", "odom", &planar(1.0, 2.0, FRAC_PI_2), Some(10 * S))
+        .unwrap();
+    let robot = mobil_geom::Pose2::new(3.0, 0.0, 0.0);
+    let tol = Duration::from_millis(100);
+    let p = t.pose_in("map", "odom", &robot, 10 * S + 50_000_000, tol).unwrap();
+    assert_relative_eq!(p.x, 1.0, epsilon = 1e-12);
+    assert_relative_eq!(p.y, 5.0, epsilon = 1e-12);
+    assert_relative_eq!(p.yaw, FRAC_PI_2, epsilon = 1e-12);
+    assert!(t.pose_in("map", "odom", &robot, 9 * S, tol).is_ok(), "dated ahead");
+    match t.pose_in("map", "odom", &robot, 10 * S + 200_000_000, tol) {
+        Err(TfError::Stale { age_s, .. }) => assert_relative_eq!(age_s, 0.2, epsilon = 1e-9),
+        other => panic!("{other:?}"),
+    }
+    assert_eq!(t.pose_in("odom", "odom", &robot, 0, tol), Ok(robot));
+    assert_eq!(
+        t.pose_in("elsewhere", "odom", &robot, 10 * S, tol),
+        Err(TfError::UnknownFrame("elsewhere".into()))
+    );
+    let mut fixed = tree();
+    fixed.insert("map", "odom", &planar(1.0, 0.0, 0.0), None).unwrap();
+    assert!(fixed.pose_in("map", "odom", &robot, 1_000 * S, tol).is_ok());
+}
