@@ -153,7 +153,9 @@ def test_follow_path_replanned_every_second_reaches_the_end_without_a_stop(
     deep = make_qos("reliable", "volatile", 5000)
     with subscribe(ros_node, Odometry, "odom", qos=deep) as odom, \
             subscribe(ros_node, Odometry, "ground_truth", qos=deep) as truth, \
-            subscribe(ros_node, Twist, "cmd_vel", qos=deep) as cmd:
+            subscribe(ros_node, Twist, "cmd_vel", qos=deep) as cmd, \
+            subscribe(ros_node, Path, "plan", qos=deep) as plans, \
+            subscribe(ros_node, Path, "local_plan", qos=deep) as local_plans:
         sim_clock.wait_started()
         odom.wait_for(None, REPLY_TIMEOUT)
         assert client.wait_for_server(timeout_sec=20.0)
@@ -185,6 +187,7 @@ def test_follow_path_replanned_every_second_reaches_the_end_without_a_stop(
         sim_clock.wait_until(sim_clock.now() + 1.0)
         commands = cmd.snapshot()
         end = truth.latest.pose.pose.position
+        plan_msgs, local_msgs = plans.snapshot(), local_plans.snapshot()
 
     assert final.status == GoalStatus.STATUS_SUCCEEDED, (final.status, final.result.error_msg)
     assert final.result.error_code == FollowPath.Result.NONE
@@ -212,6 +215,16 @@ def test_follow_path_replanned_every_second_reaches_the_end_without_a_stop(
         assert zeros == [len(commands) - 1], f"zero commands at {zeros} of {len(commands)}"
     xg, yg = ROUTE[-1]
     assert math.hypot(end.x - xg, end.y - yg) < 0.25, (end.x, end.y)
+    # Plans as nav_msgs/Path in odom: the planner's path (its sub-goals, ending at the route's
+    # end) on `plan`; what the controller heads for now on `local_plan` (local_nav: from the
+    # robot to its sub-goal; VFO: the chosen path).
+    vfo = node == "planner_node" and controller == "" and robot == "omr3"
+    if node == "planner_node":
+        assert plan_msgs and all(p.header.frame_id == "odom" for p in plan_msgs)
+        last = plan_msgs[-1].poses[-1].pose.position
+        assert math.hypot(last.x - xg, last.y - yg) < 1e-6, (last.x, last.y)
+    if node == "local_nav_node" or vfo:
+        assert local_msgs and all(len(p.poses) >= 2 and p.header.frame_id == "odom" for p in local_msgs)
 
 
 # ---------------------------------------------------------------------------------------------

@@ -198,6 +198,26 @@ impl PathGoals {
     }
 }
 
+/// `points` as poses, each headed along its leg to the next point (the last along the leg
+/// into it; a lone point, or one of a zero-length leg, takes the heading before it, 0 first):
+/// a route drawn as a path of poses.
+pub fn headed(points: &[Point2<f64>]) -> Vec<crate::Pose2> {
+    let mut heading = 0.0;
+    let mut poses = Vec::with_capacity(points.len());
+    for (i, p) in points.iter().enumerate() {
+        let leg = match (points.get(i + 1), i.checked_sub(1).map(|j| points[j])) {
+            (Some(next), _) => next - p,
+            (None, Some(before)) => p - before,
+            (None, None) => nalgebra::Vector2::zeros(),
+        };
+        if leg.norm() > 1e-12 {
+            heading = leg.y.atan2(leg.x);
+        }
+        poses.push(crate::Pose2::new(p.x, p.y, heading));
+    }
+    poses
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -295,6 +315,18 @@ mod tests {
         assert!(!goals.passes_near(p(1.5, 0.51)));
         assert!(goals.passes_near(p(3.4, 1.0)), "0.4 from the second leg");
         assert!(!goals.passes_near(p(0.3, 0.0)), "0.7 behind the start (1, 0)");
+    }
+
+    /// Headings along the legs: east, then north (the corner takes the leg out of it), the end
+    /// the leg into it; a repeated point keeps the heading before it.
+    #[test]
+    fn points_are_headed_along_their_legs() {
+        let half_pi = std::f64::consts::FRAC_PI_2;
+        let poses = headed(&[p(0.0, 0.0), p(1.0, 0.0), p(1.0, 2.0), p(1.0, 2.0)]);
+        let yaws: Vec<f64> = poses.iter().map(|q| q.yaw).collect();
+        assert_eq!(yaws, [0.0, half_pi, half_pi, half_pi]);
+        assert_eq!(headed(&[p(3.0, 4.0)])[0], crate::Pose2::new(3.0, 4.0, 0.0));
+        assert!(headed(&[]).is_empty());
     }
 
     /// Pursuing: forward only, never past the end.

@@ -11,9 +11,10 @@
 //!   free distance ahead (along the arc driven, for a car-like chassis) and near the goal, hard
 //!   stop.
 //! - [`config`]: [`NavConfig`], every default justified.
-//! - [`path`]: a path (Nav2's `FollowPath`) as sub-goals for the navigator.
-//! - [`progress`]: Nav2's progress checker (`required_movement_radius` within
-//!   `movement_time_allowance`), time as an input.
+//!
+//! A path (Nav2's `FollowPath`) becomes sub-goals for the navigator by
+//! [`mobil_geom::path::PathGoals`], and Nav2's progress checker is
+//! [`mobil_motion::progress`]: both are shared with the planner.
 //!
 //! Where the SPEC leaves a choice open, or where a Decision needed a guard to work in closed
 //! loop, the library chooses as follows (each tested in `tests/modes.rs` or

@@ -45,6 +45,7 @@ use mobil_ros::lifecycle::{CallbackReturn, Lifecycle, Transition};
 use mobil_ros::motion::{
     Applied, ClockCheck, CmdVel, EndCause, Ended, MotionSession, Outputs, SessionSettings, Watched,
 };
+use mobil_ros::plan::PlanOut;
 use mobil_ros::scan::{checked_scan, tf_static_subscription, CheckedScan, LaserPoseFrom, ScanRefusal, StaticFrames};
 use mobil_ros::status::{NavStatusView, RateGate};
 use mobil_ros::stop::FINAL_STOP_WAIT;
@@ -143,6 +144,8 @@ struct Shell {
     throttle: LogThrottle,
     /// Looks for a `cmd_vel` endpoint of the other type.
     types: mobil_ros::cmd_vel::TypeWatch,
+    /// `local_plan`: from the robot to the point the navigator heads for.
+    plans: PlanOut,
 }
 
 /// What woke the loop. One lives at a time, on the stack, so its size does not matter.
@@ -215,6 +218,7 @@ async fn start(
         path: GoalServer::create(node, "follow_path", server_config)?.gate(lifecycle.gate()),
     };
     let mut laser = StaticFrames::default();
+    let plans = PlanOut::create(node)?;
     let mut shell = Shell {
         progress: ProgressChecker::new(config.controller.progress),
         config,
@@ -228,6 +232,7 @@ async fn start(
         status_gate: RateGate::default(),
         throttle: LogThrottle::new(Duration::from_secs(2)),
         types: Default::default(),
+        plans,
     };
     shell.publish_status(node, out, NavStatus::IDLE, String::new());
     info!(
@@ -751,7 +756,14 @@ impl Shell {
         }
     }
 
+    /// The markers, and `local_plan`: the robot's pose, then the point the navigator heads for.
     fn publish_markers(&mut self, out: &Outputs, goal: Point2<f64>, stamp: Time) {
+        if let Some(odom) = self.odom.value() {
+            let target = mobil_geom::path::headed(&[odom.pose.position(), goal]);
+            let local = [odom.pose, target[1]];
+            let frame = &self.config.frames.odom_frame;
+            self.plans.send_local(&local, frame, stamp.clone(), &mut self.throttle);
+        }
         if let Some(step) = &self.last_step {
             let view = MarkerView {
                 sectors: self.nav.sectors(),

@@ -62,6 +62,7 @@ pub mod names;
 pub mod node;
 pub mod offloop;
 pub mod params;
+pub mod plan;
 pub mod qos;
 pub mod scan;
 pub mod status;

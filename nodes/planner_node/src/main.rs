@@ -62,6 +62,7 @@ use mobil_ros::motion::{
 };
 use mobil_ros::offloop::CancelToken;
 use mobil_ros::offloop::ReplyPool;
+use mobil_ros::plan::PlanOut;
 use mobil_ros::scan::{checked_scan, tf_static_subscription, LaserMount, StaticFrames};
 use mobil_ros::status::{end_state, NavStatusView, RateGate};
 use mobil_ros::stop::FINAL_STOP_WAIT;
@@ -201,6 +202,9 @@ struct Shell {
     laser: StaticFrames,
     /// dock_robot's dock database.
     docks: DockDatabase,
+    /// `plan` (the route, or the pre-check's predicted path) and `local_plan` (VFO's chosen
+    /// path).
+    plans: PlanOut,
 }
 
 #[allow(clippy::large_enum_variant)]
@@ -240,6 +244,7 @@ async fn start(node: &mut RosNode, out: &Outputs, config: PlannerConfig) -> anyh
         warn!("{w} (accepted: stability needs only positive gains)");
     }
     let docks = load_docks(node, &config)?;
+    let plans = PlanOut::create(node)?;
     let odom_sub = node.subscription::<Odometry>("odom", &qos::default_qos())?;
     let dock_sub = node.subscription::<PoseStamped>("dock_pose", &qos::default_qos())?;
     let route_sub = node.subscription::<Path>("waypoints", &qos::default_qos())?;
@@ -290,6 +295,7 @@ async fn start(node: &mut RosNode, out: &Outputs, config: PlannerConfig) -> anyh
         odom_period: ArrivalPeriod::default(),
         laser: StaticFrames::default(),
         docks,
+        plans,
     };
     shell.send_idle_status(node, out);
     let mut jobs = Jobs {

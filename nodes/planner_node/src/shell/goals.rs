@@ -3,6 +3,7 @@
 //! and the action feedback.
 
 use crate::*;
+use mobil_geom::path::headed;
 
 impl Shell {
     pub(crate) fn reconfigure(&mut self, c: PlannerConfig) {
@@ -55,11 +56,23 @@ impl Shell {
         self.send_status(node, out, &view);
     }
 
+    /// The markers, and the plans as paths: `plan` the pre-check's predicted path (else the
+    /// route, headed along its legs), `local_plan` VFO's chosen path.
     pub(crate) fn publish_markers(&mut self, node: &RosNode, out: &Outputs) {
         let view = self.drawing.view(self.odom.value().map(|p| p.position()));
-        let array = markers(&view, node.stamp(), &self.config.frames.odom_frame);
-        out.send_markers(array, &mut self.throttle);
+        let (stamp, frame) = (node.stamp(), &self.config.frames.odom_frame);
+        out.send_markers(markers(&view, stamp.clone(), frame), &mut self.throttle);
         self.markers_gate.sent(Instant::now());
+        let plan = match self.drawing.predicted.is_empty() {
+            true => headed(&self.drawing.route),
+            false => self.drawing.predicted.clone(),
+        };
+        if !plan.is_empty() {
+            self.plans.send_plan(&plan, frame, stamp.clone(), &mut self.throttle);
+        }
+        if let Some(chosen) = self.drawing.vfo.as_ref().map(|v| &v.chosen).filter(|c| !c.is_empty()) {
+            self.plans.send_local(&headed(chosen), frame, stamp, &mut self.throttle);
+        }
     }
 
     /// Ends the active goal with `outcome` (the session sends its zero command, if one is due)
