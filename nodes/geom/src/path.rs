@@ -35,7 +35,8 @@ pub enum PathError {
     /// A pose (its index) farther than [`MAX_PATH_COORD`] from the origin on an axis.
     #[error("pose {0} of the path lies beyond ±{MAX_PATH_COORD} m")]
     TooFar(usize),
-    /// More sub-goals than [`MAX_SUB_GOALS`] (the path's length over the lookahead).
+    /// More sub-goals than [`MAX_SUB_GOALS`] (the path's whole length over the lookahead, or
+    /// at least one more than the cap once counted along the path).
     #[error("the path would make {0} sub-goals, more than {MAX_SUB_GOALS}")]
     TooLong(usize),
     /// A lookahead not above zero, or not finite.
@@ -102,6 +103,9 @@ impl PathGoals {
             let mut leg = (corner - here).norm();
             while leg >= left {
                 here += (corner - here) * (left / leg);
+                if goals.len() == MAX_SUB_GOALS {
+                    return Err(PathError::TooLong(MAX_SUB_GOALS + 1));
+                }
                 goals.push(here);
                 leg -= left;
                 left = lookahead;
@@ -110,6 +114,9 @@ impl PathGoals {
             here = corner;
         }
         if goals.last().is_none_or(|g| (g - end).norm() > 1e-9) {
+            if goals.len() == MAX_SUB_GOALS {
+                return Err(PathError::TooLong(MAX_SUB_GOALS + 1));
+            }
             goals.push(end);
         }
         Ok(PathGoals {

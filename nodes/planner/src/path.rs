@@ -157,6 +157,9 @@ pub struct PathTask {
     progress: ProgressChecker,
     /// VFO: new sub-goals waiting for the law to come home.
     pending: Option<PathGoals>,
+    /// VFO: the law ended on a path a newer one replaced (its end dropped): it is not to be
+    /// kept, whatever path comes next.
+    spent: bool,
 }
 
 impl PathTask {
@@ -178,6 +181,7 @@ impl PathTask {
             },
             progress: ProgressChecker::new(progress),
             pending: None,
+            spent: false,
         })
     }
 
@@ -190,6 +194,7 @@ impl PathTask {
             law: PathLaw::Vfo(run),
             progress: ProgressChecker::new(progress),
             pending: None,
+            spent: false,
         }
     }
 
@@ -240,7 +245,7 @@ impl PathTask {
         self.goals.remaining(position)
     }
 
-    /// Nav2's progress checker at `position` at goal time `t` (s): the end (FAILED_TO_MAKE_PROGRESS)
+    /// Nav2's progress checker at `position` at ROS time `t` (s): the end (FAILED_TO_MAKE_PROGRESS)
     /// when the robot did not move its radius within its allowance.
     pub fn check_progress(&mut self, position: Point2<f64>, t: f64) -> Option<Outcome> {
         match self.progress.check(position, t) {
@@ -272,7 +277,7 @@ impl PathTask {
                 self.goals = new;
                 Ok(Replaced::Swapped { kept })
             }
-            PathLaw::Vfo(_) if near && same_end => {
+            PathLaw::Vfo(_) if near && same_end && !self.spent => {
                 self.pending = None;
                 Ok(Replaced::LawKept)
             }
@@ -298,6 +303,7 @@ impl PathTask {
         self.base = goals.index();
         self.goals = goals;
         self.law = PathLaw::Vfo(run);
+        self.spent = false;
     }
 
     /// VFO: the law came back from a step with `step` ([`VfoRun::give_back`] done): the
@@ -317,6 +323,7 @@ impl PathTask {
                     (Some(_), None) => false,
                 };
                 if self.pending.is_some() && !(end.outcome.is_success() && same_end) {
+                    self.spent = true;
                     return None;
                 }
                 Some(Step::end(as_follow_path(end.outcome), end.report))
@@ -699,6 +706,11 @@ mod vfo_tests {
         assert_eq!(task.vfo_returned(back), None);
         let failed = Step::<(), ()>::end(Outcome::failed("NO_SAFE_PATH", "", 601), ());
         assert_eq!(task.vfo_returned(failed), None);
+        // The law ended: a path to the old end, near the sub-goal, does not keep it now.
+        let same = PathGoals::new(&[from, p(3.0, 0.0), p(3.0, 3.0)], from, 1.0).unwrap();
+        assert_eq!(task.replace(same), Ok(Replaced::Pending));
+        let elsewhere = PathGoals::new(&[from, p(3.0, 0.0), p(3.0, -3.0)], from, 1.0).unwrap();
+        assert_eq!(task.replace(elsewhere), Ok(Replaced::Pending));
         let new = task.take_pending().expect("home now");
         let (points, headings, index) = PathTask::vfo_route(&new);
         let rules = (&VfoSettings::default(), &ChassisParams::omr3(), &map);
@@ -712,6 +724,19 @@ mod vfo_tests {
             panic!("the end stands")
         };
         assert_eq!(end.outcome.nav2_error(), follow_path::NO_VALID_CONTROL);
+    }
+
+    /// A law back with a success while a path waits: it stands when the waiting path ends
+    /// where the law did (it left the sub-goal pursued, not the end).
+    #[test]
+    fn a_success_at_the_same_end_stands() {
+        let route = [p(0.0, 0.0), p(3.0, 0.0)];
+        let mut task = vfo_task(&route, p(0.0, 0.0));
+        let from = p(0.0, 1.0);
+        let away = PathGoals::new(&[from, p(3.0, 1.0), p(3.0, 0.0)], from, 1.0).unwrap();
+        assert_eq!(task.replace(away), Ok(Replaced::Pending));
+        let done = Step::<(), ()>::end(Outcome::succeeded("end"), ());
+        assert!(matches!(task.vfo_returned(done), Some(Step::End(e)) if e.outcome.is_success()));
     }
 
     /// As a task: the progress checker first, on ROS time (the goal's own time stays 0 here),
