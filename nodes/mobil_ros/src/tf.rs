@@ -4,8 +4,11 @@
 //! transforms). Both names are relative, so `-r __ns:=/robot1` moves them with the publishers.
 //!
 //! A node drains both subscriptions before it looks a transform up ([`TfListener::poll`]);
-//! a transform refused (non-finite, a frame given a second parent, a stamp with `nanosec` out
-//! of range or before the epoch) is dropped and told in one rate-limited warning.
+//! a transform refused is dropped and told in one rate-limited warning: non-finite, an empty
+//! frame name, a frame given a second parent, a quaternion off unit norm (|‖q‖² − 1| ≥ 0.01,
+//! tf2's rule; closer ones are normalised), a stamp with `nanosec` out of range, and on `tf` a
+//! zero stamp (unstamped: a fixed transform belongs on `tf_static`). When ROS time goes back,
+//! the dynamic history is cleared ([`mobil_tf::FrameTree::observe_time`]).
 //!
 //! ```
 //! use mobil_msgs::geometry_msgs::msg::TransformStamped;
@@ -46,27 +49,35 @@ pub fn add_message(tree: &mut FrameTree, msg: &TFMessage, is_static: bool) -> Ve
     let mut refused = Vec::new();
     for t in &msg.transforms {
         let (parent, child) = (&t.header.frame_id, &t.child_frame_id);
+        let refuse = |why: &str| TfError::Rejected {
+            parent: parent.clone(),
+            child: child.clone(),
+            why: why.to_owned(),
+        };
         let stamp = match (is_static, nanos_from_stamp(&t.header.stamp)) {
             (true, _) => None,
-            (false, Some(ns)) if ns >= 0 => Some(ns as u64),
+            (false, Some(0)) => {
+                refused.push(refuse(
+                    "unstamped (time 0) on tf: a fixed transform belongs on tf_static",
+                ));
+                continue;
+            }
+            (false, Some(ns)) if ns > 0 => Some(ns as u64),
             (false, _) => {
-                refused.push(TfError::Rejected {
-                    parent: parent.clone(),
-                    child: child.clone(),
-                    why: "its stamp is invalid (nanosec ≥ 1e9) or before the epoch".into(),
-                });
+                refused.push(refuse("its stamp is invalid (nanosec ≥ 1e9) or before the epoch"));
                 continue;
             }
         };
         let (v, q) = (&t.transform.translation, &t.transform.rotation);
-        // Normalised here (tf2 takes a quaternion off by rounding); a zero or non-finite one is
-        // refused by the tree, whose check sees it unchanged.
+        // tf2's rule: a quaternion within 0.01 of unit norm squared is taken (normalised), any
+        // other refused.
         let raw = Quaternion::new(q.w, q.x, q.y, q.z);
-        let rotation = if raw.norm() > 1e-6 && raw.norm().is_finite() {
-            UnitQuaternion::from_quaternion(raw)
-        } else {
-            UnitQuaternion::new_unchecked(raw)
-        };
+        let off_unit = (raw.norm_squared() - 1.0).abs();
+        if off_unit.is_nan() || off_unit >= 1e-2 {
+            refused.push(refuse("its rotation is not a unit quaternion (|‖q‖² − 1| ≥ 0.01)"));
+            continue;
+        }
+        let rotation = UnitQuaternion::from_quaternion(raw);
         let iso = Isometry3::from_parts(Translation3::new(v.x, v.y, v.z), rotation);
         if let Err(e) = tree.insert(parent, child, &iso, stamp) {
             refused.push(e);
@@ -92,10 +103,14 @@ impl TfListener {
         })
     }
 
-    /// Takes every message waiting on both topics (non-blocking) into the tree; the transforms
-    /// refused are told in one warning at most every throttle period. Returns how many
-    /// transforms were taken.
-    pub fn poll(&mut self, throttle: &mut LogThrottle) -> usize {
+    /// Takes every message waiting on both topics (non-blocking) into the tree at ROS time
+    /// `now` (ns; a time gone back clears the dynamic history first); the transforms refused
+    /// are told in one warning at most every throttle period. Returns how many transforms were
+    /// taken.
+    pub fn poll(&mut self, now: u64, throttle: &mut LogThrottle) -> usize {
+        if self.tree.observe_time(now) {
+            warn_throttled!(throttle, "tf-time", "ROS time went back: the tf history is cleared");
+        }
         let mut taken = 0;
         let mut refused = Vec::new();
         for (sub, is_static) in [(&self.tf_static, true), (&self.tf, false)] {
@@ -155,14 +170,17 @@ mod tests {
         let nan = tf("map", "b", 1, f64::NAN, 0.0);
         let mut zero_q = tf("map", "c", 1, 0.0, 0.0);
         zero_q.transform.rotation.w = 0.0;
-        // A quaternion off by rounding (norm 1.0001) is taken, normalised.
+        // A quaternion off by rounding (norm 1.0001) is taken, normalised; norm 2 is refused.
         let mut rounded = tf("map", "odom", 2, 1.0, 0.0);
         rounded.transform.rotation.w = 1.0001;
+        let mut doubled = tf("map", "d", 1, 0.0, 0.0);
+        doubled.transform.rotation.w = 2.0;
+        let unstamped = tf("map", "e", 0, 0.0, 0.0);
         let msg = TFMessage {
-            transforms: vec![bad_stamp, nan, zero_q, rounded],
+            transforms: vec![bad_stamp, nan, zero_q, doubled, unstamped, rounded],
         };
         let refused = add_message(&mut tree, &msg, false);
-        assert_eq!(refused.len(), 3, "{refused:?}");
+        assert_eq!(refused.len(), 5, "{refused:?}");
         assert_eq!(tree.planar("map", "odom", At::Latest).unwrap().x, 1.0);
         let laser = TFMessage {
             transforms: vec![tf("odom", "laser", 0, 0.2, std::f64::consts::PI)],

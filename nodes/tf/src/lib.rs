@@ -10,9 +10,11 @@
 //! edges valid at every instant, no extrapolation either way, a history kept for a cache
 //! length behind each edge's newest sample, and errors that tell an unknown frame from a
 //! disconnected tree from a time outside the history. What this crate adds is tf2's
-//! conventions on top: frame names without their leading `/`, "time 0" as the latest instant
-//! every edge of the chain covers (tf2's `TimePointZero`), ROS time in nanoseconds, and the
-//! planar pose a wheeled robot's goal needs ([`FrameTree::planar`]).
+//! conventions on top: frame names without their leading `/` (tf2 strips it on insert and
+//! refuses it in a lookup; here both strip it), "time 0" as the latest instant every edge of
+//! the chain covers (tf2's `TimePointZero`), ROS time in nanoseconds, the history cleared when
+//! ROS time jumps back (as tf2_ros clears its buffer), and the planar pose a wheeled robot's goal
+//! needs ([`FrameTree::planar`]).
 //!
 //! Where it differs from tf2: a child frame keeps the parent its first transform gave it (tf2
 //! takes a new parent from the latest message; here the transform is refused with
@@ -82,17 +84,30 @@ pub enum TfError {
         detail: String,
     },
     /// No instant is covered by every edge of the chain (a [`At::Latest`] lookup).
-    #[error("no instant common to every transform between `{target}` and `{from}`")]
+    #[error("no instant common to every transform between `{target}` and `{from}`: {detail}")]
     NoCommonTime {
         /// The lookup's target frame.
         target: String,
         /// The lookup's source frame.
         from: String,
+        /// The edges and what they cover.
+        detail: String,
+    },
+    /// A lookup that failed otherwise (a transform that cannot be composed or inverted).
+    #[error("no transform from `{from}` to `{target}`: {detail}")]
+    Lookup {
+        /// The lookup's target frame.
+        target: String,
+        /// The lookup's source frame.
+        from: String,
+        /// Why.
+        detail: String,
     },
     /// The latest transform between the frames is older than the tolerance allows (a localiser
-    /// that stopped, a publisher gone).
+    /// that stopped, a publisher gone), or dated further ahead of now than the cache reaches
+    /// (a negative age: a clock that jumped back under it).
     #[error(
-        "the transform from `{from}` to `{target}` is {age_s:.3} s old, more than transform_tolerance {tolerance_s} s"
+        "the transform from `{from}` to `{target}` is {age_s:.3} s old, beyond transform_tolerance {tolerance_s} s"
     )]
     Stale {
         /// The lookup's target frame.
@@ -126,6 +141,9 @@ pub fn frame_name(name: &str) -> &str {
 #[derive(Debug)]
 pub struct FrameTree {
     registry: Registry<Timestamp>,
+    cache: Duration,
+    /// The latest ROS time the tree was told of ([`FrameTree::observe_time`]).
+    now: Option<u64>,
 }
 
 impl FrameTree {
@@ -133,7 +151,21 @@ impl FrameTree {
     pub fn new(cache: Duration) -> Self {
         FrameTree {
             registry: Registry::with_max_age(cache),
+            cache,
+            now: None,
         }
+    }
+
+    /// ROS time is now `now` (ns): when it went back (a restarted simulation, a clock reset),
+    /// every dynamic edge's history is cleared, as tf2_ros clears its buffer, so samples of the
+    /// new time are not dropped behind the old ones; static edges stay. True when it cleared.
+    pub fn observe_time(&mut self, now: u64) -> bool {
+        let back = self.now.is_some_and(|before| now < before);
+        self.now = Some(now);
+        if back {
+            self.registry.remove_transforms_before(Timestamp::from_nanos(u64::MAX));
+        }
+        back
     }
 
     /// Adds `child`'s pose in `parent`, `transform`, at ROS time `stamp` (ns; `None`: static,
@@ -152,6 +184,9 @@ impl FrameTree {
             child: child.to_owned(),
             why,
         };
+        if parent.is_empty() || child.is_empty() {
+            return Err(rejected("a frame name is empty".into()));
+        }
         let t = transform.translation.vector;
         let q = transform.rotation.quaternion();
         let stamp = stamp.map_or(Stamp::Static, |ns| Stamp::At(Timestamp::from_nanos(ns)));
@@ -200,21 +235,22 @@ impl FrameTree {
     }
 
     /// The planar pose of `source` in `target` at the latest instant, refused ([`TfError::Stale`])
-    /// when that instant is more than `tolerance` before ROS time `now` (ns), as Nav2's
-    /// `transform_tolerance` refuses it; a chain of static edges (and one frame) is never stale.
-    /// A latest instant after `now` (a localiser dating its transform ahead, as AMCL does) is
-    /// fresh.
+    /// when that instant is more than `tolerance` before ROS time `now` (ns): the age check of
+    /// ROS 1's costmap_2d on a goal's transform, with Nav2's parameter name
+    /// `transform_tolerance`. A chain of static edges (and one frame) is never stale. A latest
+    /// instant after `now` (a localiser dating its transform ahead, as AMCL does) is fresh,
+    /// up to the cache length ahead.
     pub fn planar_fresh(&self, target: &str, source: &str, now: u64, tolerance: Duration) -> Result<Pose2, TfError> {
         if frame_name(target) == frame_name(source) {
             return Ok(Pose2::identity());
         }
         if let Some(latest) = self.latest_time(target, source)? {
-            let age = Duration::from_nanos(now.saturating_sub(latest));
-            if age > tolerance {
+            let age_s = (now as f64 - latest as f64) * 1e-9;
+            if age_s > tolerance.as_secs_f64() || -age_s > self.cache.as_secs_f64() {
                 return Err(TfError::Stale {
                     target: frame_name(target).to_owned(),
                     from: frame_name(source).to_owned(),
-                    age_s: age.as_secs_f64(),
+                    age_s,
                     tolerance_s: tolerance.as_secs_f64(),
                 });
             }
@@ -262,11 +298,15 @@ fn tf_error(e: RegistryError<Timestamp>, target: &str, source: &str) -> TfError 
             target,
             from: source,
         },
-        RegistryError::NoCommonTime { .. } => TfError::NoCommonTime { target, from: source },
-        _ => TfError::Rejected {
-            parent: target,
-            child: source,
-            why: text,
+        RegistryError::NoCommonTime { .. } => TfError::NoCommonTime {
+            target,
+            from: source,
+            detail: text,
+        },
+        _ => TfError::Lookup {
+            target,
+            from: source,
+            detail: text,
         },
     }
 }

@@ -78,7 +78,7 @@ fn chains_four_frames() {
     assert_relative_eq!(ahead, Point3::new(1.0, 4.2, 0.0), epsilon = 1e-12);
     let back = t.lookup("laser", "map", At::Latest).unwrap() * ahead;
     assert_relative_eq!(back, Point3::new(1.0, 0.0, 0.0), epsilon = 1e-12);
-    // Leading slashes are ignored, as tf2 ignores them.
+    // Leading slashes are stripped (tf2 strips them on insert and refuses them in a lookup).
     assert!(t.lookup("/map", "/laser", At::Latest).is_ok());
 }
 
@@ -136,6 +136,27 @@ fn unknown_disconnected_cached_and_refused() {
         t.insert("odom", "base_link", &bad, Some(21 * S)),
         Err(TfError::Rejected { .. })
     ));
+    assert!(matches!(
+        t.insert("/", "base_link", &planar(0.0, 0.0, 0.0), Some(21 * S)),
+        Err(TfError::Rejected { .. })
+    ));
+}
+
+/// ROS time going back (a restarted simulation) clears the dynamic history, so the new time's
+/// samples are taken rather than dropped 10 s behind the old ones; a static edge stays.
+#[test]
+fn a_clock_jump_back_clears_the_dynamic_history() {
+    let mut t = tree();
+    t.insert("base_link", "laser", &planar(0.2, 0.0, 0.0), None).unwrap();
+    t.observe_time(100 * S);
+    t.insert("odom", "base_link", &planar(5.0, 0.0, 0.0), Some(100 * S))
+        .unwrap();
+    assert!(!t.observe_time(101 * S));
+    assert!(t.observe_time(S), "back to 1 s");
+    t.insert("odom", "base_link", &planar(1.0, 0.0, 0.0), Some(S)).unwrap();
+    assert_eq!(t.latest_time("odom", "laser"), Ok(Some(S)));
+    let p = t.planar("odom", "laser", At::Latest).unwrap();
+    assert_relative_eq!(p.x, 1.2, epsilon = 1e-12);
 }
 
 /// A robot's odometry pose in a goal's frame: odom in map (1, 2, π/2) at 10 s, the robot at
@@ -154,6 +175,16 @@ fn a_pose_in_the_goal_frame_needs_a_fresh_transform() {
     assert_relative_eq!(p.y, 5.0, epsilon = 1e-12);
     assert_relative_eq!(p.yaw, FRAC_PI_2, epsilon = 1e-12);
     assert!(t.pose_in("map", "odom", &robot, 9 * S, tol).is_ok(), "dated ahead");
+    // Dated more than the cache (10 s) ahead, 20 s: a clock that jumped back under it.
+    let mut ahead = tree();
+    ahead
+        .insert("map", "odom", &planar(1.0, 2.0, 0.0), Some(30 * S))
+        .unwrap();
+    assert!(ahead.pose_in("map", "odom", &robot, 21 * S, tol).is_ok(), "9 s ahead");
+    assert!(matches!(
+        ahead.pose_in("map", "odom", &robot, 10 * S, tol),
+        Err(TfError::Stale { .. })
+    ));
     match t.pose_in("map", "odom", &robot, 10 * S + 200_000_000, tol) {
         Err(TfError::Stale { age_s, .. }) => assert_relative_eq!(age_s, 0.2, epsilon = 1e-9),
         other => panic!("{other:?}"),
