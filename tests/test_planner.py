@@ -236,6 +236,7 @@ def test_omr3_docking_actions_route_check_and_refusals(start_scenario, start_nod
     with subscribe(ros_node, NavStatus, "planner/status", qos=qos_latched()) as status, \
             subscribe(ros_node, Twist, "cmd_vel", qos=DEEP) as cmd, \
             subscribe(ros_node, MarkerArray, "planner/markers", qos=DEEP) as markers, \
+            subscribe(ros_node, Path, "plan", qos=DEEP) as plans, \
             subscribe(ros_node, Odometry, "ground_truth", qos=make_qos("reliable", "volatile", 2000)) as truth:
         sim_clock.wait_started()
         status.wait_for(lambda s: s.state == NavStatus.IDLE, REPLY_TIMEOUT)
@@ -333,11 +334,18 @@ def test_omr3_docking_actions_route_check_and_refusals(start_scenario, start_nod
         assert follow.wait_for_server(timeout_sec=20.0)
         goal = FollowWaypoints.Goal()
         goal.poses = [stamped(x, y) for x, y in [(1.0, -0.3), (1.5, 0.3), (1.0, 0.8), (0.3, 0.5)]]
+        seen = len(plans.snapshot())
         handle = send_until_answered(follow, goal, planner, feedback=follow_fb.append, resent=resent)
         assert handle.accepted
         res = result_of(handle)
         assert res.status == GoalStatus.STATUS_SUCCEEDED, res.result.error_msg
         assert list(res.result.missed_waypoints) == [] and res.result.error_code == 0
+        # `plan` (nav_msgs/Path in odom): the pre-check's predicted path, ending within Z_crit
+        # (0.16 m) of the last waypoint; an empty one once the route ended.
+        predicted = plans.wait_for(lambda p: len(p.poses) > 1, REPLY_TIMEOUT, start=seen)
+        end = predicted.poses[-1].pose.position
+        assert predicted.header.frame_id == "odom" and math.hypot(end.x - 0.3, end.y - 0.5) < 0.16
+        plans.wait_for(lambda p: not p.poses, REPLY_TIMEOUT, start=seen)
         # A route with a waypoint inside the pillar: refused by the pre-check, the waypoint
         # reported missed with its index and pose: the collision on its leg (NO_VALID_PATH,
         # 208) and the waypoint itself occupied (GOAL_OCCUPIED, 206).

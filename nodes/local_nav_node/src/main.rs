@@ -494,6 +494,8 @@ impl Shell {
         self.last_step = None;
         let clear = clear_markers(node.stamp(), &self.config.frames.odom_frame);
         out.send_markers(clear, &mut self.throttle);
+        self.plans
+            .clear(&self.config.frames.odom_frame, node.stamp(), &mut self.throttle);
     }
 
     /// Starts a validated goal: the goal it replaces, if any, ends PREEMPTED (reported; an

@@ -85,8 +85,9 @@ pub enum GoalError {
 
 /// A `follow_path` goal's path as sub-goals `lookahead` apart for a robot at `from`, or the
 /// end Nav2's controller server gives such a goal at once: TF_ERROR for a path in another frame
-/// than `frame` (empty passes, as for any goal here), INVALID_PATH for an empty path or a
-/// non-finite pose. The `controller_id` is the node's to check.
+/// than `frame` (empty passes, as for any goal here), INVALID_PATH for an empty path, a
+/// non-finite pose, a pose beyond ±10 000 m or a path of more than 100 000 sub-goals. The
+/// `controller_id` is the node's to check.
 pub fn path_goals(path: &Path, frame: &str, from: Point2<f64>, lookahead: f64) -> Result<PathGoals, Outcome> {
     let got = &path.header.frame_id;
     if !got.is_empty() && !same_frame(got, frame) {

@@ -3,7 +3,9 @@
 //! and the action feedback.
 
 use crate::*;
+use mobil_geom::downsample;
 use mobil_geom::path::headed;
+use mobil_ros::plan::MAX_PATH_POSES;
 
 impl Shell {
     pub(crate) fn reconfigure(&mut self, c: PlannerConfig) {
@@ -56,23 +58,26 @@ impl Shell {
         self.send_status(node, out, &view);
     }
 
-    /// The markers, and the plans as paths: `plan` the pre-check's predicted path (else the
-    /// route, headed along its legs), `local_plan` VFO's chosen path.
+    /// The markers, and while a goal runs the plans as paths (when they changed): `plan` the
+    /// pre-check's predicted path, else the route headed along its legs (not for `follow_path`,
+    /// whose plan is Nav2's planner's), `local_plan` VFO's chosen path; with no goal, empty ones.
     pub(crate) fn publish_markers(&mut self, node: &RosNode, out: &Outputs) {
         let view = self.drawing.view(self.odom.value().map(|p| p.position()));
         let (stamp, frame) = (node.stamp(), &self.config.frames.odom_frame);
         out.send_markers(markers(&view, stamp.clone(), frame), &mut self.throttle);
         self.markers_gate.sent(Instant::now());
-        let plan = match self.drawing.predicted.is_empty() {
-            true => headed(&self.drawing.route),
-            false => self.drawing.predicted.clone(),
+        let Some(active) = self.session.active() else {
+            return self.plans.clear(frame, stamp, &mut self.throttle);
         };
-        if !plan.is_empty() {
+        if active.source != Source::PathAction {
+            let plan = match self.drawing.predicted.is_empty() {
+                true => headed(&downsample(&self.drawing.route, MAX_PATH_POSES)),
+                false => self.drawing.predicted.clone(),
+            };
             self.plans.send_plan(&plan, frame, stamp.clone(), &mut self.throttle);
         }
-        if let Some(chosen) = self.drawing.vfo.as_ref().map(|v| &v.chosen).filter(|c| !c.is_empty()) {
-            self.plans.send_local(&headed(chosen), frame, stamp, &mut self.throttle);
-        }
+        let chosen = self.drawing.vfo.as_ref().map_or(&[][..], |v| &v.chosen[..]);
+        self.plans.send_local(&headed(chosen), frame, stamp, &mut self.throttle);
     }
 
     /// Ends the active goal with `outcome` (the session sends its zero command, if one is due)
