@@ -19,6 +19,7 @@ import harness
 import rosutil
 from harness import collect, param_get, param_list, param_set, publish_until, subscribe, wait_for_message
 
+from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus
 from geometry_msgs.msg import Twist
 from mobil_msgs.msg import ChassisStatus
 from nav_msgs.msg import Odometry
@@ -294,6 +295,40 @@ def prime_feedback(ros_node, fb, odom, t0: float, positions_only: bool = False) 
     stamps = iter(t0 - 1.0 + 0.01 * k for k in range(100))
     publish_until(ros_node, fb, lambda: rest(next(stamps)), lambda: odom.latest is not None, rate_hz=10, timeout=9)
     fb.publish(rest(t0))
+
+
+def test_diagnostics_report_stale_feedback_as_an_error_and_recover(start_node, ros_node):
+    """/diagnostics, once a second and at once on a change of level: OK while rclpy plays the
+    wheels at rest, ERROR within 1.5 s of joint_states stopping (the feedback watchdog's 0.5 s),
+    OK again once they return."""
+    start_node("chassis_node", params_file="params/omr3.yaml")
+    fb = ros_node.create_publisher(JointState, "joint_states", 10)
+    feeding = {"on": True, "t": 100.0}
+
+    def rest() -> None:
+        if feeding["on"]:
+            feeding["t"] += 0.02
+            fb.publish(joint_state(feeding["t"], OMNI_WHEELS, [], [0.0, 0.0, 0.0]))
+
+    timer = ros_node.create_timer(0.02, rest)
+    ours = lambda m: next((s for s in m.status if s.name == "/chassis: watchdogs"), None)  # noqa: E731
+    try:
+        with subscribe(ros_node, DiagnosticArray, "/diagnostics", qos=harness.qos_default()) as diag:
+            ok = diag.wait_for(lambda m: (s := ours(m)) is not None and s.level == DiagnosticStatus.OK, timeout=10)
+            status = ours(ok)
+            assert status.hardware_id == "omni" and status.message.startswith("idle"), status
+            assert {"cmd_vel age [s]", "joint_states age [s]", "feedback watchdog"} <= {v.key for v in status.values}
+            feeding["on"] = False
+            stopped, seen = time.monotonic(), len(diag.snapshot())
+            err = diag.wait_for(lambda m: (s := ours(m)) is not None and s.level == DiagnosticStatus.ERROR,
+                                timeout=5, start=seen)
+            assert time.monotonic() - stopped < 1.5, "ERROR later than 1.5 s"
+            assert "joint_states" in ours(err).message, ours(err).message
+            feeding["on"], seen = True, len(diag.snapshot())
+            diag.wait_for(lambda m: (s := ours(m)) is not None and s.level == DiagnosticStatus.OK, timeout=5,
+                          start=seen)
+    finally:
+        ros_node.destroy_timer(timer)
 
 
 def test_bad_joint_states_are_dropped_and_do_not_move_odometry(start_node, ros_node):

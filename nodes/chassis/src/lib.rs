@@ -39,6 +39,7 @@
 
 pub mod controller;
 pub mod error;
+pub mod health;
 pub mod joints;
 pub mod kinematics;
 pub mod limits;

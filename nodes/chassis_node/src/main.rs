@@ -14,6 +14,7 @@ use mobil_chassis::controller::{
     ChassisController, ControllerConfig, FeedbackError, FeedbackOutcome, GatedCommand, InputAges, Safety,
     DEFAULT_FEEDBACK_SPEED_FACTOR,
 };
+use mobil_chassis::health::{chassis_health, ChassisReport};
 use mobil_chassis::joints::{joints_from_wheel_state, JointStateError};
 use mobil_chassis::kinematics::BodyTwist;
 use mobil_chassis::model::ChassisConfig;
@@ -29,6 +30,7 @@ use mobil_msgs::tf2_msgs::msg::TFMessage;
 use mobil_ros::chassis::{chassis_params, declare_chassis};
 use mobil_ros::cmd_vel::{stamped_twist, CmdVelType, TypeWatch};
 use mobil_ros::config::{Config, ConfigError, Decl};
+use mobil_ros::diagnostics::DiagnosticsOut;
 use mobil_ros::geometry::{planar_odometry, yaw_quaternion};
 use mobil_ros::input::Inputs as Streams;
 use mobil_ros::latest::Latest;
@@ -229,6 +231,10 @@ async fn run(node: &mut RosNode) -> anyhow::Result<()> {
     let odom_pub = node.publisher::<Odometry>("odom", &q)?;
     let tf_pub = node.publisher::<TFMessage>("tf", &qos::reliable(100))?;
     let status_pub = node.publisher::<ChassisStatus>("~/status", &qos::latched())?;
+    let mut diagnostics = DiagnosticsOut::create(node)?;
+    // Rejected inputs and the level at the last /diagnostics report.
+    let mut rejected_reported: u64 = 0;
+    let mut level_reported = None;
 
     // An undecodable cmd_vel stops the wheels at once; an undecodable joint_states is counted.
     let mut streams = Streams::new();
@@ -396,6 +402,23 @@ async fn run(node: &mut RosNode) -> anyhow::Result<()> {
                     rejected_messages: rejected,
                 };
                 let _ = status_pub.publish(status);
+                // /diagnostics once a second, and at once when the level changes (a stopped
+                // feedback is reported when its watchdog fires, not up to a second later).
+                let report = ChassisReport {
+                    safety,
+                    ages: inputs.ages(),
+                    clamped: cmd.reasons,
+                    rejected_total: rejected,
+                    rejected_new: rejected.saturating_sub(rejected_reported),
+                };
+                let health = chassis_health(&report);
+                let now = std::time::Instant::now();
+                if diagnostics.due(now) || level_reported != Some(health.level) {
+                    rejected_reported = rejected;
+                    level_reported = Some(health.level);
+                    let model = controller.config().params.model().as_str();
+                    diagnostics.send(&[("watchdogs", model, health)], node.stamp(), now, &mut throttle);
+                }
             }
         }
     }

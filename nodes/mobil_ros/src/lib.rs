@@ -48,6 +48,7 @@ pub mod args;
 pub mod chassis;
 pub mod cmd_vel;
 pub mod config;
+pub mod diagnostics;
 pub mod docs;
 pub mod geometry;
 pub mod goal;

@@ -1,0 +1,88 @@
+//! `/diagnostics` (diagnostic_msgs/DiagnosticArray), as diagnostic_updater publishes it: once a
+//! second (a node may send at once when a level changes, as diagnostic_updater's
+//! `force_update`), each status named `<node>: <task>` (the node's fully qualified name), so
+//! rqt_robot_monitor and diagnostic_aggregator group it by node. The topic is absolute, as
+//! diagnostic_updater's: a namespaced robot's nodes still report where the aggregator listens.
+//!
+//! ```
+//! use mobil_chassis::health::{Health, Level};
+//! use mobil_ros::diagnostics::status_msg;
+//!
+//! let health = Health { level: Level::Warn, message: "2 rejected".into(), values: vec![("k".into(), "v".into())] };
+//! let s = status_msg(&health, "/chassis", "watchdogs", "omni");
+//! assert_eq!((s.level, s.name.as_str(), s.hardware_id.as_str()), (1, "/chassis: watchdogs", "omni"));
+//! assert_eq!(s.values[0].key, "k");
+//! ```
+
+use crate::log::LogThrottle;
+use crate::node::RosNode;
+use mobil_chassis::health::Health;
+use mobil_msgs::builtin_interfaces::msg::Time;
+use mobil_msgs::diagnostic_msgs::msg::{DiagnosticArray, DiagnosticStatus, KeyValue};
+use mobil_msgs::std_msgs::msg::Header;
+use ros2_client::Publisher;
+use std::time::{Duration, Instant};
+
+/// diagnostic_updater's default period.
+pub const DIAGNOSTICS_PERIOD: Duration = Duration::from_secs(1);
+
+/// The status of `health` for task `task` of node `node` (its fully qualified name), about
+/// `hardware_id`.
+pub fn status_msg(health: &Health, node: &str, task: &str, hardware_id: &str) -> DiagnosticStatus {
+    DiagnosticStatus {
+        level: health.level.byte(),
+        name: format!("{node}: {task}"),
+        message: health.message.clone(),
+        hardware_id: hardware_id.to_owned(),
+        values: health
+            .values
+            .iter()
+            .map(|(key, value)| KeyValue {
+                key: key.clone(),
+                value: value.clone(),
+            })
+            .collect(),
+    }
+}
+
+/// A node's `/diagnostics` publisher, and when it last sent.
+pub struct DiagnosticsOut {
+    publisher: Publisher<DiagnosticArray>,
+    node: String,
+    last: Option<Instant>,
+}
+
+impl DiagnosticsOut {
+    /// The publisher of `node` (reliable, volatile, depth 10).
+    pub fn create(node: &mut RosNode) -> anyhow::Result<Self> {
+        Ok(DiagnosticsOut {
+            publisher: node.publisher::<DiagnosticArray>("/diagnostics", &crate::qos::default_qos())?,
+            node: node.names().fully_qualified_node(),
+            last: None,
+        })
+    }
+
+    /// Whether a report is due at `now` ([`DIAGNOSTICS_PERIOD`] since the last, or none yet).
+    pub fn due(&self, now: Instant) -> bool {
+        self.last.is_none_or(|t| now.duration_since(t) >= DIAGNOSTICS_PERIOD)
+    }
+
+    /// Sends the node's statuses, each `(task, hardware_id, health)`, stamped `stamp`, at `now`
+    /// (a failure: one rate-limited warning).
+    pub fn send(&mut self, statuses: &[(&str, &str, Health)], stamp: Time, now: Instant, throttle: &mut LogThrottle) {
+        let array = DiagnosticArray {
+            header: Header {
+                stamp,
+                frame_id: String::new(),
+            },
+            status: statuses
+                .iter()
+                .map(|(task, hw, health)| status_msg(health, &self.node, task, hw))
+                .collect(),
+        };
+        self.last = Some(now);
+        if let Err(e) = self.publisher.publish(array) {
+            crate::warn_throttled!(throttle, "diagnostics", "cannot publish /diagnostics: {e:?}");
+        }
+    }
+}
