@@ -83,14 +83,11 @@ pub struct ChassisReport {
 pub fn chassis_health(r: &ChassisReport) -> Health {
     let s = &r.safety;
     let (level, message) = if s.feedback_stale {
-        let age = r
-            .ages
-            .feedback_s
-            .map_or_else(|| "ever".to_owned(), |a| format!("{a:.2} s"));
-        (
-            Level::Error,
-            format!("no valid joint_states for {age}: odometry stale, wheels stopped"),
-        )
+        let text = match r.ages.feedback_s {
+            Some(a) => format!("no valid joint_states for {a:.2} s: odometry stale, wheels stopped"),
+            None => "no valid joint_states yet: odometry stale, wheels stopped".to_owned(),
+        };
+        (Level::Error, text)
     } else if s.cmd_vel_refused {
         (
             Level::Warn,
@@ -163,10 +160,7 @@ mod tests {
     fn the_worst_state_decides_the_level() {
         let h = chassis_health(&report(true, true, true, 3));
         assert_eq!(h.level, Level::Error);
-        assert_eq!(
-            h.message,
-            "no valid joint_states for ever: odometry stale, wheels stopped"
-        );
+        assert_eq!(h.message, "no valid joint_states yet: odometry stale, wheels stopped");
         assert_eq!(chassis_health(&report(true, true, false, 3)).level, Level::Warn);
         let rejected = chassis_health(&report(false, false, false, 3));
         assert_eq!(

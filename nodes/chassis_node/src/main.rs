@@ -31,6 +31,9 @@ use mobil_ros::chassis::{chassis_params, declare_chassis};
 use mobil_ros::cmd_vel::{stamped_twist, CmdVelType, TypeWatch};
 use mobil_ros::config::{Config, ConfigError, Decl};
 use mobil_ros::diagnostics::DiagnosticsOut;
+
+/// The least time between two `/diagnostics` reports when the level gets worse.
+const DIAGNOSTICS_MIN_GAP: std::time::Duration = std::time::Duration::from_millis(200);
 use mobil_ros::geometry::{planar_odometry, yaw_quaternion};
 use mobil_ros::input::Inputs as Streams;
 use mobil_ros::latest::Latest;
@@ -402,8 +405,10 @@ async fn run(node: &mut RosNode) -> anyhow::Result<()> {
                     rejected_messages: rejected,
                 };
                 let _ = status_pub.publish(status);
-                // /diagnostics once a second, and at once when the level changes (a stopped
-                // feedback is reported when its watchdog fires, not up to a second later).
+                // /diagnostics once a second (rejections counted over the period), and sooner
+                // when the level gets worse (a stopped feedback is reported when its watchdog
+                // fires, not up to a second later), at most every 0.2 s; a better level waits
+                // for the period, so a flapping input cannot flood the topic.
                 let report = ChassisReport {
                     safety,
                     ages: inputs.ages(),
@@ -413,8 +418,13 @@ async fn run(node: &mut RosNode) -> anyhow::Result<()> {
                 };
                 let health = chassis_health(&report);
                 let now = std::time::Instant::now();
-                if diagnostics.due(now) || level_reported != Some(health.level) {
-                    rejected_reported = rejected;
+                let periodic = diagnostics.due(now);
+                let worse = level_reported.is_none_or(|l| health.level > l)
+                    && diagnostics.since_last(now).is_none_or(|d| d >= DIAGNOSTICS_MIN_GAP);
+                if periodic || worse {
+                    if periodic {
+                        rejected_reported = rejected;
+                    }
                     level_reported = Some(health.level);
                     let model = controller.config().params.model().as_str();
                     diagnostics.send(&[("watchdogs", model, health)], node.stamp(), now, &mut throttle);

@@ -64,7 +64,12 @@ impl DiagnosticsOut {
 
     /// Whether a report is due at `now` ([`DIAGNOSTICS_PERIOD`] since the last, or none yet).
     pub fn due(&self, now: Instant) -> bool {
-        self.last.is_none_or(|t| now.duration_since(t) >= DIAGNOSTICS_PERIOD)
+        self.since_last(now).is_none_or(|d| d >= DIAGNOSTICS_PERIOD)
+    }
+
+    /// How long since the last report at `now` (`None`: none yet).
+    pub fn since_last(&self, now: Instant) -> Option<Duration> {
+        self.last.map(|t| now.duration_since(t))
     }
 
     /// Sends the node's statuses, each `(task, hardware_id, health)`, stamped `stamp`, at `now`

@@ -77,7 +77,7 @@ impl Controller {
             "path_lookahead",
             Controller::default().path_lookahead,
             "follow_path: the path becomes sub-goals this far apart along it, the path's end last; the \
-             next one is taken within half of it [m]",
+             next one is taken within half of it (planner_node's VFO: at vfo.switch_epsilon) [m]",
             |c, v| c.path_lookahead = v,
         )
         .above(0.0)

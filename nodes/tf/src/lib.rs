@@ -107,7 +107,7 @@ pub enum TfError {
     /// that stopped, a publisher gone), or dated further ahead of now than the cache reaches
     /// (a negative age: a clock that jumped back under it).
     #[error(
-        "the transform from `{from}` to `{target}` is {age_s:.3} s old, beyond transform_tolerance {tolerance_s} s"
+        "the transform from `{from}` to `{target}` is {age_s:.3} s old (negative: dated ahead of now), beyond transform_tolerance {tolerance_s} s or the cache ahead"
     )]
     Stale {
         /// The lookup's target frame.

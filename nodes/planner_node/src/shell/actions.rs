@@ -60,8 +60,9 @@ impl Shell {
         let (undock, notices) = UndockGoal::for_request(self.config.staging_distance, self.config.undock_speed, limit);
         mobil_ros::tell!(self.throttle, notices);
         let task = Task::Undock(undock);
-        self.begin(io, task, None, Source::UndockAction);
+        // The drawing first: the goal's start publishes the plans of the new goal, not the old.
         self.drawing = Drawing::default();
+        self.begin(io, task, None, Source::UndockAction);
         self.publish_status(io.node, io.out, NavStatus::ACTIVE, String::new());
     }
 

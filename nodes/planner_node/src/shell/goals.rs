@@ -69,13 +69,14 @@ impl Shell {
         let Some(active) = self.session.active() else {
             return self.plans.clear(frame, stamp, &mut self.throttle);
         };
-        if active.source != Source::PathAction {
-            let plan = match self.drawing.predicted.is_empty() {
-                true => headed(&downsample(&self.drawing.route, MAX_PATH_POSES)),
-                false => self.drawing.predicted.clone(),
-            };
-            self.plans.send_plan(&plan, frame, stamp.clone(), &mut self.throttle);
-        }
+        // A follow_path goal's plan is Nav2's planner's: an empty one (sent only if this node
+        // had latched one of its own) leaves it alone.
+        let plan = match (active.source, self.drawing.predicted.is_empty()) {
+            (Source::PathAction, _) => Vec::new(),
+            (_, true) => headed(&downsample(&self.drawing.route, MAX_PATH_POSES)),
+            (_, false) => self.drawing.predicted.clone(),
+        };
+        self.plans.send_plan(&plan, frame, stamp.clone(), &mut self.throttle);
         let chosen = self.drawing.vfo.as_ref().map_or(&[][..], |v| &v.chosen[..]);
         self.plans.send_local(&headed(chosen), frame, stamp, &mut self.throttle);
     }
@@ -175,11 +176,11 @@ impl Shell {
                 dock.offset()
             );
         }
-        self.begin(io, Task::Dock(dock), None, source);
         self.drawing = Drawing {
             dock: Some(goal),
             ..Drawing::default()
         };
+        self.begin(io, Task::Dock(dock), None, source);
         self.publish_status(io.node, io.out, NavStatus::ACTIVE, String::new());
         self.publish_markers(io.node, io.out);
     }

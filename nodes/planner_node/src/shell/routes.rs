@@ -42,6 +42,11 @@ impl Shell {
             route.points.len()
         );
         let task = Task::PreCheck(PreCheck::new(start, points.clone(), route.request_index.clone()));
+        // The route until its check draws the prediction: the goal's start publishes it.
+        self.drawing = Drawing {
+            route: points.clone(),
+            ..Drawing::default()
+        };
         let id = self.begin(io, task, Some(route), source);
         // The robot waits for the pre-check.
         self.session.hold(io.sink);
