@@ -159,7 +159,11 @@ impl FrameTree {
     /// ROS time is now `now` (ns): when it went back (a restarted simulation, a clock reset),
     /// every dynamic edge's history is cleared, as tf2_ros clears its buffer, so samples of the
     /// new time are not dropped behind the old ones; static edges stay. True when it cleared.
+    /// Time 0 (a simulated clock not started yet) tells nothing and is ignored.
     pub fn observe_time(&mut self, now: u64) -> bool {
+        if now == 0 {
+            return false;
+        }
         let back = self.now.is_some_and(|before| now < before);
         self.now = Some(now);
         if back {
@@ -170,7 +174,10 @@ impl FrameTree {
 
     /// Adds `child`'s pose in `parent`, `transform`, at ROS time `stamp` (ns; `None`: static,
     /// valid at every instant, as on `/tf_static`). A frame keeps its first parent and its
-    /// kind (static or dynamic); a sample older than the cache behind the newest is dropped.
+    /// kind (static or dynamic); a sample older than the cache behind the newest is dropped;
+    /// one dated more than the cache ahead of the ROS time last observed
+    /// ([`FrameTree::observe_time`]) is refused: after a clock jump back, a sample of the old
+    /// time still in flight would otherwise pin the edge's history there.
     pub fn insert(
         &mut self,
         parent: &str,
@@ -186,6 +193,16 @@ impl FrameTree {
         };
         if parent.is_empty() || child.is_empty() {
             return Err(rejected("a frame name is empty".into()));
+        }
+        if let (Some(ns), Some(now)) = (stamp, self.now) {
+            let ahead = Duration::from_nanos(ns.saturating_sub(now));
+            if ahead > self.cache {
+                return Err(rejected(format!(
+                    "dated {:.3} s ahead of ROS time, beyond the {} s cache",
+                    ahead.as_secs_f64(),
+                    self.cache.as_secs_f64()
+                )));
+            }
         }
         let t = transform.translation.vector;
         let q = transform.rotation.quaternion();

@@ -152,7 +152,14 @@ fn a_clock_jump_back_clears_the_dynamic_history() {
     t.insert("odom", "base_link", &planar(5.0, 0.0, 0.0), Some(100 * S))
         .unwrap();
     assert!(!t.observe_time(101 * S));
+    assert!(!t.observe_time(0), "a simulated clock not started yet tells nothing");
     assert!(t.observe_time(S), "back to 1 s");
+    // A sample of the old time still in flight, 99 s ahead of the new: refused, so it cannot
+    // pin the history at 100 s.
+    assert!(matches!(
+        t.insert("odom", "base_link", &planar(5.0, 0.0, 0.0), Some(100 * S)),
+        Err(TfError::Rejected { .. })
+    ));
     t.insert("odom", "base_link", &planar(1.0, 0.0, 0.0), Some(S)).unwrap();
     assert_eq!(t.latest_time("odom", "laser"), Ok(Some(S)));
     let p = t.planar("odom", "laser", At::Latest).unwrap();
