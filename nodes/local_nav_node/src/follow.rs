@@ -25,18 +25,8 @@ impl Shell {
         request: GoalRequest<FollowPathGoal>,
     ) {
         let goal = request.goal();
-        for (what, id) in [
-            ("goal_checker_id", &goal.goal_checker_id),
-            ("progress_checker_id", &goal.progress_checker_id),
-        ] {
-            if !id.is_empty() {
-                warn_throttled!(
-                    self.throttle,
-                    "checker-id",
-                    "follow_path: {what} `{id}` ignored: the node has one goal checker (xy_goal_tolerance) \
-                     and one progress checker"
-                );
-            }
+        for line in mobil_ros::goal::ignored_checkers(goal, "xy_goal_tolerance") {
+            warn_throttled!(self.throttle, "checker-id", "{line}");
         }
         let from = match (self.odom.value(), goal.path.poses.first()) {
             (Some(o), _) => o.pose.position(),

@@ -22,6 +22,7 @@ use mobil_geom::path::PathGoals;
 use mobil_geom::Pose2;
 use mobil_motion::{nav2::follow_path, Outcome};
 use mobil_msgs::geometry_msgs::msg::{Pose, PoseStamped, Quaternion};
+use mobil_msgs::nav2_msgs::action::FollowPathGoal;
 use mobil_msgs::nav_msgs::msg::Path;
 use nalgebra::Point2;
 use thiserror::Error;
@@ -81,6 +82,24 @@ pub enum GoalError {
         /// How many poses there are.
         len: usize,
     },
+}
+
+/// What a `follow_path` goal names that a node with one goal checker (its tolerance parameter
+/// `tolerance`) and one progress checker ignores: one line per non-empty `goal_checker_id` or
+/// `progress_checker_id`, for the log.
+pub fn ignored_checkers(goal: &FollowPathGoal, tolerance: &str) -> Vec<String> {
+    [
+        ("goal_checker_id", &goal.goal_checker_id),
+        ("progress_checker_id", &goal.progress_checker_id),
+    ]
+    .into_iter()
+    .filter(|(_, id)| !id.is_empty())
+    .map(|(what, id)| {
+        format!(
+            "follow_path: {what} `{id}` ignored: the node has one goal checker ({tolerance}) and one progress checker"
+        )
+    })
+    .collect()
 }
 
 /// A `follow_path` goal's path as sub-goals `lookahead` apart for a robot at `from`, or the
@@ -291,6 +310,21 @@ pub fn route_from_path(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A named checker is told as ignored, an empty one not.
+    #[test]
+    fn named_checkers_are_told_as_ignored() {
+        let mut goal = FollowPathGoal::default();
+        assert!(ignored_checkers(&goal, "xy_goal_tolerance").is_empty());
+        goal.progress_checker_id = "progress".into();
+        assert_eq!(
+            ignored_checkers(&goal, "xy_goal_tolerance"),
+            [
+                "follow_path: progress_checker_id `progress` ignored: the node has one goal checker \
+              (xy_goal_tolerance) and one progress checker"
+            ]
+        );
+    }
     use crate::geometry::{header_in, pose_stamped, yaw_quaternion};
     use mobil_msgs::std_msgs::msg::Header;
 

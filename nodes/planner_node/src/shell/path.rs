@@ -20,18 +20,8 @@ use tracing::debug;
 impl Shell {
     pub(crate) async fn path_action(&mut self, io: &mut Io<'_, '_>, request: GoalRequest<FollowPathGoal>) {
         let goal = request.goal();
-        for (what, id) in [
-            ("goal_checker_id", &goal.goal_checker_id),
-            ("progress_checker_id", &goal.progress_checker_id),
-        ] {
-            if !id.is_empty() {
-                warn_throttled!(
-                    self.throttle,
-                    "checker-id",
-                    "follow_path: {what} `{id}` ignored: the node has one goal checker (critical_distance) and \
-                     one progress checker"
-                );
-            }
+        for line in mobil_ros::goal::ignored_checkers(goal, "critical_distance") {
+            warn_throttled!(self.throttle, "checker-id", "{line}");
         }
         let from = match (self.fresh_odom(), goal.path.poses.first()) {
             (Some(o), _) => o.position(),
