@@ -102,20 +102,12 @@ pub fn ignored_checkers(goal: &FollowPathGoal, tolerance: &str) -> Vec<String> {
     .collect()
 }
 
-/// A `follow_path` goal's path as sub-goals `lookahead` apart for a robot at `from`, or the
-/// end Nav2's controller server gives such a goal at once: TF_ERROR for a path in another frame
-/// than `frame` (empty passes, as for any goal here), INVALID_PATH for an empty path, a
-/// non-finite pose, a pose beyond ±10 000 m or a path of more than 100 000 sub-goals. The
-/// `controller_id` is the node's to check.
-pub fn path_goals(path: &Path, frame: &str, from: Point2<f64>, lookahead: f64) -> Result<PathGoals, Outcome> {
-    let got = &path.header.frame_id;
-    if !got.is_empty() && !same_frame(got, frame) {
-        return Err(Outcome::failed(
-            "TF_ERROR",
-            format!("path in frame `{got}`: only `{frame}` is followed"),
-            follow_path::TF_ERROR,
-        ));
-    }
+/// A `follow_path` goal's path as sub-goals `lookahead` apart for a robot at `from` (in the
+/// path's frame), or the end Nav2's controller server gives such a goal at once: INVALID_PATH
+/// for an empty path, a non-finite pose, a pose beyond ±10 000 m or a path of more than
+/// 100 000 sub-goals. The `controller_id` and the path's frame (TF_ERROR) are the node's to
+/// check.
+pub fn path_goals(path: &Path, from: Point2<f64>, lookahead: f64) -> Result<PathGoals, Outcome> {
     let points: Vec<Point2<f64>> = path
         .poses
         .iter()
@@ -125,13 +117,20 @@ pub fn path_goals(path: &Path, frame: &str, from: Point2<f64>, lookahead: f64) -
         .map_err(|e| Outcome::failed("INVALID_PATH", e.to_string(), follow_path::INVALID_PATH))
 }
 
+/// The end Nav2's controller server gives a `follow_path` goal whose frame has no usable
+/// transform (`why`): TF_ERROR.
+pub fn path_tf_error(why: String) -> Outcome {
+    Outcome::failed("TF_ERROR", why, follow_path::TF_ERROR)
+}
+
 /// Whether frame `got` names frame `want` (a leading `/` ignored on either).
 pub fn same_frame(got: &str, want: &str) -> bool {
     got.trim_start_matches('/') == want.trim_start_matches('/')
 }
 
-/// `p`, given in `frame`, as a pose in `want`, or why not: the frames must be the same,
-/// every number finite (the quaternion's too), |x| and |y| within [`MAX_GOAL_COORD`].
+/// `p`, given in `frame`, as a pose in `want`, or why not: the frames must be the same (an
+/// empty `frame` is none: a pose names its frame, as tf2 needs), every number finite (the
+/// quaternion's too), |x| and |y| within [`MAX_GOAL_COORD`].
 pub fn pose_in_frame(what: &str, frame: &str, p: &Pose, want: &str) -> Result<Pose2, GoalError> {
     if !same_frame(frame, want) {
         return Err(GoalError::Frame {

@@ -42,6 +42,9 @@ pub struct Controller {
     pub progress: ProgressSettings,
     /// The sub-goals' spacing along a path (`path_lookahead`, m).
     pub path_lookahead: f64,
+    /// The oldest a transform from a goal's frame to the odometry frame may be
+    /// (`transform_tolerance`, s).
+    pub transform_tolerance: f64,
 }
 
 /// Nav2's progress checker defaults, sub-goals 1 m apart (the declared defaults).
@@ -50,6 +53,7 @@ impl Default for Controller {
         Controller {
             progress: ProgressSettings::default(),
             path_lookahead: 1.0,
+            transform_tolerance: 0.1,
         }
     }
 }
@@ -82,13 +86,26 @@ impl Controller {
         )
         .above(0.0)
         .max(100.0);
+        d.double(
+            "transform_tolerance",
+            Controller::default().transform_tolerance,
+            "a goal in another frame than odom_frame needs a transform from it to odom_frame on tf or tf_static \
+             no older than this (ROS time), else it is refused or ends TF_ERROR [s]",
+            |c, v| c.transform_tolerance = v,
+        )
+        .within(0.0, 10.0);
+    }
+
+    /// `transform_tolerance` as a duration.
+    pub fn transform_tolerance(&self) -> Duration {
+        seconds(self.transform_tolerance, 10.0)
     }
 }
 
 /// The frames of odometry and goals.
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct Frames {
-    /// Frame of odometry and of every goal (`odom_frame`).
+    /// The frame of odometry, in which a goal in another frame is followed (`odom_frame`).
     pub odom_frame: String,
     /// The robot frame, its reference point (`base_frame`).
     pub base_frame: String,
@@ -100,7 +117,7 @@ impl Frames {
         d.string(
             "odom_frame",
             "odom",
-            "frame of odom; goals in any other frame are refused",
+            "frame of odom; a goal in another frame is followed through tf (transform_tolerance)",
             |c, v| c.odom_frame = v,
         )
         .read_only();

@@ -32,8 +32,9 @@ use crate::log::LogThrottle;
 use crate::node::RosNode;
 use crate::time::nanos_from_stamp;
 use crate::warn_throttled;
+use mobil_geom::Pose2;
 use mobil_msgs::tf2_msgs::msg::TFMessage;
-use mobil_tf::{FrameTree, TfError};
+use mobil_tf::{FrameTree, GoalFrames, TfError};
 use nalgebra::{Isometry3, Quaternion, Translation3, UnitQuaternion};
 use ros2_client::Subscription;
 use std::time::Duration;
@@ -143,6 +144,82 @@ impl TfListener {
     pub fn tree(&self) -> &FrameTree {
         &self.tree
     }
+}
+
+/// A motion node's goal frames: the listener, and the frame rule ([`GoalFrames`]) with the
+/// node's `odom_frame` and `transform_tolerance`. Every goal a motion node takes, from a topic
+/// or an action, is placed here: [`GoalTf::accept`] when it comes (refused TF_ERROR when its
+/// frame does not connect to odometry, or its transform is stale), [`GoalTf::robot`] at every
+/// step (the goal ends TF_ERROR when the transform is lost while it runs).
+pub struct GoalTf {
+    listener: TfListener,
+    frames: GoalFrames,
+    throttle: LogThrottle,
+}
+
+impl GoalTf {
+    /// Subscribes `tf` and `tf_static` (tf2's cache length, 10 s) for goals relative to
+    /// `odom_frame`, through transforms at most `tolerance` old.
+    pub fn create(node: &mut RosNode, odom_frame: &str, tolerance: Duration) -> anyhow::Result<Self> {
+        Ok(GoalTf {
+            listener: TfListener::create(node, Duration::from_secs_f64(mobil_tf::DEFAULT_CACHE_S))?,
+            frames: GoalFrames::new(odom_frame, tolerance),
+            throttle: LogThrottle::new(Duration::from_secs(2)),
+        })
+    }
+
+    /// A new tolerance (a parameter change).
+    pub fn set_tolerance(&mut self, tolerance: Duration) {
+        self.frames = GoalFrames::new(self.frames.odom(), tolerance);
+    }
+
+    /// The frame rule.
+    pub fn frames(&self) -> &GoalFrames {
+        &self.frames
+    }
+
+    /// The frame of a goal whose header names `frame_id` (empty: the odometry frame).
+    pub fn frame_of(&self, frame_id: &str) -> String {
+        self.frames.frame_of(frame_id)
+    }
+
+    /// Takes the transforms waiting, at ROS time `now` (ns).
+    pub fn refresh(&mut self, now: i64) {
+        let now = u64::try_from(now).unwrap_or(0);
+        self.listener.poll(now, &mut self.throttle);
+    }
+
+    /// Whether a goal in `goal_frame` can be followed at ROS time `now` (ns): the odometry
+    /// frame's pose in it, or the reason it cannot (for a TF_ERROR), the transforms waiting
+    /// taken first.
+    pub fn accept(&mut self, goal_frame: &str, now: i64) -> Result<Pose2, String> {
+        self.refresh(now);
+        self.odom_in(goal_frame, now)
+    }
+
+    /// The odometry frame's pose in `goal_frame` at ROS time `now` (ns), from the transforms
+    /// taken so far; or the reason (for a TF_ERROR).
+    pub fn odom_in(&self, goal_frame: &str, now: i64) -> Result<Pose2, String> {
+        let now = u64::try_from(now).unwrap_or(0);
+        self.frames
+            .odom_in(self.listener.tree(), goal_frame, now)
+            .map_err(|e| tf_reason(goal_frame, self.frames.odom(), &e))
+    }
+
+    /// The robot's pose `odom_pose` (odometry frame) in `goal_frame` at ROS time `now` (ns),
+    /// the transforms waiting taken first; or the reason (for a TF_ERROR).
+    pub fn robot(&mut self, goal_frame: &str, odom_pose: &Pose2, now: i64) -> Result<Pose2, String> {
+        if self.frames.is_odom(goal_frame) {
+            return Ok(*odom_pose);
+        }
+        self.refresh(now);
+        self.odom_in(goal_frame, now).map(|t| t.compose(odom_pose))
+    }
+}
+
+/// The reason a goal in `goal_frame` cannot be followed from odometry frame `odom`.
+pub fn tf_reason(goal_frame: &str, odom: &str, e: &TfError) -> String {
+    format!("goal frame `{goal_frame}` has no usable transform to `{odom}`: {e}")
 }
 
 #[cfg(test)]

@@ -304,6 +304,8 @@ pub mod nav2 {
 pub struct Nav2Codes {
     /// Stale or refused input.
     pub control_failure: u16,
+    /// The goal's frame lost its transform to the odometry frame (missing or stale).
+    pub tf_error: u16,
     /// The node shut down under the goal.
     pub unknown: u16,
 }
@@ -313,24 +315,30 @@ impl Nav2Codes {
     /// NO_VALID_CONTROL, UNKNOWN.
     pub const FOLLOW_PATH: Nav2Codes = Nav2Codes {
         control_failure: nav2::follow_path::NO_VALID_CONTROL,
+        tf_error: nav2::follow_path::TF_ERROR,
         unknown: nav2::follow_path::UNKNOWN,
     };
-    /// `DockRobot` and `UndockRobot`: FAILED_TO_CONTROL, UNKNOWN.
+    /// `DockRobot` and `UndockRobot`: FAILED_TO_CONTROL, UNKNOWN (also for a transform lost:
+    /// docking_server catches tf2's exception as any other, UNKNOWN).
     pub const DOCKING: Nav2Codes = Nav2Codes {
         control_failure: nav2::docking::FAILED_TO_CONTROL,
+        tf_error: nav2::docking::UNKNOWN,
         unknown: nav2::docking::UNKNOWN,
     };
-    /// `FollowWaypoints`: TASK_EXECUTOR_FAILED, UNKNOWN.
+    /// `FollowWaypoints`: TASK_EXECUTOR_FAILED, UNKNOWN (also for a transform lost: the
+    /// action has no TF code).
     pub const FOLLOW_WAYPOINTS: Nav2Codes = Nav2Codes {
         control_failure: nav2::follow_waypoints::TASK_EXECUTOR_FAILED,
+        tf_error: nav2::follow_waypoints::UNKNOWN,
         unknown: nav2::follow_waypoints::UNKNOWN,
     };
 
-    /// A behavior (`Spin`, `BackUp`, `DriveOnHeading`): its TF_ERROR (the pose lost) and
-    /// UNKNOWN.
+    /// A behavior (`Spin`, `BackUp`, `DriveOnHeading`): its TF_ERROR (the pose lost, also
+    /// for stale input) and UNKNOWN.
     pub const fn behavior(codes: nav2::behavior::Codes) -> Nav2Codes {
         Nav2Codes {
             control_failure: codes.tf_error,
+            tf_error: codes.tf_error,
             unknown: codes.unknown,
         }
     }
@@ -354,6 +362,9 @@ pub enum EndCause {
     },
     /// An input went stale (named, e.g. `odom`, `scan and odom`).
     Stale(String),
+    /// The transform from the goal's frame to the odometry frame is missing or older than
+    /// `transform_tolerance` (why): the robot's pose relative to the goal is unknown.
+    Tf(String),
     /// ROS time went back by this many seconds while the goal ran (a restarted simulation, a
     /// clock reset): the goal's time cannot go on.
     ClockBack(f64),
@@ -392,7 +403,7 @@ impl EndCause {
     }
 
     /// The status reason's code: the outcome's, or `CANCELED`, `PREEMPTED`, `INVALID_INPUT`,
-    /// `STALE_INPUT`, `CLOCK_BACKWARDS`, `SHUTDOWN`, `DEACTIVATED`.
+    /// `STALE_INPUT`, `TF_ERROR`, `CLOCK_BACKWARDS`, `SHUTDOWN`, `DEACTIVATED`.
     pub fn code(&self) -> &str {
         match self {
             EndCause::Outcome(Outcome::Succeeded { .. }) => "SUCCEEDED",
@@ -401,6 +412,7 @@ impl EndCause {
             EndCause::Preempted(_) => "PREEMPTED",
             EndCause::Refused { .. } => "INVALID_INPUT",
             EndCause::Stale(_) => "STALE_INPUT",
+            EndCause::Tf(_) => "TF_ERROR",
             EndCause::ClockBack(_) => "CLOCK_BACKWARDS",
             EndCause::Shutdown => "SHUTDOWN",
             EndCause::Deactivated => "DEACTIVATED",
@@ -417,6 +429,7 @@ impl EndCause {
                 format!("INVALID_INPUT: the input was refused on {count} steps in a row ({last}): robot stopped")
             }
             EndCause::Stale(inputs) => format!("STALE_INPUT: {inputs} stale: robot stopped"),
+            EndCause::Tf(why) => format!("TF_ERROR: {why}: robot stopped"),
             EndCause::ClockBack(by) => format!(
                 "CLOCK_BACKWARDS: ROS time went back by {by:.3} s (a restarted simulation or a clock reset): \
                  robot stopped"
@@ -428,12 +441,14 @@ impl EndCause {
 
     /// Nav2's error code of this end in the result of an action with `codes`, one rule for
     /// every node: the law's own, none for a cancel or a pre-emption, the control failure for
-    /// stale or refused input or a clock gone back, unknown at shutdown or deactivation.
+    /// stale or refused input or a clock gone back, the TF code for a transform lost, unknown
+    /// at shutdown or deactivation.
     pub fn nav2_error(&self, codes: Nav2Codes) -> u16 {
         match self {
             EndCause::Outcome(o) => o.nav2_error(),
             EndCause::Canceled | EndCause::Preempted(_) => nav2::NONE,
             EndCause::Refused { .. } | EndCause::Stale(_) | EndCause::ClockBack(_) => codes.control_failure,
+            EndCause::Tf(_) => codes.tf_error,
             EndCause::Shutdown | EndCause::Deactivated => codes.unknown,
         }
     }
@@ -527,6 +542,24 @@ mod tests {
         );
         assert_eq!(EndCause::Stale("scan".into()).nav2_error(Nav2Codes::FOLLOW_PATH), 106);
         assert_eq!(EndCause::Shutdown.nav2_error(Nav2Codes::FOLLOW_WAYPOINTS), 600);
+        // A transform lost: FollowPath's (and so NavigateToPose's) TF_ERROR 102, a behavior's
+        // own, UNKNOWN where the action has no TF code.
+        let tf = EndCause::Tf("`map` does not exist".into());
+        assert_eq!(
+            (tf.code(), tf.kind(), tf.reason().as_str()),
+            (
+                "TF_ERROR",
+                EndKind::Aborted,
+                "TF_ERROR: `map` does not exist: robot stopped"
+            )
+        );
+        let codes = [
+            Nav2Codes::FOLLOW_PATH,
+            Nav2Codes::DOCKING,
+            Nav2Codes::FOLLOW_WAYPOINTS,
+            Nav2Codes::behavior(nav2::behavior::BACK_UP),
+        ];
+        assert_eq!(codes.map(|c| tf.nav2_error(c)), [102, 999, 600, 712]);
     }
 
     #[test]

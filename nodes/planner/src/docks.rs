@@ -4,8 +4,8 @@
 //!
 //! The node reads the instances from its parameters (`docks: [name, …]` and `name.type`,
 //! `name.frame`, `name.pose`, `name.id`) or from a `dock_database` YAML file; this module checks
-//! them and answers the look-ups, with DockRobot's codes: DOCK_NOT_IN_DB for an unknown name,
-//! DOCK_NOT_VALID for a dock in a frame the planner cannot drive to.
+//! them and answers the look-ups, with DockRobot's code DOCK_NOT_IN_DB for an unknown name. A
+//! dock's frame is the node's to place through tf (a dock in `map` needs `map → odom`).
 //!
 //! ```
 //! use mobil_planner::docks::{DockDatabase, DockFields};
@@ -14,8 +14,9 @@
 //!     DockFields { pose: Some(vec![1.0, 0.5, 0.0]), frame: Some("odom".into()), ..Default::default() },
 //! )])
 //! .unwrap();
-//! assert_eq!(db.pose_in("home", "odom").unwrap().x, 1.0);
-//! assert_eq!(db.pose_in("away", "odom").unwrap_err().nav2_error(), 901);
+//! let home = db.get("home").unwrap();
+//! assert_eq!((home.pose.x, home.frame.as_str()), (1.0, "odom"));
+//! assert_eq!(db.get("away").unwrap_err().nav2_error(), 901);
 //! ```
 
 use mobil_geom::Pose2;
@@ -124,23 +125,6 @@ impl DockDatabase {
             )
         })
     }
-
-    /// The pose of dock `name` in `frame`: DOCK_NOT_IN_DB for an unknown name, DOCK_NOT_VALID
-    /// for a dock in another frame (the planner drives in its odometry frame).
-    pub fn pose_in(&self, name: &str, frame: &str) -> Result<Pose2, Outcome> {
-        let dock = self.get(name)?;
-        if dock.frame != frame {
-            return Err(Outcome::failed(
-                "INVALID_GOAL",
-                format!(
-                    "dock `{name}` is in frame `{}`: this planner docks in `{frame}` only",
-                    dock.frame
-                ),
-                nav2::docking::DOCK_NOT_VALID,
-            ));
-        }
-        Ok(dock.pose)
-    }
 }
 
 #[cfg(test)]
@@ -163,11 +147,9 @@ mod tests {
             ("dock2".into(), fields(&[-1.0, 0.0, 3.0], None)),
         ])
         .unwrap();
-        assert_eq!(db.pose_in("dock1", "odom").unwrap(), Pose2::new(1.0, 2.0, 0.5));
+        assert_eq!(db.get("dock1").unwrap().pose, Pose2::new(1.0, 2.0, 0.5));
         assert_eq!(db.docks()[1].frame, "map");
-        let other_frame = db.pose_in("dock2", "odom").unwrap_err();
-        assert_eq!(other_frame.nav2_error(), 902);
-        let unknown = db.pose_in("dock3", "odom").unwrap_err();
+        let unknown = db.get("dock3").unwrap_err();
         assert_eq!(unknown.nav2_error(), 901);
         assert!(unknown.reason().contains("docks: dock1, dock2"), "{}", unknown.reason());
         let empty = DockDatabase::default().get("x").unwrap_err();

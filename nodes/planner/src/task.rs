@@ -702,6 +702,12 @@ impl Action {
         )
     }
 
+    /// A goal whose frame has no usable transform to the odometry frame (`why`): `TF_ERROR`,
+    /// with the action's code for it ([`Nav2Codes::tf_error`]).
+    pub fn tf_error(self, why: impl std::fmt::Display) -> Outcome {
+        Outcome::failed("TF_ERROR", why.to_string(), self.codes().tf_error)
+    }
+
     /// A goal that needs an input it has not got fresh (`odom`, `scan`): `STALE_INPUT`.
     pub fn stale_at_start(self, input: &str) -> Outcome {
         Outcome::failed(

@@ -558,3 +558,32 @@ fn new_extraction_parameters_wait_for_the_running_goal_to_end() {
     );
     assert_eq!(MapChange::Unchanged.notice(), None);
 }
+
+/// The map seen from a goal's frame in which odom sits at (2, 3) turned by π/2: a circle at
+/// (1, 0) in odom is at (2 − 0, 3 + 1) = (2, 4), its radius and id kept, the map itself
+/// unchanged. A correction moves the frame when it passes 1 mm or 1 mrad.
+#[test]
+fn the_map_seen_from_a_goal_s_frame() {
+    use mobil_planner::vfo::{frame_moved, Circle};
+    let mut map = ObstacleMap::new(ScanObstacleConfig::default()).unwrap();
+    map.merge_at(
+        &[Circle {
+            centre: Point2::new(1.0, 0.0),
+            radius: 0.2,
+        }],
+        0.0,
+    );
+    let moved = map.moved(&Pose2::new(2.0, 3.0, std::f64::consts::FRAC_PI_2));
+    assert_eq!(moved.ids(), map.ids());
+    let c = moved.circles()[0];
+    assert!(
+        (c.centre - Point2::new(2.0, 4.0)).norm() < 1e-12 && c.radius == 0.2,
+        "{c:?}"
+    );
+    assert_eq!(map.circles()[0].centre, Point2::new(1.0, 0.0));
+    let at = Pose2::new(0.5, -1.0, 1.0);
+    assert!(!frame_moved(&at, &Pose2::new(0.5009, -1.0, 1.0)));
+    assert!(frame_moved(&at, &Pose2::new(0.5, -1.0011, 1.0)));
+    assert!(frame_moved(&at, &Pose2::new(0.5, -1.0, 1.0011)));
+    assert!(frame_moved(&at, &Pose2::new(f64::NAN, -1.0, 1.0)));
+}

@@ -302,6 +302,87 @@ impl FrameTree {
     }
 }
 
+/// The frame rule of a goal: where it is given, and how the robot is seen from there.
+///
+/// A goal is given in any frame (`map` from RViz, a localiser's world); the robot's pose comes
+/// in the odometry frame. A law steering the robot to the goal is given, at every step, the
+/// robot's pose in the goal's frame ([`GoalFrames::robot`]), so the goal's pose in the
+/// odometry frame follows the latest transform between them, as a Nav2 controller's goal
+/// follows a localiser's correction; a body twist needs no transform. A goal whose frame does
+/// not connect to the odometry frame, or whose transform is older than the tolerance, is
+/// refused, and a running one ends (Nav2's TF_ERROR).
+///
+/// ```
+/// use mobil_geom::Pose2;
+/// use mobil_tf::{FrameTree, GoalFrames};
+/// use nalgebra::{Isometry3, Translation3, UnitQuaternion};
+/// use std::time::Duration;
+///
+/// let frames = GoalFrames::new("odom", Duration::from_millis(100));
+/// let mut tree = FrameTree::new(Duration::from_secs(10));
+/// let odom_in_map = Isometry3::from_parts(Translation3::new(2.0, 0.0, 0.0), UnitQuaternion::identity());
+/// tree.insert("map", "odom", &odom_in_map, Some(1_000_000_000)).unwrap();
+/// let goal_frame = frames.frame_of("/map");
+/// let robot = frames.robot(&tree, &goal_frame, &Pose2::new(1.0, 0.0, 0.0), 1_050_000_000).unwrap();
+/// assert_eq!((robot.x, robot.y), (3.0, 0.0));
+/// // 0.2 s later the transform is stale: the goal cannot go on.
+/// assert!(frames.robot(&tree, &goal_frame, &Pose2::identity(), 1_200_000_000).is_err());
+/// ```
+#[derive(Debug, Clone, PartialEq)]
+pub struct GoalFrames {
+    odom: String,
+    tolerance: Duration,
+}
+
+impl GoalFrames {
+    /// Goals relative to `odom_frame`, through transforms at most `tolerance` old
+    /// (`transform_tolerance`).
+    pub fn new(odom_frame: &str, tolerance: Duration) -> Self {
+        GoalFrames {
+            odom: frame_name(odom_frame).to_owned(),
+            tolerance,
+        }
+    }
+
+    /// The odometry frame.
+    pub fn odom(&self) -> &str {
+        &self.odom
+    }
+
+    /// The tolerance.
+    pub fn tolerance(&self) -> Duration {
+        self.tolerance
+    }
+
+    /// The frame a goal whose header names `frame_id` is in: that frame without its leading
+    /// `/`, or the odometry frame when it names none (an empty `frame_id`: a hand-typed path's
+    /// header; a node may still refuse a pose that names no frame).
+    pub fn frame_of(&self, frame_id: &str) -> String {
+        match frame_name(frame_id) {
+            "" => self.odom.clone(),
+            f => f.to_owned(),
+        }
+    }
+
+    /// Whether `goal_frame` is the odometry frame (no transform needed).
+    pub fn is_odom(&self, goal_frame: &str) -> bool {
+        frame_name(goal_frame) == self.odom
+    }
+
+    /// The odometry frame's pose in `goal_frame` at ROS time `now` (ns): what takes a point in
+    /// odometry into the goal's frame. Refused when the frames do not connect or the latest
+    /// transform is older than the tolerance ([`FrameTree::planar_fresh`]).
+    pub fn odom_in(&self, tree: &FrameTree, goal_frame: &str, now: u64) -> Result<Pose2, TfError> {
+        tree.planar_fresh(goal_frame, &self.odom, now, self.tolerance)
+    }
+
+    /// The robot's pose `odom_pose` (in the odometry frame) in `goal_frame` at ROS time `now`;
+    /// refused as [`GoalFrames::odom_in`].
+    pub fn robot(&self, tree: &FrameTree, goal_frame: &str, odom_pose: &Pose2, now: u64) -> Result<Pose2, TfError> {
+        Ok(self.odom_in(tree, goal_frame, now)?.compose(odom_pose))
+    }
+}
+
 /// The crate's error as this one's, with the lookup's frames.
 fn tf_error(e: RegistryError<Timestamp>, target: &str, source: &str) -> TfError {
     let text = e.to_string();

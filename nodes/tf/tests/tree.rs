@@ -1,7 +1,7 @@
 //! The frame tree against hand-worked transforms and tf2's behaviour at the edges.
 
 use approx::assert_relative_eq;
-use mobil_tf::{At, FrameTree, TfError};
+use mobil_tf::{At, FrameTree, GoalFrames, TfError};
 use nalgebra::{Isometry3, Point3, Translation3, UnitQuaternion};
 use std::f64::consts::{FRAC_PI_2, FRAC_PI_4, PI};
 use std::time::Duration;
@@ -204,4 +204,31 @@ fn a_pose_in_the_goal_frame_needs_a_fresh_transform() {
     let mut fixed = tree();
     fixed.insert("map", "odom", &planar(1.0, 0.0, 0.0), None).unwrap();
     assert!(fixed.pose_in("map", "odom", &robot, 1_000 * S, tol).is_ok());
+}
+
+/// A goal's frame: empty is odom, a leading `/` dropped; the robot's odometry pose (1, 1, 0)
+/// seen from `map` when odom sits at (−2, 3, π) in map: (−2 − 1, 3 − 1, π) = (−3, 2, π).
+/// Stale beyond the tolerance, unknown frames refused, odom itself always fine.
+#[test]
+fn goal_frames_see_the_robot_from_the_goal_s_frame() {
+    let frames = GoalFrames::new("odom", Duration::from_millis(100));
+    assert_eq!(frames.frame_of(""), "odom");
+    assert_eq!(frames.frame_of("/map"), "map");
+    assert!(frames.is_odom("/odom") && !frames.is_odom("map"));
+    let mut t = tree();
+    t.insert("map", "odom", &planar(-2.0, 3.0, PI), Some(5 * S)).unwrap();
+    let robot = mobil_geom::Pose2::new(1.0, 1.0, 0.0);
+    let p = frames.robot(&t, "map", &robot, 5 * S + 99_000_000).unwrap();
+    assert_relative_eq!(p.x, -3.0, epsilon = 1e-12);
+    assert_relative_eq!(p.y, 2.0, epsilon = 1e-12);
+    assert_relative_eq!(p.yaw.abs(), PI, epsilon = 1e-12);
+    assert!(matches!(
+        frames.robot(&t, "map", &robot, 5 * S + 101_000_000),
+        Err(TfError::Stale { .. })
+    ));
+    assert_eq!(
+        frames.robot(&t, "earth", &robot, 5 * S),
+        Err(TfError::UnknownFrame("earth".into()))
+    );
+    assert_eq!(frames.robot(&t, "odom", &robot, 0), Ok(robot));
 }

@@ -228,6 +228,29 @@ impl World {
         })
     }
 
+    /// The world seen from another frame: every point `p` becomes `frame.transform_point(p)`
+    /// (`frame`: this world's frame's pose in the other; a goal's frame that is not the world's).
+    pub fn moved(&self, frame: &mobil_geom::Pose2) -> World {
+        let at = |p: &[f64; 2]| {
+            let q = frame.transform_point(Point2::new(p[0], p[1]));
+            [q.x, q.y]
+        };
+        let obstacles = self
+            .obstacles
+            .iter()
+            .map(|o| match o {
+                Obstacle::Circle { center, radius } => Obstacle::Circle {
+                    center: at(center),
+                    radius: *radius,
+                },
+                Obstacle::Polygon { points } => Obstacle::Polygon {
+                    points: points.iter().map(at).collect(),
+                },
+            })
+            .collect();
+        World { obstacles }
+    }
+
     /// Checks every obstacle's geometry: finite numbers within ±[`World::MAX_COORDINATE`],
     /// radius > 0, at least 3 polygon points.
     pub fn validate(&self) -> Result<(), WorldError> {
@@ -344,6 +367,34 @@ fn ray_may_hit(o: &Obstacle, origin: Point2<f64>, d: Vector2<f64>, range: f64) -
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Seen from a frame in which this one sits at (2, 3) turned by π/2, (x, y) is at
+    /// (2 − y, 3 + x): the circle's centre (1, 0) at (2, 4), the triangle's corners
+    /// (0, 0), (1, 0), (0, 1) at (2, 3), (2, 4), (1, 3); radii kept.
+    #[test]
+    fn a_world_seen_from_another_frame() {
+        let world = World {
+            obstacles: vec![
+                Obstacle::Circle {
+                    center: [1.0, 0.0],
+                    radius: 0.5,
+                },
+                Obstacle::Polygon {
+                    points: vec![[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]],
+                },
+            ],
+        };
+        let moved = world.moved(&mobil_geom::Pose2::new(2.0, 3.0, FRAC_PI_2));
+        let close = |a: [f64; 2], b: [f64; 2]| (a[0] - b[0]).abs() < 1e-12 && (a[1] - b[1]).abs() < 1e-12;
+        match &moved.obstacles[..] {
+            [Obstacle::Circle { center, radius }, Obstacle::Polygon { points }] => {
+                assert!(close(*center, [2.0, 4.0]) && *radius == 0.5, "{center:?}");
+                let want = [[2.0, 3.0], [2.0, 4.0], [1.0, 3.0]];
+                assert!(points.iter().zip(want).all(|(p, w)| close(*p, w)), "{points:?}");
+            }
+            other => panic!("{other:?}"),
+        }
+    }
     use proptest::prelude::*;
     use std::f64::consts::{FRAC_PI_2, PI};
 

@@ -61,7 +61,8 @@ pub use optimise::{
 };
 pub use quality::{normalise, normalised, path_score, PathIndices, QualityWeights};
 pub use scan::{
-    extract_circles, fit_circle, Circle, KeptMap, MapChange, MapUpdate, ObstacleMap, ScanObstacleConfig, ScanSkipped,
+    extract_circles, fit_circle, frame_moved, Circle, KeptMap, MapChange, MapUpdate, ObstacleMap, ScanObstacleConfig,
+    ScanSkipped,
 };
 pub use settings::{
     VfoSettings, WaypointMethod, DEFAULT_OPTIMISE_BUDGET_S, DEFAULT_SCAN_ODOM_MAX_GAP_S, MAX_OPTIMISE_BUDGET_S,

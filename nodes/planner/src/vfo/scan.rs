@@ -336,6 +336,14 @@ pub struct ObstacleMap {
     next_id: u64,
 }
 
+/// Whether a frame's pose moved from `before` to `now` by more than 1 mm or 1 mrad: a
+/// localiser's correction that moves the obstacle map for a law working in the goal's frame
+/// ([`ObstacleMap::moved`]); smaller ones (rounding, a steady transform re-sent) do not.
+pub fn frame_moved(before: &Pose2, now: &Pose2) -> bool {
+    let d = before.inverse().compose(now);
+    d.x.hypot(d.y) > 1e-3 || d.yaw.abs() > 1e-3 || !d.is_finite()
+}
+
 /// Why a scan did not go into the map ([`ObstacleMap::add_scan`]).
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum ScanSkipped {
@@ -384,6 +392,17 @@ impl ObstacleMap {
     /// Whether the map is empty.
     pub fn is_empty(&self) -> bool {
         self.tracked.is_empty()
+    }
+
+    /// The map seen from another frame (`frame`: the map's frame's pose in it; a goal's frame
+    /// that is not odometry's): every centre moved, the ids, radii and histories kept, so a law
+    /// that follows the map by id ([`crate::vfo::VfoFollower::follow_map`]) follows this one.
+    pub fn moved(&self, frame: &Pose2) -> ObstacleMap {
+        let mut moved = self.clone();
+        for t in &mut moved.tracked {
+            t.circle.centre = frame.transform_point(t.circle.centre);
+        }
+        moved
     }
 
     /// The circles as detected (r_p, without the robot's radius), by index.
