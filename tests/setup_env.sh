@@ -72,10 +72,10 @@ fi
 
 # mobil_msgs Python type support, from the same CMakeLists.txt colcon uses, with its C type
 # supports only (MOBIL_MSGS_C_ONLY: rclpy loads no C++ type support; that halves the build).
-# The hash of an interface package's inputs (msgs/rust and the nested nav2_msgs and bond are not part of
-# mobil_msgs).
+# The hash of an interface package's inputs (msgs/rust and the nested nav2_msgs, bond and tf2_msgs are not
+# part of mobil_msgs).
 package_hash() {
-  (cd "$1" && find . \( -path ./rust -o -path ./nav2_msgs -o -path ./bond \) -prune -o -type f \( -name '*.msg' -o -name '*.srv' -o -name '*.action' -o -name CMakeLists.txt -o -name package.xml \) -print | sort | xargs sha256sum | sha256sum | cut -d' ' -f1)
+  (cd "$1" && find . \( -path ./rust -o -path ./nav2_msgs -o -path ./bond -o -path ./tf2_msgs \) -prune -o -type f \( -name '*.msg' -o -name '*.srv' -o -name '*.action' -o -name CMakeLists.txt -o -name package.xml \) -print | sort | xargs sha256sum | sha256sum | cut -d' ' -f1)
 }
 want_msgs="$want_ver $(package_hash "$ROOT/msgs")"
 stamp_msgs="$INSTALL/.mobil-msgs-stamp"
@@ -93,10 +93,10 @@ if [ "$(cat "$stamp_msgs" 2>/dev/null)" != "$want_msgs" ]; then
 fi
 
 # The nested interface packages that have no wheel on PyPI: nav2_msgs (Nav2's Jazzy action types,
-# msgs/nav2_msgs) and bond (msgs/bond), installed into the same prefix, so the PYTHONPATH /
-# LD_LIBRARY_PATH above serve them too. A rebuild of mobil_msgs empties the prefix and their
-# stamps with it, so these follow.
-for nested in nav2_msgs bond; do
+# msgs/nav2_msgs), bond (msgs/bond) and tf2_msgs (TFMessage, msgs/tf2_msgs), installed into the
+# same prefix, so the PYTHONPATH / LD_LIBRARY_PATH above serve them too. A rebuild of mobil_msgs
+# empties the prefix and their stamps with it, so these follow.
+for nested in nav2_msgs bond tf2_msgs; do
   nested_build="$ROOT/target/$nested-build-py$want_ver"
   want_nested="$want_ver $(package_hash "$ROOT/msgs/$nested")"
   stamp_nested="$INSTALL/.mobil-$nested-stamp"

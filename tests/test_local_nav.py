@@ -309,7 +309,8 @@ def test_foreign_lidar_with_navigate_to_pose_and_cancel(start_scenario, start_no
         truth.wait_for(None, REPLY_TIMEOUT)
         client = ActionClient(ros_node, NavigateToPose, "navigate_to_pose")
         assert client.wait_for_server(timeout_sec=20.0), "navigate_to_pose not found"
-        # A goal in `map` is rejected (it also proves goal responses arrive).
+        # A goal in `map`, which no transform joins to `odom`, is rejected (it also proves goal
+        # responses arrive).
         rejected = send_until_answered(client, nav_goal(3.0, 0.0, frame="map"), nav)
         assert not rejected.accepted
         # The cancel service answers too (a cancel naming no active goal is refused): its
@@ -425,7 +426,8 @@ def test_refusals_preemption_and_stale_scan(start_scenario, start_node, sim_cloc
         truth.wait_for(None, REPLY_TIMEOUT)
         in_map = publish_until_status(goal_pose(1.0, 0.0, frame="map"),
                                       lambda s: s.state == NavStatus.FAILED)
-        assert in_map.reason == "INVALID_GOAL: goal in frame `map`, but goals must be in `odom`"
+        assert in_map.reason.startswith("TF_ERROR: goal frame `map` has no usable transform to `odom`"), \
+            in_map.reason
         nan = publish_until_status(goal_pose(float("nan"), 0.0),
                                    lambda s: s.state == NavStatus.FAILED)
         assert nan.reason == "INVALID_GOAL: goal is not finite"
@@ -446,13 +448,13 @@ def test_refusals_preemption_and_stale_scan(start_scenario, start_node, sim_cloc
         assert res0.result.error_msg == "PREEMPTED: preempted by a newer goal (navigate_to_pose)"
         status.wait_for(lambda s: s.state == NavStatus.ACTIVE and s.goal.position.y == 0.5,
                         REPLY_TIMEOUT)
-        # A rejected action goal leaves the running goal alone. Its FAILED INVALID_GOAL status
+        # A rejected action goal leaves the running goal alone. Its FAILED TF_ERROR status
         # is followed at once by the running goal's ACTIVE, so that the latched status (depth 1:
         # the FAILED is usually superseded before it reaches a reader) is the running goal's: a
         # reader joining right after the rejection gets ACTIVE for (50, 0.5).
         rejected = send_until_answered(client, nav_goal(1.0, 0.0, frame="map"), nav)
         assert not rejected.accepted
-        nav.wait_for_log("navigate_to_pose goal rejected: INVALID_GOAL: goal in frame `map`")
+        nav.wait_for_log("navigate_to_pose goal rejected: TF_ERROR: goal frame `map`")
         with subscribe(ros_node, NavStatus, "local_nav/status", qos=qos_latched()) as late:
             latched = late.wait_for(None, REPLY_TIMEOUT)
         assert (latched.state, latched.goal.position.y) == (NavStatus.ACTIVE, 0.5), latched

@@ -435,7 +435,7 @@ DOCKS = """planner:
 def test_dock_id_goals_dock_at_the_databases_pose(start_scenario, start_node, sim_clock, ros_node, tmp_path):
     """Docks named in the planner's parameters, as opennav_docking takes them: a goal naming
     dock1 docks at its pose (ground truth within 0.05 m and 0.1 rad, as the planner's docking
-    tests ask); an unknown name gives DOCK_NOT_IN_DB, a dock in `map` DOCK_NOT_VALID."""
+    tests ask); an unknown name gives DOCK_NOT_IN_DB, a dock in `map` with no `map → odom` UNKNOWN (TF_ERROR)."""
     from nav2_msgs.action import DockRobot
 
     docks = tmp_path / "docks.yaml"
@@ -465,8 +465,9 @@ def test_dock_id_goals_dock_at_the_databases_pose(start_scenario, start_node, si
             goal.use_dock_id, goal.dock_id = True, name
             return goal
 
+        # `in_map` needs `map → odom`, which nothing publishes here: UNKNOWN (TF_ERROR).
         for name, code in (("nowhere", DockRobot.Result.DOCK_NOT_IN_DB),
-                           ("in_map", DockRobot.Result.DOCK_NOT_VALID)):
+                           ("in_map", DockRobot.Result.UNKNOWN)):
             res = run_goal(client, by_id(name))
             assert res.status == GoalStatus.STATUS_ABORTED and res.result.error_code == code, \
                 (name, res.result.error_code, res.result.error_msg)

@@ -279,22 +279,24 @@ def test_omr3_docking_actions_route_check_and_refusals(start_scenario, start_nod
         assert 0.5 < math.hypot(hit.x - PILLAR[0], hit.y - PILLAR[1]) <= 0.55 + 1e-9
         assert (blocked.problems[1].position.x, blocked.problems[1].position.y) == PILLAR
         assert blocked.reason.startswith("ROUTE_INFEASIBLE")
-        # Refused requests answer at once: frame, NaN, empty route.
+        # Refused requests answer at once: a frame no transform joins to odom, NaN, empty route.
         bad = route_request([(1.0, 0.0)])
         bad.route.header.frame_id = "map"
-        assert "INVALID_GOAL" in call(checker, bad).reason
+        assert call(checker, bad).reason.startswith("TF_ERROR: goal frame `map`")
         nan = route_request([(float("nan"), 0.0)])
         assert not call(checker, nan).feasible
         empty = call(checker, route_request([]))
         assert not empty.feasible and "no waypoints" in empty.reason
 
-        # 5. Refusals on the topics: NaN dock pose, a dock pose in `map`, an empty path.
-        for msg, pub in ((stamped(float("nan"), 0.0), dock_pub), (stamped(1.0, 0.0, frame="map"), dock_pub),
-                         (path([]), route_pub)):
+        # 5. Refusals on the topics: NaN dock pose, a dock pose in `map` (no transform to odom),
+        # an empty path.
+        for msg, pub, code in ((stamped(float("nan"), 0.0), dock_pub, "INVALID_GOAL"),
+                               (stamped(1.0, 0.0, frame="map"), dock_pub, "TF_ERROR"),
+                               (path([]), route_pub, "INVALID_GOAL")):
             n = len(status)
             publish_until_taken(pub, planner, msg)
             refused = status.wait_for(lambda s: s.state == NavStatus.FAILED, REPLY_TIMEOUT, start=n)
-            assert refused.reason.startswith("INVALID_GOAL"), refused.reason
+            assert refused.reason.startswith(code), refused.reason
 
         # 4. DockRobot: feedback CONTROLLING with docking_time growing, success.
         assert dock_client.wait_for_server(timeout_sec=20.0)
@@ -308,8 +310,9 @@ def test_omr3_docking_actions_route_check_and_refusals(start_scenario, start_nod
         in_map = DockRobot.Goal()
         in_map.use_dock_id, in_map.dock_pose = False, stamped(0.0, 0.0, frame="map")
         res = result_of(send_until_answered(dock_client, in_map, planner))
-        assert res.result.error_code == DockRobot.Result.DOCK_NOT_VALID, res.result.error_msg
-        assert "INVALID_GOAL" in res.result.error_msg
+        # docking_server's code for a transform that fails: UNKNOWN.
+        assert res.result.error_code == DockRobot.Result.UNKNOWN, res.result.error_msg
+        assert res.result.error_msg.startswith("TF_ERROR"), res.result.error_msg
         back = DockRobot.Goal()
         back.use_dock_id, back.dock_pose = False, stamped(0.2, -0.3, -0.5)
         handle = send_until_answered(dock_client, back, planner, feedback=dock_fb.append, resent=resent)

@@ -13,6 +13,7 @@ use super::*;
 use mobil_local_nav_node::follow_path_goal;
 use mobil_msgs::nav2_msgs::action::FollowPathFeedback;
 use mobil_ros::action::GoalEnd;
+use mobil_ros::goal::path_tf_error;
 use tracing::debug;
 
 impl Shell {
@@ -28,18 +29,24 @@ impl Shell {
         for line in mobil_ros::goal::ignored_checkers(goal, "xy_goal_tolerance") {
             warn_throttled!(self.throttle, "checker-id", "{line}");
         }
-        let from = match (self.odom.value(), goal.path.poses.first()) {
-            (Some(o), _) => o.pose.position(),
-            (None, Some(p)) => Point2::new(p.pose.position.x, p.pose.position.y),
-            (None, None) => Point2::origin(),
+        // The path's frame must reach odometry through a fresh transform (TF_ERROR); the
+        // sub-goals start from the robot seen from there.
+        let frame = self.tf.frame_of(&goal.path.header.frame_id);
+        let odom_in = self.tf.accept(&frame, node.now_nanos());
+        let from = match (self.odom.value(), &odom_in, goal.path.poses.first()) {
+            (Some(o), Ok(t), _) => t.compose(&o.pose).position(),
+            (_, _, Some(p)) => Point2::new(p.pose.position.x, p.pose.position.y),
+            (_, _, None) => Point2::origin(),
         };
-        let checked = follow_path_goal(
-            goal,
-            &self.config.frames.odom_frame,
-            from,
-            self.config.controller.path_lookahead,
-        );
-        let continuing = self.session.active().is_some_and(|a| a.source == Source::Path);
+        let checked = match odom_in {
+            Ok(_) => follow_path_goal(goal, from, self.config.controller.path_lookahead),
+            Err(why) => Err(path_tf_error(why)),
+        };
+        // A new path continues the running one when it is in the same frame.
+        let continuing = self
+            .session
+            .active()
+            .is_some_and(|a| a.source == Source::Path && a.goal.frame == frame);
         // The server ends a running follow_path goal itself on accept, as controller_server.
         let preempted = path_result(&EndCause::Preempted("follow_path"));
         if let Err(e) = servers.path.accept(request, |_| preempted, node.now_nanos()).await {
@@ -70,7 +77,7 @@ impl Shell {
                     path.goals().last().map_or(first.x, |g| g.x),
                     path.goals().last().map_or(first.y, |g| g.y)
                 );
-                self.start_goal(node, out, servers, Source::Path, Target::Path(path));
+                self.start_goal(node, out, servers, Source::Path, (Target::Path(path), frame));
             }
         }
     }
@@ -118,12 +125,13 @@ impl Shell {
     }
 
     /// `follow_path` feedback: the distance along the sub-goals to the end, and the speed.
-    pub(super) async fn path_feedback(&mut self, servers: &mut Servers, goal: &NavGoal) {
-        let (Some(odom), Some(path)) = (self.odom.value(), goal.path.as_ref()) else {
+    pub(super) async fn path_feedback(&mut self, node: &RosNode, servers: &mut Servers, goal: &NavGoal) {
+        let robot = self.robot_seen(node.now_nanos());
+        let (Some(odom), Some(robot), Some(path)) = (self.odom.value(), robot, goal.path.as_ref()) else {
             return;
         };
         let feedback = FollowPathFeedback {
-            distance_to_goal: path.remaining(odom.pose.position()) as f32,
+            distance_to_goal: path.remaining(robot.position()) as f32,
             speed: odom.speed as f32,
         };
         if let Err(e) = servers.path.feedback(feedback).await {

@@ -281,10 +281,11 @@ impl LocalNavConfig {
     }
 }
 
-/// The goal point in the odometry frame, or why it is refused ([`mobil_ros::goal::goal_pose`]:
-/// another frame, anything non-finite, a coordinate beyond ±10 km).
-pub fn goal_in_odom(goal: &PoseStamped, odom_frame: &str) -> Result<Point2<f64>, GoalError> {
-    goal_pose("goal", goal, odom_frame).map(|p| p.position())
+/// The goal point in `frame` (the goal's own, resolved by [`mobil_ros::tf::GoalTf::frame_of`]),
+/// or why it is refused ([`mobil_ros::goal::goal_pose`]: anything non-finite, a coordinate
+/// beyond ±10 km).
+pub fn goal_point(goal: &PoseStamped, frame: &str) -> Result<Point2<f64>, GoalError> {
+    goal_pose("goal", goal, frame).map(|p| p.position())
 }
 
 /// The progress checker after a parameter change: the same one (its window and anchor kept)
@@ -397,16 +398,11 @@ pub fn end_answer(cause: &EndCause) -> (u8, String, u16) {
 /// name of Nav2's default controller plugin (`FollowPath`, what Nav2's default trees send).
 pub const CONTROLLERS: [&str; 3] = ["", "vector_distance", nav2_error::DEFAULT_CONTROLLER_ID];
 
-/// A `follow_path` goal as sub-goals for a robot at `from`, or the end Nav2's controller
-/// server gives such a goal at once: INVALID_CONTROLLER for a `controller_id` not in
-/// [`CONTROLLERS`], TF_ERROR for a path in another frame than `odom_frame` (empty passes),
-/// INVALID_PATH for an empty path or a non-finite pose.
-pub fn follow_path_goal(
-    goal: &FollowPathGoal,
-    odom_frame: &str,
-    from: Point2<f64>,
-    lookahead: f64,
-) -> Result<PathGoals, Outcome> {
+/// A `follow_path` goal as sub-goals for a robot at `from` (in the path's frame), or the end
+/// Nav2's controller server gives such a goal at once: INVALID_CONTROLLER for a
+/// `controller_id` not in [`CONTROLLERS`], INVALID_PATH for an empty path or a non-finite
+/// pose. Its frame's transform (TF_ERROR) is checked by the node.
+pub fn follow_path_goal(goal: &FollowPathGoal, from: Point2<f64>, lookahead: f64) -> Result<PathGoals, Outcome> {
     if !CONTROLLERS.contains(&goal.controller_id.as_str()) {
         return Err(Outcome::failed(
             "INVALID_CONTROLLER",
@@ -417,7 +413,7 @@ pub fn follow_path_goal(
             nav2_error::INVALID_CONTROLLER,
         ));
     }
-    mobil_ros::goal::path_goals(&goal.path, odom_frame, from, lookahead)
+    mobil_ros::goal::path_goals(&goal.path, from, lookahead)
 }
 
 /// The status reason of a refused goal.
@@ -450,18 +446,12 @@ mod tests {
     #[test]
     fn follow_path_goals_are_checked_with_nav2_codes() {
         let from = Point2::new(0.0, 0.0);
-        let code = |g: &FollowPathGoal| follow_path_goal(g, "odom", from, 1.0).unwrap_err().nav2_error();
+        let code = |g: &FollowPathGoal| follow_path_goal(g, from, 1.0).unwrap_err().nav2_error();
         assert_eq!(code(&path_goal(&[(1.0, 0.0)], "odom", "dwb")), 101);
-        assert_eq!(code(&path_goal(&[(1.0, 0.0)], "map", "")), 102);
         assert_eq!(code(&path_goal(&[], "odom", "")), 103);
         assert_eq!(code(&path_goal(&[(0.0, 0.0), (f64::NAN, 1.0)], "odom", "")), 103);
-        assert!(follow_path_goal(&path_goal(&[(1.0, 0.0)], "odom", "FollowPath"), "odom", from, 1.0).is_ok());
-        let ok = follow_path_goal(
-            &path_goal(&[(0.0, 0.0), (2.5, 0.0)], "", "vector_distance"),
-            "odom",
-            from,
-            1.0,
-        );
+        assert!(follow_path_goal(&path_goal(&[(1.0, 0.0)], "odom", "FollowPath"), from, 1.0).is_ok());
+        let ok = follow_path_goal(&path_goal(&[(0.0, 0.0), (2.5, 0.0)], "", "vector_distance"), from, 1.0);
         assert_eq!(
             ok.unwrap().goals(),
             &[Point2::new(1.0, 0.0), Point2::new(2.0, 0.0), Point2::new(2.5, 0.0)]

@@ -23,7 +23,7 @@ use mobil_geom::path::PathGoals;
 use mobil_geom::Pose2;
 use mobil_local_nav::{Mode, MotionLimits, Navigator, Progress, ProgressChecker, StepOutput, VelocityCommand};
 use mobil_local_nav_node::{
-    clear_markers, end_answer, goal_heading, goal_in_odom, invalid_goal, markers, no_progress, reconfigured_progress,
+    clear_markers, end_answer, goal_heading, goal_point, invalid_goal, markers, no_progress, reconfigured_progress,
     LocalNavConfig, MarkerView,
 };
 use mobil_motion::{BodyTwist, GoalLaw, Nav2Codes, Step, StepInput};
@@ -38,7 +38,7 @@ use mobil_msgs::nav_msgs::msg::Odometry;
 use mobil_msgs::sensor_msgs::msg::LaserScan;
 use mobil_msgs::std_msgs::msg::Header;
 use mobil_ros::action::{goal_end, nav2_result, ActionEvent, GoalRequest, GoalServer, GoalServerConfig};
-use mobil_ros::geometry::{odom_pose, twist_msg};
+use mobil_ros::geometry::{odom_pose, pose_msg, twist_msg};
 use mobil_ros::input::Inputs;
 use mobil_ros::latest::Latest;
 use mobil_ros::lifecycle::{CallbackReturn, Lifecycle, Transition};
@@ -49,6 +49,7 @@ use mobil_ros::plan::PlanOut;
 use mobil_ros::scan::{checked_scan, tf_static_subscription, CheckedScan, LaserPoseFrom, ScanRefusal, StaticFrames};
 use mobil_ros::status::{NavStatusView, RateGate};
 use mobil_ros::stop::FINAL_STOP_WAIT;
+use mobil_ros::tf::GoalTf;
 use mobil_ros::ticker::Ticker;
 use mobil_ros::time::duration_msg;
 use mobil_ros::{qos, run_node, shutdown_signal, warn_throttled, ConfigError, LogThrottle, NodeDecl, RosNode};
@@ -103,7 +104,10 @@ impl Source {
 /// is rebuilt on a parameter change and keeps the goal).
 #[derive(Debug, Clone)]
 struct NavGoal {
+    /// The point driven to, in `frame`.
     goal: Point2<f64>,
+    /// The goal's frame: the navigator sees the robot from there ([`GoalTf::robot`]).
+    frame: String,
     started_ros_nanos: i64,
     /// A `follow_path` goal's path, as sub-goals: `goal` is the current one.
     path: Option<PathGoals>,
@@ -146,6 +150,11 @@ struct Shell {
     types: mobil_ros::cmd_vel::TypeWatch,
     /// `local_plan`: from the robot to the point the navigator heads for.
     plans: PlanOut,
+    /// `tf` and `tf_static`: goals in other frames than odometry's.
+    tf: GoalTf,
+    /// The latest goal's frame (odometry's before the first): the frame of the status, the
+    /// markers, `local_plan` and the feedback.
+    frame: String,
 }
 
 /// What woke the loop. One lives at a time, on the stack, so its size does not matter.
@@ -219,7 +228,10 @@ async fn start(
     };
     let mut laser = StaticFrames::default();
     let plans = PlanOut::create(node)?;
+    let tf = GoalTf::create(node, &config.frames.odom_frame, config.controller.transform_tolerance())?;
     let mut shell = Shell {
+        tf,
+        frame: config.frames.odom_frame.clone(),
         progress: ProgressChecker::new(config.controller.progress),
         config,
         limits,
@@ -236,7 +248,7 @@ async fn start(
     };
     shell.publish_status(node, out, NavStatus::IDLE, String::new());
     info!(
-        "waiting for goals on goal_pose and navigate_to_pose (frame `{}`)",
+        "waiting for goals on goal_pose, navigate_to_pose and follow_path (in `{}`, or a frame tf connects to it)",
         shell.config.frames.odom_frame
     );
     let outcome = event_loop(
@@ -376,6 +388,7 @@ impl Shell {
                 self.nav = nav;
                 let old = std::mem::replace(&mut self.progress, ProgressChecker::new(c.controller.progress));
                 self.progress = reconfigured_progress(old, c.controller.progress);
+                self.tf.set_tolerance(c.controller.transform_tolerance());
                 self.config = c;
             }
             Err(e) => warn!("parameters not applied: {e}"),
@@ -408,11 +421,11 @@ impl Shell {
 
     /// What the status says: the last step's distance, H and L (else the distance from the
     /// latest odometry, else NaN).
-    fn status_view(&self, state: u8, reason: String, mode: Mode, goal: Option<Point2<f64>>) -> NavStatusView {
+    fn status_view(&self, state: u8, reason: String, mode: Mode, goal: Option<Point2<f64>>, now: i64) -> NavStatusView {
         let last = self.last_step.as_ref();
-        let distance = match (last, goal, self.odom.value()) {
+        let distance = match (last, goal, self.robot_seen(now)) {
             (Some(s), _, _) => s.goal_distance,
-            (None, Some(g), Some(o)) => (g - o.pose.position()).norm(),
+            (None, Some(g), Some(robot)) => (g - robot.position()).norm(),
             _ => f64::NAN,
         };
         NavStatusView {
@@ -424,8 +437,16 @@ impl Shell {
         }
     }
 
+    /// The latest valid odometry pose seen from the latest goal's frame at ROS time `now`
+    /// (ns), through the transforms taken so far; `None` without odometry or transform.
+    fn robot_seen(&self, now: i64) -> Option<Pose2> {
+        let odom = self.odom.value()?;
+        let odom_in = self.tf.odom_in(&self.frame, now).ok()?;
+        Some(odom_in.compose(&odom.pose))
+    }
+
     fn send_status(&mut self, node: &RosNode, out: &Outputs, view: &NavStatusView) {
-        out.send_status(view, node.stamp(), &self.config.frames.odom_frame, &mut self.throttle);
+        out.send_status(view, node.stamp(), &self.frame, &mut self.throttle);
         self.status_gate.sent(Instant::now());
     }
 
@@ -437,7 +458,7 @@ impl Shell {
             false => reason,
         };
         let goal = self.session.active().map(|a| a.goal.goal).or(self.nav.goal());
-        let view = self.status_view(state, reason, self.nav.mode(), goal);
+        let view = self.status_view(state, reason, self.nav.mode(), goal, node.now_nanos());
         self.send_status(node, out, &view);
     }
 
@@ -450,7 +471,7 @@ impl Shell {
         mode: Mode,
         goal: Option<Point2<f64>>,
     ) {
-        let view = self.status_view(state, reason, mode, goal);
+        let view = self.status_view(state, reason, mode, goal, node.now_nanos());
         self.send_status(node, out, &view);
     }
 
@@ -466,6 +487,14 @@ impl Shell {
     ) {
         if let Some(ended) = self.session.end(cause, sink) {
             self.report(node, out, servers, ended);
+        }
+    }
+
+    /// Whether a goal in `frame` can be followed now: `Err` with the TF_ERROR reason if not.
+    fn goal_frame(&mut self, frame: &str, node: &RosNode) -> Result<(), String> {
+        match self.tf.accept(frame, node.now_nanos()) {
+            Ok(_) => Ok(()),
+            Err(why) => Err(format!("TF_ERROR: {why}")),
         }
     }
 
@@ -492,21 +521,28 @@ impl Shell {
         self.nav.cancel();
         self.progress.reset();
         self.last_step = None;
-        let clear = clear_markers(node.stamp(), &self.config.frames.odom_frame);
+        let clear = clear_markers(node.stamp(), &self.frame);
         out.send_markers(clear, &mut self.throttle);
-        self.plans
-            .clear(&self.config.frames.odom_frame, node.stamp(), &mut self.throttle);
+        self.plans.clear(&self.frame, node.stamp(), &mut self.throttle);
     }
 
     /// Starts a validated goal: the goal it replaces, if any, ends PREEMPTED (reported; an
     /// action goal replaced by the next one its server accepted was ended by the server).
-    fn start_goal(&mut self, node: &RosNode, out: &Outputs, servers: &mut Servers, source: Source, target: Target) {
+    fn start_goal(
+        &mut self,
+        node: &RosNode,
+        out: &Outputs,
+        servers: &mut Servers,
+        source: Source,
+        (target, frame): (Target, String),
+    ) {
         let (goal, heading, path) = match target {
             Target::Point { goal, heading } => (goal, heading, None),
             Target::Path(path) => (path.goal(), None, Some(path)),
         };
         let new = NavGoal {
             goal,
+            frame: frame.clone(),
             started_ros_nanos: node.now_nanos(),
             path,
         };
@@ -514,8 +550,9 @@ impl Shell {
         if let Some(old) = old {
             self.report(node, out, servers, old);
         }
+        self.frame = frame;
         if let Err(e) = self.nav.set_goal(goal) {
-            // goal_in_odom checked it: unreachable in practice, and safe if reached.
+            // goal_point checked it: unreachable in practice, and safe if reached.
             warn!("goal refused by the navigator: {e}");
         }
         self.progress.reset();
@@ -525,7 +562,7 @@ impl Shell {
             source.name(),
             goal.x,
             goal.y,
-            self.config.frames.odom_frame
+            self.frame
         );
         if let Some(yaw) = heading {
             info!(
@@ -546,15 +583,19 @@ impl Shell {
         servers: &mut Servers,
         m: &PoseStamped,
     ) {
-        match goal_in_odom(m, &self.config.frames.odom_frame) {
-            Ok(goal) => {
+        let frame = self.tf.frame_of(&m.header.frame_id);
+        let checked = goal_point(m, &frame)
+            .map_err(|e| invalid_goal(&e))
+            .and_then(|goal| Ok((goal, self.goal_frame(&frame, node)?)));
+        match checked {
+            Ok((goal, ())) => {
                 let heading = goal_heading(m);
-                self.start_goal(node, out, servers, Source::Topic, Target::Point { goal, heading })
+                let target = Target::Point { goal, heading };
+                self.start_goal(node, out, servers, Source::Topic, (target, frame))
             }
-            Err(e) => {
+            Err(reason) => {
                 // A goal the user meant to replace the old one with: the old one stops too.
                 self.end_goal(node, out, sink, servers, EndCause::Preempted("goal_pose, refused"));
-                let reason = invalid_goal(&e);
                 warn!("goal_pose refused: {reason}");
                 self.publish_status_with_mode(node, out, NavStatus::FAILED, reason, Mode::Idle, None);
             }
@@ -569,10 +610,13 @@ impl Shell {
         servers: &mut Servers,
         request: GoalRequest<NavigateToPoseGoal>,
     ) {
-        let goal = match goal_in_odom(&request.goal().pose, &self.config.frames.odom_frame) {
-            Ok(g) => g,
-            Err(e) => {
-                let reason = invalid_goal(&e);
+        let frame = self.tf.frame_of(&request.goal().pose.header.frame_id);
+        let checked = goal_point(&request.goal().pose, &frame)
+            .map_err(|e| invalid_goal(&e))
+            .and_then(|goal| Ok((goal, self.goal_frame(&frame, node)?)));
+        let goal = match checked {
+            Ok((g, ())) => g,
+            Err(reason) => {
                 warn!("navigate_to_pose goal rejected: {reason}");
                 servers.nav.reject(request, &reason).await;
                 // The status says so too; a running goal keeps running (unlike a refused
@@ -597,7 +641,10 @@ impl Shell {
         // The server ends a running action goal itself on accept, with this result.
         let preempted = result(&EndCause::Preempted("navigate_to_pose"));
         match servers.nav.accept(request, |_| preempted, node.now_nanos()).await {
-            Ok(()) => self.start_goal(node, out, servers, Source::Action, Target::Point { goal, heading }),
+            Ok(()) => {
+                let target = Target::Point { goal, heading };
+                self.start_goal(node, out, servers, Source::Action, (target, frame))
+            }
             Err(e) => {
                 warn_throttled!(self.throttle, "accept", "navigate_to_pose goal not started: {e}");
                 // A running action goal was ended by the server: the robot stops with it (and
@@ -671,12 +718,19 @@ impl Shell {
             );
             return self.session.hold(sink);
         };
-        self.next_subgoal(odom.pose.position());
+        // The robot seen from the goal's frame: a localiser's correction moves it relative to
+        // the goal; a transform lost ends the goal.
+        let frame = self.session.active().map(|a| a.goal.frame.clone()).unwrap_or_default();
+        let pose = match self.tf.robot(&frame, &odom.pose, node.now_nanos()) {
+            Ok(pose) => pose,
+            Err(why) => return self.end_goal(node, out, sink, servers, EndCause::Tf(why)),
+        };
+        self.next_subgoal(pose.position());
         // The method counts path, not time: the step's time is the progress checker's.
         let now = node.now_nanos() as f64 * 1e-9;
-        let step = GoalLaw::step(&mut self.nav, &StepInput::new(now, 0.0, odom.pose), &scan);
+        let step = GoalLaw::step(&mut self.nav, &StepInput::new(now, 0.0, pose), &scan);
         if let Step::Command { .. } = &step
-            && let Progress::Stuck { since } = self.progress.check(odom.pose.position(), now)
+            && let Progress::Stuck { since } = self.progress.check(pose.position(), now)
         {
             let radius = self.progress.settings().required_movement_radius;
             return self.end_goal(node, out, sink, servers, no_progress(since, radius));
@@ -749,22 +803,22 @@ impl Shell {
         let stamp = node.stamp();
         if self.status_gate.due(now, self.config.status_rate_hz) {
             self.publish_status(node, out, NavStatus::ACTIVE, String::new());
-            self.publish_markers(out, goal.goal, stamp.clone());
+            self.publish_markers(out, goal.goal, stamp.clone(), node.now_nanos());
         }
         match source {
             Source::Action => self.feedback(node, servers, &goal, stamp).await,
-            Source::Path => self.path_feedback(servers, &goal).await,
+            Source::Path => self.path_feedback(node, servers, &goal).await,
             Source::Topic => {}
         }
     }
 
     /// The markers, and `local_plan`: the robot's pose, then the point the navigator heads for.
-    fn publish_markers(&mut self, out: &Outputs, goal: Point2<f64>, stamp: Time) {
-        if let Some(odom) = self.odom.value() {
-            let target = mobil_geom::path::headed(&[odom.pose.position(), goal]);
-            let local = [odom.pose, target[1]];
-            let frame = &self.config.frames.odom_frame;
-            self.plans.send_local(&local, frame, stamp.clone(), &mut self.throttle);
+    fn publish_markers(&mut self, out: &Outputs, goal: Point2<f64>, stamp: Time, now: i64) {
+        if let Some(robot) = self.robot_seen(now) {
+            let target = mobil_geom::path::headed(&[robot.position(), goal]);
+            let local = [robot, target[1]];
+            self.plans
+                .send_local(&local, &self.frame, stamp.clone(), &mut self.throttle);
         }
         if let Some(step) = &self.last_step {
             let view = MarkerView {
@@ -774,29 +828,31 @@ impl Shell {
                 hit_point: step.hit_point,
                 leave_point: step.leave_point,
             };
-            let array = markers(
-                &view,
-                stamp,
-                &self.config.frames.odom_frame,
-                &self.config.frames.base_frame,
-            );
+            let array = markers(&view, stamp, &self.frame, &self.config.frames.base_frame);
             out.send_markers(array, &mut self.throttle);
         }
     }
 
     /// Action feedback, on every watchdog tick (20 Hz) while an action goal is active.
     async fn feedback(&mut self, node: &RosNode, servers: &mut Servers, goal: &NavGoal, stamp: Time) {
-        let Some(odom) = self.odom.value() else { return };
-        let distance = (goal.goal - odom.pose.position()).norm();
+        let (Some(odom), Some(robot)) = (self.odom.value(), self.robot_seen(node.now_nanos())) else {
+            return;
+        };
+        let distance = (goal.goal - robot.position()).norm();
         let elapsed = (node.now_nanos().saturating_sub(goal.started_ros_nanos)) as f64 * 1e-9;
         let remaining = if odom.speed > 0.01 { distance / odom.speed } else { 0.0 };
         let feedback = NavigateToPoseFeedback {
             current_pose: PoseStamped {
                 header: Header {
                     stamp: stamp.clone(),
-                    frame_id: self.config.frames.odom_frame.clone(),
+                    frame_id: goal.frame.clone(),
                 },
-                pose: odom.msg_pose.clone(),
+                // The message's own pose (its z, roll and pitch) where the goal is in odometry.
+                pose: if self.tf.frames().is_odom(&goal.frame) {
+                    odom.msg_pose.clone()
+                } else {
+                    pose_msg(&robot)
+                },
             },
             navigation_time: duration_msg(elapsed),
             estimated_time_remaining: duration_msg(remaining),

@@ -656,10 +656,7 @@ mod tests {
             ("dock2.pose".to_owned(), ParameterValue::IntegerArray(vec![2, 0, 0])),
         ];
         let db = dock_database(&config, &extra, None).unwrap();
-        assert_eq!(
-            db.pose_in("dock1", "odom").unwrap(),
-            mobil_geom::Pose2::new(1.0, 0.5, 1.0)
-        );
+        assert_eq!(db.get("dock1").unwrap().pose, mobil_geom::Pose2::new(1.0, 0.5, 1.0));
         assert_eq!((db.docks()[1].frame.as_str(), db.docks()[1].pose.x), ("map", 2.0));
         assert!(is_dock_field("dock1.pose") && is_dock_field("a.b.id"));
         assert!(!is_dock_field("pose") && !is_dock_field(".pose") && !is_dock_field("dock1.colour"));
@@ -674,7 +671,7 @@ mod tests {
         let db = dock_database(&config, &[], Some(file)).unwrap();
         assert_eq!(db.docks()[0].name, "home");
         assert_eq!(db.docks()[0].id, "c67f");
-        assert_eq!(db.pose_in("home", "odom").unwrap().yaw, 3.0);
+        assert_eq!(db.get("home").unwrap().pose.yaw, 3.0);
         assert!(dock_database(&config, &[], Some("docks: 3"))
             .unwrap_err()
             .starts_with("no `docks:`"));

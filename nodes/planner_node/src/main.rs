@@ -66,6 +66,7 @@ use mobil_ros::plan::PlanOut;
 use mobil_ros::scan::{checked_scan, tf_static_subscription, LaserMount, StaticFrames};
 use mobil_ros::status::{end_state, NavStatusView, RateGate};
 use mobil_ros::stop::FINAL_STOP_WAIT;
+use mobil_ros::tf::GoalTf;
 use mobil_ros::ticker::Ticker;
 use mobil_ros::time::{duration_msg, secs_from_stamp, DtError};
 use mobil_ros::OffLoop;
@@ -118,6 +119,19 @@ struct Goal {
     config: PlannerConfig,
     /// Cancelled when the goal ends: a VFO step's optimisation under way stops at once.
     stop: CancelToken,
+    /// The goal's frame: its law sees the robot (and VFO the obstacles) from there.
+    frame: String,
+    /// The odometry frame's pose in `frame` when a VFO law last took the obstacle map: a
+    /// localiser's correction since moves the map's obstacles for the law.
+    map_seen_from: Pose2,
+}
+
+/// A goal's frame, and the odometry frame's pose in it when the goal came
+/// ([`Shell::goal_frame`]).
+#[derive(Debug, Clone)]
+struct Placed {
+    frame: String,
+    odom_in: Pose2,
 }
 
 type Session = MotionSession<Goal, Source>;
@@ -205,6 +219,11 @@ struct Shell {
     /// `plan` (the route, or the pre-check's predicted path) and `local_plan` (VFO's chosen
     /// path).
     plans: PlanOut,
+    /// `tf` and `tf_static`: goals in other frames than odometry's.
+    tf: GoalTf,
+    /// The latest goal's frame (odometry's before the first): the frame of the status, the
+    /// markers and the plans.
+    frame: String,
 }
 
 #[allow(clippy::large_enum_variant)]
@@ -245,6 +264,7 @@ async fn start(node: &mut RosNode, out: &Outputs, config: PlannerConfig) -> anyh
     }
     let docks = load_docks(node, &config)?;
     let plans = PlanOut::create(node)?;
+    let tf = GoalTf::create(node, &config.frames.odom_frame, config.controller.transform_tolerance())?;
     let odom_sub = node.subscription::<Odometry>("odom", &qos::default_qos())?;
     let dock_sub = node.subscription::<PoseStamped>("dock_pose", &qos::default_qos())?;
     let route_sub = node.subscription::<Path>("waypoints", &qos::default_qos())?;
@@ -265,7 +285,7 @@ async fn start(node: &mut RosNode, out: &Outputs, config: PlannerConfig) -> anyh
     };
     info!(
         "{} chassis, pre-check world: {} ({} obstacles); waiting for dock_pose, waypoints, dock_robot, \
-         undock_robot, follow_waypoints, follow_path (frame `{}`)",
+         undock_robot, follow_waypoints, follow_path (in `{}`, or a frame tf connects to it)",
         chassis.model().as_str(),
         match config.world_file.as_str() {
             "" => "the sim's built-in world",
@@ -276,6 +296,8 @@ async fn start(node: &mut RosNode, out: &Outputs, config: PlannerConfig) -> anyh
         config.frames.odom_frame
     );
     let mut shell = Shell {
+        tf,
+        frame: config.frames.odom_frame.clone(),
         config,
         chassis,
         world: Arc::new(world),
@@ -368,9 +390,9 @@ fn load_docks(node: &RosNode, config: &PlannerConfig) -> anyhow::Result<DockData
             d.name, d.dock_type, d.pose.x, d.pose.y, d.pose.yaw, d.frame
         );
         if d.frame != config.frames.odom_frame {
-            warn!(
-                "dock `{}` is in frame `{}`: this planner docks in `{}` only; goals to it fail DOCK_NOT_VALID",
-                d.name, d.frame, config.frames.odom_frame
+            info!(
+                "dock `{}` is in frame `{}`: a goal to it needs `{}` → `{}` on tf or tf_static",
+                d.name, d.frame, d.frame, config.frames.odom_frame
             );
         }
     }
@@ -445,19 +467,21 @@ async fn event_loop(
             }
             Event::VfoTicked(done) => shell.vfo_ticked(&mut io, done),
             Event::DockPose(m) => {
-                let target = goal_pose("dock pose", &m, &shell.config.frames.odom_frame);
-                let target = target.map_err(|e| Action::Dock.invalid_goal(&e));
+                let frame = shell.tf.frame_of(&m.header.frame_id);
+                let target = goal_pose("dock pose", &m, &frame).map_err(|e| Action::Dock.invalid_goal(&e));
+                let target = target.and_then(|p| Ok((p, shell.goal_frame(io.node, &frame, Action::Dock)?)));
                 shell.start_dock(&mut io, target, Source::DockPose);
             }
             Event::Waypoints(m) => {
-                let start = shell.fresh_odom();
-                let route = route_from_path(
-                    &m,
-                    &shell.config.frames.odom_frame,
-                    start.map(|p| p.position()),
-                    ROUTE_LIMITS,
-                );
-                shell.start_route(&mut io, jobs, route, start, Source::Waypoints);
+                let frame = shell.tf.frame_of(&m.header.frame_id);
+                match shell.goal_frame(io.node, &frame, Action::Follow) {
+                    Ok(placed) => {
+                        let start = shell.fresh_odom().map(|p| placed.odom_in.compose(&p));
+                        let route = route_from_path(&m, &frame, start.map(|p| p.position()), ROUTE_LIMITS);
+                        shell.start_route(&mut io, jobs, route, (start, placed), Source::Waypoints);
+                    }
+                    Err(refusal) => shell.refuse(&mut io, Source::Waypoints, refusal),
+                }
             }
             Event::Dock(ActionEvent::Goal(request)) => shell.dock_action(&mut io, request).await,
             Event::Undock(ActionEvent::Goal(request)) => shell.undock_action(&mut io, request).await,

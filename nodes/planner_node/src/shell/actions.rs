@@ -6,12 +6,16 @@ use crate::*;
 impl Shell {
     pub(crate) async fn dock_action(&mut self, io: &mut Io<'_, '_>, request: GoalRequest<DockRobotGoal>) {
         let g = request.goal();
+        // The dock's pose in its frame (the database's, or the request's), placed through tf.
         let target = if g.use_dock_id {
-            self.docks.pose_in(&g.dock_id, &self.config.frames.odom_frame)
+            self.docks.get(&g.dock_id).map(|d| (d.pose, d.frame.clone()))
         } else {
-            goal_pose("dock pose", &g.dock_pose, &self.config.frames.odom_frame)
+            let frame = self.tf.frame_of(&g.dock_pose.header.frame_id);
+            goal_pose("dock pose", &g.dock_pose, &frame)
+                .map(|p| (p, frame))
                 .map_err(|e| Action::Dock.invalid_goal(&e))
         };
+        let target = target.and_then(|(p, frame)| Ok((p, self.goal_frame(io.node, &frame, Action::Dock)?)));
         if !g.use_dock_id {
             let notice = dock_request_notice(g.max_staging_time, g.navigate_to_staging_pose, &g.dock_type);
             mobil_ros::tell!(self.throttle, [notice]);
@@ -62,7 +66,8 @@ impl Shell {
         let task = Task::Undock(undock);
         // The drawing first: the goal's start publishes the plans of the new goal, not the old.
         self.drawing = Drawing::default();
-        self.begin(io, task, None, Source::UndockAction);
+        let placed = self.in_odom();
+        self.begin(io, (task, placed), None, Source::UndockAction);
         self.publish_status(io.node, io.out, NavStatus::ACTIVE, String::new());
     }
 
@@ -72,11 +77,26 @@ impl Shell {
         jobs: &mut Jobs,
         request: GoalRequest<FollowWaypointsGoal>,
     ) {
-        let start = self.fresh_odom();
         let g = request.goal();
-        let frame = &self.config.frames.odom_frame;
-        let (round, at) = ((g.goal_index, g.number_of_loops), start.map(|p| p.position()));
-        let route = route_from_poses(&g.poses, frame, frame, round, at, ROUTE_LIMITS);
+        // The route's frame is its first pose's (every pose must be in it, or name none); the
+        // route is placed through tf and starts from the robot seen from there.
+        let frame = self
+            .tf
+            .frame_of(g.poses.first().map_or("", |p| p.header.frame_id.as_str()));
+        let placed = self.goal_frame(io.node, &frame, Action::Follow);
+        let start = match &placed {
+            Ok(p) => self.fresh_odom().map(|o| p.odom_in.compose(&o)),
+            Err(_) => None,
+        };
+        let round = (g.goal_index, g.number_of_loops);
+        let route = route_from_poses(
+            &g.poses,
+            &frame,
+            &frame,
+            round,
+            start.map(|p| p.position()),
+            ROUTE_LIMITS,
+        );
         // A follow_waypoints goal pre-empted by this one lists what it had missed.
         let by = EndCause::Preempted("follow_waypoints");
         let running = self.session.active().filter(|a| a.source == Source::FollowAction);
@@ -87,7 +107,10 @@ impl Shell {
             .accept(request, |_| preempted, io.node.now_nanos())
             .await;
         if self.accepted(io, accept, Source::FollowAction) {
-            self.start_route(io, jobs, route, start, Source::FollowAction);
+            match placed {
+                Ok(placed) => self.start_route(io, jobs, route, (start, placed), Source::FollowAction),
+                Err(refusal) => self.refuse(io, Source::FollowAction, refusal),
+            }
         }
     }
 

@@ -13,16 +13,12 @@ impl Shell {
         id: RmwRequestId,
         req: &CheckRouteRequest,
     ) {
-        let (start, route) = match self.check_request(req) {
+        let (start, route, placed) = match self.check_request(node, req) {
             Err(reply) => return respond(check, id, reply, CHECK_ROUTE, &mut self.throttle),
             Ok(checked) => checked,
         };
-        let (world, chassis, config) = (self.world.clone(), self.chassis, self.config.route_check());
-        let (stamp, frame, step) = (
-            node.stamp(),
-            self.config.frames.odom_frame.clone(),
-            self.config.follow.check_length,
-        );
+        let (world, chassis, config) = (self.world_in(&placed), self.chassis, self.config.route_check());
+        let (stamp, frame, step) = (node.stamp(), placed.frame, self.config.follow.check_length);
         let job = move || {
             let began = Instant::now();
             let reply = match check_route_until(&start, &route.points, &chassis, &world, &config, || false) {
@@ -56,22 +52,31 @@ impl Shell {
         }
     }
 
-    /// The start and route of a `planner/check_route` request, or the reply refusing it.
-    pub(crate) fn check_request(&self, req: &CheckRouteRequest) -> Result<(Pose2, Route), CheckRouteResponse> {
-        let frame = &self.config.frames.odom_frame;
+    /// The start and route of a `planner/check_route` request, in the route's frame (placed
+    /// through tf; the reply is in it too), or the reply refusing it.
+    pub(crate) fn check_request(
+        &mut self,
+        node: &RosNode,
+        req: &CheckRouteRequest,
+    ) -> Result<(Pose2, Route, Placed), CheckRouteResponse> {
+        let frame = self.tf.frame_of(&req.route.header.frame_id);
+        let placed = self
+            .goal_frame(node, &frame, Action::Follow)
+            .map_err(|refusal| refused_reply(refusal.reason()))?;
         let start = if req.use_start {
-            pose_in_frame("start", frame, &req.start, frame)
+            pose_in_frame("start", &frame, &req.start, &frame)
                 .map_err(|e| refused_reply(Action::Follow.invalid_goal(&e).reason()))?
         } else {
-            self.fresh_odom().ok_or_else(|| {
+            let seen = self.fresh_odom().map(|p| placed.odom_in.compose(&p));
+            seen.ok_or_else(|| {
                 refused_reply(
                     "STALE_INPUT: no fresh odometry for the start (set use_start and start to check from a given pose)"
                         .to_owned(),
                 )
             })?
         };
-        let route = route_from_path(&req.route, frame, Some(start.position()), ROUTE_LIMITS)
+        let route = route_from_path(&req.route, &frame, Some(start.position()), ROUTE_LIMITS)
             .map_err(|e| refused_reply(Action::Follow.invalid_goal(&e).reason()))?;
-        Ok((start, route))
+        Ok((start, route, placed))
     }
 }

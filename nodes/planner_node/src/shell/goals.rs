@@ -5,6 +5,7 @@
 use crate::*;
 use mobil_geom::downsample;
 use mobil_geom::path::headed;
+use mobil_motion::Outcome;
 use mobil_ros::plan::MAX_PATH_POSES;
 
 impl Shell {
@@ -33,18 +34,48 @@ impl Shell {
             .copied()
     }
 
+    /// Whether a goal in `frame` for `action` can be followed now: where it is placed, or the
+    /// refusal (TF_ERROR with the action's code) when the frame does not reach odometry
+    /// through a fresh transform.
+    pub(crate) fn goal_frame(&mut self, node: &RosNode, frame: &str, action: Action) -> Result<Placed, Outcome> {
+        match self.tf.accept(frame, node.now_nanos()) {
+            Ok(odom_in) => Ok(Placed {
+                frame: frame.to_owned(),
+                odom_in,
+            }),
+            Err(why) => Err(action.tf_error(why)),
+        }
+    }
+
+    /// Where odometry goals are (undocking, a goal with no frame of its own).
+    pub(crate) fn in_odom(&self) -> Placed {
+        Placed {
+            frame: self.config.frames.odom_frame.clone(),
+            odom_in: Pose2::identity(),
+        }
+    }
+
+    /// The latest odometry pose seen from the latest goal's frame at ROS time `now` (ns),
+    /// through the transforms taken so far; `None` without odometry or transform.
+    pub(crate) fn robot_seen(&self, now: i64) -> Option<Pose2> {
+        let odom = self.odom.value()?;
+        Some(self.tf.odom_in(&self.frame, now).ok()?.compose(odom))
+    }
+
     pub(crate) fn send_status(&mut self, node: &RosNode, out: &Outputs, view: &NavStatusView) {
-        out.send_status(view, node.stamp(), &self.config.frames.odom_frame, &mut self.throttle);
+        out.send_status(view, node.stamp(), &self.frame, &mut self.throttle);
         self.status_gate.sent(Instant::now());
     }
 
     pub(crate) fn send_idle_status(&mut self, node: &RosNode, out: &Outputs) {
-        self.send_status(node, out, &self.status_view(None, NavStatus::IDLE, String::new()));
+        let view = self.status_view(None, NavStatus::IDLE, String::new(), node.now_nanos());
+        self.send_status(node, out, &view);
     }
 
-    /// The status of `goal` (none: idle, or a refusal) in `state` with `reason`.
-    pub(crate) fn status_view(&self, goal: Option<&Goal>, state: u8, reason: String) -> NavStatusView {
-        status_view(goal.map(|g| &g.task), self.odom.value(), state, reason)
+    /// The status of `goal` (none: idle, or a refusal) in `state` with `reason` at ROS time
+    /// `now` (ns).
+    pub(crate) fn status_view(&self, goal: Option<&Goal>, state: u8, reason: String, now: i64) -> NavStatusView {
+        status_view(goal.map(|g| &g.task), self.robot_seen(now).as_ref(), state, reason)
     }
 
     /// The active goal's status in `state` with `reason` (none given: the stopped clock's, if the
@@ -54,7 +85,7 @@ impl Shell {
             true => self.session.clock_hold_reason().unwrap_or_default(),
             false => reason,
         };
-        let view = self.status_view(self.session.active().map(|a| &a.goal), state, reason);
+        let view = self.status_view(self.session.active().map(|a| &a.goal), state, reason, node.now_nanos());
         self.send_status(node, out, &view);
     }
 
@@ -62,8 +93,10 @@ impl Shell {
     /// pre-check's predicted path, else the route headed along its legs (not for `follow_path`,
     /// whose plan is Nav2's planner's), `local_plan` VFO's chosen path; with no goal, empty ones.
     pub(crate) fn publish_markers(&mut self, node: &RosNode, out: &Outputs) {
-        let view = self.drawing.view(self.odom.value().map(|p| p.position()));
-        let (stamp, frame) = (node.stamp(), &self.config.frames.odom_frame);
+        let view = self
+            .drawing
+            .view(self.robot_seen(node.now_nanos()).map(|p| p.position()));
+        let (stamp, frame) = (node.stamp(), &self.frame);
         out.send_markers(markers(&view, stamp.clone(), frame), &mut self.throttle);
         self.markers_gate.sent(Instant::now());
         let Some(active) = self.session.active() else {
@@ -105,7 +138,7 @@ impl Shell {
             io.servers.finish(source, &cause, Some(&goal));
         }
         mobil_ros::tell!(self.throttle, [cause.notice(source.name())]);
-        let view = self.status_view(Some(&goal), end_state(&cause), cause.reason());
+        let view = self.status_view(Some(&goal), end_state(&cause), cause.reason(), io.node.now_nanos());
         self.send_status(io.node, io.out, &view);
         if self.session.active().is_none() && self.map.goal_ended() {
             info!("the obstacle map starts afresh with the new extraction parameters");
@@ -115,18 +148,27 @@ impl Shell {
 
     /// Makes `task` (of `route`, if one) from `source` the active goal: the goal it replaces ends PREEMPTED
     /// (reported; an action goal on the same server was ended by the server's accept).
-    pub(crate) fn begin(&mut self, io: &mut Io<'_, '_>, task: Task, route: Option<Route>, source: Source) -> GoalId {
+    pub(crate) fn begin(
+        &mut self,
+        io: &mut Io<'_, '_>,
+        (task, placed): (Task, Placed),
+        route: Option<Route>,
+        source: Source,
+    ) -> GoalId {
         let goal = Goal {
             task,
             route,
             chassis: self.chassis,
             config: self.config.clone(),
             stop: CancelToken::new(),
+            frame: placed.frame.clone(),
+            map_seen_from: placed.odom_in,
         };
         let (id, old) = self.session.start(goal, source, Instant::now());
         if let Some(old) = old {
             self.report(io, old);
         }
+        self.frame = placed.frame;
         id
     }
 
@@ -140,23 +182,19 @@ impl Shell {
         let cause = EndCause::Outcome(refusal);
         warn!("goal ({}) refused: {}", source.name(), cause.reason());
         io.servers.finish(source, &cause, None);
-        let view = self.status_view(None, NavStatus::FAILED, cause.reason());
+        let view = self.status_view(None, NavStatus::FAILED, cause.reason(), io.node.now_nanos());
         self.send_status(io.node, io.out, &view);
     }
 
-    /// Starts a docking onto `target` (or refuses it).
-    pub(crate) fn start_dock(
-        &mut self,
-        io: &mut Io<'_, '_>,
-        target: Result<Pose2, mobil_motion::Outcome>,
-        source: Source,
-    ) {
+    /// Starts a docking onto `target`, placed in its frame (or refuses it).
+    pub(crate) fn start_dock(&mut self, io: &mut Io<'_, '_>, target: Result<(Pose2, Placed), Outcome>, source: Source) {
         let action = source.action();
-        let built = target.and_then(|dock| {
+        let built = target.and_then(|(dock, placed)| {
             let gains = self.config.gains().map_err(|e| action.refused_goal(e))?;
-            DockGoal::onto(dock, gains, self.config.docking, &self.chassis).map_err(|e| action.refused_goal(e))
+            let law = DockGoal::onto(dock, gains, self.config.docking, &self.chassis);
+            Ok((law.map_err(|e| action.refused_goal(e))?, placed))
         });
-        let dock = match built {
+        let (dock, placed) = match built {
             Ok(dock) => dock,
             Err(refusal) => return self.refuse(io, source, refusal),
         };
@@ -167,7 +205,7 @@ impl Shell {
             goal.x,
             goal.y,
             goal.yaw,
-            self.config.frames.odom_frame
+            placed.frame
         );
         if dock.controller().finish() == Finish::ReportResidual {
             info!(
@@ -180,7 +218,7 @@ impl Shell {
             dock: Some(goal),
             ..Drawing::default()
         };
-        self.begin(io, Task::Dock(dock), None, source);
+        self.begin(io, (Task::Dock(dock), placed), None, source);
         self.publish_status(io.node, io.out, NavStatus::ACTIVE, String::new());
         self.publish_markers(io.node, io.out);
     }
@@ -231,6 +269,16 @@ impl Shell {
                 );
             }
         };
+        // The robot seen from the goal's frame: a localiser's correction moves it relative to
+        // the goal; a transform lost ends the goal.
+        let Some(frame) = self.session.active().map(|a| a.goal.frame.clone()) else {
+            return;
+        };
+        let odom_in = match self.tf.accept(&frame, io.node.now_nanos()) {
+            Ok(t) => t,
+            Err(why) => return self.end_goal(io, EndCause::Tf(why)),
+        };
+        let pose = odom_in.compose(&pose);
         let Some(active) = self.session.active_mut() else {
             return;
         };
@@ -239,7 +287,7 @@ impl Shell {
         let now = io.node.now_nanos() as f64 * 1e-9;
         match active.goal.task.step(&input, now) {
             Stepped::Waiting => {}
-            Stepped::OffLoop => self.vfo_step(io, jobs, input),
+            Stepped::OffLoop => self.vfo_step(io, jobs, input, odom_in),
             Stepped::Law(step) => {
                 if let Step::Command { feedback, .. } = &step {
                     mobil_ros::tell!(self.throttle, feedback.events.iter().map(RouteEvent::notice));
@@ -319,12 +367,12 @@ impl Shell {
         if self.markers_gate.due(now, self.config.markers_rate_hz) {
             self.publish_markers(io.node, io.out);
         }
-        self.feedback(io.servers).await;
+        self.feedback(io.servers, io.node.now_nanos()).await;
     }
 
     /// Action feedback, on every watchdog tick (20 Hz) while an action goal is active (an
     /// action's goal is always its own kind of task).
-    pub(crate) async fn feedback(&mut self, servers: &Servers) {
+    pub(crate) async fn feedback(&mut self, servers: &Servers, now: i64) {
         let Some(active) = self.session.active() else { return };
         let sent = match active.source {
             // The goal's own time: its steps' dt summed, never running backwards (a clock that
@@ -348,7 +396,7 @@ impl Shell {
                     .await
             }
             Source::UndockAction => servers.undock.feedback(UndockRobotFeedback::default()).await,
-            Source::PathAction => match self.path_feedback(&active.goal) {
+            Source::PathAction => match self.path_feedback(&active.goal, now) {
                 Some(feedback) => servers.path.feedback(feedback).await,
                 None => Ok(()),
             },

@@ -8,6 +8,7 @@
 //! (INVALID_CONTROLLER, TF_ERROR, INVALID_PATH), as controller_server ends it. The path is
 //! followed without the route pre-check: Nav2's planner has placed it in free space already.
 
+use super::routes::map_seen;
 use crate::*;
 use mobil_motion::progress::ProgressChecker;
 use mobil_msgs::nav2_msgs::action::FollowPathFeedback;
@@ -23,17 +24,26 @@ impl Shell {
         for line in mobil_ros::goal::ignored_checkers(goal, "critical_distance") {
             warn_throttled!(self.throttle, "checker-id", "{line}");
         }
-        let from = match (self.fresh_odom(), goal.path.poses.first()) {
-            (Some(o), _) => o.position(),
-            (None, Some(p)) => Point2::new(p.pose.position.x, p.pose.position.y),
-            (None, None) => Point2::origin(),
+        // The path's frame must reach odometry through a fresh transform (TF_ERROR); the
+        // sub-goals start from the robot seen from there.
+        let frame = self.tf.frame_of(&goal.path.header.frame_id);
+        let placed = self.goal_frame(io.node, &frame, Action::Path);
+        let from = match (self.fresh_odom(), &placed, goal.path.poses.first()) {
+            (Some(o), Ok(p), _) => p.odom_in.compose(&o).position(),
+            (_, _, Some(p)) => Point2::new(p.pose.position.x, p.pose.position.y),
+            (_, _, None) => Point2::origin(),
         };
-        let (frame, lookahead) = (&self.config.frames.odom_frame, self.config.controller.path_lookahead);
-        let checked = controller(&goal.controller_id, self.config.waypoint_method)
-            .and_then(|method| Ok((method, path_goals(&goal.path, frame, from, lookahead)?)));
-        // A running path by the same law goes on with the new one; by the other law, its
-        // progress checker goes on.
-        let running = self.session.active().filter(|a| a.source == Source::PathAction);
+        let lookahead = self.config.controller.path_lookahead;
+        let checked = controller(&goal.controller_id, self.config.waypoint_method).and_then(|method| {
+            let goals = path_goals(&goal.path, from, lookahead)?;
+            Ok((method, goals, placed?))
+        });
+        // A running path in the same frame by the same law goes on with the new one; by the
+        // other law, its progress checker goes on.
+        let running = self
+            .session
+            .active()
+            .filter(|a| a.source == Source::PathAction && a.goal.frame == frame);
         let (continuing, progress) = match running.map(|a| &a.goal.task) {
             Some(Task::Path(p)) => (Some(p.method()), Some(p.progress().clone())),
             _ => (None, None),
@@ -50,8 +60,8 @@ impl Shell {
         }
         match checked {
             Err(outcome) => self.refuse(io, Source::PathAction, outcome),
-            Ok((method, goals)) if continuing == Some(method) => self.replace_path(io, goals),
-            Ok((method, goals)) => self.start_path(io, method, goals, progress),
+            Ok((method, goals, _)) if continuing == Some(method) => self.replace_path(io, goals),
+            Ok((method, goals, placed)) => self.start_path(io, method, (goals, placed), progress),
         }
     }
 
@@ -61,18 +71,19 @@ impl Shell {
         &mut self,
         io: &mut Io<'_, '_>,
         method: WaypointMethod,
-        goals: PathGoals,
+        (goals, placed): (PathGoals, Placed),
         progress: Option<ProgressChecker>,
     ) {
         let settings = self.config.controller.progress;
-        let start = self.fresh_odom();
+        let start = self.fresh_odom().map(|p| placed.odom_in.compose(&p));
         let task = match method {
             WaypointMethod::Approach if start.is_none() => Err(Action::Path.stale_at_start("odom")),
             WaypointMethod::Approach => PathTask::approach(goals, (self.config.follow, &self.chassis, settings)),
             WaypointMethod::Vfo => {
                 let scan_fresh = self.scan_seen.get(self.config.vfo.scan_timeout()).is_some();
                 let (points, headings, index) = PathTask::vfo_route(&goals);
-                let rules = (&self.config.vfo, &self.chassis, self.map.map());
+                let map = self.map_in(&placed.frame, &placed.odom_in);
+                let rules = (&self.config.vfo, &self.chassis, map.as_ref());
                 let period = self.odom_period.period();
                 VfoRun::start((&points, &headings, &index), start, scan_fresh, rules, period)
                     .map(|started| {
@@ -101,7 +112,7 @@ impl Shell {
             route: task.goals().goals().to_vec(),
             ..Drawing::default()
         };
-        self.begin(io, Task::Path(task), None, Source::PathAction);
+        self.begin(io, (Task::Path(task), placed), None, Source::PathAction);
         self.publish_status(io.node, io.out, NavStatus::ACTIVE, String::new());
         self.publish_markers(io.node, io.out);
     }
@@ -122,15 +133,19 @@ impl Shell {
             Ok(Replaced::LawKept) => debug!("follow_path: new path to the same end; the VFO law goes on"),
             Ok(Replaced::Pending) => {
                 self.drawing.route = route;
-                self.rebuild_path_vfo(io);
+                let frame = self.frame.clone();
+                match self.goal_frame(io.node, &frame, Action::Path) {
+                    Ok(placed) => self.rebuild_path_vfo(io, placed.odom_in),
+                    Err(refusal) => self.end_goal(io, refusal.into()),
+                }
             }
         }
     }
 
     /// A `follow_path` goal by VFO whose new path waits for its law: the law built on it, once
     /// the old one is home (no step off the event loop); the goal ends if it cannot be.
-    pub(crate) fn rebuild_path_vfo(&mut self, io: &mut Io<'_, '_>) {
-        let start = self.fresh_odom();
+    pub(crate) fn rebuild_path_vfo(&mut self, io: &mut Io<'_, '_>, odom_in: Pose2) {
+        let start = self.fresh_odom().map(|p| odom_in.compose(&p));
         let scan_fresh = self.scan_seen.get(self.config.vfo.scan_timeout()).is_some();
         let period = self.odom_period.period();
         let Some(active) = self.session.active_mut() else {
@@ -141,7 +156,8 @@ impl Shell {
         };
         let Some(goals) = task.take_pending() else { return };
         let (points, headings, index) = PathTask::vfo_route(&goals);
-        let rules = (&active.goal.config.vfo, &active.goal.chassis, self.map.map());
+        let map = map_seen(&self.map, self.tf.frames().is_odom(&active.goal.frame), &odom_in, true);
+        let rules = (&active.goal.config.vfo, &active.goal.chassis, map.as_ref());
         match VfoRun::start((&points, &headings, &index), start, scan_fresh, rules, period) {
             Ok(started) => {
                 info!(
@@ -155,8 +171,10 @@ impl Shell {
     }
 
     /// `follow_path` feedback: the distance along the sub-goals to the end, and the speed.
-    pub(crate) fn path_feedback(&self, goal: &Goal) -> Option<FollowPathFeedback> {
-        let (Some(odom), Task::Path(task)) = (self.fresh_odom(), &goal.task) else {
+    pub(crate) fn path_feedback(&self, goal: &Goal, now: i64) -> Option<FollowPathFeedback> {
+        let odom = self.fresh_odom()?;
+        let odom_in = self.tf.odom_in(&goal.frame, now).ok()?;
+        let (odom, Task::Path(task)) = (odom_in.compose(&odom), &goal.task) else {
             return None;
         };
         Some(FollowPathFeedback {

@@ -2,6 +2,8 @@
 //! routes with their steps off the event loop, and the scans that feed VFO's obstacle map.
 
 use crate::*;
+use mobil_planner::vfo::ObstacleMap;
+use std::borrow::Cow;
 
 impl Shell {
     /// Validates a route and starts its pre-check off the event loop (or refuses it).
@@ -10,7 +12,7 @@ impl Shell {
         io: &mut Io<'_, '_>,
         jobs: &mut Jobs,
         route: Result<Route, GoalError>,
-        start: Option<Pose2>,
+        (start, placed): (Option<Pose2>, Placed),
         source: Source,
     ) {
         let route = match route {
@@ -18,7 +20,7 @@ impl Shell {
             Err(e) => return self.refuse(io, source, source.action().invalid_goal(&e)),
         };
         if self.config.waypoint_method == WaypointMethod::Vfo {
-            return self.start_vfo(io, route, start, source);
+            return self.start_vfo(io, route, (start, placed), source);
         }
         if let Some(i) = route.first_oriented() {
             info!(
@@ -32,7 +34,7 @@ impl Shell {
         };
         let (points, world, chassis, config) = (
             route.points.clone(),
-            self.world.clone(),
+            self.world_in(&placed),
             self.chassis,
             self.config.route_check(),
         );
@@ -47,7 +49,7 @@ impl Shell {
             route: points.clone(),
             ..Drawing::default()
         };
-        let id = self.begin(io, task, Some(route), source);
+        let id = self.begin(io, (task, placed), Some(route), source);
         // The robot waits for the pre-check.
         self.session.hold(io.sink);
         jobs.goal.start(move |cancel| PreCheckDone {
@@ -86,11 +88,32 @@ impl Shell {
         self.publish_markers(io.node, io.out);
     }
 
+    /// The pre-check's world (given in the odometry frame) seen from a goal's frame.
+    pub(crate) fn world_in(&self, placed: &Placed) -> Arc<World> {
+        match self.tf.frames().is_odom(&placed.frame) {
+            true => self.world.clone(),
+            false => Arc::new(self.world.moved(&placed.odom_in)),
+        }
+    }
+
+    /// VFO's obstacle map (kept in the odometry frame) seen from a goal's frame, through the
+    /// odometry frame's pose in it.
+    pub(crate) fn map_in(&self, frame: &str, odom_in: &Pose2) -> Cow<'_, ObstacleMap> {
+        map_seen(&self.map, self.tf.frames().is_odom(frame), odom_in, true)
+    }
+
     /// Starts VFO waypoint following of `route` from `start` (or refuses it).
-    pub(crate) fn start_vfo(&mut self, io: &mut Io<'_, '_>, route: Route, start: Option<Pose2>, source: Source) {
+    pub(crate) fn start_vfo(
+        &mut self,
+        io: &mut Io<'_, '_>,
+        route: Route,
+        (start, placed): (Option<Pose2>, Placed),
+        source: Source,
+    ) {
         let scan_fresh = self.scan_seen.get(self.config.vfo.scan_timeout()).is_some();
         let of_route = (&route.points[..], &route.headings()[..], &route.request_index[..]);
-        let rules = (&self.config.vfo, &self.chassis, self.map.map());
+        let map = self.map_in(&placed.frame, &placed.odom_in);
+        let rules = (&self.config.vfo, &self.chassis, map.as_ref());
         let started = match VfoRun::start(of_route, start, scan_fresh, rules, self.odom_period.period()) {
             Ok(started) => started,
             Err(refusal) => return self.refuse(io, source, refusal),
@@ -103,26 +126,37 @@ impl Shell {
             route: route.points.clone(),
             ..Drawing::default()
         };
-        self.begin(io, Task::Vfo(started.run), Some(route), source);
+        self.begin(io, (Task::Vfo(started.run), placed), Some(route), source);
         self.publish_status(io.node, io.out, NavStatus::ACTIVE, String::new());
         self.publish_markers(io.node, io.out);
     }
 
     /// A VFO step: the law goes to the blocking pool with the map's latest obstacles, or,
     /// while it is still out (optimising), the robot stops.
-    pub(crate) fn vfo_step(&mut self, io: &mut Io<'_, '_>, jobs: &mut Jobs, input: StepInput) {
+    pub(crate) fn vfo_step(&mut self, io: &mut Io<'_, '_>, jobs: &mut Jobs, input: StepInput, odom_in: Pose2) {
         // A path whose new sub-goals wait for the law: it is built now, while the law is home.
-        self.rebuild_path_vfo(io);
+        self.rebuild_path_vfo(io, odom_in);
         let Some(active) = self.session.active_mut() else {
             return;
         };
         let id = active.id();
         let budget = active.goal.config.vfo.optimise_budget();
         let stop = active.goal.stop.clone();
+        let (seen_from, frame) = (active.goal.map_seen_from, &active.goal.frame);
         let Some(v) = active.goal.task.vfo_mut() else { return };
-        let Some(mut law) = v.lend(Instant::now(), self.map.map()) else {
+        // The map seen from the goal's frame; a correction of the frame's transform since the
+        // law last took it moves the obstacles for the law (no new obstacles: no re-optimising).
+        if mobil_planner::vfo::frame_moved(&seen_from, &odom_in) {
+            v.map_updated(false);
+        }
+        let taking = v.map_pending().is_some();
+        let map = map_seen(&self.map, self.tf.frames().is_odom(frame), &odom_in, taking);
+        let Some(mut law) = v.lend(Instant::now(), &map) else {
             return self.session.hold(io.sink);
         };
+        if taking {
+            active.goal.map_seen_from = odom_in;
+        }
         let stamp = self.odom_stamp;
         jobs.vfo.start(move |cancel| {
             let (cancel, started) = (cancel.clone(), Instant::now());
@@ -220,5 +254,15 @@ impl Shell {
         if let Some(v) = self.session.active_mut().and_then(|a| a.goal.task.vfo_mut()) {
             v.map_updated(!update.new.is_empty());
         }
+    }
+}
+
+/// `map`'s obstacles (in the odometry frame) seen from a goal's frame through `odom_in` (the
+/// odometry frame's pose in it), when the law is to take them (`needed`); the map as it is for
+/// a goal in odometry, or when the law takes nothing (no copy).
+pub(crate) fn map_seen<'a>(map: &'a KeptMap, in_odom: bool, odom_in: &Pose2, needed: bool) -> Cow<'a, ObstacleMap> {
+    match in_odom || !needed {
+        true => Cow::Borrowed(map.map()),
+        false => Cow::Owned(map.map().moved(odom_in)),
     }
 }
