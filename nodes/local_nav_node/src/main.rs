@@ -729,8 +729,10 @@ impl Shell {
         // The method counts path, not time: the step's time is the progress checker's.
         let now = node.now_nanos() as f64 * 1e-9;
         let step = GoalLaw::step(&mut self.nav, &StepInput::new(now, 0.0, pose), &scan);
+        // Progress is measured in odometry, as Nav2's checker measures it in its costmap's frame:
+        // a localiser's correction is no movement.
         if let Step::Command { .. } = &step
-            && let Progress::Stuck { since } = self.progress.check(pose.position(), now)
+            && let Progress::Stuck { since } = self.progress.check(odom.pose.position(), now)
         {
             let radius = self.progress.settings().required_movement_radius;
             return self.end_goal(node, out, sink, servers, no_progress(since, radius));
@@ -785,6 +787,10 @@ impl Shell {
         }
         let Some(active) = self.session.active() else { return };
         let (goal, source) = (active.goal.clone(), active.source);
+        // The displays and the feedback see the robot through the latest transforms.
+        if !self.tf.frames().is_odom(&goal.frame) {
+            self.tf.refresh(node.now_nanos());
+        }
         let inputs = [
             Watched {
                 name: "scan",

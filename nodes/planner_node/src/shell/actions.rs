@@ -8,7 +8,7 @@ impl Shell {
         let g = request.goal();
         // The dock's pose in its frame (the database's, or the request's), placed through tf.
         let target = if g.use_dock_id {
-            self.docks.get(&g.dock_id).map(|d| (d.pose, d.frame.clone()))
+            self.docks.get(&g.dock_id).map(|d| (d.pose, self.tf.frame_of(&d.frame)))
         } else {
             let frame = self.tf.frame_of(&g.dock_pose.header.frame_id);
             goal_pose("dock pose", &g.dock_pose, &frame)

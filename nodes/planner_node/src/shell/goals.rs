@@ -21,6 +21,7 @@ impl Shell {
             Ok(change) => mobil_ros::tell!(self.throttle, change.notice()),
         }
         self.chassis = chassis;
+        self.tf.set_tolerance(c.controller.transform_tolerance());
         self.config = c;
         if running {
             info!("parameters changed: they apply from the next goal");
@@ -274,9 +275,12 @@ impl Shell {
         let Some(frame) = self.session.active().map(|a| a.goal.frame.clone()) else {
             return;
         };
-        let odom_in = match self.tf.accept(&frame, io.node.now_nanos()) {
-            Ok(t) => t,
-            Err(why) => return self.end_goal(io, EndCause::Tf(why)),
+        let odom_in = match self.tf.frames().is_odom(&frame) {
+            true => Pose2::identity(),
+            false => match self.tf.accept(&frame, io.node.now_nanos()) {
+                Ok(t) => t,
+                Err(why) => return self.end_goal(io, EndCause::Tf(why)),
+            },
         };
         let pose = odom_in.compose(&pose);
         let Some(active) = self.session.active_mut() else {

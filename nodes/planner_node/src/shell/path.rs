@@ -133,7 +133,9 @@ impl Shell {
             Ok(Replaced::LawKept) => debug!("follow_path: new path to the same end; the VFO law goes on"),
             Ok(Replaced::Pending) => {
                 self.drawing.route = route;
-                let frame = self.frame.clone();
+                let Some(frame) = self.session.active().map(|a| a.goal.frame.clone()) else {
+                    return;
+                };
                 match self.goal_frame(io.node, &frame, Action::Path) {
                     Ok(placed) => self.rebuild_path_vfo(io, placed.odom_in),
                     Err(refusal) => self.end_goal(io, refusal.into()),
@@ -165,6 +167,7 @@ impl Shell {
                     started.summary
                 );
                 task.rebuilt(goals, started.run);
+                active.goal.map_seen_from = odom_in;
             }
             Err(refusal) => self.end_goal(io, as_follow_path(refusal).into()),
         }
