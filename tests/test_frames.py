@@ -24,6 +24,7 @@ from harness import make_qos, qos_latched, subscribe, wait_until
 from rosutil import wait_for_future
 
 from action_msgs.msg import GoalStatus
+from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus
 from geometry_msgs.msg import PoseStamped, TransformStamped, Twist
 from nav_msgs.msg import Odometry
 from rclpy.action import ActionClient
@@ -167,6 +168,14 @@ def stopped(cmd, start: int) -> None:
     assert is_zero(cmd.snapshot()[-1]), "the last command is not zero"
 
 
+def status_named(array: DiagnosticArray, name: str):
+    return next((s for s in array.status if s.name == name), None)
+
+
+def values(status) -> dict:
+    return {kv.key: kv.value for kv in status.values}
+
+
 def no_motion_after(cmd, n: int, wall: float = 1.0) -> None:
     """No command but zero after the first ``n``, for ``wall`` seconds."""
     time.sleep(wall)
@@ -183,9 +192,11 @@ def test_local_nav_follows_goals_in_map_through_the_localiser(robot, start_scena
     (2.7, 0), its feedback in map. A goal in a frame no transform reaches, and one in map after
     the localiser stopped (transform older than transform_tolerance, 0.1 s), are refused
     TF_ERROR with no motion; a goal running when the localiser stops ends TF_ERROR, the robot
-    stopped."""
+    stopped. /diagnostics: sim_node's `simulation` status with the factor asked; local_nav's
+    `motion` status OK with its inputs' ages, and WARN once the simulation stops (odometry older
+    than odom_timeout_s while idle)."""
     params = f"params/{robot}.yaml"
-    start_scenario(params, real_time_factor=REAL_TIME_FACTOR, lidar=True, node_args=CHASSIS_ARGS)
+    sim = start_scenario(params, real_time_factor=REAL_TIME_FACTOR, lidar=True, node_args=CHASSIS_ARGS)[0]
     nav = start_node("local_nav_node", *NODE_ARGS, params_file=params)
     tolerance = {"omr3": 0.10, "mobil2": 0.15}[robot] + 0.05
     goal_pub = ros_node.create_publisher(PoseStamped, "goal_pose", 10)
@@ -194,6 +205,7 @@ def test_local_nav_follows_goals_in_map_through_the_localiser(robot, start_scena
     with subscribe(ros_node, NavStatus, "local_nav/status", qos=qos_latched()) as status, \
             subscribe(ros_node, Twist, "cmd_vel", qos=DEEP) as cmd, \
             subscribe(ros_node, Odometry, "ground_truth", qos=DEEP) as truth, \
+            subscribe(ros_node, DiagnosticArray, "/diagnostics", qos=DEEP) as diag, \
             Localiser(ros_node, sim_clock) as localiser:
         sim_clock.wait_started()
         truth.wait_for(None, REPLY_TIMEOUT)
@@ -256,6 +268,24 @@ def test_local_nav_follows_goals_in_map_through_the_localiser(robot, start_scena
                                         lambda s: s.state == NavStatus.FAILED)
         assert stale.reason.startswith("TF_ERROR: goal frame `map`") and " s old" in stale.reason, stale.reason
         no_motion_after(cmd, n, 0.5)
+
+        # 6. /diagnostics, once a second from each node.
+        n = len(diag)
+        motion = diag.wait_for(lambda a: status_named(a, "/local_nav: motion") is not None, REPLY_TIMEOUT,
+                               start=n)
+        ok = status_named(motion, "/local_nav: motion")
+        assert ok.level == DiagnosticStatus.OK and ok.message == "idle", ok
+        assert values(ok)["last end"] == "TF_ERROR" and float(values(ok)["odom age [s]"]) < 2.0, values(ok)
+        simulation = diag.wait_for(lambda a: status_named(a, "/sim: simulation") is not None, REPLY_TIMEOUT)
+        assert values(status_named(simulation, "/sim: simulation"))["real_time_factor asked"] == "5.000"
+        # The simulation stops: odometry ages past odom_timeout_s (2 s) and the idle node warns.
+        n = len(diag)
+        sim.stop()
+        warned = diag.wait_for(lambda a: (s := status_named(a, "/local_nav: motion")) is not None
+                               and s.level == DiagnosticStatus.WARN and "odom" in s.message, 6.0, start=n)
+        text = status_named(warned, "/local_nav: motion").message
+        assert re.match(r"idle; (scan [0-9.]+ s old \(timeout [0-9.]+ s\), )?odom [0-9.]+ s old \(timeout 2\.00 s\): "
+                        r"a goal would be refused$", text), text
 
 
 @pytest.mark.timeout(150)

@@ -38,6 +38,7 @@ use mobil_msgs::nav_msgs::msg::Odometry;
 use mobil_msgs::sensor_msgs::msg::LaserScan;
 use mobil_msgs::std_msgs::msg::Header;
 use mobil_ros::action::{goal_end, nav2_result, ActionEvent, GoalRequest, GoalServer, GoalServerConfig};
+use mobil_ros::diagnostics::MotionDiagnostics;
 use mobil_ros::geometry::{odom_pose, pose_msg, twist_msg};
 use mobil_ros::input::Inputs;
 use mobil_ros::latest::Latest;
@@ -155,6 +156,8 @@ struct Shell {
     /// The latest goal's frame (odometry's before the first): the frame of the status, the
     /// markers, `local_plan` and the feedback.
     frame: String,
+    /// `/diagnostics`.
+    diagnostics: MotionDiagnostics,
 }
 
 /// What woke the loop. One lives at a time, on the stack, so its size does not matter.
@@ -229,7 +232,10 @@ async fn start(
     let mut laser = StaticFrames::default();
     let plans = PlanOut::create(node)?;
     let tf = GoalTf::create(node, &config.frames.odom_frame, config.controller.transform_tolerance())?;
+    let model = mobil_ros::chassis::chassis_params(&config.chassis)?.model().as_str();
+    let diagnostics = MotionDiagnostics::create(node, model)?;
     let mut shell = Shell {
+        diagnostics,
         tf,
         frame: config.frames.odom_frame.clone(),
         progress: ProgressChecker::new(config.controller.progress),
@@ -785,12 +791,6 @@ impl Shell {
                 ClockCheck::Held { .. } | ClockCheck::Running => {}
             }
         }
-        let Some(active) = self.session.active() else { return };
-        let (goal, source) = (active.goal.clone(), active.source);
-        // The displays and the feedback see the robot through the latest transforms.
-        if !self.tf.frames().is_odom(&goal.frame) {
-            self.tf.refresh(node.now_nanos());
-        }
         let inputs = [
             Watched {
                 name: "scan",
@@ -803,6 +803,27 @@ impl Shell {
                 timeout: self.config.timeouts.odom_timeout(),
             },
         ];
+        let described = |a: &mobil_ros::motion::Active<NavGoal, Source>| {
+            let g = &a.goal;
+            format!("{} ({:.3}, {:.3}) in {}", a.source.name(), g.goal.x, g.goal.y, g.frame)
+        };
+        let mode = mobil_local_nav_node::mode_name(self.nav.mode());
+        let goal = || self.session.active().map(described);
+        self.diagnostics.tick(
+            &self.session,
+            now,
+            &inputs,
+            goal,
+            mode,
+            node.stamp(),
+            &mut self.throttle,
+        );
+        let Some(active) = self.session.active() else { return };
+        let (goal, source) = (active.goal.clone(), active.source);
+        // The displays and the feedback see the robot through the latest transforms.
+        if !self.tf.frames().is_odom(&goal.frame) {
+            self.tf.refresh(node.now_nanos());
+        }
         if let Some(stale) = self.session.stale(now, &inputs) {
             return self.end_goal(node, out, sink, servers, EndCause::Stale(stale));
         }

@@ -91,3 +91,43 @@ impl DiagnosticsOut {
         }
     }
 }
+
+/// A motion node's `/diagnostics`: one status, `<node>: motion`, from its motion session
+/// ([`crate::motion::MotionSession::health_report`], [`mobil_motion::health::motion_health`]),
+/// once a second.
+pub struct MotionDiagnostics {
+    out: DiagnosticsOut,
+    hardware_id: String,
+}
+
+impl MotionDiagnostics {
+    /// The publisher of `node`; `hardware_id` names the robot (its chassis model).
+    pub fn create(node: &mut RosNode, hardware_id: &str) -> anyhow::Result<Self> {
+        Ok(MotionDiagnostics {
+            out: DiagnosticsOut::create(node)?,
+            hardware_id: hardware_id.to_owned(),
+        })
+    }
+
+    /// At a watchdog tick at `now`: when a report is due, the session's, with the `inputs` a
+    /// goal needs, the active goal as `goal` describes it and the law's `mode`, stamped `stamp`.
+    #[allow(clippy::too_many_arguments)]
+    pub fn tick<G, S>(
+        &mut self,
+        session: &crate::motion::MotionSession<G, S>,
+        now: Instant,
+        inputs: &[crate::motion::Watched],
+        goal: impl FnOnce() -> Option<String>,
+        mode: &str,
+        stamp: Time,
+        throttle: &mut LogThrottle,
+    ) {
+        if !self.out.due(now) {
+            return;
+        }
+        let report = session.health_report(now, inputs, goal(), mode);
+        let health = mobil_motion::health::motion_health(&report);
+        self.out
+            .send(&[("motion", &self.hardware_id, health)], stamp, now, throttle);
+    }
+}

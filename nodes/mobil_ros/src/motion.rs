@@ -52,6 +52,7 @@ use crate::cmd_vel::CmdVelOut;
 use crate::log::LogThrottle;
 use crate::status::{NavStatusView, StatusMessage};
 use crate::time::{ClockState, ClockWatch, DtClock, DtError};
+use mobil_motion::health::{InputAge, MotionReport};
 use mobil_motion::{BodyTwist, End, Step};
 pub use mobil_motion::{EndCause, EndKind};
 use mobil_msgs::builtin_interfaces::msg::Time;
@@ -255,6 +256,8 @@ pub struct MotionSession<G, S> {
     clock: ClockWatch,
     /// How long ROS time had stood still when last looked at, while the robot is held for it.
     clock_held: Option<Duration>,
+    /// How the last goal ended (its code), for `/diagnostics`.
+    last_end: Option<String>,
 }
 
 /// What [`MotionSession::watch_clock`] found.
@@ -316,6 +319,7 @@ impl<G, S> MotionSession<G, S> {
             next_id: 0,
             clock: ClockWatch::new(),
             clock_held: None,
+            last_end: None,
         }
     }
 
@@ -365,6 +369,9 @@ impl<G, S> MotionSession<G, S> {
             t: a.t,
             zeroed: false,
         });
+        if let Some(old) = &old {
+            self.last_end = Some(old.cause.code().to_owned());
+        }
         let id = GoalId(self.next_id);
         self.next_id += 1;
         self.active = Some(Active {
@@ -457,6 +464,7 @@ impl<G, S> MotionSession<G, S> {
             self.send_zero(sink);
         }
         let a = self.active.take()?;
+        self.last_end = Some(cause.code().to_owned());
         Some(Ended {
             id: a.id,
             goal: a.goal,
@@ -513,6 +521,32 @@ impl<G, S> MotionSession<G, S> {
                 Some(ended) => Applied::Ended(ended, report),
                 None => Applied::Idle,
             },
+        }
+    }
+
+    /// What the node reports on `/diagnostics` at `now` ([`mobil_motion::health::motion_health`]):
+    /// the active goal as `goal` describes it (ignored when idle), the law's `mode`, the
+    /// `inputs` (with a goal, an input counts no older than the goal, as in
+    /// [`MotionSession::stale`]), the stopped clock the robot is held for, the last end's code.
+    pub fn health_report(&self, now: Instant, inputs: &[Watched], goal: Option<String>, mode: &str) -> MotionReport {
+        let goal_age = self.active.as_ref().map(|a| a.age(now));
+        MotionReport {
+            goal: self.active.as_ref().and(goal),
+            mode: mode.to_owned(),
+            inputs: inputs
+                .iter()
+                .map(|w| InputAge {
+                    name: w.name,
+                    age_s: match (w.age, goal_age) {
+                        (Some(a), Some(g)) => Some(a.min(g).as_secs_f64()),
+                        (None, Some(g)) => Some(g.as_secs_f64()),
+                        (age, None) => age.map(|a| a.as_secs_f64()),
+                    },
+                    timeout_s: w.timeout.as_secs_f64(),
+                })
+                .collect(),
+            clock_held_s: self.clock_held.map(|d| d.as_secs_f64()),
+            last_end: self.last_end.clone(),
         }
     }
 
@@ -601,6 +635,34 @@ impl<G, S> MotionSession<G, S> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// `/diagnostics`' report: idle, an input's own age; with a goal, no older than the goal;
+    /// the goal described only while active; the last end's code; a held clock.
+    #[test]
+    fn the_health_report_follows_the_session() {
+        let mut sent: Vec<Twist> = Vec::new();
+        let mut s = MotionSession::<&str, &str>::new(SessionSettings::default());
+        let t0 = Instant::now();
+        let odom = |age: Option<u64>| Watched {
+            name: "odom",
+            age: age.map(Duration::from_millis),
+            timeout: Duration::from_millis(500),
+        };
+        let idle = s.health_report(t0, &[odom(Some(3000))], Some("ignored".into()), "idle");
+        assert_eq!(
+            (idle.goal, idle.inputs[0].age_s, idle.last_end),
+            (None, Some(3.0), None)
+        );
+        s.start("g", "dock_pose", t0);
+        let at = t0 + Duration::from_millis(200);
+        let active = s.health_report(at, &[odom(Some(3000)), odom(None)], Some("dock".into()), "dock");
+        assert_eq!(active.goal.as_deref(), Some("dock"));
+        assert_eq!((active.inputs[0].age_s, active.inputs[1].age_s), (Some(0.2), Some(0.2)));
+        s.end(EndCause::Canceled, &mut sent);
+        let after = s.health_report(at, &[], None, "idle");
+        assert_eq!(after.last_end.as_deref(), Some("CANCELED"));
+        assert_eq!(after.clock_held_s, None);
+    }
     use mobil_motion::{GoalLaw, Outcome, Pose2, StepInput};
 
     /// The goal source of the tests.

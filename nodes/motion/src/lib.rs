@@ -44,6 +44,7 @@
 //! ```
 #![warn(missing_docs)]
 
+pub mod health;
 pub mod progress;
 pub mod slot;
 pub mod status;

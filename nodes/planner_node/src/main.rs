@@ -52,6 +52,7 @@ use mobil_planner_node::{
     RouteAnswer, MAX_REPLY_POSES, ROUTE_LIMITS,
 };
 use mobil_ros::action::{goal_end, nav2_result, ActionEvent, GoalRequest, GoalServer, GoalServerConfig};
+use mobil_ros::diagnostics::MotionDiagnostics;
 use mobil_ros::geometry::{odom_pose, twist_msg};
 use mobil_ros::goal::{goal_pose, pose_in_frame, route_from_path, route_from_poses};
 use mobil_ros::input::Inputs;
@@ -224,6 +225,8 @@ struct Shell {
     /// The latest goal's frame (odometry's before the first): the frame of the status, the
     /// markers and the plans.
     frame: String,
+    /// `/diagnostics`.
+    diagnostics: MotionDiagnostics,
 }
 
 #[allow(clippy::large_enum_variant)]
@@ -296,6 +299,7 @@ async fn start(node: &mut RosNode, out: &Outputs, config: PlannerConfig) -> anyh
         config.frames.odom_frame
     );
     let mut shell = Shell {
+        diagnostics: MotionDiagnostics::create(node, chassis.model().as_str())?,
         tf,
         frame: config.frames.odom_frame.clone(),
         config,

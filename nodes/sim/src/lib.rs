@@ -10,5 +10,6 @@
 //! The world it moves in (circles and polygons from YAML, or the built-in world) is
 //! [`mobil_world`].
 
+pub mod health;
 pub mod lidar;
 pub mod plant;

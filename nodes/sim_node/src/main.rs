@@ -18,11 +18,13 @@ use mobil_msgs::tf2_msgs::msg::TFMessage;
 use mobil_msgs::visualization_msgs::msg::{Marker, MarkerArray};
 use mobil_ros::chassis::{chassis_params, declare_chassis};
 use mobil_ros::config::{Config, ConfigError, Decl};
+use mobil_ros::diagnostics::DiagnosticsOut;
 use mobil_ros::geometry::{planar_odometry, yaw_quaternion};
 use mobil_ros::input::Inputs;
 use mobil_ros::latest::{Freshness, Latest};
 use mobil_ros::time::{stamp_from_nanos, stamp_from_secs};
 use mobil_ros::{qos, run_node, shutdown_signal, warn_throttled, LogThrottle, NodeDecl, RosNode, Ticker};
+use mobil_sim::health::{sim_health, SimReport};
 use mobil_sim::lidar::{Lidar, LidarConfig};
 use mobil_sim::plant::{CommandOutcome, Plant, PlantConfig};
 use mobil_world::{Obstacle, World};
@@ -382,6 +384,12 @@ async fn run(node: &mut RosNode) -> anyhow::Result<()> {
     let (mut next_joints, mut next_scan) = (0.0f64, 0.0f64);
     let mut reported_collision = false;
     let mut watch = CommandWatch::default();
+    let mut diagnostics = SimDiagnostics {
+        out: DiagnosticsOut::create(node)?,
+        since: None,
+        refused: 0,
+        collision: None,
+    };
 
     loop {
         tokio::select! {
@@ -416,15 +424,22 @@ async fn run(node: &mut RosNode) -> anyhow::Result<()> {
                             plant.commanded()
                             )
                         }
-                        Err(e) => warn_throttled!(throttle, "cmd", "wheel_commands refused: {e}"),
+                        Err(e) => {
+                            diagnostics.refused += 1;
+                            warn_throttled!(throttle, "cmd", "wheel_commands refused: {e}")
+                        }
                     },
                     Err(e) => {
+                        diagnostics.refused += 1;
                         plant.stop();
                         warn_throttled!(throttle, "cmd", "wheel_commands dropped, wheels stopped: {e}");
                     }
                 },
                 // Logged (rate-limited) by the inputs.
-                Command::Undecodable => plant.stop(),
+                Command::Undecodable => {
+                    diagnostics.refused += 1;
+                    plant.stop()
+                }
             },
             scheduled = tick.tick() => {
                 // With its own clock the simulation never runs ahead of the nodes it drives by
@@ -448,8 +463,17 @@ async fn run(node: &mut RosNode) -> anyhow::Result<()> {
                 plant.step(dt, &world);
                 let t = plant.time();
                 if plant.collided() && !reported_collision {
-                    warn!("the robot hit an obstacle at {:?}", plant.reference_pose());
+                    let at = plant.reference_pose();
+                    warn!("the robot hit an obstacle at {at:?}");
+                    diagnostics.collision = Some((at.x, at.y));
                     reported_collision = true;
+                }
+                let now = Instant::now();
+                if diagnostics.out.due(now) {
+                    let report = diagnostics.report(&config, t, watch.last.age_at(now), now);
+                    let health = sim_health(&report);
+                    let model = plant_config.params.model().as_str();
+                    diagnostics.out.send(&[("simulation", model, health)], stamp_at(t, config.publish_clock), now, &mut throttle);
                 }
                 if let Some(clock) = &clock_pub {
                     let _ = clock.publish(Clock { clock: stamp_from_secs(t) });
@@ -498,6 +522,37 @@ async fn run(node: &mut RosNode) -> anyhow::Result<()> {
         }
     }
     Ok(())
+}
+
+/// `/diagnostics` once a second, and what it gathers between reports.
+struct SimDiagnostics {
+    out: DiagnosticsOut,
+    /// Simulated time and the wall instant at the last report.
+    since: Option<(f64, Instant)>,
+    /// `wheel_commands` refused or dropped since the last report.
+    refused: u64,
+    /// Where the robot first hit an obstacle.
+    collision: Option<(f64, f64)>,
+}
+
+impl SimDiagnostics {
+    /// The report at simulated time `t` and wall instant `now` (the factor measured since the
+    /// last one; the refusals counted anew from here).
+    fn report(&mut self, config: &SimConfig, t: f64, command_age: Option<Duration>, now: Instant) -> SimReport {
+        let factor_measured = self.since.and_then(|(t0, wall0)| {
+            let wall = now.duration_since(wall0).as_secs_f64();
+            (wall > 0.0).then(|| (t - t0) / wall)
+        });
+        self.since = Some((t, now));
+        SimReport {
+            factor_asked: config.real_time_factor,
+            factor_measured,
+            command_age_s: command_age.map(|a| a.as_secs_f64()),
+            command_timeout_s: config.command_timeout_s,
+            commands_refused: std::mem::take(&mut self.refused),
+            collision: self.collision,
+        }
+    }
 }
 
 /// The simulated drivers' command timeout: the last valid `wheel_commands` in a [`Latest`]

@@ -27,11 +27,13 @@ use mobil_msgs::sensor_msgs::msg::LaserScan;
 use mobil_ros::action::{goal_end, ActionEvent, GoalEnd, GoalRequest, GoalServer, GoalServerConfig};
 use mobil_ros::cmd_vel::{CmdVelOut, CmdVelType, TypeWatch};
 use mobil_ros::config::{Config, ConfigError, Decl};
+use mobil_ros::diagnostics::MotionDiagnostics;
 use mobil_ros::geometry::planar_pose;
 use mobil_ros::groups::{GoalTimeouts, MAX_INPUT_TIMEOUT_S};
 use mobil_ros::input::Inputs;
 use mobil_ros::latest::Latest;
 use mobil_ros::lifecycle::{CallbackReturn, Lifecycle, Managed};
+use mobil_ros::motion::Watched;
 use mobil_ros::motion::{Applied, ClockCheck, CmdVel, EndCause, EndKind, Ended, MotionSession, SessionSettings};
 use mobil_ros::node::NodeClock;
 use mobil_ros::scan::{checked_scan, tf_static_subscription, LaserParams, StaticFrames};
@@ -435,6 +437,7 @@ async fn drive_loop(
         started_nanos: 0,
     };
     let mut shell = Shell {
+        diagnostics: MotionDiagnostics::create(node, &config.base_frame)?,
         config,
         latest: Latest::new(),
         echoes: Latest::new(),
@@ -485,6 +488,8 @@ struct Shell {
     laser: StaticFrames,
     types: TypeWatch,
     throttle: LogThrottle,
+    /// `/diagnostics`.
+    diagnostics: MotionDiagnostics,
 }
 
 /// A Nav2 behavior's goal: the law, or the end Nav2's behavior server gives it at once.
@@ -725,6 +730,23 @@ impl Shell {
                 return;
             }
         }
+        let now = Instant::now();
+        // The scan is not needed: without one the collision check is off (warned at a goal).
+        let inputs = [Watched {
+            name: "odom",
+            age: self.latest.age_at(now),
+            timeout: self.config.timeouts.odom_timeout(),
+        }];
+        let kind_now = session.active().map(|a| <&str>::from(a.source));
+        self.diagnostics.tick(
+            session,
+            now,
+            &inputs,
+            || kind_now.map(str::to_owned),
+            kind_now.unwrap_or("idle"),
+            node.stamp(),
+            &mut self.throttle,
+        );
         let Some(kind) = session.active().map(|a| a.source) else {
             return;
         };

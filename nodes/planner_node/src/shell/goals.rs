@@ -349,18 +349,35 @@ impl Shell {
                 ClockCheck::Held { .. } | ClockCheck::Running => {}
             }
         }
-        let Some(active) = self.session.active() else { return };
+        // /diagnostics: odometry always, the scan for VFO (the method's, or the running goal's).
+        let active = self.session.active();
+        let config = active.map_or(&self.config, |a| &a.goal.config);
         let mut inputs = vec![Watched {
             name: "odom",
             age: self.odom.age_at(now),
-            timeout: active.goal.config.timeouts.odom_timeout(),
+            timeout: config.timeouts.odom_timeout(),
         }];
-        if active.goal.task.is_vfo() {
+        let vfo = active.map_or(config.waypoint_method == WaypointMethod::Vfo, |a| a.goal.task.is_vfo());
+        if vfo {
             inputs.push(Watched {
                 name: "scan",
                 age: self.scan_seen.age_at(now),
-                timeout: active.goal.config.vfo.scan_timeout(),
+                timeout: config.vfo.scan_timeout(),
             });
+        }
+        let mode = active.map_or(mobil_planner::task::Mode::Idle, |a| a.goal.task.mode());
+        let goal = || active.map(|a| format!("{} in {}", a.source.name(), a.goal.frame));
+        self.diagnostics.tick(
+            &self.session,
+            now,
+            &inputs,
+            goal,
+            mode.as_str(),
+            io.node.stamp(),
+            &mut self.throttle,
+        );
+        if self.session.active().is_none() {
+            return;
         }
         if let Some(stale) = self.session.stale(now, &inputs) {
             return self.end_goal(io, EndCause::Stale(stale));
