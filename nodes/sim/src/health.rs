@@ -48,7 +48,9 @@ pub struct SimReport {
 /// the timeout, the refusals, the collision.
 pub fn sim_health(r: &SimReport) -> Health {
     let driven = r.command_age_s.is_some_and(|a| a <= r.command_timeout_s);
-    let slow = r.factor_measured.filter(|m| m.is_nan() || *m < SLOW_SHARE * r.factor_asked);
+    let slow = r
+        .factor_measured
+        .filter(|m| m.is_nan() || *m < SLOW_SHARE * r.factor_asked);
     let (level, message) = match (r.collision, slow) {
         (Some((x, y)), _) => (Level::Error, format!("the robot hit an obstacle at ({x:.2}, {y:.2})")),
         (None, Some(m)) => (
