@@ -26,6 +26,9 @@ use std::time::{Duration, Instant};
 /// diagnostic_updater's default period.
 pub const DIAGNOSTICS_PERIOD: Duration = Duration::from_secs(1);
 
+/// How early a report may go out on a tick that falls just short of the period.
+pub const DUE_SLACK: Duration = Duration::from_millis(50);
+
 /// The status of `health` for task `task` of node `node` (its fully qualified name), about
 /// `hardware_id`.
 pub fn status_msg(health: &Health, node: &str, task: &str, hardware_id: &str) -> DiagnosticStatus {
@@ -62,9 +65,11 @@ impl DiagnosticsOut {
         })
     }
 
-    /// Whether a report is due at `now` ([`DIAGNOSTICS_PERIOD`] since the last, or none yet).
+    /// Whether a report is due at `now` ([`DIAGNOSTICS_PERIOD`] since the last, less
+    /// [`DUE_SLACK`], or none yet): a node that looks once a second on a jittery tick still
+    /// reports once a second, not every other one.
     pub fn due(&self, now: Instant) -> bool {
-        self.since_last(now).is_none_or(|d| d >= DIAGNOSTICS_PERIOD)
+        self.since_last(now).is_none_or(|d| d + DUE_SLACK >= DIAGNOSTICS_PERIOD)
     }
 
     /// How long since the last report at `now` (`None`: none yet).

@@ -636,33 +636,6 @@ impl<G, S> MotionSession<G, S> {
 mod tests {
     use super::*;
 
-    /// `/diagnostics`' report: idle, an input's own age; with a goal, no older than the goal;
-    /// the goal described only while active; the last end's code; a held clock.
-    #[test]
-    fn the_health_report_follows_the_session() {
-        let mut sent: Vec<Twist> = Vec::new();
-        let mut s = MotionSession::<&str, &str>::new(SessionSettings::default());
-        let t0 = Instant::now();
-        let odom = |age: Option<u64>| Watched {
-            name: "odom",
-            age: age.map(Duration::from_millis),
-            timeout: Duration::from_millis(500),
-        };
-        let idle = s.health_report(t0, &[odom(Some(3000))], Some("ignored".into()), "idle");
-        assert_eq!(
-            (idle.goal, idle.inputs[0].age_s, idle.last_end),
-            (None, Some(3.0), None)
-        );
-        s.start("g", "dock_pose", t0);
-        let at = t0 + Duration::from_millis(200);
-        let active = s.health_report(at, &[odom(Some(3000)), odom(None)], Some("dock".into()), "dock");
-        assert_eq!(active.goal.as_deref(), Some("dock"));
-        assert_eq!((active.inputs[0].age_s, active.inputs[1].age_s), (Some(0.2), Some(0.2)));
-        s.end(EndCause::Canceled, &mut sent);
-        let after = s.health_report(at, &[], None, "idle");
-        assert_eq!(after.last_end.as_deref(), Some("CANCELED"));
-        assert_eq!(after.clock_held_s, None);
-    }
     use mobil_motion::{GoalLaw, Outcome, Pose2, StepInput};
 
     /// The goal source of the tests.
@@ -1132,5 +1105,33 @@ mod tests {
         // A goal that never commanded an idle robot needs none.
         s.start(ToX { to: 5.0 }, Src::Action, Instant::now());
         assert!(!s.shutdown().1);
+    }
+
+    /// `/diagnostics`' report: idle, an input's own age; with a goal, no older than the goal;
+    /// the goal described only while active; the last end's code; a held clock.
+    #[test]
+    fn the_health_report_follows_the_session() {
+        let mut sent: Vec<Twist> = Vec::new();
+        let mut s = MotionSession::<&str, &str>::new(SessionSettings::default());
+        let t0 = Instant::now();
+        let odom = |age: Option<u64>| Watched {
+            name: "odom",
+            age: age.map(Duration::from_millis),
+            timeout: Duration::from_millis(500),
+        };
+        let idle = s.health_report(t0, &[odom(Some(3000))], Some("ignored".into()), "idle");
+        assert_eq!(
+            (idle.goal, idle.inputs[0].age_s, idle.last_end),
+            (None, Some(3.0), None)
+        );
+        s.start("g", "dock_pose", t0);
+        let at = t0 + Duration::from_millis(200);
+        let active = s.health_report(at, &[odom(Some(3000)), odom(None)], Some("dock".into()), "dock");
+        assert_eq!(active.goal.as_deref(), Some("dock"));
+        assert_eq!((active.inputs[0].age_s, active.inputs[1].age_s), (Some(0.2), Some(0.2)));
+        s.end(EndCause::Canceled, &mut sent);
+        let after = s.health_report(at, &[], None, "idle");
+        assert_eq!(after.last_end.as_deref(), Some("CANCELED"));
+        assert_eq!(after.clock_held_s, None);
     }
 }

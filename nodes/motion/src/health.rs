@@ -16,7 +16,7 @@
 //! };
 //! let health = motion_health(&report);
 //! assert_eq!(health.level, Level::Warn);
-//! assert_eq!(health.message, "idle; odom 3.50 s old (timeout 2.00 s): a goal would be refused");
+//! assert_eq!(health.message, "idle; odom 3.50 s old (timeout 2.00 s): a goal would fail (stale input)");
 //! ```
 
 use mobil_chassis::health::{age_text, Health, Level};
@@ -56,7 +56,7 @@ pub struct MotionReport {
 
 /// The node's health, the worst first: with a goal, ERROR while the robot is held for a
 /// stopped clock or an input is stale (the goal is ending `STALE_INPUT`); idle, WARN when an
-/// input is stale (a goal would be refused or end at once); else OK, active or idle. The
+/// input is stale (a goal would fail (stale input) or end at once); else OK, active or idle. The
 /// values: the state, the goal, the mode, each input's age and timeout, the last end.
 pub fn motion_health(r: &MotionReport) -> Health {
     let stale: Vec<String> = r
@@ -80,7 +80,7 @@ pub fn motion_health(r: &MotionReport) -> Health {
         (Some(goal), None, true) => (Level::Ok, format!("active: {goal} ({})", r.mode)),
         (None, _, false) => (
             Level::Warn,
-            format!("idle; {}: a goal would be refused", stale.join(", ")),
+            format!("idle; {}: a goal would fail (stale input)", stale.join(", ")),
         ),
         (None, _, true) => (Level::Ok, "idle".to_owned()),
     };
@@ -176,7 +176,10 @@ mod tests {
         let never = motion_health(&report(false, None, None));
         assert_eq!(
             (never.level, never.message.as_str()),
-            (Level::Warn, "idle; odom never received: a goal would be refused")
+            (
+                Level::Warn,
+                "idle; odom never received: a goal would fail (stale input)"
+            )
         );
         assert_eq!(never.values[3].1, "never");
         let idle = motion_health(&report(false, Some(0.4), None));

@@ -47,7 +47,10 @@ pub struct SimReport {
 /// drivers' timeout) or idle (wheels stopped). The values: both factors, the command's age and
 /// the timeout, the refusals, the collision.
 pub fn sim_health(r: &SimReport) -> Health {
-    let driven = r.command_age_s.is_some_and(|a| a <= r.command_timeout_s);
+    // A timeout of 0 never expires: the drivers keep the last command.
+    let driven = r
+        .command_age_s
+        .is_some_and(|a| r.command_timeout_s <= 0.0 || a <= r.command_timeout_s);
     let slow = r
         .factor_measured
         .filter(|m| m.is_nan() || *m < SLOW_SHARE * r.factor_asked);
@@ -63,7 +66,7 @@ pub fn sim_health(r: &SimReport) -> Health {
         (None, None) if r.commands_refused > 0 => (
             Level::Warn,
             format!(
-                "{} wheel_commands refused since the last report: wheels stopped",
+                "{} wheel_commands refused or dropped since the last report",
                 r.commands_refused
             ),
         ),
@@ -121,6 +124,13 @@ mod tests {
             ..report()
         });
         assert_eq!(idle.message, "idle: no wheel_commands, wheels stopped");
+        // No timeout (0): the drivers keep the last command, however old.
+        let kept = sim_health(&SimReport {
+            command_age_s: Some(60.0),
+            command_timeout_s: 0.0,
+            ..report()
+        });
+        assert_eq!(kept.message, "driven");
         // 4.0 is 0.8 of 5: not slow; 3.99 is.
         let at_share = sim_health(&SimReport {
             factor_measured: Some(4.0),
@@ -138,10 +148,7 @@ mod tests {
         });
         assert_eq!(
             (refused.level, refused.message.as_str()),
-            (
-                Level::Warn,
-                "3 wheel_commands refused since the last report: wheels stopped"
-            )
+            (Level::Warn, "3 wheel_commands refused or dropped since the last report")
         );
         let hit = sim_health(&SimReport {
             collision: Some((1.0, -2.5)),

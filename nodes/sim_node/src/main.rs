@@ -405,6 +405,10 @@ async fn run(node: &mut RosNode) -> anyhow::Result<()> {
                         (Some(c), _) => Some(Lidar::new(c, config.seed.wrapping_add(1))),
                         (None, _) => None,
                     };
+                    if new.real_time_factor != config.real_time_factor {
+                        // The next measurement starts at the new rate, not blended with the old.
+                        diagnostics.since = None;
+                    }
                     plant.reconfigure(new_plant);
                     plant_config = new_plant;
                     config = new;
