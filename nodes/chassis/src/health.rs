@@ -55,6 +55,17 @@ pub struct Health {
     pub values: Vec<(String, String)>,
 }
 
+impl Health {
+    /// A status of `level` with `message` and the fixed-order `values` (key, value).
+    pub fn new<const N: usize>(level: Level, message: String, values: [(&str, String); N]) -> Self {
+        Health {
+            level,
+            message,
+            values: values.into_iter().map(|(k, v)| (k.to_owned(), v)).collect(),
+        }
+    }
+}
+
 /// The age of an input for a value: seconds with three decimals, or `never`.
 pub fn age_text(age: Option<f64>) -> String {
     age.map_or_else(|| "never".to_owned(), |a| format!("{a:.3}"))
@@ -125,11 +136,7 @@ pub fn chassis_health(r: &ChassisReport) -> Health {
         ),
         ("rejected messages", r.rejected_total.to_string()),
     ];
-    Health {
-        level,
-        message,
-        values: values.into_iter().map(|(k, v)| (k.to_owned(), v)).collect(),
-    }
+    Health::new(level, message, values)
 }
 
 #[cfg(test)]

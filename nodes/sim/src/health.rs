@@ -89,11 +89,7 @@ pub fn sim_health(r: &SimReport) -> Health {
                 .map_or_else(|| "none".to_owned(), |(x, y)| format!("({x:.3}, {y:.3})")),
         ),
     ];
-    Health {
-        level,
-        message,
-        values: values.into_iter().map(|(k, v)| (k.to_owned(), v)).collect(),
-    }
+    Health::new(level, message, values)
 }
 
 #[cfg(test)]
