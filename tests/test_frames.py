@@ -2,7 +2,7 @@
 `map → odom` on `/tf`, and local_nav_node and planner_node follow goals given in `map` on the
 simulated OMR-III and MOBIL-II (the built-in world, simulated clock at 5× real time).
 
-The localiser dates each transform 0.5 s ahead of the simulated clock it last saw, as AMCL
+The localiser dates each transform 1.5 s ahead of the simulated clock it last saw, as AMCL
 dates its own ahead by its `transform_tolerance`, and sends it every 20 ms of wall time.
 
 The hand-worked frames: odom sits at (0.5, −1.0) in map, turned by π/2, so a point (x, y) in
@@ -41,7 +41,9 @@ DEEP = make_qos("reliable", "volatile", 5000)
 # odom's pose in map: before the correction, after it.
 ODOM_IN_MAP = (0.5, -1.0, math.pi / 2)
 CORRECTED = (0.5, -0.7, math.pi / 2)
-DATED_AHEAD = 0.5
+# Dated ahead as AMCL dates its transforms (by its transform_tolerance, 1 s by default), a
+# little more: a test process stalled for a moment must not let the transform age.
+DATED_AHEAD = 1.5
 
 
 def in_map(frame, x: float, y: float) -> tuple[float, float]:
@@ -252,7 +254,8 @@ def test_local_nav_follows_goals_in_map_through_the_localiser(robot, start_scena
         no_motion_after(cmd, n, 0.5)
 
         # 4. A goal under way when the localiser stops: TF_ERROR (stale), the robot stopped.
-        _, start = publish_until_status(goal_pub, pose("map", 0.5, 3.0), status,
+        # (5.2, 0) in odom: still far when the transform ages out, 1.6 s after the last one.
+        _, start = publish_until_status(goal_pub, pose("map", 0.5, 4.5), status,
                                         lambda s: s.state == NavStatus.ACTIVE)
         cmd.wait_for(lambda t: not is_zero(t), REPLY_TIMEOUT, start=n)
         n = len(cmd)
