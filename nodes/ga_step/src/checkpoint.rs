@@ -139,9 +139,14 @@ pub fn from_json_tagged(text: &str) -> Result<(GaState, EvaluatorTag), Checkpoin
     // A checkpoint written before the robust score existed was scored without it (a missing
     // key elsewhere takes its default, which for this one is on).
     let named = value.pointer("/setup/fitness/robust_check").is_some();
+    // One written before the physics model could be chosen was scored by the DC-motor model.
+    let physics_named = value.pointer("/setup/fitness/physics").is_some();
     let mut doc: Document = serde_json::from_value(value).map_err(|e| CheckpointError::Corrupt(e.to_string()))?;
     if !named {
         doc.setup.fitness.robust_check = false;
+    }
+    if !physics_named {
+        doc.setup.fitness.physics = crate::config::PhysicsModel::DcMotor;
     }
     let word_pos: u128 = doc
         .rng_word_pos

@@ -8,6 +8,37 @@ use serde::{Deserialize, Serialize};
 use std::fmt;
 use std::str::FromStr;
 
+/// The built-in physics' model of the robot (the parameter `physics`; the built-in physics
+/// only, an external simulator has its own).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum PhysicsModel {
+    /// The Nao of Webots, the source's simulator: its motors (position control by velocity,
+    /// maxTorque, maxVelocity), its foot and the floor contact of its Nao worlds, 20 ms steps
+    /// (docs/ga_step.md, "The physics evaluator").
+    #[default]
+    Webots,
+    /// The earlier model from Aldebaran's motor datasheet: a PD servo limited to the motor's
+    /// continuous torque, μ 0.8, 5 ms steps (docs/experiments/ga-step-physics.md).
+    DcMotor,
+}
+
+impl PhysicsModel {
+    /// The parameter's spelling: `webots` or `dc-motor`.
+    pub fn name(self) -> &'static str {
+        match self {
+            PhysicsModel::Webots => "webots",
+            PhysicsModel::DcMotor => "dc-motor",
+        }
+    }
+}
+
+impl std::fmt::Display for PhysicsModel {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
 /// The crossover operator of a run (SPEC §8; the names are the `--crossover` option's).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
 #[serde(rename_all = "kebab-case")]
@@ -261,6 +292,9 @@ pub struct FitnessConfig {
     /// both scores the smaller Δx). Default `true` (see docs/experiments/ga-step-physics.md). The
     /// built-in physics refuses it with [`distance_on_fall`](Self::distance_on_fall); others ignore it.
     pub robust_check: bool,
+    /// The built-in physics' model of the robot. Default [`PhysicsModel::Webots`]; others
+    /// ignore it.
+    pub physics: PhysicsModel,
 }
 
 impl Default for FitnessConfig {
@@ -274,6 +308,7 @@ impl Default for FitnessConfig {
             distance_on_fall: false,
             backward_allowance: 1.0,
             robust_check: true,
+            physics: PhysicsModel::Webots,
         }
     }
 }

@@ -110,7 +110,7 @@ pub use checkpoint::{
     read_checkpoint, read_checkpoint_tagged, write_checkpoint, EvaluatorTag, CHECKPOINT_FORMAT, CHECKPOINT_VERSION,
     MAX_CHECKPOINT_BYTES,
 };
-pub use config::{BlxVariant, Crossover, FitnessConfig, GaConfig, MAX_POPULATION};
+pub use config::{BlxVariant, Crossover, FitnessConfig, GaConfig, PhysicsModel, MAX_POPULATION};
 pub use error::{CheckpointError, GaError, MotionError, ParamsError};
 pub use evaluate::{evaluate_all, resolve_threads, Evaluation, Evaluator, TestLandscape};
 pub use ga::{GaRng, GaSetup, GaState, GenerationStats, StopReason};

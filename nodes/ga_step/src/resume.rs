@@ -90,9 +90,16 @@ pub fn run_differences(
         was_f.robust_check.to_string(),
         now_f.robust_check.to_string(),
     );
+    differ(
+        !robust_counts || was_f.physics == now_f.physics,
+        "physics",
+        was_f.physics.to_string(),
+        now_f.physics.to_string(),
+    );
     let mut theirs = state.setup.clone();
     if !robust_counts {
         theirs.fitness.robust_check = now_f.robust_check;
+        theirs.fitness.physics = now_f.physics;
     }
     if differences.is_empty() && theirs != *setup {
         differences.push("other parameters of the robot, the algorithm or the fitness (--params)".to_owned());

@@ -48,6 +48,7 @@ fn the_file_holds_the_documented_defaults() {
         "distance_on_fall",
         "backward_allowance",
         "robust_check",
+        "physics",
         "blx_alpha",
         "blx_variant",
         "crossover_weight",

@@ -75,6 +75,11 @@ pub fn key_docs() -> Vec<KeyDoc> {
             Constraint::Any,
             "score each individual under a second solver setting too and keep the worse (built-in physics only)",
         ),
+        doc(
+            "physics",
+            Constraint::Choices(vec!["webots".to_owned(), "dc-motor".to_owned()]),
+            "the built-in physics' robot model: Webots' Nao, or the earlier DC-motor model",
+        ),
         doc("blx_alpha", non_negative(), "α of BLX-α"),
         doc(
             "blx_variant",

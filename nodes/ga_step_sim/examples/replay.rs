@@ -16,20 +16,7 @@
 //! that keeps `PHYSICS_VERSION` must pass this); the exit status is 1 if any differs.
 use mobil_ga_step::Evaluator;
 use mobil_ga_step::{EvaluatorTag, FitnessConfig, NaoModel};
-use mobil_ga_step_sim::{BodyParams, PhysicsEvaluator, CHECK_SETTING, PHYSICS_VERSION};
-
-/// The settings replayed without any given: the default, the robust score's check (4 ms/4/2),
-/// then 2.5 ms/8/2 and 1.25 ms/16/4.
-const SETTINGS: [(f64, usize, usize); 4] = [
-    (0.005, 4, 2),
-    (
-        CHECK_SETTING.dt,
-        CHECK_SETTING.solver_iterations,
-        CHECK_SETTING.pgs_iterations,
-    ),
-    (0.0025, 8, 2),
-    (0.00125, 16, 4),
-];
+use mobil_ga_step_sim::{BodyParams, PhysicsEvaluator, SolverSetting, PHYSICS_VERSION};
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mut args = std::env::args().skip(1).peekable();
@@ -48,9 +35,6 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             return Err(format!("{a}: expected DT_MS:ITERATIONS:PASSES").into());
         }
         settings.push((p[0].parse::<f64>()? / 1e3, p[1].parse()?, p[2].parse()?));
-    }
-    if settings.is_empty() {
-        settings = SETTINGS.to_vec();
     }
     let (model, fitness, ind, stored) = if path.ends_with(".motion") {
         let model = NaoModel::default();
@@ -80,11 +64,26 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         );
     }
     let duration = fitness.sim_time(model.step_time);
+    let base = BodyParams::named(fitness.physics);
+    if settings.is_empty() {
+        // The run's model's default and check settings, then two ever finer ones.
+        let check = base.check;
+        for s in [SolverSetting::of(&base), check, check.finer(), check.finer().finer()] {
+            settings.push((s.dt, s.solver_iterations, s.pgs_iterations));
+        }
+    }
+    println!("  physics model: {}", fitness.physics);
     // The robust score's verdict when the fitness asks for it (the default and the check).
     if fitness.robust_check && !fitness.distance_on_fall {
         let e = PhysicsEvaluator::new(model.clone(), fitness.clone())?.evaluate(&ind);
         println!(
-            "  robust score (5 ms/4/2 and 4 ms/4/2): fitness {:.4}, {}, t {:.3} s, dx {:+.4} m",
+            "  robust score ({} ms/{}/{} and {} ms/{}/{}): fitness {:.4}, {}, t {:.3} s, dx {:+.4} m",
+            base.dt * 1e3,
+            base.solver_iterations,
+            base.pgs_iterations,
+            base.check.dt * 1e3,
+            base.check.solver_iterations,
+            base.check.pgs_iterations,
             e.fitness,
             if e.fell { "falls" } else { "upright" },
             e.t_fall,
@@ -110,7 +109,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             dt,
             solver_iterations: iterations,
             pgs_iterations: passes,
-            ..BodyParams::default()
+            ..base.clone()
         };
         let ev = PhysicsEvaluator::with_body(model.clone(), fitness.clone(), body)?;
         let (o, r) = ev.simulate_feet_report(&ind, duration);

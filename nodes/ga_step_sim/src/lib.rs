@@ -9,21 +9,23 @@
 //! robot's 4.996 kg less both legs: head, arms and pelvis links held rigid, as the hip yaw-pitch,
 //! the arms and the head are not evolved) and two legs of Nao's chain torso → hip roll → hip
 //! pitch → knee → ankle pitch → ankle roll, with Nao's link lengths (hips 50 mm either side of
-//! and 85 mm below the torso frame, thigh 100 mm, tibia 102.9 mm, foot height 45.19 mm) and link
-//! masses. Thighs and tibias are capsules, hip and ankle links small balls, the feet 160 × 90 mm
-//! boxes in Coulomb contact (μ = 0.8) with a flat floor; the legs collide with each other, not
-//! with the links they are jointed to.
+//! and 85 mm below the torso frame, thigh 100 mm, tibia 102.9 mm) and link masses. Thighs and
+//! tibias are capsules, hip and ankle links small balls, the feet boxes in Coulomb contact with a
+//! flat floor; the legs collide with each other, not with the links they are jointed to.
 //!
-//! **The servos**: revolute joints of a rapier multibody (reduced coordinates: the chain cannot
-//! drift apart), each a position motor (stiffness 156 N·m/rad, damping 3 N·m·s/rad) whose torque
-//! is what Nao's motor gives continuously: the nominal torque (1.61 N·m pitch, 2.47 N·m roll),
-//! cut above the nominal speed by the DC motor's torque–speed line (stall torque 7.78 / 11.97
-//! N·m at rest, 0 at the no-load speed 6.40 / 4.16 rad/s) while the motor drives the joint the
-//! way it turns; Table 1's limits; the commanded angle moves towards the trajectory no faster
-//! than the no-load speed ([`BodyParams::torque_limit`]). Joint signs are Nao's (Aldebaran,
-//! "H25 – Joints": every joint frame is the torso's at the zero pose, roll turns about x, pitch
-//! about y, right-handed): a negative hip pitch swings the leg forward, a positive knee bends it
-//! back, a positive ankle roll lifts the foot's left edge ([`PhysicsEvaluator::reach`]).
+//! **Two models** ([`mobil_ga_step::PhysicsModel`]). The default, [`BodyParams::webots`], is the
+//! Nao of Webots, the source's simulator (docs/ga_step.md, "Calibration", gives every figure's
+//! file and line): each servo is Webots' position control, the velocity P·(target − angle)
+//! (P = 10) clamped to `maxVelocity` (6.40 / 4.16 rad/s) and reached by a hard velocity motor of
+//! at most `maxTorque` (8 N·m pitch, 12 N·m roll, version V3.3); the sole is Webots' 147 × 89 mm
+//! plate 46 mm below the ankle; the floor contact is nao_robocup.wbt's (μ 7, bounce 0.3) with
+//! ODE's contact softness; 20 ms steps, Webots' own. [`BodyParams::dc_motor`] is the earlier
+//! model from Aldebaran's motor datasheet: a PD servo (156 N·m/rad, 3 N·m·s/rad) limited to the
+//! motor's continuous torque (1.61 / 2.47 N·m) and its torque–speed line, a 160 × 90 mm sole,
+//! μ 0.8, 5 ms steps. Joint signs are Nao's (Aldebaran, "H25 – Joints": every joint frame is the
+//! torso's at the zero pose, roll turns about x, pitch about y, right-handed): a negative hip
+//! pitch swings the leg forward, a positive knee bends it back, a positive ankle roll lifts the
+//! foot's left edge ([`PhysicsEvaluator::reach`]).
 //!
 //! **A fall**, tested after every step; the simulation ends there: the torso frame below
 //! `fall_height` (0.20 m; it starts about 0.32 m up), its vertical axis tilted more than
@@ -36,18 +38,16 @@
 //! model (a knot not finite, outside its servo's limits, or an end off the standing pose) is
 //! not simulated: a fall at t = 0 ([`FallCause::Invalid`]), fitness 0.
 //!
-//! **The solver**: 5 ms steps, 4 solver iterations (substeps) of 2 projected Gauss–Seidel
-//! passes each. With 1 pass (rapier's default) the friction does not converge: a standing robot
-//! crept 11 mm in 3 s and evolved motions travelled 0.3–0.6 m by hopping and sliding, motions
-//! that fall at any finer setting; with 2 passes the outcomes of standing, bobbing in place and
-//! those motions match those at a quarter of the step with four times the iterations (the
-//! solver table of docs/experiments/ga-step-physics.md), at the same cost.
+//! **The solver**: rapier's soft-constraint solver, 4 iterations (substeps) of 2 projected
+//! Gauss–Seidel passes a step. The Webots model solves friction in every pass
+//! ([`BodyParams::friction_every_pass`]), as ODE solves it with the motors; the scores at 20 ms
+//! agree with those at 10 ms and 8 iterations (docs/ga_step.md, "Convergence").
 //!
 //! **The robust score** ([`FitnessConfig::robust_check`], on by default): near the edge of a
 //! fall the verdict does not converge with the setting, and selection finds such edges, so
-//! [`Evaluator::evaluate`] simulates at the default and at [`CHECK_SETTING`] and keeps the worse
-//! outcome ([`PhysicsEvaluator::robust_simulate`]); about 2.3 times the cost for an individual
-//! that stays up, less for one that falls.
+//! [`Evaluator::evaluate`] simulates at the default and at the body's
+//! [`check`](BodyParams::check) setting (the Webots model: 10 ms, 8 iterations; the DC-motor
+//! model: [`CHECK_SETTING`]) and keeps the worse outcome ([`PhysicsEvaluator::robust_simulate`]).
 //!
 //! **Determinism**: each evaluation builds its own world and steps it on the calling thread;
 //! rapier is built with `enhanced-determinism`, so the same individual gives the same
@@ -62,6 +62,9 @@ pub mod motions;
 /// and a run made under another is not resumed: the same individual scores differently. Raise it
 /// with every change that moves a score.
 ///
+/// 4: the Nao of Webots ([`BodyParams::webots`], [`mobil_ga_step::PhysicsModel::Webots`]) by
+/// default; the earlier model stays selectable as [`BodyParams::dc_motor`], scoring as at 3.
+///
 /// 3: the robust score ([`FitnessConfig::robust_check`], on by default): each individual is
 /// simulated at the default solver setting and at [`CHECK_SETTING`] and scores the worse, so an
 /// individual is upright only if it stays up under both.
@@ -70,13 +73,19 @@ pub mod motions;
 /// passes per solver iteration, so that friction converges (the standing robot no longer
 /// creeps, motions no longer travel by sliding); a floor contact of any body but the feet is a
 /// fall. 1 was the first evaluator.
-pub const PHYSICS_VERSION: u32 = 3;
+pub const PHYSICS_VERSION: u32 = 4;
 
-pub use body::{BodyParams, LegMasses};
+pub use body::{BodyParams, LegMasses, ServoKind};
 
 use body::{is_roll, leg_chain};
 use mobil_ga_step::{Evaluation, Evaluator, FitnessConfig, GaError, Individual, NaoModel, Servo, KNOTS, SERVO_COUNT};
 use rapier3d::prelude::*;
+
+/// The damping (N·m·s/rad) of rapier's velocity motor standing in for ODE's joint motor, which
+/// reaches the asked velocity within the step whenever its torque limit allows: a million makes
+/// the motor's softness (1/(dt·damping), 5·10⁻⁵ at 20 ms) negligible beside the inverse inertia
+/// of any link about its joint (above 10 (kg·m²)⁻¹), so the motor is as hard as ODE's.
+const HARD_MOTOR_DAMPING: Real = 1.0e6;
 
 /// Why an evaluator could not be built.
 #[derive(Debug, thiserror::Error, PartialEq)]
@@ -155,6 +164,79 @@ impl SolverSetting {
             ..body.clone()
         }
     }
+}
+
+impl SolverSetting {
+    /// The setting of `body`.
+    pub fn of(body: &BodyParams) -> SolverSetting {
+        SolverSetting {
+            dt: body.dt,
+            solver_iterations: body.solver_iterations,
+            pgs_iterations: body.pgs_iterations,
+        }
+    }
+
+    /// The convergence check's finer setting: half the step, twice the solver iterations, the
+    /// same Gauss–Seidel passes.
+    pub fn finer(&self) -> SolverSetting {
+        SolverSetting {
+            dt: self.dt / 2.0,
+            solver_iterations: self.solver_iterations * 2,
+            ..*self
+        }
+    }
+}
+
+/// How far two evaluators agree on a set of individuals ([`agreement`]): the convergence check
+/// of a solver setting against a finer one.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct Agreement {
+    /// Individuals compared.
+    pub individuals: usize,
+    /// Those with the same verdict (fall or no fall) under both.
+    pub same_verdict: usize,
+    /// Those upright under both.
+    pub upright_both: usize,
+    /// The largest relative fitness difference, |f₁ − f₂| / max(f₁, f₂), among those upright
+    /// under both (0 without any).
+    pub worst_upright_gap: f64,
+    /// The largest difference of Δx (m) among those upright under both.
+    pub worst_upright_dx_gap: f64,
+}
+
+impl Agreement {
+    /// The share of individuals with the same verdict (1 for none).
+    pub fn verdict_share(&self) -> f64 {
+        if self.individuals == 0 {
+            1.0
+        } else {
+            self.same_verdict as f64 / self.individuals as f64
+        }
+    }
+}
+
+/// Scores every individual under `a` and under `b` (each with its own robust score, if any)
+/// and counts where they agree.
+pub fn agreement(a: &PhysicsEvaluator, b: &PhysicsEvaluator, individuals: &[Individual]) -> Agreement {
+    let mut out = Agreement {
+        individuals: individuals.len(),
+        ..Agreement::default()
+    };
+    for ind in individuals {
+        let (oa, ob) = (a.robust_simulate(ind), b.robust_simulate(ind));
+        if oa.fell == ob.fell {
+            out.same_verdict += 1;
+        }
+        if !oa.fell && !ob.fell {
+            out.upright_both += 1;
+            let (fa, fb) = (a.score(&oa).fitness, b.score(&ob).fitness);
+            out.worst_upright_gap = out.worst_upright_gap.max((fa - fb).abs() / fa.max(fb));
+            out.worst_upright_dx_gap = out
+                .worst_upright_dx_gap
+                .max((oa.forward_distance - ob.forward_distance).abs());
+        }
+    }
+    out
 }
 
 /// The second setting of the robust score ([`FitnessConfig::robust_check`]): 4 ms steps, 4
@@ -251,6 +333,8 @@ pub struct FootContact {
     pub sole_height: f64,
     /// Position along x (forward, m) of the centre of the sole's bottom face.
     pub sole_x: f64,
+    /// Position along y (left, m) of the centre of the sole's bottom face.
+    pub sole_y: f64,
 }
 
 /// The normal force (N) above which a foot counts as loaded (carrying weight): a tenth of the
@@ -354,17 +438,19 @@ pub struct PhysicsEvaluator {
 }
 
 impl PhysicsEvaluator {
-    /// An evaluator of `model`'s step scored by `fitness`, with the default body.
+    /// An evaluator of `model`'s step scored by `fitness`, with the body of its physics model
+    /// ([`FitnessConfig::physics`]).
     pub fn new(model: NaoModel, fitness: FitnessConfig) -> Result<PhysicsEvaluator, SimError> {
-        PhysicsEvaluator::with_body(model, fitness, BodyParams::default())
+        let body = BodyParams::named(fitness.physics);
+        PhysicsEvaluator::with_body(model, fitness, body)
     }
 
-    /// An evaluator with a body of one's own.
-    /// With [`FitnessConfig::robust_check`] it scores under `body` and under `body` at
-    /// [`CHECK_SETTING`]; without, under `body` alone.
+    /// An evaluator with a body of one's own ([`FitnessConfig::physics`] is not read).
+    /// With [`FitnessConfig::robust_check`] it scores under `body` and under `body` at its
+    /// [`check`](BodyParams::check) setting; without, under `body` alone.
     pub fn with_body(model: NaoModel, fitness: FitnessConfig, body: BodyParams) -> Result<PhysicsEvaluator, SimError> {
         let checks = if fitness.robust_check {
-            vec![CHECK_SETTING]
+            vec![body.check]
         } else {
             Vec::new()
         };
@@ -414,16 +500,36 @@ impl PhysicsEvaluator {
             ("limb_radius", b.limb_radius),
             ("pitch_max_torque", b.pitch_max_torque),
             ("roll_max_torque", b.roll_max_torque),
-            ("pitch_stall_torque", b.pitch_stall_torque),
-            ("roll_stall_torque", b.roll_stall_torque),
             ("pitch_max_speed", b.pitch_max_speed),
             ("roll_max_speed", b.roll_max_speed),
-            ("servo_stiffness", b.servo_stiffness),
-            ("servo_damping", b.servo_damping),
             ("friction", b.friction),
             ("dt", b.dt),
-        ] {
+        ]
+        .into_iter()
+        .chain(match b.servo {
+            ServoKind::Webots => vec![("p_gain", b.p_gain)],
+            ServoKind::DcMotor => vec![
+                ("pitch_stall_torque", b.pitch_stall_torque),
+                ("roll_stall_torque", b.roll_stall_torque),
+                ("servo_stiffness", b.servo_stiffness),
+                ("servo_damping", b.servo_damping),
+            ],
+        })
+        .chain(
+            b.contact_softness
+                .map(|[f, z]| [("contact natural frequency", f), ("contact damping ratio", z)])
+                .into_iter()
+                .flatten(),
+        ) {
             if !(value.is_finite() && value > 0.0) {
+                return Err(SimError::BadBody { name, value });
+            }
+        }
+        for (name, value, hi) in [
+            ("foot_outward", b.foot_outward, f64::MAX),
+            ("restitution", b.restitution, 1.0),
+        ] {
+            if !(value.is_finite() && (0.0..=hi).contains(&value)) {
                 return Err(SimError::BadBody { name, value });
             }
         }
@@ -442,7 +548,7 @@ impl PhysicsEvaluator {
             ("pitch", b.pitch_stall_torque, b.pitch_max_torque),
             ("roll", b.roll_stall_torque, b.roll_max_torque),
         ] {
-            if stall < continuous {
+            if b.servo == ServoKind::DcMotor && stall < continuous {
                 return Err(SimError::StallBelowContinuous {
                     joints,
                     stall,
@@ -640,8 +746,7 @@ impl PhysicsEvaluator {
             let wanted = individual.angles_at(t, self.model.step_time);
             for s in Servo::ALL {
                 let i = s.index();
-                let max_move = body.max_speed(s) * dt;
-                command[i] = s.clamp(command[i] + (wanted[i] - command[i]).clamp(-max_move, max_move));
+                command[i] = body.next_target(s, command[i], wanted[i]);
             }
             robot.command(&command, body);
             robot.world.step();
@@ -727,8 +832,7 @@ impl PhysicsEvaluator {
         for _ in 0..steps {
             for s in Servo::ALL {
                 let i = s.index();
-                let max_move = b.max_speed(s) * b.dt;
-                command[i] = s.clamp(command[i] + (pose[i] - command[i]).clamp(-max_move, max_move));
+                command[i] = b.next_target(s, command[i], pose[i]);
             }
             robot.command(&command, b);
             robot.world.step();
@@ -758,10 +862,16 @@ impl PhysicsEvaluator {
     }
 }
 
+impl PhysicsEvaluator {
+    /// The evaluation of an outcome under this evaluator's fitness.
+    pub fn score(&self, o: &SimOutcome) -> Evaluation {
+        Evaluation::from_outcome(&self.fitness, self.model.step_time, o.fell, o.t_end, o.forward_distance)
+    }
+}
+
 impl Evaluator for PhysicsEvaluator {
     fn evaluate(&self, individual: &Individual) -> Evaluation {
-        let o = self.robust_simulate(individual);
-        Evaluation::from_outcome(&self.fitness, self.model.step_time, o.fell, o.t_end, o.forward_distance)
+        self.score(&self.robust_simulate(individual))
     }
 }
 
@@ -811,6 +921,12 @@ impl Robot {
         world.integration_parameters.dt = b.dt as Real;
         world.integration_parameters.num_solver_iterations = b.solver_iterations.max(1);
         world.integration_parameters.num_internal_pgs_iterations = b.pgs_iterations.max(1);
+        world.integration_parameters.friction_in_bias_pass = b.friction_every_pass;
+        if let Some([f, z]) = b.contact_softness {
+            let soft = SpringCoefficients::new(f as Real, z as Real);
+            world.integration_parameters.contact_softness = soft;
+            world.integration_parameters.static_contact_softness = soft;
+        }
 
         // Forward kinematics of both legs in the standing pose, relative to the torso frame.
         struct LegGeom {
@@ -852,7 +968,7 @@ impl Robot {
                     + foot_rot
                         * v(
                             b.foot_forward + sx * b.foot_length / 2.0,
-                            sy * b.foot_width / 2.0,
+                            -side * b.foot_outward + sy * b.foot_width / 2.0,
                             -b.foot_height,
                         );
                 lowest = lowest.min(c.z as f64);
@@ -871,7 +987,8 @@ impl Robot {
         let floor = world.insert_collider(
             ColliderBuilder::cuboid(50.0, 50.0, 0.5)
                 .translation(v(0.0, 0.0, -0.5))
-                .friction(b.friction as Real),
+                .friction(b.friction as Real)
+                .restitution(b.restitution as Real),
             None,
         );
 
@@ -919,7 +1036,8 @@ impl Robot {
                     }
                     4 => {
                         let rot = g.rotations[4];
-                        let centre = rot * v(b.foot_forward, 0.0, -b.foot_height + b.sole_thickness / 2.0);
+                        let outward = if left { b.foot_outward } else { -b.foot_outward };
+                        let centre = rot * v(b.foot_forward, outward, -b.foot_height + b.sole_thickness / 2.0);
                         ColliderBuilder::cuboid(
                             (b.foot_length / 2.0) as Real,
                             (b.foot_width / 2.0) as Real,
@@ -927,6 +1045,7 @@ impl Robot {
                         )
                         .position(Pose::from_parts(centre, rot))
                         .friction(b.friction as Real)
+                        .restitution(b.restitution as Real)
                     }
                     _ => ColliderBuilder::ball(0.02),
                 };
@@ -945,9 +1064,12 @@ impl Robot {
                     .local_anchor2(Vector::ZERO)
                     .contacts_enabled(false)
                     .limits([(lo - q0) as Real, (hi - q0) as Real])
-                    .motor_model(MotorModel::ForceBased)
-                    .motor_position(0.0, b.servo_stiffness as Real, b.servo_damping as Real)
-                    .motor_max_force(b.max_torque(s) as Real);
+                    .motor_model(MotorModel::ForceBased);
+                let joint = match b.servo {
+                    ServoKind::Webots => joint.motor_velocity(0.0, HARD_MOTOR_DAMPING),
+                    ServoKind::DcMotor => joint.motor_position(0.0, b.servo_stiffness as Real, b.servo_damping as Real),
+                }
+                .motor_max_force(b.max_torque(s) as Real);
                 // The chain is a tree hanging from the torso: insertion cannot fail.
                 if let Some(h) = world.insert_multibody_joint(parent, link, joint) {
                     motors.push((h, s, q0));
@@ -978,12 +1100,18 @@ impl Robot {
                 let q = link.joint.coords()[3] as f64;
                 let target = angles[s.index()] - q0;
                 let limit = body.torque_limit(s, omega, (target - q) * omega > 0.0);
-                if let Some(link) = mb.link_mut(id) {
-                    link.joint
-                        .data
-                        .set_motor_position(JointAxis::AngX, target as Real, self.stiffness, self.damping)
-                        .set_motor_max_force(JointAxis::AngX, limit as Real);
+                let Some(link) = mb.link_mut(id) else { continue };
+                let data = &mut link.joint.data;
+                match body.servo {
+                    ServoKind::Webots => {
+                        let velocity = body.webots_velocity(s, target, q);
+                        data.set_motor_velocity(JointAxis::AngX, velocity as Real, HARD_MOTOR_DAMPING)
+                    }
+                    ServoKind::DcMotor => {
+                        data.set_motor_position(JointAxis::AngX, target as Real, self.stiffness, self.damping)
+                    }
                 }
+                .set_motor_max_force(JointAxis::AngX, limit as Real);
             }
         }
     }
@@ -1038,6 +1166,7 @@ impl Robot {
                     lowest = lowest.min(p.z as f64);
                     if sx == 0.0 && sy == 0.0 {
                         c.sole_x = p.x as f64;
+                        c.sole_y = p.y as f64;
                     }
                 }
             }
@@ -1146,6 +1275,7 @@ mod contact_tests {
             slip_speed: slip,
             sole_height: h,
             sole_x: x,
+            sole_y: 0.0,
         };
         let off = foot(0.0, 0.3, 0.02, 0.0);
         let mut t = FeetTracker::new(0.01, &[foot(0.0, 0.0, 0.0, 0.10), foot(0.0, 0.0, 0.0, -0.05)]);
@@ -1191,17 +1321,34 @@ mod contact_tests {
 
     #[test]
     fn a_loaded_sole_grips_below_coulombs_bound_and_slides_above_it() {
-        let b = BodyParams::default();
-        // The whole robot weighs 4.996 kg · 9.81 = 49.0 N, half of it on each foot: 24.5 N.
-        // Both soles hold the robot against a push until μ·W = 0.8 · 49.0 = 39.2 N.
-        let (load, held) = push_right_foot(&b, 25.0);
-        assert!((load - 24.5).abs() < 2.5, "the right sole carries {load} N");
-        // 25 N < 39.2 N: the sole stays within 5 mm over the second (the servos' sag under the
-        // push and the standing creep are millimetres).
-        assert!(held.abs() < 0.005, "a 25 N push moved the sole {held} m");
-        // 50 N > 39.2 N: the robot slides; with the 10.8 N excess on 5 kg it would move
-        // ½ · 2.2 m/s² · (1 s)² = 1.1 m; anything beyond 0.2 m is sliding, not sag.
-        let (_, slid) = push_right_foot(&b, 50.0);
-        assert!(slid > 0.2, "a 50 N push moved the sole only {slid} m");
+        // Both models, each at μ 0.8 (Webots' μ 7 would need a push the legs cannot pass on).
+        for b in [
+            BodyParams::dc_motor(),
+            BodyParams {
+                friction: 0.8,
+                ..BodyParams::webots()
+            },
+        ] {
+            // The whole robot weighs 4.996 kg · 9.81 = 49.0 N, half of it on each foot: 24.5 N.
+            // The pushed sole alone holds until μ·24.5 = 19.6 N, both soles together until
+            // μ·W = 0.8 · 49.0 = 39.2 N.
+            let (load, held) = push_right_foot(&b, 15.0);
+            assert!(
+                (load - 24.5).abs() < 2.5,
+                "the right sole carries {load} N ({:?})",
+                b.servo
+            );
+            // 15 N < 19.6 N: the sole stays within 2 mm over the second (the servos' sag under
+            // the push).
+            assert!(
+                held.abs() < 0.002,
+                "a 15 N push moved the sole {held} m ({:?})",
+                b.servo
+            );
+            // 50 N > 39.2 N: the robot slides; with the 10.8 N excess on 5 kg it would move
+            // ½ · 2.2 m/s² · (1 s)² = 1.1 m; anything beyond 0.2 m is sliding, not sag.
+            let (_, slid) = push_right_foot(&b, 50.0);
+            assert!(slid > 0.2, "a 50 N push moved the sole only {slid} m ({:?})", b.servo);
+        }
     }
 }

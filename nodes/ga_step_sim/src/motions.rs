@@ -1,7 +1,9 @@
 //! Reference motions whose outcome is known without a simulation, to check the physics against:
 //! the robot bobbing in place on both feet, and poses held after a ramp from standing; and
-//! gentle random motions about the standing pose, for samples.
+//! gentle random motions about the standing pose, for samples; and a hand-made forward step
+//! ([`forward_step`]), the evaluator's control experiment.
 
+use crate::body::{leg_chain, BodyParams};
 use mobil_ga_step::{Individual, NaoModel, Servo, KNOTS};
 
 /// Both legs bob in place: knees `stand + 2a·s(t)`, hip and ankle pitch `stand − a·s(t)` with
@@ -60,4 +62,108 @@ pub fn gentle(model: &NaoModel, fraction: f64, uniform: &mut dyn FnMut() -> f64)
         }
     }
     ind
+}
+
+/// A hand-made open-loop forward step ([`forward_step`]): how far each foot moves, how far the
+/// torso sways over the stance foot, how high a foot is lifted and how far the torso sinks while
+/// stepping (m).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct StepPlan {
+    /// Forward distance of each foot, and so of the torso (m).
+    pub length: f64,
+    /// Lateral shift of the torso over the stance foot (m).
+    pub sway: f64,
+    /// Height a swing foot is lifted (m).
+    pub lift: f64,
+    /// How far the torso sinks below its standing height while stepping (m), to keep both legs
+    /// within reach with the torso swayed and a foot ahead.
+    pub dip: f64,
+}
+
+impl Default for StepPlan {
+    fn default() -> Self {
+        StepPlan {
+            length: 0.06,
+            sway: 0.045,
+            lift: 0.03,
+            dip: 0.015,
+        }
+    }
+}
+
+/// A key instant of the hand-made step: its time as a fraction of T, the torso's displacement
+/// (forward, left, down), the right and the left foot's (forward, up).
+type StepKey = (f64, [f64; 3], [f64; 2], [f64; 2]);
+
+/// The hand-made step's key instants as fractions of the step time T, each with the torso's
+/// displacement (forward, left, down) and each foot's (forward, up), in units of the plan's
+/// length, sway, dip and lift: sway onto the left foot, lift the right, swing it ahead, put it
+/// down, carry the torso over it, lift the left, swing it ahead, put it down, sway back to the
+/// middle. Between instants every displacement follows a smoothstep.
+const STEP_KEYS: [StepKey; 10] = [
+    (0.00, [0.0, 0.0, 0.0], [0.0, 0.0], [0.0, 0.0]),
+    (0.20, [0.0, 1.0, 1.0], [0.0, 0.0], [0.0, 0.0]),
+    (0.25, [0.0, 1.0, 1.0], [0.0, 1.0], [0.0, 0.0]),
+    (0.35, [0.0, 1.0, 1.0], [1.0, 1.0], [0.0, 0.0]),
+    (0.40, [0.0, 1.0, 1.0], [1.0, 0.0], [0.0, 0.0]),
+    (0.60, [1.0, -1.0, 1.0], [1.0, 0.0], [0.0, 0.0]),
+    (0.65, [1.0, -1.0, 1.0], [1.0, 0.0], [0.0, 1.0]),
+    (0.75, [1.0, -1.0, 1.0], [1.0, 0.0], [1.0, 1.0]),
+    (0.80, [1.0, -1.0, 1.0], [1.0, 0.0], [1.0, 0.0]),
+    (1.00, [1.0, 0.0, 0.0], [1.0, 0.0], [1.0, 0.0]),
+];
+
+/// A hand-made open-loop forward step as an individual (knots in the genome's format): the
+/// step's key instants (sway onto the left foot, lift the right, swing it ahead, put it down,
+/// carry the torso over it, lift the left, swing it ahead, put it down, sway back) scaled by
+/// `plan`, sampled at the knots, each leg's angles from [`BodyParams::leg_angles`] with the torso upright and the soles flat; the first and last knots
+/// the standing pose. `None` if a knot is out of a leg's reach or a servo's limits.
+pub fn forward_step(model: &NaoModel, body: &BodyParams, plan: &StepPlan) -> Option<Individual> {
+    let mut ind = model.standing();
+    let scale = |torso: [f64; 3], right: [f64; 2], left: [f64; 2]| {
+        (
+            [torso[0] * plan.length, torso[1] * plan.sway, -torso[2] * plan.dip],
+            [
+                [right[0] * plan.length, right[1] * plan.lift],
+                [left[0] * plan.length, left[1] * plan.lift],
+            ],
+        )
+    };
+    for k in 1..KNOTS - 1 {
+        let f = k as f64 / (KNOTS - 1) as f64;
+        let i = STEP_KEYS.iter().position(|key| key.0 >= f)?;
+        let (t0, a_torso, a_r, a_l) = STEP_KEYS[i.saturating_sub(1)];
+        let (t1, b_torso, b_r, b_l) = STEP_KEYS[i];
+        let u = if t1 > t0 {
+            ((f - t0) / (t1 - t0)).clamp(0.0, 1.0)
+        } else {
+            1.0
+        };
+        let w = u * u * (3.0 - 2.0 * u);
+        let mix = |a: f64, b: f64| a + (b - a) * w;
+        let (torso, feet) = scale(
+            [0, 1, 2].map(|j| mix(a_torso[j], b_torso[j])),
+            [0, 1].map(|j| mix(a_r[j], b_r[j])),
+            [0, 1].map(|j| mix(a_l[j], b_l[j])),
+        );
+        for (side, left) in [false, true].into_iter().enumerate() {
+            let chain = leg_chain(left);
+            let stand = chain.map(|s| model.standing_pose[s.index()]);
+            let a0 = body.ankle_from_hip(&stand);
+            let ankle = [
+                a0[0] + feet[side][0] - torso[0],
+                a0[1] - torso[1],
+                a0[2] + feet[side][1] - torso[2],
+            ];
+            let q = body.leg_angles(ankle)?;
+            for (s, angle) in chain.into_iter().zip(q) {
+                let (lo, hi) = s.limits();
+                if !(lo..=hi).contains(&angle) {
+                    return None;
+                }
+                ind.knots[s.index()][k] = angle;
+            }
+        }
+    }
+    Some(ind)
 }

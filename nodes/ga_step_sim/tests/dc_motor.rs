@@ -1,8 +1,9 @@
-//! The physics evaluator against what a body of Nao's figures must do. Each test simulates at
-//! most T_sim = 3 s.
+//! The earlier physics model, `physics: dc-motor` ([`BodyParams::dc_motor`]), against what a
+//! body of Nao's figures must do, and against the runs made under it: it scores as it did. Each
+//! test simulates at most T_sim = 3 s.
 
 use mobil_ga_step::{
-    evaluate_all, Evaluation, Evaluator, FitnessConfig, Individual, NaoModel, Servo, KNOTS, SERVO_COUNT,
+    evaluate_all, Evaluation, Evaluator, FitnessConfig, Individual, NaoModel, PhysicsModel, Servo, KNOTS, SERVO_COUNT,
 };
 use mobil_ga_step_sim::{
     motions, BodyParams, FallCause, PhysicsEvaluator, SimError, SimOutcome, SolverSetting, CHECK_SETTING,
@@ -11,17 +12,25 @@ use mobil_ga_step_sim::{
 use rand::{Rng, SeedableRng};
 use std::f64::consts::{FRAC_PI_2, FRAC_PI_4};
 
+/// The default fitness with the DC-motor model.
+fn dc_fitness() -> FitnessConfig {
+    FitnessConfig {
+        physics: PhysicsModel::DcMotor,
+        ..FitnessConfig::default()
+    }
+}
+
 fn evaluator() -> PhysicsEvaluator {
-    PhysicsEvaluator::new(NaoModel::default(), FitnessConfig::default()).unwrap()
+    PhysicsEvaluator::new(NaoModel::default(), dc_fitness()).unwrap()
 }
 
 /// An evaluator of one setting alone (no robust score): the default body at `setting`.
 fn single(setting: SolverSetting) -> PhysicsEvaluator {
     let fitness = FitnessConfig {
         robust_check: false,
-        ..FitnessConfig::default()
+        ..dc_fitness()
     };
-    PhysicsEvaluator::with_body(NaoModel::default(), fitness, setting.apply(&BodyParams::default())).unwrap()
+    PhysicsEvaluator::with_body(NaoModel::default(), fitness, setting.apply(&BodyParams::dc_motor())).unwrap()
 }
 
 /// The default solver setting, 5 ms, 4 iterations of 2 passes.
@@ -159,7 +168,7 @@ fn the_same_individual_gives_the_same_evaluation_bit_for_bit_on_any_thread() {
 
 #[test]
 fn the_motor_figures_are_the_re_max_24_through_naos_reductions() {
-    let b = BodyParams::default();
+    let b = BodyParams::dc_motor();
     // Continuous torques: the RE-Max 24's nominal 12.3 mN·m × 130.85 = 1.609 N·m (the
     // documentation prints 1.61) and × 201.3 = 2.476 N·m (the documentation prints 2.47, which
     // the body keeps: its runs were scored with it). Stall torques: 59.5 mN·m × 130.85 = 7.786
@@ -177,9 +186,9 @@ fn the_motor_figures_are_the_re_max_24_through_naos_reductions() {
 fn bad_body_figures_are_refused() {
     let body = BodyParams {
         dt: 0.0,
-        ..BodyParams::default()
+        ..BodyParams::dc_motor()
     };
-    let r = PhysicsEvaluator::with_body(NaoModel::default(), FitnessConfig::default(), body);
+    let r = PhysicsEvaluator::with_body(NaoModel::default(), dc_fitness(), body);
     assert_eq!(r.err(), Some(SimError::BadBody { name: "dt", value: 0.0 }));
     // The time step within 10 µs … 50 ms, both ends accepted.
     for (dt, ok) in [
@@ -191,9 +200,9 @@ fn bad_body_figures_are_refused() {
     ] {
         let body = BodyParams {
             dt,
-            ..BodyParams::default()
+            ..BodyParams::dc_motor()
         };
-        let r = PhysicsEvaluator::with_body(NaoModel::default(), FitnessConfig::default(), body);
+        let r = PhysicsEvaluator::with_body(NaoModel::default(), dc_fitness(), body);
         if ok {
             assert!(r.is_ok(), "dt {dt}");
         } else {
@@ -205,15 +214,15 @@ fn bad_body_figures_are_refused() {
         dt: 1e-6,
         ..CHECK_SETTING
     };
-    let fitness = FitnessConfig::default();
-    let r = PhysicsEvaluator::with_checks(NaoModel::default(), fitness, BodyParams::default(), &[fine]);
+    let fitness = dc_fitness();
+    let r = PhysicsEvaluator::with_checks(NaoModel::default(), fitness, BodyParams::dc_motor(), &[fine]);
     assert_eq!(r.err(), Some(SimError::BadTimeStep { value: 1e-6 }));
     let body = BodyParams {
         friction: f64::NAN,
-        ..BodyParams::default()
+        ..BodyParams::dc_motor()
     };
     assert!(matches!(
-        PhysicsEvaluator::with_body(NaoModel::default(), FitnessConfig::default(), body),
+        PhysicsEvaluator::with_body(NaoModel::default(), dc_fitness(), body),
         Err(SimError::BadBody { name: "friction", .. })
     ));
     // Solver counts within 1 … 256 (usize::MAX would never finish a step).
@@ -226,24 +235,24 @@ fn bad_body_figures_are_refused() {
         let body = BodyParams {
             solver_iterations: it,
             pgs_iterations: pgs,
-            ..BodyParams::default()
+            ..BodyParams::dc_motor()
         };
-        let r = PhysicsEvaluator::with_body(NaoModel::default(), FitnessConfig::default(), body);
+        let r = PhysicsEvaluator::with_body(NaoModel::default(), dc_fitness(), body);
         assert_eq!(r.err(), Some(SimError::BadSolverCount { name, value }));
     }
     let body = BodyParams {
         solver_iterations: 256,
         pgs_iterations: 1,
-        ..BodyParams::default()
+        ..BodyParams::dc_motor()
     };
-    assert!(PhysicsEvaluator::with_body(NaoModel::default(), FitnessConfig::default(), body).is_ok());
+    assert!(PhysicsEvaluator::with_body(NaoModel::default(), dc_fitness(), body).is_ok());
     // A stall torque below the continuous one would cut the torque at rest.
     let body = BodyParams {
         roll_stall_torque: 2.0,
-        ..BodyParams::default()
+        ..BodyParams::dc_motor()
     };
     assert_eq!(
-        PhysicsEvaluator::with_body(NaoModel::default(), FitnessConfig::default(), body).err(),
+        PhysicsEvaluator::with_body(NaoModel::default(), dc_fitness(), body).err(),
         Some(SimError::StallBelowContinuous {
             joints: "roll",
             stall: 2.0,
@@ -376,9 +385,9 @@ fn servos_weaker_than_the_standing_load_let_the_robot_collapse() {
     let with = |tau: f64| {
         let body = BodyParams {
             pitch_max_torque: tau,
-            ..BodyParams::default()
+            ..BodyParams::dc_motor()
         };
-        PhysicsEvaluator::with_body(model.clone(), FitnessConfig::default(), body)
+        PhysicsEvaluator::with_body(model.clone(), dc_fitness(), body)
             .unwrap()
             .simulate(&model.standing())
     };
@@ -402,7 +411,7 @@ fn an_observer_sees_every_step_and_the_same_end() {
 
 #[test]
 fn the_motor_gives_its_continuous_torque_up_to_the_nominal_speed_then_follows_its_line() {
-    let b = BodyParams::default();
+    let b = BodyParams::dc_motor();
     let k = Servo::RKneePitch;
     // At rest and at 3 rad/s the line τ_stall·(1 − ω/ω₀) = 7.78·(1 − 3/6.402) = 4.14 N·m lies
     // above the continuous 1.61 N·m, which caps it.
@@ -550,7 +559,7 @@ fn kneeling_is_a_fall_though_the_torso_is_high_and_upright() {
     ] {
         model.standing_pose[s.index()] = q;
     }
-    let ev = PhysicsEvaluator::new(model.clone(), FitnessConfig::default()).unwrap();
+    let ev = PhysicsEvaluator::new(model.clone(), dc_fitness()).unwrap();
     let o = ev.simulate(&model.standing());
     assert!((o.start_height - 0.20705).abs() < 1e-4, "{o:?}");
     assert!(o.fell && o.cause == Some(FallCause::Contact), "{o:?}");
@@ -573,13 +582,13 @@ fn knees_fully_bent_at_once_fall_whatever_the_solver_settings() {
 
 /// The default evaluator with its step divided by `k` and its iterations multiplied by `k`.
 fn finer(k: usize) -> PhysicsEvaluator {
-    let d = BodyParams::default();
+    let d = BodyParams::dc_motor();
     let body = BodyParams {
         dt: d.dt / k as f64,
         solver_iterations: d.solver_iterations * k,
         ..d
     };
-    PhysicsEvaluator::with_body(NaoModel::default(), FitnessConfig::default(), body).unwrap()
+    PhysicsEvaluator::with_body(NaoModel::default(), dc_fitness(), body).unwrap()
 }
 
 #[test]
@@ -619,10 +628,10 @@ fn bobbing_in_place_on_both_feet_goes_nowhere() {
     }
     let one_pass = PhysicsEvaluator::with_body(
         NaoModel::default(),
-        FitnessConfig::default(),
+        dc_fitness(),
         BodyParams {
             pgs_iterations: 1,
-            ..BodyParams::default()
+            ..BodyParams::dc_motor()
         },
     )
     .unwrap()
@@ -757,8 +766,8 @@ fn the_robust_score_is_the_worst_of_the_scores_under_each_setting() {
     // motions tried never give the default pair (its check is the finer setting).
     let swapped = PhysicsEvaluator::with_checks(
         model.clone(),
-        FitnessConfig::default(),
-        CHECK_SETTING.apply(&BodyParams::default()),
+        dc_fitness(),
+        CHECK_SETTING.apply(&BodyParams::dc_motor()),
         &[DEFAULT],
     )
     .unwrap();
@@ -826,13 +835,14 @@ fn a_check_is_cut_at_the_fall_so_far_and_skipped_after_a_fall_at_once() {
 
 #[test]
 fn the_check_setting_and_the_physics_version_are_pinned() {
-    // The robust score's check setting is part of physics version 3: changing either moves
-    // every score, and checkpoints of version 3 would resume under other numbers. The test's
-    // DEFAULT is the body's default setting.
+    // The robust score's check setting is part of the physics version (4; the DC-motor model
+    // scores as at 3): changing either moves every score, and checkpoints would resume under
+    // other numbers. The test's DEFAULT is the body's default setting.
+    assert_eq!(BodyParams::dc_motor().check, CHECK_SETTING);
     assert_eq!(
         (PHYSICS_VERSION, CHECK_SETTING),
         (
-            3,
+            4,
             SolverSetting {
                 dt: 0.004,
                 solver_iterations: 4,
@@ -840,7 +850,7 @@ fn the_check_setting_and_the_physics_version_are_pinned() {
             }
         )
     );
-    assert_eq!(DEFAULT.apply(&BodyParams::default()), BodyParams::default());
+    assert_eq!(DEFAULT.apply(&BodyParams::dc_motor()), BodyParams::dc_motor());
 }
 
 #[test]
@@ -934,7 +944,7 @@ fn checks_are_refused_when_a_falls_distance_counts() {
     // higher score. The combination is refused; without checks it is accepted.
     let fitness = FitnessConfig {
         distance_on_fall: true,
-        ..FitnessConfig::default()
+        ..dc_fitness()
     };
     assert!(fitness.robust_check);
     assert_eq!(
@@ -942,7 +952,7 @@ fn checks_are_refused_when_a_falls_distance_counts() {
         Some(SimError::ChecksWithDistanceOnFall)
     );
     assert_eq!(
-        PhysicsEvaluator::with_checks(NaoModel::default(), fitness.clone(), BodyParams::default(), &[DEFAULT]).err(),
+        PhysicsEvaluator::with_checks(NaoModel::default(), fitness.clone(), BodyParams::dc_motor(), &[DEFAULT]).err(),
         Some(SimError::ChecksWithDistanceOnFall)
     );
     let alone = FitnessConfig {
@@ -958,7 +968,7 @@ fn the_robust_score_can_be_switched_off() {
     // does; the edge individuals then score their stored, upright, evaluation again.
     let fitness = FitnessConfig {
         robust_check: false,
-        ..FitnessConfig::default()
+        ..dc_fitness()
     };
     let ev = PhysicsEvaluator::new(NaoModel::default(), fitness).unwrap();
     assert!(ev.check_bodies().is_empty());
