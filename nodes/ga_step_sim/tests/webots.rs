@@ -166,6 +166,8 @@ fn scores_agree_with_those_at_half_the_step_and_twice_the_iterations() {
     assert!(r.verdict_share() >= 0.95, "{r:?}");
     assert!(r.upright_both >= 2, "{r:?}");
     assert!(r.worst_upright_gap < 0.05, "{r:?}");
+    // Δx within half the 4 cm step threshold.
+    assert!(r.worst_upright_dx_gap < 0.02, "{r:?}");
 }
 
 #[test]
