@@ -39,6 +39,8 @@ PIP_PACKAGES=(
   # pytest 9 reads a test's id from Node._id, while pytest-xdist 3.8 marks a test's xdist_group
   # by rewriting Node._nodeid: under pytest 9 --dist loadgroup groups nothing.
   "pytest>=8.4,<9" pytest-timeout "pytest-xdist>=3.8,<4" pyyaml
+  # The second engine of ga_step's evaluator (tests/mujoco_replay.py); the wheel ships MuJoCo.
+  mujoco==4.0.1
 )
 stamp_pip="$VENV/.mobil-pip-stamp"
 want_pip="$(printf '%s\n' "${PIP_PACKAGES[@]}" | sha256sum | cut -d' ' -f1)"
