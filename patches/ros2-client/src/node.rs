@@ -1125,6 +1125,8 @@ impl Node {
   ) -> CreateResult<Subscription<D>> {
     let sub = self.ros_context.create_subscription(topic, qos)?;
     self.add_reader(sub.guid().into());
+    // Known with no match yet: get_publisher_count() is then 0, not an error.
+    self.readers_to_remote_writers.lock().unwrap().entry(sub.guid()).or_default();
     Ok(sub)
   }
 
@@ -1142,6 +1144,8 @@ impl Node {
   ) -> CreateResult<Publisher<D>> {
     let p = self.ros_context.create_publisher(topic, qos)?;
     self.add_writer(p.guid().into());
+    // Known with no match yet: get_subscription_count() is then 0, not an error.
+    self.writers_to_remote_readers.lock().unwrap().entry(p.guid()).or_default();
     Ok(p)
   }
 
@@ -1773,6 +1777,33 @@ mod tests {
     drop(kept);
     drop(node.status_receiver().unwrap());
     assert_eq!(node.status_event_senders.lock().unwrap().len(), 1);
+  }
+
+  #[test]
+  fn a_new_endpoint_has_no_matches_rather_than_being_unknown() {
+    use crate::{MessageTypeName, Name};
+    let ctx = Context::new().unwrap();
+    let mut node = Node::new(
+      NodeName::new("/", "new_endpoint_counts").unwrap(),
+      NodeOptions::new().start_parameter_services(false),
+      ctx,
+    )
+    .unwrap();
+    let topic = node
+      .create_topic(
+        &Name::new("/", "unmatched_for_a_test").unwrap(),
+        MessageTypeName::new("std_msgs", "String"),
+        &crate::DEFAULT_PUBLISHER_QOS,
+      )
+      .unwrap();
+    let publisher: crate::Publisher<String> = node.create_publisher(&topic, None).unwrap();
+    let subscription: crate::Subscription<String> = node.create_subscription(&topic, None).unwrap();
+    // Known to the node with no remote match (this process's own endpoints are not remote):
+    // the entries exist, so the counts are 0 without an "not known to node" error.
+    assert!(node.writers_to_remote_readers.lock().unwrap().contains_key(&publisher.guid()));
+    assert!(node.readers_to_remote_writers.lock().unwrap().contains_key(&subscription.guid()));
+    assert_eq!(publisher.get_subscription_count(&node), 0);
+    assert_eq!(subscription.get_publisher_count(&node), 0);
   }
 
   #[test]
