@@ -21,6 +21,8 @@
 //! - [`summary`]: how a run ended, [`RunSummary`] and its line.
 //! - [`external`]: the ROS-free half of an external simulator's evaluation (its answer's
 //!   values, the void score).
+//! - [`pool`]: the bookkeeping of a pool of external simulators: which one gets the next
+//!   candidate, when a candidate is sent again or void, when the pool gives up.
 //! - [`config`]: [`GaConfig`], [`FitnessConfig`], every default justified; `params/nao_step.yaml`
 //!   holds the same values.
 //! - [`params`]: a parameter file of `params/nao_step.yaml`'s form read into a [`GaSetup`].
@@ -102,6 +104,7 @@ pub mod model;
 pub mod operators;
 pub mod output;
 pub mod params;
+pub mod pool;
 pub mod resume;
 pub mod selection;
 pub mod summary;

@@ -34,10 +34,28 @@
 //! in a row end the run ([`RosEvalError::Unanswered`]): the simulator hears but does not
 //! answer. An interrupt (Ctrl-C) stops the waiting at once ([`RosEvalError::Interrupted`]).
 //! Once stopped, every later call returns at once, and `ga_step` exits without writing the
-//! generation in flight, so the run resumes from its last checkpoint. Evaluations are sequential
-//! (one simulator): run this evaluator on one thread.
+//! generation in flight, so the run resumes from its last checkpoint.
+//!
+//! **A pool of simulators** (an extension of the contract above; a lone simulator in the node's
+//! namespace is served exactly as before): every simulator that serves the two topics in a
+//! namespace *below* the node's (`<ns>/ga_step/candidate` and `<ns>/ga_step/outcome`, e.g.
+//! `/sim1/ga_step/…` and `/sim2/ga_step/…` for a node in `/`) is found by discovery, from the
+//! writers of its outcomes, as it appears, and is named by that namespace. Each simulator has one
+//! candidate in flight at a time; the rules of which one gets the next candidate, when a candidate
+//! is sent again and when the pool gives up are `mobil_ga_step::pool`'s: a candidate goes to a
+//! free simulator among those with the fewest attempts missed in a row; one whose simulator
+//! leaves (its endpoints vanish) is sent again to another without counting an attempt; a
+//! simulator that missed an answer gets no candidate while another answers; the run ends when
+//! every simulator present has missed [`MAX_UNANSWERED_IN_A_ROW`] attempts in a row, or when
+//! none has been present for the timeout. Headers are as above (a candidate sent to a second
+//! simulator keeps its header), so a simulator never needs to know of the others. Which simulator
+//! scored a candidate does not change its score, so the results depend on the seed alone. The
+//! candidates in flight are at most the threads the evaluator runs on ([`MAX_IN_FLIGHT`] with
+//! `--threads 0`). When the outcome topic is remapped to a name that does not end in
+//! `ga_step/outcome`, only that one simulator is used.
 
 use mobil_ga_step::external::{candidate_name, Outcome, VOID};
+use mobil_ga_step::pool::{AttemptEnd, CandidateTries, NextTry, Pick, SimulatorPool};
 use mobil_ga_step::{Evaluation, Evaluator, FitnessConfig, Individual, NaoModel, KNOTS};
 use mobil_msgs::builtin_interfaces::msg::{Duration as RosDuration, Time};
 use mobil_msgs::sensor_msgs::msg::JointState;
@@ -46,17 +64,17 @@ use mobil_msgs::trajectory_msgs::msg::{JointTrajectory, JointTrajectoryPoint};
 use mobil_ros::args::RosArgs;
 use mobil_ros::node::{NodeDecl, RosNode};
 use mobil_ros::{qos, warn_throttled, LogThrottle};
-use ros2_client::{EntityKind, GraphEvent, NodeEvent, Publisher, Subscription};
+use ros2_client::{NodeEvent, Publisher, Subscription};
 use std::sync::atomic::{AtomicBool, Ordering};
-use std::sync::{Arc, Mutex, PoisonError};
+use std::sync::{Arc, Condvar, Mutex, MutexGuard, PoisonError};
 use std::time::{Duration, Instant};
 
 /// Topic of the candidates.
 pub const CANDIDATE_TOPIC: &str = "ga_step/candidate";
 /// Topic of the simulator's answers.
 pub const OUTCOME_TOPIC: &str = "ga_step/outcome";
-/// Attempts in a row without an answer (of the timeout each, over one or more candidates)
-/// that end the run.
+/// Attempts in a row without an answer (of the timeout each, over one or more candidates) at
+/// every simulator present that end the run.
 pub const MAX_UNANSWERED_IN_A_ROW: u32 = 3;
 /// Attempts per candidate, each with its own timeout, before it scores 0.
 pub const ATTEMPTS: u32 = 2;
@@ -123,25 +141,51 @@ pub fn parse_outcome(m: &JointState) -> Result<Outcome, String> {
     Outcome::from_named(&m.name, &m.position)
 }
 
+/// One simulator of the pool: its two topics and what was last counted of them.
 // Field order is drop order: the writer and reader go before the node that owns their
 // participant (mobil_ros: readers and writers must go while their participant exists).
-struct Link {
+struct SimLink {
+    /// The simulator's name: the namespace its topics are in (`/` for the root).
+    id: String,
     candidates: Publisher<JointTrajectory>,
     outcome: Subscription<JointState>,
-    /// The node's graph events, taken once: a remote reader matched while a candidate waits
-    /// (a simulator that restarted) is told by them. `None` without a spinner.
+    /// Readers of the candidates at the last count.
+    readers: usize,
+    /// A reader of the candidates was matched since the attempt last sent its candidate (a
+    /// simulator that restarted, even within the old one's lease; a first sample lost during
+    /// discovery): the candidate is sent again.
+    new_reader: bool,
+    /// The simulator's endpoints vanished since its attempt began.
+    lost: bool,
+    throttle: LogThrottle,
+}
+
+/// The evaluator's state behind its lock.
+// Field order is drop order: the links go before the node.
+struct Shared {
+    links: Vec<Arc<Mutex<SimLink>>>,
+    book: SimulatorPool,
+    /// The node's graph events, taken once. `None` without a spinner.
     events: Option<async_channel::Receiver<NodeEvent>>,
     node: RosNode,
+    /// Where simulators in other namespaces are looked for: topics `<base><ns>/ga_step/outcome`.
+    /// `None` when the outcome topic is remapped to a name of another form.
+    base: Option<String>,
+    /// The outcome topic of the simulator in the node's own namespace (resolved and remapped).
+    own_outcome: String,
     sent: u64,
-    unanswered_in_a_row: u32,
     void_scores: u64,
     failed: Option<RosEvalError>,
+    last_scan: Option<Instant>,
+    /// Since when no simulator has been present.
+    absent_since: Option<Instant>,
     throttle: LogThrottle,
 }
 
 /// The evaluator over ROS 2 (see the module's documentation).
 pub struct RosEvaluator {
-    link: Mutex<Option<Link>>,
+    shared: Mutex<Option<Shared>>,
+    freed: Condvar,
     model: NaoModel,
     fitness: FitnessConfig,
     timeout: Duration,
@@ -150,15 +194,67 @@ pub struct RosEvaluator {
     runtime: tokio::runtime::Runtime,
 }
 
-/// How often the wait for a simulator looks at the interrupt.
+/// How often a wait looks at the interrupt, the graph and the answers.
 const POLL: Duration = Duration::from_millis(10);
+/// How often the discovered topics are searched for simulators while candidates wait.
+const SCAN_EVERY: Duration = Duration::from_millis(250);
 /// Answers taken in one pass before the deadline and the interrupt are looked at again (a
 /// publisher flooding the outcome topic cannot hold the wait).
 const ANSWERS_PER_PASS: usize = 64;
+/// The most candidates in flight at once with `--threads 0`.
+pub const MAX_IN_FLIGHT: usize = 64;
+/// The last two levels of the contract's topics.
+const OUTCOME_SUFFIX: &str = "/ga_step/outcome";
+const CANDIDATE_SUFFIX: &str = "/ga_step/candidate";
+
+/// How an attempt ended, with the answer's score.
+enum Ended {
+    Answered(Evaluation),
+    Missed,
+    Lost,
+}
+
+impl Ended {
+    fn kind(&self) -> AttemptEnd {
+        match self {
+            Ended::Answered(_) => AttemptEnd::Answered,
+            Ended::Missed => AttemptEnd::Missed,
+            Ended::Lost => AttemptEnd::Lost,
+        }
+    }
+}
+
+/// The simulators' namespaces that `topics` (writers of outcomes) show under `base`: each
+/// `<base><ns>/ga_step/outcome` with `<ns>` not empty gives `<base><ns>`; the node's own
+/// `own_outcome` is not among them. `base` ends with `/`.
+pub fn pool_namespaces(topics: &[String], base: &str, own_outcome: &str) -> Vec<String> {
+    topics
+        .iter()
+        .filter(|t| t.as_str() != own_outcome && t.starts_with(base))
+        .filter_map(|t| t.strip_suffix(OUTCOME_SUFFIX))
+        .filter(|ns| ns.len() >= base.len() && !ns[base.len()..].is_empty())
+        .map(str::to_string)
+        .collect()
+}
+
+/// The namespace under which a node whose outcome topic resolved to `own_outcome` looks for
+/// more simulators (ending with `/`), and the name of its own simulator: `None` for the base
+/// when the topic was remapped to a name that does not end with `ga_step/outcome`.
+pub fn pool_base(own_outcome: &str) -> (Option<String>, String) {
+    match own_outcome.strip_suffix(OUTCOME_SUFFIX) {
+        Some(ns) => (
+            Some(format!("{ns}/")),
+            if ns.is_empty() { "/".into() } else { ns.into() },
+        ),
+        None if own_outcome == "/ga_step/outcome" => (Some("/".into()), "/".into()),
+        None => (None, own_outcome.to_string()),
+    }
+}
 
 impl RosEvaluator {
     /// Joins the DDS domain of `ROS_DOMAIN_ID` as node `ga_step` (its name, namespace and topics
-    /// remapped by `args`) and creates the topics. `interrupt` set stops any waiting.
+    /// remapped by `args`) and creates the topics of the simulator in its namespace; simulators
+    /// in namespaces below it are found as they appear. `interrupt` set stops any waiting.
     pub fn new(
         model: NaoModel,
         fitness: FitnessConfig,
@@ -170,28 +266,43 @@ impl RosEvaluator {
             .worker_threads(1)
             .enable_all()
             .build()?;
-        let link = {
+        let shared = {
             let _entered = runtime.enter();
             let decl = NodeDecl::new("ga_step", "evolves a humanoid step; evaluates candidates over ROS 2");
             let mut node = RosNode::start(&decl, args)?;
             let q = qos::reliable(10);
+            let own_outcome = node.names().resolve(OUTCOME_TOPIC)?;
+            let (base, own_id) = pool_base(&own_outcome);
             let candidates = node.publisher::<JointTrajectory>(CANDIDATE_TOPIC, &q)?;
             let outcome = node.subscription::<JointState>(OUTCOME_TOPIC, &q)?;
             let events = node.inner().status_receiver();
-            Link {
+            let own = SimLink {
+                id: own_id,
                 candidates,
                 outcome,
+                readers: 0,
+                new_reader: false,
+                lost: false,
+                throttle: LogThrottle::default(),
+            };
+            Shared {
+                links: vec![Arc::new(Mutex::new(own))],
+                book: SimulatorPool::new(MAX_UNANSWERED_IN_A_ROW),
                 events,
                 node,
+                base,
+                own_outcome,
                 sent: 0,
-                unanswered_in_a_row: 0,
                 void_scores: 0,
                 failed: None,
+                last_scan: None,
+                absent_since: Some(Instant::now()),
                 throttle: LogThrottle::default(),
             }
         };
         Ok(RosEvaluator {
-            link: Mutex::new(Some(link)),
+            shared: Mutex::new(Some(shared)),
+            freed: Condvar::new(),
             model,
             fitness,
             timeout,
@@ -208,243 +319,328 @@ impl RosEvaluator {
         self
     }
 
+    fn lock(&self) -> MutexGuard<'_, Option<Shared>> {
+        self.shared.lock().unwrap_or_else(PoisonError::into_inner)
+    }
+
     /// The error that stopped the evaluator, if one did.
     pub fn failure(&self) -> Option<RosEvalError> {
-        let link = self.link.lock().unwrap_or_else(PoisonError::into_inner);
-        link.as_ref().and_then(|l| l.failed.clone())
+        self.lock().as_ref().and_then(|s| s.failed.clone())
     }
 
     /// Candidates that went unanswered after every attempt and scored 0 (void scores).
     pub fn void_scores(&self) -> u64 {
-        let link = self.link.lock().unwrap_or_else(PoisonError::into_inner);
-        link.as_ref().map_or(0, |l| l.void_scores)
+        self.lock().as_ref().map_or(0, |s| s.void_scores)
     }
 
-    /// Waits until a simulator is matched on both topics, up to the timeout. The two match
-    /// futures (each holds a graph-event channel of the node) are made at the start and again
-    /// only when the graph changed: a future's channel holds 8 events, and one that overflowed
-    /// while the other future was waiting could miss its match.
-    fn await_simulator(&self, link: &mut Link, n: u64) -> Result<(), RosEvalError> {
-        let deadline = Instant::now() + self.timeout;
+    /// The simulators present now.
+    pub fn simulators(&self) -> usize {
+        self.lock().as_ref().map_or(0, |s| s.book.present())
+    }
+
+    /// Brings the pool up to date with the graph: simulators found in new namespaces, the
+    /// readers and writers of each, who joined, restarted or left. Cheap unless the graph
+    /// changed or [`SCAN_EVERY`] passed.
+    fn refresh(&self, sh: &mut Shared) {
+        let changed = match &sh.events {
+            Some(events) => {
+                let mut changed = false;
+                while events.try_recv().is_ok() {
+                    changed = true;
+                }
+                changed
+            }
+            None => false,
+        };
+        let now = Instant::now();
+        if !changed && sh.last_scan.is_some_and(|t| now.duration_since(t) < SCAN_EVERY) {
+            return;
+        }
+        sh.last_scan = Some(now);
+        if let Some(base) = sh.base.clone() {
+            let topics = sh.node.writer_topics::<JointState>();
+            for ns in pool_namespaces(&topics, &base, &sh.own_outcome) {
+                if sh
+                    .links
+                    .iter()
+                    .any(|l| l.lock().unwrap_or_else(PoisonError::into_inner).id == ns)
+                {
+                    continue;
+                }
+                let _entered = self.runtime.enter();
+                let q = qos::reliable(10);
+                let made = sh
+                    .node
+                    .publisher::<JointTrajectory>(&format!("{ns}{CANDIDATE_SUFFIX}"), &q)
+                    .and_then(|c| {
+                        Ok((
+                            c,
+                            sh.node
+                                .subscription::<JointState>(&format!("{ns}{OUTCOME_SUFFIX}"), &q)?,
+                        ))
+                    });
+                match made {
+                    Ok((candidates, outcome)) => sh.links.push(Arc::new(Mutex::new(SimLink {
+                        id: ns,
+                        candidates,
+                        outcome,
+                        readers: 0,
+                        new_reader: false,
+                        lost: false,
+                        throttle: LogThrottle::default(),
+                    }))),
+                    Err(e) => warn_throttled!(sh.throttle, "link", "cannot reach the simulator in {ns}: {e:#}"),
+                }
+            }
+        }
+        let Shared { links, book, node, .. } = sh;
+        for link in links.iter() {
+            let mut l = link.lock().unwrap_or_else(PoisonError::into_inner);
+            let readers = l.candidates.get_subscription_count(node.inner());
+            let writers = l.outcome.get_publisher_count(node.inner());
+            let was = book.is_present(&l.id);
+            if readers > l.readers {
+                l.new_reader = true;
+                if was {
+                    book.restarted(&l.id);
+                }
+            }
+            l.readers = readers;
+            if readers > 0 && writers > 0 {
+                if book.seen(&l.id) {
+                    tracing::info!("simulator {} joined ({} present)", l.id, book.present());
+                }
+            } else if was {
+                book.gone(&l.id);
+                l.lost = true;
+                tracing::warn!("simulator {} left ({} present)", l.id, book.present());
+            }
+        }
+        sh.absent_since = match (sh.book.present(), sh.absent_since) {
+            (0, None) => Some(now),
+            (0, since) => since,
+            _ => None,
+        };
+    }
+
+    /// A simulator for candidate `n`: waits while every usable one is busy, up to the timeout
+    /// while none is present. Assigns the candidate's number on its first attempt.
+    fn acquire(&self, ident: &mut Option<u64>) -> Result<(Arc<Mutex<SimLink>>, u64), RosEvalError> {
+        let started = Instant::now();
+        let mut guard = self.lock();
         loop {
-            let Link {
-                node,
-                candidates,
-                outcome,
-                events,
-                ..
-            } = &mut *link;
-            let node = &*node.inner();
-            // Events from before the futures are made are in their own first look at the graph.
-            Self::readers_changed(events);
-            let reader = candidates.wait_for_subscription(node);
-            let writer = outcome.wait_for_publisher(node);
-            let waited = self.runtime.block_on(async {
-                let both = async {
-                    tokio::join!(reader, writer);
-                };
-                tokio::pin!(both);
-                loop {
-                    if tokio::time::timeout(POLL, &mut both).await.is_ok() {
-                        return Some(Ok(()));
+            let Some(sh) = guard.as_mut() else {
+                return Err(RosEvalError::Interrupted(0));
+            };
+            let n = ident.unwrap_or(sh.sent + 1);
+            if let Some(e) = &sh.failed {
+                return Err(e.clone());
+            }
+            if self.interrupt.load(Ordering::SeqCst) {
+                return Err(RosEvalError::Interrupted(n));
+            }
+            self.refresh(sh);
+            match sh.book.pick() {
+                Pick::Use(id) => {
+                    let found = sh
+                        .links
+                        .iter()
+                        .find(|l| l.lock().unwrap_or_else(PoisonError::into_inner).id == id)
+                        .cloned();
+                    if let Some(link) = found {
+                        if ident.is_none() {
+                            sh.sent = n;
+                            *ident = Some(n);
+                        }
+                        return Ok((link, n));
                     }
-                    if self.interrupt.load(Ordering::SeqCst) {
-                        return Some(Err(RosEvalError::Interrupted(n)));
-                    }
-                    if Instant::now() >= deadline {
-                        return Some(Err(RosEvalError::NoSimulator(self.timeout.as_secs_f64())));
-                    }
-                    if Self::graph_changed(events) {
-                        return None;
+                    // A slot without a link cannot be: slots are made from links.
+                    sh.book.release(&id, AttemptEnd::Lost);
+                    sh.book.gone(&id);
+                }
+                Pick::Exhausted => {
+                    return Err(RosEvalError::Unanswered {
+                        candidate: n,
+                        timeout: self.timeout.as_secs_f64(),
+                    });
+                }
+                Pick::Wait => {
+                    // None present for the timeout, counted from this wait's start at the earliest.
+                    if sh
+                        .absent_since
+                        .is_some_and(|t| t.max(started).elapsed() >= self.timeout)
+                    {
+                        return Err(RosEvalError::NoSimulator(self.timeout.as_secs_f64()));
                     }
                 }
-            });
-            if let Some(result) = waited {
-                return result;
             }
+            guard = self
+                .freed
+                .wait_timeout(guard, POLL)
+                .unwrap_or_else(PoisonError::into_inner)
+                .0;
         }
     }
 
-    /// Whether the graph changed since the last call (draining the node's events).
-    fn graph_changed(events: &Option<async_channel::Receiver<NodeEvent>>) -> bool {
-        let Some(events) = events else {
-            return false;
-        };
-        let mut changed = false;
-        while events.try_recv().is_ok() {
-            changed = true;
-        }
-        changed
-    }
-
-    /// Whether a remote reader was matched or lost since the last call (draining the node's
-    /// events). The events name the remote entity only, not the local writer it matched.
-    fn readers_changed(events: &Option<async_channel::Receiver<NodeEvent>>) -> bool {
-        let Some(events) = events else {
-            return false;
-        };
-        let mut changed = false;
-        while let Ok(event) = events.try_recv() {
-            if let NodeEvent::Graph(GraphEvent::EntityDeclared(e) | GraphEvent::EntityUndeclared(e)) = event {
-                changed |= e.kind == EntityKind::Subscription;
-            }
-        }
-        changed
-    }
-
-    /// The readers matched to the candidates now (the candidates' writer has been matched
-    /// before, so ros2-client knows it).
-    fn candidate_readers(link: &mut Link) -> usize {
-        let Link { node, candidates, .. } = link;
-        candidates.get_subscription_count(node.inner())
-    }
-
-    /// Whether the candidates gained a reader since `known` readers were counted (updated),
-    /// looked at only when the graph changed.
-    fn new_reader(link: &mut Link, known: &mut usize) -> bool {
-        if !Self::readers_changed(&link.events) {
-            return false;
-        }
-        let now = Self::candidate_readers(link);
-        let grew = now > *known;
-        *known = now;
-        grew
-    }
-
-    /// One candidate: its outcome, `None` when every attempt went unanswered.
-    fn round_trip(&self, link: &mut Link, individual: &Individual) -> Result<Option<Evaluation>, RosEvalError> {
-        let n = link.sent + 1;
-        self.await_simulator(link, n)?;
-        link.sent = n;
-        // Wall-clock time: unique across runs even under use_sim_time.
-        let nanos = std::time::SystemTime::now()
-            .duration_since(std::time::UNIX_EPOCH)
-            .map(|d| d.as_nanos() as i64)
-            .unwrap_or(0);
-        let header = candidate_header(n, mobil_ros::time::stamp_from_nanos(nanos));
-        let message = candidate_message(&self.model, individual, header.clone());
-        for attempt in 1..=ATTEMPTS {
-            if attempt > 1 {
-                self.await_simulator(link, n)?;
-            }
-            // Matches from before this publication say nothing about who heard it.
-            Self::readers_changed(&link.events);
-            let mut readers = Self::candidate_readers(link);
-            link.candidates
-                .publish(message.clone())
-                .map_err(|e| RosEvalError::Publish(n, format!("{e:?}")))?;
-            if let Some(e) = self.await_answer(link, n, &header, &message, &mut readers)? {
-                return Ok(Some(e));
-            }
-            link.unanswered_in_a_row += 1;
-            warn_throttled!(
-                link.throttle,
-                "timeout",
-                "candidate {n}: no outcome within {:.1} s (attempt {attempt} of {ATTEMPTS})",
-                self.timeout.as_secs_f64()
-            );
-            if link.unanswered_in_a_row >= MAX_UNANSWERED_IN_A_ROW {
-                return Err(RosEvalError::Unanswered {
-                    candidate: n,
-                    timeout: self.timeout.as_secs_f64(),
-                });
-            }
-        }
-        Ok(None)
-    }
-
-    /// Waits up to the timeout for the answer to the candidate just published, sending it again
-    /// every `resend_every` and whenever a new remote reader is matched (a simulator that
-    /// restarted, even before the old one's lease ended, or a first sample lost during
-    /// discovery). `readers`: the candidates' readers when it was published. `None`: no answer
-    /// in time.
-    fn await_answer(
+    /// One attempt of candidate `n` at `link`: sends it, then waits up to the timeout for its
+    /// answer, sending it again every `resend_every` and whenever a new reader of the
+    /// candidates is matched; ends early when the simulator's endpoints vanish.
+    fn attempt(
         &self,
-        link: &mut Link,
+        link: &Arc<Mutex<SimLink>>,
         n: u64,
         header: &Header,
         message: &JointTrajectory,
-        readers: &mut usize,
-    ) -> Result<Option<Evaluation>, RosEvalError> {
+    ) -> Result<Ended, RosEvalError> {
+        let lock = || link.lock().unwrap_or_else(PoisonError::into_inner);
+        {
+            let mut l = lock();
+            l.new_reader = false;
+            l.lost = false;
+            l.candidates
+                .publish(message.clone())
+                .map_err(|e| RosEvalError::Publish(n, format!("{e:?}")))?;
+        }
         let deadline = Instant::now() + self.timeout;
         let mut next_send = Instant::now() + self.resend_every;
         loop {
-            for _ in 0..ANSWERS_PER_PASS {
-                let Ok(Some((m, _))) = link.outcome.take() else {
-                    break;
-                };
-                if m.header != *header {
-                    warn_throttled!(
-                        link.throttle,
-                        "stale",
-                        "discarded an outcome for `{}` at {}.{:09} while waiting for `{}` at {}.{:09}",
-                        m.header.frame_id,
-                        m.header.stamp.sec,
-                        m.header.stamp.nanosec,
-                        header.frame_id,
-                        header.stamp.sec,
-                        header.stamp.nanosec
-                    );
-                    continue;
-                }
-                return Ok(Some(match parse_outcome(&m) {
-                    Ok(o) => o.evaluation(&self.fitness, &self.model),
-                    Err(reason) => {
+            {
+                let mut l = lock();
+                for _ in 0..ANSWERS_PER_PASS {
+                    let Ok(Some((m, _))) = l.outcome.take() else {
+                        break;
+                    };
+                    if m.header != *header {
                         warn_throttled!(
-                            link.throttle,
-                            "bad",
-                            "candidate {n}: bad outcome ({reason}); scored 0 as a fall at 0 s"
+                            l.throttle,
+                            "stale",
+                            "discarded an outcome for `{}` at {}.{:09} while waiting for `{}` at {}.{:09} from {}",
+                            m.header.frame_id,
+                            m.header.stamp.sec,
+                            m.header.stamp.nanosec,
+                            header.frame_id,
+                            header.stamp.sec,
+                            header.stamp.nanosec,
+                            l.id
                         );
-                        VOID
+                        continue;
                     }
-                }));
+                    return Ok(Ended::Answered(match parse_outcome(&m) {
+                        Ok(o) => o.evaluation(&self.fitness, &self.model),
+                        Err(reason) => {
+                            warn_throttled!(
+                                l.throttle,
+                                "bad",
+                                "candidate {n}: bad outcome from {} ({reason}); scored 0 as a fall at 0 s",
+                                l.id
+                            );
+                            VOID
+                        }
+                    }));
+                }
             }
             if self.interrupt.load(Ordering::SeqCst) {
                 return Err(RosEvalError::Interrupted(n));
             }
             let now = Instant::now();
             if now >= deadline {
-                return Ok(None);
+                return Ok(Ended::Missed);
+            }
+            if let Some(sh) = self.lock().as_mut() {
+                self.refresh(sh);
+            }
+            let mut l = lock();
+            if l.lost {
+                return Ok(Ended::Lost);
             }
             // The same candidate again (same header: the answers to the copies are discarded).
-            if Self::new_reader(link, readers) || now >= next_send {
-                link.candidates
+            if std::mem::take(&mut l.new_reader) || now >= next_send {
+                l.candidates
                     .publish(message.clone())
                     .map_err(|e| RosEvalError::Publish(n, format!("{e:?}")))?;
                 next_send = now + self.resend_every;
             }
+            drop(l);
             std::thread::sleep(Duration::from_millis(1));
+        }
+    }
+
+    /// The attempt at `link` is over: the simulator is free again.
+    fn release(&self, link: &Arc<Mutex<SimLink>>, end: AttemptEnd) {
+        let id = link.lock().unwrap_or_else(PoisonError::into_inner).id.clone();
+        if let Some(sh) = self.lock().as_mut() {
+            sh.book.release(&id, end);
+        }
+        self.freed.notify_all();
+    }
+
+    fn fail(&self, e: RosEvalError) {
+        if let Some(sh) = self.lock().as_mut() {
+            sh.failed.get_or_insert(e);
+        }
+        self.freed.notify_all();
+    }
+
+    /// A candidate evaluated by the pool, or the error that stops the evaluator.
+    fn evaluate_candidate(&self, individual: &Individual) -> Result<Evaluation, RosEvalError> {
+        let mut tries = CandidateTries::new(ATTEMPTS);
+        let mut ident = None;
+        let mut sent: Option<(Header, JointTrajectory)> = None;
+        loop {
+            let (link, n) = self.acquire(&mut ident)?;
+            let (header, message) = sent.get_or_insert_with(|| {
+                // Wall-clock time: unique across runs even under use_sim_time.
+                let nanos = std::time::SystemTime::now()
+                    .duration_since(std::time::UNIX_EPOCH)
+                    .map(|d| d.as_nanos() as i64)
+                    .unwrap_or(0);
+                let header = candidate_header(n, mobil_ros::time::stamp_from_nanos(nanos));
+                let message = candidate_message(&self.model, individual, header.clone());
+                (header, message)
+            });
+            let ended = self.attempt(&link, n, header, message);
+            let kind = ended.as_ref().map_or(AttemptEnd::Lost, Ended::kind);
+            self.release(&link, kind);
+            let id = link.lock().unwrap_or_else(PoisonError::into_inner).id.clone();
+            match ended? {
+                Ended::Answered(e) => return Ok(e),
+                Ended::Lost => {
+                    tracing::warn!("candidate {n}: simulator {id} left before answering; sent again");
+                }
+                Ended::Missed => {
+                    let mut guard = self.lock();
+                    let Some(sh) = guard.as_mut() else {
+                        return Ok(VOID);
+                    };
+                    warn_throttled!(
+                        sh.throttle,
+                        "timeout",
+                        "candidate {n}: no outcome from {id} within {:.1} s (attempt {} of {ATTEMPTS})",
+                        self.timeout.as_secs_f64(),
+                        tries.missed() + 1
+                    );
+                    if tries.after(AttemptEnd::Missed) == NextTry::Void {
+                        sh.void_scores += 1;
+                        warn_throttled!(
+                            sh.throttle,
+                            "void",
+                            "candidate {n}: unanswered after {ATTEMPTS} attempts; scored 0 as a fall at 0 s ({} so far)",
+                            sh.void_scores
+                        );
+                        return Ok(VOID);
+                    }
+                }
+            }
         }
     }
 }
 
 impl Evaluator for RosEvaluator {
     fn evaluate(&self, individual: &Individual) -> Evaluation {
-        let mut guard = self.link.lock().unwrap_or_else(PoisonError::into_inner);
-        let Some(link) = guard.as_mut() else {
-            return VOID;
-        };
-        if link.failed.is_some() {
-            return VOID;
-        }
-        match self.round_trip(link, individual) {
-            Ok(Some(e)) => {
-                link.unanswered_in_a_row = 0;
-                e
-            }
-            Ok(None) => {
-                link.void_scores += 1;
-                let n = link.sent;
-                warn_throttled!(
-                    link.throttle,
-                    "void",
-                    "candidate {n}: unanswered after {ATTEMPTS} attempts; scored 0 as a fall at 0 s ({} so far)",
-                    link.void_scores
-                );
-                VOID
-            }
+        match self.evaluate_candidate(individual) {
+            Ok(e) => e,
             Err(e) => {
-                link.failed = Some(e);
+                self.fail(e);
                 VOID
             }
         }
@@ -452,18 +648,12 @@ impl Evaluator for RosEvaluator {
 }
 
 impl Drop for RosEvaluator {
-    /// Leaves the DDS domain cleanly: writer and reader first, then the node and its participant.
+    /// Leaves the DDS domain cleanly: writers and readers first, then the node and its
+    /// participant.
     fn drop(&mut self) {
-        let link = self.link.get_mut().unwrap_or_else(PoisonError::into_inner).take();
-        if let Some(Link {
-            candidates,
-            outcome,
-            node,
-            ..
-        }) = link
-        {
-            drop(candidates);
-            drop(outcome);
+        let shared = self.shared.get_mut().unwrap_or_else(PoisonError::into_inner).take();
+        if let Some(Shared { links, node, .. }) = shared {
+            drop(links);
             self.runtime.block_on(node.shutdown());
         }
     }

@@ -2,7 +2,7 @@
 //! with its outputs and progress bar, and the way it ends.
 
 use crate::outputs;
-use crate::ros_eval::{RosEvalError, RosEvaluator};
+use crate::ros_eval::{RosEvalError, RosEvaluator, MAX_IN_FLIGHT};
 use anyhow::{anyhow, bail, Context as _};
 use clap::{Parser, ValueEnum};
 use indicatif::{ProgressBar, ProgressStyle};
@@ -56,7 +56,8 @@ pub enum EvaluatorArg {
     /// The built-in rigid-body simulation (rapier3d), on every core.
     Physics,
     /// An external simulator over ROS 2 (topics ga_step/candidate and ga_step/outcome; node
-    /// name, namespace and topics remapped by --ros-args -r …), one individual at a time.
+    /// name, namespace and topics remapped by --ros-args -r …), one individual at a time per
+    /// simulator; simulators serving the same topics in namespaces below the node's join a pool.
     Ros,
 }
 
@@ -102,7 +103,8 @@ pub struct Cli {
     /// Who evaluates an individual.
     #[arg(long, value_enum, default_value = "physics")]
     pub evaluator: EvaluatorArg,
-    /// Threads evaluating the physics (0: one per core).
+    /// Threads evaluating the physics (0: one per core); with --evaluator ros, the most candidates
+    /// in flight at once, one per simulator (0: 64).
     #[arg(long, value_name = "K", default_value_t = 0)]
     pub threads: usize,
     /// Seconds to wait for an external simulator's answer to one candidate, and for a simulator
@@ -314,7 +316,8 @@ pub fn run(cli: &Cli, ros_args: &RosArgs, interrupt: &Arc<AtomicBool>) -> anyhow
                 )
                 .context("cannot start the ROS 2 evaluator")?,
             )),
-            1,
+            // A thread per candidate in flight: each waits for a free simulator.
+            if cli.threads == 0 { MAX_IN_FLIGHT } else { cli.threads },
         ),
     };
     let evaluator = chosen.evaluator();

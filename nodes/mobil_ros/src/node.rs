@@ -495,6 +495,29 @@ impl RosNode {
         out
     }
 
+    /// The topics (ROS names, e.g. `/sim1/ga_step/outcome`) on which writers of messages of type
+    /// `M` have been discovered, sorted, each once: how a node finds peers that serve a
+    /// contract in namespaces it was not told of.
+    pub fn writer_topics<M: RosMessage>(&self) -> Vec<String> {
+        let dds_type = M::type_name().dds_msg_type();
+        let mut topics: Vec<String> = self
+            .context
+            .domain_participant()
+            .discovered_writers()
+            .iter()
+            .filter(|w| w.publication_topic_data.type_name == dds_type)
+            .filter_map(|w| {
+                w.publication_topic_data
+                    .topic_name
+                    .strip_prefix("rt")
+                    .map(str::to_string)
+            })
+            .collect();
+        topics.sort();
+        topics.dedup();
+        topics
+    }
+
     /// The node's clock as a message stamp.
     pub fn stamp(&self) -> Time {
         crate::time::stamp_from_nanos(self.now_nanos())
