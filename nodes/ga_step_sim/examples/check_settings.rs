@@ -3,7 +3,8 @@
 //! A SOURCE is a `ga_step` checkpoint (its whole population), a Webots motion file as
 //! `ga_step` writes it (knots rebuilt as `--example replay` does) or `random:N:FRACTION` (N
 //! gentle motions, inner knots uniform within FRACTION of each range about standing, seed 5).
-//! Every motion is simulated at the default (5 ms, 4 iterations, 2 passes), at each candidate
+//! The body is the DC-motor model (`physics: dc-motor`), whose robust check this chose.
+//! Every motion is simulated at its default (5 ms, 4 iterations, 2 passes), at each candidate
 //! (5 ms/8/2, 4 ms/4/2, 2.5 ms/8/2, μ 0.7 at the default's solver) and at the reference
 //! (1.25 ms/16/4). Prints per candidate: of the motions upright at the default, how many it
 //! turns into falls and how many of those the reference also calls falls; how many the pair
@@ -34,7 +35,7 @@ fn settings() -> Vec<(String, BodyParams)> {
         solver_iterations: it,
         pgs_iterations: passes,
         friction: mu,
-        ..BodyParams::default()
+        ..BodyParams::dc_motor()
     };
     vec![
         ("5 ms/4/2 (default)".into(), s(0.005, 4, 2, 0.8)),

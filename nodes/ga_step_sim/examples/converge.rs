@@ -9,6 +9,8 @@
 //! list (the columns of the solver table of docs/experiments/ga-step-physics.md, 5:4:1 5:4:2
 //! 5:8:2 2.5:8:2 2.5:16:2 1.25:16:4; the last is the reference). Prints per motion and setting:
 //! fall or not (and why), fall time, Δx, Δy, and the cost in simulated seconds per wall second.
+//! The body is the DC-motor model (`physics: dc-motor`), that table's; `--example agreement`
+//! is the same check for the Webots model.
 use mobil_ga_step::{FitnessConfig, Individual, NaoModel, Servo};
 use mobil_ga_step_sim::{motions, BodyParams, PhysicsEvaluator};
 use rand::{Rng, SeedableRng};
@@ -102,7 +104,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 dt,
                 solver_iterations: iterations,
                 pgs_iterations: pgs,
-                ..BodyParams::default()
+                ..BodyParams::dc_motor()
             };
             let ev = PhysicsEvaluator::with_checks(model.clone(), fitness.clone(), body, &[])?;
             let t = Instant::now();

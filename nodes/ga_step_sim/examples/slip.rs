@@ -2,14 +2,15 @@
 //! slides over the floor: `cargo run --release -p mobil_ga_step_sim --example slip --
 //! DIR/checkpoint.json [LOAD_N]`. A foot counts as loaded while the floor pushes it with more
 //! than LOAD_N newtons (default 5 N, a tenth of the robot's weight). Optional further arguments
-//! replay under another body: `MU SOLVER_ITERATIONS DT`.
+//! replay under another body: `MU SOLVER_ITERATIONS DT`. The body is the checkpoint's
+//! physics model (`physics`), at its default setting.
 use mobil_ga_step_sim::PhysicsEvaluator;
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let path = std::env::args().nth(1).ok_or("usage: slip CHECKPOINT [LOAD_N]")?;
     let load: f64 = std::env::args().nth(2).map_or(Ok(5.0), |s| s.parse())?;
     let state = mobil_ga_step::read_checkpoint(std::path::Path::new(&path))?;
-    let mut body = mobil_ga_step_sim::BodyParams::default();
+    let mut body = mobil_ga_step_sim::BodyParams::named(state.setup.fitness.physics);
     if let Some(mu) = std::env::args().nth(3) {
         body.friction = mu.parse()?;
     }

@@ -1,5 +1,6 @@
 //! Prints the torso's path for the best individual of a `ga_step` checkpoint, every 50 ms:
-//! `cargo run --release -p mobil_ga_step_sim --example trace -- DIR/checkpoint.json`.
+//! `cargo run --release -p mobil_ga_step_sim --example trace -- DIR/checkpoint.json`, under
+//! the checkpoint's physics model at its default setting.
 use mobil_ga_step_sim::{BodyParams, PhysicsEvaluator};
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
@@ -8,7 +9,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let ev = PhysicsEvaluator::with_checks(
         state.setup.model.clone(),
         state.setup.fitness.clone(),
-        BodyParams::default(),
+        BodyParams::named(state.setup.fitness.physics),
         &[],
     )?;
     let best = &state.best().individual;
