@@ -6,11 +6,12 @@ first answer to the last, and the ratio to one simulator.
     .venv/bin/python tests/bench_ga_pool.py [--delay 0.1] [--population 20] [--generations 2]
 
 A benchmark, not a test: it prints figures. ROS_DOMAIN_ID is taken from the environment (a
-domain of its own is best).
+domain of its own is best); ga_step from MOBIL_BIN_DIR (default target/release).
 """
 from __future__ import annotations
 
 import argparse
+import os
 import subprocess
 import sys
 import tempfile
@@ -21,7 +22,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 import rosutil  # noqa: E402
 
 ROOT = Path(__file__).resolve().parent
-BIN = ROOT.parent / "target" / "release" / "ga_step"
+BIN = Path(os.environ.get("MOBIL_BIN_DIR", ROOT.parent / "target" / "release")) / "ga_step"
 
 
 def run(k: int, delay: float, population: int, generations: int, tmp: Path) -> tuple[int, float]:
@@ -33,7 +34,7 @@ def run(k: int, delay: float, population: int, generations: int, tmp: Path) -> t
     try:
         time.sleep(2.0)
         out = subprocess.run([str(BIN), "--population", str(population), "--generations", str(generations),
-                              "--seed", "1", "--crossover", "blx", "--evaluator", "ros", "--eval-timeout", "10",
+                              "--seed", "1", "--crossover", "blx", "--evaluator", "ros", "--pool", "--eval-timeout", "10",
                               "--out", str(tmp / f"k{k}"), "--ros-args", "-r", "__ns:=/bench"],
                              env=rosutil.ros_environ(), capture_output=True, text=True, timeout=600)
         if out.returncode != 0:
@@ -42,8 +43,14 @@ def run(k: int, delay: float, population: int, generations: int, tmp: Path) -> t
         for s in sims:
             s.terminate()
         for s in sims:
-            s.wait(timeout=10)
+            try:
+                s.wait(timeout=10)
+            except subprocess.TimeoutExpired:
+                s.kill()
+                s.wait()
     times = sorted(float(line.split()[0]) for log in logs if log.exists() for line in log.read_text().splitlines())
+    if len(times) < 2 or times[-1] <= times[0]:
+        raise SystemExit(f"{k} simulators answered {len(times)} candidates: nothing to measure")
     return len(times), (len(times) - 1) / (times[-1] - times[0])
 
 

@@ -8,7 +8,8 @@ knots alone, so that any simulator gives a candidate the same score.
 
 The rule is `rule`'s, a function of the mean knee knots, so that scores vary from candidate to
 candidate and a run's course depends on every one of them. `--die-at N` kills the process (SIGKILL, no goodbye on the wire) when its N-th distinct
-candidate arrives, before answering it. `--log FILE` appends a line per candidate answered: the time (s since the epoch), the
+candidate arrives, before answering it; `--leave-at N` leaves then instead, destroying its node
+and participant, which peers see at once. `--log FILE` appends a line per candidate answered: the time (s since the epoch), the
 namespace and the candidate's name.
 """
 from __future__ import annotations
@@ -32,6 +33,10 @@ from sensor_msgs.msg import JointState  # noqa: E402
 from trajectory_msgs.msg import JointTrajectory  # noqa: E402
 
 
+class Leave(Exception):
+    """Raised in the callback to leave the spin and go cleanly."""
+
+
 def rule(msg: JointTrajectory) -> tuple[bool, float, float]:
     """(fell, fall_time, forward_distance) of a candidate, from the mean knee knots r (right) and
     l (left), rad: it falls when r > 1 rad, at 3·(2.27 − r)/1.27 s (within 0.01–2.99 s); upright,
@@ -48,6 +53,8 @@ def main(argv: list[str]) -> int:
     parser.add_argument("--ns", required=True, help="namespace of the two topics, e.g. /sim1")
     parser.add_argument("--delay", type=float, default=0.05, help="seconds per evaluation")
     parser.add_argument("--die-at", type=int, default=0, help="die when the N-th candidate arrives")
+    parser.add_argument("--leave-at", type=int, default=0,
+                        help="leave cleanly (node and participant destroyed) when the N-th arrives")
     parser.add_argument("--log", type=Path, help="append a line per candidate answered")
     args = parser.parse_args(argv)
     ns = args.ns.rstrip("/")
@@ -67,6 +74,8 @@ def main(argv: list[str]) -> int:
         seen.add(key)
         if args.die_at and len(seen) >= args.die_at:
             os.kill(os.getpid(), signal.SIGKILL)
+        if args.leave_at and len(seen) >= args.leave_at:
+            raise Leave()
         time.sleep(args.delay)
         fell, t, dx = rule(msg)
         names, values = ["fell", "forward_distance"], [1.0 if fell else 0.0, dx]
@@ -83,6 +92,10 @@ def main(argv: list[str]) -> int:
         rclpy.spin(node)
     except (KeyboardInterrupt, SystemExit):
         pass
+    except Leave:
+        # Endpoints and participant disposed on the wire: peers see them go at once.
+        node.destroy_node()
+        rclpy.shutdown()
     return 0
 
 

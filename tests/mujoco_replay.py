@@ -162,7 +162,10 @@ class Outcome:
                 f"moved {self.foot_dx[0]:+.4f} m; left foot lifted {1e3 * self.lift[1]:.1f} mm, moved {self.foot_dx[1]:+.4f} m")
 
 
-def simulate(times: np.ndarray, rows: np.ndarray, dt: float = 0.0005, kv: float = 50.0) -> Outcome:
+def simulate(times: np.ndarray, rows: np.ndarray, dt: float = 0.0005, kv: float = 50.0,
+             control_period: float = 0.0) -> Outcome:
+    """Plays a motion; the servos' P-controller runs every `control_period` (s; 0: every step),
+    its velocity held in between, as Webots holds it over a `basicTimeStep`."""
     model = mujoco.MjModel.from_xml_string(model_xml(dt, kv))
     data = mujoco.MjData(model)
     qadr = [model.jnt_qposadr[model.joint(n).id] for n in SERVOS]
@@ -187,12 +190,14 @@ def simulate(times: np.ndarray, rows: np.ndarray, dt: float = 0.0005, kv: float 
     hi = np.array([LIMITS[n][1] for n in SERVOS])
     vmax = np.array([ROLL_SPEED if is_roll(n) else PITCH_SPEED for n in SERVOS])
     steps = int(round(duration / dt))
+    every = max(1, int(round(control_period / dt)))
     out = Outcome(False, "", duration, 0.0, (0.0, 0.0), (0.0, 0.0))
     for n in range(1, steps + 1):
         t = n * dt
         target = stand if t >= step_time else np.array([np.interp(t, times, rows[:, j]) for j in range(len(SERVOS))])
         target = np.clip(target, lo, hi)
-        data.ctrl[:] = np.clip(P_GAIN * (target - data.qpos[qadr]), -vmax, vmax)
+        if (n - 1) % every == 0:
+            data.ctrl[:] = np.clip(P_GAIN * (target - data.qpos[qadr]), -vmax, vmax)
         mujoco.mj_step(model, data)
         z = data.xpos[torso][2]
         up = data.xmat[torso].reshape(3, 3)[:, 2]
@@ -242,10 +247,12 @@ def main(argv: list[str]) -> int:
     parser.add_argument("motions", nargs="+", type=Path)
     parser.add_argument("--dt", type=float, default=0.0005, help="MuJoCo's time step (s)")
     parser.add_argument("--kv", type=float, default=50.0, help="the velocity actuators' gain (N·m·s/rad)")
+    parser.add_argument("--control-period", type=float, default=0.0,
+                        help="the P-controller's period (s; 0: every step; Webots: its basicTimeStep)")
     args = parser.parse_args(argv)
     for path in args.motions:
         times, rows = read_motion(path)
-        print(simulate(times, rows, args.dt, args.kv).line(str(path)))
+        print(simulate(times, rows, args.dt, args.kv, args.control_period).line(str(path)))
     return 0
 
 

@@ -7,17 +7,22 @@ from __future__ import annotations
 from pathlib import Path
 
 import numpy as np
+import pytest
+import yaml
 
 import mujoco_replay
 
 ROOT = Path(__file__).resolve().parent.parent
 HAND_STEP = ROOT / "nodes/ga_step_sim/motions/hand_step.motion"
-STEP_MIN_FORWARD = 0.04  # params/nao_step.yaml's step_min_forward
+STEP_MIN_FORWARD = yaml.safe_load((ROOT / "params/nao_step.yaml").read_text())["ga_step"][
+    "ros__parameters"]["step_min_forward"]
 
 
-def test_the_hand_made_step_is_a_non_falling_forward_step_in_mujoco() -> None:
+@pytest.mark.parametrize("control_period", [0.0, 0.02])
+def test_the_hand_made_step_is_a_non_falling_forward_step_in_mujoco(control_period: float) -> None:
+    # The servos' P-controller every MuJoCo step, and every 20 ms as Webots runs it.
     times, rows = mujoco_replay.read_motion(HAND_STEP)
-    o = mujoco_replay.simulate(times, rows)
+    o = mujoco_replay.simulate(times, rows, control_period=control_period)
     assert not o.fell, o
     assert o.dx >= STEP_MIN_FORWARD, o
     # A step: each foot lifted at least 1 cm and put down at least 4 cm ahead.

@@ -36,26 +36,29 @@
 //! Once stopped, every later call returns at once, and `ga_step` exits without writing the
 //! generation in flight, so the run resumes from its last checkpoint.
 //!
-//! **A pool of simulators** (an extension of the contract above; a lone simulator in the node's
-//! namespace is served exactly as before): every simulator that serves the two topics in a
-//! namespace *below* the node's (`<ns>/ga_step/candidate` and `<ns>/ga_step/outcome`, e.g.
-//! `/sim1/ga_step/…` and `/sim2/ga_step/…` for a node in `/`) is found by discovery, from the
-//! writers of its outcomes, as it appears, and is named by that namespace. Each simulator has one
-//! candidate in flight at a time; the rules of which one gets the next candidate, when a candidate
-//! is sent again and when the pool gives up are `mobil_ga_step::pool`'s: a candidate goes to a
-//! free simulator among those with the fewest attempts missed in a row; one whose simulator
-//! leaves (its endpoints vanish) is sent again to another without counting an attempt; a
-//! simulator that missed an answer gets no candidate while another answers; the run ends when
-//! every simulator present has missed [`MAX_UNANSWERED_IN_A_ROW`] attempts in a row, or when
-//! none has been present for the timeout. Headers are as above (a candidate sent to a second
-//! simulator keeps its header), so a simulator never needs to know of the others. Which simulator
-//! scored a candidate does not change its score, so the results depend on the seed alone. The
-//! candidates in flight are at most the threads the evaluator runs on ([`MAX_IN_FLIGHT`] with
-//! `--threads 0`). When the outcome topic is remapped to a name that does not end in
-//! `ga_step/outcome`, only that one simulator is used.
+//! **A pool of simulators** (`--pool`, an extension of the contract above; without it a lone
+//! simulator in the node's namespace is served exactly as before): every simulator that serves
+//! the two topics in a namespace *below* the node's (`<ns>/ga_step/candidate` and
+//! `<ns>/ga_step/outcome`, e.g. `/sim1/ga_step/…` and `/sim2/ga_step/…` for a node in `/`), and
+//! the one in the node's own namespace if there is one, is found by discovery, from the writers
+//! of its outcomes, as it appears, and is named by its namespace. Each simulator has one
+//! candidate in flight at a time. The rules of which one gets the next candidate, when a
+//! candidate is sent again and when the pool gives up are `mobil_ga_step::pool`'s: a candidate
+//! goes to a free simulator among those with the fewest attempts missed in a row; one whose
+//! simulator leaves (its endpoints vanish) is sent again to another without counting an attempt
+//! (up to three times); a simulator that missed an answer gets no candidate while another
+//! answers; the run ends when every simulator present has missed [`MAX_UNANSWERED_IN_A_ROW`]
+//! attempts in a row, or when none has been present for the timeout. Headers are as above (a
+//! candidate sent to a second simulator keeps its header), so a simulator never needs to know
+//! of the others. Which simulator scored a candidate does not change its score, so the results
+//! depend on the seed alone. The candidates in flight are at most the threads the evaluator runs
+//! on ([`MAX_IN_FLIGHT`] with `--threads 0`). When the outcome topic is remapped to a name that
+//! does not end in `ga_step/outcome`, only that one simulator is used.
 
 use mobil_ga_step::external::{candidate_name, Outcome, VOID};
-use mobil_ga_step::pool::{AttemptEnd, CandidateTries, NextTry, Pick, SimulatorPool};
+use mobil_ga_step::pool::{
+    pool_base, pool_namespaces, AttemptEnd, CandidateTries, Change, NextTry, Pick, SimulatorPool, OUTCOME_SUFFIX,
+};
 use mobil_ga_step::{Evaluation, Evaluator, FitnessConfig, Individual, NaoModel, KNOTS};
 use mobil_msgs::builtin_interfaces::msg::{Duration as RosDuration, Time};
 use mobil_msgs::sensor_msgs::msg::JointState;
@@ -88,7 +91,7 @@ pub enum RosEvalError {
     #[error("no simulator subscribed to {CANDIDATE_TOPIC} and publishing {OUTCOME_TOPIC} within {0:.1} s")]
     NoSimulator(f64),
     /// Several attempts in a row went unanswered.
-    #[error("the simulator left {MAX_UNANSWERED_IN_A_ROW} attempts in a row (the last for candidate {candidate}) unanswered within {timeout:.1} s each")]
+    #[error("every simulator left {MAX_UNANSWERED_IN_A_ROW} attempts in a row (the last for candidate {candidate}) unanswered within {timeout:.1} s each")]
     Unanswered {
         /// The last candidate's number.
         candidate: u64,
@@ -141,35 +144,42 @@ pub fn parse_outcome(m: &JointState) -> Result<Outcome, String> {
     Outcome::from_named(&m.name, &m.position)
 }
 
-/// One simulator of the pool: its two topics and what was last counted of them.
-// Field order is drop order: the writer and reader go before the node that owns their
-// participant (mobil_ros: readers and writers must go while their participant exists).
+/// One simulator: its name and its two topics.
 struct SimLink {
-    /// The simulator's name: the namespace its topics are in (`/` for the root).
+    /// The simulator's name: the namespace its topics are in (`/` for the root), or its outcome
+    /// topic when that is remapped to another form.
     id: String,
+    io: Mutex<SimIo>,
+}
+
+/// A simulator's topics and what its waiting candidate needs to know.
+// Field order is drop order: the writer and reader go before the node that owns their
+// participant (mobil_ros: readers and writers must go while their participant exists), which
+// `Shared` drops after its links.
+struct SimIo {
     candidates: Publisher<JointTrajectory>,
     outcome: Subscription<JointState>,
-    /// Readers of the candidates at the last count.
-    readers: usize,
-    /// A reader of the candidates was matched since the attempt last sent its candidate (a
-    /// simulator that restarted, even within the old one's lease; a first sample lost during
-    /// discovery): the candidate is sent again.
+    /// A new reader of the candidates was matched (a restarted simulator, even within the old
+    /// one's lease; a first sample lost during discovery): the waiting candidate is sent again.
     new_reader: bool,
-    /// The simulator's endpoints vanished since its attempt began.
-    lost: bool,
     throttle: LogThrottle,
+}
+
+impl SimLink {
+    fn io(&self) -> MutexGuard<'_, SimIo> {
+        self.io.lock().unwrap_or_else(PoisonError::into_inner)
+    }
 }
 
 /// The evaluator's state behind its lock.
 // Field order is drop order: the links go before the node.
 struct Shared {
-    links: Vec<Arc<Mutex<SimLink>>>,
+    links: Vec<Arc<SimLink>>,
     book: SimulatorPool,
     /// The node's graph events, taken once. `None` without a spinner.
     events: Option<async_channel::Receiver<NodeEvent>>,
     node: RosNode,
-    /// Where simulators in other namespaces are looked for: topics `<base><ns>/ga_step/outcome`.
-    /// `None` when the outcome topic is remapped to a name of another form.
+    /// With `--pool`, where more simulators are looked for: topics `<base><ns>/ga_step/outcome`.
     base: Option<String>,
     /// The outcome topic of the simulator in the node's own namespace (resolved and remapped).
     own_outcome: String,
@@ -185,7 +195,8 @@ struct Shared {
 /// The evaluator over ROS 2 (see the module's documentation).
 pub struct RosEvaluator {
     shared: Mutex<Option<Shared>>,
-    freed: Condvar,
+    /// Told when a simulator is freed or joins, and when the evaluator fails.
+    changed: Condvar,
     model: NaoModel,
     fitness: FitnessConfig,
     timeout: Duration,
@@ -194,8 +205,12 @@ pub struct RosEvaluator {
     runtime: tokio::runtime::Runtime,
 }
 
-/// How often a wait looks at the interrupt, the graph and the answers.
+/// How often a waiting candidate looks at the graph, the interrupt and the evaluator's failure.
 const POLL: Duration = Duration::from_millis(10);
+/// How often a waiting candidate looks for its answer.
+const ANSWER_POLL: Duration = Duration::from_millis(1);
+/// How long a candidate waiting for a free simulator sleeps unless told of one.
+const FREE_WAIT: Duration = Duration::from_millis(100);
 /// How often the discovered topics are searched for simulators while candidates wait.
 const SCAN_EVERY: Duration = Duration::from_millis(250);
 /// Answers taken in one pass before the deadline and the interrupt are looked at again (a
@@ -203,9 +218,6 @@ const SCAN_EVERY: Duration = Duration::from_millis(250);
 const ANSWERS_PER_PASS: usize = 64;
 /// The most candidates in flight at once with `--threads 0`.
 pub const MAX_IN_FLIGHT: usize = 64;
-/// The last two levels of the contract's topics.
-const OUTCOME_SUFFIX: &str = "/ga_step/outcome";
-const CANDIDATE_SUFFIX: &str = "/ga_step/candidate";
 
 /// How an attempt ended, with the answer's score.
 enum Ended {
@@ -224,41 +236,16 @@ impl Ended {
     }
 }
 
-/// The simulators' namespaces that `topics` (writers of outcomes) show under `base`: each
-/// `<base><ns>/ga_step/outcome` with `<ns>` not empty gives `<base><ns>`; the node's own
-/// `own_outcome` is not among them. `base` ends with `/`.
-pub fn pool_namespaces(topics: &[String], base: &str, own_outcome: &str) -> Vec<String> {
-    topics
-        .iter()
-        .filter(|t| t.as_str() != own_outcome && t.starts_with(base))
-        .filter_map(|t| t.strip_suffix(OUTCOME_SUFFIX))
-        .filter(|ns| ns.len() >= base.len() && !ns[base.len()..].is_empty())
-        .map(str::to_string)
-        .collect()
-}
-
-/// The namespace under which a node whose outcome topic resolved to `own_outcome` looks for
-/// more simulators (ending with `/`), and the name of its own simulator: `None` for the base
-/// when the topic was remapped to a name that does not end with `ga_step/outcome`.
-pub fn pool_base(own_outcome: &str) -> (Option<String>, String) {
-    match own_outcome.strip_suffix(OUTCOME_SUFFIX) {
-        Some(ns) => (
-            Some(format!("{ns}/")),
-            if ns.is_empty() { "/".into() } else { ns.into() },
-        ),
-        None if own_outcome == "/ga_step/outcome" => (Some("/".into()), "/".into()),
-        None => (None, own_outcome.to_string()),
-    }
-}
-
 impl RosEvaluator {
     /// Joins the DDS domain of `ROS_DOMAIN_ID` as node `ga_step` (its name, namespace and topics
-    /// remapped by `args`) and creates the topics of the simulator in its namespace; simulators
-    /// in namespaces below it are found as they appear. `interrupt` set stops any waiting.
+    /// remapped by `args`) and creates the topics of the simulator in its namespace; with `pool`,
+    /// simulators in namespaces below it are found as they appear. `interrupt` set stops any
+    /// waiting.
     pub fn new(
         model: NaoModel,
         fitness: FitnessConfig,
         timeout: Duration,
+        pool: bool,
         args: &RosArgs,
         interrupt: Arc<AtomicBool>,
     ) -> anyhow::Result<RosEvaluator> {
@@ -278,19 +265,19 @@ impl RosEvaluator {
             let events = node.inner().status_receiver();
             let own = SimLink {
                 id: own_id,
-                candidates,
-                outcome,
-                readers: 0,
-                new_reader: false,
-                lost: false,
-                throttle: LogThrottle::default(),
+                io: Mutex::new(SimIo {
+                    candidates,
+                    outcome,
+                    new_reader: false,
+                    throttle: LogThrottle::default(),
+                }),
             };
             Shared {
-                links: vec![Arc::new(Mutex::new(own))],
+                links: vec![Arc::new(own)],
                 book: SimulatorPool::new(MAX_UNANSWERED_IN_A_ROW),
                 events,
                 node,
-                base,
+                base: base.filter(|_| pool),
                 own_outcome,
                 sent: 0,
                 void_scores: 0,
@@ -302,7 +289,7 @@ impl RosEvaluator {
         };
         Ok(RosEvaluator {
             shared: Mutex::new(Some(shared)),
-            freed: Condvar::new(),
+            changed: Condvar::new(),
             model,
             fitness,
             timeout,
@@ -333,14 +320,9 @@ impl RosEvaluator {
         self.lock().as_ref().map_or(0, |s| s.void_scores)
     }
 
-    /// The simulators present now.
-    pub fn simulators(&self) -> usize {
-        self.lock().as_ref().map_or(0, |s| s.book.present())
-    }
-
-    /// Brings the pool up to date with the graph: simulators found in new namespaces, the
-    /// readers and writers of each, who joined, restarted or left. Cheap unless the graph
-    /// changed or [`SCAN_EVERY`] passed.
+    /// Brings the pool up to date with the graph: simulators found in new namespaces (with
+    /// `--pool`), the readers and writers of each, who joined, restarted or left. Cheap unless
+    /// the graph changed or [`SCAN_EVERY`] passed.
     fn refresh(&self, sh: &mut Shared) {
         let changed = match &sh.events {
             Some(events) => {
@@ -360,60 +342,45 @@ impl RosEvaluator {
         if let Some(base) = sh.base.clone() {
             let topics = sh.node.writer_topics::<JointState>();
             for ns in pool_namespaces(&topics, &base, &sh.own_outcome) {
-                if sh
-                    .links
-                    .iter()
-                    .any(|l| l.lock().unwrap_or_else(PoisonError::into_inner).id == ns)
-                {
+                if sh.links.iter().any(|l| l.id == ns) {
                     continue;
                 }
                 let _entered = self.runtime.enter();
                 let q = qos::reliable(10);
+                let candidate_topic = format!("{ns}{}", CANDIDATE_SUFFIX);
+                let outcome_topic = format!("{ns}{OUTCOME_SUFFIX}");
                 let made = sh
                     .node
-                    .publisher::<JointTrajectory>(&format!("{ns}{CANDIDATE_SUFFIX}"), &q)
-                    .and_then(|c| {
-                        Ok((
-                            c,
-                            sh.node
-                                .subscription::<JointState>(&format!("{ns}{OUTCOME_SUFFIX}"), &q)?,
-                        ))
-                    });
+                    .publisher::<JointTrajectory>(&candidate_topic, &q)
+                    .and_then(|c| Ok((c, sh.node.subscription::<JointState>(&outcome_topic, &q)?)));
                 match made {
-                    Ok((candidates, outcome)) => sh.links.push(Arc::new(Mutex::new(SimLink {
+                    Ok((candidates, outcome)) => sh.links.push(Arc::new(SimLink {
                         id: ns,
-                        candidates,
-                        outcome,
-                        readers: 0,
-                        new_reader: false,
-                        lost: false,
-                        throttle: LogThrottle::default(),
-                    }))),
+                        io: Mutex::new(SimIo {
+                            candidates,
+                            outcome,
+                            new_reader: false,
+                            throttle: LogThrottle::default(),
+                        }),
+                    })),
                     Err(e) => warn_throttled!(sh.throttle, "link", "cannot reach the simulator in {ns}: {e:#}"),
                 }
             }
         }
         let Shared { links, book, node, .. } = sh;
+        let mut joined = false;
         for link in links.iter() {
-            let mut l = link.lock().unwrap_or_else(PoisonError::into_inner);
-            let readers = l.candidates.get_subscription_count(node.inner());
-            let writers = l.outcome.get_publisher_count(node.inner());
-            let was = book.is_present(&l.id);
-            if readers > l.readers {
-                l.new_reader = true;
-                if was {
-                    book.restarted(&l.id);
+            let mut io = link.io();
+            let readers = io.candidates.get_subscription_count(node.inner());
+            let writers = io.outcome.get_publisher_count(node.inner());
+            match book.observe(&link.id, readers, writers) {
+                Change::None => {}
+                Change::Joined => {
+                    joined = true;
+                    tracing::info!("simulator {} joined ({} present)", link.id, book.present());
                 }
-            }
-            l.readers = readers;
-            if readers > 0 && writers > 0 {
-                if book.seen(&l.id) {
-                    tracing::info!("simulator {} joined ({} present)", l.id, book.present());
-                }
-            } else if was {
-                book.gone(&l.id);
-                l.lost = true;
-                tracing::warn!("simulator {} left ({} present)", l.id, book.present());
+                Change::Restarted => io.new_reader = true,
+                Change::Left => tracing::warn!("simulator {} left ({} present)", link.id, book.present()),
             }
         }
         sh.absent_since = match (sh.book.present(), sh.absent_since) {
@@ -421,17 +388,21 @@ impl RosEvaluator {
             (0, since) => since,
             _ => None,
         };
+        if joined {
+            self.changed.notify_all();
+        }
     }
 
-    /// A simulator for candidate `n`: waits while every usable one is busy, up to the timeout
-    /// while none is present. Assigns the candidate's number on its first attempt.
-    fn acquire(&self, ident: &mut Option<u64>) -> Result<(Arc<Mutex<SimLink>>, u64), RosEvalError> {
+    /// A simulator for a candidate: waits while every usable one is busy, up to the timeout
+    /// while none is present. Gives the candidate its number (`ident`) on its first attempt.
+    fn acquire(&self, ident: &mut Option<u64>) -> Result<Arc<SimLink>, RosEvalError> {
         let started = Instant::now();
         let mut guard = self.lock();
         loop {
             let Some(sh) = guard.as_mut() else {
-                return Err(RosEvalError::Interrupted(0));
+                return Err(RosEvalError::Interrupted(ident.unwrap_or(0)));
             };
+            // The number the candidate has or will have (for the errors).
             let n = ident.unwrap_or(sh.sent + 1);
             if let Some(e) = &sh.failed {
                 return Err(e.clone());
@@ -442,25 +413,20 @@ impl RosEvaluator {
             self.refresh(sh);
             match sh.book.pick() {
                 Pick::Use(id) => {
-                    let found = sh
-                        .links
-                        .iter()
-                        .find(|l| l.lock().unwrap_or_else(PoisonError::into_inner).id == id)
-                        .cloned();
-                    if let Some(link) = found {
+                    if let Some(link) = sh.links.iter().find(|l| l.id == id).cloned() {
                         if ident.is_none() {
                             sh.sent = n;
                             *ident = Some(n);
                         }
-                        return Ok((link, n));
+                        return Ok(link);
                     }
-                    // A slot without a link cannot be: slots are made from links.
+                    // Slots are made from links only; a slot without one is left out.
                     sh.book.release(&id, AttemptEnd::Lost);
                     sh.book.gone(&id);
                 }
                 Pick::Exhausted => {
                     return Err(RosEvalError::Unanswered {
-                        candidate: n,
+                        candidate: sh.sent,
                         timeout: self.timeout.as_secs_f64(),
                     });
                 }
@@ -474,9 +440,12 @@ impl RosEvaluator {
                     }
                 }
             }
+            // The first wait for a simulator to appear looks at the graph often; a wait for a
+            // busy one is told when it is freed.
+            let nap = if sh.book.present() == 0 { POLL } else { FREE_WAIT };
             guard = self
-                .freed
-                .wait_timeout(guard, POLL)
+                .changed
+                .wait_timeout(guard, nap)
                 .unwrap_or_else(PoisonError::into_inner)
                 .0;
         }
@@ -484,35 +453,34 @@ impl RosEvaluator {
 
     /// One attempt of candidate `n` at `link`: sends it, then waits up to the timeout for its
     /// answer, sending it again every `resend_every` and whenever a new reader of the
-    /// candidates is matched; ends early when the simulator's endpoints vanish.
+    /// candidates is matched; ends early when the simulator leaves or the evaluator fails.
     fn attempt(
         &self,
-        link: &Arc<Mutex<SimLink>>,
+        link: &SimLink,
         n: u64,
         header: &Header,
         message: &JointTrajectory,
     ) -> Result<Ended, RosEvalError> {
-        let lock = || link.lock().unwrap_or_else(PoisonError::into_inner);
         {
-            let mut l = lock();
-            l.new_reader = false;
-            l.lost = false;
-            l.candidates
+            let mut io = link.io();
+            io.new_reader = false;
+            io.candidates
                 .publish(message.clone())
                 .map_err(|e| RosEvalError::Publish(n, format!("{e:?}")))?;
         }
         let deadline = Instant::now() + self.timeout;
         let mut next_send = Instant::now() + self.resend_every;
+        let mut next_look = Instant::now();
         loop {
             {
-                let mut l = lock();
+                let mut io = link.io();
                 for _ in 0..ANSWERS_PER_PASS {
-                    let Ok(Some((m, _))) = l.outcome.take() else {
+                    let Ok(Some((m, _))) = io.outcome.take() else {
                         break;
                     };
                     if m.header != *header {
                         warn_throttled!(
-                            l.throttle,
+                            io.throttle,
                             "stale",
                             "discarded an outcome for `{}` at {}.{:09} while waiting for `{}` at {}.{:09} from {}",
                             m.header.frame_id,
@@ -521,7 +489,7 @@ impl RosEvaluator {
                             header.frame_id,
                             header.stamp.sec,
                             header.stamp.nanosec,
-                            l.id
+                            link.id
                         );
                         continue;
                     }
@@ -529,10 +497,10 @@ impl RosEvaluator {
                         Ok(o) => o.evaluation(&self.fitness, &self.model),
                         Err(reason) => {
                             warn_throttled!(
-                                l.throttle,
+                                io.throttle,
                                 "bad",
                                 "candidate {n}: bad outcome from {} ({reason}); scored 0 as a fall at 0 s",
-                                l.id
+                                link.id
                             );
                             VOID
                         }
@@ -543,42 +511,51 @@ impl RosEvaluator {
                 return Err(RosEvalError::Interrupted(n));
             }
             let now = Instant::now();
+            if now >= next_look {
+                next_look = now + POLL;
+                let mut guard = self.lock();
+                let Some(sh) = guard.as_mut() else {
+                    return Err(RosEvalError::Interrupted(n));
+                };
+                if let Some(e) = &sh.failed {
+                    return Err(e.clone());
+                }
+                self.refresh(sh);
+                // Decided here, under the lock that `refresh` and `acquire` hold: a simulator
+                // that left at any time since it was picked is gone from the pool.
+                if !sh.book.is_present(&link.id) {
+                    return Ok(Ended::Lost);
+                }
+            }
             if now >= deadline {
                 return Ok(Ended::Missed);
             }
-            if let Some(sh) = self.lock().as_mut() {
-                self.refresh(sh);
-            }
-            let mut l = lock();
-            if l.lost {
-                return Ok(Ended::Lost);
-            }
+            let mut io = link.io();
             // The same candidate again (same header: the answers to the copies are discarded).
-            if std::mem::take(&mut l.new_reader) || now >= next_send {
-                l.candidates
+            if std::mem::take(&mut io.new_reader) || now >= next_send {
+                io.candidates
                     .publish(message.clone())
                     .map_err(|e| RosEvalError::Publish(n, format!("{e:?}")))?;
                 next_send = now + self.resend_every;
             }
-            drop(l);
-            std::thread::sleep(Duration::from_millis(1));
+            drop(io);
+            std::thread::sleep(ANSWER_POLL);
         }
     }
 
     /// The attempt at `link` is over: the simulator is free again.
-    fn release(&self, link: &Arc<Mutex<SimLink>>, end: AttemptEnd) {
-        let id = link.lock().unwrap_or_else(PoisonError::into_inner).id.clone();
+    fn release(&self, link: &SimLink, end: AttemptEnd) {
         if let Some(sh) = self.lock().as_mut() {
-            sh.book.release(&id, end);
+            sh.book.release(&link.id, end);
         }
-        self.freed.notify_all();
+        self.changed.notify_all();
     }
 
     fn fail(&self, e: RosEvalError) {
         if let Some(sh) = self.lock().as_mut() {
             sh.failed.get_or_insert(e);
         }
-        self.freed.notify_all();
+        self.changed.notify_all();
     }
 
     /// A candidate evaluated by the pool, or the error that stops the evaluator.
@@ -587,7 +564,8 @@ impl RosEvaluator {
         let mut ident = None;
         let mut sent: Option<(Header, JointTrajectory)> = None;
         loop {
-            let (link, n) = self.acquire(&mut ident)?;
+            let link = self.acquire(&mut ident)?;
+            let n = ident.unwrap_or(0);
             let (header, message) = sent.get_or_insert_with(|| {
                 // Wall-clock time: unique across runs even under use_sim_time.
                 let nanos = std::time::SystemTime::now()
@@ -599,41 +577,47 @@ impl RosEvaluator {
                 (header, message)
             });
             let ended = self.attempt(&link, n, header, message);
-            let kind = ended.as_ref().map_or(AttemptEnd::Lost, Ended::kind);
-            self.release(&link, kind);
-            let id = link.lock().unwrap_or_else(PoisonError::into_inner).id.clone();
-            match ended? {
+            self.release(&link, ended.as_ref().map_or(AttemptEnd::Lost, Ended::kind));
+            let end = match ended? {
                 Ended::Answered(e) => return Ok(e),
                 Ended::Lost => {
-                    tracing::warn!("candidate {n}: simulator {id} left before answering; sent again");
+                    tracing::warn!("candidate {n}: simulator {} left before answering; sent again", link.id);
+                    AttemptEnd::Lost
                 }
                 Ended::Missed => {
                     let mut guard = self.lock();
-                    let Some(sh) = guard.as_mut() else {
-                        return Ok(VOID);
-                    };
-                    warn_throttled!(
-                        sh.throttle,
-                        "timeout",
-                        "candidate {n}: no outcome from {id} within {:.1} s (attempt {} of {ATTEMPTS})",
-                        self.timeout.as_secs_f64(),
-                        tries.missed() + 1
-                    );
-                    if tries.after(AttemptEnd::Missed) == NextTry::Void {
-                        sh.void_scores += 1;
+                    if let Some(sh) = guard.as_mut() {
                         warn_throttled!(
                             sh.throttle,
-                            "void",
-                            "candidate {n}: unanswered after {ATTEMPTS} attempts; scored 0 as a fall at 0 s ({} so far)",
-                            sh.void_scores
+                            "timeout",
+                            "candidate {n}: no outcome from {} within {:.1} s (attempt {} of {ATTEMPTS})",
+                            link.id,
+                            self.timeout.as_secs_f64(),
+                            tries.missed() + 1
                         );
-                        return Ok(VOID);
                     }
+                    AttemptEnd::Missed
                 }
+            };
+            if tries.after(end) == NextTry::Void {
+                let mut guard = self.lock();
+                if let Some(sh) = guard.as_mut() {
+                    sh.void_scores += 1;
+                    warn_throttled!(
+                        sh.throttle,
+                        "void",
+                        "candidate {n}: unanswered after {ATTEMPTS} attempts; scored 0 as a fall at 0 s ({} so far)",
+                        sh.void_scores
+                    );
+                }
+                return Ok(VOID);
             }
         }
     }
 }
+
+/// The last two levels of the contract's candidate topic.
+const CANDIDATE_SUFFIX: &str = "/ga_step/candidate";
 
 impl Evaluator for RosEvaluator {
     fn evaluate(&self, individual: &Individual) -> Evaluation {

@@ -57,7 +57,8 @@ pub enum EvaluatorArg {
     Physics,
     /// An external simulator over ROS 2 (topics ga_step/candidate and ga_step/outcome; node
     /// name, namespace and topics remapped by --ros-args -r …), one individual at a time per
-    /// simulator; simulators serving the same topics in namespaces below the node's join a pool.
+    /// simulator; with --pool, simulators serving the same topics in namespaces below the
+    /// node's share the candidates.
     Ros,
 }
 
@@ -111,6 +112,10 @@ pub struct Cli {
     /// to appear (--evaluator ros); at most 86400.
     #[arg(long, value_name = "SECONDS", default_value_t = 30.0)]
     pub eval_timeout: f64,
+    /// With --evaluator ros: also use every simulator serving the topics in a namespace below
+    /// the node's (e.g. /sim1/ga_step/candidate), found as it appears, one candidate each.
+    #[arg(long)]
+    pub pool: bool,
     /// Parameter file of the robot, the fitness and the algorithm (params/nao_step.yaml's
     /// form); without it the built-in defaults, which are that file's values. A resume must
     /// repeat it.
@@ -280,6 +285,9 @@ pub fn run(cli: &Cli, ros_args: &RosArgs, interrupt: &Arc<AtomicBool>) -> anyhow
             cli.eval_timeout
         );
     }
+    if cli.pool && cli.evaluator != EvaluatorArg::Ros {
+        bail!("--pool needs --evaluator ros");
+    }
     let tag = evaluator_tag(cli.evaluator);
     // The built-in physics refuses a setup it cannot score before anything is created in DIR.
     let physics = match cli.evaluator {
@@ -311,6 +319,7 @@ pub fn run(cli: &Cli, ros_args: &RosArgs, interrupt: &Arc<AtomicBool>) -> anyhow
                     setup.model.clone(),
                     setup.fitness.clone(),
                     Duration::from_secs_f64(cli.eval_timeout),
+                    cli.pool,
                     ros_args,
                     interrupt.clone(),
                 )

@@ -148,6 +148,7 @@ fn ros_evaluator(model: &NaoModel, timeout_s: u64, interrupt: &Arc<AtomicBool>) 
         model.clone(),
         FitnessConfig::default(),
         Duration::from_secs(timeout_s),
+        false,
         &namespaced(),
         interrupt.clone(),
     )
