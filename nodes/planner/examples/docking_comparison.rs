@@ -15,6 +15,11 @@
 //! It is run twice: with the comparison's limits and 20 ms period, and as the paper's
 //! unlimited unicycle integrated by RK4 in steps of 10 ms (as `benches/planner.rs` does).
 //!
+//! A third table runs the law alone from every start. Last, a sweep of the gains within the
+//! paper's printed ranges under any reading of them: which let the law alone bring the heading
+//! within 0.03 rad by the time e first falls below 0.02 m, from the paper's start and from all
+//! six.
+//!
 //! `cargo run --release -p mobil_planner --example docking_comparison`
 
 #[path = "../benches/common/graceful.rs"]
@@ -74,18 +79,16 @@ fn nav2_limits() -> VelocityLimits {
 
 /// Our docking controller with the paper's gains, the default thresholds and `limits`.
 fn controller(limits: VelocityLimits) -> DockingController {
+    controller_with(DockingGains::paper(), limits)
+}
+
+/// Our docking controller with `gains`, the default thresholds and `limits`.
+fn controller_with(gains: DockingGains, limits: VelocityLimits) -> DockingController {
     let config = DockingConfig {
         time_limit_s: TIME_LIMIT + 1.0,
         ..DockingConfig::default()
     };
-    DockingController::new(
-        DockingGains::paper(),
-        config,
-        limits,
-        Finish::RotateInPlace,
-        Pose2::identity(),
-    )
-    .expect("valid settings")
+    DockingController::new(gains, config, limits, Finish::RotateInPlace, Pose2::identity()).expect("valid settings")
 }
 
 fn lyapunov(start: Pose2, limits: VelocityLimits) -> Outcome {
@@ -213,6 +216,164 @@ fn paper_start_in_two_parts(start: Pose2) {
     }
 }
 
+/// The law alone (the paper's gains, no rotation) from every start: when e first falls below
+/// 0.02 m and the heading error then, next to the whole docking's.
+fn law_alone_from_every_start(starts: &[(&str, Pose2)]) {
+    println!("| start (x, y, ϑ) | setting | law alone: e < 0.02 m at (s) | heading error then | with the rotation: time (s) | final heading error |");
+    println!("|---|---|---|---|---|---|");
+    let settings = [
+        ("Nav2's limits, held 20 ms", nav2_limits(), Motion::Held),
+        ("unlimited, RK4 10 ms", VelocityLimits::unlimited(), Motion::Rk4(0.01)),
+    ];
+    for (name, start) in starts {
+        for (setting, limits, motion) in settings {
+            let alone = law_alone(&controller(limits), *start, motion, &[0.02])[0];
+            let whole = with_rotation(limits, *start, motion);
+            let alone = match alone {
+                Some((t, heading)) => format!("{t:.2} | {}", angle(heading)),
+                None => "not within the time limit | —".to_string(),
+            };
+            println!(
+                "| {name} ({:.1}, {:.1}, {:.2}) | {setting} | {alone} | {:.2} | {} |",
+                start.x,
+                start.y,
+                start.yaw,
+                whole.time,
+                angle(whole.heading_error)
+            );
+        }
+    }
+}
+
+/// Gain values for the sweep: within (0, 1) in steps of 0.05, and within (1, 6) in steps of 0.25.
+fn sweep_values(wide: bool) -> Vec<f64> {
+    let mut v: Vec<f64> = (1..20).map(|i| f64::from(i) * 0.05).collect();
+    if wide {
+        v.extend((5..24).map(|i| f64::from(i) * 0.25));
+    }
+    v
+}
+
+/// Which gains, within the paper's printed ranges under any reading of them (each of γ, k, h
+/// within (0, 1), or one of them within (0, 6); λ enters neither v nor ω), let the law alone
+/// bring the heading within 0.03 rad by the time e first falls below 0.02 m, from the paper's
+/// start, unlimited (RK4, 10 ms); the best ones then checked under Nav2's limits and from every
+/// start.
+fn gain_sweep(starts: &[(&str, Pose2)]) {
+    const HEADING: f64 = 0.03;
+    let paper = starts[0].1;
+    let mut tried = 0u32;
+    let mut met: Vec<(f64, f64, f64, f64, f64)> = Vec::new(); // (|heading|, t, γ, k, h)
+    let mut best: Option<(f64, f64, f64, f64, f64)> = None;
+    for gamma in sweep_values(true) {
+        for k in sweep_values(true) {
+            for h in sweep_values(true) {
+                if [gamma, k, h].iter().filter(|g| **g > 1.0).count() > 1 {
+                    continue; // only one gain has the (0, 6) range, whichever it is
+                }
+                let Ok(gains) = DockingGains::new(gamma, k, h, 0.55) else {
+                    continue;
+                };
+                tried += 1;
+                let c = controller_with(gains, VelocityLimits::unlimited());
+                if let Some((t, heading)) = law_alone(&c, paper, Motion::Rk4(0.01), &[0.02])[0] {
+                    let row = (heading.abs(), t, gamma, k, h);
+                    if best.is_none_or(|b| row.0 < b.0) {
+                        best = Some(row);
+                    }
+                    if heading.abs() <= HEADING {
+                        met.push(row);
+                    }
+                }
+            }
+        }
+    }
+    println!(
+        "gain sweep, paper's start, unlimited RK4 10 ms: {tried} gain sets; {} bring the heading within {HEADING} rad when e first < 0.02 m",
+        met.len()
+    );
+    let by_reading = |pred: &dyn Fn(f64, f64, f64) -> bool| met.iter().filter(|m| pred(m.2, m.3, m.4)).count();
+    println!(
+        "  of them: all of γ, k, h within (0, 1): {}; γ > 1: {}; k > 1: {}; h > 1: {}",
+        by_reading(&|g, k, h| g < 1.0 && k < 1.0 && h < 1.0),
+        by_reading(&|g, _, _| g > 1.0),
+        by_reading(&|_, k, _| k > 1.0),
+        by_reading(&|_, _, h| h > 1.0)
+    );
+    if let Some((heading, t, gamma, k, h)) = best {
+        println!(
+            "  the smallest heading error: {} at {t:.2} s with γ {gamma:.2}, k {k:.2}, h {h:.2}",
+            angle(heading)
+        );
+    }
+    // Each set that meets it there, from every start and in both settings: its worst heading
+    // error when e first < 0.02 m (π when e never does).
+    let worst = |gamma: f64, k: f64, h: f64| -> f64 {
+        let Ok(gains) = DockingGains::new(gamma, k, h, 0.55) else {
+            return PI;
+        };
+        let mut worst: f64 = 0.0;
+        for (_, start) in starts {
+            for (limits, motion) in [
+                (VelocityLimits::unlimited(), Motion::Rk4(0.01)),
+                (nav2_limits(), Motion::Held),
+            ] {
+                worst = worst.max(
+                    match law_alone(&controller_with(gains, limits), *start, motion, &[0.02])[0] {
+                        Some((_, heading)) => heading.abs(),
+                        None => PI,
+                    },
+                );
+            }
+        }
+        worst
+    };
+    let mut ranked: Vec<(f64, f64, f64, f64)> = met.iter().map(|m| (worst(m.2, m.3, m.4), m.2, m.3, m.4)).collect();
+    ranked.sort_by(|a, b| a.0.total_cmp(&b.0));
+    println!(
+        "  of those, {} meet it from all six starts in both settings; the smallest worst case: {}",
+        ranked.iter().filter(|r| r.0 <= HEADING).count(),
+        ranked.first().map_or("none".to_string(), |r| format!(
+            "{} with γ {:.2}, k {:.2}, h {:.2}",
+            angle(r.0),
+            r.1,
+            r.2,
+            r.3
+        ))
+    );
+    let narrow: Vec<&(f64, f64, f64, f64)> = ranked.iter().filter(|r| r.1 < 1.0 && r.2 < 1.0 && r.3 < 1.0).collect();
+    println!(
+        "  with all of γ, k, h within (0, 1): {} from all six starts; the smallest worst case: {}",
+        narrow.iter().filter(|r| r.0 <= HEADING).count(),
+        narrow.first().map_or("none".to_string(), |r| format!(
+            "{} with γ {:.2}, k {:.2}, h {:.2}",
+            angle(r.0),
+            r.1,
+            r.2,
+            r.3
+        ))
+    );
+    println!("| γ, k, h | start | setting | e < 0.02 m at (s) | heading error then |");
+    println!("|---|---|---|---|---|");
+    for &(_, gamma, k, h) in ranked.iter().take(1).chain(narrow.iter().take(1).copied()) {
+        let Ok(gains) = DockingGains::new(gamma, k, h, 0.55) else {
+            continue;
+        };
+        for (name, start) in starts {
+            for (setting, limits, motion) in [
+                ("unlimited, RK4 10 ms", VelocityLimits::unlimited(), Motion::Rk4(0.01)),
+                ("Nav2's limits, held 20 ms", nav2_limits(), Motion::Held),
+            ] {
+                let cell = match law_alone(&controller_with(gains, limits), *start, motion, &[0.02])[0] {
+                    Some((t, heading)) => format!("{t:.2} | {}", angle(heading)),
+                    None => "not within the time limit | —".to_string(),
+                };
+                println!("| {gamma:.2}, {k:.2}, {h:.2} | {name} | {setting} | {cell} |");
+            }
+        }
+    }
+}
+
 fn main() {
     let starts = [
         ("paper S (faces away)", Pose2::new(-1.0, 1.0, 3.0 * FRAC_PI_4)),
@@ -244,4 +405,8 @@ fn main() {
     }
     println!();
     paper_start_in_two_parts(starts[0].1);
+    println!();
+    law_alone_from_every_start(&starts);
+    println!();
+    gain_sweep(&starts);
 }
