@@ -919,3 +919,33 @@ fn a_republished_pose_is_no_rest_and_rest_needs_consecutive_still_intervals() {
     let out = f.update_stamped(&moving(1), 0.24, 0.14, &|| None).expect("valid");
     assert!(optimised(&out) && !f.is_settling());
 }
+
+proptest::proptest! {
+    #![proptest_config(proptest::prelude::ProptestConfig { cases: 24, ..Default::default() })]
+
+    /// Eq. 23 of the VFO paper (source 002): the decision graph holds at most 2^Np paths. Each
+    /// path decides every obstacle at most once, on entering its zone, so the paths are the
+    /// leaves of a binary tree whose depth is the number of obstacles decided: at most
+    /// 2^(obstacles decided on any path) ≤ 2^(obstacles). Random fields of 1–6 obstacles between
+    /// the start and the waypoint.
+    #[test]
+    fn the_decision_graph_holds_at_most_two_to_the_obstacles_decided(
+        field in proptest::collection::vec((1.0f64..5.0, -1.5f64..1.5, 0.15f64..0.4), 1..7)
+    ) {
+        let obstacles: Vec<Obstacle> = field.iter().map(|&(x, y, r)| ob(x, y, r, r + 0.5)).collect();
+        let segment = Segment {
+            waypoint: wp(6.0, 0.0, 0.0),
+            last: true,
+            obstacles: &obstacles,
+        };
+        let r = find_sigmas(&Pose2::identity(), &controller(), &segment, &OptimiseConfig::default())
+            .expect("valid");
+        let decided = (0..obstacles.len())
+            .filter(|&k| r.paths.iter().any(|p| p.sigmas[k] != Sigma::Undecided))
+            .count();
+        proptest::prop_assert!(!r.paths.is_empty());
+        proptest::prop_assert!(r.paths.len() <= 1 << decided, "{} paths, {} obstacles decided", r.paths.len(), decided);
+        proptest::prop_assert!(r.candidates() <= r.paths.len());
+        proptest::prop_assert!(decided <= obstacles.len());
+    }
+}

@@ -162,8 +162,8 @@ pub enum Interrupt {
     Budget,
 }
 
-/// A virtual robot asks the caller's interrupt closure every this many steps (at T_p = 0.02 s,
-/// every 0.64 s of simulated time, some tens of microseconds of computation).
+/// A virtual robot asks the caller's interrupt closure every this many steps (at the default
+/// T_p = 0.01 s, every 0.32 s of simulated time, some tens of microseconds of computation).
 pub const INTERRUPT_CHECK_STEPS: usize = 32;
 
 /// One virtual robot: the simulation from one stop to the next.
