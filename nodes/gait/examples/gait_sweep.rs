@@ -1,12 +1,15 @@
 //! How the paper's table (SPEC §7, source 000) moves with the settings the paper does not give:
-//! the state key's resolution (`key_quantum`), k3 of evaluation (3), and the stability margin,
+//! the state key's resolution (`key_quantum`), the tie rule (`tie_break`), k3 of evaluation (3),
+//! and the stability margin,
 //! forward reading, each row one complete search from the paper's start to (−10, 10). Which
 //! setting, if any, brings A,(3) near the paper's 39 826 expansions and B,(1) near its 211
 //! states, and what evaluation (3) does to the leg moves across the margin's range.
 //!
 //!     cargo run --release -p mobil_gait --example gait_sweep
 
-use mobil_gait::{plan, BodyPose, Evaluation, GaitConfig, GaitState, LegAngleReading, QuadrupedModel, RuleSet};
+use mobil_gait::{
+    plan, BodyPose, Evaluation, GaitConfig, GaitState, LegAngleReading, QuadrupedModel, RuleSet, TieBreak,
+};
 use nalgebra::Point2;
 use std::f64::consts::PI;
 
@@ -59,6 +62,15 @@ fn main() {
         };
         let cells: Vec<String> = ROWS.iter().map(|&(s, e)| row(&cfg, s, e)).collect();
         println!("| key {quantum:e} | {} |", cells.join(" | "));
+    }
+    for quantum in [1e-3, 1e-4] {
+        let cfg = GaitConfig {
+            key_quantum: quantum,
+            tie_break: TieBreak::Newest,
+            ..base.clone()
+        };
+        let cells: Vec<String> = ROWS.iter().map(|&(s, e)| row(&cfg, s, e)).collect();
+        println!("| key {quantum:e}, ties newest first | {} |", cells.join(" | "));
     }
     println!();
     println!("| k3 (A's, B's) | A,(3) | B,(3) |");

@@ -130,6 +130,31 @@ pub struct GaitConfig {
     pub b3_k2: f64,
     /// k3 of evaluation (3) with set B. Default 0.2 (the paper's).
     pub b3_k3: f64,
+    /// Which of OPEN's states tied on f (and on being a goal) is expanded first. Default
+    /// oldest (FIFO): the paper states no rule; docs/experiments/gait-paper-table.md sweeps both.
+    pub tie_break: TieBreak,
+}
+
+/// Which of the states tied on f the search expands first.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum TieBreak {
+    /// The one generated first (FIFO).
+    #[default]
+    Oldest,
+    /// The one generated last (LIFO).
+    Newest,
+}
+
+impl std::str::FromStr for TieBreak {
+    type Err = GaitError;
+    fn from_str(s: &str) -> Result<Self, GaitError> {
+        match s {
+            "oldest" => Ok(TieBreak::Oldest),
+            "newest" => Ok(TieBreak::Newest),
+            other => Err(GaitError::UnknownTieBreak(other.to_string())),
+        }
+    }
 }
 
 impl Default for GaitConfig {
@@ -149,6 +174,7 @@ impl Default for GaitConfig {
             b3_k1: 1.0,
             b3_k2: 50.0,
             b3_k3: 0.2,
+            tie_break: TieBreak::Oldest,
         }
     }
 }

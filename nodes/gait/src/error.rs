@@ -27,6 +27,9 @@ pub enum GaitError {
     /// A leg-angle reading other than "forward" or "rearward".
     #[error("unknown leg-angle reading `{0}` (expected \"forward\" or \"rearward\")")]
     UnknownReading(String),
+    /// A tie rule other than "oldest" or "newest".
+    #[error("unknown tie rule `{0}` (expected \"oldest\" or \"newest\")")]
+    UnknownTieBreak(String),
     /// A state the model cannot stand in.
     #[error("invalid state: {0}")]
     InvalidState(String),

@@ -78,7 +78,7 @@ pub mod rules;
 pub mod search;
 pub mod walker;
 
-pub use config::{Evaluation, GaitConfig, RuleSet, Weights};
+pub use config::{Evaluation, GaitConfig, RuleSet, TieBreak, Weights};
 pub use error::GaitError;
 pub use horizon::{Chunk, RecedingHorizon, Walk};
 pub use model::{is_stable, is_supported, BodyPose, GaitState, LegAngleReading, QuadrupedModel, Workspace};

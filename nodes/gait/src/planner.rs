@@ -202,6 +202,9 @@ impl Problem for GaitProblem<'_> {
     fn remaining(&self, s: &GaitState) -> f64 {
         vzd(s, self.goal)
     }
+    fn newest_first(&self) -> bool {
+        self.cfg.tie_break == crate::config::TieBreak::Newest
+    }
 }
 
 /// Why `start` cannot begin a plan, if it cannot: coordinates not finite, a foot outside its

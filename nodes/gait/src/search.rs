@@ -4,7 +4,8 @@
 //! 1. OPEN ← {s0}, CLOSED ← ∅.
 //! 2. If OPEN is empty, there is no solution: stop.
 //! 3. Take the state i with least f(i) from OPEN (f on a 1e-7 grid, [`VALUE_QUANTUM`]); among ties prefer a goal state, then the one
-//!    generated first (FIFO).
+//!    generated first (FIFO), or last (LIFO) when [`Problem::newest_first`] says so: the paper
+//!    states no tie rule.
 //! 4. Move i from OPEN to CLOSED.
 //! 5. If i is a goal, the solution is found: stop.
 //! 6. Expand i: for each successor j compute f(j). If j is in neither list, put it on OPEN. If it
@@ -88,6 +89,11 @@ pub trait Problem {
     /// How far the state is from a goal, used only to choose the best partial path when the
     /// search ends without a goal (lower is better).
     fn remaining(&self, s: &Self::State) -> f64;
+    /// Among states tied on f and on being a goal, take the one generated last (LIFO) rather
+    /// than first (FIFO, the default).
+    fn newest_first(&self) -> bool {
+        false
+    }
 }
 
 /// Why the search ended.
@@ -147,12 +153,13 @@ struct Node<S, St> {
     parent_version: u32,
 }
 
-/// An OPEN entry: least f (on the [`VALUE_QUANTUM`] grid) first, then a goal, then the oldest
-/// generation.
+/// An OPEN entry: least f (on the [`VALUE_QUANTUM`] grid) first, then a goal, then the least
+/// `order`: the generation (oldest first) or its complement (newest first).
 struct Entry {
     value: i64,
     goal: bool,
     generation: u64,
+    order: u64,
     node: u32,
 }
 
@@ -174,7 +181,7 @@ impl Ord for Entry {
             .value
             .cmp(&self.value)
             .then(self.goal.cmp(&other.goal))
-            .then(other.generation.cmp(&self.generation))
+            .then(other.order.cmp(&self.order))
     }
 }
 
@@ -253,10 +260,13 @@ pub fn search<P: Problem>(
         version: 0,
         parent_version: 0,
     });
+    let newest = problem.newest_first();
+    let order = |generation: u64| if newest { u64::MAX - generation } else { generation };
     open.push(Entry {
         value: rank(f0),
         goal: goal0,
         generation,
+        order: order(generation),
         node: 0,
     });
 
@@ -324,6 +334,7 @@ pub fn search<P: Problem>(
                         value: rank(f),
                         goal,
                         generation,
+                        order: order(generation),
                         node: id,
                     });
                 }
@@ -356,6 +367,7 @@ pub fn search<P: Problem>(
                             value: rank(f),
                             goal: n.goal,
                             generation,
+                            order: order(generation),
                             node: id,
                         });
                     }

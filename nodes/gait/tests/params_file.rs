@@ -44,6 +44,7 @@ fn every_key_of_the_config_is_in_the_file() {
         "b3_k1",
         "b3_k2",
         "b3_k3",
+        "tie_break",
     ];
     for k in keys {
         assert!(p.get(k).is_some(), "params/quadruped.yaml lacks `{k}`");

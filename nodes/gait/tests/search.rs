@@ -521,3 +521,73 @@ fn re_parenting_within_the_key_keeps_the_path_exact() {
         assert_eq!(p.apply(w[1].step.unwrap(), w[0].state), w[1].state);
     }
 }
+
+/// Two successors tied on f: which one the search expands first.
+struct Fork {
+    expanded: RefCell<Vec<u8>>,
+    newest: bool,
+}
+
+impl Problem for Fork {
+    type State = u8;
+    type Key = u8;
+    type Step = u8;
+    fn key(&self, s: &u8) -> u8 {
+        *s
+    }
+    fn is_goal(&self, s: &u8) -> bool {
+        *s == 9
+    }
+    fn start_value(&self, _: &u8) -> f64 {
+        0.0
+    }
+    fn successors(&self, s: &u8, out: &mut Vec<(u8, u8)>) {
+        self.expanded.borrow_mut().push(*s);
+        // 0 → 1, 2 (in that order), both f = 1; each of 1 and 2 → 9 at f = 2.
+        match s {
+            0 => out.extend([(1, 1), (2, 2)]),
+            1 | 2 => out.push((9, 9)),
+            _ => {}
+        }
+    }
+    fn value(&self, _: &u8, parent_f: f64, _: u8, _: &u8) -> f64 {
+        parent_f + 1.0
+    }
+    fn remaining(&self, s: &u8) -> f64 {
+        f64::from(9 - s.min(&9))
+    }
+    fn newest_first(&self) -> bool {
+        self.newest
+    }
+}
+
+#[test]
+fn ties_go_to_the_oldest_state_or_with_newest_first_to_the_newest() {
+    for (newest, order, path) in [
+        (false, vec![0, 1, 2], vec![0, 1, 9]),
+        (true, vec![0, 2, 1], vec![0, 2, 9]),
+    ] {
+        let p = Fork {
+            expanded: RefCell::new(Vec::new()),
+            newest,
+        };
+        let r = search(&p, 0, 100, &mut || false);
+        // 0, then the tied 1 and 2 (f = 1) before the goal 9 (f = 2): oldest first 1 then 2,
+        // newest first 2 then 1. The goal keeps the parent that generated it first (the second
+        // path to it is no better).
+        assert_eq!(*p.expanded.borrow(), order, "newest first: {newest}");
+        let states: Vec<u8> = r.path.iter().map(|n| n.state).collect();
+        assert_eq!(states, path, "newest first: {newest}");
+    }
+    // The gait planner takes the rule from its configuration.
+    let cfg = GaitConfig {
+        tie_break: mobil_gait::TieBreak::Newest,
+        ..GaitConfig::default()
+    };
+    assert_eq!(
+        "newest".parse::<mobil_gait::TieBreak>(),
+        Ok(mobil_gait::TieBreak::Newest)
+    );
+    assert!("lifo".parse::<mobil_gait::TieBreak>().is_err());
+    assert_ne!(cfg, GaitConfig::default());
+}

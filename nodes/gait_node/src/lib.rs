@@ -29,7 +29,7 @@
 
 use mobil_gait::{
     BodyPose, Evaluation, GaitConfig, GaitState, LegAngleReading, Plan, PlanFailure, PlanStep, QuadrupedModel,
-    RecedingHorizon, RuleSet,
+    RecedingHorizon, RuleSet, TieBreak,
 };
 use mobil_msgs::builtin_interfaces::msg::Time;
 use mobil_msgs::geometry_msgs::msg::{Point, Pose, Pose2D, PoseStamped};
@@ -177,6 +177,13 @@ fn declare_gait(d: &mut Decl<GaitConfig>) {
         |c, v| c.reading = v,
     )
     .choices(&["forward", "rearward"]);
+    d.parsed::<TieBreak>(
+        "tie_break",
+        "oldest",
+        "which of the states tied on f the search expands first: oldest (FIFO) or newest (LIFO)",
+        |c, v| c.tie_break = v,
+    )
+    .choices(&["oldest", "newest"]);
     for (name, value, what, set) in [
         (
             "k1",
