@@ -211,7 +211,7 @@ impl Hasher for FxHasher {
 /// f is compared on a grid of this size: (2) and (3) accumulate f along the path, so two
 /// states whose f is equal in exact arithmetic (the same body pose reached by different
 /// paths, which (1) ranks as an exact tie) differ by rounding noise of 1e-15..1e-12. On the
-/// grid they tie, and the tie rule (goal first, then FIFO) decides, as it does under (1); a
+/// grid they tie, and the tie rule (goal first, then FIFO or LIFO) decides, as it does under (1); a
 /// state is re-parented only when its f improves by a grid step. No rule changes f by less
 /// than the key quantum's effect (≥ 1e-4 at the default 1e-3), far above the grid.
 pub const VALUE_QUANTUM: f64 = 1e-7;

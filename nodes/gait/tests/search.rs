@@ -591,3 +591,29 @@ fn ties_go_to_the_oldest_state_or_with_newest_first_to_the_newest() {
     assert!("lifo".parse::<mobil_gait::TieBreak>().is_err());
     assert_ne!(cfg, GaitConfig::default());
 }
+
+#[test]
+fn the_planner_takes_the_tie_rule_from_its_configuration() {
+    // A,(1) from the paper's start: the search under `newest` is not the search under `oldest`
+    // (a planner that ignored the setting would give the same counts and plan).
+    let m = QuadrupedModel::default();
+    let start = GaitState::nominal(
+        &m,
+        BodyPose {
+            x: 0.0,
+            y: 0.0,
+            phi: PI / 4.0,
+        },
+    );
+    let run = |tie_break| {
+        let cfg = GaitConfig {
+            tie_break,
+            ..GaitConfig::default()
+        };
+        let p = plan(&m, &cfg, &start, GOAL, RuleSet::A, Evaluation::One, 0, &mut || false);
+        assert!(p.success, "{:?}", p.failure);
+        check_plan(&m, &cfg, &start, GOAL, &p);
+        (p.expanded, p.steps.len())
+    };
+    assert_ne!(run(mobil_gait::TieBreak::Oldest), run(mobil_gait::TieBreak::Newest));
+}

@@ -341,6 +341,15 @@ fn gain_sweep(starts: &[(&str, Pose2)]) {
             r.3
         ))
     );
+    let all_six =
+        |pred: &dyn Fn(f64, f64, f64) -> bool| ranked.iter().filter(|r| r.0 <= HEADING && pred(r.1, r.2, r.3)).count();
+    println!(
+        "  of those from all six: all of γ, k, h within (0, 1): {}; γ > 1: {}; k > 1: {}; h > 1: {}",
+        all_six(&|g, k, h| g < 1.0 && k < 1.0 && h < 1.0),
+        all_six(&|g, _, _| g > 1.0),
+        all_six(&|_, k, _| k > 1.0),
+        all_six(&|_, _, h| h > 1.0)
+    );
     let narrow: Vec<&(f64, f64, f64, f64)> = ranked.iter().filter(|r| r.1 < 1.0 && r.2 < 1.0 && r.3 < 1.0).collect();
     println!(
         "  with all of γ, k, h within (0, 1): {} from all six starts; the smallest worst case: {}",

@@ -46,6 +46,17 @@ fn main() {
     for step in [0.5, 0.4, 0.3, 0.25, 0.2, 0.1, 0.05, 0.02] {
         show("paper's S (−1, 1, 3π/4)", paper, step);
     }
+    // The suite's own MOBIL-II (params/mobil2.yaml): δ_eff 39.4°, R_min 0.73 m.
+    let suite = Steering::new(0.60, (0.60f64 / 0.73).atan()).expect("valid steering");
+    let suite_motion = Motion::Steered(suite);
+    let suite_run = |start: Pose2, step: f64| {
+        let config = ApproachConfig {
+            step_length: step,
+            critical_distance: 1e-9,
+            ..ApproachConfig::default()
+        };
+        approach(&start, &goal, &suite_motion, &config).expect("valid run")
+    };
     for (name, start) in [
         ("(−0.7, 0, 0)", Pose2::new(-0.7, 0.0, 0.0)),
         ("(−1, 0.5, 0)", Pose2::new(-1.0, 0.5, 0.0)),
@@ -55,6 +66,34 @@ fn main() {
     ] {
         for step in [0.5, 0.02] {
             show(name, start, step);
+        }
+    }
+    println!();
+    println!(
+        "the suite's MOBIL-II: δ_eff {:.1}°, R_min {:.3} m",
+        suite.limit().to_degrees(),
+        suite.min_radius()
+    );
+    println!("| start | full step (m) | steps | closest approach (m) | at the end (m) | why it ended | path (m) |");
+    println!("|---|---:|---:|---:|---:|---|---:|");
+    for (name, start) in [
+        ("paper's S (−1, 1, 3π/4)", paper),
+        ("(−0.7, 0, 0)", Pose2::new(-0.7, 0.0, 0.0)),
+        ("(−1, 0.5, 0)", Pose2::new(-1.0, 0.5, 0.0)),
+        ("(−1.5, −1, π/2)", Pose2::new(-1.5, -1.0, FRAC_PI_2)),
+        ("(−2, 0.8, −π/6)", Pose2::new(-2.0, 0.8, -PI / 6.0)),
+        ("(0, 1, −π/2)", Pose2::new(0.0, 1.0, -FRAC_PI_2)),
+    ] {
+        for step in [0.5, 0.02] {
+            let r = suite_run(start, step);
+            println!(
+                "| {name} | {step} | {} | {:.3} | {:.3} | {:?} | {:.2} |",
+                r.path.len() - 1,
+                r.closest,
+                r.final_distance,
+                r.end,
+                r.travelled
+            );
         }
     }
 }
