@@ -13,18 +13,20 @@ use mobil_geom::Pose2;
 use mobil_planner::{approach, ApproachConfig, Motion, Steering};
 use nalgebra::Point2;
 
+/// The approach from `start` to G = (0, 0) in full steps of `step`, with no capture circle.
+fn closest(motion: &Motion, start: Pose2, step: f64) -> mobil_planner::ApproachRun {
+    let config = ApproachConfig {
+        step_length: step,
+        critical_distance: 1e-9,
+        ..ApproachConfig::default()
+    };
+    approach(&start, &Point2::new(0.0, 0.0), motion, &config).expect("valid run")
+}
+
 fn main() {
     let steering = Steering::new(0.60, 70f64.to_radians()).expect("valid steering");
     let motion = Motion::Steered(steering);
-    let goal = Point2::new(0.0, 0.0);
-    let run = |start: Pose2, step: f64| {
-        let config = ApproachConfig {
-            step_length: step,
-            critical_distance: 1e-9,
-            ..ApproachConfig::default()
-        };
-        approach(&start, &goal, &motion, &config).expect("valid run")
-    };
+    let run = |start: Pose2, step: f64| closest(&motion, start, step);
     let paper = Pose2::new(-1.0, 1.0, 3.0 * FRAC_PI_4);
     println!(
         "MOBIL-II, wheelbase 0.60 m, steering ±70° (R_min {:.3} m), G = (0, 0)",
@@ -49,14 +51,7 @@ fn main() {
     // The suite's own MOBIL-II (params/mobil2.yaml): δ_eff 39.4°, R_min 0.73 m.
     let suite = Steering::new(0.60, (0.60f64 / 0.73).atan()).expect("valid steering");
     let suite_motion = Motion::Steered(suite);
-    let suite_run = |start: Pose2, step: f64| {
-        let config = ApproachConfig {
-            step_length: step,
-            critical_distance: 1e-9,
-            ..ApproachConfig::default()
-        };
-        approach(&start, &goal, &suite_motion, &config).expect("valid run")
-    };
+    let suite_run = |start: Pose2, step: f64| closest(&suite_motion, start, step);
     for (name, start) in [
         ("(−0.7, 0, 0)", Pose2::new(-0.7, 0.0, 0.0)),
         ("(−1, 0.5, 0)", Pose2::new(-1.0, 0.5, 0.0)),
