@@ -48,6 +48,41 @@ pub enum ConfigError {
     },
 }
 
+/// How T-mode (004 §4.2.4 step 4) chooses the direction along the obstacle's boundary.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum TrackMethod {
+    /// The tangent of the nearest reading, bent toward or away from the boundary by
+    /// `track_gain`·(d − d_sa): the boundary is kept at d_sa on the side opposite the chosen one.
+    #[default]
+    Tangent,
+    /// The vector-distance function, eq. 3.50, as step 4 of §4.2.4 says: F with the asymmetric
+    /// weights of the side L-mode chose, w'0 turned toward G at every step as in R-mode (the
+    /// source neither locks nor re-aims the weights in T-mode; this reading uses nothing it
+    /// does not define).
+    VectorDistance,
+    /// No T-mode (rotate and lock only, the ablation of 004 §4.3.3): where T-mode would begin
+    /// (eq. 3.58 or a stalled lock), L-mode goes on with a new progress window.
+    Off,
+}
+
+impl TrackMethod {
+    /// The parameter value: `tangent`, `vector_distance` or `off`.
+    pub fn name(self) -> &'static str {
+        match self {
+            TrackMethod::Tangent => "tangent",
+            TrackMethod::VectorDistance => "vector_distance",
+            TrackMethod::Off => "off",
+        }
+    }
+
+    /// The method a parameter value names, if any.
+    pub fn from_name(name: &str) -> Option<Self> {
+        [TrackMethod::Tangent, TrackMethod::VectorDistance, TrackMethod::Off]
+            .into_iter()
+            .find(|m| m.name() == name)
+    }
+}
+
 /// Everything the navigator needs besides the chassis limits.
 #[derive(Debug, Clone, PartialEq)]
 pub struct NavConfig {
@@ -112,6 +147,9 @@ pub struct NavConfig {
     /// (d > d_sa) or away from (d < d_sa) the boundary, b clamped to ±π/3. Default 1.5: the bend
     /// reaches ±π/3 at a 0.70 m error.
     pub track_gain: f64,
+    /// T-mode's direction: the tangent follower (default) or eq. 3.50; `Off` disables T-mode.
+    /// The default is the one the five scenarios favour (docs/experiments/local-nav.md).
+    pub track_method: TrackMethod,
     /// Gain (1/s), > 0, of an omni chassis' turns: in place toward a direction outside the field
     /// of view, and in T-mode to face its direction of motion. Default 1.5.
     pub heading_gain: f64,
@@ -138,6 +176,7 @@ impl Default for NavConfig {
             goal_tolerance: 0.10,
             slow_down_radius: 0.60,
             track_gain: 1.5,
+            track_method: TrackMethod::Tangent,
             heading_gain: 1.5,
         }
     }

@@ -83,7 +83,7 @@ pub mod motion;
 pub mod navigator;
 pub mod sectors;
 
-pub use config::{ConfigError, NavConfig};
+pub use config::{ConfigError, NavConfig, TrackMethod};
 pub use field::{vector_distance, Side, WeightProfile};
 pub use mobil_motion::progress::{Progress, ProgressChecker, ProgressSettings};
 pub use motion::{

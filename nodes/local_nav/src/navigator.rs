@@ -2,7 +2,7 @@
 //! function. One [`Navigator::step`] per scan: pose (odom) and scan in, a velocity command and
 //! the mode out. No clock: steps are path increments ds.
 
-use crate::config::{ConfigError, NavConfig};
+use crate::config::{ConfigError, NavConfig, TrackMethod};
 use crate::field::{vector_distance, Side};
 use crate::motion::{car_arc, command_along, Drive, MotionInput, MotionLimits, SpeedProfile, VelocityCommand};
 use crate::sectors::Sectors;
@@ -296,6 +296,7 @@ impl Navigator {
                 } else if self
                     .close_progress_window(q, goal_distance, self.config.lock_steps)
                     .is_some_and(|p| p < self.config.lock_min_progress)
+                    && self.config.track_method != TrackMethod::Off
                 {
                     self.hit = Some(q);
                     self.left_hit = false;
@@ -366,7 +367,8 @@ impl Navigator {
             // A lock that cannot move (F into a concave corner, the hard stop) makes no progress
             // however long it waits, and steps are path increments: the hit point is here. So
             // for a car that must turn away from F because every arc toward it is blocked.
-            if command.speed() < self.config.stall_speed || against {
+            let stalled = command.speed() < self.config.stall_speed || against;
+            if stalled && self.config.track_method != TrackMethod::Off {
                 self.hit = Some(q);
                 self.left_hit = false;
                 self.leave = None;
@@ -397,11 +399,24 @@ impl Navigator {
         }
     }
 
-    /// T-mode: along the boundary of the nearest obstacle, at d_sa. Turning left (Side::Left)
-    /// keeps the obstacle on the right, so the tangent is the nearest reading's bearing + π/2,
-    /// bent toward the obstacle by `track_gain`·(d − d_sa) (at most ±π/3) when farther than d_sa
-    /// and away when nearer. With no reading at all: toward G.
+    /// T-mode's direction by the configured [`TrackMethod`]; the sectors are referenced to G.
     fn track_direction(&self, side: Side, goal_bearing: f64) -> Vector2<f64> {
+        match self.config.track_method {
+            TrackMethod::VectorDistance => vector_distance(
+                &self.sectors,
+                &self.config.weights,
+                Some(side),
+                self.config.safe_distance,
+            ),
+            TrackMethod::Tangent | TrackMethod::Off => self.tangent_direction(side, goal_bearing),
+        }
+    }
+
+    /// The tangent follower: along the boundary of the nearest obstacle, at d_sa. Turning left
+    /// (Side::Left) keeps the obstacle on the right, so the tangent is the nearest reading's
+    /// bearing + π/2, bent toward the obstacle by `track_gain`·(d − d_sa) (at most ±π/3) when
+    /// farther than d_sa and away when nearer. With no reading at all: toward G.
+    fn tangent_direction(&self, side: Side, goal_bearing: f64) -> Vector2<f64> {
         let bearing = match self.sectors.nearest() {
             Some((d, phi)) => {
                 let bend = (self.config.track_gain * (d - self.config.safe_distance)).clamp(-FRAC_PI_3, FRAC_PI_3);
@@ -546,6 +561,66 @@ impl GoalLaw for Navigator {
 mod tests {
     use super::*;
     use approx::assert_relative_eq;
+
+    /// A navigator whose sectors come from eight beams on the sector centres (sector i at
+    /// −45°·i), ranges given per sector, G straight ahead.
+    fn with_sectors(method: TrackMethod, d: [f32; 8]) -> Navigator {
+        use crate::sectors::UnseenSectors;
+        use std::f64::consts::PI;
+        let config = NavConfig {
+            track_method: method,
+            ..NavConfig::default()
+        };
+        let limits = MotionLimits::from_chassis(&mobil_chassis::ChassisParams::omr3());
+        let mut nav = Navigator::new(config, limits).unwrap();
+        // Beam k looks at −180° + 45°·k.
+        let mut ranges = vec![0.0f32; 8];
+        for (i, &r) in d.iter().enumerate() {
+            let k = ((-45 * i as i32 + 180).rem_euclid(360) / 45) as usize;
+            ranges[k] = r;
+        }
+        let scan = Scan::new(-PI, 0.75 * PI, PI / 4.0, 0.05, 10.0, ranges, vec![], Pose2::identity()).unwrap();
+        nav.sectors = Sectors::compute(&scan, 0.0, 8, UnseenSectors::Blocked);
+        nav
+    }
+
+    #[test]
+    fn track_direction_by_each_method_by_hand() {
+        // Sector 0 (toward G) blocked at 0.4 m, the seven others clear (|f| = d_sa = 0.8).
+        let d = [0.4, 9.0, 9.0, 9.0, 9.0, 9.0, 9.0, 9.0];
+        // Eq. 3.50 with the left-turning set (3.56): sector i carries w'_{(8−i) mod 8} of
+        // [1, 0.775, 0.55, 0.325, 0.1, 0.1625, 0.275, 0.3875], along −45°·i:
+        //   0: 0.4·1 at 0°; 1: 0.8·0.3875 = 0.31 at −45°; 2: 0.8·0.275 = 0.22 at −90°;
+        //   3: 0.8·0.1625 = 0.13 at −135°; 4: 0.8·0.1 = 0.08 at 180°; 5: 0.8·0.325 = 0.26 at
+        //   135°; 6: 0.8·0.55 = 0.44 at 90°; 7: 0.8·0.775 = 0.62 at 45°.
+        //   x = 0.4 + (0.31 − 0.13 − 0.26 + 0.62)/√2 − 0.08 = 0.32 + 0.54/√2 = 0.701838
+        //   y = (−0.31 − 0.13 + 0.26 + 0.62)/√2 − 0.22 + 0.44 = 0.22 + 0.44/√2 = 0.531127
+        let nav = with_sectors(TrackMethod::VectorDistance, d);
+        let f = nav.track_direction(Side::Left, 0.0);
+        assert_relative_eq!(f.x, 0.32 + 0.54 / 2f64.sqrt(), epsilon = 1e-6);
+        assert_relative_eq!(f.y, 0.22 + 0.44 / 2f64.sqrt(), epsilon = 1e-6);
+        // The right-turning set mirrors it (3.57).
+        let f = nav.track_direction(Side::Right, 0.0);
+        assert_relative_eq!(f.x, 0.32 + 0.54 / 2f64.sqrt(), epsilon = 1e-6);
+        assert_relative_eq!(f.y, -(0.22 + 0.44 / 2f64.sqrt()), epsilon = 1e-6);
+        // The tangent follower: the nearest reading at 0°, 0.4 m; turning left the tangent is
+        // +90°, bent away from the too-near boundary by 1.5·(0.8 − 0.4) = 0.6 rad: 90° + 0.6 rad
+        // = 2.170796 rad, |d_sa| long.
+        for method in [TrackMethod::Tangent, TrackMethod::Off] {
+            let nav = with_sectors(method, d);
+            let f = nav.track_direction(Side::Left, 0.0);
+            assert_relative_eq!(f.x, 0.8 * (FRAC_PI_2 + 0.6).cos(), epsilon = 1e-6);
+            assert_relative_eq!(f.y, 0.8 * (FRAC_PI_2 + 0.6).sin(), epsilon = 1e-6);
+        }
+    }
+
+    #[test]
+    fn track_method_names_round_trip() {
+        for m in [TrackMethod::Tangent, TrackMethod::VectorDistance, TrackMethod::Off] {
+            assert_eq!(TrackMethod::from_name(m.name()), Some(m));
+        }
+        assert_eq!(TrackMethod::from_name("bug2"), None);
+    }
 
     #[test]
     fn crossing_by_hand() {

@@ -1,239 +1,13 @@
 //! Closed loop in pure Rust: the navigator's command integrated by an omni (or unicycle) model
 //! over a synthetic world of circles and segments, scanned by a tiny raycaster.
 
+mod harness;
+
+use harness::{config_for, drive, drive_config, drive_with, rect, scenarios, Ending, Plant, Shape, World, SIM};
 use mobil_chassis::ChassisParams;
-use mobil_geom::{Pose2, Scan};
-use mobil_local_nav::{
-    Mode, MotionLimits, NavConfig, Navigator, NoPathReason, Progress, ProgressChecker, ProgressSettings, Side,
-};
-use nalgebra::{Point2, Vector2};
-
-enum Shape {
-    Circle(Point2<f64>, f64),
-    Segment(Point2<f64>, Point2<f64>),
-}
-
-struct World(Vec<Shape>);
-
-/// The four edges of the rectangle [x0, x1] × [y0, y1] (a wall of a world file).
-fn rect(x0: f64, y0: f64, x1: f64, y1: f64) -> [Shape; 4] {
-    let p = Point2::new;
-    [
-        Shape::Segment(p(x0, y0), p(x1, y0)),
-        Shape::Segment(p(x1, y0), p(x1, y1)),
-        Shape::Segment(p(x1, y1), p(x0, y1)),
-        Shape::Segment(p(x0, y1), p(x0, y0)),
-    ]
-}
-
-impl World {
-    /// Distance along the ray o + t·u to the first shape, if within `max`.
-    fn ray(&self, o: Point2<f64>, u: Vector2<f64>, max: f64) -> Option<f64> {
-        let mut best = f64::INFINITY;
-        for s in &self.0 {
-            let t = match *s {
-                Shape::Circle(c, r) => {
-                    // |o + t u − c|² = r²: t² + 2 b t + k = 0.
-                    let oc = o - c;
-                    let b = oc.dot(&u);
-                    let k = oc.norm_squared() - r * r;
-                    let disc = b * b - k;
-                    if disc < 0.0 {
-                        continue;
-                    }
-                    let t = -b - disc.sqrt();
-                    if t >= 0.0 {
-                        t
-                    } else {
-                        continue;
-                    }
-                }
-                Shape::Segment(a, b) => {
-                    let e = b - a;
-                    let den = u.x * e.y - u.y * e.x;
-                    if den.abs() < 1e-12 {
-                        continue;
-                    }
-                    let ao = a - o;
-                    let t = (ao.x * e.y - ao.y * e.x) / den;
-                    let s = (ao.x * u.y - ao.y * u.x) / den;
-                    if t >= 0.0 && (0.0..=1.0).contains(&s) {
-                        t
-                    } else {
-                        continue;
-                    }
-                }
-            };
-            best = best.min(t);
-        }
-        (best <= max).then_some(best)
-    }
-
-    /// Smallest distance from a point to any shape.
-    fn clearance(&self, p: Point2<f64>) -> f64 {
-        self.0
-            .iter()
-            .map(|s| match *s {
-                Shape::Circle(c, r) => (p - c).norm() - r,
-                Shape::Segment(a, b) => {
-                    let e = b - a;
-                    let t = ((p - a).dot(&e) / e.norm_squared()).clamp(0.0, 1.0);
-                    (p - (a + e * t)).norm()
-                }
-            })
-            .fold(f64::INFINITY, f64::min)
-    }
-
-    /// A 270° scan of 541 beams (0.5°), range [0.05, 10], laser at the centre.
-    fn scan(&self, pose: Pose2) -> Scan {
-        let fov = 0.75 * std::f64::consts::PI;
-        let inc = 2.0 * fov / 540.0;
-        let ranges = (0..541)
-            .map(|i| {
-                let a = pose.yaw - fov + i as f64 * inc;
-                match self.ray(pose.position(), Vector2::new(a.cos(), a.sin()), 10.0) {
-                    Some(t) => t as f32,
-                    None => f32::INFINITY,
-                }
-            })
-            .collect();
-        Scan::new(-fov, fov, inc, 0.05, 10.0, ranges, vec![], Pose2::identity()).expect("valid scan")
-    }
-}
-
-/// MOBIL-II: body radius 0.53 m; d_sa must leave room for the 0.73 m turning radius, so
-/// d_sa = 0.53 + 0.73 + 0.24 = 1.5 m; hard stop 0.12 m beyond the body.
-fn mobil2_config() -> NavConfig {
-    NavConfig {
-        robot_radius: 0.53,
-        stop_distance: 0.65,
-        safe_distance: 1.5,
-        ..NavConfig::default()
-    }
-}
-
-struct Run {
-    modes: Vec<Mode>,
-    final_mode: Mode,
-    min_clearance: f64,
-    final_pose: Pose2,
-    last_speed: f64,
-    hit: Option<Point2<f64>>,
-    leave: Option<Point2<f64>>,
-    /// Simulated seconds until the final mode (or the step limit).
-    time: f64,
-    /// The longest time (s) Nav2's default progress checker (0.5 m in 10 s) saw without
-    /// progress, had it been running; `None` if it never would have aborted.
-    stuck: Option<f64>,
-    /// Length of the path driven (m).
-    path: f64,
-}
-
-/// How the robot is simulated between navigator steps.
-#[derive(Clone, Copy)]
-struct Plant {
-    /// Seconds between navigator steps (one per scan).
-    dt: f64,
-    /// First-order lag of the body twist (s; 0 = ideal). For an omni chassis the wheel speeds
-    /// are linear in the body twist, so this is the sim's motor lag.
-    tau: f64,
-    /// The scan the navigator gets was taken this many steps before the pose it gets.
-    scan_age: usize,
-}
-
-/// The ideal plant: 20 Hz, no lag, no latency.
-const IDEAL: Plant = Plant {
-    dt: 0.05,
-    tau: 0.0,
-    scan_age: 0,
-};
-
-/// Drives from `start` to `goal` for at most `max_steps` of 0.05 s.
-fn drive(world: &World, chassis: ChassisParams, start: Pose2, goal: Point2<f64>, max_steps: usize) -> Run {
-    drive_with(world, chassis, start, goal, max_steps, IDEAL)
-}
-
-/// Drives from `start` to `goal` for at most `max_steps` steps of `plant.dt`.
-fn drive_with(
-    world: &World,
-    chassis: ChassisParams,
-    start: Pose2,
-    goal: Point2<f64>,
-    max_steps: usize,
-    plant: Plant,
-) -> Run {
-    let config = if chassis.model().is_nonholonomic() {
-        mobil2_config()
-    } else {
-        NavConfig::default()
-    };
-    let limits = MotionLimits::from_chassis(&chassis);
-    let mut nav = Navigator::new(config, limits).expect("valid config");
-    nav.set_goal(goal).expect("finite goal");
-    let dt = plant.dt;
-    let substeps = if plant.tau > 0.0 { 10 } else { 1 };
-    let h = dt / substeps as f64;
-    let mut pose = start;
-    let mut past = std::collections::VecDeque::from(vec![start; plant.scan_age]);
-    let mut twist = (0.0, 0.0, 0.0);
-    let mut modes = vec![nav.mode()];
-    let mut min_clearance = world.clearance(pose.position());
-    let mut last_speed = f64::NAN;
-    let mut hit = None;
-    let mut leave = None;
-    let mut checker = ProgressChecker::new(ProgressSettings::default());
-    let mut stuck = None;
-    let mut time = 0.0;
-    let mut path = 0.0;
-    for _ in 0..max_steps {
-        if let Progress::Stuck { since } = checker.check(pose.position(), time) {
-            stuck = Some(since);
-        }
-        past.push_back(pose);
-        let scanned = past.pop_front().unwrap_or(pose);
-        let out = nav.step(pose, &world.scan(scanned));
-        if modes.last() != Some(&out.mode) {
-            modes.push(out.mode);
-        }
-        hit = hit.or(out.hit_point);
-        leave = out.leave_point.or(leave);
-        let c = out.command;
-        last_speed = c.speed() + c.omega.abs();
-        if out.mode.is_final() {
-            break;
-        }
-        // The twist follows the command with the lag (exact per sub-step), integrated in
-        // sub-steps: exact enough at 5 ms.
-        let follow = if plant.tau > 0.0 {
-            1.0 - (-h / plant.tau).exp()
-        } else {
-            1.0
-        };
-        for _ in 0..substeps {
-            twist.0 += (c.vx - twist.0) * follow;
-            twist.1 += (c.vy - twist.1) * follow;
-            twist.2 += (c.omega - twist.2) * follow;
-            let v = pose.rotate(Vector2::new(twist.0, twist.1));
-            let before = pose.position();
-            pose = Pose2::new(pose.x + v.x * h, pose.y + v.y * h, pose.yaw + twist.2 * h);
-            path += (pose.position() - before).norm();
-        }
-        time += dt;
-        min_clearance = min_clearance.min(world.clearance(pose.position()));
-    }
-    Run {
-        modes,
-        final_mode: nav.mode(),
-        min_clearance,
-        final_pose: pose,
-        last_speed,
-        hit,
-        leave,
-        time,
-        stuck,
-        path,
-    }
-}
+use mobil_geom::Pose2;
+use mobil_local_nav::{Mode, NavConfig, NoPathReason, Side, TrackMethod};
+use nalgebra::Point2;
 
 #[test]
 fn open_space_goes_straight_to_the_goal() {
@@ -306,6 +80,106 @@ fn u_trap_needs_track_mode_and_escapes() {
         "L {l} H {h}"
     );
     assert!(run.min_clearance > 0.25, "clearance {}", run.min_clearance);
+}
+
+/// Runs scenario `name` for `chassis` with T-mode by `method`, at sim_node's rates, for at
+/// most `seconds` of simulated time.
+fn scenario_run(name: &str, chassis: ChassisParams, method: TrackMethod, seconds: f64) -> harness::Run {
+    let s = scenarios(chassis.model().is_nonholonomic())
+        .into_iter()
+        .find(|s| s.name == name)
+        .expect("a scenario of that name");
+    let config = NavConfig {
+        track_method: method,
+        ..config_for(&chassis)
+    };
+    let steps = (seconds / SIM.dt) as usize;
+    drive_config(&s.world, chassis, config, Pose2::identity(), s.goal, steps, SIM)
+}
+
+#[test]
+fn u_trap_without_track_mode_stalls_where_the_tangent_follower_escapes() {
+    // 004 §4.3.3: rotate and lock alone manage only small convex obstacles. In the U-trap the
+    // lock slides into the bottom's corner, its progress window fails (eq. 3.58) and, with no
+    // T-mode to go to, it locks again where it stands: a stall Nav2's progress checker (0.5 m
+    // in 10 s) would abort. The same run with T-mode by the tangent follower reaches G.
+    let off = scenario_run("u_trap", ChassisParams::omr3(), TrackMethod::Off, 60.0);
+    assert_eq!(Ending::of(&off), Ending::Stalls, "{:?}", off.modes);
+    assert!(
+        !off.modes.iter().any(|m| matches!(m, Mode::Track(_))),
+        "{:?}",
+        off.modes
+    );
+    assert!(off.first_abort.is_some_and(|t| t < 30.0), "{:?}", off.first_abort);
+    let tangent = scenario_run("u_trap", ChassisParams::omr3(), TrackMethod::Tangent, 60.0);
+    assert_eq!(Ending::of(&tangent), Ending::Reached, "{:?}", tangent.modes);
+    assert_eq!(tangent.first_abort, None);
+}
+
+#[test]
+fn u_trap_with_a_180_degree_scanner_stalls_in_track_mode() {
+    // MOBIL-II's lesson (004 §4.3.4): 180° of scan is not enough. Following the U's bottom and
+    // arm with the obstacle on its right, OMR-III turns to face its direction of motion; with
+    // 180° the boundary abeam and behind is outside the scan, the nearest reading jumps to the
+    // wall ahead and the follower stops in the corner. With 270° (the test above) it escapes.
+    let s = scenarios(false)
+        .into_iter()
+        .find(|s| s.name == "u_trap")
+        .expect("u_trap");
+    let plant = Plant {
+        fov: std::f64::consts::PI,
+        ..SIM
+    };
+    let steps = (60.0 / plant.dt) as usize;
+    let config = config_for(&ChassisParams::omr3());
+    let run = drive_config(
+        &s.world,
+        ChassisParams::omr3(),
+        config,
+        Pose2::identity(),
+        s.goal,
+        steps,
+        plant,
+    );
+    assert_eq!(Ending::of(&run), Ending::Stalls, "{:?}", run.modes);
+    assert!(run.modes.iter().any(|m| matches!(m, Mode::Track(_))), "{:?}", run.modes);
+    assert!(run.first_abort.is_some(), "the progress checker would abort");
+}
+
+#[test]
+fn enclosure_without_track_mode_is_never_given_up() {
+    // Without T-mode there is no no-path verdict (eq. 3.60 and the return to H belong to it):
+    // round the closed box the robot locks and releases for as long as it runs, still moving
+    // at the end, and the progress checker never fires. Both T-modes end it NO_PATH.
+    for chassis in [ChassisParams::omr3(), ChassisParams::mobil2()] {
+        let off = scenario_run("enclosed", chassis, TrackMethod::Off, 120.0);
+        assert_eq!(Ending::of(&off), Ending::Loops, "{:?}", off.modes);
+        assert!(off.path > 40.0, "{} m", off.path);
+        for method in [TrackMethod::Tangent, TrackMethod::VectorDistance] {
+            let run = scenario_run("enclosed", chassis, method, 120.0);
+            assert_eq!(Ending::of(&run), Ending::NoPath, "{method:?} {:?}", run.modes);
+        }
+    }
+}
+
+#[test]
+fn track_mode_by_eq_3_50_passes_the_wall_but_stalls_in_the_u_trap() {
+    // T-mode by the vector-distance function (weights of the chosen side, w'0 toward G) goes
+    // round the wall's end like the tangent follower, but in the U-trap the goal is still
+    // straight through the bottom: F is L-mode's F again, the robot stops in the corner and T-mode
+    // never closes a progress window (steps are path), so only the progress checker ends it.
+    let wall = scenario_run("wall", ChassisParams::omr3(), TrackMethod::VectorDistance, 60.0);
+    assert_eq!(Ending::of(&wall), Ending::Reached, "{:?}", wall.modes);
+    assert!(
+        wall.modes.iter().any(|m| matches!(m, Mode::Track(_))),
+        "{:?}",
+        wall.modes
+    );
+    assert!(wall.min_clearance > 0.25, "clearance {}", wall.min_clearance);
+    let u = scenario_run("u_trap", ChassisParams::omr3(), TrackMethod::VectorDistance, 60.0);
+    assert_eq!(Ending::of(&u), Ending::Stalls, "{:?}", u.modes);
+    assert!(u.modes.iter().any(|m| matches!(m, Mode::Track(_))), "{:?}", u.modes);
+    assert!(u.first_abort.is_some(), "the progress checker would abort");
 }
 
 #[test]
@@ -433,11 +307,7 @@ fn omni_tracks_the_enclosure_with_the_sims_scan_rate_and_motor_lag() {
             .collect(),
     );
     // The scan the navigator steps on is one scan (25 ms) older than its pose.
-    let plant = Plant {
-        dt: 0.025,
-        tau: 0.05,
-        scan_age: 1,
-    };
+    let plant = Plant { ..harness::SIM };
     let run = drive_with(
         &world,
         ChassisParams::omr3(),

@@ -12,7 +12,8 @@ use mobil_chassis::model::ChassisConfig;
 use mobil_geom::path::PathGoals;
 use mobil_geom::Pose2;
 use mobil_local_nav::{
-    Mode, MotionLimits, NavConfig, ProgressChecker, ProgressSettings, Sectors, Side, UnseenSectors, WeightProfile,
+    Mode, MotionLimits, NavConfig, ProgressChecker, ProgressSettings, Sectors, Side, TrackMethod, UnseenSectors,
+    WeightProfile,
 };
 use mobil_motion::{Nav2Codes, Outcome};
 use mobil_msgs::builtin_interfaces::msg::Time;
@@ -206,6 +207,13 @@ impl Config for LocalNavConfig {
             |c, v| c.nav.track_gain = v,
         )
         .min(0.0);
+        d.string(
+            "track_method",
+            n.track_method.name(),
+            "T-mode's direction: tangent (the nearest reading's tangent), vector_distance (eq. 3.50 with the chosen side's weights) or off (rotate and lock only)",
+            |c, v| c.nav.track_method = TrackMethod::from_name(&v).unwrap_or_default(),
+        )
+        .choices(&["tangent", "vector_distance", "off"]);
         d.double(
             "heading_gain",
             n.heading_gain,
