@@ -118,10 +118,11 @@ fn u_trap_without_track_mode_stalls_where_the_tangent_follower_escapes() {
 
 #[test]
 fn u_trap_with_a_180_degree_scanner_stalls_in_track_mode() {
-    // MOBIL-II's lesson (004 §4.3.4): 180° of scan is not enough. Following the U's bottom and
-    // arm with the obstacle on its right, OMR-III turns to face its direction of motion; with
-    // 180° the boundary abeam and behind is outside the scan, the nearest reading jumps to the
-    // wall ahead and the follower stops in the corner. With 270° (the test above) it escapes.
+    // MOBIL-II's lesson (004 §4.3.4): 180° of scan is not enough. In T-mode inside the U,
+    // OMR-III turns in place toward a tracking direction outside the 180° scan; each turn
+    // changes the nearest reading and so the direction, and the robot swings between about
+    // −14° and −20° at (1.8, 0.7) without moving. With 270° (u_trap_needs_track_mode_and_escapes)
+    // it escapes.
     let s = scenarios(false)
         .into_iter()
         .find(|s| s.name == "u_trap")

@@ -140,6 +140,8 @@ pub struct Run {
     pub final_pose: Pose2,
     /// |v| + |ω| of the last command.
     pub last_speed: f64,
+    /// ω of the last command (rad/s).
+    pub last_omega: f64,
     /// The first hit point H.
     pub hit: Option<Point2<f64>>,
     /// The last leave point L.
@@ -236,6 +238,7 @@ pub fn drive_config(
     let mut modes = vec![nav.mode()];
     let mut min_clearance = world.clearance(pose.position(), 0.0);
     let mut last_speed = f64::NAN;
+    let mut last_omega = f64::NAN;
     let mut hit = None;
     let mut leave = None;
     let mut checker = ProgressChecker::new(ProgressSettings::default());
@@ -261,6 +264,7 @@ pub fn drive_config(
         leave = out.leave_point.or(leave);
         let c = out.command;
         last_speed = c.speed() + c.omega.abs();
+        last_omega = c.omega;
         if out.mode.is_final() {
             break;
         }
@@ -299,6 +303,7 @@ pub fn drive_config(
         min_clearance,
         final_pose: pose,
         last_speed,
+        last_omega,
         hit,
         leave,
         time,
