@@ -36,6 +36,9 @@ pub enum ConfigError {
         /// Which weights, with their values.
         detail: String,
     },
+    /// A `track_method` that names no method.
+    #[error("track_method `{0}` is not one of tangent, vector_distance, off")]
+    UnknownTrackMethod(String),
     /// A length or threshold is out of range or inconsistent with another.
     #[error("{name} = {value}: {reason}")]
     Value {
@@ -58,28 +61,44 @@ pub enum TrackMethod {
     /// The vector-distance function, eq. 3.50, as step 4 of §4.2.4 says: F with the asymmetric
     /// weights of the side L-mode chose, w'0 turned toward G at every step as in R-mode (the
     /// source neither locks nor re-aims the weights in T-mode; this reading uses nothing it
-    /// does not define).
+    /// does not define). `track_gain` plays no part.
     VectorDistance,
-    /// No T-mode (rotate and lock only, the ablation of 004 §4.3.3): where T-mode would begin
-    /// (eq. 3.58 or a stalled lock), L-mode goes on with a new progress window.
+    /// No T-mode (rotate and lock only, the ablation of 004 §4.3.3): where T-mode would begin,
+    /// L-mode goes on (with a new progress window when eq. 3.58 held, with the stalled command
+    /// when the lock stalled). Without T-mode there is no no-path verdict either, so a goal
+    /// with no way round runs until something else ends it: for experiments, not for robots.
     Off,
 }
 
 impl TrackMethod {
+    /// Every method, in the order of their names in [`TrackMethod::NAMES`].
+    pub const ALL: [TrackMethod; 3] = [TrackMethod::Tangent, TrackMethod::VectorDistance, TrackMethod::Off];
+    /// The parameter values, one per method.
+    pub const NAMES: [&'static str; 3] = ["tangent", "vector_distance", "off"];
+
     /// The parameter value: `tangent`, `vector_distance` or `off`.
     pub fn name(self) -> &'static str {
         match self {
-            TrackMethod::Tangent => "tangent",
-            TrackMethod::VectorDistance => "vector_distance",
-            TrackMethod::Off => "off",
+            TrackMethod::Tangent => Self::NAMES[0],
+            TrackMethod::VectorDistance => Self::NAMES[1],
+            TrackMethod::Off => Self::NAMES[2],
         }
     }
+}
 
-    /// The method a parameter value names, if any.
-    pub fn from_name(name: &str) -> Option<Self> {
-        [TrackMethod::Tangent, TrackMethod::VectorDistance, TrackMethod::Off]
+impl std::fmt::Display for TrackMethod {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+impl std::str::FromStr for TrackMethod {
+    type Err = ConfigError;
+    fn from_str(s: &str) -> Result<Self, ConfigError> {
+        Self::ALL
             .into_iter()
-            .find(|m| m.name() == name)
+            .find(|m| m.name() == s)
+            .ok_or_else(|| ConfigError::UnknownTrackMethod(s.to_string()))
     }
 }
 
@@ -148,7 +167,8 @@ pub struct NavConfig {
     /// reaches ±π/3 at a 0.70 m error.
     pub track_gain: f64,
     /// T-mode's direction: the tangent follower (default) or eq. 3.50; `Off` disables T-mode.
-    /// The default is the one the five scenarios favour (docs/experiments/local-nav.md).
+    /// The default is the one the five scenarios with the 270° scanner favour
+    /// (docs/experiments/local-nav.md).
     pub track_method: TrackMethod,
     /// Gain (1/s), > 0, of an omni chassis' turns: in place toward a direction outside the field
     /// of view, and in T-mode to face its direction of motion. Default 1.5.

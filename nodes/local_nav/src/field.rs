@@ -147,14 +147,14 @@ pub fn vector_distance(
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
     use crate::sectors::UnseenSectors;
     use approx::assert_relative_eq;
     use mobil_geom::{Pose2, Scan};
 
     /// Eight beams exactly on the sector centres (sector i at −45°·i), ranges given per sector.
-    fn eight(d: [f32; 8]) -> Sectors {
+    pub(crate) fn eight(d: [f32; 8]) -> Sectors {
         // Beam k looks at −180° + 45°·k.
         let mut ranges = vec![0.0f32; 8];
         for (i, &r) in d.iter().enumerate() {

@@ -565,22 +565,13 @@ mod tests {
     /// A navigator whose sectors come from eight beams on the sector centres (sector i at
     /// −45°·i), ranges given per sector, G straight ahead.
     fn with_sectors(method: TrackMethod, d: [f32; 8]) -> Navigator {
-        use crate::sectors::UnseenSectors;
-        use std::f64::consts::PI;
         let config = NavConfig {
             track_method: method,
             ..NavConfig::default()
         };
         let limits = MotionLimits::from_chassis(&mobil_chassis::ChassisParams::omr3());
         let mut nav = Navigator::new(config, limits).unwrap();
-        // Beam k looks at −180° + 45°·k.
-        let mut ranges = vec![0.0f32; 8];
-        for (i, &r) in d.iter().enumerate() {
-            let k = ((-45 * i as i32 + 180).rem_euclid(360) / 45) as usize;
-            ranges[k] = r;
-        }
-        let scan = Scan::new(-PI, 0.75 * PI, PI / 4.0, 0.05, 10.0, ranges, vec![], Pose2::identity()).unwrap();
-        nav.sectors = Sectors::compute(&scan, 0.0, 8, UnseenSectors::Blocked);
+        nav.sectors = crate::field::tests::eight(d);
         nav
     }
 
@@ -616,10 +607,12 @@ mod tests {
 
     #[test]
     fn track_method_names_round_trip() {
-        for m in [TrackMethod::Tangent, TrackMethod::VectorDistance, TrackMethod::Off] {
-            assert_eq!(TrackMethod::from_name(m.name()), Some(m));
+        for (m, name) in TrackMethod::ALL.into_iter().zip(TrackMethod::NAMES) {
+            assert_eq!(m.name(), name);
+            assert_eq!(name.parse::<TrackMethod>(), Ok(m));
+            assert_eq!(m.to_string(), name);
         }
-        assert_eq!(TrackMethod::from_name("bug2"), None);
+        assert!("bug2".parse::<TrackMethod>().unwrap_err().to_string().contains("bug2"));
     }
 
     #[test]

@@ -61,6 +61,23 @@ fn u_trap() -> World {
 
 #[test]
 fn u_trap_needs_track_mode_and_escapes() {
+    // Needs: 004 §4.3.3 says rotate and lock alone manage only small convex obstacles. With
+    // T-mode off, in the U-trap the lock slides into the corner of the bottom and an arm, its
+    // progress window fails (eq. 3.58) and, with no T-mode to go to, it locks again where it
+    // stands: a stall Nav2's progress checker (0.5 m in 10 s) would abort.
+    let off = scenario_run("u_trap", ChassisParams::omr3(), TrackMethod::Off, 60.0);
+    assert_eq!(Ending::of(&off), Ending::Stalls, "{:?}", off.modes);
+    assert!(
+        !off.modes.iter().any(|m| matches!(m, Mode::Track(_))),
+        "{:?}",
+        off.modes
+    );
+    assert!(off.first_abort.is_some_and(|t| t < 30.0), "{:?}", off.first_abort);
+    // Escapes: the same run with T-mode (the default tangent follower) reaches G.
+    let tangent = scenario_run("u_trap", ChassisParams::omr3(), TrackMethod::Tangent, 60.0);
+    assert_eq!(Ending::of(&tangent), Ending::Reached, "{:?}", tangent.modes);
+    assert_eq!(tangent.first_abort, None);
+    // And on the ideal plant, with H and L where they belong.
     let world = u_trap();
     let run = drive(
         &world,
@@ -95,25 +112,6 @@ fn scenario_run(name: &str, chassis: ChassisParams, method: TrackMethod, seconds
     };
     let steps = (seconds / SIM.dt) as usize;
     drive_config(&s.world, chassis, config, Pose2::identity(), s.goal, steps, SIM)
-}
-
-#[test]
-fn u_trap_without_track_mode_stalls_where_the_tangent_follower_escapes() {
-    // 004 §4.3.3: rotate and lock alone manage only small convex obstacles. In the U-trap the
-    // lock slides into the bottom's corner, its progress window fails (eq. 3.58) and, with no
-    // T-mode to go to, it locks again where it stands: a stall Nav2's progress checker (0.5 m
-    // in 10 s) would abort. The same run with T-mode by the tangent follower reaches G.
-    let off = scenario_run("u_trap", ChassisParams::omr3(), TrackMethod::Off, 60.0);
-    assert_eq!(Ending::of(&off), Ending::Stalls, "{:?}", off.modes);
-    assert!(
-        !off.modes.iter().any(|m| matches!(m, Mode::Track(_))),
-        "{:?}",
-        off.modes
-    );
-    assert!(off.first_abort.is_some_and(|t| t < 30.0), "{:?}", off.first_abort);
-    let tangent = scenario_run("u_trap", ChassisParams::omr3(), TrackMethod::Tangent, 60.0);
-    assert_eq!(Ending::of(&tangent), Ending::Reached, "{:?}", tangent.modes);
-    assert_eq!(tangent.first_abort, None);
 }
 
 #[test]
@@ -156,6 +154,12 @@ fn enclosure_without_track_mode_is_never_given_up() {
         let off = scenario_run("enclosed", chassis, TrackMethod::Off, 120.0);
         assert_eq!(Ending::of(&off), Ending::Loops, "{:?}", off.modes);
         assert!(off.path > 40.0, "{} m", off.path);
+        assert!(
+            !off.modes.iter().any(|m| matches!(m, Mode::Track(_))),
+            "{:?}",
+            off.modes
+        );
+        assert_eq!(off.first_abort, None, "the progress checker fired");
         for method in [TrackMethod::Tangent, TrackMethod::VectorDistance] {
             let run = scenario_run("enclosed", chassis, method, 120.0);
             assert_eq!(Ending::of(&run), Ending::NoPath, "{method:?} {:?}", run.modes);
@@ -166,9 +170,10 @@ fn enclosure_without_track_mode_is_never_given_up() {
 #[test]
 fn track_mode_by_eq_3_50_passes_the_wall_but_stalls_in_the_u_trap() {
     // T-mode by the vector-distance function (weights of the chosen side, w'0 toward G) goes
-    // round the wall's end like the tangent follower, but in the U-trap the goal is still
-    // straight through the bottom: F is L-mode's F again, the robot stops in the corner and T-mode
-    // never closes a progress window (steps are path), so only the progress checker ends it.
+    // round the wall's end like the tangent follower. In the U-trap, from H in the corner it
+    // slides along the bottom, turned to face its motion, until F points into the bottom and
+    // the robot stops (at about (2.65, −0.20)); a stop closes no progress window (steps are
+    // path), so only the progress checker ends it.
     let wall = scenario_run("wall", ChassisParams::omr3(), TrackMethod::VectorDistance, 60.0);
     assert_eq!(Ending::of(&wall), Ending::Reached, "{:?}", wall.modes);
     assert!(

@@ -203,17 +203,17 @@ impl Config for LocalNavConfig {
         d.double(
             "track_gain",
             n.track_gain,
-            "T-mode: bend of the tracking direction per metre of distance error [rad/m]",
+            "T-mode (track_method tangent): bend of the tracking direction per metre of distance error [rad/m]",
             |c, v| c.nav.track_gain = v,
         )
         .min(0.0);
-        d.string(
+        d.parsed::<TrackMethod>(
             "track_method",
             n.track_method.name(),
-            "T-mode's direction: tangent (the nearest reading's tangent), vector_distance (eq. 3.50 with the chosen side's weights) or off (rotate and lock only)",
-            |c, v| c.nav.track_method = TrackMethod::from_name(&v).unwrap_or_default(),
+            "T-mode's direction: tangent (the nearest reading's tangent), vector_distance (eq. 3.50 with the chosen side's weights) or off (rotate and lock only, for experiments: no NO_PATH verdict)",
+            |c, v| c.nav.track_method = v,
         )
-        .choices(&["tangent", "vector_distance", "off"]);
+        .choices(&TrackMethod::NAMES);
         d.double(
             "heading_gain",
             n.heading_gain,
@@ -573,6 +573,26 @@ mod tests {
         assert_eq!(c.laser_pose(), Some(Pose2::new(0.2, -0.1, 0.5)));
         values.set("laser_pose", ros2_client::ParameterValue::DoubleArray(vec![0.2, -0.1]));
         assert!(mobil_ros::config::load::<LocalNavConfig>(&values).is_err());
+    }
+
+    #[test]
+    fn track_method_reaches_the_navigator_and_unknown_names_are_refused() {
+        let mut values = ParamValues::defaults(&Decl::<LocalNavConfig>::of().specs());
+        let c: LocalNavConfig = mobil_ros::config::load(&values).unwrap();
+        assert_eq!(c.nav.track_method, TrackMethod::Tangent);
+        for (name, method) in [
+            ("vector_distance", TrackMethod::VectorDistance),
+            ("off", TrackMethod::Off),
+        ] {
+            values.set("track_method", ros2_client::ParameterValue::String(name.into()));
+            let c: LocalNavConfig = mobil_ros::config::load(&values).unwrap();
+            assert_eq!(c.nav.track_method, method);
+        }
+        values.set("track_method", ros2_client::ParameterValue::String("bug2".into()));
+        let e = mobil_ros::config::load::<LocalNavConfig>(&values)
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("bug2"), "{e}");
     }
 
     #[test]

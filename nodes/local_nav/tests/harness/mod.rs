@@ -1,6 +1,7 @@
 //! A ROS-free closed loop for the navigator, shared by `tests/closed_loop.rs` and the
 //! `track_ablation` example: the navigator's command integrated by an omni (or unicycle) model
 //! over a synthetic world of circles, segments and moving discs, scanned by a tiny raycaster.
+// Each user (the tests, the example) takes part of it.
 #![allow(dead_code)]
 
 use mobil_chassis::ChassisParams;
@@ -140,16 +141,15 @@ pub struct Run {
     pub final_pose: Pose2,
     /// |v| + |ω| of the last command.
     pub last_speed: f64,
-    /// ω of the last command (rad/s).
-    pub last_omega: f64,
     /// The first hit point H.
     pub hit: Option<Point2<f64>>,
     /// The last leave point L.
     pub leave: Option<Point2<f64>>,
     /// Simulated seconds until the final mode (or the step limit).
     pub time: f64,
-    /// The longest time (s) Nav2's default progress checker (0.5 m in 10 s) saw without
-    /// progress, had it been running; `None` if it never would have aborted.
+    /// How long (s) the robot had gone without progress the last time Nav2's default progress
+    /// checker (0.5 m in 10 s), had it been running, found it stuck; `None` if it never would
+    /// have aborted.
     pub stuck: Option<f64>,
     /// When (simulated s) that checker would first have aborted the goal.
     pub first_abort: Option<f64>,
@@ -238,7 +238,6 @@ pub fn drive_config(
     let mut modes = vec![nav.mode()];
     let mut min_clearance = world.clearance(pose.position(), 0.0);
     let mut last_speed = f64::NAN;
-    let mut last_omega = f64::NAN;
     let mut hit = None;
     let mut leave = None;
     let mut checker = ProgressChecker::new(ProgressSettings::default());
@@ -264,7 +263,6 @@ pub fn drive_config(
         leave = out.leave_point.or(leave);
         let c = out.command;
         last_speed = c.speed() + c.omega.abs();
-        last_omega = c.omega;
         if out.mode.is_final() {
             break;
         }
@@ -303,7 +301,6 @@ pub fn drive_config(
         min_clearance,
         final_pose: pose,
         last_speed,
-        last_omega,
         hit,
         leave,
         time,
