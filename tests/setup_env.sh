@@ -41,6 +41,8 @@ PIP_PACKAGES=(
   "pytest>=8.4,<9" pytest-timeout "pytest-xdist>=3.8,<4" pyyaml
   # The second engine of ga_step's evaluator (tests/mujoco_replay.py); the wheel ships MuJoCo.
   mujoco==4.0.1
+  # A Cyclone DDS peer (tests/cyclone_peer.py); the wheel ships Eclipse Cyclone DDS's library.
+  cyclonedds==11.0.1
 )
 stamp_pip="$VENV/.mobil-pip-stamp"
 want_pip="$(printf '%s\n' "${PIP_PACKAGES[@]}" | sha256sum | cut -d' ' -f1)"

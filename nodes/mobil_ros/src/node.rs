@@ -418,12 +418,14 @@ impl RosNode {
             .map_err(|e| anyhow!("cannot subscribe {name}: {e:?}"))
     }
 
-    /// A service server on `service` (resolved and remapped), rclpy/rclcpp compatible.
+    /// A service server on `service` (resolved and remapped), rclpy/rclcpp compatible: each
+    /// request is answered in the request/reply layout of the client that sent it, Fast DDS's
+    /// or Cyclone DDS's (`ServiceMapping::Auto`, patches/README.md).
     pub fn service<S: RosService>(&mut self, service: &str) -> anyhow::Result<Server<S::Request, S::Response>> {
         let name = self.topic_name(service)?;
         let qos = crate::qos::reliable(10);
         self.node
-            .create_server(ServiceMapping::Enhanced, &name, &S::type_name(), qos.clone(), qos)
+            .create_server(ServiceMapping::Auto, &name, &S::type_name(), qos.clone(), qos)
             .map_err(|e| anyhow!("cannot serve {name}: {e:?}"))
     }
 

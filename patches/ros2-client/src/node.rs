@@ -656,7 +656,8 @@ impl Node {
     self.suppress_node_info_updates(true);
 
     let parameter_servers = if self.options.start_parameter_services {
-      let service_mapping = ServiceMapping::Enhanced; //TODO: parameterize
+      // Per request, so that clients of both Fast DDS and Cyclone DDS get answers.
+      let service_mapping = ServiceMapping::Auto;
       let get_parameters_server = self.create_server(
         service_mapping,
         &Name::new(&node_name, "get_parameters").unwrap(),

@@ -330,11 +330,12 @@ where
         Self::on_node(node.inner(), &name, config)
     }
 
-    /// Serves the action `name` on a bare ros2-client node.
+    /// Serves the action `name` on a bare ros2-client node; its three services answer each
+    /// request in the layout of the client that sent it, Fast DDS's or Cyclone DDS's.
     pub fn on_node(node: &mut Node, name: &Name, config: GoalServerConfig) -> Result<Self, ActionError> {
         let server = node
             .create_action_server::<A::Goal, A::Result, A::Feedback>(
-                ServiceMapping::Enhanced,
+                ServiceMapping::Auto,
                 name,
                 &A::type_name(),
                 server_qos(),

@@ -88,7 +88,7 @@ where
     )?;
     let write_opts_builder = WriteOptionsBuilder::new().source_timestamp(Timestamp::now()); // always add source timestamp
 
-    let write_opts_builder = if self.service_mapping == ServiceMapping::Enhanced {
+    let write_opts_builder = if self.service_mapping.for_client() == ServiceMapping::Enhanced {
       write_opts_builder
     } else {
       write_opts_builder.related_sample_identity(SampleIdentity::from(gen_rmw_req_id))
@@ -99,8 +99,8 @@ where
       .map(RmwRequestId::from)
       .map_err(|e| e.forget_data())?;
 
-    match self.service_mapping {
-      ServiceMapping::Enhanced => Ok(sent_rmw_req_id),
+    match self.service_mapping.for_client() {
+      ServiceMapping::Enhanced | ServiceMapping::Auto => Ok(sent_rmw_req_id),
       ServiceMapping::Basic | ServiceMapping::Cyclone => Ok(gen_rmw_req_id),
     }
   }
@@ -149,7 +149,7 @@ where
     )?;
     let write_opts_builder = WriteOptionsBuilder::new().source_timestamp(Timestamp::now()); // always add source timestamp
 
-    let write_opts_builder = if self.service_mapping == ServiceMapping::Enhanced {
+    let write_opts_builder = if self.service_mapping.for_client() == ServiceMapping::Enhanced {
       write_opts_builder
     } else {
       write_opts_builder.related_sample_identity(SampleIdentity::from(gen_rmw_req_id))
@@ -161,8 +161,8 @@ where
       .map(RmwRequestId::from)
       .map_err(|e| e.forget_data())?;
 
-    let req_id = match self.service_mapping {
-      ServiceMapping::Enhanced => sent_rmw_req_id,
+    let req_id = match self.service_mapping.for_client() {
+      ServiceMapping::Enhanced | ServiceMapping::Auto => sent_rmw_req_id,
       ServiceMapping::Basic | ServiceMapping::Cyclone => gen_rmw_req_id,
     };
     debug!(

@@ -49,4 +49,50 @@ pub enum ServiceMapping {
   /// * ROS2 Galactic with CycloneDDS - Seems to work on the same host only, not
   ///   over actual network.
   Cyclone,
+
+  /// Per request, the mapping of the peer that sent it, so that one server
+  /// answers the clients of both ROS 2 Tier 1 DDS RMWs at once:
+  /// * a request written by Eclipse Cyclone DDS (vendor id 01.10, the first two
+  ///   bytes of every GUID it makes) is decoded as `Cyclone` and answered in
+  ///   that layout;
+  /// * any other request (eProsima Fast DDS, RustDDS, ...) as `Enhanced`.
+  ///
+  /// The choice for a reply is read back from its `RmwRequestId`, whose writer
+  /// GID starts with the request writer's GUID prefix in both layouts.
+  /// Clients created with `Auto` send and receive `Enhanced`.
+  Auto,
+}
+
+/// RTPS vendor id of Eclipse Cyclone DDS, the first two bytes of every GUID
+/// prefix it makes (RTPS 2.5, 9.3.1.5).
+pub const VENDOR_ID_ECLIPSE_CYCLONE: [u8; 2] = [0x01, 0x10];
+
+impl ServiceMapping {
+  fn resolve(self, gid: &crate::gid::Gid) -> ServiceMapping {
+    match self {
+      ServiceMapping::Auto if gid.as_bytes()[..2] == VENDOR_ID_ECLIPSE_CYCLONE => {
+        ServiceMapping::Cyclone
+      }
+      ServiceMapping::Auto => ServiceMapping::Enhanced,
+      other => other,
+    }
+  }
+
+  /// The mapping of a request written by the DDS writer `writer`.
+  pub fn of_request(self, writer: &crate::gid::Gid) -> ServiceMapping {
+    self.resolve(writer)
+  }
+
+  /// The mapping of the reply to the request `id` (as the server decoded it).
+  pub fn of_reply(self, id: &RmwRequestId) -> ServiceMapping {
+    self.resolve(&id.writer_gid)
+  }
+
+  /// The mapping a client uses: `Auto` is `Enhanced`.
+  pub fn for_client(self) -> ServiceMapping {
+    match self {
+      ServiceMapping::Auto => ServiceMapping::Enhanced,
+      other => other,
+    }
+  }
 }

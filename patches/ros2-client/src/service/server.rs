@@ -95,14 +95,7 @@ where
       RepresentationIdentifier::CDR_LE,
       response,
     )?;
-    let write_opts = WriteOptionsBuilder::new()
-      .source_timestamp(Timestamp::now()) // always add source timestamp
-      .related_sample_identity(SampleIdentity::from(rmw_req_id))
-      // TODO: Check if this is right. Cyclone mapping does not send
-      // Related Sample Identity in
-      // WriteOptions (QoS ParameterList), but within data payload.
-      // But maybe it is not harmful to send it in both?
-      .build();
+    let write_opts = reply_options(self.service_mapping, rmw_req_id);
     self
       .response_sender
       .write_with_options(resp_wrapper, write_opts)
@@ -182,14 +175,7 @@ where
       "async_send_response: related_sample_identity = {:?}",
       SampleIdentity::from(rmw_req_id)
     );
-    let write_opts = WriteOptionsBuilder::new()
-      .source_timestamp(Timestamp::now()) // always add source timestamp
-      .related_sample_identity(SampleIdentity::from(rmw_req_id))
-      // TODO: Check if this is right. Cyclone mapping does not send
-      // Related Sample Identity in
-      // WriteOptions (QoS ParameterList), but within data payload.
-      // But maybe it is not harmful to send it in both?
-      .build();
+    let write_opts = reply_options(self.service_mapping, rmw_req_id);
     self
       .response_sender
       .async_write_with_options(resp_wrapper, write_opts)
@@ -253,5 +239,20 @@ where
 
   fn deregister(&mut self, registry: &mio1::Registry) -> io::Result<()> {
     mio1::event::Source::deregister(&mut self.request_receiver, registry)
+  }
+}
+
+/// The write options of a reply: a source timestamp, and the related sample
+/// identity (the request's id) except in the Cyclone layout, which carries the
+/// id in the payload's header (rmw_cyclonedds ignores the inline QoS, and a Fast
+/// DDS client on the same service drops such a reply by it at once anyway).
+fn reply_options(mapping: ServiceMapping, rmw_req_id: RmwRequestId) -> WriteOptions {
+  let options = WriteOptionsBuilder::new().source_timestamp(Timestamp::now()); // always add source timestamp
+  if mapping.of_reply(&rmw_req_id) == ServiceMapping::Cyclone {
+    options.build()
+  } else {
+    options
+      .related_sample_identity(SampleIdentity::from(rmw_req_id))
+      .build()
   }
 }

@@ -53,7 +53,7 @@ impl<R: Message> RequestWrapper<R> {
     service_mapping: ServiceMapping,
     message_info: &MessageInfo,
   ) -> ReadResult<(RmwRequestId, R)> {
-    match service_mapping {
+    match service_mapping.of_request(&message_info.publisher_gid()) {
       ServiceMapping::Basic => {
         // 1. decode "RequestHeader" and
         // 2. decode Request
@@ -110,6 +110,7 @@ impl<R: Message> RequestWrapper<R> {
         GUID::from(message_info.publisher_gid()),
         self.encoding,
       ),
+      ServiceMapping::Auto => unreachable!("of_request resolves Auto"),
     }
   }
 
@@ -123,7 +124,7 @@ impl<R: Message> RequestWrapper<R> {
     let mut ser_buffer = BytesMut::with_capacity(std::mem::size_of::<R>() * 3 / 2).writer();
 
     // First, write header
-    match service_mapping {
+    match service_mapping.for_client() {
       ServiceMapping::Basic => {
         let basic_header = BasicRequestHeader::new(r_id.into());
         serialization::to_writer_with_rep_id(&mut ser_buffer, &basic_header, encoding)?;
@@ -135,6 +136,7 @@ impl<R: Message> RequestWrapper<R> {
         let cyclone_header = CycloneHeader::new(r_id);
         serialization::to_writer_with_rep_id(&mut ser_buffer, &cyclone_header, encoding)?;
       }
+      ServiceMapping::Auto => unreachable!("for_client resolves Auto"),
     }
     // Second, write request
     serialization::to_writer_with_rep_id(&mut ser_buffer, &request, encoding)?;
@@ -175,7 +177,7 @@ impl<R: Message> ResponseWrapper<R> {
     message_info: MessageInfo,
     client_guid: GUID,
   ) -> ReadResult<(RmwRequestId, R)> {
-    match service_mapping {
+    match service_mapping.for_client() {
       ServiceMapping::Basic => {
         let mut bytes = self.serialized_message.clone(); // ref copy only
         let (header, header_size) =
@@ -209,6 +211,7 @@ impl<R: Message> ResponseWrapper<R> {
         // header and reassembled inside cyclone_unwrap.
         cyclone_unwrap::<R>(self.serialized_message.clone(), client_guid, self.encoding)
       }
+      ServiceMapping::Auto => unreachable!("for_client resolves Auto"),
     }
   }
 
@@ -220,7 +223,7 @@ impl<R: Message> ResponseWrapper<R> {
     response: R,
   ) -> WriteResult<Self, ()> {
     let mut ser_buffer = BytesMut::with_capacity(std::mem::size_of::<R>() * 3 / 2).writer();
-    match service_mapping {
+    match service_mapping.of_reply(&r_id) {
       ServiceMapping::Basic => {
         let basic_header = BasicReplyHeader::new(r_id.into());
         serialization::to_writer_with_rep_id(&mut ser_buffer, &basic_header, encoding)?;
@@ -232,6 +235,7 @@ impl<R: Message> ResponseWrapper<R> {
         let cyclone_header = CycloneHeader::new(r_id);
         serialization::to_writer_with_rep_id(&mut ser_buffer, &cyclone_header, encoding)?;
       }
+      ServiceMapping::Auto => unreachable!("of_reply resolves Auto"),
     }
     serialization::to_writer_with_rep_id(&mut ser_buffer, &response, encoding)?;
     let serialized_message = ser_buffer.into_inner().freeze();
@@ -285,23 +289,26 @@ impl Message for BasicReplyHeader {}
 // https://github.com/ros2/rmw_cyclonedds/blob/master/rmw_cyclonedds_cpp/src/serdata.hpp
 // This is a header that Cyclone puts in DDS messages. Same header is used for
 // Request and Response.
+//
+// rmw_cyclonedds_cpp (serdata.hpp) declares it `struct { uint64_t guid; int64_t
+// seq; }`, written right after the encapsulation header in the payload's byte
+// order: `guid` is the client's request writer's instance handle (opaque, local
+// to the client's process) and `seq` its request counter. A server must echo
+// both unchanged; a client keeps only the replies whose `guid` is its own.
 #[derive(Serialize, Deserialize)]
 pub struct CycloneHeader {
-  guid_second_half: [u8; 8], // CycloneDDS RMW only sends last 8 bytes of client GUID
-  sequence_number_high: i32,
-  sequence_number_low: u32,
+  guid: u64,
+  seq: i64,
 }
 impl CycloneHeader {
+  // The header's guid lives in bytes 8..16 of `RmwRequestId.writer_gid`, as the
+  // little-endian bytes of the number (see `cyclone_unwrap`).
   fn new(r_id: RmwRequestId) -> Self {
-    let sn = SequenceNumber::from(r_id.sequence_number);
-    let mut guid_second_half = [0; 8];
-    // writer_gid means client GUID (i.e. request writer)
-    guid_second_half.copy_from_slice(&r_id.writer_gid.to_bytes16()[8..16]);
-
+    let mut guid = [0; 8];
+    guid.copy_from_slice(&r_id.writer_gid.to_bytes16()[8..16]);
     CycloneHeader {
-      guid_second_half,
-      sequence_number_high: sn.high(),
-      sequence_number_low: sn.low(),
+      guid: u64::from_le_bytes(guid),
+      seq: r_id.sequence_number,
     }
   }
 }
@@ -341,17 +348,15 @@ fn cyclone_unwrap<R: Message>(
     let (response, _response_bytes) = deserialize_from_cdr_with_rep_id::<R>(&payload, encoding)?;
 
     // Reassemble the full client GUID: upper 8 bytes from the supplied source,
-    // lower 8 bytes from the Cyclone header.
+    // lower 8 bytes from the Cyclone header's guid (as a number, so that a
+    // big-endian peer's guid is echoed as the same number).
     let mut client_guid_bytes = [0u8; 16];
     client_guid_bytes[0..8].copy_from_slice(&guid_upper_half_source.to_bytes()[0..8]);
-    client_guid_bytes[8..16].copy_from_slice(&header.guid_second_half);
+    client_guid_bytes[8..16].copy_from_slice(&header.guid.to_le_bytes());
 
     let req_id = RmwRequestId {
       writer_gid: crate::gid::Gid::from(GUID::from_bytes(client_guid_bytes)),
-      sequence_number: i64::from(SequenceNumber::from_high_low(
-        header.sequence_number_high,
-        header.sequence_number_low,
-      )),
+      sequence_number: header.seq,
     };
     Ok((req_id, response))
   }
@@ -419,5 +424,134 @@ impl<RW: Wrapper> no_key::SerializerAdapter<RW> for ServiceSerializerAdapter<RW>
 
   fn to_bytes(value: &RW) -> WriteResult<Bytes, ()> {
     Ok(value.bytes())
+  }
+}
+
+#[cfg(test)]
+mod tests {
+  use super::*;
+  use crate::gid::Gid;
+  use crate::service::VENDOR_ID_ECLIPSE_CYCLONE;
+
+  #[derive(Serialize, Deserialize, Debug, PartialEq)]
+  struct Names {
+    names: Vec<String>,
+  }
+  impl Message for Names {}
+
+  // A GID whose prefix starts with `vendor`.
+  fn gid(vendor: [u8; 2], rest: u8) -> Gid {
+    let mut b = [rest; 16];
+    b[0..2].copy_from_slice(&vendor);
+    Gid::from(b)
+  }
+
+  // The body (after the 4-byte encapsulation) of an rmw_cyclonedds
+  // GetParameters-like request `names = ["v_max"]`, little-endian: the header
+  // {guid: u64, seq: i64} then the message, as rmw_cyclonedds_cpp's
+  // Serialization.cpp writes it.
+  fn cyclone_le_body() -> Vec<u8> {
+    let mut b = vec![];
+    b.extend_from_slice(&0x1122_3344_5566_7788_u64.to_le_bytes()); // guid
+    b.extend_from_slice(&1_i64.to_le_bytes()); // seq
+    b.extend_from_slice(&1_u32.to_le_bytes()); // names.length
+    b.extend_from_slice(&6_u32.to_le_bytes()); // "v_max" + NUL
+    b.extend_from_slice(b"v_max\0");
+    b
+  }
+
+  #[test]
+  fn auto_decodes_a_cyclone_request_and_echoes_its_header() {
+    let body = cyclone_le_body();
+    let writer = gid(VENDOR_ID_ECLIPSE_CYCLONE, 0xab);
+    let mi = MessageInfo::new(None, None, 3, writer, None);
+    let w = RequestWrapper::<Names>::from_bytes_and_ri(&body, RepresentationIdentifier::CDR_LE);
+    let (id, req) = w.unwrap(ServiceMapping::Auto, &mi).unwrap();
+    assert_eq!(req.names, vec!["v_max".to_string()]);
+    assert_eq!(id.sequence_number, 1);
+    assert_eq!(id.writer_gid.as_bytes()[0..8], writer.as_bytes()[0..8]);
+    assert_eq!(id.writer_gid.as_bytes()[8..16], body[0..8]);
+    // The reply starts with the same 16 bytes, then the response.
+    let reply = ResponseWrapper::<Names>::new(
+      ServiceMapping::Auto,
+      id,
+      RepresentationIdentifier::CDR_LE,
+      Names { names: vec!["ok".into()] },
+    )
+    .unwrap()
+    .bytes();
+    assert_eq!(reply[0..16], body[0..16]);
+    assert_eq!(reply[16..20], 1_u32.to_le_bytes());
+  }
+
+  #[test]
+  fn a_big_endian_cyclone_request_keeps_its_guid_and_seq_as_numbers() {
+    let mut b = vec![];
+    b.extend_from_slice(&0x1122_3344_5566_7788_u64.to_be_bytes());
+    b.extend_from_slice(&5_i64.to_be_bytes());
+    b.extend_from_slice(&0_u32.to_be_bytes()); // no names
+    let mi = MessageInfo::new(None, None, 1, gid(VENDOR_ID_ECLIPSE_CYCLONE, 1), None);
+    let w = RequestWrapper::<Names>::from_bytes_and_ri(&b, RepresentationIdentifier::CDR_BE);
+    let (id, req) = w.unwrap(ServiceMapping::Cyclone, &mi).unwrap();
+    assert!(req.names.is_empty());
+    assert_eq!(id.sequence_number, 5);
+    // Replied little-endian: the same numbers in the reply's byte order.
+    let reply = ResponseWrapper::<Names>::new(
+      ServiceMapping::Cyclone,
+      id,
+      RepresentationIdentifier::CDR_LE,
+      Names { names: vec![] },
+    )
+    .unwrap()
+    .bytes();
+    assert_eq!(reply[0..8], 0x1122_3344_5566_7788_u64.to_le_bytes());
+    assert_eq!(reply[8..16], 5_i64.to_le_bytes());
+  }
+
+  #[test]
+  fn auto_decodes_a_fast_dds_request_by_its_related_sample_identity() {
+    // Fast DDS: no header; the client's reply reader in the inline QoS.
+    let mut body = vec![];
+    body.extend_from_slice(&1_u32.to_le_bytes());
+    body.extend_from_slice(&6_u32.to_le_bytes());
+    body.extend_from_slice(b"v_max\0");
+    let related = RmwRequestId {
+      writer_gid: gid([0x01, 0x0f], 0x42),
+      sequence_number: 7,
+    };
+    let mi = MessageInfo::new(None, None, 7, gid([0x01, 0x0f], 0x41), Some(related));
+    let w = RequestWrapper::<Names>::from_bytes_and_ri(&body, RepresentationIdentifier::CDR_LE);
+    let (id, req) = w.unwrap(ServiceMapping::Auto, &mi).unwrap();
+    assert_eq!(id, related);
+    assert_eq!(req.names, vec!["v_max".to_string()]);
+    let reply = ResponseWrapper::<Names>::new(
+      ServiceMapping::Auto,
+      id,
+      RepresentationIdentifier::CDR_LE,
+      Names { names: vec![] },
+    )
+    .unwrap()
+    .bytes();
+    // No header: just the empty sequence's length.
+    assert_eq!(reply[..], 0_u32.to_le_bytes());
+  }
+
+  #[test]
+  fn auto_resolves_by_vendor_and_clients_use_enhanced() {
+    let cyclone = gid(VENDOR_ID_ECLIPSE_CYCLONE, 0);
+    let fast = gid([0x01, 0x0f], 0);
+    let rust = gid([0x01, 0x12], 0);
+    assert_eq!(ServiceMapping::Auto.of_request(&cyclone), ServiceMapping::Cyclone);
+    assert_eq!(ServiceMapping::Auto.of_request(&fast), ServiceMapping::Enhanced);
+    assert_eq!(ServiceMapping::Auto.of_request(&rust), ServiceMapping::Enhanced);
+    let id = RmwRequestId {
+      writer_gid: cyclone,
+      sequence_number: 1,
+    };
+    assert_eq!(ServiceMapping::Auto.of_reply(&id), ServiceMapping::Cyclone);
+    // Fixed mappings stay what they are.
+    assert_eq!(ServiceMapping::Enhanced.of_request(&cyclone), ServiceMapping::Enhanced);
+    assert_eq!(ServiceMapping::Cyclone.of_request(&fast), ServiceMapping::Cyclone);
+    assert_eq!(ServiceMapping::Auto.for_client(), ServiceMapping::Enhanced);
   }
 }
