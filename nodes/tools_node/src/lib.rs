@@ -47,7 +47,8 @@ pub fn route_now(node: &RosNode, route: &[(f64, f64)]) -> Path {
 }
 
 /// A client of the service `name` (resolved in the node's namespace; reliable, depth 10, both
-/// ways).
+/// ways), sending in the request/reply layout of the servers it reaches: Cyclone DDS's when
+/// every one is Cyclone DDS, Fast DDS's otherwise (which the suite's servers also answer).
 pub fn service_client<S: RosService>(
     node: &mut RosNode,
     name: &str,
@@ -56,7 +57,7 @@ pub fn service_client<S: RosService>(
     let name = Name::parse(&name).map_err(|e| anyhow::anyhow!("bad service name {name}: {e:?}"))?;
     let qos = qos::reliable(10);
     node.inner()
-        .create_client::<S::Request, S::Response>(ServiceMapping::Enhanced, &name, &S::type_name(), qos.clone(), qos)
+        .create_client::<S::Request, S::Response>(ServiceMapping::Auto, &name, &S::type_name(), qos.clone(), qos)
         .map_err(|e| anyhow::anyhow!("cannot create a client of {name}: {e:?}"))
 }
 

@@ -937,6 +937,12 @@ impl Node {
     }
   }
 
+  /// The table of the remote readers each local writer has matched (kept by the
+  /// spinner).
+  pub(crate) fn writers_to_remote_readers(&self) -> Arc<Mutex<BTreeMap<GUID, BTreeSet<GUID>>>> {
+    Arc::clone(&self.writers_to_remote_readers)
+  }
+
   pub(crate) fn get_publisher_count(&self, subscription_guid: GUID) -> usize {
     self
       .readers_to_remote_writers

@@ -1,6 +1,9 @@
 #[cfg(any(feature = "mio_06", feature = "mio_1"))]
 use std::io;
-use std::sync::atomic;
+use std::{
+  collections::{BTreeMap, BTreeSet},
+  sync::{atomic, Arc, Mutex},
+};
 
 #[cfg(feature = "mio_06")]
 use rustdds::mio::{Evented, Poll, PollOpt, Ready, Token};
@@ -32,6 +35,9 @@ where
   response_receiver: SimpleDataReaderR<ResponseWrapper<Resp>>,
   sequence_number_gen: atomic::AtomicI64, // used by basic and cyclone
   client_guid: GUID,                      // used by the Cyclone ServiceMapping
+  // The node's table of the remote readers each local writer has matched, for
+  // ServiceMapping::Auto to tell which servers the request writer reaches.
+  remote_readers: Arc<Mutex<BTreeMap<GUID, BTreeSet<GUID>>>>,
 }
 
 impl<Req, Resp> Client<Req, Resp>
@@ -69,7 +75,22 @@ where
       response_receiver,
       sequence_number_gen: atomic::AtomicI64::new(SequenceNumber::default().into()),
       client_guid,
+      remote_readers: node.writers_to_remote_readers(),
     })
+  }
+
+  /// The mapping the next request is sent in (`Auto`: by the servers matched).
+  fn send_mapping(&self) -> ServiceMapping {
+    match self.service_mapping {
+      ServiceMapping::Auto => {
+        let table = self.remote_readers.lock().unwrap_or_else(|e| e.into_inner());
+        match table.get(&self.request_sender.guid()) {
+          Some(readers) => self.service_mapping.for_servers(readers),
+          None => self.service_mapping.for_servers(std::iter::empty()),
+        }
+      }
+      other => other,
+    }
   }
 
   /// Send a request to Service Server.
@@ -80,15 +101,16 @@ where
       writer_gid: Gid::from(self.client_guid),
       sequence_number: i64::from(self.sequence_number()),
     };
+    let mapping = self.send_mapping();
     let req_wrapper = RequestWrapper::<Req>::new(
-      self.service_mapping,
+      mapping,
       gen_rmw_req_id,
       RepresentationIdentifier::CDR_LE,
       request,
     )?;
     let write_opts_builder = WriteOptionsBuilder::new().source_timestamp(Timestamp::now()); // always add source timestamp
 
-    let write_opts_builder = if self.service_mapping.for_client() == ServiceMapping::Enhanced {
+    let write_opts_builder = if mapping == ServiceMapping::Enhanced {
       write_opts_builder
     } else {
       write_opts_builder.related_sample_identity(SampleIdentity::from(gen_rmw_req_id))
@@ -99,7 +121,7 @@ where
       .map(RmwRequestId::from)
       .map_err(|e| e.forget_data())?;
 
-    match self.service_mapping.for_client() {
+    match mapping {
       ServiceMapping::Enhanced | ServiceMapping::Auto => Ok(sent_rmw_req_id),
       ServiceMapping::Basic | ServiceMapping::Cyclone => Ok(gen_rmw_req_id),
     }
@@ -141,15 +163,16 @@ where
         }
       }.await;
 
+    let mapping = self.send_mapping();
     let req_wrapper = RequestWrapper::<Req>::new(
-      self.service_mapping,
+      mapping,
       gen_rmw_req_id,
       RepresentationIdentifier::CDR_LE,
       request,
     )?;
     let write_opts_builder = WriteOptionsBuilder::new().source_timestamp(Timestamp::now()); // always add source timestamp
 
-    let write_opts_builder = if self.service_mapping.for_client() == ServiceMapping::Enhanced {
+    let write_opts_builder = if mapping == ServiceMapping::Enhanced {
       write_opts_builder
     } else {
       write_opts_builder.related_sample_identity(SampleIdentity::from(gen_rmw_req_id))
@@ -161,7 +184,7 @@ where
       .map(RmwRequestId::from)
       .map_err(|e| e.forget_data())?;
 
-    let req_id = match self.service_mapping.for_client() {
+    let req_id = match mapping {
       ServiceMapping::Enhanced | ServiceMapping::Auto => sent_rmw_req_id,
       ServiceMapping::Basic | ServiceMapping::Cyclone => gen_rmw_req_id,
     };
@@ -185,6 +208,15 @@ where
         Some(Err(e)) => return Err(e.into()),
         Some(Ok(dcc)) => {
           let mi = MessageInfo::from(&dcc);
+          if self.service_mapping == ServiceMapping::Auto
+            && self.service_mapping.of_writer(&mi.publisher_gid()) == ServiceMapping::Enhanced
+            && mi.related_request_id() != Some(request_id)
+          {
+            // Another client's reply, possibly in another layout (a server
+            // answering Cyclone DDS clients too): skipped undecoded, as Fast DDS
+            // clients do.
+            continue;
+          }
           let (req_id, response) =
             dcc
               .into_value()

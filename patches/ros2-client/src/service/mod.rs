@@ -59,7 +59,10 @@ pub enum ServiceMapping {
   ///
   /// The choice for a reply is read back from its `RmwRequestId`, whose writer
   /// GID starts with the request writer's GUID prefix in both layouts.
-  /// Clients created with `Auto` send and receive `Enhanced`.
+  ///
+  /// A client created with `Auto` sends in the Cyclone layout when every server
+  /// its request writer has matched is Cyclone DDS's, in `Enhanced` otherwise,
+  /// and reads each reply in the layout of its writer's vendor.
   Auto,
 }
 
@@ -78,8 +81,9 @@ impl ServiceMapping {
     }
   }
 
-  /// The mapping of a request written by the DDS writer `writer`.
-  pub fn of_request(self, writer: &crate::gid::Gid) -> ServiceMapping {
+  /// The mapping of a request or a reply written by the DDS writer `writer`
+  /// (`Auto`: by the writer's vendor).
+  pub fn of_writer(self, writer: &crate::gid::Gid) -> ServiceMapping {
     self.resolve(writer)
   }
 
@@ -88,10 +92,26 @@ impl ServiceMapping {
     self.resolve(&id.writer_gid)
   }
 
-  /// The mapping a client uses: `Auto` is `Enhanced`.
-  pub fn for_client(self) -> ServiceMapping {
+  /// The mapping a client sends in, given the GUIDs of the readers its request
+  /// writer has matched (`Auto`: `Cyclone` when there is at least one and every
+  /// one is Cyclone DDS's, otherwise `Enhanced`, which every server of this
+  /// crate also answers).
+  pub fn for_servers<'a>(self, matched: impl IntoIterator<Item = &'a rustdds::GUID>) -> ServiceMapping {
     match self {
-      ServiceMapping::Auto => ServiceMapping::Enhanced,
+      ServiceMapping::Auto => {
+        let mut any = false;
+        for reader in matched {
+          if crate::gid::Gid::from(*reader).as_bytes()[..2] != VENDOR_ID_ECLIPSE_CYCLONE {
+            return ServiceMapping::Enhanced;
+          }
+          any = true;
+        }
+        if any {
+          ServiceMapping::Cyclone
+        } else {
+          ServiceMapping::Enhanced
+        }
+      }
       other => other,
     }
   }

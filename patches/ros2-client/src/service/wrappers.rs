@@ -53,7 +53,7 @@ impl<R: Message> RequestWrapper<R> {
     service_mapping: ServiceMapping,
     message_info: &MessageInfo,
   ) -> ReadResult<(RmwRequestId, R)> {
-    match service_mapping.of_request(&message_info.publisher_gid()) {
+    match service_mapping.of_writer(&message_info.publisher_gid()) {
       ServiceMapping::Basic => {
         // 1. decode "RequestHeader" and
         // 2. decode Request
@@ -110,7 +110,7 @@ impl<R: Message> RequestWrapper<R> {
         GUID::from(message_info.publisher_gid()),
         self.encoding,
       ),
-      ServiceMapping::Auto => unreachable!("of_request resolves Auto"),
+      ServiceMapping::Auto => unreachable!("of_writer resolves Auto"),
     }
   }
 
@@ -123,8 +123,9 @@ impl<R: Message> RequestWrapper<R> {
   ) -> WriteResult<Self, ()> {
     let mut ser_buffer = BytesMut::with_capacity(std::mem::size_of::<R>() * 3 / 2).writer();
 
-    // First, write header
-    match service_mapping.for_client() {
+    // First, write header (the client resolves Auto before; unresolved, it is
+    // Enhanced)
+    match service_mapping.for_servers(std::iter::empty()) {
       ServiceMapping::Basic => {
         let basic_header = BasicRequestHeader::new(r_id.into());
         serialization::to_writer_with_rep_id(&mut ser_buffer, &basic_header, encoding)?;
@@ -136,7 +137,7 @@ impl<R: Message> RequestWrapper<R> {
         let cyclone_header = CycloneHeader::new(r_id);
         serialization::to_writer_with_rep_id(&mut ser_buffer, &cyclone_header, encoding)?;
       }
-      ServiceMapping::Auto => unreachable!("for_client resolves Auto"),
+      ServiceMapping::Auto => unreachable!("for_servers resolves Auto"),
     }
     // Second, write request
     serialization::to_writer_with_rep_id(&mut ser_buffer, &request, encoding)?;
@@ -177,7 +178,7 @@ impl<R: Message> ResponseWrapper<R> {
     message_info: MessageInfo,
     client_guid: GUID,
   ) -> ReadResult<(RmwRequestId, R)> {
-    match service_mapping.for_client() {
+    match service_mapping.of_writer(&message_info.publisher_gid()) {
       ServiceMapping::Basic => {
         let mut bytes = self.serialized_message.clone(); // ref copy only
         let (header, header_size) =
@@ -211,7 +212,7 @@ impl<R: Message> ResponseWrapper<R> {
         // header and reassembled inside cyclone_unwrap.
         cyclone_unwrap::<R>(self.serialized_message.clone(), client_guid, self.encoding)
       }
-      ServiceMapping::Auto => unreachable!("for_client resolves Auto"),
+      ServiceMapping::Auto => unreachable!("of_writer resolves Auto"),
     }
   }
 
@@ -541,17 +542,47 @@ mod tests {
     let cyclone = gid(VENDOR_ID_ECLIPSE_CYCLONE, 0);
     let fast = gid([0x01, 0x0f], 0);
     let rust = gid([0x01, 0x12], 0);
-    assert_eq!(ServiceMapping::Auto.of_request(&cyclone), ServiceMapping::Cyclone);
-    assert_eq!(ServiceMapping::Auto.of_request(&fast), ServiceMapping::Enhanced);
-    assert_eq!(ServiceMapping::Auto.of_request(&rust), ServiceMapping::Enhanced);
+    assert_eq!(ServiceMapping::Auto.of_writer(&cyclone), ServiceMapping::Cyclone);
+    assert_eq!(ServiceMapping::Auto.of_writer(&fast), ServiceMapping::Enhanced);
+    assert_eq!(ServiceMapping::Auto.of_writer(&rust), ServiceMapping::Enhanced);
     let id = RmwRequestId {
       writer_gid: cyclone,
       sequence_number: 1,
     };
     assert_eq!(ServiceMapping::Auto.of_reply(&id), ServiceMapping::Cyclone);
     // Fixed mappings stay what they are.
-    assert_eq!(ServiceMapping::Enhanced.of_request(&cyclone), ServiceMapping::Enhanced);
-    assert_eq!(ServiceMapping::Cyclone.of_request(&fast), ServiceMapping::Cyclone);
-    assert_eq!(ServiceMapping::Auto.for_client(), ServiceMapping::Enhanced);
+    assert_eq!(ServiceMapping::Enhanced.of_writer(&cyclone), ServiceMapping::Enhanced);
+    assert_eq!(ServiceMapping::Cyclone.of_writer(&fast), ServiceMapping::Cyclone);
+    // A client: Cyclone only when every matched server is Cyclone DDS's.
+    let reader = |g: Gid| GUID::from(g);
+    let (c, f) = (reader(cyclone), reader(fast));
+    assert_eq!(ServiceMapping::Auto.for_servers([&c]), ServiceMapping::Cyclone);
+    assert_eq!(ServiceMapping::Auto.for_servers([&c, &f]), ServiceMapping::Enhanced);
+    assert_eq!(ServiceMapping::Auto.for_servers(std::iter::empty()), ServiceMapping::Enhanced);
+    assert_eq!(ServiceMapping::Basic.for_servers([&c]), ServiceMapping::Basic);
+  }
+
+  #[test]
+  fn an_auto_client_reads_each_reply_in_its_writers_layout() {
+    let client = GUID::from(gid([0x01, 0x12], 0x33));
+    // From Cyclone DDS: the header echoing our request (guid = our GUID's lower
+    // 8 bytes, seq 9), then the response.
+    let mut lower = [0; 8];
+    lower.copy_from_slice(&Gid::from(client).as_bytes()[8..16]);
+    let mut body = vec![];
+    body.extend_from_slice(&u64::from_le_bytes(lower).to_le_bytes());
+    body.extend_from_slice(&9_i64.to_le_bytes());
+    body.extend_from_slice(&0_u32.to_le_bytes());
+    let mi = MessageInfo::new(None, None, 1, gid(VENDOR_ID_ECLIPSE_CYCLONE, 5), None);
+    let w = ResponseWrapper::<Names>::from_bytes_and_ri(&body, RepresentationIdentifier::CDR_LE);
+    let (id, resp) = w.unwrap(ServiceMapping::Auto, mi, client).unwrap();
+    assert_eq!(id, RmwRequestId { writer_gid: Gid::from(client), sequence_number: 9 });
+    assert!(resp.names.is_empty());
+    // From Fast DDS: no header, the id in the related sample identity.
+    let related = RmwRequestId { writer_gid: Gid::from(client), sequence_number: 4 };
+    let mi = MessageInfo::new(None, None, 1, gid([0x01, 0x0f], 5), Some(related));
+    let w = ResponseWrapper::<Names>::from_bytes_and_ri(&0_u32.to_le_bytes(), RepresentationIdentifier::CDR_LE);
+    let (id, _) = w.unwrap(ServiceMapping::Auto, mi, client).unwrap();
+    assert_eq!(id, related);
   }
 }
