@@ -43,6 +43,8 @@ PIP_PACKAGES=(
   mujoco==4.0.1
   # A Cyclone DDS peer (tests/cyclone_peer.py); the wheel ships Eclipse Cyclone DDS's library.
   cyclonedds==11.0.1
+  # rosbag2 (MCAP) bags without a ROS install (tests/test_bag_replay.py); pure Python.
+  rosbags==0.10.9
 )
 stamp_pip="$VENV/.mobil-pip-stamp"
 want_pip="$(printf '%s\n' "${PIP_PACKAGES[@]}" | sha256sum | cut -d' ' -f1)"
