@@ -229,12 +229,14 @@ def resolve_executable(exe: Union[str, Path]) -> Path:
 def launch_node(exe: Union[str, Path], *ros_args: str, log_dir: Path,
                 params_file: Union[str, Path, None] = None, name: Optional[str] = None,
                 args: Sequence[str] = (), env: Optional[dict[str, str]] = None,
-                check_exit_code: bool = True, niceness: int = 0) -> NodeProcess:
+                check_exit_code: bool = True, niceness: int = 0,
+                prefix: Sequence[str] = ()) -> NodeProcess:
     """Start ``exe [args] --ros-args ROS_ARGS [--params-file F] [-r __node:=NAME]``.
 
     ``params_file`` relative paths are relative to the repository root. ``env`` entries are
     added to the ROS environment (domain id, Fast DDS profile, RUST_BACKTRACE=1). A
-    ``niceness`` above 0 starts it under ``nice`` (a lower CPU priority).
+    ``niceness`` above 0 starts it under ``nice`` (a lower CPU priority). ``prefix`` is a
+    command that execs the node, e.g. ``ip netns exec NS`` (the node keeps the process id).
     """
     path = resolve_executable(exe)
     ros = list(ros_args)
@@ -251,6 +253,7 @@ def launch_node(exe: Union[str, Path], *ros_args: str, log_dir: Path,
     cmd = [str(path), *args] + (["--ros-args", *ros] if ros else [])
     if niceness > 0:
         cmd = ["nice", "-n", str(niceness), *cmd]
+    cmd = [*prefix, *cmd]
     child_env = rosutil.ros_environ()
     child_env.setdefault("RUST_BACKTRACE", "1")
     child_env.update(env or {})

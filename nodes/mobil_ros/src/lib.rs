@@ -49,6 +49,7 @@ pub mod chassis;
 pub mod cmd_vel;
 pub mod config;
 pub mod diagnostics;
+pub mod discovery;
 pub mod docs;
 pub mod geometry;
 pub mod goal;

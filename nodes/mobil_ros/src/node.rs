@@ -26,8 +26,8 @@ use mobil_msgs::builtin_interfaces::msg::Time;
 use mobil_msgs::rosgraph_msgs::msg::Clock;
 use mobil_msgs::{RosMessage, RosService};
 use ros2_client::{
-    Context, ContextOptions, Name, Node, NodeName, NodeOptions, ParameterValue, Publisher, QosProfile, RmwRequestId,
-    Server, ServiceMapping, Subscription,
+    Context, Name, Node, NodeName, NodeOptions, ParameterValue, Publisher, QosProfile, RmwRequestId, Server,
+    ServiceMapping, Subscription,
 };
 use std::fmt::Write as _;
 use std::sync::atomic::{AtomicI64, Ordering};
@@ -322,7 +322,15 @@ impl RosNode {
         }));
 
         let domain = domain_id_from_env()?;
-        let context = Context::with_options(ContextOptions::new().domain_id(domain))
+        let discovery = crate::discovery::Discovery::from_env()?;
+        for note in &discovery.notes {
+            warn!("{note}");
+        }
+        let participant = discovery
+            .apply(rustdds::DomainParticipantBuilder::new(domain))?
+            .build()
+            .map_err(|e| anyhow!("cannot join DDS domain {domain}: {e:?}"))?;
+        let context = Context::from_domain_participant(participant)
             .map_err(|e| anyhow!("cannot join DDS domain {domain}: {e:?}"))?;
         let ns = names.namespace().to_owned();
         let mut node = context
@@ -337,7 +345,7 @@ impl RosNode {
                 warn!("spinner stopped: {e:?}");
             }
         });
-        info!("{fqn} up on ROS_DOMAIN_ID {domain}");
+        info!("{fqn} up on ROS_DOMAIN_ID {domain}, {}", discovery.describe());
         let mut ros_node = RosNode {
             node,
             context,

@@ -78,6 +78,10 @@ pub struct DomainParticipantBuilder {
 
   same_host_loopback: bool, // prefer loopback for same-host peers + localhost SPDP discovery peers
 
+  multicast: bool, // multicast discovery and user traffic listeners (and so SPDP by multicast)
+
+  static_peers: Vec<IpAddr>, // more unicast SPDP destinations (ROS_STATIC_PEERS)
+
   socket_receive_buffer_size: usize,
   socket_send_buffer_size: usize,
 
@@ -93,6 +97,8 @@ impl DomainParticipantBuilder {
       domain_id,
       only_networks: None,
       same_host_loopback: true,
+      multicast: true,
+      static_peers: Vec::new(),
       socket_receive_buffer_size: Self::DEFAULT_SOCKET_RECEIVE_BUFFER_SIZE,
       socket_send_buffer_size: Self::DEFAULT_SOCKET_SEND_BUFFER_SIZE,
       #[cfg(feature = "security")]
@@ -126,6 +132,28 @@ impl DomainParticipantBuilder {
   /// `src/rtps/loopback_same_host_design.md`.
   pub fn same_host_loopback(mut self, enabled: bool) -> Self {
     self.same_host_loopback = enabled;
+    self
+  }
+
+  /// Enable/disable multicast (default: enabled). Disabled, the participant
+  /// joins no multicast group and so neither announces itself (SPDP) nor
+  /// listens by multicast: discovery goes only to the localhost peers (see
+  /// [`Self::same_host_loopback`]) and the static peers
+  /// ([`Self::with_static_peers`]), and to the participants those find. For
+  /// networks without multicast, and for ROS 2's
+  /// `ROS_AUTOMATIC_DISCOVERY_RANGE=LOCALHOST` / `OFF`.
+  pub fn multicast(mut self, enabled: bool) -> Self {
+    self.multicast = enabled;
+    self
+  }
+
+  /// Hosts to announce this participant to by unicast SPDP, besides multicast:
+  /// each gets the announcements at its well-known discovery ports of the
+  /// first participant ids, as the localhost peers do. A participant found
+  /// this way is then reached at the locators it advertises. ROS 2's
+  /// `ROS_STATIC_PEERS`.
+  pub fn with_static_peers(mut self, peers: impl IntoIterator<Item = IpAddr>) -> Self {
+    self.static_peers = peers.into_iter().collect();
     self
   }
 
@@ -344,6 +372,8 @@ impl DomainParticipantBuilder {
       self.socket_send_buffer_size,
       self.only_networks,
       self.same_host_loopback,
+      self.multicast,
+      self.static_peers.into(),
       dp_waker,
       discovery_sample_sender,
     )?;
@@ -977,6 +1007,8 @@ impl DomainParticipantDisc {
     socket_send_buffer_size: usize,
     only_networks: Option<Vec<IpAddr>>,
     same_host_loopback: bool,
+    multicast: bool,
+    static_peers: Arc<[IpAddr]>,
     dp_waker: LoopWaker,
     discovery_sample_sender: ReadySender<mio1::Token>,
   ) -> CreateResult<Self> {
@@ -994,6 +1026,8 @@ impl DomainParticipantDisc {
       socket_send_buffer_size,
       only_networks,
       same_host_loopback,
+      multicast,
+      static_peers,
       dp_waker,
       discovery_sample_sender,
     )?;
@@ -1236,6 +1270,8 @@ impl DomainParticipantInner {
     socket_send_buffer_size: usize,
     only_networks: Option<Vec<IpAddr>>,
     same_host_loopback: bool,
+    multicast: bool,
+    static_peers: Arc<[IpAddr]>,
     dp_waker: LoopWaker,
     discovery_sample_sender: ReadySender<mio1::Token>,
   ) -> CreateResult<Self> {
@@ -1246,16 +1282,25 @@ impl DomainParticipantInner {
 
     let mut listeners = HashMap::new();
 
-    match UDPListener::new_multicast_with_buf_size(
-      "0.0.0.0",
-      spdp_well_known_multicast_port(domain_id),
-      Ipv4Addr::new(239, 255, 0, 1),
-      socket_receive_buffer_size,
-      only_networks.as_deref(),
-    ) {
-      Ok(l) => {
+    // Without a multicast listener the participant's SPDP reader advertises no
+    // multicast locator, so its SPDP writer sends nothing by multicast either.
+    let multicast_discovery = if multicast {
+      UDPListener::new_multicast_with_buf_size(
+        "0.0.0.0",
+        spdp_well_known_multicast_port(domain_id),
+        Ipv4Addr::new(239, 255, 0, 1),
+        socket_receive_buffer_size,
+        only_networks.as_deref(),
+      )
+      .map(Some)
+    } else {
+      Ok(None)
+    };
+    match multicast_discovery {
+      Ok(Some(l)) => {
         listeners.insert(DISCOVERY_MUL_LISTENER_TOKEN, l);
       }
+      Ok(None) => info!("Multicast disabled: discovery by unicast only"),
       Err(e) => warn!("Cannot get multicast discovery listener: {e:?}"),
     }
 
@@ -1288,16 +1333,23 @@ impl DomainParticipantInner {
 
     // Now the user traffic listeners
 
-    match UDPListener::new_multicast_with_buf_size(
-      "0.0.0.0",
-      user_traffic_multicast_port(domain_id),
-      Ipv4Addr::new(239, 255, 0, 1),
-      socket_receive_buffer_size,
-      only_networks.as_deref(),
-    ) {
-      Ok(l) => {
+    let multicast_user = if multicast {
+      UDPListener::new_multicast_with_buf_size(
+        "0.0.0.0",
+        user_traffic_multicast_port(domain_id),
+        Ipv4Addr::new(239, 255, 0, 1),
+        socket_receive_buffer_size,
+        only_networks.as_deref(),
+      )
+      .map(Some)
+    } else {
+      Ok(None)
+    };
+    match multicast_user {
+      Ok(Some(l)) => {
         listeners.insert(USER_TRAFFIC_MUL_LISTENER_TOKEN, l);
       }
+      Ok(None) => {}
       Err(e) => warn!("Cannot get multicast user traffic listener: {e:?}"),
     }
 
@@ -1412,6 +1464,7 @@ impl DomainParticipantInner {
           only_networks_for_ev_loop,
           socket_send_buffer_size,
           same_host_loopback,
+          static_peers,
           reader_ready_rx,
           writer_ready_rx,
           dp_waker,
@@ -1774,6 +1827,27 @@ mod tests {
     test::{random_data::RandomData, test_domain::test_domain_id},
   };
   use super::DomainParticipant;
+
+  #[test]
+  fn without_multicast_no_multicast_locator_is_advertised() {
+    use crate::rtps::constant::{DISCOVERY_MUL_LISTENER_TOKEN, USER_TRAFFIC_MUL_LISTENER_TOKEN};
+    let plain = super::DomainParticipantBuilder::new(test_domain_id(20))
+      .build()
+      .expect("participant");
+    let unicast_only = super::DomainParticipantBuilder::new(test_domain_id(20))
+      .multicast(false)
+      .with_static_peers(["127.0.0.1".parse().unwrap()])
+      .build()
+      .expect("participant");
+    let locators = unicast_only.self_locators();
+    assert!(!locators.contains_key(&DISCOVERY_MUL_LISTENER_TOKEN));
+    assert!(!locators.contains_key(&USER_TRAFFIC_MUL_LISTENER_TOKEN));
+    // The default participant has them (where the host can join the group at all).
+    let default_locators = plain.self_locators();
+    if let Some(mul) = default_locators.get(&DISCOVERY_MUL_LISTENER_TOKEN) {
+      assert!(!mul.is_empty());
+    }
+  }
 
   // TODO: improve basic test when more or the structure is known
   #[test]

@@ -177,6 +177,26 @@ pub fn localhost_spdp_peer_locators(
     .collect()
 }
 
+/// The unicast SPDP destinations of static peers: each peer's well-known
+/// discovery port for participant ids `0..max_participants`.
+pub fn static_peer_spdp_locators(
+  peers: &[IpAddr],
+  domain_id: u16,
+  max_participants: u16,
+) -> Vec<Locator> {
+  peers
+    .iter()
+    .flat_map(|ip| {
+      (0..max_participants).map(move |pid| {
+        Locator::from(SocketAddr::new(
+          *ip,
+          crate::network::constant::spdp_well_known_unicast_port(domain_id, pid),
+        ))
+      })
+    })
+    .collect()
+}
+
 pub fn get_local_unicast_locators_filtered(
   port: u16,
   only_networks: Option<&[IpAddr]>,
@@ -329,6 +349,19 @@ mod tests {
       netmask: Some(Ipv4Addr::from(mask)),
       mtu: Some(mtu),
     }
+  }
+
+  #[test]
+  fn static_peer_spdp_locators_cover_each_peers_first_participant_ids() {
+    let peers = [v4(10, 0, 0, 2), v4(10, 0, 0, 3)];
+    let locs = super::static_peer_spdp_locators(&peers, 0, 3);
+    // Domain 0: 7400 + 10 + 2·pid (RTPS 9.6.2.3).
+    let expect: Vec<Locator> = [(2, 7410), (2, 7412), (2, 7414), (3, 7410), (3, 7412), (3, 7414)]
+      .into_iter()
+      .map(|(host, port)| Locator::from(SocketAddr::new(v4(10, 0, 0, host), port)))
+      .collect();
+    assert_eq!(locs, expect);
+    assert!(super::static_peer_spdp_locators(&[], 0, 3).is_empty());
   }
 
   #[test]

@@ -27,7 +27,7 @@ use crate::{
     constant::SPDP_LOCALHOST_PEER_COUNT,
     udp_listener::UDPListener,
     udp_sender::UDPSender,
-    util::{local_interface_table, localhost_spdp_peer_locators, IfAddr},
+    util::{local_interface_table, localhost_spdp_peer_locators, static_peer_spdp_locators, IfAddr},
   },
   polling::{
     new_shared_timer, timeout_until, wake_channel, LoopWaker, ReadyReceiver, SharedTimer,
@@ -140,6 +140,10 @@ pub struct DPEventLoop {
   // route same-host peers over loopback. See
   // `src/rtps/loopback_same_host_design.md`.
   same_host_loopback: bool,
+
+  // Static peers (participant-builder `with_static_peers`): more unicast SPDP
+  // destinations.
+  static_peers: Arc<[IpAddr]>,
 }
 
 impl DPEventLoop {
@@ -164,6 +168,7 @@ impl DPEventLoop {
     only_networks: Option<Arc<[IpAddr]>>,
     socket_send_buffer_size: usize,
     same_host_loopback: bool,
+    static_peers: Arc<[IpAddr]>,
     reader_ready: ReadyReceiver<EntityId>,
     writer_ready: ReadyReceiver<EntityId>,
     waker: LoopWaker,
@@ -257,6 +262,7 @@ impl DPEventLoop {
       participant_status_sender,
       discovery_command_sender,
       same_host_loopback,
+      static_peers,
     })
   }
 
@@ -1113,14 +1119,23 @@ impl DPEventLoop {
     // - every writer may route a confirmed same-host peer over loopback.
     // See `src/rtps/loopback_same_host_design.md`.
     new_writer.set_prefer_loopback_same_host(self.same_host_loopback);
-    if self.same_host_loopback
-      && new_writer.guid().entity_id == EntityId::SPDP_BUILTIN_PARTICIPANT_WRITER
-    {
-      new_writer.set_extra_unicast_destinations(localhost_spdp_peer_locators(
+    if new_writer.guid().entity_id == EntityId::SPDP_BUILTIN_PARTICIPANT_WRITER {
+      let mut extra = Vec::new();
+      if self.same_host_loopback {
+        extra = localhost_spdp_peer_locators(
+          self.domain_info.domain_id,
+          self.domain_info.participant_id,
+          SPDP_LOCALHOST_PEER_COUNT,
+        );
+      }
+      extra.extend(static_peer_spdp_locators(
+        &self.static_peers,
         self.domain_info.domain_id,
-        self.domain_info.participant_id,
         SPDP_LOCALHOST_PEER_COUNT,
       ));
+      if !extra.is_empty() {
+        new_writer.set_extra_unicast_destinations(extra);
+      }
     }
 
     // The doorbell is a shared ready-queue plus the poll waker, not a
@@ -1344,6 +1359,7 @@ mod tests {
         None,
         0,
         true,
+        Vec::new().into(),
         reader_ready,
         writer_ready,
         waker,
