@@ -14,6 +14,7 @@
 #[path = "src/idl.rs"]
 mod idl;
 
+use sha2::{Digest, Sha256};
 use std::path::{Path, PathBuf};
 
 fn main() {
@@ -55,9 +56,24 @@ fn main() {
             panic!("{}: {e}", path.display());
         }
     }
-    let code = packages
+    let mut code = packages
         .generate()
         .unwrap_or_else(|e| panic!("generating message types: {e}"));
+    // REP-2011 type hashes: RIHS01_ and the SHA-256 of each hashable type description.
+    let descriptions = packages
+        .hashable_descriptions()
+        .unwrap_or_else(|e| panic!("describing message types: {e}"));
+    code.push_str(
+        "/// REP-2011 type hashes (`RIHS01_` + SHA-256 of the hashable type description) of every\n\
+         /// message, service part and action part, sorted by type name (`pkg/msg/Name`).\n\
+         pub static TYPE_HASHES: &[(&str, &str)] = &[\n",
+    );
+    for (name, json) in &descriptions {
+        let digest = Sha256::digest(json.as_bytes());
+        let hex: String = digest.iter().map(|b| format!("{b:02x}")).collect();
+        code.push_str(&format!("    (\"{name}\", \"RIHS01_{hex}\"),\n"));
+    }
+    code.push_str("];\n");
     let out = PathBuf::from(std::env::var_os("OUT_DIR").expect("cargo sets OUT_DIR")).join("generated.rs");
     std::fs::write(&out, code).expect("writing generated.rs");
     println!("cargo:rerun-if-changed=src/idl.rs");

@@ -382,6 +382,109 @@ fn rust_field_name(name: &str) -> String {
     }
 }
 
+/// Type ids of `type_description_interfaces/msg/FieldType` (REP-2011), as rosidl gives them.
+mod type_id {
+    pub const NESTED_TYPE: u8 = 1;
+    pub const STRING: u8 = 17;
+    pub const BOUNDED_STRING: u8 = 21;
+    pub const ARRAY_OFFSET: u8 = 48;
+    pub const BOUNDED_SEQUENCE_OFFSET: u8 = 96;
+    pub const UNBOUNDED_SEQUENCE_OFFSET: u8 = 144;
+}
+
+impl Primitive {
+    /// The `FIELD_TYPE_*` id: `char` is `uint8` and `byte` `octet` in the .msg → IDL mapping.
+    fn type_id(self) -> u8 {
+        match self {
+            Self::Int8 => 2,
+            Self::Uint8 | Self::Char => 3,
+            Self::Int16 => 4,
+            Self::Uint16 => 5,
+            Self::Int32 => 6,
+            Self::Uint32 => 7,
+            Self::Int64 => 8,
+            Self::Uint64 => 9,
+            Self::Float32 => 10,
+            Self::Float64 => 11,
+            Self::Bool => 15,
+            Self::Byte => 16,
+        }
+    }
+}
+
+/// `"…"` with Python's `json.dumps` escapes (type and field names are ASCII identifiers).
+fn json_string(s: &str) -> String {
+    let mut out = String::from("\"");
+    for c in s.chars() {
+        match c {
+            '"' => out.push_str("\\\""),
+            '\\' => out.push_str("\\\\"),
+            c if (c as u32) < 0x20 || !c.is_ascii() => {
+                let mut buf = [0u16; 2];
+                for unit in c.encode_utf16(&mut buf) {
+                    let _ = write!(out, "\\u{unit:04x}");
+                }
+            }
+            c => out.push(c),
+        }
+    }
+    out.push('"');
+    out
+}
+
+impl MsgSpec {
+    /// `pkg/<kind>/Name` of the type: `msg`, `srv` (`Name_Request`, `Name_Response`) or
+    /// `action` (`Name_Goal`, …).
+    fn type_name(&self, kind: &str) -> String {
+        format!("{}/{kind}/{}", self.package, self.name)
+    }
+
+    /// The individual type description in the hashable form of REP-2011 (field defaults left
+    /// out), and the nested message types it names.
+    fn hashable_description(&self, kind: &str) -> (String, Vec<String>) {
+        let mut nested = Vec::new();
+        let mut fields = Vec::new();
+        let empty = [Field {
+            name: "structure_needs_at_least_one_member".into(),
+            ty: FieldType {
+                base: BaseType::Primitive(Primitive::Uint8),
+                array: ArrayKind::Single,
+            },
+            default: None,
+        }];
+        let all: &[Field] = if self.fields.is_empty() { &empty } else { &self.fields };
+        for field in all {
+            let (base_id, string_capacity, nested_name) = match &field.ty.base {
+                BaseType::Primitive(p) => (p.type_id(), 0, String::new()),
+                BaseType::String { bound: None } => (type_id::STRING, 0, String::new()),
+                BaseType::String { bound: Some(n) } => (type_id::BOUNDED_STRING, *n, String::new()),
+                BaseType::Message { package, name } => {
+                    let full = format!("{package}/msg/{name}");
+                    nested.push(full.clone());
+                    (type_id::NESTED_TYPE, 0, full)
+                }
+            };
+            let (id, capacity) = match field.ty.array {
+                ArrayKind::Single => (base_id, 0),
+                ArrayKind::Fixed(n) => (base_id + type_id::ARRAY_OFFSET, n),
+                ArrayKind::Bounded(n) => (base_id + type_id::BOUNDED_SEQUENCE_OFFSET, n),
+                ArrayKind::Unbounded => (base_id + type_id::UNBOUNDED_SEQUENCE_OFFSET, 0),
+            };
+            fields.push(format!(
+                "{{\"name\": {}, \"type\": {{\"type_id\": {id}, \"capacity\": {capacity}, \"string_capacity\": {string_capacity}, \"nested_type_name\": {}}}}}",
+                json_string(&field.name),
+                json_string(&nested_name)
+            ));
+        }
+        let json = format!(
+            "{{\"type_name\": {}, \"fields\": [{}]}}",
+            json_string(&self.type_name(kind)),
+            fields.join(", ")
+        );
+        (json, nested)
+    }
+}
+
 impl Packages {
     /// Adds a message definition.
     pub fn add_message(&mut self, package: &str, name: &str, text: &str) -> Result<(), IdlError> {
@@ -607,6 +710,59 @@ impl Packages {
     }
 }
 
+impl Packages {
+    /// Every message type with its REP-2011 hashable type description: the type, then its
+    /// nested message types' descriptions sorted by name, as
+    /// `rosidl_generator_type_description` writes it (`json.dumps(…, separators=(', ', ': '))`,
+    /// defaults left out). Service and action parts are described under `srv` / `action`.
+    pub fn hashable_descriptions(&self) -> Result<BTreeMap<String, String>, IdlError> {
+        let mut by_name: BTreeMap<String, (String, Vec<String>)> = BTreeMap::new();
+        let mut tops = Vec::new();
+        for contents in self.packages.values() {
+            for spec in &contents.msgs {
+                by_name.insert(spec.type_name("msg"), spec.hashable_description("msg"));
+                tops.push(spec.type_name("msg"));
+            }
+            for (_, request, response) in &contents.srvs {
+                for spec in [request, response] {
+                    by_name.insert(spec.type_name("srv"), spec.hashable_description("srv"));
+                    tops.push(spec.type_name("srv"));
+                }
+            }
+            for (_, goal, result, feedback) in &contents.actions {
+                for spec in [goal, result, feedback] {
+                    by_name.insert(spec.type_name("action"), spec.hashable_description("action"));
+                    tops.push(spec.type_name("action"));
+                }
+            }
+        }
+        let mut out = BTreeMap::new();
+        for top in tops {
+            let mut seen = std::collections::BTreeSet::new();
+            let mut stack = by_name[&top].1.clone();
+            while let Some(name) = stack.pop() {
+                if seen.insert(name.clone()) {
+                    let (_, nested) = by_name.get(&name).ok_or_else(|| IdlError {
+                        line: 0,
+                        message: format!("{top} refers to {name}, which is not defined"),
+                    })?;
+                    stack.extend(nested.iter().cloned());
+                }
+            }
+            let referenced: Vec<&str> = seen.iter().map(|n| by_name[n].0.as_str()).collect();
+            out.insert(
+                top.clone(),
+                format!(
+                    "{{\"type_description\": {}, \"referenced_type_descriptions\": [{}]}}",
+                    by_name[&top].0,
+                    referenced.join(", ")
+                ),
+            );
+        }
+        Ok(out)
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -748,5 +904,31 @@ Point[] points
             .generate()
             .unwrap()
             .contains("pub structure_needs_at_least_one_member: u8,"));
+    }
+
+    #[test]
+    fn hashable_description_by_hand() {
+        let mut p = Packages::default();
+        p.add_message("pkg", "Inner", "uint8 A=1\nchar c\n").unwrap();
+        p.add_message("pkg", "Outer", "string<=5 s\nint32[3] a\nInner[] inner\nbyte[<=2] b\n")
+            .unwrap();
+        p.add_message("pkg", "Empty", "").unwrap();
+        let d = p.hashable_descriptions().unwrap();
+        // REP-2011 field type ids: char is uint8 (3); string<=5 is BOUNDED_STRING (21) with
+        // string_capacity 5; int32 (6) + ARRAY (48) = 54 with capacity 3; a nested type (1) +
+        // UNBOUNDED_SEQUENCE (144) = 145; byte (16) + BOUNDED_SEQUENCE (96) = 112. Constants
+        // are not fields.
+        let inner = "{\"type_name\": \"pkg/msg/Inner\", \"fields\": [{\"name\": \"c\", \"type\": {\"type_id\": 3, \"capacity\": 0, \"string_capacity\": 0, \"nested_type_name\": \"\"}}]}";
+        let outer = "{\"type_name\": \"pkg/msg/Outer\", \"fields\": [\
+{\"name\": \"s\", \"type\": {\"type_id\": 21, \"capacity\": 0, \"string_capacity\": 5, \"nested_type_name\": \"\"}}, \
+{\"name\": \"a\", \"type\": {\"type_id\": 54, \"capacity\": 3, \"string_capacity\": 0, \"nested_type_name\": \"\"}}, \
+{\"name\": \"inner\", \"type\": {\"type_id\": 145, \"capacity\": 0, \"string_capacity\": 0, \"nested_type_name\": \"pkg/msg/Inner\"}}, \
+{\"name\": \"b\", \"type\": {\"type_id\": 112, \"capacity\": 2, \"string_capacity\": 0, \"nested_type_name\": \"\"}}]}";
+        assert_eq!(
+            d["pkg/msg/Outer"],
+            format!("{{\"type_description\": {outer}, \"referenced_type_descriptions\": [{inner}]}}")
+        );
+        // An empty message has the IDL mapping's one octet.
+        assert!(d["pkg/msg/Empty"].contains("\"structure_needs_at_least_one_member\", \"type\": {\"type_id\": 3"));
     }
 }

@@ -17,6 +17,15 @@ pub use generated::*;
 
 pub mod idl;
 
+/// The REP-2011 type hash (`RIHS01_…`) of a message type, computed at build time from its
+/// definition and its nested types' (`geometry_msgs/msg/Twist`); `None` for a type not built here.
+pub fn type_hash(type_name: &str) -> Option<&'static str> {
+    TYPE_HASHES
+        .binary_search_by(|(name, _)| (*name).cmp(type_name))
+        .ok()
+        .map(|i| TYPE_HASHES[i].1)
+}
+
 use ros2_client::{ActionTypeName, MessageTypeName, ServiceTypeName};
 
 /// A message type generated from a `.msg` file.
