@@ -306,3 +306,21 @@ def test_a_goal_storm_and_a_clock_with_bad_stamps_leave_few_log_lines(start_node
             lines = log_lines(proc, marks[proc.name])
             print(f"{proc.name}, bad clock: {len(lines)} lines")
             assert len(lines) <= 2 * (BURST + 3), "\n".join(lines[-20:])
+
+
+def test_a_node_stopped_while_it_starts_shuts_down_cleanly(start_node, tmp_path):
+    """SIGINT the moment a node has logged a line of its start-up (the planner, its dock
+    database, as tests/test_nav2_roles.py does), before its main loop waits for signals: the
+    signal is remembered from the start, so the node goes through its shutdown (the participant
+    leaves the domain, "shut down" is logged, exit code 0) within the harness's 5 s, rather than
+    being ended by the signal's default action on the spot."""
+    database = tmp_path / "dock_database.yaml"
+    database.write_text("docks:\n  home:\n    type: charging_dock\n    frame: odom\n    pose: [0.3, -0.2, 3.0]\n")
+    for i in range(3):
+        proc = start_node("planner_node", "-p", f"dock_database:={database}", params_file="params/omr3.yaml",
+                          name=f"planner_{i}")
+        proc.wait_for_log(r"dock `home` \(charging_dock\)", timeout=15)
+        started = time.monotonic()
+        code = proc.stop()  # raises if the node had to be killed
+        assert time.monotonic() - started < 5.0
+        assert code == 0 and "shut down" in proc.log_text(), proc.log_text()[-1500:]

@@ -8,15 +8,17 @@
 //! | `LOCALHOST` | off | `127.0.0.1`, the static peers | this host, the static peers |
 //! | `OFF` | off | nobody (static peers ignored, with a warning) | none by itself (one that announces itself to it is answered) |
 //! | `SYSTEM_DEFAULT` | as `SUBNET` (the participant's own defaults) | | |
+//! | anything else | as `LOCALHOST`, with a warning (rcl's rule) | | |
 //!
-//! A static peer is an IP address or a host name (resolved once, at start-up), separated by
-//! `;`; announcements go to its well-known discovery ports of the first participant ids, so a
-//! node there in any range but `OFF` finds this one, and answers.
+//! A static peer is an IPv4 address or a host name (resolved once, at start-up; one that does
+//! not resolve is left out with a warning), separated by `;`; announcements go to its
+//! well-known discovery ports of the first 12 participant ids (so, as for `LOCALHOST`, to the
+//! first 12 DDS participants of that host), so a node there in any range but `OFF` finds this
+//! one, and answers.
 
 use std::net::{IpAddr, ToSocketAddrs};
 
 use rustdds::DomainParticipantBuilder;
-use thiserror::Error;
 
 /// `ROS_AUTOMATIC_DISCOVERY_RANGE`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -42,44 +44,12 @@ pub struct Discovery {
     pub notes: Vec<String>,
 }
 
-/// An environment the node cannot run with.
-#[derive(Debug, Clone, PartialEq, Eq, Error)]
-pub enum DiscoveryError {
-    /// `ROS_AUTOMATIC_DISCOVERY_RANGE` names no range.
-    #[error("ROS_AUTOMATIC_DISCOVERY_RANGE `{0}` is not one of SUBNET, LOCALHOST, OFF, SYSTEM_DEFAULT")]
-    Range(String),
-    /// A static peer that is not an address and does not resolve.
-    #[error("ROS_STATIC_PEERS: `{0}` is not an IP address and does not resolve to one")]
-    Peer(String),
-}
-
 impl Discovery {
-    /// The settings from the variables' values (`None`: unset).
-    pub fn from_values(
-        range: Option<&str>,
-        static_peers: Option<&str>,
-        localhost_only: Option<&str>,
-    ) -> Result<Self, DiscoveryError> {
+    /// The settings from the variables' values (`None`: unset), as Jazzy's rcl reads them:
+    /// `ROS_LOCALHOST_ONLY=1` wins (LOCALHOST, the range and the static peers ignored, with a
+    /// warning); an unknown range is LOCALHOST, with a warning; values are compared exactly.
+    pub fn from_values(range: Option<&str>, static_peers: Option<&str>, localhost_only: Option<&str>) -> Self {
         let mut notes = Vec::new();
-        let mut range = match range.map(str::trim) {
-            None | Some("") => None,
-            Some("SUBNET") => Some(Range::Subnet),
-            Some("LOCALHOST") => Some(Range::Localhost),
-            Some("OFF") => Some(Range::Off),
-            Some("SYSTEM_DEFAULT") => Some(Range::SystemDefault),
-            Some(other) => return Err(DiscoveryError::Range(other.to_owned())),
-        };
-        if localhost_only.map(str::trim) == Some("1") {
-            if range.is_none() {
-                range = Some(Range::Localhost);
-                notes.push(
-                    "ROS_LOCALHOST_ONLY is deprecated; it is read as ROS_AUTOMATIC_DISCOVERY_RANGE=LOCALHOST".into(),
-                );
-            } else {
-                notes.push("ROS_LOCALHOST_ONLY ignored: ROS_AUTOMATIC_DISCOVERY_RANGE is set".into());
-            }
-        }
-        let range = range.unwrap_or(Range::Subnet);
         let mut static_peers: Vec<String> = static_peers
             .unwrap_or("")
             .split(';')
@@ -87,19 +57,43 @@ impl Discovery {
             .filter(|p| !p.is_empty())
             .map(str::to_owned)
             .collect();
+        if localhost_only == Some("1") {
+            notes.push(
+                "ROS_LOCALHOST_ONLY=1 (deprecated): discovery range LOCALHOST; ROS_AUTOMATIC_DISCOVERY_RANGE and ROS_STATIC_PEERS ignored"
+                    .into(),
+            );
+            return Discovery {
+                range: Range::Localhost,
+                static_peers: Vec::new(),
+                notes,
+            };
+        }
+        let range = match range {
+            None | Some("") => Range::Subnet,
+            Some("SUBNET") => Range::Subnet,
+            Some("LOCALHOST") => Range::Localhost,
+            Some("OFF") => Range::Off,
+            Some("SYSTEM_DEFAULT") => Range::SystemDefault,
+            Some(other) => {
+                notes.push(format!(
+                    "ROS_AUTOMATIC_DISCOVERY_RANGE `{other}` is not one of SUBNET, LOCALHOST, OFF, SYSTEM_DEFAULT: LOCALHOST assumed"
+                ));
+                Range::Localhost
+            }
+        };
         if range == Range::Off && !static_peers.is_empty() {
             notes.push("ROS_STATIC_PEERS ignored: ROS_AUTOMATIC_DISCOVERY_RANGE is OFF".into());
             static_peers.clear();
         }
-        Ok(Discovery {
+        Discovery {
             range,
             static_peers,
             notes,
-        })
+        }
     }
 
     /// The settings from the process environment.
-    pub fn from_env() -> Result<Self, DiscoveryError> {
+    pub fn from_env() -> Self {
         let var = |name: &str| std::env::var(name).ok();
         Self::from_values(
             var("ROS_AUTOMATIC_DISCOVERY_RANGE").as_deref(),
@@ -108,31 +102,43 @@ impl Discovery {
         )
     }
 
-    /// The static peers' addresses (host names resolved).
-    pub fn peer_addresses(&self) -> Result<Vec<IpAddr>, DiscoveryError> {
-        self.static_peers
-            .iter()
-            .map(|peer| {
-                peer.parse::<IpAddr>().or_else(|_| {
-                    (peer.as_str(), 0)
-                        .to_socket_addrs()
-                        .ok()
-                        .and_then(|mut a| a.next())
-                        .map(|a| a.ip())
-                        .ok_or_else(|| DiscoveryError::Peer(peer.clone()))
-                })
-            })
-            .collect()
+    /// The static peers' IPv4 addresses (host names resolved, IPv4 preferred), and a note for
+    /// each peer left out: one that does not resolve (the network may not be up yet), or IPv6
+    /// only (RustDDS's unicast socket is IPv4).
+    pub fn peer_addresses(&self) -> (Vec<IpAddr>, Vec<String>) {
+        let mut addresses = Vec::new();
+        let mut notes = Vec::new();
+        for peer in &self.static_peers {
+            let resolved: Vec<IpAddr> = match peer.parse::<IpAddr>() {
+                Ok(ip) => vec![ip],
+                Err(_) => (peer.as_str(), 0)
+                    .to_socket_addrs()
+                    .map(|a| a.map(|a| a.ip()).collect())
+                    .unwrap_or_default(),
+            };
+            match resolved.iter().find(|ip| ip.is_ipv4()) {
+                Some(ip) => addresses.push(*ip),
+                None if resolved.is_empty() => {
+                    notes.push(format!("ROS_STATIC_PEERS: `{peer}` does not resolve: left out"))
+                }
+                None => notes.push(format!(
+                    "ROS_STATIC_PEERS: `{peer}` has no IPv4 address (IPv6 peers are not supported): left out"
+                )),
+            }
+        }
+        (addresses, notes)
     }
 
-    /// The participant builder set up for these settings.
-    pub fn apply(&self, builder: DomainParticipantBuilder) -> Result<DomainParticipantBuilder, DiscoveryError> {
-        let peers = self.peer_addresses()?;
-        Ok(match self.range {
+    /// The participant builder set up for these settings, with a note for each static peer left
+    /// out.
+    pub fn apply(&self, builder: DomainParticipantBuilder) -> (DomainParticipantBuilder, Vec<String>) {
+        let (peers, notes) = self.peer_addresses();
+        let builder = match self.range {
             Range::Subnet | Range::SystemDefault => builder.with_static_peers(peers),
             Range::Localhost => builder.multicast(false).with_static_peers(peers),
             Range::Off => builder.multicast(false).same_host_loopback(false),
-        })
+        };
+        (builder, notes)
     }
 
     /// One line for the node's start-up log.
@@ -157,52 +163,48 @@ mod tests {
 
     #[test]
     fn unset_is_subnet_without_peers() {
-        let d = Discovery::from_values(None, None, None).unwrap();
+        let d = Discovery::from_values(None, None, None);
         assert_eq!(d.range, Range::Subnet);
         assert!(d.static_peers.is_empty() && d.notes.is_empty());
-        assert_eq!(
-            Discovery::from_values(Some(""), Some(""), None).unwrap().range,
-            Range::Subnet
-        );
+        assert_eq!(Discovery::from_values(Some(""), Some(""), None).range, Range::Subnet);
     }
 
     #[test]
     fn ranges_and_peers_are_read_as_rcl_reads_them() {
-        let d = Discovery::from_values(Some("LOCALHOST"), Some("10.0.0.2; robot.local;;"), None).unwrap();
+        let d = Discovery::from_values(Some("LOCALHOST"), Some("10.0.0.2; robot.local;;"), None);
         assert_eq!(d.range, Range::Localhost);
         assert_eq!(d.static_peers, vec!["10.0.0.2".to_string(), "robot.local".to_string()]);
         assert_eq!(
-            Discovery::from_values(Some("SYSTEM_DEFAULT"), None, None)
-                .unwrap()
-                .range,
+            Discovery::from_values(Some("SYSTEM_DEFAULT"), None, None).range,
             Range::SystemDefault
         );
-        let e = Discovery::from_values(Some("subnet"), None, None).unwrap_err();
-        assert!(e.to_string().contains("`subnet`"), "{e}");
+        // rcl: an unknown value (compared exactly) is LOCALHOST, with a warning.
+        let d = Discovery::from_values(Some("subnet"), None, None);
+        assert_eq!(d.range, Range::Localhost);
+        assert!(d.notes[0].contains("`subnet`"), "{:?}", d.notes);
     }
 
     #[test]
-    fn off_ignores_static_peers_and_localhost_only_is_a_deprecated_localhost() {
-        let d = Discovery::from_values(Some("OFF"), Some("10.0.0.2"), None).unwrap();
+    fn off_ignores_static_peers_and_localhost_only_wins() {
+        let d = Discovery::from_values(Some("OFF"), Some("10.0.0.2"), None);
         assert_eq!(d.range, Range::Off);
         assert!(d.static_peers.is_empty());
         assert_eq!(d.notes.len(), 1);
-        let d = Discovery::from_values(None, None, Some("1")).unwrap();
+        // rcl: ROS_LOCALHOST_ONLY=1 forces LOCALHOST and drops the range and the peers.
+        let d = Discovery::from_values(Some("SUBNET"), Some("10.0.0.2"), Some("1"));
         assert_eq!(d.range, Range::Localhost);
+        assert!(d.static_peers.is_empty());
         assert!(d.notes[0].contains("deprecated"));
-        let d = Discovery::from_values(Some("SUBNET"), None, Some("1")).unwrap();
-        assert_eq!(d.range, Range::Subnet);
-        assert!(d.notes[0].contains("ignored"));
+        assert_eq!(Discovery::from_values(None, None, Some("0")).range, Range::Subnet);
     }
 
     #[test]
-    fn peers_resolve_or_are_refused() {
-        let d = Discovery::from_values(None, Some("127.0.0.1;::1;localhost"), None).unwrap();
-        let a = d.peer_addresses().unwrap();
-        assert_eq!(a[0], IpAddr::from([127, 0, 0, 1]));
-        assert_eq!(a[1], "::1".parse::<IpAddr>().unwrap());
-        assert!(a[2].is_loopback());
-        let d = Discovery::from_values(None, Some("no-such-host.invalid"), None).unwrap();
-        assert!(matches!(d.peer_addresses(), Err(DiscoveryError::Peer(_))));
+    fn peers_resolve_to_ipv4_or_are_left_out_with_a_note() {
+        let d = Discovery::from_values(None, Some("127.0.0.1;::1;localhost;no-such-host.invalid"), None);
+        let (a, notes) = d.peer_addresses();
+        assert_eq!(a, vec![IpAddr::from([127, 0, 0, 1]), IpAddr::from([127, 0, 0, 1])]);
+        assert_eq!(notes.len(), 2, "{notes:?}");
+        assert!(notes[0].contains("`::1`") && notes[0].contains("IPv6"));
+        assert!(notes[1].contains("does not resolve"));
     }
 }

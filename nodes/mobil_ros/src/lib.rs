@@ -78,7 +78,7 @@ pub use config::{Config, ConfigError, Decl};
 pub use latest::{Freshness, Latest};
 pub use log::LogThrottle;
 pub use mobil_motion::Notice;
-pub use node::{respond, run_node, shutdown_signal, NodeBody, NodeDecl, RosNode};
+pub use node::{listen_for_shutdown, respond, run_node, shutdown_signal, NodeBody, NodeDecl, RosNode};
 pub use offloop::{CancelToken, OffLoop};
 pub use params::{ParamSpec, ParamValues};
 pub use ticker::Ticker;

@@ -322,12 +322,12 @@ impl RosNode {
         }));
 
         let domain = domain_id_from_env()?;
-        let discovery = crate::discovery::Discovery::from_env()?;
-        for note in &discovery.notes {
+        let discovery = crate::discovery::Discovery::from_env();
+        let (builder, peer_notes) = discovery.apply(rustdds::DomainParticipantBuilder::new(domain));
+        for note in discovery.notes.iter().chain(&peer_notes) {
             warn!("{note}");
         }
-        let participant = discovery
-            .apply(rustdds::DomainParticipantBuilder::new(domain))?
+        let participant = builder
             .build()
             .map_err(|e| anyhow!("cannot join DDS domain {domain}: {e:?}"))?;
         let context = Context::from_domain_participant(participant)
@@ -563,26 +563,63 @@ impl RosNode {
     }
 }
 
-/// Resolves when SIGINT (Ctrl-C) or SIGTERM arrives.
-pub async fn shutdown_signal() {
+/// Set once SIGINT or SIGTERM has arrived, by the listener [`listen_for_shutdown`] installs.
+static SHUTDOWN: std::sync::OnceLock<tokio::sync::watch::Sender<bool>> = std::sync::OnceLock::new();
+
+/// Installs the process's SIGINT / SIGTERM listener (once; must run inside the runtime). From
+/// then on a signal is remembered, so a node still starting up when it arrives (a test that
+/// stops a node as soon as it has logged something) stops as soon as its body waits for
+/// [`shutdown_signal`], instead of missing it: a tokio signal stream created after a signal
+/// does not see it, and with the handler installed the default action no longer ends the process.
+pub fn listen_for_shutdown() {
+    if SHUTDOWN.get().is_some() {
+        return;
+    }
+    let (tx, _) = tokio::sync::watch::channel(false);
+    if SHUTDOWN.set(tx).is_err() {
+        return;
+    }
     #[cfg(unix)]
     {
         use tokio::signal::unix::{signal, SignalKind};
         match (signal(SignalKind::interrupt()), signal(SignalKind::terminate())) {
             (Ok(mut int), Ok(mut term)) => {
-                tokio::select! {
-                    _ = int.recv() => info!("SIGINT: shutting down"),
-                    _ = term.recv() => info!("SIGTERM: shutting down"),
-                }
+                tokio::spawn(async move {
+                    tokio::select! {
+                        _ = int.recv() => info!("SIGINT: shutting down"),
+                        _ = term.recv() => info!("SIGTERM: shutting down"),
+                    }
+                    if let Some(tx) = SHUTDOWN.get() {
+                        tx.send_replace(true);
+                    }
+                });
             }
             _ => {
-                let _ = tokio::signal::ctrl_c().await;
+                tokio::spawn(async {
+                    let _ = tokio::signal::ctrl_c().await;
+                    if let Some(tx) = SHUTDOWN.get() {
+                        tx.send_replace(true);
+                    }
+                });
             }
         }
     }
     #[cfg(not(unix))]
-    {
+    tokio::spawn(async {
         let _ = tokio::signal::ctrl_c().await;
+        if let Some(tx) = SHUTDOWN.get() {
+            tx.send_replace(true);
+        }
+    });
+}
+
+/// Resolves when SIGINT (Ctrl-C) or SIGTERM has arrived, also one that came before the call
+/// (the listener is installed by [`run_node`] before the node starts, or here on first use).
+pub async fn shutdown_signal() {
+    listen_for_shutdown();
+    if let Some(tx) = SHUTDOWN.get() {
+        let mut rx = tx.subscribe();
+        let _ = rx.wait_for(|arrived| *arrived).await;
     }
 }
 
@@ -627,6 +664,8 @@ where
         }
     };
     let result = runtime.block_on(async {
+        // Before anything slow: a signal during start-up is then not lost.
+        listen_for_shutdown();
         let mut node = RosNode::start(decl, &args)?;
         let result = body(&mut node).await;
         node.shutdown().await;
