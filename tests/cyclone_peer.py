@@ -225,6 +225,7 @@ class ServiceClient:
         # What rmw_cyclonedds puts in the header: the writer's instance handle, as unsigned.
         self.guid = self.writer.get_instance_handle() & 0xFFFF_FFFF_FFFF_FFFF
         self.seq = 0
+        self.skipped = 0  # samples that did not decode (other clients' replies)
 
     def wait_matched(self, timeout: float) -> bool:
         deadline = time.monotonic() + timeout
@@ -245,7 +246,14 @@ class ServiceClient:
             self.writer.write(request)
             deadline = time.monotonic() + timeout
             while time.monotonic() < deadline:
-                for sample in self.reader.take(N=16):
+                try:
+                    samples = self.reader.take(N=16)
+                except Exception:  # noqa: BLE001 - another client's reply in Fast DDS's layout
+                    # (no header) need not decode as ours: skipped, as rmw_cyclonedds skips
+                    # what it cannot read.
+                    self.skipped += 1
+                    continue
+                for sample in samples:
                     if getattr(sample, "guid", None) == self.guid and sample.seq == self.seq:
                         return sample
                 time.sleep(0.01)

@@ -62,6 +62,11 @@ def ros_environ(base: Optional[dict[str, str]] = None, domain_id: Optional[int] 
     LD_LIBRARY_PATH for the mobil_msgs (and nav2_msgs) install. ``domain_id`` overrides ROS_DOMAIN_ID.
     """
     env = dict(os.environ if base is None else base)
+    if base is None:
+        # A developer's shell must not reshape the tests' graph: discovery range and peers are
+        # set by the tests that need them (tests/test_multi_host.py).
+        for key in ("ROS_AUTOMATIC_DISCOVERY_RANGE", "ROS_STATIC_PEERS", "ROS_LOCALHOST_ONLY"):
+            env.pop(key, None)
     env.setdefault("RMW_IMPLEMENTATION", RMW_IMPLEMENTATION)
     env.setdefault("FASTRTPS_DEFAULT_PROFILES_FILE", str(FASTDDS_PROFILE))
     env.setdefault("ROS_DISTRO", "jazzy")  # ros2-client warns at start-up when it is unset

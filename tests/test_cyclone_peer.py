@@ -40,9 +40,12 @@ def test_cyclone_peer_reads_commands_calls_a_service_and_an_action(start_node, r
     def fast_dds_client() -> None:
         while not stop.is_set():
             try:
+                # Strings and a double: a reply that a Cyclone client would misread as its own
+                # (a header, then values) would not decode to these.
                 r = rosutil.call_service(ros_node, GetParameters, "/chassis/get_parameters",
-                                         GetParameters.Request(names=["v_max"]), timeout=10.0)
-                answers.append(r.values[0].double_value)
+                                         GetParameters.Request(names=["odom_frame", "v_max", "model"]),
+                                         timeout=10.0)
+                answers.append((r.values[0].string_value, r.values[1].double_value, r.values[2].string_value))
             except Exception as e:  # noqa: BLE001 - reported below
                 errors.append(repr(e))
             time.sleep(0.05)
@@ -66,6 +69,8 @@ def test_cyclone_peer_reads_commands_calls_a_service_and_an_action(start_node, r
                           "send_goal", "get_result"}, steps
     assert steps["scan"]["beams"] == 1081
     v_max = harness.param_get(ros_node, "chassis", "v_max")
+    expected = (harness.param_get(ros_node, "chassis", "odom_frame"), v_max,
+                harness.param_get(ros_node, "chassis", "model"))
     # The small call: v_max (a double, type 3) and model (a string, type 4) as params give them.
     assert steps["get_parameters"]["values"][0] == [3, v_max, ""]
     assert steps["get_parameters"]["values"][1][0] == 4
@@ -73,4 +78,4 @@ def test_cyclone_peer_reads_commands_calls_a_service_and_an_action(start_node, r
     assert abs(steps["get_result"]["travelled"] - 0.2) < 0.03
     # The Fast DDS client got answers all along, each its own (v_max), none lost.
     assert not errors, errors[:3]
-    assert len(answers) >= 10 and all(a == v_max for a in answers), answers[:10]
+    assert len(answers) >= 10 and all(a == expected for a in answers), answers[:10]

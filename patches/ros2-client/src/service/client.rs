@@ -138,15 +138,34 @@ where
     let dcc_rw: Option<no_key::DeserializedCacheChange<ResponseWrapper<Resp>>> =
       self.response_receiver.try_take_one()?;
 
-    match dcc_rw {
-      None => Ok(None),
-      Some(dcc) => {
-        let mi = MessageInfo::from(&dcc);
-        let res_wrapper = dcc.into_value();
-        let (ri, res) = res_wrapper.unwrap(self.service_mapping, mi, self.client_guid)?;
-        Ok(Some((ri, res)))
-      }
-    } // match
+    let mut next = dcc_rw;
+    loop {
+      match next {
+        None => return Ok(None),
+        Some(dcc) => {
+          let mi = MessageInfo::from(&dcc);
+          if self.someone_elses(&mi) {
+            next = self.response_receiver.try_take_one()?;
+            continue;
+          }
+          let res_wrapper = dcc.into_value();
+          let (ri, res) = res_wrapper.unwrap(self.service_mapping, mi, self.client_guid)?;
+          return Ok(Some((ri, res)));
+        }
+      } // match
+    }
+  }
+
+  /// Whether a reply in the Enhanced layout is another client's: its related
+  /// sample identity (the request's id) is missing or names another request
+  /// writer. Such a reply is skipped undecoded, as rmw_fastrtps's clients do: a
+  /// server that answers Cyclone DDS clients too sends replies in a layout this
+  /// client cannot decode.
+  fn someone_elses(&self, mi: &MessageInfo) -> bool {
+    self.service_mapping.of_writer(&mi.publisher_gid()) == ServiceMapping::Enhanced
+      && mi
+        .related_request_id()
+        .is_none_or(|id| id.writer_gid != Gid::from(self.client_guid))
   }
 
   /// Send a request to Service Server asynchronously.
@@ -208,13 +227,7 @@ where
         Some(Err(e)) => return Err(e.into()),
         Some(Ok(dcc)) => {
           let mi = MessageInfo::from(&dcc);
-          if self.service_mapping == ServiceMapping::Auto
-            && self.service_mapping.of_writer(&mi.publisher_gid()) == ServiceMapping::Enhanced
-            && mi.related_request_id() != Some(request_id)
-          {
-            // Another client's reply, possibly in another layout (a server
-            // answering Cyclone DDS clients too): skipped undecoded, as Fast DDS
-            // clients do.
+          if self.someone_elses(&mi) {
             continue;
           }
           let (req_id, response) =
