@@ -7,11 +7,7 @@
 //!
 //!     cargo run --release -p mobil_gait --example gait_sweep
 
-use mobil_gait::{
-    plan, BodyPose, Evaluation, GaitConfig, GaitState, LegAngleReading, QuadrupedModel, RuleSet, TieBreak,
-};
-use nalgebra::Point2;
-use std::f64::consts::PI;
+use mobil_gait::{plan_paper_run, Evaluation, GaitConfig, LegAngleReading, QuadrupedModel, RuleSet, TieBreak};
 
 const ROWS: [(RuleSet, u8); 6] = [
     (RuleSet::A, 1),
@@ -25,15 +21,8 @@ const ROWS: [(RuleSet, u8); 6] = [
 /// One row: "expanded / states (leg moves)", or why there is no plan.
 fn row(cfg: &GaitConfig, set: RuleSet, evaluation: u8) -> String {
     let model = QuadrupedModel::paper(LegAngleReading::Forward);
-    let phi = match set {
-        RuleSet::A => PI / 4.0,
-        RuleSet::B => 1.5 * PI,
-    };
-    let start = GaitState::nominal(&model, BodyPose { x: 0.0, y: 0.0, phi });
     let eval = Evaluation::try_from(evaluation).expect("1..=3");
-    let p = plan(&model, cfg, &start, Point2::new(-10.0, 10.0), set, eval, 0, &mut || {
-        false
-    });
+    let p = plan_paper_run(&model, cfg, set, eval);
     match p.failure {
         None => format!("{} / {} ({})", p.expanded, p.steps.len(), p.leg_moves()),
         Some(_) => format!("no plan in {}", p.expanded),

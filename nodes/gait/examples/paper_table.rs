@@ -4,9 +4,7 @@
 //!
 //!     cargo run --release -p mobil_gait --example paper_table [-- --margin M] [--reading forward|rearward]
 
-use mobil_gait::{plan, BodyPose, Evaluation, GaitConfig, GaitState, LegAngleReading, QuadrupedModel, RuleSet};
-use nalgebra::Point2;
-use std::f64::consts::PI;
+use mobil_gait::{plan_paper_run, Evaluation, GaitConfig, LegAngleReading, QuadrupedModel, RuleSet};
 use std::time::Instant;
 
 /// The paper's (expanded, plan length) for each row.
@@ -53,23 +51,9 @@ fn main() {
         let cfg = GaitConfig { reading, ..cfg.clone() };
         let model = QuadrupedModel::paper(reading);
         for (set, e, p_exp, p_len) in PAPER {
-            let phi = match set {
-                RuleSet::A => PI / 4.0,
-                RuleSet::B => 1.5 * PI,
-            };
-            let start = GaitState::nominal(&model, BodyPose { x: 0.0, y: 0.0, phi });
             let eval = Evaluation::try_from(e).expect("1..=3");
             let (t, cpu) = (Instant::now(), thread_cpu_ns());
-            let p = plan(
-                &model,
-                &cfg,
-                &start,
-                Point2::new(-10.0, 10.0),
-                set,
-                eval,
-                0,
-                &mut || false,
-            );
+            let p = plan_paper_run(&model, &cfg, set, eval);
             let ms = t.elapsed().as_secs_f64() * 1e3;
             let cpu_ms = (thread_cpu_ns() - cpu) as f64 / 1e6;
             println!(

@@ -82,6 +82,6 @@ pub use config::{Evaluation, GaitConfig, RuleSet, TieBreak, Weights};
 pub use error::GaitError;
 pub use horizon::{Chunk, RecedingHorizon, Walk};
 pub use model::{is_stable, is_supported, BodyPose, GaitState, LegAngleReading, QuadrupedModel, Workspace};
-pub use planner::{plan, GaitProblem, Plan, PlanFailure, PlanStep};
+pub use planner::{plan, plan_paper_run, GaitProblem, Plan, PlanFailure, PlanStep, PAPER_GOAL};
 pub use rules::{dev, vzd, Rule};
 pub use walker::{WalkNext, Walker};

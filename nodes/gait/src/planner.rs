@@ -2,7 +2,7 @@
 //! functions (1), (2), (3), the quantised key and the goal test; [`plan`] runs it.
 
 use crate::config::{Evaluation, GaitConfig, RuleSet, Weights};
-use crate::model::{is_stable, is_supported, GaitState, QuadrupedModel, TOLERANCE};
+use crate::model::{is_stable, is_supported, BodyPose, GaitState, QuadrupedModel, TOLERANCE};
 use crate::rules::{dev, vzd, Rule};
 use crate::search::{search, Problem, SearchEnd};
 use nalgebra::Point2;
@@ -229,6 +229,20 @@ pub fn check_start(model: &QuadrupedModel, cfg: &GaitConfig, start: &GaitState) 
         ));
     }
     Ok(())
+}
+
+/// The goal of the paper's runs (000, Tab. 2): (−10, 10), from the origin.
+pub const PAPER_GOAL: Point2<f64> = Point2::new(-10.0, 10.0);
+
+/// The paper's run of a rule set under an evaluation: from the origin in the nominal stance,
+/// facing 45° (rule set A) or 270° (B), to [`PAPER_GOAL`], with the configuration's limit.
+pub fn plan_paper_run(model: &QuadrupedModel, cfg: &GaitConfig, set: RuleSet, eval: Evaluation) -> Plan {
+    let phi = match set {
+        RuleSet::A => std::f64::consts::FRAC_PI_4,
+        RuleSet::B => 1.5 * std::f64::consts::PI,
+    };
+    let start = GaitState::nominal(model, BodyPose { x: 0.0, y: 0.0, phi });
+    plan(model, cfg, &start, PAPER_GOAL, set, eval, 0, &mut || false)
 }
 
 /// Plans a free gait from `start` toward `goal` by best-first search with the rules of `set` and

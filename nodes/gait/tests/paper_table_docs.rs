@@ -3,9 +3,7 @@
 //! both readings of Tab. 1, and the rearward A,(3) row's failure, run again here from the
 //! table's own text.
 
-use mobil_gait::{plan, BodyPose, Evaluation, GaitConfig, GaitState, LegAngleReading, QuadrupedModel, RuleSet};
-use nalgebra::Point2;
-use std::f64::consts::PI;
+use mobil_gait::{plan_paper_run, Evaluation, GaitConfig, LegAngleReading, QuadrupedModel, RuleSet};
 
 /// (expanded, generated, plan length, leg moves), or the failure's expansions and generated
 /// states.
@@ -47,22 +45,8 @@ fn computed(reading: LegAngleReading, set: RuleSet, evaluation: u8) -> Row {
         ..GaitConfig::default()
     };
     let model = QuadrupedModel::paper(reading);
-    let phi = match set {
-        RuleSet::A => PI / 4.0,
-        RuleSet::B => 1.5 * PI,
-    };
-    let start = GaitState::nominal(&model, BodyPose { x: 0.0, y: 0.0, phi });
     let eval = Evaluation::try_from(evaluation).expect("1..=3");
-    let p = plan(
-        &model,
-        &cfg,
-        &start,
-        Point2::new(-10.0, 10.0),
-        set,
-        eval,
-        0,
-        &mut || false,
-    );
+    let p = plan_paper_run(&model, &cfg, set, eval);
     match p.failure {
         None => Row::Plan(
             u64::from(p.expanded),
