@@ -3,7 +3,7 @@
 
 mod harness;
 
-use harness::{config_for, drive, drive_config, drive_with, rect, scenarios, Ending, Plant, Shape, World, SIM};
+use harness::{config_for, drive, drive_config, drive_with, rect, scenario, Ending, Plant, Shape, World, SIM};
 use mobil_chassis::ChassisParams;
 use mobil_geom::Pose2;
 use mobil_local_nav::{Mode, NavConfig, NoPathReason, Side, TrackMethod};
@@ -102,10 +102,7 @@ fn u_trap_needs_track_mode_and_escapes() {
 /// Runs scenario `name` for `chassis` with T-mode by `method`, at sim_node's rates, for at
 /// most `seconds` of simulated time.
 fn scenario_run(name: &str, chassis: ChassisParams, method: TrackMethod, seconds: f64) -> harness::Run {
-    let s = scenarios(chassis.model().is_nonholonomic())
-        .into_iter()
-        .find(|s| s.name == name)
-        .expect("a scenario of that name");
+    let s = scenario(name, chassis.model().is_nonholonomic());
     let config = NavConfig {
         track_method: method,
         ..config_for(&chassis)
@@ -121,10 +118,7 @@ fn u_trap_with_a_180_degree_scanner_stalls_in_track_mode() {
     // changes the nearest reading and so the direction, and the robot swings between about
     // −14° and −20° at (1.8, 0.7) without moving. With 270° (u_trap_needs_track_mode_and_escapes)
     // it escapes.
-    let s = scenarios(false)
-        .into_iter()
-        .find(|s| s.name == "u_trap")
-        .expect("u_trap");
+    let s = scenario("u_trap", false);
     let plant = Plant {
         fov: std::f64::consts::PI,
         ..SIM
@@ -303,25 +297,9 @@ fn omni_tracks_the_enclosure_with_the_sims_scan_rate_and_motor_lag() {
     // instead go round at about d_sa = 0.8 m outside the 2 m box (4·(2 + 1.6) ≈ 14 m of
     // boundary plus the ~4 m approach and locks: < 25 m, < 50 s at 0.5 m/s; 60 s allowed for
     // the slow-downs), and stop back at H.
-    let p = Point2::new;
-    let world = World(
-        rect(4.0, -1.0, 6.0, -0.9)
-            .into_iter()
-            .chain(rect(4.0, 0.9, 6.0, 1.0))
-            .chain(rect(4.0, -1.0, 4.1, 1.0))
-            .chain(rect(5.9, -1.0, 6.0, 1.0))
-            .collect(),
-    );
+    let s = scenario("enclosed", false);
     // The scan the navigator steps on is one scan (25 ms) older than its pose.
-    let plant = Plant { ..harness::SIM };
-    let run = drive_with(
-        &world,
-        ChassisParams::omr3(),
-        Pose2::identity(),
-        p(5.0, 0.0),
-        8000,
-        plant,
-    );
+    let run = drive_with(&s.world, ChassisParams::omr3(), Pose2::identity(), s.goal, 8000, SIM);
     assert_eq!(
         run.final_mode,
         Mode::NoPath(NoPathReason::ReturnedToHitPoint),

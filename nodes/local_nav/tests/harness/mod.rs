@@ -384,6 +384,14 @@ pub fn scenarios(car_like: bool) -> Vec<Scenario> {
     ]
 }
 
+/// The scenario of that name for a chassis kind (see [`scenarios`]).
+pub fn scenario(name: &str, car_like: bool) -> Scenario {
+    scenarios(car_like)
+        .into_iter()
+        .find(|s| s.name == name)
+        .unwrap_or_else(|| panic!("no scenario {name}"))
+}
+
 /// How a run ended, in the words of the docs' tables.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Ending {
