@@ -1282,21 +1282,24 @@ impl DomainParticipantInner {
 
     let mut listeners = HashMap::new();
 
+    // A multicast listener on `port`, or none when multicast is disabled.
     // Without a multicast listener the participant's SPDP reader advertises no
     // multicast locator, so its SPDP writer sends nothing by multicast either.
-    let multicast_discovery = if multicast {
-      UDPListener::new_multicast_with_buf_size(
-        "0.0.0.0",
-        spdp_well_known_multicast_port(domain_id),
-        Ipv4Addr::new(239, 255, 0, 1),
-        socket_receive_buffer_size,
-        only_networks.as_deref(),
-      )
-      .map(Some)
-    } else {
-      Ok(None)
+    let multicast_listener = |port: u16| {
+      if multicast {
+        UDPListener::new_multicast_with_buf_size(
+          "0.0.0.0",
+          port,
+          Ipv4Addr::new(239, 255, 0, 1),
+          socket_receive_buffer_size,
+          only_networks.as_deref(),
+        )
+        .map(Some)
+      } else {
+        Ok(None)
+      }
     };
-    match multicast_discovery {
+    match multicast_listener(spdp_well_known_multicast_port(domain_id)) {
       Ok(Some(l)) => {
         listeners.insert(DISCOVERY_MUL_LISTENER_TOKEN, l);
       }
@@ -1333,19 +1336,7 @@ impl DomainParticipantInner {
 
     // Now the user traffic listeners
 
-    let multicast_user = if multicast {
-      UDPListener::new_multicast_with_buf_size(
-        "0.0.0.0",
-        user_traffic_multicast_port(domain_id),
-        Ipv4Addr::new(239, 255, 0, 1),
-        socket_receive_buffer_size,
-        only_networks.as_deref(),
-      )
-      .map(Some)
-    } else {
-      Ok(None)
-    };
-    match multicast_user {
+    match multicast_listener(user_traffic_multicast_port(domain_id)) {
       Ok(Some(l)) => {
         listeners.insert(USER_TRAFFIC_MUL_LISTENER_TOKEN, l);
       }
