@@ -2,7 +2,11 @@
 `.srv` / `.action` closure, against the hashes rosidl generated into the type-description JSON
 files: of the ROS 2 Jazzy packages installed with rclpy (std_msgs, geometry_msgs, ...) and of
 the mobil_msgs / nav2_msgs / bond build that tests/setup_env.sh makes. Every type the suite
-builds must be found there, with the same hash."""
+builds must be found there, with the same hash.
+
+On the wire, each of mobil's topic endpoints announces its type's hash in DDS USER_DATA
+(`typehash=RIHS01_…;`) as rmw_fastrtps and rmw_cyclonedds do; rclpy reads it back as the
+endpoint's `topic_type_hash`."""
 
 from __future__ import annotations
 
@@ -10,7 +14,7 @@ import json
 import subprocess
 
 import harness
-from harness import ROOT
+from harness import ROOT, wait_until
 
 
 def reference_hashes() -> dict[str, str]:
@@ -42,3 +46,88 @@ def test_every_type_hash_is_rosidls():
     for name in ("nav_msgs/msg/Odometry", "sensor_msgs/msg/LaserScan", "geometry_msgs/msg/Twist",
                  "mobil_msgs/msg/NavStatus"):
         assert name in ours
+
+
+# (topic, endpoint kind, mobil node, ROS type): odometry and status out, commands and scans in.
+ENDPOINTS = [
+    ("/odom", "publisher", "chassis", "nav_msgs/msg/Odometry"),
+    ("/cmd_vel", "subscription", "chassis", "geometry_msgs/msg/Twist"),
+    ("/scan", "subscription", "local_nav", "sensor_msgs/msg/LaserScan"),
+    ("/local_nav/status", "publisher", "local_nav", "mobil_msgs/msg/NavStatus"),
+]
+
+
+# The DDS topics of services, an action's parts and rosout (no ROS name mangling): (DDS topic,
+# endpoint kind, mobil node, the type whose hash it carries, the same endpoint of rclpy's: `{ref}`
+# is the reference servers' namespace, `{me}` the rclpy node). As rmw_fastrtps does, a service's
+# request endpoints carry the hash of `Name_Request`, its reply endpoints `Name_Response`'s.
+SERVICE_ENDPOINTS = [
+    ("rq/local_nav/get_stateRequest", "subscription", "local_nav", "lifecycle_msgs/srv/GetState_Request",
+     "rq/{ref}/get_stateRequest"),
+    ("rr/local_nav/get_stateReply", "publisher", "local_nav", "lifecycle_msgs/srv/GetState_Response",
+     "rr/{ref}/get_stateReply"),
+    ("rq/local_nav/get_parametersRequest", "subscription", "local_nav",
+     "rcl_interfaces/srv/GetParameters_Request", "rq/{me}/get_parametersRequest"),
+    ("rr/local_nav/get_parametersReply", "publisher", "local_nav",
+     "rcl_interfaces/srv/GetParameters_Response", "rr/{me}/get_parametersReply"),
+    ("rt/rosout", "publisher", "local_nav", "rcl_interfaces/msg/Log", "rt/rosout"),
+    ("rq/navigate_to_pose/_action/send_goalRequest", "subscription", "local_nav",
+     "nav2_msgs/action/NavigateToPose_SendGoal_Request", "rq/{ref}/navigate_to_pose/_action/send_goalRequest"),
+    ("rr/navigate_to_pose/_action/get_resultReply", "publisher", "local_nav",
+     "nav2_msgs/action/NavigateToPose_GetResult_Response", "rr/{ref}/navigate_to_pose/_action/get_resultReply"),
+    ("rq/navigate_to_pose/_action/cancel_goalRequest", "subscription", "local_nav",
+     "action_msgs/srv/CancelGoal_Request", "rq/{ref}/navigate_to_pose/_action/cancel_goalRequest"),
+    ("rt/navigate_to_pose/_action/feedback", "publisher", "local_nav",
+     "nav2_msgs/action/NavigateToPose_FeedbackMessage", "rt/{ref}/navigate_to_pose/_action/feedback"),
+    ("rt/navigate_to_pose/_action/status", "publisher", "local_nav", "action_msgs/msg/GoalStatusArray",
+     "rt/{ref}/navigate_to_pose/_action/status"),
+]
+
+
+def endpoints_of(ros_node, topic: str, kind: str, node: str, no_mangle: bool = False) -> list:
+    query = (ros_node.get_publishers_info_by_topic if kind == "publisher"
+             else ros_node.get_subscriptions_info_by_topic)
+    return [e for e in query(topic, no_mangle=no_mangle) if e.node_name == node]
+
+
+def test_endpoints_announce_their_type_hash_as_rclpys_do(start_node, ros_node):
+    from lifecycle_msgs.srv import GetState
+    from nav2_msgs.action import NavigateToPose
+    from rclpy.action import ActionServer
+    start_node("chassis_node", params_file="params/omr3.yaml")
+    start_node("local_nav_node", params_file="params/omr3.yaml")
+    refs = reference_hashes()
+    # rclpy's own publisher of each type (Fast DDS computes its hash from the type support).
+    ours_pubs = [ros_node.create_publisher(harness.import_type(t), f"/hash_reference/t{i}", 1)
+                 for i, (_, _, _, t) in enumerate(ENDPOINTS)]
+    try:
+        for i, (topic, kind, node, type_name) in enumerate(ENDPOINTS):
+            found = wait_until(lambda: endpoints_of(ros_node, topic, kind, node), 15)
+            assert found, f"no {kind} of {node} on {topic}"
+            reference = ros_node.get_publishers_info_by_topic(f"/hash_reference/t{i}")
+            assert len(reference) == 1, reference
+            rclpys = str(reference[0].topic_type_hash)
+            for endpoint in found:
+                assert endpoint.topic_type == type_name
+                assert str(endpoint.topic_type_hash) == rclpys == refs[type_name], (topic, node)
+        # A service and the parts of an action, against rclpy's own server of the same types
+        # (under /hash_reference) and the type-description JSON.
+        service = ros_node.create_service(GetState, "/hash_reference/get_state", lambda _req, resp: resp)
+        action = ActionServer(ros_node, NavigateToPose, "/hash_reference/navigate_to_pose",
+                              lambda handle: NavigateToPose.Result())
+        try:
+            for topic, kind, node, type_name, reference_topic in SERVICE_ENDPOINTS:
+                found = wait_until(lambda: endpoints_of(ros_node, topic, kind, node, no_mangle=True), 15)
+                assert found, f"no {kind} of {node} on {topic}"
+                reference_topic = reference_topic.format(ref="hash_reference", me=ros_node.get_name())
+                reference = endpoints_of(ros_node, reference_topic, kind, ros_node.get_name(), no_mangle=True)
+                assert len(reference) == 1, (reference_topic, reference)
+                rclpys = str(reference[0].topic_type_hash)
+                for endpoint in found:
+                    assert str(endpoint.topic_type_hash) == rclpys == refs[type_name], (topic, node)
+        finally:
+            action.destroy()
+            ros_node.destroy_service(service)
+    finally:
+        for pub in ours_pubs:
+            ros_node.destroy_publisher(pub)

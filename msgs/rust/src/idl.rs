@@ -470,19 +470,176 @@ impl MsgSpec {
                 ArrayKind::Bounded(n) => (base_id + type_id::BOUNDED_SEQUENCE_OFFSET, n),
                 ArrayKind::Unbounded => (base_id + type_id::UNBOUNDED_SEQUENCE_OFFSET, 0),
             };
-            fields.push(format!(
-                "{{\"name\": {}, \"type\": {{\"type_id\": {id}, \"capacity\": {capacity}, \"string_capacity\": {string_capacity}, \"nested_type_name\": {}}}}}",
-                json_string(&field.name),
-                json_string(&nested_name)
-            ));
+            fields.push(DescribedField {
+                name: field.name.clone(),
+                type_id: id,
+                capacity,
+                string_capacity,
+                nested: nested_name,
+            });
         }
-        let json = format!(
-            "{{\"type_name\": {}, \"fields\": [{}]}}",
-            json_string(&self.type_name(kind)),
-            fields.join(", ")
-        );
-        (json, nested)
+        (describe(&self.type_name(kind), &fields), nested)
     }
+}
+
+/// One field of an individual type description (`type_description_interfaces/msg/Field`
+/// without its default value).
+struct DescribedField {
+    name: String,
+    type_id: u8,
+    capacity: usize,
+    string_capacity: usize,
+    nested: String,
+}
+
+impl DescribedField {
+    /// A field of the nested type `type_name` (`pkg/kind/Name`).
+    fn nested(name: &str, type_name: &str) -> Self {
+        Self::nested_array(name, type_id::NESTED_TYPE, 0, type_name)
+    }
+
+    fn nested_array(name: &str, type_id: u8, capacity: usize, type_name: &str) -> Self {
+        Self {
+            name: name.to_owned(),
+            type_id,
+            capacity,
+            string_capacity: 0,
+            nested: type_name.to_owned(),
+        }
+    }
+
+    fn primitive(name: &str, p: Primitive) -> Self {
+        Self {
+            name: name.to_owned(),
+            type_id: p.type_id(),
+            capacity: 0,
+            string_capacity: 0,
+            nested: String::new(),
+        }
+    }
+}
+
+/// The hashable JSON of one individual type description.
+fn describe(type_name: &str, fields: &[DescribedField]) -> String {
+    let fields: Vec<String> = fields
+        .iter()
+        .map(|f| {
+            format!(
+                "{{\"name\": {}, \"type\": {{\"type_id\": {}, \"capacity\": {}, \"string_capacity\": {}, \"nested_type_name\": {}}}}}",
+                json_string(&f.name),
+                f.type_id,
+                f.capacity,
+                f.string_capacity,
+                json_string(&f.nested)
+            )
+        })
+        .collect();
+    format!(
+        "{{\"type_name\": {}, \"fields\": [{}]}}",
+        json_string(type_name),
+        fields.join(", ")
+    )
+}
+
+/// A type description that no definition file spells out, and the types it nests.
+fn synthetic(type_name: &str, fields: Vec<DescribedField>) -> (String, (String, Vec<String>)) {
+    let nested = fields
+        .iter()
+        .filter(|f| !f.nested.is_empty())
+        .map(|f| f.nested.clone())
+        .collect();
+    (type_name.to_owned(), (describe(type_name, &fields), nested))
+}
+
+const SERVICE_EVENT_INFO: &str = "service_msgs/msg/ServiceEventInfo";
+const UUID: &str = "unique_identifier_msgs/msg/UUID";
+const TIME: &str = "builtin_interfaces/msg/Time";
+
+/// The types rosidl derives from a service `base` (`pkg/srv/Name`, or an action's
+/// `pkg/action/Name_SendGoal`) whose request and response are `base_Request`, `base_Response`:
+/// the event message `base_Event` (what service introspection publishes) and the service type
+/// itself, whose three fields are the request, the response and the event.
+fn service_types(base: &str) -> [(String, (String, Vec<String>)); 2] {
+    let (request, response, event) = (
+        format!("{base}_Request"),
+        format!("{base}_Response"),
+        format!("{base}_Event"),
+    );
+    // `Name_Request[<=1] request`, `Name_Response[<=1] response`: bounded sequences of one.
+    let one = type_id::NESTED_TYPE + type_id::BOUNDED_SEQUENCE_OFFSET;
+    [
+        synthetic(
+            &event,
+            vec![
+                DescribedField::nested("info", SERVICE_EVENT_INFO),
+                DescribedField::nested_array("request", one, 1, &request),
+                DescribedField::nested_array("response", one, 1, &response),
+            ],
+        ),
+        synthetic(
+            base,
+            vec![
+                DescribedField::nested("request_message", &request),
+                DescribedField::nested("response_message", &response),
+                DescribedField::nested("event_message", &event),
+            ],
+        ),
+    ]
+}
+
+/// The types rosidl derives from an action `pkg/action/Name` with parts `Name_Goal`,
+/// `Name_Result`, `Name_Feedback`: the goal and result services' requests and responses, the
+/// two services, the feedback message of the feedback topic, and the action type itself.
+fn action_types(base: &str) -> Vec<(String, (String, Vec<String>))> {
+    let part = |suffix: &str| format!("{base}_{suffix}");
+    let mut out = vec![
+        synthetic(
+            &part("SendGoal_Request"),
+            vec![
+                DescribedField::nested("goal_id", UUID),
+                DescribedField::nested("goal", &part("Goal")),
+            ],
+        ),
+        synthetic(
+            &part("SendGoal_Response"),
+            vec![
+                DescribedField::primitive("accepted", Primitive::Bool),
+                DescribedField::nested("stamp", TIME),
+            ],
+        ),
+        synthetic(
+            &part("GetResult_Request"),
+            vec![DescribedField::nested("goal_id", UUID)],
+        ),
+        synthetic(
+            &part("GetResult_Response"),
+            vec![
+                DescribedField::primitive("status", Primitive::Int8),
+                DescribedField::nested("result", &part("Result")),
+            ],
+        ),
+        synthetic(
+            &part("FeedbackMessage"),
+            vec![
+                DescribedField::nested("goal_id", UUID),
+                DescribedField::nested("feedback", &part("Feedback")),
+            ],
+        ),
+        synthetic(
+            base,
+            vec![
+                DescribedField::nested("goal", &part("Goal")),
+                DescribedField::nested("result", &part("Result")),
+                DescribedField::nested("feedback", &part("Feedback")),
+                DescribedField::nested("send_goal_service", &part("SendGoal")),
+                DescribedField::nested("get_result_service", &part("GetResult")),
+                DescribedField::nested("feedback_message", &part("FeedbackMessage")),
+            ],
+        ),
+    ];
+    out.extend(service_types(&part("SendGoal")));
+    out.extend(service_types(&part("GetResult")));
+    out
 }
 
 impl Packages {
@@ -714,7 +871,11 @@ impl Packages {
     /// Every message type with its REP-2011 hashable type description: the type, then its
     /// nested message types' descriptions sorted by name, as
     /// `rosidl_generator_type_description` writes it (`json.dumps(…, separators=(', ', ': '))`,
-    /// defaults left out). Service and action parts are described under `srv` / `action`.
+    /// defaults left out). Service and action parts are described under `srv` / `action`, with
+    /// the types rosidl derives from them: each service `pkg/srv/Name` and its `Name_Event`
+    /// (which need `service_msgs/msg/ServiceEventInfo` to be built), each action `pkg/action/Name`
+    /// with its `Name_SendGoal`, `Name_GetResult` services and `Name_FeedbackMessage` (which
+    /// need `unique_identifier_msgs/msg/UUID`).
     pub fn hashable_descriptions(&self) -> Result<BTreeMap<String, String>, IdlError> {
         let mut by_name: BTreeMap<String, (String, Vec<String>)> = BTreeMap::new();
         let mut tops = Vec::new();
@@ -723,16 +884,24 @@ impl Packages {
                 by_name.insert(spec.type_name("msg"), spec.hashable_description("msg"));
                 tops.push(spec.type_name("msg"));
             }
-            for (_, request, response) in &contents.srvs {
+            for (name, request, response) in &contents.srvs {
                 for spec in [request, response] {
                     by_name.insert(spec.type_name("srv"), spec.hashable_description("srv"));
                     tops.push(spec.type_name("srv"));
                 }
+                for (type_name, description) in service_types(&format!("{}/srv/{name}", request.package)) {
+                    tops.push(type_name.clone());
+                    by_name.insert(type_name, description);
+                }
             }
-            for (_, goal, result, feedback) in &contents.actions {
+            for (name, goal, result, feedback) in &contents.actions {
                 for spec in [goal, result, feedback] {
                     by_name.insert(spec.type_name("action"), spec.hashable_description("action"));
                     tops.push(spec.type_name("action"));
+                }
+                for (type_name, description) in action_types(&format!("{}/action/{name}", goal.package)) {
+                    tops.push(type_name.clone());
+                    by_name.insert(type_name, description);
                 }
             }
         }
@@ -930,5 +1099,84 @@ Point[] points
         );
         // An empty message has the IDL mapping's one octet.
         assert!(d["pkg/msg/Empty"].contains("\"structure_needs_at_least_one_member\", \"type\": {\"type_id\": 3"));
+    }
+
+    #[test]
+    fn service_and_action_types_rosidl_derives_by_hand() {
+        let mut p = Packages::default();
+        p.add_message("builtin_interfaces", "Time", "int32 sec\nuint32 nanosec\n")
+            .unwrap();
+        p.add_message(
+            "service_msgs",
+            "ServiceEventInfo",
+            "uint8 event_type\nbuiltin_interfaces/Time stamp\nchar[16] client_gid\nint64 sequence_number\n",
+        )
+        .unwrap();
+        p.add_message("unique_identifier_msgs", "UUID", "uint8[16] uuid\n")
+            .unwrap();
+        p.add_service("pkg", "Do", "bool a\n---\nbool b\n").unwrap();
+        p.add_action("pkg", "Go", "bool g\n---\nbool r\n---\nbool f\n").unwrap();
+        let d = p.hashable_descriptions().unwrap();
+        let nested = |name: &str, ty: &str| {
+            format!("{{\"name\": \"{name}\", \"type\": {{\"type_id\": 1, \"capacity\": 0, \"string_capacity\": 0, \"nested_type_name\": \"{ty}\"}}}}")
+        };
+        // `pkg/srv/Do`: request, response and event messages, each a nested type (1).
+        let service = format!(
+            "{{\"type_name\": \"pkg/srv/Do\", \"fields\": [{}, {}, {}]}}",
+            nested("request_message", "pkg/srv/Do_Request"),
+            nested("response_message", "pkg/srv/Do_Response"),
+            nested("event_message", "pkg/srv/Do_Event")
+        );
+        assert!(d["pkg/srv/Do"].starts_with(&format!("{{\"type_description\": {service}, ")));
+        // `Do_Event`: the event info, then request and response as sequences of at most one:
+        // nested (1) + BOUNDED_SEQUENCE (96) = 97, capacity 1.
+        let event = format!(
+            "{{\"type_name\": \"pkg/srv/Do_Event\", \"fields\": [{}, \
+{{\"name\": \"request\", \"type\": {{\"type_id\": 97, \"capacity\": 1, \"string_capacity\": 0, \"nested_type_name\": \"pkg/srv/Do_Request\"}}}}, \
+{{\"name\": \"response\", \"type\": {{\"type_id\": 97, \"capacity\": 1, \"string_capacity\": 0, \"nested_type_name\": \"pkg/srv/Do_Response\"}}}}]}}",
+            nested("info", "service_msgs/msg/ServiceEventInfo")
+        );
+        assert!(d["pkg/srv/Do_Event"].starts_with(&format!("{{\"type_description\": {event}, ")));
+        // The service's references: the three messages, the event info and the Time it holds,
+        // sorted by name.
+        let refs = &d["pkg/srv/Do"][d["pkg/srv/Do"].find("referenced_type_descriptions").unwrap()..];
+        let order: Vec<usize> = [
+            "builtin_interfaces/msg/Time",
+            "pkg/srv/Do_Event",
+            "pkg/srv/Do_Request",
+            "pkg/srv/Do_Response",
+            "service_msgs/msg/ServiceEventInfo",
+        ]
+        .iter()
+        .map(|n| {
+            refs.find(&format!("{{\"type_name\": \"{n}\""))
+                .unwrap_or_else(|| panic!("{n} not referenced"))
+        })
+        .collect();
+        assert!(order.windows(2).all(|w| w[0] < w[1]), "{order:?}");
+        // An action: `SendGoal_Response` is `bool accepted` (15) and the stamp; the feedback
+        // message pairs the goal id with the feedback; the action type lists six parts.
+        assert!(d["pkg/action/Go_SendGoal_Response"].starts_with(&format!(
+            "{{\"type_description\": {{\"type_name\": \"pkg/action/Go_SendGoal_Response\", \"fields\": [\
+{{\"name\": \"accepted\", \"type\": {{\"type_id\": 15, \"capacity\": 0, \"string_capacity\": 0, \"nested_type_name\": \"\"}}}}, {}]}}",
+            nested("stamp", "builtin_interfaces/msg/Time")
+        )));
+        assert!(d["pkg/action/Go_FeedbackMessage"].starts_with(&format!(
+            "{{\"type_description\": {{\"type_name\": \"pkg/action/Go_FeedbackMessage\", \"fields\": [{}, {}]}}",
+            nested("goal_id", "unique_identifier_msgs/msg/UUID"),
+            nested("feedback", "pkg/action/Go_Feedback")
+        )));
+        let action = &d["pkg/action/Go"];
+        for (field, ty) in [
+            ("goal", "Go_Goal"),
+            ("result", "Go_Result"),
+            ("feedback", "Go_Feedback"),
+            ("send_goal_service", "Go_SendGoal"),
+            ("get_result_service", "Go_GetResult"),
+            ("feedback_message", "Go_FeedbackMessage"),
+        ] {
+            assert!(action.contains(&nested(field, &format!("pkg/action/{ty}"))), "{field}");
+        }
+        assert!(d.contains_key("pkg/action/Go_GetResult_Event"));
     }
 }

@@ -330,7 +330,9 @@ impl RosNode {
         let participant = builder
             .build()
             .map_err(|e| anyhow!("cannot join DDS domain {domain}: {e:?}"))?;
-        let context = Context::from_domain_participant(participant)
+        // Every endpoint announces its type's REP-2011 hash (USER_DATA `typehash=RIHS01_…;`),
+        // computed at build time for every type mobil_msgs builds, as the Jazzy RMWs do.
+        let context = Context::from_domain_participant_with_type_hashes(participant, mobil_msgs::type_hash)
             .map_err(|e| anyhow!("cannot join DDS domain {domain}: {e:?}"))?;
         let ns = names.namespace().to_owned();
         let mut node = context

@@ -47,9 +47,44 @@ struct SecurityConfig {
   private_key_password: String,
 }
 
+/// Looks up the REP-2011 type hash (`RIHS01_` and 64 hex digits, as `rosidl`
+/// computes it) of a ROS type by its name: `pkg/msg/Name`, a service's
+/// `pkg/srv/Name_Request` / `pkg/srv/Name_Response`, an action's
+/// `pkg/action/Name_SendGoal_Request`, `pkg/action/Name_FeedbackMessage`, ….
+///
+/// With one ([`ContextOptions::type_hashes`],
+/// [`Context::from_domain_participant_with_type_hashes`]), every DDS endpoint
+/// the Context creates announces the hash of its topic's type in its USER_DATA
+/// as `typehash=RIHS01_…;`, as the ROS 2 Jazzy RMWs do (ROS tools show it as
+/// the endpoint's `topic_type_hash`); an endpoint whose type the lookup does
+/// not know announces none.
+pub type TypeHashLookup = fn(&str) -> Option<&'static str>;
+
+fn no_type_hashes(_ros_type_name: &str) -> Option<&'static str> {
+  None
+}
+
+/// The ROS name of a DDS type name: `pkg::msg::dds_::Name_` → `pkg/msg/Name`.
+fn ros_type_name(dds_type_name: &str) -> Option<String> {
+  let (namespace, name) = dds_type_name.split_once("::dds_::")?;
+  let name = name.strip_suffix('_')?;
+  Some(format!("{}/{name}", namespace.replace("::", "/")))
+}
+
+/// `qos` with the USER_DATA that announces the type hash of `dds_type_name`,
+/// when `lookup` knows it (`rmw_dds_common`'s
+/// `encode_type_hash_for_user_data_qos` writes the same text).
+fn with_type_hash(qos: QosPolicies, dds_type_name: &str, lookup: TypeHashLookup) -> QosPolicies {
+  match ros_type_name(dds_type_name).and_then(|name| lookup(&name)) {
+    Some(hash) => qos.with_user_data(format!("typehash={hash};").into_bytes()),
+    None => qos,
+  }
+}
+
 /// Builder for configuring a `Context`
 pub struct ContextOptions {
   domain_id: u16,
+  type_hashes: TypeHashLookup,
   #[cfg(feature = "security")]
   security_config: Option<SecurityConfig>,
 }
@@ -58,9 +93,16 @@ impl ContextOptions {
   pub fn new() -> Self {
     Self {
       domain_id: 0,
+      type_hashes: no_type_hashes,
       #[cfg(feature = "security")]
       security_config: None,
     }
+  }
+
+  /// Announce the type hashes `lookup` knows (see [`TypeHashLookup`]).
+  pub fn type_hashes(mut self, lookup: TypeHashLookup) -> Self {
+    self.type_hashes = lookup;
+    self
   }
 
   /// Set the DDS Domain Id.
@@ -132,17 +174,26 @@ impl Context {
       }
     }
 
-    Self::from_domain_participant(dpb.build()?)
+    Self::from_domain_participant_with_type_hashes(dpb.build()?, opt.type_hashes)
   }
 
   /// Create a new Context from an existing [`DomainParticipant`].
   pub fn from_domain_participant(domain_participant: DomainParticipant) -> CreateResult<Context> {
+    Self::from_domain_participant_with_type_hashes(domain_participant, no_type_hashes)
+  }
+
+  /// Like [`Self::from_domain_participant`], and every endpoint announces the
+  /// type hash `lookup` gives for its type (see [`TypeHashLookup`]).
+  pub fn from_domain_participant_with_type_hashes(
+    domain_participant: DomainParticipant,
+    lookup: TypeHashLookup,
+  ) -> CreateResult<Context> {
     // Check the runtime ROS_DISTRO against the distribution we were compiled
     // for. Guarded so it logs only once per process even with many Contexts.
     static ROS_DISTRO_CHECK: std::sync::Once = std::sync::Once::new();
     ROS_DISTRO_CHECK.call_once(crate::distributions::verify_ros_distro_env);
 
-    let i = ContextInner::from_domain_participant(domain_participant)?;
+    let i = ContextInner::from_domain_participant(domain_participant, lookup)?;
     Ok(Context {
       inner: Arc::new(Mutex::new(i)),
     })
@@ -212,6 +263,13 @@ impl Context {
     self.inner.lock().unwrap().domain_participant.clone()
   }
 
+  /// `qos` for an endpoint of the DDS type `dds_type_name`: with the USER_DATA
+  /// that announces its type hash, if the Context's lookup knows it.
+  pub(crate) fn with_type_hash(&self, qos: QosPolicies, dds_type_name: &str) -> QosPolicies {
+    let lookup = self.inner.lock().unwrap().type_hashes;
+    with_type_hash(qos, dds_type_name, lookup)
+  }
+
   // pub fn ros_discovery_stream(&self) -> impl Stream<Item =
   // ReadResult<(ParticipantEntitiesInfo, MessageInfo)>> + FusedStream + '_ {
   //   self.inner.lock().unwrap().node_reader.async_stream()
@@ -226,7 +284,7 @@ impl Context {
     qos: &QosProfile,
   ) -> CreateResult<Topic> {
     info!("Creating topic, DDS name: {topic_dds_name}");
-    let dds_qos: QosPolicies = qos.into();
+    let dds_qos = self.with_type_hash(qos.into(), &type_name.dds_msg_type());
     let topic = self.domain_participant().create_topic(
       topic_dds_name,
       type_name.dds_msg_type(),
@@ -341,12 +399,15 @@ struct ContextInner {
 
   ros_parameter_events_topic: Topic,
   ros_rosout_topic: Topic,
+
+  type_hashes: TypeHashLookup,
 }
 
 impl ContextInner {
   // "new"
   pub fn from_domain_participant(
     domain_participant: DomainParticipant,
+    type_hashes: TypeHashLookup,
   ) -> CreateResult<ContextInner> {
     let ros_default_publisher =
       domain_participant.create_publisher(&QosPolicies::from(DEFAULT_PUBLISHER_QOS))?;
@@ -357,21 +418,33 @@ impl ContextInner {
     let ros_discovery_topic = domain_participant.create_topic(
       builtin_topics::ros_discovery::TOPIC_NAME.to_string(),
       builtin_topics::ros_discovery::TYPE_NAME.to_string(),
-      &builtin_topics::ros_discovery::QOS_PUB,
+      &with_type_hash(
+        builtin_topics::ros_discovery::QOS_PUB.clone(),
+        builtin_topics::ros_discovery::TYPE_NAME,
+        type_hashes,
+      ),
       TopicKind::NoKey,
     )?;
 
     let ros_parameter_events_topic = domain_participant.create_topic(
       builtin_topics::parameter_events::TOPIC_NAME.to_string(),
       builtin_topics::parameter_events::TYPE_NAME.to_string(),
-      &builtin_topics::parameter_events::QOS,
+      &with_type_hash(
+        builtin_topics::parameter_events::QOS.clone(),
+        builtin_topics::parameter_events::TYPE_NAME,
+        type_hashes,
+      ),
       TopicKind::NoKey,
     )?;
 
     let ros_rosout_topic = domain_participant.create_topic(
       builtin_topics::rosout::TOPIC_NAME.to_string(),
       builtin_topics::rosout::TYPE_NAME.to_string(),
-      &builtin_topics::rosout::QOS,
+      &with_type_hash(
+        builtin_topics::rosout::QOS.clone(),
+        builtin_topics::rosout::TYPE_NAME,
+        type_hashes,
+      ),
       TopicKind::NoKey,
     )?;
 
@@ -388,6 +461,7 @@ impl ContextInner {
       ros_default_subscriber,
       ros_parameter_events_topic,
       ros_rosout_topic,
+      type_hashes,
     })
   }
 
@@ -448,4 +522,51 @@ fn test_node_create() {
       NodeOptions::new().declare_parameter("foo", ParameterValue::Boolean(true)),
     )
     .is_ok();
+}
+
+#[test]
+fn type_hashes_go_into_user_data_by_ros_type_name() {
+  use rustdds::qos::HasQoSPolicy;
+
+  assert_eq!(
+    ros_type_name("lifecycle_msgs::srv::dds_::GetState_Request_").as_deref(),
+    Some("lifecycle_msgs/srv/GetState_Request")
+  );
+  assert_eq!(
+    ros_type_name("nav2_msgs::action::dds_::Spin_FeedbackMessage_").as_deref(),
+    Some("nav2_msgs/action/Spin_FeedbackMessage")
+  );
+  assert_eq!(ros_type_name("NotRos"), None);
+  assert_eq!(ros_type_name("pkg::msg::dds_::NoUnderscore"), None);
+
+  fn lookup(name: &str) -> Option<&'static str> {
+    (name == "std_msgs/msg/String").then_some("RIHS01_df66")
+  }
+  let qos = with_type_hash(QosPolicies::qos_none(), "std_msgs::msg::dds_::String_", lookup);
+  assert_eq!(
+    qos.user_data(),
+    Some(policy::UserData {
+      value: b"typehash=RIHS01_df66;".to_vec()
+    })
+  );
+  let unknown = with_type_hash(QosPolicies::qos_none(), "std_msgs::msg::dds_::Bool_", lookup);
+  assert_eq!(unknown.user_data(), None);
+
+  // Topics the Context creates carry it.
+  let context = Context::from_domain_participant_with_type_hashes(
+    DomainParticipant::new(0).unwrap(),
+    lookup,
+  )
+  .unwrap();
+  let topic = context
+    .create_topic(
+      "rt/type_hash_test".to_owned(),
+      MessageTypeName::new("std_msgs", "String"),
+      &QosProfile::default(),
+    )
+    .unwrap();
+  assert_eq!(
+    topic.qos().user_data().map(|u| u.value),
+    Some(b"typehash=RIHS01_df66;".to_vec())
+  );
 }

@@ -204,7 +204,7 @@ pub mod dds {
 
   #[doc(inline)]
   pub use crate::context::{
-    Context, ContextOptions, DEFAULT_PUBLISHER_QOS, DEFAULT_SUBSCRIPTION_QOS,
+    Context, ContextOptions, TypeHashLookup, DEFAULT_PUBLISHER_QOS, DEFAULT_SUBSCRIPTION_QOS,
   };
   #[doc(inline)]
   pub use crate::node::{

@@ -1207,8 +1207,12 @@ impl Node {
     // Where are the suffixes documented?
     // And why "Reply" and not "Response" ?
 
-    let request_dds_qos: QosPolicies = (&request_qos).into();
-    let response_dds_qos: QosPolicies = (&response_qos).into();
+    let request_dds_qos = self
+      .ros_context
+      .with_type_hash((&request_qos).into(), &service_type_name.dds_request_type());
+    let response_dds_qos = self
+      .ros_context
+      .with_type_hash((&response_qos).into(), &service_type_name.dds_response_type());
 
     let rq_topic = self.ros_context.domain_participant().create_topic(
       service_name.to_dds_name("rq", &self.node_name, "Request"),
@@ -1262,8 +1266,12 @@ impl Node {
     // Self::check_name_and_add_prefix("rr/", &(service_name.to_owned() +
     // "Reply"))?;
 
-    let request_dds_qos: QosPolicies = (&request_qos).into();
-    let response_dds_qos: QosPolicies = (&response_qos).into();
+    let request_dds_qos = self
+      .ros_context
+      .with_type_hash((&request_qos).into(), &service_type_name.dds_request_type());
+    let response_dds_qos = self
+      .ros_context
+      .with_type_hash((&response_qos).into(), &service_type_name.dds_response_type());
 
     let rq_topic = self.ros_context.domain_participant().create_topic(
       //rq_name,
