@@ -16,6 +16,13 @@ checks in one run, printing one JSON line per step and exiting 0 only if all pas
 odom and scan received (rt/odom, rt/scan), cmd_vel sent (rt/cmd_vel, the robot moves: odom's
 twist follows), `/chassis/get_parameters` answered (once small, once large enough to travel as
 DATA_FRAGs), and a `drive_distance` goal accepted and its result received.
+
+    cyclone_peer.py --serve-gait SECONDS [--domain N]
+
+serves `gait/compute_plan` (mobil_msgs/srv/PlanGait) as an rmw_cyclonedds_cpp server would, for
+mobil's clients: prints `{"step": "ready"}`, then one JSON line per request (its header and
+fields), answering each with a two-state plan from the request's start to its goal, 7 states
+expanded and 11 generated; exits 0 after SECONDS if it served at least one request.
 """
 
 import argparse
@@ -200,6 +207,53 @@ class GetResultResponse(IdlStruct, typename="mobil_msgs::action::dds_::DriveDist
     result: DriveDistanceResult = field(default_factory=DriveDistanceResult)
 
 
+@dataclass
+class Pose2D(IdlStruct, typename="geometry_msgs::msg::dds_::Pose2D_"):
+    x: float64 = 0.0
+    y: float64 = 0.0
+    theta: float64 = 0.0
+
+
+@dataclass
+class GaitStep(IdlStruct, typename="mobil_msgs::msg::dds_::GaitStep_"):
+    rule: uint8 = 0
+    rule_name: str = ""
+    body: Pose2D = field(default_factory=Pose2D)
+    feet: array[Point, 4] = field(default_factory=lambda: [Point() for _ in range(4)])
+    moving_leg: int8 = -1
+    evaluation: float64 = 0.0
+
+
+@dataclass
+class GaitPlan(IdlStruct, typename="mobil_msgs::msg::dds_::GaitPlan_"):
+    header: Header = field(default_factory=Header)
+    rule_set: str = ""
+    evaluation: uint8 = 0
+    success: bool = False
+    reason: str = ""
+    states_expanded: uint32 = 0
+    states_generated: uint32 = 0
+    steps: sequence[GaitStep] = field(default_factory=list)
+
+
+@dataclass
+class PlanGaitRequest(IdlStruct, typename="mobil_msgs::srv::dds_::PlanGait_Request_"):
+    guid: uint64 = 0
+    seq: int64 = 0
+    start: Pose2D = field(default_factory=Pose2D)
+    goal: Point = field(default_factory=Point)
+    rule_set: str = ""
+    evaluation: uint8 = 0
+    max_expansions: uint32 = 0
+
+
+@dataclass
+class PlanGaitResponse(IdlStruct, typename="mobil_msgs::srv::dds_::PlanGait_Response_"):
+    guid: uint64 = 0
+    seq: int64 = 0
+    plan: GaitPlan = field(default_factory=GaitPlan)
+
+
 # ---- the peer --------------------------------------------------------------------------------
 
 XCDR1 = Policy.DataRepresentation(use_cdrv0_representation=True)
@@ -269,15 +323,46 @@ def first_sample(reader: DataReader, timeout: float):
     return None
 
 
+def serve_gait(dp: DomainParticipant, seconds: float) -> int:
+    """A `gait/compute_plan` server in rmw_cyclonedds_cpp's layout: the reply echoes the
+    request's header (its writer's guid and its seq)."""
+    requests = DataReader(dp, Topic(dp, "rq/gait/compute_planRequest", PlanGaitRequest), qos=SERVICE)
+    replies = DataWriter(dp, Topic(dp, "rr/gait/compute_planReply", PlanGaitResponse), qos=SERVICE)
+    report("ready", True)
+    served = 0
+    end = time.monotonic() + seconds
+    while time.monotonic() < end:
+        try:
+            samples = requests.take(N=16)
+        except Exception as e:  # noqa: BLE001 - a request in another layout does not decode
+            report("request", False, error=repr(e))
+            continue
+        for r in samples:
+            report("request", True, guid=r.guid, seq=r.seq, start=[r.start.x, r.start.y, r.start.theta],
+                   goal=[r.goal.x, r.goal.y], rule_set=r.rule_set, evaluation=r.evaluation)
+            steps = [GaitStep(rule_name="start", body=Pose2D(r.start.x, r.start.y, r.start.theta)),
+                     GaitStep(rule=1, rule_name="cyclone", body=Pose2D(r.goal.x, r.goal.y, r.start.theta))]
+            plan = GaitPlan(rule_set=r.rule_set, evaluation=r.evaluation, success=True,
+                            states_expanded=7, states_generated=11, steps=steps)
+            replies.write(PlanGaitResponse(guid=r.guid, seq=r.seq, plan=plan))
+            served += 1
+        time.sleep(0.01)
+    return 0 if served else 1
+
+
 def main() -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--domain", type=int, default=int(os.environ.get("ROS_DOMAIN_ID", "0")))
+    ap.add_argument("--serve-gait", type=float, metavar="SECONDS",
+                    help="only serve gait/compute_plan, this long")
     ap.add_argument("--names-repeat", type=int, default=40,
                     help="the large get_parameters call asks for its names this many times")
     ap.add_argument("--timeout", type=float, default=20.0)
     args = ap.parse_args()
     os.environ.setdefault("CYCLONEDDS_URI", CYCLONE_LOOPBACK)
     dp = DomainParticipant(args.domain)
+    if args.serve_gait is not None:
+        return serve_gait(dp, args.serve_gait)
     ok = True
 
     odom_reader = DataReader(dp, Topic(dp, "rt/odom", Odometry), qos=READER)

@@ -4,6 +4,10 @@ received, cmd_vel obeyed, a parameter call answered (small, and large enough for
 and a drive_distance goal accepted and finished. Meanwhile an rclpy (Fast DDS) client calls the
 same parameter service over and over: every answer each client gets must be its own, in its own
 request/reply layout (mobil's servers choose it per request, patches/README.md).
+
+The other way round, the peer serves `gait/compute_plan` as a Cyclone DDS server and mobil's
+client (gait_demo) calls it: the client sends in the Cyclone layout when every server it
+reaches is Cyclone DDS, and reads the Cyclone reply.
 """
 
 from __future__ import annotations
@@ -79,3 +83,33 @@ def test_cyclone_peer_reads_commands_calls_a_service_and_an_action(start_node, r
     # The Fast DDS client got answers all along, each its own (v_max), none lost.
     assert not errors, errors[:3]
     assert len(answers) >= 10 and all(a == expected for a in answers), answers[:10]
+
+
+def test_mobil_client_calls_a_cyclone_server(tmp_path, ros_domain_id):
+    env = rosutil.ros_environ(domain_id=ros_domain_id)
+    peer = subprocess.Popen(
+        [sys.executable, str(ROOT / "tests" / "cyclone_peer.py"), "--serve-gait", "25"],
+        stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env)
+    try:
+        assert peer.stdout is not None
+        ready = peer.stdout.readline()
+        assert '"ready"' in ready, ready + (peer.stderr.read() if peer.poll() is not None else "")
+        svg = tmp_path / "gait.svg"
+        demo = subprocess.run(
+            [str(harness.resolve_executable("gait_demo")), "--ros-args", "-p", f"output_svg:={svg}",
+             "-p", "timeout_s:=20.0"],
+            capture_output=True, text=True, timeout=60, env=env)
+    finally:
+        peer.terminate()
+        out, err = peer.communicate(timeout=15)
+    requests = [json.loads(line) for line in out.splitlines() if line.startswith("{")]
+    assert demo.returncode == 0, f"{demo.stdout}\n{demo.stderr[-3000:]}\npeer: {out}\n{err[-2000:]}"
+    # Every request decoded in the Cyclone layout: a header (seq from 1), then gait_demo's own
+    # request (experiment B,(3) to (-10, 10)); a Fast DDS-layout request would not decode so.
+    assert requests and all(r["ok"] for r in requests), requests
+    first = requests[0]
+    assert first["seq"] >= 1 and first["rule_set"] == "B" and first["evaluation"] == 3, first
+    assert first["goal"] == [-10.0, 10.0], first
+    # ... and gait_demo read the Cyclone reply: the peer's plan, its 2 states, 7 and 11.
+    assert "2 states" in demo.stdout and "7 expanded, 11 generated" in demo.stdout, demo.stdout
+    assert svg.is_file()

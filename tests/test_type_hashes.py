@@ -37,7 +37,7 @@ def test_every_type_hash_is_rosidls():
     out = subprocess.run([str(exe)], capture_output=True, text=True, check=True, timeout=30).stdout
     ours = dict(line.split() for line in out.splitlines())
     refs = reference_hashes()
-    assert len(ours) >= 90, len(ours)
+    assert len(ours) >= 249, len(ours)
     missing = sorted(set(ours) - set(refs))
     assert not missing, f"no rosidl hash to compare with for {missing}"
     differ = {name: (ours[name], refs[name]) for name in ours if ours[name] != refs[name]}
@@ -45,6 +45,11 @@ def test_every_type_hash_is_rosidls():
     # The four the suite's topics use most, by name.
     for name in ("nav_msgs/msg/Odometry", "sensor_msgs/msg/LaserScan", "geometry_msgs/msg/Twist",
                  "mobil_msgs/msg/NavStatus"):
+        assert name in ours
+    # And the types rosidl derives from services and actions, by name.
+    for name in ("lifecycle_msgs/srv/GetState", "lifecycle_msgs/srv/GetState_Event",
+                 "nav2_msgs/action/NavigateToPose", "nav2_msgs/action/NavigateToPose_SendGoal_Request",
+                 "mobil_msgs/action/DriveDistance_FeedbackMessage", "rmw_dds_common/msg/ParticipantEntitiesInfo"):
         assert name in ours
 
 
@@ -71,6 +76,8 @@ SERVICE_ENDPOINTS = [
     ("rr/local_nav/get_parametersReply", "publisher", "local_nav",
      "rcl_interfaces/srv/GetParameters_Response", "rr/{me}/get_parametersReply"),
     ("rt/rosout", "publisher", "local_nav", "rcl_interfaces/msg/Log", "rt/rosout"),
+    ("rt/parameter_events", "publisher", "local_nav", "rcl_interfaces/msg/ParameterEvent",
+     "rt/parameter_events"),
     ("rq/navigate_to_pose/_action/send_goalRequest", "subscription", "local_nav",
      "nav2_msgs/action/NavigateToPose_SendGoal_Request", "rq/{ref}/navigate_to_pose/_action/send_goalRequest"),
     ("rr/navigate_to_pose/_action/get_resultReply", "publisher", "local_nav",
@@ -91,43 +98,42 @@ def endpoints_of(ros_node, topic: str, kind: str, node: str, no_mangle: bool = F
 
 
 def test_endpoints_announce_their_type_hash_as_rclpys_do(start_node, ros_node):
+    import rclpy
     from lifecycle_msgs.srv import GetState
     from nav2_msgs.action import NavigateToPose
     from rclpy.action import ActionServer
     start_node("chassis_node", params_file="params/omr3.yaml")
     start_node("local_nav_node", params_file="params/omr3.yaml")
     refs = reference_hashes()
-    # rclpy's own publisher of each type (Fast DDS computes its hash from the type support).
-    ours_pubs = [ros_node.create_publisher(harness.import_type(t), f"/hash_reference/t{i}", 1)
-                 for i, (_, _, _, t) in enumerate(ENDPOINTS)]
+    # rclpy's own endpoints of the same types (Fast DDS takes their hashes from the type
+    # support), on a node of their own that is never spun: nothing runs in them, and they go
+    # with the node.
+    reference = rclpy.create_node("hash_reference", context=ros_node.context)
+    me = reference.get_name()
     try:
+        for i, (_, _, _, t) in enumerate(ENDPOINTS):
+            reference.create_publisher(harness.import_type(t), f"/hash_reference/t{i}", 1)
+        reference.create_service(GetState, "/hash_reference/get_state", lambda _req, resp: resp)
+        ActionServer(reference, NavigateToPose, "/hash_reference/navigate_to_pose",
+                     lambda handle: NavigateToPose.Result())
         for i, (topic, kind, node, type_name) in enumerate(ENDPOINTS):
             found = wait_until(lambda: endpoints_of(ros_node, topic, kind, node), 15)
             assert found, f"no {kind} of {node} on {topic}"
-            reference = ros_node.get_publishers_info_by_topic(f"/hash_reference/t{i}")
-            assert len(reference) == 1, reference
-            rclpys = str(reference[0].topic_type_hash)
+            ours = wait_until(lambda i=i: endpoints_of(ros_node, f"/hash_reference/t{i}", "publisher", me), 5)
+            assert ours and len(ours) == 1, ours
+            rclpys = str(ours[0].topic_type_hash)
             for endpoint in found:
                 assert endpoint.topic_type == type_name
                 assert str(endpoint.topic_type_hash) == rclpys == refs[type_name], (topic, node)
-        # A service and the parts of an action, against rclpy's own server of the same types
-        # (under /hash_reference) and the type-description JSON.
-        service = ros_node.create_service(GetState, "/hash_reference/get_state", lambda _req, resp: resp)
-        action = ActionServer(ros_node, NavigateToPose, "/hash_reference/navigate_to_pose",
-                              lambda handle: NavigateToPose.Result())
-        try:
-            for topic, kind, node, type_name, reference_topic in SERVICE_ENDPOINTS:
-                found = wait_until(lambda: endpoints_of(ros_node, topic, kind, node, no_mangle=True), 15)
-                assert found, f"no {kind} of {node} on {topic}"
-                reference_topic = reference_topic.format(ref="hash_reference", me=ros_node.get_name())
-                reference = endpoints_of(ros_node, reference_topic, kind, ros_node.get_name(), no_mangle=True)
-                assert len(reference) == 1, (reference_topic, reference)
-                rclpys = str(reference[0].topic_type_hash)
-                for endpoint in found:
-                    assert str(endpoint.topic_type_hash) == rclpys == refs[type_name], (topic, node)
-        finally:
-            action.destroy()
-            ros_node.destroy_service(service)
+        # Services, rosout and the parts of an action.
+        for topic, kind, node, type_name, reference_topic in SERVICE_ENDPOINTS:
+            found = wait_until(lambda: endpoints_of(ros_node, topic, kind, node, no_mangle=True), 15)
+            assert found, f"no {kind} of {node} on {topic}"
+            reference_topic = reference_topic.format(ref="hash_reference", me=me)
+            ours = wait_until(lambda: endpoints_of(ros_node, reference_topic, kind, me, no_mangle=True), 5)
+            assert ours and len(ours) == 1, (reference_topic, ours)
+            rclpys = str(ours[0].topic_type_hash)
+            for endpoint in found:
+                assert str(endpoint.topic_type_hash) == rclpys == refs[type_name], (topic, node)
     finally:
-        for pub in ours_pubs:
-            ros_node.destroy_publisher(pub)
+        reference.destroy_node()

@@ -65,7 +65,8 @@ fn main() {
         .unwrap_or_else(|e| panic!("describing message types: {e}"));
     code.push_str(
         "/// REP-2011 type hashes (`RIHS01_` + SHA-256 of the hashable type description) of every\n\
-         /// message, service part and action part, sorted by type name (`pkg/msg/Name`).\n\
+         /// message, service part and action part, and of the service, event and action types\n\
+         /// rosidl derives from them, sorted by type name (`pkg/msg/Name`).\n\
          pub static TYPE_HASHES: &[(&str, &str)] = &[\n",
     );
     for (name, json) in &descriptions {

@@ -17,8 +17,11 @@ pub use generated::*;
 
 pub mod idl;
 
-/// The REP-2011 type hash (`RIHS01_…`) of a message type, computed at build time from its
-/// definition and its nested types' (`geometry_msgs/msg/Twist`); `None` for a type not built here.
+/// The REP-2011 type hash (`RIHS01_…`) of a type built here, computed at build time from its
+/// definition and its nested types', as rosidl computes it: a message (`geometry_msgs/msg/Twist`),
+/// a service or action part (`lifecycle_msgs/srv/GetState_Request`,
+/// `nav2_msgs/action/Spin_FeedbackMessage`) or the service, event or action type itself
+/// (`lifecycle_msgs/srv/GetState`); `None` for a type not built here.
 pub fn type_hash(type_name: &str) -> Option<&'static str> {
     TYPE_HASHES
         .binary_search_by(|(name, _)| (*name).cmp(type_name))

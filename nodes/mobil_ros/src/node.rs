@@ -332,7 +332,9 @@ impl RosNode {
             .map_err(|e| anyhow!("cannot join DDS domain {domain}: {e:?}"))?;
         // Every endpoint announces its type's REP-2011 hash (USER_DATA `typehash=RIHS01_…;`),
         // computed at build time for every type mobil_msgs builds, as the Jazzy RMWs do.
-        let context = Context::from_domain_participant_with_type_hashes(participant, mobil_msgs::type_hash)
+        let type_hashes: ros2_client::TypeHashLookup =
+            std::sync::Arc::new(|name: &str| mobil_msgs::type_hash(name).map(String::from));
+        let context = Context::from_domain_participant_with_type_hashes(participant, type_hashes)
             .map_err(|e| anyhow!("cannot join DDS domain {domain}: {e:?}"))?;
         let ns = names.namespace().to_owned();
         let mut node = context

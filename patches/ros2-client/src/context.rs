@@ -57,11 +57,11 @@ struct SecurityConfig {
 /// the Context creates announces the hash of its topic's type in its USER_DATA
 /// as `typehash=RIHS01_…;`, as the ROS 2 Jazzy RMWs do (ROS tools show it as
 /// the endpoint's `topic_type_hash`); an endpoint whose type the lookup does
-/// not know announces none.
-pub type TypeHashLookup = fn(&str) -> Option<&'static str>;
+/// not know announces none. A closure may hold a table built at run time.
+pub type TypeHashLookup = Arc<dyn Fn(&str) -> Option<String> + Send + Sync>;
 
-fn no_type_hashes(_ros_type_name: &str) -> Option<&'static str> {
-  None
+fn no_type_hashes() -> TypeHashLookup {
+  Arc::new(|_ros_type_name: &str| None)
 }
 
 /// The ROS name of a DDS type name: `pkg::msg::dds_::Name_` → `pkg/msg/Name`.
@@ -74,7 +74,7 @@ fn ros_type_name(dds_type_name: &str) -> Option<String> {
 /// `qos` with the USER_DATA that announces the type hash of `dds_type_name`,
 /// when `lookup` knows it (`rmw_dds_common`'s
 /// `encode_type_hash_for_user_data_qos` writes the same text).
-fn with_type_hash(qos: QosPolicies, dds_type_name: &str, lookup: TypeHashLookup) -> QosPolicies {
+fn with_type_hash(qos: QosPolicies, dds_type_name: &str, lookup: &TypeHashLookup) -> QosPolicies {
   match ros_type_name(dds_type_name).and_then(|name| lookup(&name)) {
     Some(hash) => qos.with_user_data(format!("typehash={hash};").into_bytes()),
     None => qos,
@@ -93,7 +93,7 @@ impl ContextOptions {
   pub fn new() -> Self {
     Self {
       domain_id: 0,
-      type_hashes: no_type_hashes,
+      type_hashes: no_type_hashes(),
       #[cfg(feature = "security")]
       security_config: None,
     }
@@ -149,6 +149,7 @@ impl Default for ContextOptions {
 #[derive(Clone)]
 pub struct Context {
   inner: Arc<Mutex<ContextInner>>,
+  type_hashes: TypeHashLookup,
 }
 
 impl Context {
@@ -179,7 +180,7 @@ impl Context {
 
   /// Create a new Context from an existing [`DomainParticipant`].
   pub fn from_domain_participant(domain_participant: DomainParticipant) -> CreateResult<Context> {
-    Self::from_domain_participant_with_type_hashes(domain_participant, no_type_hashes)
+    Self::from_domain_participant_with_type_hashes(domain_participant, no_type_hashes())
   }
 
   /// Like [`Self::from_domain_participant`], and every endpoint announces the
@@ -193,9 +194,10 @@ impl Context {
     static ROS_DISTRO_CHECK: std::sync::Once = std::sync::Once::new();
     ROS_DISTRO_CHECK.call_once(crate::distributions::verify_ros_distro_env);
 
-    let i = ContextInner::from_domain_participant(domain_participant, lookup)?;
+    let i = ContextInner::from_domain_participant(domain_participant, &lookup)?;
     Ok(Context {
       inner: Arc::new(Mutex::new(i)),
+      type_hashes: lookup,
     })
   }
 
@@ -266,8 +268,7 @@ impl Context {
   /// `qos` for an endpoint of the DDS type `dds_type_name`: with the USER_DATA
   /// that announces its type hash, if the Context's lookup knows it.
   pub(crate) fn with_type_hash(&self, qos: QosPolicies, dds_type_name: &str) -> QosPolicies {
-    let lookup = self.inner.lock().unwrap().type_hashes;
-    with_type_hash(qos, dds_type_name, lookup)
+    with_type_hash(qos, dds_type_name, &self.type_hashes)
   }
 
   // pub fn ros_discovery_stream(&self) -> impl Stream<Item =
@@ -399,15 +400,13 @@ struct ContextInner {
 
   ros_parameter_events_topic: Topic,
   ros_rosout_topic: Topic,
-
-  type_hashes: TypeHashLookup,
 }
 
 impl ContextInner {
   // "new"
   pub fn from_domain_participant(
     domain_participant: DomainParticipant,
-    type_hashes: TypeHashLookup,
+    type_hashes: &TypeHashLookup,
   ) -> CreateResult<ContextInner> {
     let ros_default_publisher =
       domain_participant.create_publisher(&QosPolicies::from(DEFAULT_PUBLISHER_QOS))?;
@@ -461,7 +460,6 @@ impl ContextInner {
       ros_default_subscriber,
       ros_parameter_events_topic,
       ros_rosout_topic,
-      type_hashes,
     })
   }
 
@@ -539,25 +537,29 @@ fn type_hashes_go_into_user_data_by_ros_type_name() {
   assert_eq!(ros_type_name("NotRos"), None);
   assert_eq!(ros_type_name("pkg::msg::dds_::NoUnderscore"), None);
 
-  fn lookup(name: &str) -> Option<&'static str> {
-    (name == "std_msgs/msg/String").then_some("RIHS01_df66")
-  }
-  let qos = with_type_hash(QosPolicies::qos_none(), "std_msgs::msg::dds_::String_", lookup);
-  assert_eq!(
-    qos.user_data(),
-    Some(policy::UserData {
-      value: b"typehash=RIHS01_df66;".to_vec()
-    })
+  let lookup: TypeHashLookup = Arc::new(|name: &str| match name {
+    "std_msgs/msg/String" => Some("RIHS01_df66".to_owned()),
+    "rcl_interfaces/msg/Log" => Some("RIHS01_e28c".to_owned()),
+    _ => None,
+  });
+  let user_data = |qos: QosPolicies| qos.user_data().map(|u| u.value);
+  let known = with_type_hash(
+    QosPolicies::qos_none(),
+    "std_msgs::msg::dds_::String_",
+    &lookup,
   );
-  let unknown = with_type_hash(QosPolicies::qos_none(), "std_msgs::msg::dds_::Bool_", lookup);
-  assert_eq!(unknown.user_data(), None);
+  assert_eq!(user_data(known), Some(b"typehash=RIHS01_df66;".to_vec()));
+  let unknown = with_type_hash(
+    QosPolicies::qos_none(),
+    "std_msgs::msg::dds_::Bool_",
+    &lookup,
+  );
+  assert_eq!(user_data(unknown), None);
 
-  // Topics the Context creates carry it.
-  let context = Context::from_domain_participant_with_type_hashes(
-    DomainParticipant::new(0).unwrap(),
-    lookup,
-  )
-  .unwrap();
+  // Topics the Context creates carry it, the built-in ones too.
+  let context =
+    Context::from_domain_participant_with_type_hashes(DomainParticipant::new(0).unwrap(), lookup)
+      .unwrap();
   let topic = context
     .create_topic(
       "rt/type_hash_test".to_owned(),
@@ -566,7 +568,12 @@ fn type_hashes_go_into_user_data_by_ros_type_name() {
     )
     .unwrap();
   assert_eq!(
-    topic.qos().user_data().map(|u| u.value),
+    user_data(topic.qos()),
     Some(b"typehash=RIHS01_df66;".to_vec())
   );
+  assert_eq!(
+    user_data(context.get_rosout_topic().qos()),
+    Some(b"typehash=RIHS01_e28c;".to_vec())
+  );
+  assert_eq!(user_data(context.get_parameter_events_topic().qos()), None);
 }

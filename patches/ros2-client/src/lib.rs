@@ -291,7 +291,7 @@ pub use dds::{
   ActionClient, ActionServer, AsyncActionServer, Client, Context, ContextOptions,
   DEFAULT_PUBLISHER_QOS, DEFAULT_SUBSCRIPTION_QOS, Node, NodeCreateError, NodeEvent,
   NodeLoggingHandle, ParameterError, Publisher, ReaderWait, RosoutRaw, Server, ServiceMapping,
-  Spinner, Subscription, WriterWait,
+  Spinner, Subscription, TypeHashLookup, WriterWait,
 };
 #[cfg(all(feature = "zenoh", not(feature = "dds")))]
 #[doc(inline)]

@@ -674,7 +674,18 @@ impl QosPolicies {
       data_representation,
       policy::DataRepresentation
     );
-    emit_option!(PID_USER_DATA, user_data, policy::UserData);
+    if let Some(user_data) = user_data {
+      // A parameter's length is 16 bits: the sequence's 4-byte length, the
+      // bytes and their padding must fit.
+      if user_data.value.len() > policy::UserData::MAX_LEN {
+        return Err(PlCdrSerializeError::NotSupported(format!(
+          "USER_DATA of {} bytes; at most {} fit in a parameter",
+          user_data.value.len(),
+          policy::UserData::MAX_LEN
+        )));
+      }
+      emit!(PID_USER_DATA, user_data, policy::UserData);
+    }
 
     Ok(pl)
   }
@@ -741,7 +752,15 @@ impl QosPolicies {
     let lifespan: Option<policy::Lifespan> = get_option!(PID_LIFESPAN);
     let data_representation: Option<policy::DataRepresentation> =
       get_option!(PID_DATA_REPRESENTATION);
-    let user_data: Option<policy::UserData> = get_option!(PID_USER_DATA);
+    // USER_DATA is opaque and takes no part in matching: a malformed one is
+    // dropped, not the endpoint it came with.
+    let user_data: Option<policy::UserData> =
+      get_option_from_pl_map(pl_map, ctx, ParameterId::PID_USER_DATA, "user data").unwrap_or_else(
+        |e| {
+          warn!("QosPolicies deserializer: USER_DATA ignored: {e}");
+          None
+        },
+      );
 
     #[cfg(feature = "security")]
     let property: Option<policy::Property> = None; // TODO: Should also properties be read?
@@ -825,6 +844,12 @@ pub mod policy {
   #[derive(Clone, Debug, PartialEq, Eq, Hash, Readable, Writable, Serialize, Deserialize)]
   pub struct UserData {
     pub value: Vec<u8>,
+  }
+
+  impl UserData {
+    /// The longest value that fits in a discovery parameter (whose length is
+    /// 16 bits, holding the 4-byte sequence length and the padded bytes).
+    pub const MAX_LEN: usize = 65528;
   }
 
   /*

@@ -1502,7 +1502,9 @@ mod tests {
     expected.extend_from_slice(&text);
     expected.push(0);
     assert!(
-      sdata.windows(expected.len()).any(|w| w == expected.as_slice()),
+      sdata
+        .windows(expected.len())
+        .any(|w| w == expected.as_slice()),
       "no USER_DATA parameter in {sdata:x?}"
     );
 
@@ -1535,13 +1537,85 @@ mod tests {
       .unwrap();
     let mut expected = vec![0x2c, 0x00, 24, 0x00, 20, 0, 0, 0];
     expected.extend_from_slice(&text);
-    assert!(sdata.windows(expected.len()).any(|w| w == expected.as_slice()));
+    assert!(sdata
+      .windows(expected.len())
+      .any(|w| w == expected.as_slice()));
     let drd2: DiscoveredReaderData =
       PlCdrDeserializerAdapter::from_bytes(&sdata, RepresentationIdentifier::PL_CDR_LE).unwrap();
     assert_eq!(
       drd2.subscription_topic_data.qos().user_data(),
       Some(UserData { value: text })
     );
+  }
+
+  fn writer_data_with_user_data(value: Vec<u8>) -> DiscoveredWriterData {
+    let mut writer_proxy = writer_proxy_data().unwrap();
+    let mut pub_topic_data = publication_builtin_topic_data().unwrap();
+    writer_proxy.remote_writer_guid = pub_topic_data.key;
+    let qos = pub_topic_data.qos().with_user_data(value);
+    pub_topic_data.set_qos(&qos);
+    DiscoveredWriterData {
+      last_updated: Instant::now(),
+      writer_proxy,
+      publication_topic_data: pub_topic_data,
+      user_data: Vec::new(),
+    }
+  }
+
+  #[test]
+  fn user_data_big_endian() {
+    let text = b"typehash=RIHS01_0a;".to_vec();
+    let dwd = writer_data_with_user_data(text.clone());
+    let sdata = dwd
+      .to_pl_cdr_bytes(RepresentationIdentifier::PL_CDR_BE)
+      .unwrap();
+    // PID and parameter length, then the sequence length, all big-endian.
+    let mut expected = vec![0x00, 0x2c, 0x00, 24, 0, 0, 0, 19];
+    expected.extend_from_slice(&text);
+    expected.push(0);
+    assert!(
+      sdata
+        .windows(expected.len())
+        .any(|w| w == expected.as_slice()),
+      "no big-endian USER_DATA parameter in {sdata:x?}"
+    );
+    let dwd2: DiscoveredWriterData =
+      PlCdrDeserializerAdapter::from_bytes(&sdata, RepresentationIdentifier::PL_CDR_BE).unwrap();
+    assert_eq!(
+      dwd2.publication_topic_data.qos().user_data(),
+      Some(UserData { value: text })
+    );
+  }
+
+  #[test]
+  fn malformed_user_data_is_dropped_not_the_endpoint() {
+    let dwd = writer_data_with_user_data(b"abcd".to_vec());
+    let mut sdata = dwd
+      .to_pl_cdr_bytes(RepresentationIdentifier::PL_CDR_LE)
+      .unwrap()
+      .to_vec();
+    let at = sdata
+      .windows(4)
+      .position(|w| w == [0x2c, 0x00, 8, 0x00])
+      .expect("the USER_DATA parameter");
+    // The sequence claims 4 GB in an 8-byte parameter.
+    sdata[at + 4..at + 8].copy_from_slice(&[0xff, 0xff, 0xff, 0xff]);
+    let dwd2: DiscoveredWriterData =
+      PlCdrDeserializerAdapter::from_bytes(&sdata, RepresentationIdentifier::PL_CDR_LE).unwrap();
+    assert_eq!(dwd2.publication_topic_data.qos().user_data(), None);
+    assert_eq!(dwd2.writer_proxy, dwd.writer_proxy);
+  }
+
+  #[test]
+  fn user_data_too_long_for_a_parameter_is_refused() {
+    let fits = writer_data_with_user_data(vec![7; UserData::MAX_LEN]);
+    assert!(fits
+      .to_pl_cdr_bytes(RepresentationIdentifier::PL_CDR_LE)
+      .is_ok());
+    let too_long = writer_data_with_user_data(vec![7; UserData::MAX_LEN + 1]);
+    assert!(too_long
+      .to_pl_cdr_bytes(RepresentationIdentifier::PL_CDR_LE)
+      .is_err());
   }
 
   #[test]
