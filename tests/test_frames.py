@@ -44,6 +44,10 @@ CORRECTED = (0.5, -0.7, math.pi / 2)
 # Dated ahead as AMCL dates its transforms (by its transform_tolerance, 1 s by default), a
 # little more: a test process stalled for a moment must not let the transform age.
 DATED_AHEAD = 1.5
+# The docking test ages no transform on purpose, so it dates them further ahead: 5 s of simulated
+# time is 1 s of the test's wall time at REAL_TIME_FACTOR 5 (1.5 s, 0.3 s of wall time, was
+# seen outlived under load: a transform 0.12 s old refused a dock).
+DOCK_DATED_AHEAD = 5.0
 
 
 def in_map(frame, x: float, y: float) -> tuple[float, float]:
@@ -84,18 +88,18 @@ def is_zero(t: Twist) -> bool:
 
 
 class Localiser:
-    """`map → odom` on `/tf` every 20 ms (wall), dated ``DATED_AHEAD`` past the latest
+    """`map → odom` on `/tf` every 20 ms (wall), dated ``dated_ahead`` past the latest
     simulated time; ``frame`` may change while it runs (a correction)."""
 
-    def __init__(self, node, sim_clock) -> None:
+    def __init__(self, node, sim_clock, dated_ahead: float = DATED_AHEAD) -> None:
         self.pub = node.create_publisher(TFMessage, "/tf", make_qos("reliable", "volatile", 100))
-        self.clock, self.frame = sim_clock, ODOM_IN_MAP
+        self.clock, self.frame, self.dated_ahead = sim_clock, ODOM_IN_MAP, dated_ahead
         self._stop = threading.Event()
         self._thread = threading.Thread(target=self._run, daemon=True)
 
     def message(self) -> TFMessage:
         t = TransformStamped()
-        stamp = self.clock.now() + DATED_AHEAD
+        stamp = self.clock.now() + self.dated_ahead
         t.header.stamp.sec, t.header.stamp.nanosec = int(stamp), int((stamp % 1.0) * 1e9)
         t.header.frame_id, t.child_frame_id = "map", "odom"
         x, y, th = self.frame
@@ -309,7 +313,7 @@ def test_planner_docks_in_map_through_the_localiser(robot, start_scenario, start
     with subscribe(ros_node, NavStatus, "planner/status", qos=qos_latched()) as status, \
             subscribe(ros_node, Twist, "cmd_vel", qos=DEEP) as cmd, \
             subscribe(ros_node, Odometry, "ground_truth", qos=DEEP) as truth, \
-            Localiser(ros_node, sim_clock) as localiser:
+            Localiser(ros_node, sim_clock, dated_ahead=DOCK_DATED_AHEAD) as localiser:
         sim_clock.wait_started()
         truth.wait_for(None, REPLY_TIMEOUT)
         status.wait_for(lambda s: s.state == NavStatus.IDLE, REPLY_TIMEOUT)
