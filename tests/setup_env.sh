@@ -62,6 +62,30 @@ if [ "$(cat "$stamp_pip" 2>/dev/null)" != "$want_pip" ]; then
   echo "$want_pip" > "$stamp_pip"
 fi
 
+# colcon, for the ROS 2 workspace test (tests/test_colcon.py): a venv of its own, so that
+# colcon-core's pytest plugins stay out of the test runner; colcon then runs with this venv's
+# cmake, Python and ament packages first on PATH and CMAKE_PREFIX_PATH, as a ROS install's would be.
+COLCON_VENV="$ROOT/target/colcon-venv-py$want_ver"
+COLCON_PACKAGES=(
+  colcon-core==0.21.3 colcon-ros==0.5.0 colcon-cmake==0.2.30 colcon-recursive-crawl==0.2.3
+  colcon-package-selection==0.2.10 colcon-package-information==0.4.1 colcon-parallel-executor==0.4.0
+  colcon-library-path==0.2.1 colcon-output==0.2.15
+  colcon-pkg-config==0.1.0 colcon-python-setup-py==0.2.9 catkin_pkg
+)
+stamp_colcon="$COLCON_VENV/.mobil-pip-stamp"
+want_colcon="$(printf '%s\n' "${COLCON_PACKAGES[@]}" | sha256sum | cut -d' ' -f1)"
+if [ "$(cat "$stamp_colcon" 2>/dev/null)" != "$want_colcon" ]; then
+  echo "setup_env: installing colcon into $COLCON_VENV (about 15 s)" >&2
+  rm -rf "$COLCON_VENV"
+  mkdir -p "$ROOT/target"
+  "$PY" -m venv "$COLCON_VENV"
+  "$COLCON_VENV/bin/pip" install -q --disable-pip-version-check "${COLCON_PACKAGES[@]}"
+  echo "$want_colcon" > "$stamp_colcon"
+fi
+# target/ holds build output, the installed interface packages among it: colcon must not take
+# those for the packages' sources when the repository is in a workspace's src/.
+mkdir -p "$ROOT/target" && touch "$ROOT/target/COLCON_IGNORE"
+
 # The wheels' CMake exports name the include dir of the interpreter they were built with
 # (/opt/python/cpXY-cpXY/..., one per Python version); point them at this venv's interpreter
 # headers and site-packages instead (venv-local, idempotent).
@@ -78,19 +102,18 @@ fi
 
 # mobil_msgs Python type support, from the same CMakeLists.txt colcon uses, with its C type
 # supports only (MOBIL_MSGS_C_ONLY: rclpy loads no C++ type support; that halves the build).
-# The hash of an interface package's inputs (msgs/rust and the nested nav2_msgs, bond and tf2_msgs are not
-# part of mobil_msgs).
+# The hash of an interface package's inputs.
 package_hash() {
-  (cd "$1" && find . \( -path ./rust -o -path ./nav2_msgs -o -path ./bond -o -path ./tf2_msgs \) -prune -o -type f \( -name '*.msg' -o -name '*.srv' -o -name '*.action' -o -name CMakeLists.txt -o -name package.xml \) -print | sort | xargs sha256sum | sha256sum | cut -d' ' -f1)
+  (cd "$1" && find . -type f \( -name '*.msg' -o -name '*.srv' -o -name '*.action' -o -name CMakeLists.txt -o -name package.xml \) -print | sort | xargs sha256sum | sha256sum | cut -d' ' -f1)
 }
-want_msgs="$want_ver $(package_hash "$ROOT/msgs")"
+want_msgs="$want_ver $(package_hash "$ROOT/msgs/mobil_msgs")"
 stamp_msgs="$INSTALL/.mobil-msgs-stamp"
 if [ "$(cat "$stamp_msgs" 2>/dev/null)" != "$want_msgs" ]; then
   echo "setup_env: building mobil_msgs Python type support (about 1 CPU-minute)" >&2
   rm -rf "$BUILD" "$INSTALL"
   mkdir -p "$ROOT/target"
   PATH="$VENV/bin:$PATH" AMENT_PREFIX_PATH="$VENV" CMAKE_PREFIX_PATH="$VENV" \
-    "$VENV/bin/cmake" -S "$ROOT/msgs" -B "$BUILD" -DPython3_EXECUTABLE="$VENV/bin/python" \
+    "$VENV/bin/cmake" -S "$ROOT/msgs/mobil_msgs" -B "$BUILD" -DPython3_EXECUTABLE="$VENV/bin/python" \
       -DBUILD_TESTING=OFF -DMOBIL_MSGS_C_ONLY=ON -DCMAKE_INSTALL_PREFIX="$INSTALL" >"$ROOT/target/msgs-cmake.log" 2>&1 \
     && PATH="$VENV/bin:$PATH" "$VENV/bin/cmake" --build "$BUILD" -j2 >>"$ROOT/target/msgs-cmake.log" 2>&1 \
     && "$VENV/bin/cmake" --install "$BUILD" >>"$ROOT/target/msgs-cmake.log" 2>&1 \
@@ -98,11 +121,11 @@ if [ "$(cat "$stamp_msgs" 2>/dev/null)" != "$want_msgs" ]; then
   echo "$want_msgs" > "$stamp_msgs"
 fi
 
-# The nested interface packages that have no wheel on PyPI: nav2_msgs (Nav2's Jazzy action types,
+# The other interface packages, which have no wheel on PyPI: nav2_msgs (Nav2's Jazzy action types,
 # msgs/nav2_msgs), bond (msgs/bond) and tf2_msgs (TFMessage, msgs/tf2_msgs), installed into the
 # same prefix, so the PYTHONPATH / LD_LIBRARY_PATH above serve them too. A rebuild of mobil_msgs
 # empties the prefix and their stamps with it, so these follow.
-for nested in nav2_msgs bond tf2_msgs; do
+for nested in nav2_msgs bond tf2_msgs; do  # beside mobil_msgs in msgs/
   nested_build="$ROOT/target/$nested-build-py$want_ver"
   want_nested="$want_ver $(package_hash "$ROOT/msgs/$nested")"
   stamp_nested="$INSTALL/.mobil-$nested-stamp"

@@ -48,7 +48,7 @@ DEEP = harness.make_qos("reliable", "volatile", 1000)
 # How soon after a refused odometry or scan a moving robot must be given a zero command (s): the
 # node holds it on receipt; the rest is DDS latency and scheduling on a loaded 2-core machine.
 REACTION = 0.4
-# NavStatus fields documented as NaN while unknown (msgs/msg/NavStatus.msg).
+# NavStatus fields documented as NaN while unknown (msgs/mobil_msgs/msg/NavStatus.msg).
 NAN_WHEN_NONE = frozenset({"distance_to_goal", "e", "alpha", "theta", "lyapunov", "psi_z",
                            "chi_length", "chi_danger", "chi_control", "chi_smoothness"})
 

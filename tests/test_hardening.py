@@ -42,7 +42,7 @@ WATCHDOG_PERIOD_S = 0.05  # both nodes' 20 Hz watchdog tick
 # What a loaded 2-core machine adds to the bound: DDS hops and a late tick or callback.
 SCHEDULING_S = 0.25
 DEEP = make_qos("reliable", "volatile", 1000)
-# NavStatus fields documented as NaN while unknown (msgs/msg/NavStatus.msg): the distance with no
+# NavStatus fields documented as NaN while unknown (msgs/mobil_msgs/msg/NavStatus.msg): the distance with no
 # goal or odometry, a docking's figures before its first odometry, the VFO figures outside VFO.
 NAN_WHEN_NONE = frozenset({"distance_to_goal", "e", "alpha", "theta", "lyapunov", "psi_z",
                            "chi_length", "chi_danger", "chi_control", "chi_smoothness"})

@@ -1,7 +1,6 @@
 //! Generates the Rust message types from `.msg` / `.srv` / `.action` files at build time.
 //!
-//! Inputs: the suite's own interface package (`msgs/msg`, `msgs/srv`, `msgs/action`, package
-//! `mobil_msgs`), Nav2's Jazzy action types (`msgs/nav2_msgs`, package `nav2_msgs`), bond's
+//! Inputs: the suite's own interface package (`msgs/mobil_msgs`, package `mobil_msgs`), Nav2's Jazzy action types (`msgs/nav2_msgs`, package `nav2_msgs`), bond's
 //! messages (`msgs/bond`, package `bond`) and the
 //! standard ROS 2 Jazzy definitions the suite uses, vendored unchanged under `msgs/rust/ros`.
 //! Output: `$OUT_DIR/generated.rs`, one module per package (`geometry_msgs::msg::Twist`, …),
@@ -19,13 +18,13 @@ use std::path::{Path, PathBuf};
 
 fn main() {
     let manifest = PathBuf::from(std::env::var_os("CARGO_MANIFEST_DIR").expect("cargo sets CARGO_MANIFEST_DIR"));
-    let own_package = manifest.join("..");
+    let msgs = manifest.join("..");
     let vendored = manifest.join("ros");
 
     let mut sources: Vec<(String, PathBuf)> = Vec::new();
-    collect(&own_package, "mobil_msgs", &mut sources);
-    collect(&own_package.join("nav2_msgs"), "nav2_msgs", &mut sources);
-    collect(&own_package.join("bond"), "bond", &mut sources);
+    collect(&msgs.join("mobil_msgs"), "mobil_msgs", &mut sources);
+    collect(&msgs.join("nav2_msgs"), "nav2_msgs", &mut sources);
+    collect(&msgs.join("bond"), "bond", &mut sources);
     let mut std_packages: Vec<_> = std::fs::read_dir(&vendored)
         .expect("msgs/rust/ros exists")
         .filter_map(|e| e.ok())
@@ -79,9 +78,7 @@ fn main() {
     std::fs::write(&out, code).expect("writing generated.rs");
     println!("cargo:rerun-if-changed=src/idl.rs");
     println!("cargo:rerun-if-changed=ros");
-    println!("cargo:rerun-if-changed=../msg");
-    println!("cargo:rerun-if-changed=../srv");
-    println!("cargo:rerun-if-changed=../action");
+    println!("cargo:rerun-if-changed=../mobil_msgs");
     println!("cargo:rerun-if-changed=../nav2_msgs");
     println!("cargo:rerun-if-changed=../bond");
 }
