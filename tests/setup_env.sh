@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Idempotent set-up of everything the tests and demo need beyond cargo:
 # a Python venv with real ROS 2 Jazzy rclpy (Fast DDS) and the mobil_msgs Python type support,
-# built from msgs/ with plain CMake exactly as colcon would build it.
+# built from msgs/mobil_msgs with plain CMake exactly as colcon would build it.
 # Quick when already done (stamp files keyed on the inputs).
 set -euo pipefail
 ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"

@@ -22,8 +22,10 @@ from pathlib import Path
 import pytest
 
 import harness
-import rosutil
 from harness import ROOT
+
+# One workspace for the module: its tests on one worker.
+pytestmark = pytest.mark.xdist_group("colcon")
 
 PY = f"{sys.version_info.major}.{sys.version_info.minor}"
 COLCON = ROOT / "target" / f"colcon-venv-py{PY}" / "bin" / "colcon"
@@ -31,11 +33,16 @@ VENV = Path(sys.prefix)
 PACKAGES = {"mobil", "mobil_msgs", "nav2_msgs", "bond", "tf2_msgs"}
 
 
+# What a login shell has, of the test process's environment: nothing of the repository.
+KEPT = ("HOME", "USER", "LANG", "LC_ALL", "TERM", "TMPDIR", "CARGO_HOME", "RUSTUP_HOME", "ROS_DOMAIN_ID")
+
+
 def build_env() -> dict[str, str]:
-    """A shell as a ROS user's would be after sourcing the ROS install (here: the rclpy venv)."""
-    env = {k: v for k, v in os.environ.items()
-           if not k.startswith(("AMENT_", "COLCON_", "CMAKE_", "PYTHONPATH", "ROS_"))}
-    env["PATH"] = f"{VENV / 'bin'}{os.pathsep}{env.get('PATH', '')}"
+    """A shell as a ROS user's would be after sourcing the ROS install (here: the rclpy venv,
+    its bin/ first on PATH and its prefix as the ament and CMake prefix), and nothing else."""
+    env = {k: os.environ[k] for k in KEPT if k in os.environ}
+    system_path = [p for p in os.environ.get("PATH", "").split(os.pathsep) if str(ROOT) not in p]
+    env["PATH"] = os.pathsep.join([str(VENV / "bin"), *system_path])
     env["AMENT_PREFIX_PATH"] = str(VENV)
     env["CMAKE_PREFIX_PATH"] = str(VENV)
     return env
@@ -43,8 +50,8 @@ def build_env() -> dict[str, str]:
 
 def sourced(setup: Path, env: dict[str, str]) -> dict[str, str]:
     """The environment after `. setup` in a POSIX shell."""
-    out = subprocess.run(["sh", "-c", f'. "{setup}" && env -0'], env=env, capture_output=True,
-                         check=True, timeout=60).stdout
+    out = subprocess.run(["sh", "-c", f'. "{setup}" && env -0'], env=env, cwd=setup.parent,
+                         capture_output=True, check=True, timeout=60).stdout
     return dict(line.split("=", 1) for line in out.decode().split("\0") if "=" in line)
 
 
@@ -68,8 +75,10 @@ def workspace(tmp_path_factory: pytest.TempPathFactory) -> Path:
     log = ws / "colcon-build.log"
     log.write_text(build.stdout + build.stderr)
     assert build.returncode == 0, f"colcon build failed (see {log}):\n{build.stderr[-4000:]}"
-    # cargo ran in the workspace's own target directory, which the suite's build had filled.
-    cargo_log = "\n".join(p.read_text() for p in (ws / "log" / "latest_build" / "mobil").glob("stdout*.log"))
+    # cargo ran in the workspace's own target directory, which the suite's build had filled:
+    # nothing compiled (nodes/feature_set makes the two builds' feature sets one).
+    cargo_log = (ws / "log" / "latest_build" / "mobil" / "stdout_stderr.log").read_text()
+    assert "Finished `release` profile" in cargo_log, cargo_log[-3000:]
     assert "Compiling" not in cargo_log, cargo_log[-3000:]
     return ws
 
@@ -112,14 +121,19 @@ def test_ament_index_finds_the_package_and_its_params(workspace: Path):
 
 def test_installed_chassis_node_with_installed_params_answers_rclpy(workspace: Path, start_node, ros_node):
     env = installed_env(workspace)
+    # Only the install tree and the rclpy venv: no value names the repository otherwise.
+    leaks = {k: v for k, v in env.items() if str(ROOT) in v.replace(str(VENV), "")}
+    assert not leaks, leaks
     prefix = next(Path(p) for p in env["AMENT_PREFIX_PATH"].split(os.pathsep) if p.endswith("/mobil"))
     exe = prefix / "lib" / "mobil" / "chassis_node"
     params = prefix / "share" / "mobil" / "params" / "mobil2.yaml"
     assert exe.is_file() and params.is_file()
-    # Run from an empty directory: nothing may be found relative to the repository.
+    # Run from an empty directory with exactly that environment (env -i drops what the test
+    # harness adds): nothing may be found relative to the repository.
     cwd = workspace / "empty"
     cwd.mkdir(exist_ok=True)
-    start_node(str(exe), params_file=params, prefix=("env", "-C", str(cwd)), env=env)
+    start_node(str(exe), params_file=params,
+               prefix=("env", "-i", *(f"{k}={v}" for k, v in env.items()), "env", "-C", str(cwd)))
     assert harness.param_get(ros_node, "chassis", "model") == "car_like"
     assert harness.param_get(ros_node, "chassis", "min_turning_radius") == pytest.approx(0.73)
 
@@ -127,6 +141,8 @@ def test_installed_chassis_node_with_installed_params_answers_rclpy(workspace: P
 # ---- launch files --------------------------------------------------------------------------------
 
 SUBST = re.compile(r"\$\(find-pkg-share ([A-Za-z0-9_]+)\)")
+# ROS 2 launch's own grammar of substitutions (Jazzy's, vendored), with the lark the venv has.
+GRAMMAR = ROOT / "tests" / "launch_grammar.lark"
 
 
 def declared_exec_depends() -> set[str]:
@@ -141,6 +157,10 @@ def test_launch_files_name_installed_executables_and_files(workspace: Path):
     assert {f.name for f in files} == {"omr3.launch.xml", "mobil2.launch.xml", "tricycle.launch.xml",
                                       "robot.launch.xml", "nav2_mobil.launch.xml"}
     outside = declared_exec_depends()
+    from lark import Lark
+    substitutions = Lark(GRAMMAR.read_text(), start="template")
+    declared_by = {f.name: {a.get("name"): a.get("default") for a in ET.parse(f).getroot().findall("arg")}
+                   for f in files}
 
     def resolve(text: str) -> str:
         return SUBST.sub(lambda m: str(install / m.group(1) / "share" / m.group(1)), text)
@@ -158,8 +178,17 @@ def test_launch_files_name_installed_executables_and_files(workspace: Path):
                 assert pkg in outside, (f.name, pkg, "not an exec_depend of ros/mobil/package.xml")
         for element in root.iter():
             for value in element.attrib.values():
+                if "$(" in value:
+                    substitutions.parse(value)  # raises on a malformed substitution
                 for path in re.findall(r"\$\(find-pkg-share [^)]*\)[^\s\"']*", value):
                     assert Path(resolve(path)).is_file(), (f.name, path)
+        # An included file gets only arguments it declares, and every one it needs (no default).
+        for include in root.iter("include"):
+            included = Path(resolve(include.get("file"))).name
+            given = {a.get("name") for a in include.findall("arg")}
+            assert given <= set(declared_by[included]), (f.name, included, given)
+            needed = {name for name, default in declared_by[included].items() if default is None}
+            assert needed <= given, (f.name, included, needed - given)
         # Every $(var x) names an argument the file declares.
         declared = {a.get("name") for a in root.findall("arg")}
         for element in root.iter():

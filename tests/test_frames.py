@@ -2,8 +2,9 @@
 `map → odom` on `/tf`, and local_nav_node and planner_node follow goals given in `map` on the
 simulated OMR-III and MOBIL-II (the built-in world, simulated clock at 5× real time).
 
-The localiser dates each transform 1.5 s ahead of the simulated clock it last saw, as AMCL
-dates its own ahead by its `transform_tolerance`, and sends it every 20 ms of wall time.
+The localiser dates each transform ahead of the simulated clock it last saw (1.5 s; 5 s in the
+docking test, which ages none), as AMCL dates its own ahead by its `transform_tolerance`, and
+sends it every 20 ms of wall time.
 
 The hand-worked frames: odom sits at (0.5, −1.0) in map, turned by π/2, so a point (x, y) in
 odom is (0.5 − y, −1.0 + x) in map, and a point (X, Y) in map is (Y + 1.0, 0.5 − X) in odom. The

@@ -1,6 +1,6 @@
 """The suite's own messages (mobil_msgs) between rclpy and the Rust nodes, both ways.
 
-rclpy publishes with the type support built from msgs/ by CMake (as colcon would), the Rust
+rclpy publishes with the type support built from msgs/mobil_msgs by CMake (as colcon would), the Rust
 relay (`mobil_msgs_relay`, types generated from the same .msg files) republishes, and rclpy must
 get back exactly what it sent: every field, fixed arrays, nested sequences, constants.
 """
