@@ -184,6 +184,10 @@ def test_action_servers_answer_the_protocol_as_rclpy_does(start_node, ros_node):
             protocols.append(Protocol(ros_node, action_type, name, goal))
         for p in protocols:
             p.wait_for_server()
+        # drive_node refuses goals until it has odometry: every node has the feed, and a few
+        # samples of it, before the first goal (CI under load once saw drive_distance's refused).
+        assert wait_until(lambda: feed.pub.get_subscription_count() >= 3, 20), "a node does not subscribe odom"
+        time.sleep(0.5)
         for p in protocols:
             p.running()
         time.sleep(EXPIRED_AFTER_S)

@@ -24,8 +24,9 @@ import pytest
 import harness
 from harness import ROOT
 
-# One workspace for the module: its tests on one worker.
-pytestmark = pytest.mark.xdist_group("colcon")
+# One workspace for the module, its tests on one worker; the build takes about 40 s alone
+# (tests/run_all runs the module after cargo doc, which holds target/'s lock).
+pytestmark = [pytest.mark.xdist_group("colcon"), pytest.mark.timeout(600)]
 
 PY = f"{sys.version_info.major}.{sys.version_info.minor}"
 COLCON = ROOT / "target" / f"colcon-venv-py{PY}" / "bin" / "colcon"
