@@ -1207,12 +1207,8 @@ impl Node {
     // Where are the suffixes documented?
     // And why "Reply" and not "Response" ?
 
-    let request_dds_qos = self
-      .ros_context
-      .with_type_hash((&request_qos).into(), &service_type_name.dds_request_type());
-    let response_dds_qos = self
-      .ros_context
-      .with_type_hash((&response_qos).into(), &service_type_name.dds_response_type());
+    let (request_dds_qos, response_dds_qos) =
+      self.service_dds_qos(service_type_name, &request_qos, &response_qos);
 
     let rq_topic = self.ros_context.domain_participant().create_topic(
       service_name.to_dds_name("rq", &self.node_name, "Request"),
@@ -1241,6 +1237,24 @@ impl Node {
     Ok(c)
   }
 
+  /// The DDS QoS of a service's request and response topics, each with the
+  /// USER_DATA that announces its type's hash when the Context knows it.
+  fn service_dds_qos(
+    &self,
+    service_type_name: &ServiceTypeName,
+    request_qos: &QosProfile,
+    response_qos: &QosProfile,
+  ) -> (QosPolicies, QosPolicies) {
+    (
+      self
+        .ros_context
+        .with_type_hash(request_qos.into(), &service_type_name.dds_request_type()),
+      self
+        .ros_context
+        .with_type_hash(response_qos.into(), &service_type_name.dds_response_type()),
+    )
+  }
+
   /// Creates ROS2 Service Server
   ///
   /// # Arguments
@@ -1266,12 +1280,8 @@ impl Node {
     // Self::check_name_and_add_prefix("rr/", &(service_name.to_owned() +
     // "Reply"))?;
 
-    let request_dds_qos = self
-      .ros_context
-      .with_type_hash((&request_qos).into(), &service_type_name.dds_request_type());
-    let response_dds_qos = self
-      .ros_context
-      .with_type_hash((&response_qos).into(), &service_type_name.dds_response_type());
+    let (request_dds_qos, response_dds_qos) =
+      self.service_dds_qos(service_type_name, &request_qos, &response_qos);
 
     let rq_topic = self.ros_context.domain_participant().create_topic(
       //rq_name,

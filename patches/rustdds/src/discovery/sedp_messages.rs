@@ -1476,22 +1476,28 @@ mod tests {
     assert_eq!(sdata, sdata2);
   }
 
-  #[test]
-  fn td_discovered_writer_data_carries_user_data() {
-    // ROS 2 Jazzy's RMWs put the endpoint's type hash into USER_DATA.
-    let text = b"typehash=RIHS01_0a;".to_vec(); // 19 bytes: 1 byte of padding
+  /// Test writer data, with `user_data` as its QoS USER_DATA when given.
+  fn writer_data(user_data: Option<Vec<u8>>) -> DiscoveredWriterData {
     let mut writer_proxy = writer_proxy_data().unwrap();
     let mut pub_topic_data = publication_builtin_topic_data().unwrap();
     writer_proxy.remote_writer_guid = pub_topic_data.key;
-    let qos = pub_topic_data.qos().with_user_data(text.clone());
-    pub_topic_data.set_qos(&qos);
-
-    let dwd = DiscoveredWriterData {
+    if let Some(value) = user_data {
+      let qos = pub_topic_data.qos().with_user_data(value);
+      pub_topic_data.set_qos(&qos);
+    }
+    DiscoveredWriterData {
       last_updated: Instant::now(),
       writer_proxy,
       publication_topic_data: pub_topic_data,
       user_data: Vec::new(),
-    };
+    }
+  }
+
+  #[test]
+  fn td_discovered_writer_data_carries_user_data() {
+    // ROS 2 Jazzy's RMWs put the endpoint's type hash into USER_DATA.
+    let text = b"typehash=RIHS01_0a;".to_vec(); // 19 bytes: 1 byte of padding
+    let dwd = writer_data(Some(text.clone()));
     let sdata = dwd
       .to_pl_cdr_bytes(RepresentationIdentifier::PL_CDR_LE)
       .unwrap();
@@ -1548,24 +1554,10 @@ mod tests {
     );
   }
 
-  fn writer_data_with_user_data(value: Vec<u8>) -> DiscoveredWriterData {
-    let mut writer_proxy = writer_proxy_data().unwrap();
-    let mut pub_topic_data = publication_builtin_topic_data().unwrap();
-    writer_proxy.remote_writer_guid = pub_topic_data.key;
-    let qos = pub_topic_data.qos().with_user_data(value);
-    pub_topic_data.set_qos(&qos);
-    DiscoveredWriterData {
-      last_updated: Instant::now(),
-      writer_proxy,
-      publication_topic_data: pub_topic_data,
-      user_data: Vec::new(),
-    }
-  }
-
   #[test]
   fn user_data_big_endian() {
     let text = b"typehash=RIHS01_0a;".to_vec();
-    let dwd = writer_data_with_user_data(text.clone());
+    let dwd = writer_data(Some(text.clone()));
     let sdata = dwd
       .to_pl_cdr_bytes(RepresentationIdentifier::PL_CDR_BE)
       .unwrap();
@@ -1589,7 +1581,7 @@ mod tests {
 
   #[test]
   fn malformed_user_data_is_dropped_not_the_endpoint() {
-    let dwd = writer_data_with_user_data(b"abcd".to_vec());
+    let dwd = writer_data(Some(b"abcd".to_vec()));
     let mut sdata = dwd
       .to_pl_cdr_bytes(RepresentationIdentifier::PL_CDR_LE)
       .unwrap()
@@ -1608,11 +1600,11 @@ mod tests {
 
   #[test]
   fn user_data_too_long_for_a_parameter_is_refused() {
-    let fits = writer_data_with_user_data(vec![7; UserData::MAX_LEN]);
+    let fits = writer_data(Some(vec![7; UserData::MAX_LEN]));
     assert!(fits
       .to_pl_cdr_bytes(RepresentationIdentifier::PL_CDR_LE)
       .is_ok());
-    let too_long = writer_data_with_user_data(vec![7; UserData::MAX_LEN + 1]);
+    let too_long = writer_data(Some(vec![7; UserData::MAX_LEN + 1]));
     assert!(too_long
       .to_pl_cdr_bytes(RepresentationIdentifier::PL_CDR_LE)
       .is_err());
@@ -1620,16 +1612,8 @@ mod tests {
 
   #[test]
   fn user_data_is_not_written_when_unset() {
-    let mut writer_proxy = writer_proxy_data().unwrap();
-    let pub_topic_data = publication_builtin_topic_data().unwrap();
-    writer_proxy.remote_writer_guid = pub_topic_data.key;
-    assert_eq!(pub_topic_data.qos().user_data(), None);
-    let dwd = DiscoveredWriterData {
-      last_updated: Instant::now(),
-      writer_proxy,
-      publication_topic_data: pub_topic_data,
-      user_data: Vec::new(),
-    };
+    let dwd = writer_data(None);
+    assert_eq!(dwd.publication_topic_data.qos().user_data(), None);
     let pl = dwd
       .to_parameter_list(RepresentationIdentifier::PL_CDR_LE)
       .unwrap();
