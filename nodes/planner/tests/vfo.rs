@@ -456,7 +456,8 @@ fn caps_return_the_best_so_far_with_a_warning() {
 #[test]
 fn the_result_does_not_depend_on_the_number_of_threads() {
     // Twelve obstacles scattered over the way: the whole result, every virtual robot and every
-    // path, is the same on one thread and on four.
+    // path, is the same on one thread and on two, three or four — also when a cap cuts the
+    // search short, while helper threads are working ahead of it.
     let mut seed: u64 = 7;
     let mut rnd = move || {
         seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
@@ -474,20 +475,39 @@ fn the_result_does_not_depend_on_the_number_of_threads() {
         last: true,
         obstacles: &obstacles,
     };
-    let run = |threads| {
-        let config = OptimiseConfig {
-            threads,
-            ..OptimiseConfig::default()
-        };
-        find_sigmas(&Pose2::identity(), &controller(), &segment, &config).expect("valid")
+    let run =
+        |config: OptimiseConfig| find_sigmas(&Pose2::identity(), &controller(), &segment, &config).expect("valid");
+    let full = OptimiseConfig::default();
+    let one = run(OptimiseConfig { threads: 1, ..full });
+    // Helpers start after the first eight virtual robots.
+    assert!(one.robots.len() > 30, "too few virtual robots: {}", one.robots.len());
+    for threads in [2, 3, 4] {
+        assert_eq!(one, run(OptimiseConfig { threads, ..full }), "{threads} threads");
+    }
+    // Caps in the middle of the search: the same cut on every thread count.
+    let by_robots = OptimiseConfig {
+        max_virtual_robots: one.robots.len() / 2,
+        ..full
     };
-    let one = run(1);
-    assert!(
-        one.robots.len() > 8,
-        "too few virtual robots to batch: {}",
-        one.robots.len()
-    );
-    assert_eq!(one, run(4));
+    let by_time = OptimiseConfig {
+        max_total_time_s: one.simulated_time / 3.0,
+        ..full
+    };
+    for capped in [by_robots, by_time] {
+        let serial = run(OptimiseConfig { threads: 1, ..capped });
+        assert!(serial.robots.len() < one.robots.len());
+        assert!(serial.warnings.iter().any(|w| matches!(
+            w,
+            OptimiseWarning::VirtualRobotCap { pending, .. } | OptimiseWarning::TotalTimeCap { pending, .. } if *pending > 0
+        )));
+        for threads in [2, 3] {
+            assert_eq!(
+                serial,
+                run(OptimiseConfig { threads, ..capped }),
+                "{threads} threads, capped"
+            );
+        }
+    }
 }
 
 #[test]

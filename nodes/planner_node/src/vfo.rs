@@ -52,7 +52,7 @@ pub fn declare_vfo(d: &mut Decl<PlannerConfig>) {
         double "vfo.max_total_time_s" = o.max_total_time_s => vfo.optimise.max_total_time_s, above(0.0);
             "most simulated time over all virtual robots of one optimisation [s]";
         count "vfo.threads" = o.threads => vfo.optimise.threads, min(0.0);
-            "threads for a batch of virtual robots (0: every core)";
+            "threads that simulate virtual robots (0: every core; the result is the same)";
         double "vfo.influence_margin" = s.influence_margin => vfo.scan.influence_margin, above(0.0);
             "R − r of every obstacle seen [m]";
         double "vfo.cluster_gap" = s.cluster_gap => vfo.scan.cluster_gap, above(0.0);
@@ -121,11 +121,15 @@ mod tests {
         assert_eq!(c.vfo.gains, VfoGains::default());
         assert_eq!(c.vfo.optimise, OptimiseConfig::default());
         // The library's figures, from its docs: k_p 1, k_a 5, U_2 0.3, |ω| ≤ 4, T_p 0.01,
-        // 4096 virtual robots, weights {K_D 1, K_B 2, K_E 1, K_S 1}.
+        // 16 384 virtual robots, 80 000 s of simulated time, weights {K_D 1, K_B 2, K_E 1, K_S 1}.
         assert_eq!((c.vfo.gains.k_p, c.vfo.gains.k_a, c.vfo.gains.speed), (1.0, 5.0, 0.3));
         assert_eq!(
-            (c.vfo.optimise.time_step, c.vfo.optimise.max_virtual_robots),
-            (0.01, 4096)
+            (
+                c.vfo.optimise.time_step,
+                c.vfo.optimise.max_virtual_robots,
+                c.vfo.optimise.max_total_time_s
+            ),
+            (0.01, 16_384, 80_000.0)
         );
         let w = c.vfo.optimise.weights;
         assert_eq!((w.length, w.danger, w.control, w.smoothness), (1.0, 2.0, 1.0, 1.0));

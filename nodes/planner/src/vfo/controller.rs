@@ -149,8 +149,59 @@ fn rot_o(v: Vector2<f64>) -> Vector2<f64> {
     Vector2::new(v.y, -v.x)
 }
 
-fn guide(wp: &VfoWaypoint) -> Vector2<f64> {
-    Vector2::new(wp.heading.cos(), wp.heading.sin())
+/// [cos θ_r, sin θ_r], the direction of a waypoint's guiding effect.
+pub(crate) fn guide(wp: &VfoWaypoint) -> Vector2<f64> {
+    let (sin, cos) = wp.heading.sin_cos();
+    Vector2::new(cos, sin)
+}
+
+/// The obstacles a step evaluates: all of them, or a caller's subset (ascending indices) that
+/// holds every obstacle whose influence zone the position can be in. The others contribute
+/// exactly nothing (V = V' = 0 beyond R), so the result is the same either way.
+#[derive(Debug, Clone, Copy)]
+pub(crate) enum Near<'a> {
+    /// Every obstacle.
+    All,
+    /// Only these indices (ascending).
+    Only(&'a [usize]),
+}
+
+impl Near<'_> {
+    /// Calls `f` with each index, ascending.
+    pub(crate) fn for_each(self, count: usize, mut f: impl FnMut(usize)) {
+        match self {
+            Near::All => (0..count).for_each(f),
+            Near::Only(indices) => indices.iter().for_each(|&k| f(k)),
+        }
+    }
+}
+
+/// An obstacle whose influence zone holds a point (d ≤ R), with what the law needs of it there.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Nearby {
+    /// Its index.
+    pub(crate) k: usize,
+    /// q* − p_k.
+    pub(crate) away: Vector2<f64>,
+    /// d_k = ‖q* − p_k‖.
+    pub(crate) d: f64,
+}
+
+/// The obstacles among `candidates` whose influence zone holds `position`, ascending, into
+/// `out` (cleared first): one distance per candidate, which the zone test, H*, Ḣ* and the
+/// danger then share.
+pub(crate) fn measure(obstacles: &[Obstacle], candidates: Near<'_>, position: &Point2<f64>, out: &mut Vec<Nearby>) {
+    out.clear();
+    candidates.for_each(obstacles.len(), |k| {
+        let Some(o) = obstacles.get(k) else {
+            return;
+        };
+        let away = position - o.centre();
+        let d = away.norm();
+        if d <= o.influence_radius() {
+            out.push(Nearby { k, away, d });
+        }
+    });
 }
 
 /// The convergence field H* at `position` for waypoint `wp` (eq. 6, 7, 10–12; ζ ≡ +1).
@@ -162,16 +213,31 @@ pub fn convergence_field(
     obstacles: &[Obstacle],
     sigmas: &[Sigma],
 ) -> Field {
+    let mut nearby = Vec::new();
+    measure(obstacles, Near::All, position, &mut nearby);
+    field_among(position, wp, &guide(wp), k_p, obstacles, sigmas, &nearby)
+}
+
+/// [`convergence_field`] from the obstacles [`measure`]d at `position`, with the guide
+/// [cos θ_r, sin θ_r] given.
+fn field_among(
+    position: &Point2<f64>,
+    wp: &VfoWaypoint,
+    guide: &Vector2<f64>,
+    k_p: f64,
+    obstacles: &[Obstacle],
+    sigmas: &[Sigma],
+    nearby: &[Nearby],
+) -> Field {
     let error = wp.position - position;
-    let h = k_p * error - k_p * wp.guiding * error.norm() * guide(wp);
+    let h = k_p * error - k_p * wp.guiding * error.norm() * guide;
     let mut signed = 0.0;
     let mut danger = 0.0;
     let mut collision = None;
-    for (k, o) in obstacles.iter().enumerate() {
-        let d = o.distance(position);
-        if d > o.influence_radius() {
+    for &Nearby { k, d, .. } in nearby {
+        let Some(o) = obstacles.get(k) else {
             continue;
-        }
+        };
         if d <= o.forbidden_radius() {
             collision.get_or_insert(k);
             continue;
@@ -215,19 +281,37 @@ pub fn field_rate(
     obstacles: &[Obstacle],
     sigmas: &[Sigma],
 ) -> Vector2<f64> {
+    let mut nearby = Vec::new();
+    measure(obstacles, Near::All, position, &mut nearby);
+    rate_among(field, velocity, wp, &guide(wp), k_p, obstacles, sigmas, &nearby)
+}
+
+/// [`field_rate`] from the obstacles [`measure`]d at the field's point, with the guide given.
+#[allow(clippy::too_many_arguments)] // the law's inputs, private
+fn rate_among(
+    field: &Field,
+    velocity: &Vector2<f64>,
+    wp: &VfoWaypoint,
+    guide: &Vector2<f64>,
+    k_p: f64,
+    obstacles: &[Obstacle],
+    sigmas: &[Sigma],
+    nearby: &[Nearby],
+) -> Vector2<f64> {
     let norm = field.error.norm();
     let mut h_dot = -k_p * velocity;
     if norm > 0.0 {
-        h_dot += k_p * wp.guiding * field.error.dot(velocity) / norm * guide(wp);
+        h_dot += k_p * wp.guiding * field.error.dot(velocity) / norm * guide;
     }
     if field.collision.is_some() {
         return h_dot;
     }
     let mut s_dot = 0.0;
-    for (k, o) in obstacles.iter().enumerate() {
-        let away = position - o.centre();
-        let d = away.norm();
-        if d > o.influence_radius() || d <= o.forbidden_radius() {
+    for &Nearby { k, away, d } in nearby {
+        let Some(o) = obstacles.get(k) else {
+            continue;
+        };
+        if d <= o.forbidden_radius() {
             continue;
         }
         let dv = potential_derivative(d, o.forbidden_radius(), o.influence_radius());
@@ -239,17 +323,25 @@ pub fn field_rate(
 /// Moves a unicycle at `pose` along the exact arc of (v, ω) held for `dt` seconds. The
 /// heading is not wrapped (the law keeps it continuous).
 pub fn integrate_unicycle(pose: &Pose2, v: f64, omega: f64, dt: f64) -> Pose2 {
+    integrate_from(pose, pose.yaw.sin_cos(), v, omega, dt).0
+}
+
+/// [`integrate_unicycle`] with (sin, cos) of the pose's yaw given; also returns the new yaw's.
+pub(crate) fn integrate_from(pose: &Pose2, (sin, cos): (f64, f64), v: f64, omega: f64, dt: f64) -> (Pose2, (f64, f64)) {
     let turn = omega * dt;
     let yaw = pose.yaw + turn;
+    let next = yaw.sin_cos();
     if turn.abs() < 1e-9 {
-        let mid = pose.yaw + 0.5 * turn;
-        Pose2::new(pose.x + v * dt * mid.cos(), pose.y + v * dt * mid.sin(), yaw)
+        let (mid_sin, mid_cos) = (pose.yaw + 0.5 * turn).sin_cos();
+        (
+            Pose2::new(pose.x + v * dt * mid_cos, pose.y + v * dt * mid_sin, yaw),
+            next,
+        )
     } else {
         let r = v / omega;
-        Pose2::new(
-            pose.x + r * (yaw.sin() - pose.yaw.sin()),
-            pose.y - r * (yaw.cos() - pose.yaw.cos()),
-            yaw,
+        (
+            Pose2::new(pose.x + r * (next.0 - sin), pose.y - r * (next.1 - cos), yaw),
+            next,
         )
     }
 }
@@ -291,6 +383,17 @@ pub struct ControlStep {
     pub epsilon: f64,
     /// What the step decided.
     pub outcome: StepOutcome,
+}
+
+/// The waypoint a step aims at, with what a virtual robot computes once per segment.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Aim<'a> {
+    /// The waypoint.
+    pub(crate) waypoint: &'a VfoWaypoint,
+    /// [cos θ_r, sin θ_r].
+    pub(crate) guide: Vector2<f64>,
+    /// Whether it is the last waypoint.
+    pub(crate) last: bool,
 }
 
 /// The VFO law's state over a segment: the unwrapped heading and θ_a (Atan2c) and ϵ_i.
@@ -341,6 +444,29 @@ impl VfoController {
         obstacles: &[Obstacle],
         sigmas: &[Sigma],
     ) -> ControlStep {
+        let aim = Aim {
+            waypoint: wp,
+            guide: guide(wp),
+            last,
+        };
+        let mut nearby = Vec::new();
+        measure(obstacles, Near::All, &pose.position(), &mut nearby);
+        self.step_among(pose, pose.yaw.sin_cos(), &aim, obstacles, sigmas, &nearby)
+    }
+
+    /// [`VfoController::step`] from the obstacles [`measure`]d at the pose's position, with
+    /// (sin, cos) of its yaw and the waypoint's guide given (a virtual robot keeps them from its
+    /// integration and its segment).
+    pub(crate) fn step_among(
+        &mut self,
+        pose: &Pose2,
+        (sin_yaw, cos_yaw): (f64, f64),
+        aim: &Aim<'_>,
+        obstacles: &[Obstacle],
+        sigmas: &[Sigma],
+        nearby: &[Nearby],
+    ) -> ControlStep {
+        let (wp, last) = (aim.waypoint, aim.last);
         let g = self.gains;
         let theta = match self.theta {
             Some(prev) => prev + wrap(pose.yaw - prev),
@@ -348,7 +474,7 @@ impl VfoController {
         };
         self.theta = Some(theta);
         let position = pose.position();
-        let field = convergence_field(&position, wp, g.k_p, obstacles, sigmas);
+        let field = field_among(&position, wp, &aim.guide, g.k_p, obstacles, sigmas, nearby);
         let stop = |outcome, field: Field, epsilon, theta_a: f64| ControlStep {
             omega: 0.0,
             v: 0.0,
@@ -391,6 +517,7 @@ impl VfoController {
             }
         }
         let hh = field.big_h.norm_squared();
+        let norm_h = hh.sqrt();
         let theta_a = if hh > 0.0 {
             let raw = field.big_h.y.atan2(field.big_h.x);
             theta_a_prev + wrap(raw - theta_a_prev)
@@ -399,11 +526,18 @@ impl VfoController {
         };
         self.theta_a = Some(theta_a);
         let e_a = theta_a - theta;
-        let speed = if last { g.speed.min(hh.sqrt()) } else { g.speed };
-        let v = speed * e_a.cos();
-        let velocity = v * Vector2::new(theta.cos(), theta.sin());
+        let speed = if last { g.speed.min(norm_h) } else { g.speed };
+        // cos e_a = H*·[cos θ, sin θ]/‖H*‖ (θ_a is H*'s direction); θ and the pose's yaw differ
+        // by whole turns only.
+        let cos_e_a = if hh > 0.0 {
+            (field.big_h.x * cos_yaw + field.big_h.y * sin_yaw) / norm_h
+        } else {
+            e_a.cos()
+        };
+        let v = speed * cos_e_a;
+        let velocity = v * Vector2::new(cos_yaw, sin_yaw);
         let theta_a_rate = if hh > 0.0 {
-            let h_dot = field_rate(&field, &position, &velocity, wp, g.k_p, obstacles, sigmas);
+            let h_dot = rate_among(&field, &velocity, wp, &aim.guide, g.k_p, obstacles, sigmas, nearby);
             (h_dot.y * field.big_h.x - h_dot.x * field.big_h.y) / hh
         } else {
             0.0

@@ -157,8 +157,8 @@ pub struct VfoSetup {
 }
 
 /// What a VFO step senses besides the pose: the pose's stamp (s, on the odometry's clock; the
-/// rest test times by it) and the interrupt an optimisation asks before every batch of virtual
-/// robots: stop (the goal ended) or take the best so far (the budget is spent).
+/// rest test times by it) and the interrupt an optimisation asks before every virtual
+/// robot and as it runs: stop (the goal ended) or take the best so far (the budget is spent).
 pub struct VfoTick {
     /// The pose's stamp (s).
     pub stamp: f64,

@@ -5,7 +5,7 @@
 //! - [`controller`]: the VFO law (eq. 5–13) with avoidance, Algorithm 1 and Algorithm 3,
 //!   one step at a time ([`VfoController`]), and the unicycle's exact arc.
 //! - [`quality`]: χ_D, χ_B, χ_E, χ_S (eq. 14–19), merge, normalisation (20–21), Ψ_z (22).
-//! - [`optimise`]: Algorithm 2 (findSigmas) with cycle detection, caps and parallel batches.
+//! - [`optimise`]: Algorithm 2 (findSigmas) with cycle detection, caps and helper threads.
 //! - [`follower`]: [`VfoFollower`], the online follower: one control tick at a time, Σ per
 //!   segment, re-optimised on new obstacles; the last optimisation for display.
 //! - [`scan`]: obstacles from a laser scan (clusters → circles) merged over time in odom,
@@ -39,6 +39,7 @@ pub mod optimise;
 pub mod quality;
 pub mod scan;
 pub mod settings;
+mod speculate;
 
 pub use controller::{
     convergence_field, field_rate, integrate_unicycle, ControlStep, Field, StepOutcome, VfoController, VfoGains,
@@ -57,7 +58,6 @@ pub use obstacles::{potential, potential_derivative, Obstacle, Sigma};
 pub use optimise::{
     find_sigmas, find_sigmas_until, path_time_limit, simulate_uninterrupted, DecisionEdge, ExploredPath, Interrupt,
     Optimisation, OptimiseConfig, OptimiseWarning, PathFate, RobotEnd, Segment, VirtualRobot, INTERRUPT_CHECK_STEPS,
-    PARALLEL_MIN_BATCH,
 };
 pub use quality::{normalise, normalised, path_score, PathIndices, QualityWeights};
 pub use scan::{

@@ -17,33 +17,37 @@
 //! - Caps: at most `max_virtual_robots` virtual robots and `max_total_time_s` of simulated time
 //!   per optimisation; when one is hit the pending branches are abandoned and the best
 //!   candidate so far is returned with a warning.
-//! - **Interrupts** ([`find_sigmas_until`]): the caller's closure is asked before every batch
-//!   and every [`INTERRUPT_CHECK_STEPS`] steps of each virtual robot. [`Interrupt::Cancel`]
+//! - **Interrupts** ([`find_sigmas_until`]): the caller's closure is asked before every virtual
+//!   robot and every [`INTERRUPT_CHECK_STEPS`] steps of each virtual robot. [`Interrupt::Cancel`]
 //!   (the result is no longer wanted: a cancel, a new goal, shutdown) ends the optimisation at
 //!   once with [`PlannerError::Stopped`]; [`Interrupt::Budget`] (the caller's wall-clock budget
 //!   is spent) abandons the virtual robots under way and the pending branches and returns the
 //!   best candidate so far with [`OptimiseWarning::WallTimeBudget`], as the caps do. The clock
 //!   is the caller's: the library reads none.
 //!
-//! **Parallel branches.** The pending branches are a stack (LIFO, depth first). The optimiser
-//! pops up to `batch` branches at a time (the top of the stack first), simulates them — one
-//! virtual robot each, up to its next stop — on up to `threads` threads
-//! (`std::thread::scope`), then handles the results in pop order, pushing each one's children
-//! (−1 first, so +1 is on top). The schedule depends on `batch` alone, never on the number of
-//! threads, so the result (Σ, every virtual robot, every warning) is the same on any machine;
-//! the caps are checked between batches. Threads are used for batches of at least
-//! [`PARALLEL_MIN_BATCH`] branches, where they can pay (the bench measures it).
-//! `std::thread::scope` needs no dependency: each task is a whole virtual robot, coarse
-//! enough that a work-stealing pool (rayon) would have nothing to balance.
+//! **Order and threads.** The pending branches are a stack (LIFO, depth first: σ = +1 before
+//! σ = −1), and the caps and interrupts are checked before each virtual robot is taken from it,
+//! in that serial order. With `threads` > 1, helper threads simulate the branches ahead of it
+//! (the earliest in that order first) while the optimiser takes their results in order
+//! ([`speculate`](super::speculate)); a branch's simulation and children depend on the branch
+//! alone, so the result (Σ, every virtual robot, every path, every warning) is the same for any
+//! number of threads, and what was simulated beyond a cap is thrown away. The helpers start
+//! after the first few virtual robots: a small segment is done before a thread starts.
+//!
+//! **A step's cost.** A virtual robot evaluates only the obstacles near it: a list of those
+//! whose influence zone lies within a margin, rebuilt after it has driven half of the margin;
+//! one distance per listed obstacle and step serves the zone test, H*, Ḣ* and the danger.
 
 use std::num::NonZeroUsize;
+use std::sync::atomic::{AtomicBool, Ordering as AtomicOrdering};
 
 use mobil_geom::Pose2;
 use nalgebra::Point2;
 
-use super::controller::{integrate_unicycle, StepOutcome, VfoController, VfoWaypoint};
-use super::obstacles::{Obstacle, Sigma};
+use super::controller::{guide, integrate_from, measure, Aim, Near, Nearby, StepOutcome, VfoController, VfoWaypoint};
+use super::obstacles::{potential, Obstacle, Sigma};
 use super::quality::{normalised, path_score, PathIndices, QualityWeights};
+use super::speculate::{speculate, Keyed};
 use crate::error::{positive_finite, PlannerError};
 
 /// Settings of Algorithm 2; every default justified.
@@ -55,8 +59,9 @@ pub struct OptimiseConfig {
     /// §5 Decision: T_p = the integration step). Default 0.01 s: 3 mm of path at 0.3 m/s. A node
     /// stepping once per odometry message sets it to that period (`vfo.time_step`).
     pub time_step: f64,
-    /// Most virtual robots per optimisation. Default 4096: 2^12 leaves, far beyond the |D| of
-    /// any layout the paper shows, and about a second of work at 30 obstacles.
+    /// Most virtual robots per optimisation. Default 16 384 (2^14): the bench's 40-obstacle
+    /// layouts need up to 9 500 (docs/experiments/vfo.md), far beyond the |D| of any layout
+    /// the paper shows.
     pub max_virtual_robots: usize,
     /// A path whose simulated time from the segment start exceeds this (s) is dropped with a
     /// warning. Default 120 s: 36 m at 0.3 m/s, beyond any segment the planner is given.
@@ -69,12 +74,12 @@ pub struct OptimiseConfig {
     /// See `path_time_factor` (s). Default 20: the slow final approach at the last waypoint
     /// (v = min(U_2, ‖H*‖)·cos e_a) plus turning round at the start.
     pub path_time_margin_s: f64,
-    /// Most simulated time over all virtual robots of one optimisation (s). Default 20 000 s:
-    /// about a second of computation at 50 steps per simulated second.
+    /// Most simulated time over all virtual robots of one optimisation (s). Default 80 000 s:
+    /// about a second of computation on one core at T_p = 0.01 s (the bench measures 11–14 µs
+    /// per simulated second); the bench's 40-obstacle layouts need up to 57 000 s.
     pub max_total_time_s: f64,
-    /// Branches simulated per batch (fixes the schedule; see the module docs). Default 8.
-    pub batch: usize,
-    /// Threads for a batch; 0 = the machine's available parallelism. Default 0.
+    /// Threads that simulate virtual robots; 0 = the machine's available parallelism. The result
+    /// does not depend on it (see the module docs). Default 0.
     pub threads: usize,
     /// A point of a virtual robot's path is kept every this much path (m), for display. Default
     /// 0.05.
@@ -86,12 +91,11 @@ impl Default for OptimiseConfig {
         OptimiseConfig {
             weights: QualityWeights::default(),
             time_step: 0.01,
-            max_virtual_robots: 4096,
+            max_virtual_robots: 16_384,
             max_path_time_s: 120.0,
             path_time_factor: 3.0,
             path_time_margin_s: 20.0,
-            max_total_time_s: 20_000.0,
-            batch: 8,
+            max_total_time_s: 80_000.0,
             threads: 0,
             path_resolution: 0.05,
         }
@@ -108,14 +112,12 @@ impl OptimiseConfig {
         positive_finite("path_time_margin_s", self.path_time_margin_s)?;
         positive_finite("max_total_time_s", self.max_total_time_s)?;
         positive_finite("path_resolution", self.path_resolution)?;
-        for (name, value) in [("max_virtual_robots", self.max_virtual_robots), ("batch", self.batch)] {
-            if value == 0 {
-                return Err(PlannerError::InvalidConfig {
-                    name,
-                    value: 0.0,
-                    reason: "must be at least 1",
-                });
-            }
+        if self.max_virtual_robots == 0 {
+            return Err(PlannerError::InvalidConfig {
+                name: "max_virtual_robots",
+                value: 0.0,
+                reason: "must be at least 1",
+            });
         }
         Ok(())
     }
@@ -339,12 +341,130 @@ struct RobotState {
 /// A pending branch of Algorithm 2.
 #[derive(Debug, Clone)]
 struct Branch {
+    /// Its place in the serial order (see [`Key`]).
+    key: Key,
     state: RobotState,
     sigmas: Vec<Sigma>,
     edges: Vec<DecisionEdge>,
     indices: PathIndices,
     last_stop: Option<usize>,
-    robots: Vec<usize>,
+}
+
+/// A branch's choices from the segment's start: 0 for the first (σ = +1, or the only) child,
+/// 1 for the second (σ = −1). Keys compare lexicographically, a prefix first: the depth-first
+/// order in which the serial optimiser takes the branches.
+type Key = Vec<u8>;
+
+impl Keyed for Branch {
+    type Key = Key;
+    fn key(&self) -> &Key {
+        &self.key
+    }
+}
+
+impl Branch {
+    /// The child that goes on from this branch's next stop, `choice` its last key element.
+    fn child(&self, choice: u8) -> Branch {
+        let mut child = self.clone();
+        child.key.push(choice);
+        child
+    }
+}
+
+/// A branch simulated to its next stop: its virtual robot and what follows.
+struct Advance {
+    /// The virtual robot (its parent is set when it is taken in order).
+    robot: VirtualRobot,
+    next: Next,
+}
+
+/// What follows a virtual robot.
+enum Next {
+    /// The path goes on: one child (key + 0), or two (σ = +1 at key + 0, σ = −1 at key + 1).
+    Children(usize),
+    /// The path ends.
+    End {
+        fate: PathFate,
+        sigmas: Vec<Sigma>,
+        indices: PathIndices,
+        time: f64,
+    },
+    /// The caller interrupted it.
+    Interrupted,
+}
+
+/// Simulates a branch to its next stop and forms its children (the same for every branch with
+/// this state, whichever thread runs it).
+fn advance(
+    mut branch: Branch,
+    segment: &Segment<'_>,
+    config: &OptimiseConfig,
+    time_limit: f64,
+    interrupt: &(dyn Fn() -> Option<Interrupt> + Sync),
+) -> (Advance, Vec<Branch>) {
+    let piece = simulate(
+        segment,
+        config,
+        time_limit,
+        branch.state.clone(),
+        &branch.sigmas,
+        true,
+        interrupt,
+    );
+    let robot = VirtualRobot {
+        parent: None,
+        sigmas: branch.sigmas.clone(),
+        path: piece.path,
+        time: piece.time,
+        end: piece.end,
+    };
+    branch.state = piece.state;
+    branch.indices = branch.indices.merge(&piece.indices);
+    let fate = match piece.end {
+        RobotEnd::Entry { obstacle } => {
+            let edge = DecisionEdge {
+                from: branch.last_stop,
+                to: obstacle,
+                sigmas: branch.sigmas.clone(),
+            };
+            if branch.edges.contains(&edge) {
+                PathFate::Cyclic { edge }
+            } else {
+                branch.edges.push(edge);
+                branch.last_stop = Some(obstacle);
+                let children = if branch.sigmas.get(obstacle) == Some(&Sigma::Undecided) {
+                    let mut right = branch.child(0);
+                    let mut left = branch.child(1);
+                    right.sigmas[obstacle] = Sigma::Right;
+                    left.sigmas[obstacle] = Sigma::Left;
+                    vec![right, left]
+                } else {
+                    vec![branch.child(0)]
+                };
+                let next = Next::Children(children.len());
+                return (Advance { robot, next }, children);
+            }
+        }
+        RobotEnd::Reached { vortex } => PathFate::Candidate { vortex },
+        RobotEnd::Collided { obstacle } => PathFate::Collided { obstacle },
+        RobotEnd::TimeCap => PathFate::TimeCap,
+        RobotEnd::Interrupted => {
+            return (
+                Advance {
+                    robot,
+                    next: Next::Interrupted,
+                },
+                Vec::new(),
+            )
+        }
+    };
+    let next = Next::End {
+        fate,
+        sigmas: branch.sigmas,
+        indices: branch.indices,
+        time: branch.state.time,
+    };
+    (Advance { robot, next }, Vec::new())
 }
 
 /// The result of simulating one virtual robot.
@@ -356,8 +476,32 @@ struct Piece {
     end: RobotEnd,
 }
 
+/// How far beyond its influence radius an obstacle is kept in a virtual robot's near list
+/// (m). The list is rebuilt once the robot has driven half of it: at 0.3 m/s and T_p = 0.01 s
+/// every 50 steps, a distance per obstacle against the two to five per obstacle and step that
+/// evaluating the law over all of them costs.
+const NEAR_MARGIN: f64 = 0.2;
+
+/// The obstacles whose influence zone a point within `NEAR_MARGIN` of `point` can be in
+/// (ascending); the others are outside their zones there, so their flags in `inside` go down.
+fn near_list(obstacles: &[Obstacle], point: &Point2<f64>, near: &mut Vec<usize>, inside: &mut [bool]) {
+    near.clear();
+    for (k, (o, flag)) in obstacles.iter().zip(inside.iter_mut()).enumerate() {
+        if o.distance(point) <= o.influence_radius() + NEAR_MARGIN {
+            near.push(k);
+        } else {
+            *flag = false;
+        }
+    }
+}
+
 /// F_s: simulates from `state` with `sigmas` until the next stop (a zone entry, the waypoint, a
 /// collision or the path time cap), accumulating X_n from zero.
+///
+/// Each step evaluates only the obstacles of a near list, rebuilt whenever the robot has driven
+/// `NEAR_MARGIN / 2` since the last build: an obstacle left out is farther than
+/// `NEAR_MARGIN / 2` beyond its influence radius there, so V, V' and the zone test are exactly
+/// those of the full sum.
 fn simulate(
     segment: &Segment<'_>,
     config: &OptimiseConfig,
@@ -368,24 +512,43 @@ fn simulate(
     interrupt: &(dyn Fn() -> Option<Interrupt> + Sync),
 ) -> Piece {
     let dt = config.time_step;
+    let obstacles = segment.obstacles;
+    let aim = Aim {
+        waypoint: &segment.waypoint,
+        guide: guide(&segment.waypoint),
+        last: segment.last,
+    };
     let mut indices = PathIndices::default();
     let mut path = vec![state.pose.position()];
     let mut travelled_since_point = 0.0;
     let start_time = state.time;
     let mut steps = 0usize;
+    let mut sincos = state.pose.yaw.sin_cos();
+    let mut near = Vec::with_capacity(obstacles.len());
+    near_list(obstacles, &state.pose.position(), &mut near, &mut state.inside);
+    // Distance driven since the near list was built.
+    let mut since_near = 0.0;
+    // The obstacles whose zone holds the current position.
+    let mut nearby = Vec::new();
+    measure(obstacles, Near::Only(&near), &state.pose.position(), &mut nearby);
     let end = loop {
         steps += 1;
         if steps.is_multiple_of(INTERRUPT_CHECK_STEPS) && interrupt().is_some() {
             break RobotEnd::Interrupted;
         }
-        if let Some(obstacle) = entry(segment.obstacles, &state.pose.position(), &mut state.inside)
+        if since_near > 0.5 * NEAR_MARGIN {
+            // `nearby` stays right: it was measured within NEAR_MARGIN of the old list's point.
+            near_list(obstacles, &state.pose.position(), &mut near, &mut state.inside);
+            since_near = 0.0;
+        }
+        if let Some(obstacle) = entry(&near, &nearby, &mut state.inside)
             && stop_at_entries
         {
             break RobotEnd::Entry { obstacle };
         }
         let step = state
             .controller
-            .step(&state.pose, &segment.waypoint, segment.last, segment.obstacles, sigmas);
+            .step_among(&state.pose, sincos, &aim, obstacles, sigmas, &nearby);
         match step.outcome {
             StepOutcome::Reached { vortex } => break RobotEnd::Reached { vortex },
             StepOutcome::Collision { obstacle } => break RobotEnd::Collided { obstacle },
@@ -394,17 +557,30 @@ fn simulate(
         if state.time >= time_limit {
             break RobotEnd::TimeCap;
         }
-        state.pose = integrate_unicycle(&state.pose, step.v, step.omega, dt);
+        (state.pose, sincos) = integrate_from(&state.pose, sincos, step.v, step.omega, dt);
         state.time += dt;
-        let danger: f64 = segment
-            .obstacles
+        let moved = step.v.abs() * dt;
+        since_near += moved;
+        // The near list holds within NEAR_MARGIN of where it was built; a longer step (a large
+        // T_p) measures every obstacle.
+        let candidates = if since_near <= NEAR_MARGIN {
+            Near::Only(&near)
+        } else {
+            Near::All
+        };
+        let here = state.pose.position();
+        measure(obstacles, candidates, &here, &mut nearby);
+        let danger: f64 = nearby
             .iter()
-            .map(|o| o.potential_at(&state.pose.position()))
+            .filter_map(|n| {
+                let o = obstacles.get(n.k)?;
+                Some(potential(n.d, o.forbidden_radius(), o.influence_radius()))
+            })
             .sum();
         indices.accumulate(step.v, step.omega, danger, dt);
-        travelled_since_point += step.v.abs() * dt;
+        travelled_since_point += moved;
         if travelled_since_point >= config.path_resolution {
-            path.push(state.pose.position());
+            path.push(here);
             travelled_since_point = 0.0;
         }
     };
@@ -420,13 +596,19 @@ fn simulate(
     }
 }
 
-/// The first zone (lowest index) the point is inside and was not before; updates `inside`
-/// for every zone left. Zones entered after the returned one are found on the next call.
-fn entry(obstacles: &[Obstacle], point: &Point2<f64>, inside: &mut [bool]) -> Option<usize> {
+/// The first zone (lowest index) the point is inside and was not before, from the obstacles
+/// of `near` and those of them whose zone holds the point (`nearby`, both ascending); updates
+/// `inside` for every zone of `near` left. Zones entered after the returned one are found on
+/// the next call.
+fn entry(near: &[usize], nearby: &[Nearby], inside: &mut [bool]) -> Option<usize> {
     let mut found = None;
-    for (k, (o, flag)) in obstacles.iter().zip(inside.iter_mut()).enumerate() {
-        let within = o.distance(point) <= o.influence_radius();
-        if !within {
+    let mut within = nearby.iter().map(|n| n.k).peekable();
+    for &k in near {
+        let inside_zone = within.next_if_eq(&k).is_some();
+        let Some(flag) = inside.get_mut(k) else {
+            continue;
+        };
+        if !inside_zone {
             *flag = false;
         } else if !*flag && found.is_none() {
             *flag = true;
@@ -448,7 +630,7 @@ pub fn find_sigmas(
     find_sigmas_until(start, controller, segment, config, &|| None)
 }
 
-/// [`find_sigmas`] that asks `interrupt` between batches and every [`INTERRUPT_CHECK_STEPS`]
+/// [`find_sigmas`] that asks `interrupt` before each virtual robot and every [`INTERRUPT_CHECK_STEPS`]
 /// steps of a virtual robot whether to stop (module docs): [`Interrupt::Cancel`] returns
 /// [`PlannerError::Stopped`], [`Interrupt::Budget`] the best candidate so far with
 /// [`OptimiseWarning::WallTimeBudget`].
@@ -464,7 +646,8 @@ pub fn find_sigmas_until(
     let n = segment.obstacles.len();
     let threads = config.thread_count();
     let time_limit = path_time_limit(start, segment, controller, config);
-    let mut stack = vec![Branch {
+    let first = Branch {
+        key: Key::new(),
         state: RobotState {
             pose: *start,
             controller: *controller,
@@ -475,8 +658,18 @@ pub fn find_sigmas_until(
         edges: Vec::new(),
         indices: PathIndices::default(),
         last_stop: None,
-        robots: Vec::new(),
-    }];
+    };
+    let work = |branch: Branch, closed: &AtomicBool| {
+        // Work ahead of a finished optimisation is thrown away: it stops at once.
+        let stop = || {
+            if closed.load(AtomicOrdering::Relaxed) {
+                Some(Interrupt::Cancel)
+            } else {
+                interrupt()
+            }
+        };
+        advance(branch, segment, config, time_limit, &stop)
+    };
     let mut result = Optimisation {
         sigmas: vec![Sigma::Undecided; n],
         best: None,
@@ -485,119 +678,91 @@ pub fn find_sigmas_until(
         warnings: Vec::new(),
         simulated_time: 0.0,
     };
-    while !stack.is_empty() {
-        match interrupt() {
-            Some(Interrupt::Cancel) => return Err(PlannerError::Stopped),
-            Some(Interrupt::Budget) => {
-                result
-                    .warnings
-                    .push(OptimiseWarning::WallTimeBudget { pending: stack.len() });
+    speculate(threads, first, &work, |speculation| {
+        // The serial stack: keys and the virtual robots of the path so far.
+        let mut stack: Vec<(Key, Vec<usize>)> = vec![(Key::new(), Vec::new())];
+        while let Some((key, _)) = stack.last() {
+            match interrupt() {
+                Some(Interrupt::Cancel) => return Err(PlannerError::Stopped),
+                Some(Interrupt::Budget) => {
+                    result
+                        .warnings
+                        .push(OptimiseWarning::WallTimeBudget { pending: stack.len() });
+                    break;
+                }
+                None => {}
+            }
+            if result.robots.len() >= config.max_virtual_robots {
+                result.warnings.push(OptimiseWarning::VirtualRobotCap {
+                    limit: config.max_virtual_robots,
+                    pending: stack.len(),
+                });
                 break;
             }
-            None => {}
-        }
-        if result.robots.len() >= config.max_virtual_robots {
-            result.warnings.push(OptimiseWarning::VirtualRobotCap {
-                limit: config.max_virtual_robots,
-                pending: stack.len(),
-            });
-            break;
-        }
-        if result.simulated_time >= config.max_total_time_s {
-            result.warnings.push(OptimiseWarning::TotalTimeCap {
-                limit: config.max_total_time_s,
-                pending: stack.len(),
-            });
-            break;
-        }
-        let take = config
-            .batch
-            .min(stack.len())
-            .min(config.max_virtual_robots - result.robots.len());
-        let batch: Vec<Branch> = (0..take).filter_map(|_| stack.pop()).collect();
-        let pieces = simulate_batch(segment, config, time_limit, &batch, threads, interrupt);
-        let cut = pieces.iter().filter(|p| p.end == RobotEnd::Interrupted).count();
-        // A cancel ends it here; on the budget the batch's finished pieces still count, the
-        // interrupted ones and the stack are abandoned below.
-        if cut > 0 && interrupt() == Some(Interrupt::Cancel) {
-            return Err(PlannerError::Stopped);
-        }
-        for (mut branch, piece) in batch.into_iter().zip(pieces) {
-            if piece.end == RobotEnd::Interrupted {
-                continue;
+            if result.simulated_time >= config.max_total_time_s {
+                result.warnings.push(OptimiseWarning::TotalTimeCap {
+                    limit: config.max_total_time_s,
+                    pending: stack.len(),
+                });
+                break;
+            }
+            // `None` only if a helper thread panicked, which the scope raises again.
+            let Some(Advance { mut robot, next }) = speculation.take(key) else {
+                break;
+            };
+            let Some((key, mut robots)) = stack.pop() else {
+                break;
+            };
+            if matches!(next, Next::Interrupted) {
+                // A cancel ends it here; on the budget the stack is abandoned, this branch too.
+                if interrupt() == Some(Interrupt::Cancel) {
+                    return Err(PlannerError::Stopped);
+                }
+                result.warnings.push(OptimiseWarning::WallTimeBudget {
+                    pending: stack.len() + 1,
+                });
+                break;
             }
             let id = result.robots.len();
-            result.simulated_time += piece.time;
-            result.robots.push(VirtualRobot {
-                parent: branch.robots.last().copied(),
-                sigmas: branch.sigmas.clone(),
-                path: piece.path,
-                time: piece.time,
-                end: piece.end,
-            });
-            branch.robots.push(id);
-            branch.state = piece.state;
-            let fate = match piece.end {
-                RobotEnd::Entry { obstacle } => {
-                    let edge = DecisionEdge {
-                        from: branch.last_stop,
-                        to: obstacle,
-                        sigmas: branch.sigmas.clone(),
-                    };
-                    if branch.edges.contains(&edge) {
-                        branch.indices = branch.indices.merge(&piece.indices);
-                        Some(PathFate::Cyclic { edge })
-                    } else {
-                        branch.edges.push(edge);
-                        branch.indices = branch.indices.merge(&piece.indices);
-                        branch.last_stop = Some(obstacle);
-                        if branch.sigmas.get(obstacle) == Some(&Sigma::Undecided) {
-                            let mut left = branch.clone();
-                            left.sigmas[obstacle] = Sigma::Left;
-                            branch.sigmas[obstacle] = Sigma::Right;
-                            stack.push(left);
-                        }
-                        stack.push(branch);
-                        continue;
+            robot.parent = robots.last().copied();
+            result.simulated_time += robot.time;
+            result.robots.push(robot);
+            robots.push(id);
+            match next {
+                Next::Children(count) => {
+                    // The second child below the first: the first is taken next.
+                    for choice in (0..count).rev() {
+                        let mut child = key.clone();
+                        child.push(choice as u8);
+                        stack.push((child, robots.clone()));
                     }
                 }
-                RobotEnd::Reached { vortex } => {
-                    branch.indices = branch.indices.merge(&piece.indices);
-                    Some(PathFate::Candidate { vortex })
-                }
-                RobotEnd::Collided { obstacle } => {
-                    branch.indices = branch.indices.merge(&piece.indices);
-                    Some(PathFate::Collided { obstacle })
-                }
-                RobotEnd::TimeCap => {
-                    branch.indices = branch.indices.merge(&piece.indices);
-                    result.warnings.push(OptimiseWarning::PathTimeCap {
-                        path: result.paths.len(),
-                    });
-                    Some(PathFate::TimeCap)
-                }
-                // Skipped above.
-                RobotEnd::Interrupted => None,
-            };
-            if let Some(fate) = fate {
-                result.paths.push(ExploredPath {
-                    sigmas: branch.sigmas,
-                    indices: branch.indices,
-                    robots: branch.robots,
-                    time: branch.state.time,
+                Next::End {
                     fate,
-                    normalised: None,
-                    score: None,
-                });
+                    sigmas,
+                    indices,
+                    time,
+                } => {
+                    if fate == PathFate::TimeCap {
+                        result.warnings.push(OptimiseWarning::PathTimeCap {
+                            path: result.paths.len(),
+                        });
+                    }
+                    result.paths.push(ExploredPath {
+                        sigmas,
+                        indices,
+                        robots,
+                        time,
+                        fate,
+                        normalised: None,
+                        score: None,
+                    });
+                }
+                Next::Interrupted => {}
             }
         }
-        if cut > 0 {
-            result.warnings.push(OptimiseWarning::WallTimeBudget {
-                pending: stack.len() + cut,
-            });
-            break;
-        }
-    }
+        Ok(())
+    })?;
     choose(&mut result, &config.weights);
     Ok(result)
 }
@@ -611,43 +776,6 @@ pub fn path_time_limit(
 ) -> f64 {
     let straight = (segment.waypoint.position - start.position()).norm() / controller.gains().speed;
     (config.path_time_factor * straight + config.path_time_margin_s).min(config.max_path_time_s)
-}
-
-/// Fewest branches in a batch worth spreading over threads: below, the scoped threads'
-/// start-up (tens of µs each, more on a loaded machine) costs about what the few virtual
-/// robots of a small layout take (the bench: with up to 4 obstacles, Algorithm 2 took
-/// 0.4–2 ms on one thread and 1.4–17 ms on two, at a load of 4–5 other builds).
-pub const PARALLEL_MIN_BATCH: usize = 4;
-
-/// Simulates every branch of a batch to its next stop, on up to `threads` threads; the
-/// results come back in the batch's order.
-fn simulate_batch(
-    segment: &Segment<'_>,
-    config: &OptimiseConfig,
-    time_limit: f64,
-    batch: &[Branch],
-    threads: usize,
-    interrupt: &(dyn Fn() -> Option<Interrupt> + Sync),
-) -> Vec<Piece> {
-    let run = |b: &Branch| simulate(segment, config, time_limit, b.state.clone(), &b.sigmas, true, interrupt);
-    let workers = threads.min(batch.len());
-    if workers <= 1 || batch.len() < PARALLEL_MIN_BATCH {
-        return batch.iter().map(run).collect();
-    }
-    let chunk = batch.len().div_ceil(workers);
-    std::thread::scope(|scope| {
-        let handles: Vec<_> = batch
-            .chunks(chunk)
-            .map(|part| scope.spawn(move || part.iter().map(run).collect::<Vec<Piece>>()))
-            .collect();
-        handles
-            .into_iter()
-            .flat_map(|h| match h.join() {
-                Ok(pieces) => pieces,
-                Err(panic) => std::panic::resume_unwind(panic),
-            })
-            .collect()
-    })
 }
 
 /// Normalises the candidates and picks the best by Ψ_z with the tie rule.
