@@ -13,7 +13,10 @@
 //! 7. Go to 2.
 //!
 //! OPEN is a binary heap with lazy deletion: a state's entry is stale once the state is closed
-//! or re-entered under a newer generation number; both lists are one hash map on the key.
+//! or re-entered under a newer generation number. Both lists are one node store, indexed by a
+//! hash table of node numbers: a key is not stored but made again from the node's state when a
+//! lookup meets it, so the index costs 8 bytes a state, not the key's size
+//! ([`bytes_per_state`]).
 //!
 //! **Paths are exact**: each state of a returned path is its step applied to the state before
 //! it, as [`Problem::successors`] made it, not merely a state under the same key. Two states
@@ -62,8 +65,10 @@
 //! ```
 
 use std::cmp::Ordering;
-use std::collections::{BinaryHeap, HashMap};
-use std::hash::{BuildHasherDefault, Hash, Hasher};
+use std::collections::BinaryHeap;
+use std::hash::{Hash, Hasher};
+
+use hashbrown::HashTable;
 
 /// How often (in expansions) the stop callback is asked.
 pub const STOP_CHECK_EVERY: u32 = 256;
@@ -144,7 +149,7 @@ struct Node<S, St> {
     parent: u32,
     step: Option<St>,
     value: f64,
-    generation: u64,
+    generation: u32,
     goal: bool,
     closed: bool,
     /// Bumped each time re-parenting replaces the state.
@@ -154,13 +159,54 @@ struct Node<S, St> {
 }
 
 /// An OPEN entry: least f (on the [`VALUE_QUANTUM`] grid) first, then a goal, then the least
-/// `order`: the generation (oldest first) or its complement (newest first).
+/// `order`: the generation (oldest first) or its complement (newest first), from which the
+/// generation is also recovered ([`Order`]). 24 bytes.
 struct Entry {
     value: i64,
-    goal: bool,
-    generation: u64,
-    order: u64,
+    order: u32,
     node: u32,
+    goal: bool,
+}
+
+/// Generation numbers and the heap's order: equal (oldest first) or complements (newest first).
+#[derive(Clone, Copy)]
+struct Order {
+    newest: bool,
+}
+
+impl Order {
+    fn of(self, generation: u32) -> u32 {
+        if self.newest {
+            u32::MAX - generation
+        } else {
+            generation
+        }
+    }
+
+    /// The generation an entry was made under (the map is its own inverse).
+    fn generation(self, entry: &Entry) -> u32 {
+        self.of(entry.order)
+    }
+}
+
+/// An index slot: a node number and 32 bits of its key's hash, compared before the key is made
+/// again from the node's state.
+#[derive(Clone, Copy)]
+struct Slot {
+    node: u32,
+    hash: u32,
+}
+
+/// A key's hash: FxHash folded to 32 bits (kept in the slot), spread again for the table.
+fn key_hash<K: Hash>(key: &K) -> u32 {
+    let mut h = FxHasher::default();
+    key.hash(&mut h);
+    let full = h.finish();
+    (full >> 32) as u32 ^ full as u32
+}
+
+fn table_hash(hash: u32) -> u64 {
+    u64::from(hash).wrapping_mul(0x9e37_79b9_7f4a_7c15)
 }
 
 impl PartialEq for Entry {
@@ -183,6 +229,14 @@ impl Ord for Entry {
             .then(self.goal.cmp(&other.goal))
             .then(other.order.cmp(&self.order))
     }
+}
+
+/// Bytes a search stores per distinct state of problem `P`: its node, its index slot (with the
+/// table's control byte, at its load factor of 7/8) and one OPEN entry — the estimate the
+/// long-search bench prints; re-opened states add an OPEN entry each.
+pub fn bytes_per_state<P: Problem>() -> usize {
+    use std::mem::size_of;
+    size_of::<Node<P::State, P::Step>>() + (size_of::<Slot>() + 1) * 8 / 7 + size_of::<Entry>()
 }
 
 /// FxHash (rustc's): one multiply per word, ample for quantised integer keys.
@@ -239,16 +293,24 @@ pub fn search<P: Problem>(
     stop: &mut dyn FnMut() -> bool,
 ) -> SearchResult<P::State, P::Step> {
     let mut nodes: Vec<Node<P::State, P::Step>> = Vec::new();
-    let mut index: HashMap<P::Key, u32, BuildHasherDefault<FxHasher>> = HashMap::default();
+    let mut index: HashTable<Slot> = HashTable::new();
     let mut open = BinaryHeap::new();
-    let mut generation: u64 = 0;
+    let mut generation: u32 = 0;
     let (mut expanded, mut generated) = (0u32, 0u32);
     let mut succ: Vec<(P::Step, P::State)> = Vec::new();
 
     let f0 = problem.start_value(&start);
     let goal0 = problem.is_goal(&start);
     let mut best = (problem.remaining(&start), 0u32);
-    index.insert(problem.key(&start), 0);
+    let start_hash = key_hash(&problem.key(&start));
+    index.insert_unique(
+        table_hash(start_hash),
+        Slot {
+            node: 0,
+            hash: start_hash,
+        },
+        |s| table_hash(s.hash),
+    );
     nodes.push(Node {
         state: start,
         parent: u32::MAX,
@@ -260,13 +322,13 @@ pub fn search<P: Problem>(
         version: 0,
         parent_version: 0,
     });
-    let newest = problem.newest_first();
-    let order = |generation: u64| if newest { u64::MAX - generation } else { generation };
+    let order = Order {
+        newest: problem.newest_first(),
+    };
     open.push(Entry {
         value: rank(f0),
         goal: goal0,
-        generation,
-        order: order(generation),
+        order: order.of(generation),
         node: 0,
     });
 
@@ -277,7 +339,7 @@ pub fn search<P: Problem>(
             break SearchEnd::OpenEmpty;
         };
         let i = e.node as usize;
-        if nodes[i].closed || nodes[i].generation != e.generation {
+        if nodes[i].closed || nodes[i].generation != order.generation(&e) {
             continue; // stale entry: lazy deletion
         }
         // Steps 3–5.
@@ -308,17 +370,23 @@ pub fn search<P: Problem>(
         for (step, child) in succ.drain(..) {
             generated += 1;
             let key = problem.key(&child);
-            match index.get(&key) {
+            let hash = key_hash(&key);
+            let found = index
+                .find(table_hash(hash), |s| {
+                    s.hash == hash && nodes.get(s.node as usize).is_some_and(|n| problem.key(&n.state) == key)
+                })
+                .map(|s| s.node);
+            match found {
                 None => {
                     let f = problem.value(&nodes[i].state, parent_f, step, &child);
-                    generation += 1;
+                    generation = generation.wrapping_add(1);
                     let id = nodes.len() as u32;
                     let goal = problem.is_goal(&child);
                     let rem = problem.remaining(&child);
                     if rem < best.0 {
                         best = (rem, id);
                     }
-                    index.insert(key, id);
+                    index.insert_unique(table_hash(hash), Slot { node: id, hash }, |s| table_hash(s.hash));
                     nodes.push(Node {
                         state: child,
                         parent: i as u32,
@@ -333,12 +401,11 @@ pub fn search<P: Problem>(
                     open.push(Entry {
                         value: rank(f),
                         goal,
-                        generation,
-                        order: order(generation),
+                        order: order.of(generation),
                         node: id,
                     });
                 }
-                Some(&id) if id as usize != i => {
+                Some(id) if id as usize != i => {
                     // Whether the new path is better is judged on the state already stored
                     // under the key, so a state whose f does not depend on its path, as under
                     // (1), is never re-parented for the quantum's difference between two of its
@@ -349,7 +416,7 @@ pub fn search<P: Problem>(
                         // Re-parented, the node takes the state this step makes from its new
                         // parent, so the link is exact; its f is that state's.
                         let f = problem.value(&nodes[i].state, parent_f, step, &child);
-                        generation += 1;
+                        generation = generation.wrapping_add(1);
                         let n = &mut nodes[id as usize];
                         if n.state != child {
                             // The copy may lie on the other side of the goal's boundary.
@@ -366,8 +433,7 @@ pub fn search<P: Problem>(
                         open.push(Entry {
                             value: rank(f),
                             goal: n.goal,
-                            generation,
-                            order: order(generation),
+                            order: order.of(generation),
                             node: id,
                         });
                     }

@@ -17,8 +17,8 @@
 //!   once with `success` false and the reason ([`query_from_request`]); `max_expansions` above
 //!   `max_expansions_limit`, or above what `max_generated_states` allows, is capped to it (the
 //!   reason says so if the limit is hit);
-//! - a plan longer than `max_plan_states` is sent truncated, with `success` false and the
-//!   reason ([`reply_plan`]), so that no reply or `gait/plan` grows past what DDS carries;
+//! - a plan is sent whole by default; with `max_plan_states` set (not 0), a longer plan is sent
+//!   truncated, with `success` false and the reason ([`reply_plan`]);
 //! - a `goal_pose` in another frame, with NaN, beyond ±[`MAX_COORDINATE`] \[j\] or undecodable
 //!   is refused and logged; the walk under way, if any, stops where it is (a quadruped
 //!   standing on four feet is safe);
@@ -45,8 +45,7 @@ use thiserror::Error;
 
 /// Largest coordinate of a start or goal accepted, \[j\]: 333 body lengths, about 30 times the
 /// paper's experiment (15 \[j\]). A search toward a goal this far ends at its expansion,
-/// memory or time limit with a partial plan, truncated to `max_plan_states`; a walk gets there
-/// plan by plan.
+/// memory or time limit with a partial plan; a walk gets there plan by plan.
 pub const MAX_COORDINATE: f64 = 1000.0;
 
 /// A bound on the successors one expansion can generate with a rule set: two per rule. It is
@@ -71,7 +70,8 @@ pub struct NodeParams {
     /// Most states one search may generate (its memory): a search's expansions are capped to
     /// this over [`max_successors`] of its rule set.
     pub max_generated_states: u32,
-    /// Most states of a plan sent (a reply or `gait/plan`); a longer plan is truncated.
+    /// Most states of a plan sent (a reply or `gait/plan`); a longer plan is truncated. 0 (the
+    /// default): no limit, every plan is sent whole.
     pub max_plan_states: u32,
     /// Wall time one search may take before it is stopped with its best partial plan \[s\].
     pub time_limit_s: f64,
@@ -107,7 +107,7 @@ impl Default for NodeParams {
         NodeParams {
             max_expansions_limit: 1_000_000,
             max_generated_states: 2_000_000,
-            max_plan_states: 400,
+            max_plan_states: 0,
             time_limit_s: 2.0,
             unit_length: 1.0,
             frame: "odom".into(),
@@ -233,10 +233,10 @@ fn declare_node(d: &mut Decl<NodeParams>) {
     d.count(
         "max_plan_states",
         c.max_plan_states,
-        "most states of a plan sent in a reply or on gait/plan; a longer plan is truncated (success false)",
+        "most states of a plan sent in a reply or on gait/plan, a longer plan truncated (success false); 0: no limit",
         |c, v| c.max_plan_states = v,
     )
-    .within(2.0, 100_000.0);
+    .within(0.0, f64::from(u32::MAX));
     d.double(
         "time_limit_s",
         c.time_limit_s,
@@ -644,11 +644,15 @@ pub fn chunk_reason(plan: &Plan, cause: StopCause, time_limit_s: f64) -> String 
 }
 
 /// A plan as the message sent (a reply or `gait/plan`, header left default for the caller to
-/// stamp): at most `max_plan_states` states. A longer plan is truncated to its first
-/// `max_plan_states` states, `success` false, and the reason says so and what the whole plan
-/// was (the prefix is a valid walk, and a new request from its end continues it).
+/// stamp): the whole plan when `max_plan_states` is 0, else at most that many states. A longer
+/// plan is truncated to its first `max_plan_states` states, `success` false, and the reason says
+/// so and what the whole plan was (the prefix is a valid walk, and a new request from its end
+/// continues it).
 pub fn reply_plan(plan: &Plan, set: RuleSet, evaluation: Evaluation, reason: String, max_plan_states: u32) -> GaitPlan {
-    let keep = usize::try_from(max_plan_states.max(1)).unwrap_or(usize::MAX);
+    let keep = match max_plan_states {
+        0 => usize::MAX,
+        n => usize::try_from(n).unwrap_or(usize::MAX),
+    };
     let mut msg = GaitPlan {
         header: Header::default(),
         rule_set: set.to_string(),

@@ -435,9 +435,10 @@ fn the_params_file_sets_every_parameter_and_invalid_sets_are_refused() {
         (0.15, 0.5)
     );
     assert_eq!(cfg.node.max_expansions_limit, 1_000_000);
+    // Plans are sent whole by default.
     assert_eq!(
         (cfg.node.max_generated_states, cfg.node.max_plan_states),
-        (2_000_000, 400)
+        (2_000_000, 0)
     );
 
     let refused = |name: &str, value: ros2_client::ParameterValue| {
@@ -563,9 +564,11 @@ fn a_plan_longer_than_max_plan_states_is_sent_truncated() {
     assert!(msg
         .reason
         .ends_with("only the first 4 are sent (max_plan_states); EXPANSION_LIMIT: x"));
-    // Five states within a limit of 5: sent whole.
-    let msg = reply_plan(&reached, RuleSet::A, Evaluation::One, String::new(), 5);
-    assert_eq!((msg.steps.len(), msg.success, msg.reason.as_str()), (5, true, ""));
+    // Five states within a limit of 5, or no limit (0, the default): sent whole.
+    for limit in [5, 0] {
+        let msg = reply_plan(&reached, RuleSet::A, Evaluation::One, String::new(), limit);
+        assert_eq!((msg.steps.len(), msg.success, msg.reason.as_str()), (5, true, ""));
+    }
 }
 
 /// Least distance of the body centre inside the triangle of the three feet other than `leg`,
