@@ -308,14 +308,23 @@ fn notes(runs: &[Run]) -> String {
     let capped = runs.iter().filter(|r| r.capped).count();
     let unsafe_layouts = runs.iter().filter(|r| r.unsafe_layout).count();
     let mut parts = Vec::new();
+    let plural = |n: usize, one: &str, many: &str| format!("{n} {}", if n == 1 { one } else { many });
     if time_capped > 0 {
-        parts.push(format!("{time_capped} paths over the time limit"));
+        parts.push(plural(
+            time_capped,
+            "path over the time limit",
+            "paths over the time limit",
+        ));
     }
     if capped > 0 {
-        parts.push(format!("{capped} optimisations capped"));
+        parts.push(plural(capped, "optimisation capped", "optimisations capped"));
     }
     if unsafe_layouts > 0 {
-        parts.push(format!("{unsafe_layouts} layouts without a safe Σ"));
+        parts.push(plural(
+            unsafe_layouts,
+            "layout without a safe Σ",
+            "layouts without a safe Σ",
+        ));
     }
     parts.join(", ")
 }
