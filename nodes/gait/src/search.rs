@@ -283,6 +283,9 @@ pub fn rank(f: f64) -> i64 {
 /// `max_expansions` states have been expanded, or `stop()` returns true (asked every
 /// [`STOP_CHECK_EVERY`] expansions).
 ///
+/// Counts and node numbers are `u32`: a search must stay below 2^32 generated states (the
+/// node bounds it by `max_generated_states`; beyond, the tie order of older states would wrap).
+///
 /// The returned path is exact: each state is its step applied to the state before it, as
 /// [`Problem::successors`] made it (see the module's documentation for how re-parenting keeps
 /// this, and [`SearchResult::path`] for the rare goal whose path cannot be rebuilt).

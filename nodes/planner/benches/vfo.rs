@@ -330,15 +330,18 @@ fn notes(runs: &[Run]) -> String {
 }
 
 fn human(seconds: f64) -> String {
+    let year = 365.0 * 86400.0;
     if seconds < 120.0 {
         format!("{seconds:.0} s")
     } else if seconds < 7200.0 {
         format!("{:.0} min", seconds / 60.0)
     } else if seconds < 2.0 * 86400.0 {
         format!("{:.0} h", seconds / 3600.0)
-    } else if seconds < 2.0 * 365.0 * 86400.0 {
+    } else if seconds < 2.0 * year {
         format!("{:.0} days", seconds / 86400.0)
+    } else if seconds < 1e4 * year {
+        format!("{:.0} years", seconds / year)
     } else {
-        format!("{:.0} years", seconds / (365.0 * 86400.0))
+        format!("{:.0e} years", seconds / year)
     }
 }

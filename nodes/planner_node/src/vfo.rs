@@ -52,7 +52,7 @@ pub fn declare_vfo(d: &mut Decl<PlannerConfig>) {
         double "vfo.max_total_time_s" = o.max_total_time_s => vfo.optimise.max_total_time_s, above(0.0);
             "most simulated time over all virtual robots of one optimisation [s]";
         count "vfo.threads" = o.threads => vfo.optimise.threads, min(0.0);
-            "threads that simulate virtual robots (0: every core; the result is the same)";
+            "threads that simulate virtual robots (0, or more than the cores: every core; the result is the same)";
         double "vfo.influence_margin" = s.influence_margin => vfo.scan.influence_margin, above(0.0);
             "R − r of every obstacle seen [m]";
         double "vfo.cluster_gap" = s.cluster_gap => vfo.scan.cluster_gap, above(0.0);

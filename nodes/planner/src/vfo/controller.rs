@@ -326,10 +326,12 @@ pub fn integrate_unicycle(pose: &Pose2, v: f64, omega: f64, dt: f64) -> Pose2 {
     integrate_from(pose, pose.yaw.sin_cos(), v, omega, dt).0
 }
 
-/// [`integrate_unicycle`] with (sin, cos) of the pose's yaw given; also returns the new yaw's.
+/// [`integrate_unicycle`] with (sin, cos) of the pose's yaw given; also returns the new pose's
+/// (of its yaw as [`Pose2`] keeps it, wrapped, so that a simulation started from that pose
+/// computes the same values).
 pub(crate) fn integrate_from(pose: &Pose2, (sin, cos): (f64, f64), v: f64, omega: f64, dt: f64) -> (Pose2, (f64, f64)) {
     let turn = omega * dt;
-    let yaw = pose.yaw + turn;
+    let yaw = wrap(pose.yaw + turn);
     let next = yaw.sin_cos();
     if turn.abs() < 1e-9 {
         let (mid_sin, mid_cos) = (pose.yaw + 0.5 * turn).sin_cos();

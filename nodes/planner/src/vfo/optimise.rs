@@ -29,7 +29,7 @@
 //! σ = −1), and the caps and interrupts are checked before each virtual robot is taken from it,
 //! in that serial order. With `threads` > 1, helper threads simulate the branches ahead of it
 //! (the earliest in that order first) while the optimiser takes their results in order
-//! ([`speculate`](super::speculate)); a branch's simulation and children depend on the branch
+//! (the private module `speculate`); a branch's simulation and children depend on the branch
 //! alone, so the result (Σ, every virtual robot, every path, every warning) is the same for any
 //! number of threads, and what was simulated beyond a cap is thrown away. The helpers start
 //! after the first few virtual robots: a small segment is done before a thread starts.
@@ -78,8 +78,8 @@ pub struct OptimiseConfig {
     /// about a second of computation on one core at T_p = 0.01 s (the bench measures 11–14 µs
     /// per simulated second); the bench's 40-obstacle layouts need up to 57 000 s.
     pub max_total_time_s: f64,
-    /// Threads that simulate virtual robots; 0 = the machine's available parallelism. The result
-    /// does not depend on it (see the module docs). Default 0.
+    /// Threads that simulate virtual robots; 0 = the machine's available parallelism, which also
+    /// bounds a larger value. The result does not depend on it (see the module docs). Default 0.
     pub threads: usize,
     /// A point of a virtual robot's path is kept every this much path (m), for display. Default
     /// 0.05.
@@ -122,11 +122,13 @@ impl OptimiseConfig {
         Ok(())
     }
 
+    /// `threads`, at most the machine's available parallelism (more would only queue).
     fn thread_count(&self) -> usize {
+        let cores = std::thread::available_parallelism().map_or(1, NonZeroUsize::get);
         if self.threads > 0 {
-            self.threads
+            self.threads.min(cores)
         } else {
-            std::thread::available_parallelism().map_or(1, NonZeroUsize::get)
+            cores
         }
     }
 }

@@ -13,8 +13,10 @@
 //! coarse enough that one lock per task costs nothing measurable, and the queue must hand out
 //! the *earliest* item, which a work-stealing pool does not.
 
+use std::any::Any;
 use std::collections::{BinaryHeap, HashMap};
 use std::hash::Hash;
+use std::panic::AssertUnwindSafe;
 use std::sync::atomic::{AtomicBool, Ordering as AtomicOrdering};
 use std::sync::{Condvar, Mutex, MutexGuard, PoisonError};
 use std::thread::Scope;
@@ -55,8 +57,9 @@ struct State<W: Keyed, R> {
     done: HashMap<W::Key, R>,
     /// Items being worked.
     running: usize,
-    /// A helper panicked: its item's result will never come.
-    failed: bool,
+    /// A helper panicked (its payload, raised again in the caller's thread): its item's result
+    /// will never come.
+    failed: Option<Box<dyn Any + Send>>,
 }
 
 struct Shared<W: Keyed, R> {
@@ -104,8 +107,8 @@ pub(crate) struct Speculation<'scope, 'env, W: Keyed, R, F> {
     taken: usize,
 }
 
-/// Helpers start once the committer has taken this many results: a smaller job is done before
-/// a thread would have started (tens of microseconds each).
+/// Helpers start at the committer's request for this result (the first being 1): a smaller job
+/// is done before a thread would have started (tens of microseconds each).
 pub(crate) const HELPERS_AFTER: usize = 8;
 
 impl<'scope, 'env, W, R, F> Speculation<'scope, 'env, W, R, F>
@@ -116,13 +119,20 @@ where
 {
     /// The result for `key`, an item queued or worked already (the first item, or one yielded
     /// by a result taken before). `None` if it can never come: a helper panicked (the panic is
-    /// raised again when the threads are joined) or no such item exists.
+    /// raised again in the caller's thread when [`speculate`] returns) or no such item exists.
     pub(crate) fn take(&mut self, key: &W::Key) -> Option<R> {
         self.taken += 1;
         if self.taken == HELPERS_AFTER {
             for _ in 0..std::mem::take(&mut self.helpers) {
                 let (shared, work) = (self.shared, self.work);
-                self.scope.spawn(move || help(shared, work));
+                // A thread the system refuses leaves the work to the others.
+                if std::thread::Builder::new()
+                    .name("vfo-helper".into())
+                    .spawn_scoped(self.scope, move || help(shared, work))
+                    .is_err()
+                {
+                    break;
+                }
             }
         }
         let mut state = self.shared.lock();
@@ -130,7 +140,7 @@ where
             if let Some(result) = state.done.remove(key) {
                 return Some(result);
             }
-            if state.failed {
+            if state.failed.is_some() {
                 return None;
             }
             if let Some(Queued(item)) = state.queue.pop() {
@@ -150,19 +160,16 @@ where
     }
 }
 
-/// A helper thread: works the earliest queued item until the committer closes.
+/// A helper thread: works the earliest queued item until the committer closes. A panic is
+/// kept for the caller's thread, and the committer told not to wait for this thread's result.
 fn help<W: Keyed, R, F: Fn(W, &AtomicBool) -> (R, Vec<W>)>(shared: &Shared<W, R>, work: &F) {
-    // On a panic the committer must not wait for this thread's result.
-    struct Failed<'a, W: Keyed, R>(&'a Shared<W, R>);
-    impl<W: Keyed, R> Drop for Failed<'_, W, R> {
-        fn drop(&mut self) {
-            if std::thread::panicking() {
-                self.0.lock().failed = true;
-                self.0.changed.notify_all();
-            }
-        }
+    if let Err(payload) = std::panic::catch_unwind(AssertUnwindSafe(|| help_until_closed(shared, work))) {
+        shared.lock().failed.get_or_insert(payload);
+        shared.changed.notify_all();
     }
-    let _failed = Failed(shared);
+}
+
+fn help_until_closed<W: Keyed, R, F: Fn(W, &AtomicBool) -> (R, Vec<W>)>(shared: &Shared<W, R>, work: &F) {
     loop {
         let item = {
             let mut state = shared.lock();
@@ -203,12 +210,12 @@ where
             queue: BinaryHeap::from([Queued(first)]),
             done: HashMap::new(),
             running: 0,
-            failed: false,
+            failed: None,
         }),
         changed: Condvar::new(),
         closed: AtomicBool::new(false),
     };
-    std::thread::scope(|scope| {
+    let out = std::thread::scope(|scope| {
         // Closes on the way out, a panic included, so the helpers end and the scope can join.
         struct Close<'a, W: Keyed, R>(&'a Shared<W, R>);
         impl<W: Keyed, R> Drop for Close<'_, W, R> {
@@ -225,7 +232,11 @@ where
             taken: 0,
         };
         commit(&mut speculation)
-    })
+    });
+    if let Some(payload) = shared.lock().failed.take() {
+        std::panic::resume_unwind(payload);
+    }
+    out
 }
 
 #[cfg(test)]
@@ -344,6 +355,11 @@ mod tests {
                 }
             })
         });
-        assert!(outcome.is_err(), "the panic was lost");
+        let payload = outcome.expect_err("the panic was lost");
+        let message = payload
+            .downcast_ref::<String>()
+            .map(String::as_str)
+            .or_else(|| payload.downcast_ref::<&str>().copied());
+        assert_eq!(message, Some("helper failed"));
     }
 }
