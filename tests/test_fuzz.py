@@ -84,7 +84,8 @@ REACTION = 0.4
 
 def status_after(status: Any, t: float) -> ChassisStatus:
     """The first chassis status published after the time ``t`` (the host's clock)."""
-    return status.wait_for(lambda st: stamp_s(st) > t, timeout=2.0, start=max(0, len(status) - 5))
+    # The wait is long for a loaded machine (the check on the reaction is on the stamps).
+    return status.wait_for(lambda st: stamp_s(st) > t, timeout=5.0, start=max(0, len(status) - 5))
 
 
 def settled(node: Any, cmd: Any, status: Any, vx: float) -> Optional[ChassisStatus]:
@@ -177,9 +178,10 @@ def test_fuzz_cmd_vel_every_bad_command_stops_the_wheels(start_node, ros_node, t
                 fuzz.count("bad cmd_vel")
             fuzz.count("good cmd_vel")
             try:
-                stopped = wheels.wait_for(zero, timeout=1.0, start=start)
+                # Long for a loaded machine: the reaction is checked on the stamps below.
+                stopped = wheels.wait_for(zero, timeout=3.0, start=start)
             except TimeoutError:
-                fuzz.fail("the wheels were not stopped within 1 s")
+                fuzz.fail("the wheels were not stopped within 3 s")
                 if fuzz.repeated(3):
                     break
                 continue
@@ -221,7 +223,7 @@ def test_fuzz_cmd_vel_every_bad_command_stops_the_wheels(start_node, ros_node, t
             start, sent_at = len(wheels), time.time()
             cmd.publish(bad_twist(rng))
             try:
-                stopped = wheels.wait_for(zero, timeout=1.0, start=start)
+                stopped = wheels.wait_for(zero, timeout=3.0, start=start)
                 time.sleep(0.03)
                 fuzz.check(stamp_s(stopped) - sent_at < REACTION, "the wheels were stopped late")
                 late = [m for m in wheels.snapshot()[start:] if stamp_s(m) > sent_at + REACTION and not zero(m)]
