@@ -479,7 +479,7 @@ fn the_result_does_not_depend_on_the_number_of_threads() {
         |config: OptimiseConfig| find_sigmas(&Pose2::identity(), &controller(), &segment, &config).expect("valid");
     let full = OptimiseConfig::default();
     let one = run(OptimiseConfig { threads: 1, ..full });
-    // Helpers start after the first eight virtual robots.
+    // Helpers start at the eighth virtual robot.
     assert!(one.robots.len() > 30, "too few virtual robots: {}", one.robots.len());
     for threads in [2, 3, 4] {
         assert_eq!(one, run(OptimiseConfig { threads, ..full }), "{threads} threads");

@@ -191,7 +191,7 @@ fn help_until_closed<W: Keyed, R, F: Fn(W, &AtomicBool) -> (R, Vec<W>)>(shared: 
 }
 
 /// Runs `commit` with a [`Speculation`] seeded with `first`, on up to `threads` threads (the
-/// caller's and `threads − 1` helpers, started after [`HELPERS_AFTER`] results). `work` gets
+/// caller's and `threads − 1` helpers, started at the [`HELPERS_AFTER`]th request). `work` gets
 /// an item and the flag that says the committer has finished (its result is then thrown away,
 /// so it may stop early) and returns its result and the items it yields.
 pub(crate) fn speculate<W, R, F, T>(
