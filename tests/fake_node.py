@@ -19,6 +19,7 @@ rosutil.setup_process_environment()
 import rclpy  # noqa: E402
 from rcl_interfaces.msg import SetParametersResult  # noqa: E402
 from rclpy.executors import ExternalShutdownException  # noqa: E402
+from rclpy._rclpy_pybind11 import RCLError  # noqa: E402
 from rclpy.node import Node  # noqa: E402
 from std_msgs.msg import String  # noqa: E402
 
@@ -44,7 +45,13 @@ class FakeNode(Node):
 
     def tick(self) -> None:
         self.count += 1
-        self.pub.publish(String(data=f"{self.get_parameter('prefix').value} {self.count}"))
+        try:
+            self.pub.publish(String(data=f"{self.get_parameter('prefix').value} {self.count}"))
+        except RCLError:
+            # SIGINT shuts the context down under a timer callback already running: the node
+            # is stopping, not failing (a CI run once exited 1 here).
+            if rclpy.ok():
+                raise
 
 
 def main() -> int:
