@@ -527,6 +527,20 @@ mod tests {
     );
   }
 
+  // Loopback's MTU of 65 536 would allow a 65 508-byte UDP payload, above
+  // IPv4's 65 507 and Fast DDS's 65 500: the budget stops at a 65 500-byte
+  // payload, 65 480 bytes after the 20-byte RTPS header.
+  #[test]
+  fn path_mtu_is_capped_at_the_largest_udp_payload() {
+    let ifaces = vec![iface_v4(127, 0, 0, 1, 8, 65536, true)];
+    assert_eq!(path_mtu_payload_for_peer(&ifaces, v4(127, 0, 0, 1)), 65_480);
+    // Just under the cap, the MTU still decides: 65 528 − 48.
+    let ifaces = vec![iface_v4(127, 0, 0, 1, 8, 65528, true)];
+    assert_eq!(path_mtu_payload_for_peer(&ifaces, v4(127, 0, 0, 1)), 65_480);
+    let ifaces = vec![iface_v4(127, 0, 0, 1, 8, 65527, true)];
+    assert_eq!(path_mtu_payload_for_peer(&ifaces, v4(127, 0, 0, 1)), 65_479);
+  }
+
   // A peer not in any local subnet is assumed to be behind a router: use the
   // conservative Ethernet default.
   #[test]

@@ -362,54 +362,47 @@ impl RtpsReaderProxy {
   }
 
   /// Recompute this reader's
-  /// [`max_datagram_payload`](Self::max_datagram_payload) from its advertised
-  /// unicast locators and the local interface table.
+  /// [`max_datagram_payload`](Self::max_datagram_payload) from the
+  /// destinations its [`SendRoute`] sends to and the local interface table.
+  /// Call it after [`resolve_send_route`](Self::resolve_send_route).
   ///
-  /// We take the minimum budget over all of the reader's unicast locators
-  /// (including the loopback bucket) so that whichever path the [`SendRoute`]
-  /// ends up using, the datagram fits. A loopback locator resolves to the
-  /// (typically large) loopback-interface MTU, so it never lowers the minimum;
-  /// its only effect is to give a same-host-only peer (which advertises *only*
-  /// loopback) the large loopback budget instead of the conservative default.
-  /// When the reader advertises no unicast locators at all, we keep the
-  /// default.
+  /// The budget must fit every destination a datagram built for this reader
+  /// goes to, so it is the minimum over them:
   ///
-  /// # Design note: current vs. ideal (future work)
+  /// * A narrowed route (`fallback: false`) sends only to its unicast locator
+  ///   and/or its multicast locator, so only those count. In particular a
+  ///   same-host peer routed over loopback gets the loopback-interface MTU even
+  ///   when it also advertises a LAN address of smaller MTU: the LAN address is
+  ///   never sent to. A multicast destination matches no local subnet and so
+  ///   always counts at the conservative default.
+  /// * The legacy route (`fallback: true`) may send to every advertised unicast
+  ///   locator, so all of them count (loopback included: it never lowers the
+  ///   minimum, and it gives a peer that advertises *only* loopback the large
+  ///   loopback budget instead of the default).
   ///
-  /// What could be improved: today a peer only gets a larger-than-fallback
-  /// budget if *every* advertised unicast address clears the bar (IPv4,
-  /// same-subnet as a local interface, OS-reported MTU > 1500), or if it
-  /// advertises loopback only. Ideally it should suffice that the *single
-  /// locator we actually send to* has a large MTU (e.g. one jumbo-frame
-  /// same-subnet address should win even when the peer also advertises an
-  /// ordinary 1500-MTU address).
-  ///
-  /// Why we take the conservative `min` now: the budget is a single per-reader
-  /// scalar, fixed here and consumed at message-build time, and the resulting
-  /// datagram can legitimately be sent to *all* of the peer's locators (the
-  /// `SendRoute { fallback: true }` path in `Writer::send_message_to_readers`,
-  /// and the multicast-to-all path via `min_datagram_payload`). So it must fit
-  /// the smallest MTU among them; an overestimate would cause IP fragmentation
-  /// on the copies aimed at the smaller-MTU locators.
-  ///
-  /// Three things missing before "some locator suffices" would be correct:
-  /// 1. MTU resolved *per chosen route/locator* rather than as this per-reader
-  ///    `min` scalar decoupled from route selection.
-  /// 2. A route selector that *deterministically prefers* the large-MTU locator
-  ///    (today `DefaultRouteSelector::select_unicast` narrows by observed
-  ///    source IP, not by subnet/MTU, and otherwise falls back to all
-  ///    locators).
-  /// 3. A guarantee that a datagram built with the larger budget is sent to
-  ///    *only* that one locator (today the fallback and multicast-to-all paths
-  ///    reuse one datagram across many locators).
+  /// With no UDP destination at all, the default stays. Datagrams packed for
+  /// several readers at once use the writer-wide minimum of these budgets.
   pub fn resolve_path_mtu(&mut self, local_interfaces: &[IfAddr]) {
-    let budget = self
-      .unicast_locator_list
-      .iter()
-      .chain(self.loopback_unicast_locators.iter())
-      .filter(|l| l.is_udp())
-      .map(|l| path_mtu_payload_for_peer(local_interfaces, SocketAddr::from(*l).ip()))
-      .min();
+    let budget_of =
+      |l: &Locator| path_mtu_payload_for_peer(local_interfaces, SocketAddr::from(*l).ip());
+    let budget = if self.send_route.fallback {
+      self
+        .unicast_locator_list
+        .iter()
+        .chain(self.loopback_unicast_locators.iter())
+        .filter(|l| l.is_udp())
+        .map(budget_of)
+        .min()
+    } else {
+      self
+        .send_route
+        .unicast
+        .iter()
+        .chain(self.send_route.multicast.iter().map(|(l, _)| l))
+        .filter(|l| l.is_udp())
+        .map(budget_of)
+        .min()
+    };
     self.max_datagram_payload = budget.unwrap_or(FALLBACK_MAX_AGGREGATED_DATAGRAM_SIZE);
   }
 
@@ -908,5 +901,107 @@ mod route_tests {
     let route = rp.send_route();
     assert!(!route.fallback);
     assert_eq!(route.unicast, Some(udp([127, 0, 0, 1], 7413)));
+  }
+
+  // The local interfaces of the path-MTU tests: loopback (MTU 65536) and a
+  // LAN interface 10.0.0.1/24 of MTU 1400.
+  fn interfaces() -> Vec<IfAddr> {
+    let v4 = |ip: [u8; 4]| IpAddr::V4(Ipv4Addr::new(ip[0], ip[1], ip[2], ip[3]));
+    vec![
+      IfAddr {
+        ip: v4([127, 0, 0, 1]),
+        index: 1,
+        is_loopback: true,
+        is_multicast: false,
+        netmask: Some(Ipv4Addr::new(255, 0, 0, 0)),
+        mtu: Some(65536),
+      },
+      IfAddr {
+        ip: v4([10, 0, 0, 1]),
+        index: 2,
+        is_loopback: false,
+        is_multicast: true,
+        netmask: Some(Ipv4Addr::new(255, 255, 255, 0)),
+        mtu: Some(1400),
+      },
+    ]
+  }
+
+  // A same-host peer advertising loopback and a LAN address.
+  fn same_host_peer(observed_from: Ipv4Addr) -> RtpsReaderProxy {
+    let prefix = GuidPrefix::new(&[6; 12]);
+    let mut rp = proxy_with_prefix(prefix);
+    rp.unicast_locator_list = vec![udp([10, 0, 0, 5], 7413)];
+    rp.loopback_unicast_locators = vec![udp([127, 0, 0, 1], 7413)];
+    let mut observations = InterfaceObservations::new();
+    observations.record(
+      prefix,
+      None,
+      SocketAddr::new(IpAddr::V4(observed_from), 7410),
+    );
+    rp.resolve_send_route(&observations, &[], &DefaultRouteSelector::default());
+    rp
+  }
+
+  #[test]
+  fn a_loopback_route_gets_the_loopback_mtu() {
+    // Routed over loopback, the peer's 1400-MTU LAN address is never sent to,
+    // so it does not lower the budget: loopback's, a UDP payload of at most
+    // 65 500 bytes less the 20-byte RTPS header.
+    let mut rp = same_host_peer(Ipv4Addr::LOCALHOST);
+    assert_eq!(rp.send_route().unicast, Some(udp([127, 0, 0, 1], 7413)));
+    rp.resolve_path_mtu(&interfaces());
+    assert_eq!(rp.max_datagram_payload(), 65_480);
+  }
+
+  #[test]
+  fn the_legacy_route_gets_the_smallest_mtu_of_all_locators() {
+    // No observation: the fallback route may send to every locator, the LAN
+    // one included, so its 1400 − 48 bytes bound the budget.
+    let mut rp = proxy_with_prefix(GuidPrefix::new(&[4; 12]));
+    rp.unicast_locator_list = vec![udp([10, 0, 0, 5], 7413)];
+    rp.loopback_unicast_locators = vec![udp([127, 0, 0, 1], 7413)];
+    assert!(rp.send_route().fallback);
+    rp.resolve_path_mtu(&interfaces());
+    assert_eq!(rp.max_datagram_payload(), 1400 - 48);
+  }
+
+  #[test]
+  fn a_lan_route_gets_the_lan_mtu() {
+    // Seen from its LAN address (not from loopback): routed there, with the
+    // LAN interface's budget.
+    let mut rp = same_host_peer(Ipv4Addr::new(10, 0, 0, 5));
+    assert_eq!(rp.send_route().unicast, Some(udp([10, 0, 0, 5], 7413)));
+    rp.resolve_path_mtu(&interfaces());
+    assert_eq!(rp.max_datagram_payload(), 1400 - 48);
+  }
+
+  #[test]
+  fn a_route_with_multicast_gets_the_default_budget() {
+    // A multicast destination matches no local subnet: the conservative
+    // default bounds the budget, below the LAN interface's.
+    let prefix = GuidPrefix::new(&[3; 12]);
+    let mut rp = proxy_with_prefix(prefix);
+    rp.unicast_locator_list = vec![udp([10, 0, 0, 5], 7410)];
+    rp.multicast_locator_list = vec![udp([239, 255, 0, 1], 7401)];
+    let mut observations = InterfaceObservations::new();
+    observations.record(
+      prefix,
+      Some(iface([10, 0, 0, 1])),
+      SocketAddr::new(IpAddr::V4(Ipv4Addr::new(10, 0, 0, 5)), 7410),
+    );
+    rp.resolve_send_route(
+      &observations,
+      &[iface([10, 0, 0, 1])],
+      &DefaultRouteSelector::default(),
+    );
+    assert!(rp.send_route().multicast.is_some());
+    let mut jumbo = interfaces();
+    jumbo[1].mtu = Some(9000);
+    rp.resolve_path_mtu(&jumbo);
+    assert_eq!(
+      rp.max_datagram_payload(),
+      FALLBACK_MAX_AGGREGATED_DATAGRAM_SIZE
+    );
   }
 }
