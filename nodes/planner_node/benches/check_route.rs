@@ -10,7 +10,10 @@
 //! domain of its own, waits for the first answer (discovery), sends 20 calls to warm up, then
 //! times 300 calls one after the other. The node's answer must equal the in-process one (the
 //! same work). Reported: the in-process median (library check alone, and with the answer and
-//! reply message), the round trip's p50 / p90 / p99, and the ratio of the medians.
+//! reply message), the reply's CDR encoding and decoding in-process, the round trip's p50 / p90 /
+//! p99, and the ratio of the medians. Interleaved with those calls, two more kinds show where the
+//! rest goes: a request refused at once (no check, a reply of a few bytes: DDS's floor) and a
+//! 1-waypoint route (the hand-offs to the node's check pool and back, a small reply).
 
 #[path = "../../planner/benches/common/demo_loop.rs"]
 mod demo_loop;
@@ -138,6 +141,16 @@ fn main() -> anyhow::Result<()> {
     let in_process = time_median(&|| {
         std::hint::black_box(local());
     });
+    // The reply's CDR encoding (on the node) and decoding (on the client), as the service
+    // layer does them: measured apart, they are part of the transfer, not of the node's work.
+    let encode = || cdr_encoding::to_vec::<_, byteorder::LittleEndian>(&expected).expect("a reply encodes");
+    let encoded = encode();
+    let encode_time = time_median(&|| {
+        std::hint::black_box(encode());
+    });
+    let decode_time = time_median(&|| {
+        std::hint::black_box(cdr_encoding::from_bytes::<CheckRouteResponse, byteorder::LittleEndian>(&encoded).ok());
+    });
 
     let runtime = tokio::runtime::Builder::new_multi_thread().enable_all().build()?;
     let trips = runtime.block_on(async {
@@ -181,9 +194,26 @@ fn main() -> anyhow::Result<()> {
         // The floor: a request the node refuses at once (a NaN start), a reply of a few bytes.
         let mut refused = request.clone();
         refused.start.position.x = f64::NAN;
-        let mut trips = [Vec::with_capacity(CALLS), Vec::with_capacity(CALLS)];
+        // A check of a single waypoint 0.3 m ahead: the hand-offs to the node's check pool and
+        // back, with a small reply.
+        let mut short = request.clone();
+        short.route.poses.truncate(1);
+        short.route.poses[0].pose = pose_msg(&Pose2::new(0.3, 0.0, 0.0));
+        let answer = tokio::time::timeout(Duration::from_secs(5), client.async_call_service(short.clone()))
+            .await
+            .map_err(|_| anyhow::anyhow!("the 1-waypoint call: no answer in 5 s"))?
+            .map_err(|e| anyhow::anyhow!("the 1-waypoint call: {e:?}"))?;
+        anyhow::ensure!(
+            answer.feasible && !answer.simulated_path.poses.is_empty(),
+            "the 1-waypoint route was not checked: {answer:?}"
+        );
+        let mut trips = [
+            Vec::with_capacity(CALLS),
+            Vec::with_capacity(CALLS),
+            Vec::with_capacity(CALLS),
+        ];
         for k in 0..WARM_UP + CALLS {
-            for (times, req) in trips.iter_mut().zip([&request, &refused]) {
+            for (times, req) in trips.iter_mut().zip([&request, &refused, &short]) {
                 let t0 = Instant::now();
                 let reply = tokio::time::timeout(Duration::from_secs(5), client.async_call_service(req.clone()))
                     .await
@@ -198,9 +228,10 @@ fn main() -> anyhow::Result<()> {
         node.shutdown().await;
         anyhow::Ok(trips)
     })?;
-    let [mut trips, mut floor] = trips;
-    trips.sort_by(f64::total_cmp);
-    floor.sort_by(f64::total_cmp);
+    let [mut trips, mut floor, mut short] = trips;
+    for t in [&mut trips, &mut floor, &mut short] {
+        t.sort_by(f64::total_cmp);
+    }
     let p50 = percentile(&trips, 0.5);
     println!(
         "planner/check_route, 20 waypoints, MOBIL-II, built-in world; reply {} poses, {} problems",
@@ -213,6 +244,10 @@ fn main() -> anyhow::Result<()> {
     println!("| in-process: the check alone | {check_alone:.3} | | |");
     println!("| in-process: check, answer, reply message | {in_process:.3} | | |");
     println!(
+        "| in-process: the reply's CDR encoding / decoding ({} bytes) | {encode_time:.3} / {decode_time:.3} | | |",
+        encoded.len()
+    );
+    println!(
         "| Rust client, round trip ({CALLS} calls) | {p50:.3} | {:.3} | {:.3} |",
         percentile(&trips, 0.9),
         percentile(&trips, 0.99)
@@ -222,6 +257,12 @@ fn main() -> anyhow::Result<()> {
         percentile(&floor, 0.5),
         percentile(&floor, 0.9),
         percentile(&floor, 0.99)
+    );
+    println!(
+        "| Rust client, a 1-waypoint route 0.3 m ahead | {:.3} | {:.3} | {:.3} |",
+        percentile(&short, 0.5),
+        percentile(&short, 0.9),
+        percentile(&short, 0.99)
     );
     println!();
     println!("round trip / in-process: {:.2}×", p50 / in_process);
