@@ -137,6 +137,21 @@ pub fn path_mtu_payload_for_peer(ifaces: &[IfAddr], peer_ip: IpAddr) -> usize {
   FALLBACK_MAX_AGGREGATED_DATAGRAM_SIZE
 }
 
+/// The budget of a datagram sent to a multicast group out of the local
+/// interface `iface_ip`: that interface's MTU (minus headers), at most
+/// [`FALLBACK_MAX_AGGREGATED_DATAGRAM_SIZE`] (the group may span routers whose
+/// MTU is unknown). An interface not in the table, or of unknown MTU, gets the
+/// default.
+pub fn multicast_payload_via(ifaces: &[IfAddr], iface_ip: IpAddr) -> usize {
+  ifaces
+    .iter()
+    .find(|ifa| ifa.ip == iface_ip)
+    .and_then(|ifa| ifa.mtu)
+    .map_or(FALLBACK_MAX_AGGREGATED_DATAGRAM_SIZE, |mtu| {
+      payload_budget_for_mtu(mtu).min(FALLBACK_MAX_AGGREGATED_DATAGRAM_SIZE)
+    })
+}
+
 /// True when `local` and `peer` share the IPv4 subnet defined by `mask`.
 fn same_subnet_v4(local: Ipv4Addr, mask: Ipv4Addr, peer: Ipv4Addr) -> bool {
   let m = u32::from(mask);
@@ -311,7 +326,8 @@ mod tests {
 
   use super::{
     build_ifindex_map_inner, get_local_multicast_ip_addrs_inner, get_local_unicast_locators_inner,
-    localhost_spdp_peer_locators, path_mtu_payload_for_peer, IfAddr, InterfaceSelector,
+    localhost_spdp_peer_locators, multicast_payload_via, path_mtu_payload_for_peer, IfAddr,
+    InterfaceSelector,
   };
   use crate::{
     network::constant::spdp_well_known_unicast_port,
@@ -527,18 +543,36 @@ mod tests {
     );
   }
 
-  // Loopback's MTU of 65 536 would allow a 65 508-byte UDP payload, above
-  // IPv4's 65 507 and Fast DDS's 65 500: the budget stops at a 65 500-byte
-  // payload, 65 480 bytes after the 20-byte RTPS header.
+  // Loopback's MTU of 65 536 would give a budget of 65 488 bytes; it stops at
+  // 64 476 (65 500, the receivers' limit, less a 1 024-byte reserve for what
+  // the writer does not count against it).
   #[test]
-  fn path_mtu_is_capped_at_the_largest_udp_payload() {
+  fn path_mtu_is_capped_below_the_largest_udp_payload() {
     let ifaces = vec![iface_v4(127, 0, 0, 1, 8, 65536, true)];
-    assert_eq!(path_mtu_payload_for_peer(&ifaces, v4(127, 0, 0, 1)), 65_480);
-    // Just under the cap, the MTU still decides: 65 528 − 48.
-    let ifaces = vec![iface_v4(127, 0, 0, 1, 8, 65528, true)];
-    assert_eq!(path_mtu_payload_for_peer(&ifaces, v4(127, 0, 0, 1)), 65_480);
-    let ifaces = vec![iface_v4(127, 0, 0, 1, 8, 65527, true)];
-    assert_eq!(path_mtu_payload_for_peer(&ifaces, v4(127, 0, 0, 1)), 65_479);
+    assert_eq!(path_mtu_payload_for_peer(&ifaces, v4(127, 0, 0, 1)), 64_476);
+    // At and just under the cap, the MTU decides: 64 524 − 48, 64 523 − 48.
+    let ifaces = vec![iface_v4(127, 0, 0, 1, 8, 64524, true)];
+    assert_eq!(path_mtu_payload_for_peer(&ifaces, v4(127, 0, 0, 1)), 64_476);
+    let ifaces = vec![iface_v4(127, 0, 0, 1, 8, 64523, true)];
+    assert_eq!(path_mtu_payload_for_peer(&ifaces, v4(127, 0, 0, 1)), 64_475);
+  }
+
+  // Multicast out of an interface: its MTU, at most the default.
+  #[test]
+  fn multicast_budget_is_the_interface_mtu_at_most_the_default() {
+    let ifaces = vec![
+      iface_v4(10, 0, 0, 1, 24, 1400, false),
+      iface_v4(10, 1, 0, 1, 24, 9000, false),
+    ];
+    assert_eq!(multicast_payload_via(&ifaces, v4(10, 0, 0, 1)), 1400 - 48);
+    assert_eq!(
+      multicast_payload_via(&ifaces, v4(10, 1, 0, 1)),
+      FALLBACK_MAX_AGGREGATED_DATAGRAM_SIZE
+    );
+    assert_eq!(
+      multicast_payload_via(&ifaces, v4(10, 2, 0, 1)),
+      FALLBACK_MAX_AGGREGATED_DATAGRAM_SIZE
+    );
   }
 
   // A peer not in any local subnet is assumed to be behind a router: use the

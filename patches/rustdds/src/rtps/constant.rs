@@ -109,31 +109,33 @@ pub const DATAGRAM_HEADER_OVERHEAD: usize = 48;
 // into each DATAFRAG submessage / datagram, never the fragment size itself.
 pub const FRAGMENT_SIZE: usize = 256;
 
-// The largest UDP payload (RTPS message) sent whatever the interface MTU:
-// 65 500 bytes, the largest message Fast DDS receives by default
-// (`maxMessageSize`), below IPv4's own limit of 65 507 (65 535 - IPv4 20 - UDP
-// 8). Loopback's MTU of 65 536 would otherwise give datagrams the kernel
-// refuses (EMSGSIZE) and that Fast DDS truncates.
-pub const MAX_UDP_PAYLOAD: usize = 65_500;
-
-// Size of the RTPS message header, the part of `DATAGRAM_HEADER_OVERHEAD`
-// inside the UDP payload.
-const RTPS_HEADER_SIZE: usize = 20;
+// The largest budget whatever the interface MTU. A receiver takes UDP payloads
+// (RTPS messages) of at most 65 500 bytes: Fast DDS's default
+// `maxMessageSize`, below IPv4's own 65 507 (65 535 - IPv4 20 - UDP 8), above
+// which the kernel refuses the datagram (EMSGSIZE). The writer checks only part
+// of a datagram against the budget: the unfragmented-or-fragmented decision
+// leaves out the RTPS header, INFO_TS, INFO_DST and a DATA's inline QoS (a
+// service reply's related sample identity alone is 60 bytes), and a run of
+// DATAFRAGs that ends the sample leaves out the inline QoS. A datagram may
+// therefore exceed its budget by a few hundred bytes: harmless IP
+// fragmentation at an ordinary MTU, a lost datagram at 64 KiB. So the budget
+// stops 1 KiB below the receivers' limit: 64 476 bytes, where loopback's MTU of
+// 65 536 would give 65 488.
+pub const MAX_DATAGRAM_BUDGET: usize = 65_500 - 1_024;
 
 /// Convert an interface MTU into the RTPS-message (UDP payload) budget usable
 /// for submessage/fragment packing: `mtu - DATAGRAM_HEADER_OVERHEAD`, at most
-/// [`MAX_UDP_PAYLOAD`] less the RTPS header, and floored so a pathologically
-/// small MTU still yields a usable (if tiny) budget. The caller always emits at
-/// least the first submessage even if it exceeds the budget, so an
-/// underestimate degrades to one submessage per datagram rather than dropping
-/// data.
+/// [`MAX_DATAGRAM_BUDGET`], and floored so a pathologically small MTU still
+/// yields a usable (if tiny) budget. The caller always emits at least the first
+/// submessage even if it exceeds the budget, so an underestimate degrades to
+/// one submessage per datagram rather than dropping data.
 pub const fn payload_budget_for_mtu(mtu: u32) -> usize {
   let mtu = mtu as usize;
   if mtu <= DATAGRAM_HEADER_OVERHEAD {
     // Nonsensical / tiny MTU: fall back to a minimal but non-zero budget.
     64
-  } else if mtu - DATAGRAM_HEADER_OVERHEAD > MAX_UDP_PAYLOAD - RTPS_HEADER_SIZE {
-    MAX_UDP_PAYLOAD - RTPS_HEADER_SIZE
+  } else if mtu - DATAGRAM_HEADER_OVERHEAD > MAX_DATAGRAM_BUDGET {
+    MAX_DATAGRAM_BUDGET
   } else {
     mtu - DATAGRAM_HEADER_OVERHEAD
   }

@@ -12,7 +12,7 @@ use crate::{
   dds::{participant::DomainParticipant, qos::QosPolicies},
   discovery::sedp_messages::DiscoveredReaderData,
   messages::submessages::submessage::AckSubmessage,
-  network::util::{path_mtu_payload_for_peer, IfAddr},
+  network::util::{multicast_payload_via, path_mtu_payload_for_peer, IfAddr},
   rtps::{
     constant::*,
     transmit::{InterfaceObservations, InterfaceSelector, RouteSelector, SendRoute},
@@ -367,40 +367,46 @@ impl RtpsReaderProxy {
   /// Call it after [`resolve_send_route`](Self::resolve_send_route).
   ///
   /// The budget must fit every destination a datagram built for this reader
-  /// goes to, so it is the minimum over them:
+  /// goes to (`Writer::send_message_to_readers`), so it is the smallest over
+  /// them:
   ///
-  /// * A narrowed route (`fallback: false`) sends only to its unicast locator
-  ///   and/or its multicast locator, so only those count. In particular a
-  ///   same-host peer routed over loopback gets the loopback-interface MTU even
-  ///   when it also advertises a LAN address of smaller MTU: the LAN address is
-  ///   never sent to. A multicast destination matches no local subnet and so
-  ///   always counts at the conservative default.
-  /// * The legacy route (`fallback: true`) may send to every advertised unicast
-  ///   locator, so all of them count (loopback included: it never lowers the
-  ///   minimum, and it gives a peer that advertises *only* loopback the large
-  ///   loopback budget instead of the default).
+  /// * A narrowed route (`fallback: false`) sends to its unicast locator and/or
+  ///   its multicast group, so only those count: the unicast locator at the MTU
+  ///   of the local interface whose subnet holds it, the group at the MTU of the
+  ///   interface it goes out of, at most the conservative default. In
+  ///   particular a same-host peer routed over loopback gets the loopback
+  ///   budget even when it also advertises a LAN address of smaller MTU: the
+  ///   LAN address is never sent to.
+  /// * The legacy route (`fallback: true`) sends to every advertised unicast
+  ///   locator or every multicast group (never to the loopback bucket), so all
+  ///   of those count, the groups at the default.
   ///
   /// With no UDP destination at all, the default stays. Datagrams packed for
   /// several readers at once use the writer-wide minimum of these budgets.
   pub fn resolve_path_mtu(&mut self, local_interfaces: &[IfAddr]) {
-    let budget_of =
+    let unicast =
       |l: &Locator| path_mtu_payload_for_peer(local_interfaces, SocketAddr::from(*l).ip());
     let budget = if self.send_route.fallback {
       self
         .unicast_locator_list
         .iter()
-        .chain(self.loopback_unicast_locators.iter())
+        .chain(self.multicast_locator_list.iter())
         .filter(|l| l.is_udp())
-        .map(budget_of)
+        .map(unicast)
         .min()
     } else {
+      let multicast = self
+        .send_route
+        .multicast
+        .filter(|(l, _)| l.is_udp())
+        .map(|(_, InterfaceSelector::Ip(via))| multicast_payload_via(local_interfaces, via));
       self
         .send_route
         .unicast
-        .iter()
-        .chain(self.send_route.multicast.iter().map(|(l, _)| l))
-        .filter(|l| l.is_udp())
-        .map(budget_of)
+        .filter(Locator::is_udp)
+        .map(|l| unicast(&l))
+        .into_iter()
+        .chain(multicast)
         .min()
     };
     self.max_datagram_payload = budget.unwrap_or(FALLBACK_MAX_AGGREGATED_DATAGRAM_SIZE);
@@ -946,24 +952,35 @@ mod route_tests {
   #[test]
   fn a_loopback_route_gets_the_loopback_mtu() {
     // Routed over loopback, the peer's 1400-MTU LAN address is never sent to,
-    // so it does not lower the budget: loopback's, a UDP payload of at most
-    // 65 500 bytes less the 20-byte RTPS header.
+    // so it does not lower the budget: loopback's MTU of 65 536 less 48 bytes
+    // of headers, capped at 64 476 (65 500 less a 1 024-byte reserve).
     let mut rp = same_host_peer(Ipv4Addr::LOCALHOST);
     assert_eq!(rp.send_route().unicast, Some(udp([127, 0, 0, 1], 7413)));
     rp.resolve_path_mtu(&interfaces());
-    assert_eq!(rp.max_datagram_payload(), 65_480);
+    assert_eq!(rp.max_datagram_payload(), 64_476);
   }
 
   #[test]
-  fn the_legacy_route_gets_the_smallest_mtu_of_all_locators() {
-    // No observation: the fallback route may send to every locator, the LAN
-    // one included, so its 1400 − 48 bytes bound the budget.
+  fn the_legacy_route_gets_the_smallest_mtu_of_what_it_sends_to() {
+    // No observation: the fallback route may send to every unicast locator,
+    // the LAN one included, so its 1400 − 48 bytes bound the budget.
     let mut rp = proxy_with_prefix(GuidPrefix::new(&[4; 12]));
     rp.unicast_locator_list = vec![udp([10, 0, 0, 5], 7413)];
     rp.loopback_unicast_locators = vec![udp([127, 0, 0, 1], 7413)];
     assert!(rp.send_route().fallback);
     rp.resolve_path_mtu(&interfaces());
     assert_eq!(rp.max_datagram_payload(), 1400 - 48);
+
+    // It never sends to the loopback bucket, and a multicast group counts at
+    // the default: loopback and a group give the default, not loopback's.
+    let mut rp = proxy_with_prefix(GuidPrefix::new(&[2; 12]));
+    rp.loopback_unicast_locators = vec![udp([127, 0, 0, 1], 7413)];
+    rp.multicast_locator_list = vec![udp([239, 255, 0, 1], 7401)];
+    rp.resolve_path_mtu(&interfaces());
+    assert_eq!(
+      rp.max_datagram_payload(),
+      FALLBACK_MAX_AGGREGATED_DATAGRAM_SIZE
+    );
   }
 
   #[test]
@@ -976,13 +993,12 @@ mod route_tests {
     assert_eq!(rp.max_datagram_payload(), 1400 - 48);
   }
 
-  #[test]
-  fn a_route_with_multicast_gets_the_default_budget() {
-    // A multicast destination matches no local subnet: the conservative
-    // default bounds the budget, below the LAN interface's.
+  // A peer seen on the LAN interface 10.0.0.1, advertising `unicast` and the
+  // group 239.255.0.1.
+  fn lan_peer_with_a_group(unicast: Vec<Locator>) -> RtpsReaderProxy {
     let prefix = GuidPrefix::new(&[3; 12]);
     let mut rp = proxy_with_prefix(prefix);
-    rp.unicast_locator_list = vec![udp([10, 0, 0, 5], 7410)];
+    rp.unicast_locator_list = unicast;
     rp.multicast_locator_list = vec![udp([239, 255, 0, 1], 7401)];
     let mut observations = InterfaceObservations::new();
     observations.record(
@@ -995,13 +1011,27 @@ mod route_tests {
       &[iface([10, 0, 0, 1])],
       &DefaultRouteSelector::default(),
     );
+    assert!(!rp.send_route().fallback);
     assert!(rp.send_route().multicast.is_some());
+    rp
+  }
+
+  #[test]
+  fn a_route_with_multicast_gets_its_interface_mtu_at_most_the_default() {
+    // On a jumbo-frame LAN (MTU 9000) the group still counts at the default:
+    // it may cross routers.
     let mut jumbo = interfaces();
     jumbo[1].mtu = Some(9000);
+    let mut rp = lan_peer_with_a_group(vec![udp([10, 0, 0, 5], 7410)]);
     rp.resolve_path_mtu(&jumbo);
     assert_eq!(
       rp.max_datagram_payload(),
       FALLBACK_MAX_AGGREGATED_DATAGRAM_SIZE
     );
+    // A group alone, out of the 1400-MTU interface: 1400 − 48.
+    let mut rp = lan_peer_with_a_group(Vec::new());
+    assert_eq!(rp.send_route().unicast, None);
+    rp.resolve_path_mtu(&interfaces());
+    assert_eq!(rp.max_datagram_payload(), 1400 - 48);
   }
 }
