@@ -13,7 +13,9 @@
 //! reply message), the reply's CDR encoding and decoding in-process, the round trip's p50 / p90 /
 //! p99, and the ratio of the medians. Interleaved with those calls, two more kinds show where the
 //! rest goes: a request refused at once (no check, a reply of a few bytes: DDS's floor) and a
-//! 1-waypoint route (the hand-offs to the node's check pool and back, a small reply).
+//! 1-waypoint route (the hand-offs to the node's check pool and back, a small reply). The last
+//! row is the transport without DDS: UDP round trips on loopback between two threads with the
+//! same request and reply sizes.
 
 #[path = "../../planner/benches/common/demo_loop.rs"]
 mod demo_loop;
@@ -152,6 +154,12 @@ fn main() -> anyhow::Result<()> {
         std::hint::black_box(cdr_encoding::from_bytes::<CheckRouteResponse, byteorder::LittleEndian>(&encoded).ok());
     });
 
+    // The transport's floor, without DDS: a UDP round trip on loopback to a thread that answers
+    // each datagram with one of the size it asks for, blocking sockets on both sides. Requests as
+    // large as the service request's CDR; replies as large as the refused call's and the check's.
+    let request_size = cdr_encoding::to_vec::<_, byteorder::LittleEndian>(&request)?.len();
+    let [udp_small, udp_large] = udp_round_trips(request_size, [64, encoded.len()])?;
+
     let runtime = tokio::runtime::Builder::new_multi_thread().enable_all().build()?;
     let trips = runtime.block_on(async {
         let decl = NodeDecl::new("check_route_bench", "planner/check_route round trips");
@@ -264,7 +272,60 @@ fn main() -> anyhow::Result<()> {
         percentile(&short, 0.9),
         percentile(&short, 0.99)
     );
+    println!(
+        "| UDP on loopback between two threads, no DDS: a {request_size}-byte request, a 64-byte / {}-byte reply | {:.3} / {:.3} | | |",
+        encoded.len(),
+        udp_small,
+        udp_large
+    );
     println!();
     println!("round trip / in-process: {:.2}×", p50 / in_process);
     Ok(())
+}
+
+/// Median round trip (ms) of `CALLS` UDP requests of `request_size` bytes on loopback, each
+/// answered by an echo thread with a datagram of the size the request names, for each reply
+/// size.
+fn udp_round_trips<const N: usize>(request_size: usize, reply_sizes: [usize; N]) -> anyhow::Result<[f64; N]> {
+    use std::net::UdpSocket;
+    let server = UdpSocket::bind("127.0.0.1:0")?;
+    let client = UdpSocket::bind("127.0.0.1:0")?;
+    client.connect(server.local_addr()?)?;
+    client.set_read_timeout(Some(Duration::from_secs(5)))?;
+    let echo = std::thread::spawn(move || {
+        let mut buf = vec![0u8; 65_536];
+        let reply = vec![0u8; 65_507];
+        // A request of fewer than 8 bytes ends the thread.
+        while let Ok((n, from)) = server.recv_from(&mut buf) {
+            let Some(size) = buf.get(..8).filter(|_| n >= 8) else {
+                break;
+            };
+            let size = u64::from_le_bytes(size.try_into().unwrap_or_default()) as usize;
+            if server.send_to(&reply[..size.min(reply.len())], from).is_err() {
+                break;
+            }
+        }
+    });
+    let mut request = vec![0u8; request_size.max(8)];
+    let mut buf = vec![0u8; 65_536];
+    let mut medians = [0.0; N];
+    for (median, size) in medians.iter_mut().zip(reply_sizes) {
+        request[..8].copy_from_slice(&(size as u64).to_le_bytes());
+        let mut t = Vec::with_capacity(CALLS);
+        for k in 0..WARM_UP + CALLS {
+            let t0 = Instant::now();
+            client.send(&request)?;
+            let n = client.recv(&mut buf)?;
+            anyhow::ensure!(n == size, "a {n}-byte UDP reply where {size} bytes were asked for");
+            if k >= WARM_UP {
+                t.push(t0.elapsed().as_secs_f64() * 1e3);
+            }
+        }
+        t.sort_by(f64::total_cmp);
+        *median = percentile(&t, 0.5);
+    }
+    client.send(&[0u8])?;
+    echo.join()
+        .map_err(|_| anyhow::anyhow!("the UDP echo thread panicked"))?;
+    Ok(medians)
 }
