@@ -156,7 +156,8 @@ fn main() -> anyhow::Result<()> {
 
     // The transport's floor, without DDS: a UDP round trip on loopback to a thread that answers
     // each datagram with one of the size it asks for, blocking sockets on both sides. Requests as
-    // large as the service request's CDR; replies as large as the refused call's and the check's.
+    // large as the service request's CDR; replies of 64 bytes (a small reply) and as large as the
+    // check's CDR.
     let request_size = cdr_encoding::to_vec::<_, byteorder::LittleEndian>(&request)?.len();
     let [udp_small, udp_large] = udp_round_trips(request_size, [64, encoded.len()])?;
 

@@ -16,11 +16,24 @@ use socket2::{Domain, Protocol, SockAddr, Socket, Type};
 use crate::{
   network::util::get_local_multicast_ip_addrs_filtered,
   rtps::{
+    constant::MAX_UDP_PAYLOAD,
     outbound::{ControlQueue, Datagram, SendOutcome, SocketId, CONTROL_QUEUE_WARN_LEN},
     transmit::InterfaceSelector,
   },
   structure::locator::Locator,
 };
+
+/// Logs a datagram that no receiver takes (over [`MAX_UDP_PAYLOAD`]) as a
+/// warning. One over 1500 bytes is IP-fragmented on an Ethernet path but
+/// expected over loopback, where same-host peers get datagrams of up to 64 KB:
+/// debug level only.
+fn note_size(context: &str, len: usize) {
+  if len > MAX_UDP_PAYLOAD {
+    warn!("{context}: a {len}-byte datagram, above the {MAX_UDP_PAYLOAD} bytes receivers take");
+  } else if len > 1500 {
+    debug!("{context}: Message size = {len}");
+  }
+}
 
 // We need one multicast sender socket per interface
 
@@ -353,9 +366,7 @@ impl UDPSender {
   /// multicast interface (legacy reachability). Datagrams are queued (never
   /// dropped) if the socket is congested.
   pub fn send_to_locator(&self, buffer: &[u8], locator: &Locator) {
-    if buffer.len() > 1500 {
-      warn!("send_to_locator: Message size = {}", buffer.len());
-    }
+    note_size("send_to_locator", buffer.len());
     let Some(socket_address) = self.locator_socket_addr(locator, "send_to_locator") else {
       return;
     };
@@ -395,12 +406,7 @@ impl UDPSender {
     locator: &Locator,
     interface: &InterfaceSelector,
   ) {
-    if buffer.len() > 1500 {
-      warn!(
-        "send_to_multicast_locator_via: Message size = {}",
-        buffer.len()
-      );
-    }
+    note_size("send_to_multicast_locator_via", buffer.len());
     let Some(socket_address) = self.locator_socket_addr(locator, "send_to_multicast_locator_via")
     else {
       return;
@@ -438,9 +444,7 @@ impl UDPSender {
   /// Bulk send to a locator. Returns the sockets that could not accept the
   /// datagram (WouldBlock), so the caller can stop and arm write readiness.
   pub(crate) fn try_send_to_locator(&self, buffer: &[u8], locator: &Locator) -> Vec<SocketId> {
-    if buffer.len() > 1500 {
-      warn!("try_send_to_locator: Message size = {}", buffer.len());
-    }
+    note_size("try_send_to_locator", buffer.len());
     let mut blocked = Vec::new();
     let Some(socket_address) = self.locator_socket_addr(locator, "try_send_to_locator") else {
       return blocked;
@@ -467,12 +471,7 @@ impl UDPSender {
     locator: &Locator,
     interface: &InterfaceSelector,
   ) -> Vec<SocketId> {
-    if buffer.len() > 1500 {
-      warn!(
-        "try_send_to_multicast_locator_via: Message size = {}",
-        buffer.len()
-      );
-    }
+    note_size("try_send_to_multicast_locator_via", buffer.len());
     let mut blocked = Vec::new();
     let Some(socket_address) =
       self.locator_socket_addr(locator, "try_send_to_multicast_locator_via")

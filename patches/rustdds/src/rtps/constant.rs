@@ -98,7 +98,8 @@ pub const FALLBACK_MAX_AGGREGATED_DATAGRAM_SIZE: usize = 1452;
 // payload) budget usable for submessage/fragment packing: IPv4 (20) + UDP (8) +
 // RTPS message header (20) = 48 bytes. Matches
 // `FALLBACK_MAX_AGGREGATED_DATAGRAM_SIZE` for a 1500-byte MTU (1500 - 48 =
-// 1452).
+// 1452). The writer compares the budget with whole RTPS messages, header
+// included, so the header is counted twice: 20 bytes to spare.
 pub const DATAGRAM_HEADER_OVERHEAD: usize = 48;
 
 // Constant RTPS fragment size (serialized-payload bytes per fragment) used by
@@ -115,13 +116,18 @@ pub const FRAGMENT_SIZE: usize = 256;
 // which the kernel refuses the datagram (EMSGSIZE). The writer checks only part
 // of a datagram against the budget: the unfragmented-or-fragmented decision
 // leaves out the RTPS header, INFO_TS, INFO_DST and a DATA's inline QoS (a
-// service reply's related sample identity alone is 60 bytes), and a run of
-// DATAFRAGs that ends the sample leaves out the inline QoS. A datagram may
-// therefore exceed its budget by a few hundred bytes: harmless IP
-// fragmentation at an ordinary MTU, a lost datagram at 64 KiB. So the budget
-// stops 1 KiB below the receivers' limit: 64 476 bytes, where loopback's MTU of
-// 65 536 would give 65 488.
-pub const MAX_DATAGRAM_BUDGET: usize = 65_500 - 1_024;
+// service reply's related sample identity alone is 60 bytes), and each run of
+// DATAFRAGs leaves out the inline QoS. A datagram may therefore exceed its
+// budget, by at most 179 bytes without the `security` feature (an unfragmented
+// DATA with INFO_TS, INFO_DST, a GAP, the largest inline QoS, 88 bytes, and a
+// HEARTBEAT): harmless IP fragmentation at an ordinary MTU, a lost datagram at
+// 64 KiB. So the budget stops 1 KiB below the receivers' limit: 64 476 bytes,
+// where loopback's MTU of 65 536 would give 65 488. With `security`, inline QoS
+// and per-reader MACs grow with the readers, beyond any fixed reserve.
+pub const MAX_DATAGRAM_BUDGET: usize = MAX_UDP_PAYLOAD - 1_024;
+
+// The largest UDP payload a receiver takes (see `MAX_DATAGRAM_BUDGET`).
+pub const MAX_UDP_PAYLOAD: usize = 65_500;
 
 /// Convert an interface MTU into the RTPS-message (UDP payload) budget usable
 /// for submessage/fragment packing: `mtu - DATAGRAM_HEADER_OVERHEAD`, at most
