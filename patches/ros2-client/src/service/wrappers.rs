@@ -85,7 +85,10 @@ impl<R: Message> RequestWrapper<R> {
                 writer_gid: message_info.publisher_gid(),
                 sequence_number: message_info.sequence_number(),
               };
-              warn!("RequestWrapper::unwrap: related_sample_identity missing. Using sample_identity = {backup_identity:?}");
+              // Not a fault: RPC over DDS names a request by its own sample
+              // identity; rmw_fastrtps adds this parameter (naming its reply
+              // reader), a RustDDS client does not, so this is its every request.
+              debug!("RequestWrapper::unwrap: related_sample_identity missing. Using sample_identity = {backup_identity:?}");
               backup_identity
             });
 
@@ -459,6 +462,53 @@ mod tests {
     b.extend_from_slice(&6_u32.to_le_bytes()); // "v_max" + NUL
     b.extend_from_slice(b"v_max\0");
     b
+  }
+
+  /// Every log record of this test binary, with its level.
+  struct Capture(std::sync::Mutex<Vec<(log::Level, String)>>);
+
+  impl log::Log for Capture {
+    fn enabled(&self, _: &log::Metadata) -> bool {
+      true
+    }
+    fn log(&self, record: &log::Record) {
+      let mut records = self.0.lock().unwrap_or_else(|e| e.into_inner());
+      records.push((record.level(), record.args().to_string()));
+    }
+    fn flush(&self) {}
+  }
+
+  static CAPTURE: Capture = Capture(std::sync::Mutex::new(Vec::new()));
+
+  #[test]
+  fn a_request_without_related_sample_identity_is_no_warning() {
+    // No other test of this binary sets a logger.
+    log::set_logger(&CAPTURE).unwrap();
+    log::set_max_level(log::LevelFilter::Trace);
+    // A RustDDS client's request: Enhanced, its identity only in the DATA.
+    let writer = gid([0x01, 0x12], 0x21);
+    let mi = MessageInfo::new(None, None, 17, writer, None);
+    let body = 0_u32.to_le_bytes(); // no names
+    let w = RequestWrapper::<Names>::from_bytes_and_ri(&body, RepresentationIdentifier::CDR_LE);
+    let (id, req) = w.unwrap(ServiceMapping::Enhanced, &mi).unwrap();
+    assert!(req.names.is_empty());
+    assert_eq!(
+      id,
+      RmwRequestId {
+        writer_gid: writer,
+        sequence_number: 17
+      }
+    );
+    let records = CAPTURE.0.lock().unwrap_or_else(|e| e.into_inner());
+    let about: Vec<_> = records
+      .iter()
+      .filter(|(_, text)| text.contains("related_sample_identity missing"))
+      .collect();
+    assert!(!about.is_empty(), "the fallback is logged");
+    assert!(
+      about.iter().all(|(level, _)| *level > log::Level::Info),
+      "logged above debug: {about:?}"
+    );
   }
 
   #[test]
