@@ -9,11 +9,11 @@
 //! The bench starts `planner_node` (from `MOBIL_BIN_DIR`, default `target/release`) on a
 //! domain of its own, waits for the first answer (discovery), sends 20 calls to warm up, then
 //! times 300 calls one after the other. The node's answer must equal the in-process one (the
-//! same work). Reported: the in-process median (library check alone, and with the answer and
-//! reply message, in a loop of their own and once before each round of calls), the reply's CDR
-//! encoding and decoding in-process, the round trip's p50 / p90 / p99, and the ratio of the
-//! round trip's median to each in-process median (the budget's is the work timed between the
-//! calls). Interleaved with those calls, two more kinds show where the rest goes: a request
+//! same work). Reported: the in-process medians of the library check alone and of the node's
+//! work (check, answer, reply message), both in a loop of their own, and of the node's work
+//! timed once before each round of calls (with p90 / p99); the reply's CDR encoding and decoding
+//! in-process; the round trip's p50 / p90 / p99; and the ratio of the round trip's median to
+//! each of the two medians of the node's work (the budget's is the one timed between the calls). Interleaved with those calls, two more kinds show where the rest goes: a request
 //! refused at once (no check, a reply of a few bytes: DDS's floor) and a 1-waypoint route (the
 //! hand-offs to the node's check pool and back, a small reply). The last row is the transport
 //! without DDS: UDP round trips on loopback between two threads with the same request and reply
@@ -226,9 +226,9 @@ fn main() -> anyhow::Result<()> {
         ];
         for k in 0..WARM_UP + CALLS {
             // The in-process work once before each round of calls: the ratio then compares
-            // times taken under the same conditions, over the same minutes (this machine's
-            // speed changes between runs by up to 1.5×), with caches as the node's check
-            // finds them after DDS's work rather than warm from the check before.
+            // times taken over the same minutes (this machine's speed changes between runs by
+            // up to 1.5×), each after DDS work as the node's checks are, not warm from the
+            // check before.
             let t0 = Instant::now();
             std::hint::black_box(local());
             if k >= WARM_UP {

@@ -76,18 +76,15 @@ impl<R: Message> RequestWrapper<R> {
           deserialize_from_cdr_with_rep_id::<R>(&self.serialized_message, self.encoding)?;
         let mut rmw_req_id = message_info.related_request_id()
             .unwrap_or_else(|| {
-              // ServiceMapping::Enhanced is supposed to contain related sample identity as 
-              // inline QoS parameter.
-              //
-              // Use the identity of the incoming request as a default, if there was no
-              // related sample identity specified in inline QoS.
+              // Without a related sample identity in the inline QoS, the request
+              // is named by its own sample identity, as RPC over DDS specifies.
+              // Not a fault: rmw_fastrtps's clients add the parameter (naming
+              // their reply reader), a RustDDS client does not, so every request
+              // of a RustDDS client takes this path.
               let backup_identity = RmwRequestId {
                 writer_gid: message_info.publisher_gid(),
                 sequence_number: message_info.sequence_number(),
               };
-              // Not a fault: RPC over DDS names a request by its own sample
-              // identity; rmw_fastrtps adds this parameter (naming its reply
-              // reader), a RustDDS client does not, so this is its every request.
               debug!("RequestWrapper::unwrap: related_sample_identity missing. Using sample_identity = {backup_identity:?}");
               backup_identity
             });
@@ -464,14 +461,18 @@ mod tests {
     b
   }
 
-  /// Every log record of this test binary, with its level.
+  /// The log records of this module, with their levels (other tests of the
+  /// binary, some running DDS, log through it too: their records are not kept).
   struct Capture(std::sync::Mutex<Vec<(log::Level, String)>>);
 
   impl log::Log for Capture {
-    fn enabled(&self, _: &log::Metadata) -> bool {
-      true
+    fn enabled(&self, metadata: &log::Metadata) -> bool {
+      metadata.target().starts_with(module_path!().trim_end_matches("::tests"))
     }
     fn log(&self, record: &log::Record) {
+      if !self.enabled(record.metadata()) {
+        return;
+      }
       let mut records = self.0.lock().unwrap_or_else(|e| e.into_inner());
       records.push((record.level(), record.args().to_string()));
     }
@@ -484,7 +485,7 @@ mod tests {
   fn a_request_without_related_sample_identity_is_no_warning() {
     // No other test of this binary sets a logger.
     log::set_logger(&CAPTURE).unwrap();
-    log::set_max_level(log::LevelFilter::Trace);
+    log::set_max_level(log::LevelFilter::Debug);
     // A RustDDS client's request: Enhanced, its identity only in the DATA.
     let writer = gid([0x01, 0x12], 0x21);
     let mi = MessageInfo::new(None, None, 17, writer, None);
