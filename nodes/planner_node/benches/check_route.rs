@@ -13,7 +13,8 @@
 //! work (check, answer, reply message), both in a loop of their own, and of the node's work
 //! timed once before each round of calls (with p90 / p99); the reply's CDR encoding and decoding
 //! in-process; the round trip's p50 / p90 / p99; and the ratio of the round trip's median to
-//! each of the two medians of the node's work (the budget's is the one timed between the calls). Interleaved with those calls, two more kinds show where the rest goes: a request
+//! each of the two medians of the node's work (the budget's is the one timed between the
+//! calls). Interleaved with those calls, two more kinds show where the rest goes: a request
 //! refused at once (no check, a reply of a few bytes: DDS's floor) and a 1-waypoint route (the
 //! hand-offs to the node's check pool and back, a small reply). The last row is the transport
 //! without DDS: UDP round trips on loopback between two threads with the same request and reply
