@@ -11,7 +11,11 @@ use log::{debug, error, trace, warn};
 
 use crate::{
   dds::{ddsdata::DDSData, with_key::datawriter::WriteOptions},
-  structure::{cache_change::CacheChange, guid::GUID, sequence_number::SequenceNumber},
+  structure::{
+    cache_change::CacheChange,
+    guid::{EntityKind, GUID},
+    sequence_number::SequenceNumber,
+  },
 };
 
 /// Result of an admission attempt into the [`WriterSendBuffer`].
@@ -298,6 +302,31 @@ impl WriterSendBuffer {
           Some(sn) => sn,
           None => break,
         };
+        inner.changes.remove(&oldest);
+        inner.first_seq = oldest.plus_1();
+      }
+    }
+
+    // A reliable writer of a topic without a key, with reliable readers matched:
+    // the History depth of acknowledged samples and every unacknowledged one are
+    // kept, as the periodic cache cleaning keeps them
+    // (`Writer::remove_all_acked_changes_but_keep_depth`), but at once. Between
+    // two cleanings (6 s) a writer answering a thousand calls a second otherwise
+    // held thousands of acknowledged samples: a service with 33 KB replies held
+    // 330 MB. A sample is acknowledged by every reliable reader below
+    // `acked_before`, so none still to be sent or repaired is evicted.
+    let one_instance =
+      shared.writer_guid.entity_id.kind() == EntityKind::WRITER_NO_KEY_USER_DEFINED;
+    if !shared.is_builtin
+      && shared.reliable_writer
+      && one_instance
+      && inner.reliable_readers_present
+    {
+      let keep_from = i64::from(inner.acked_before) - inner.max_retain as i64;
+      while let Some(oldest) = inner.changes.keys().next().copied() {
+        if i64::from(oldest) >= keep_from {
+          break;
+        }
         inner.changes.remove(&oldest);
         inner.first_seq = oldest.plus_1();
       }
@@ -662,5 +691,80 @@ mod tests {
       assert!(admit_now(&buf, WriteOptions::default()));
     }
     assert_eq!(buf.retained_len(), max_retain + 10);
+  }
+
+  // A reliable writer of a topic without a key, its reader acknowledging as it
+  // goes (a service's reply writer answering call after call): it keeps the
+  // History depth of acknowledged samples and every unacknowledged one from one
+  // write to the next, not every sample until the next periodic cleaning.
+  #[test]
+  fn acknowledged_samples_beyond_depth_leave_at_once() {
+    let depth = 10;
+    let no_key_writer = GUID::new(
+      crate::structure::guid::GuidPrefix::UNKNOWN,
+      crate::structure::guid::EntityId::new([0, 0, 1], EntityKind::WRITER_NO_KEY_USER_DEFINED),
+    );
+    let buf = WriterSendBuffer::new(
+      no_key_writer,
+      "t".to_string(),
+      /* reliable_writer */ true,
+      /* is_builtin */ false,
+      /* volatile */ true,
+      /* window_limit */ 8192,
+      /* backlog_limit */ 8192,
+      /* max_retain */ depth,
+    );
+    buf.set_acked_frontier(Some(SequenceNumber::new(0)));
+    // 1000 calls, each acknowledged before the next is written.
+    for n in 1..=1000 {
+      assert!(admit_now(&buf, WriteOptions::default()));
+      buf.set_sent_frontier(SequenceNumber::new(n));
+      buf.set_acked_frontier(Some(SequenceNumber::new(n + 1)));
+    }
+    // The last write saw 999 acknowledged: it kept 990..=999 and itself.
+    assert_eq!(buf.retained_len(), depth + 1);
+    assert_eq!(buf.first_change_sequence_number(), SequenceNumber::new(990));
+    assert!(buf.get_by_sn(SequenceNumber::new(989)).is_none());
+
+    // The reader has acknowledged 1000 and stops: 50 more writes are all kept
+    // for repair, and the depth of acknowledged ones before them (991..=1000).
+    for n in 1001..=1050 {
+      assert!(admit_now(&buf, WriteOptions::default()));
+      buf.set_sent_frontier(SequenceNumber::new(n));
+    }
+    assert_eq!(buf.retained_len(), depth + 50);
+    assert_eq!(buf.first_change_sequence_number(), SequenceNumber::new(991));
+    for n in 991..=1050 {
+      assert!(
+        buf.get_by_sn(SequenceNumber::new(n)).is_some(),
+        "{n} evicted"
+      );
+    }
+  }
+
+  // A keyed writer's depth counts per instance, which the send buffer does not
+  // know: it is left to the periodic cleaning.
+  #[test]
+  fn a_keyed_writer_is_not_trimmed_on_write() {
+    let keyed_writer = GUID::new(
+      crate::structure::guid::GuidPrefix::UNKNOWN,
+      crate::structure::guid::EntityId::new([0, 0, 1], EntityKind::WRITER_WITH_KEY_USER_DEFINED),
+    );
+    let buf = WriterSendBuffer::new(
+      keyed_writer,
+      "t".to_string(),
+      true,
+      false,
+      true,
+      8192,
+      8192,
+      2,
+    );
+    buf.set_acked_frontier(Some(SequenceNumber::new(0)));
+    for n in 1..=20 {
+      assert!(admit_now(&buf, WriteOptions::default()));
+      buf.set_acked_frontier(Some(SequenceNumber::new(n + 1)));
+    }
+    assert_eq!(buf.retained_len(), 20);
   }
 }
