@@ -3,12 +3,7 @@ use std::marker::PhantomData;
 use serde::{Deserialize, Serialize};
 #[allow(unused_imports)]
 use log::{debug, error, info, warn};
-use rustdds::{
-  bytes::{BufMut, Bytes, BytesMut},
-  rpc::*,
-  serialization::deserialize_from_cdr_with_rep_id,
-  *,
-};
+use rustdds::{bytes::Bytes, rpc::*, serialization::deserialize_from_cdr_with_rep_id, *};
 
 use crate::{
   error::{ReadError, ReadResult, WriteError, WriteResult},
@@ -121,7 +116,7 @@ impl<R: Message> RequestWrapper<R> {
     encoding: RepresentationIdentifier,
     request: R,
   ) -> WriteResult<Self, ()> {
-    let mut ser_buffer = BytesMut::with_capacity(std::mem::size_of::<R>() * 3 / 2).writer();
+    let mut ser_buffer: Vec<u8> = Vec::with_capacity(std::mem::size_of::<R>() * 3 / 2);
 
     // First, write header (the client resolves Auto before; unresolved, it is
     // Enhanced)
@@ -143,7 +138,7 @@ impl<R: Message> RequestWrapper<R> {
     serialization::to_writer_with_rep_id(&mut ser_buffer, &request, encoding)?;
     // Ok, assemble result
     Ok(RequestWrapper {
-      serialized_message: ser_buffer.into_inner().freeze(),
+      serialized_message: Bytes::from(ser_buffer),
       encoding,
       phantom: PhantomData,
     })
@@ -223,7 +218,7 @@ impl<R: Message> ResponseWrapper<R> {
     encoding: RepresentationIdentifier,
     response: R,
   ) -> WriteResult<Self, ()> {
-    let mut ser_buffer = BytesMut::with_capacity(std::mem::size_of::<R>() * 3 / 2).writer();
+    let mut ser_buffer: Vec<u8> = Vec::with_capacity(std::mem::size_of::<R>() * 3 / 2);
     match service_mapping.of_reply(&r_id) {
       ServiceMapping::Basic => {
         let basic_header = BasicReplyHeader::new(r_id.into());
@@ -239,7 +234,7 @@ impl<R: Message> ResponseWrapper<R> {
       ServiceMapping::Auto => unreachable!("of_reply resolves Auto"),
     }
     serialization::to_writer_with_rep_id(&mut ser_buffer, &response, encoding)?;
-    let serialized_message = ser_buffer.into_inner().freeze();
+    let serialized_message = Bytes::from(ser_buffer);
     Ok(ResponseWrapper {
       serialized_message,
       encoding,
@@ -510,6 +505,40 @@ mod tests {
       about.iter().all(|(level, _)| *level > log::Level::Info),
       "logged above debug: {about:?}"
     );
+  }
+
+  // A request or reply of the Enhanced mapping is the message's CDR alone, after
+  // the encapsulation header; the Basic one puts its header before it.
+  #[test]
+  fn an_enhanced_or_basic_payload_is_the_message_s_cdr() {
+    let names = || Names {
+      names: vec!["v_max".into(), "a".into()],
+    };
+    fn cdr<T: Serialize>(value: &T) -> Vec<u8> {
+      let mut bytes = Vec::new();
+      rustdds::serialization::to_writer_with_rep_id(
+        &mut bytes,
+        value,
+        RepresentationIdentifier::CDR_LE,
+      )
+      .unwrap();
+      bytes
+    }
+    let message = cdr(&names());
+    let id = RmwRequestId {
+      writer_gid: gid([0x01, 0x0f], 0x21),
+      sequence_number: 9,
+    };
+    let le = RepresentationIdentifier::CDR_LE;
+    let enhanced =
+      ResponseWrapper::<Names>::new(ServiceMapping::Enhanced, id, le, names()).unwrap();
+    assert_eq!(enhanced.bytes()[..], message[..]);
+    let request = RequestWrapper::<Names>::new(ServiceMapping::Enhanced, id, le, names()).unwrap();
+    assert_eq!(request.bytes()[..], message[..]);
+    let basic = ResponseWrapper::<Names>::new(ServiceMapping::Basic, id, le, names()).unwrap();
+    let header = cdr(&BasicReplyHeader::new(id.into()));
+    assert_eq!(basic.bytes()[..header.len()], header[..]);
+    assert_eq!(basic.bytes()[header.len()..], message[..]);
   }
 
   #[test]
