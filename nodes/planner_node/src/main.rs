@@ -75,7 +75,7 @@ use mobil_ros::{qos, respond, run_node, shutdown_signal, warn_throttled, ConfigE
 use mobil_world::World;
 use ros2_client::{RmwRequestId, Server, Subscription};
 use std::process::ExitCode;
-use std::sync::Arc;
+use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
 use tracing::{info, warn};
 
@@ -181,7 +181,9 @@ struct VfoTickDone {
 struct Jobs {
     goal: OffLoop<PreCheckDone>,
     vfo: OffLoop<VfoTickDone>,
-    checks: ReplyPool<RmwRequestId, CheckRouteResponse>,
+    /// Each job answers its request itself, from the pool's thread (the reply leaves as soon as
+    /// it is computed, not when the event loop next runs).
+    checks: ReplyPool<RmwRequestId, ()>,
 }
 
 /// Everything the loop holds between events.
@@ -198,6 +200,8 @@ struct Shell {
     markers_gate: RateGate,
     drawing: Drawing,
     throttle: LogThrottle,
+    /// The check jobs' rate limit for a reply that cannot be sent, shared by the pool's threads.
+    reply_throttle: Arc<Mutex<LogThrottle>>,
     /// Looks for a `cmd_vel` endpoint of the other type.
     types: mobil_ros::cmd_vel::TypeWatch,
     /// Obstacles seen by the LIDAR, in odom (VFO); kept between goals, new extraction
@@ -244,7 +248,7 @@ enum Event {
     Path(ActionEvent<FollowPathGoal>),
     Lifecycle(Transition),
     Check(RmwRequestId, CheckRouteRequest),
-    Checked(RmwRequestId, CheckRouteResponse),
+    Checked,
     RouteChecked(PreCheckDone),
     Tick,
 }
@@ -275,7 +279,7 @@ async fn start(node: &mut RosNode, out: &Outputs, config: PlannerConfig) -> anyh
     let tf_sub = tf_static_subscription(node)?;
     let map = KeptMap::new(config.vfo.scan_config(config.robot_radius))
         .map_err(|e| anyhow::anyhow!("vfo obstacle extraction: {e}"))?;
-    let check = node.service::<CheckRoute>(CHECK_ROUTE)?;
+    let check = Arc::new(node.service::<CheckRoute>(CHECK_ROUTE)?);
     let server_config = GoalServerConfig {
         result_timeout: config.timeouts.result_timeout(),
     };
@@ -313,6 +317,7 @@ async fn start(node: &mut RosNode, out: &Outputs, config: PlannerConfig) -> anyh
         markers_gate: RateGate::default(),
         drawing: Drawing::default(),
         throttle: LogThrottle::new(Duration::from_secs(2)),
+        reply_throttle: Arc::new(Mutex::new(LogThrottle::new(Duration::from_secs(2)))),
         types: Default::default(),
         map,
         odom_history: PoseHistory::new(ODOM_HISTORY),
@@ -414,7 +419,7 @@ async fn event_loop(
     lifecycle: &mut Lifecycle,
     (odom_sub, dock_sub, route_sub): (&Subscription<Odometry>, &Subscription<PoseStamped>, &Subscription<Path>),
     (scan_sub, tf_sub): (&Subscription<LaserScan>, &Subscription<TFMessage>),
-    check: &Server<CheckRouteRequest, CheckRouteResponse>,
+    check: &Arc<Server<CheckRouteRequest, CheckRouteResponse>>,
 ) -> anyhow::Result<()> {
     let mut inputs = Inputs::new();
     inputs
@@ -433,7 +438,7 @@ async fn event_loop(
             e = inputs.next() => e?,
             done = jobs.goal.result() => Event::RouteChecked(done),
             done = jobs.vfo.result() => Event::VfoTicked(done),
-            (id, reply) = jobs.checks.next() => Event::Checked(id, reply),
+            _ = jobs.checks.next() => Event::Checked,
             e = servers.dock.next_event() => Event::Dock(e),
             e = servers.undock.next_event() => Event::Undock(e),
             e = servers.follow.next_event() => Event::Follow(e),
@@ -496,7 +501,8 @@ async fn event_loop(
             Event::Follow(ActionEvent::CancelRequested(id)) => shell.cancel(&mut io, Source::FollowAction, id),
             Event::Path(ActionEvent::CancelRequested(id)) => shell.cancel(&mut io, Source::PathAction, id),
             Event::Check(id, req) => shell.check_in(io.node, jobs, check, id, &req),
-            Event::Checked(id, reply) => respond(check, id, reply, CHECK_ROUTE, &mut shell.throttle),
+            // The job has answered; `next` counted it done.
+            Event::Checked => {}
             Event::RouteChecked(done) => shell.pre_checked(&mut io, done),
             Event::Tick => shell.tick(&mut io).await,
         }

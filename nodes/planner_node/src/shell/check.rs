@@ -1,15 +1,17 @@
-//! `planner/check_route`: a route's pre-check as a service, computed on the blocking pool.
+//! `planner/check_route`: a route's pre-check as a service, computed and answered on the
+//! blocking pool.
 
 use crate::*;
 
 impl Shell {
     /// A `planner/check_route` request: refused at once, answered BUSY when too many are being
-    /// computed, or checked on the blocking pool and answered from there.
+    /// computed, or checked on the blocking pool and answered from there: the reply leaves from
+    /// the thread that computed it, without a hand-off back to the event loop.
     pub(crate) fn check_in(
         &mut self,
         node: &RosNode,
         jobs: &mut Jobs,
-        check: &Server<CheckRouteRequest, CheckRouteResponse>,
+        check: &Arc<Server<CheckRouteRequest, CheckRouteResponse>>,
         id: RmwRequestId,
         req: &CheckRouteRequest,
     ) {
@@ -19,6 +21,7 @@ impl Shell {
         };
         let (world, chassis, config) = (self.world_in(&placed), self.chassis, self.config.route_check());
         let (stamp, frame, step) = (node.stamp(), placed.frame, self.config.follow.check_length);
+        let (server, throttle) = (Arc::clone(check), Arc::clone(&self.reply_throttle));
         let job = move || {
             let began = Instant::now();
             let reply = match check_route_until(&start, &route.points, &chassis, &world, &config, || false) {
@@ -42,7 +45,8 @@ impl Shell {
                 },
                 began.elapsed().as_secs_f64() * 1e3
             );
-            reply
+            let mut throttle = throttle.lock().unwrap_or_else(|poisoned| poisoned.into_inner());
+            respond(&server, id, reply, CHECK_ROUTE, &mut throttle);
         };
         if let Err((id, running)) = jobs.checks.start(id, job) {
             let reply = refused_reply(format!(
