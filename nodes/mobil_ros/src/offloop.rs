@@ -18,8 +18,9 @@
 //! # }
 //! ```
 
-use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::sync::Arc;
+use std::time::Duration;
 use tokio::sync::mpsc;
 
 /// Tells a running job it has been pre-empted; the algorithm checks it between steps and
@@ -166,67 +167,82 @@ impl<R: Send + 'static> OffLoop<R> {
     }
 }
 
-/// Requests computed on the blocking pool several at once, up to a limit (a service whose
-/// requests each take up to a second of one core): each reply comes back with its request's
-/// key, in any order; beyond the limit a request is turned away at once, for the caller to
-/// answer BUSY, so a burst of requests never piles up threads.
-pub struct ReplyPool<K, R> {
+/// Requests computed and answered on the blocking pool several at once, up to a limit (a
+/// service whose requests each take up to a second of one core): each job's answer (the reply
+/// sent) runs on the thread that computed it, without a hand-off back to the event loop; beyond
+/// the limit a request is turned away at once, for the caller to answer BUSY, so a burst of
+/// requests never piles up threads. A job's place is free again before its answer goes out, so
+/// a client that calls again as soon as it is answered always finds one.
+pub struct ReplyPool {
     limit: usize,
-    running: usize,
-    tx: mpsc::UnboundedSender<(K, R)>,
-    rx: mpsc::UnboundedReceiver<(K, R)>,
+    running: Arc<AtomicUsize>,
 }
 
-impl<K: Send + 'static, R: Send + 'static> ReplyPool<K, R> {
+/// Frees a place of a [`ReplyPool`] when dropped: after the job, before its answer, or while a
+/// panicking job unwinds.
+struct Place(Arc<AtomicUsize>);
+
+impl Drop for Place {
+    fn drop(&mut self) {
+        self.0.fetch_sub(1, Ordering::AcqRel);
+    }
+}
+
+impl ReplyPool {
     /// A pool of at most `limit` jobs at once.
     pub fn new(limit: usize) -> Self {
-        let (tx, rx) = mpsc::unbounded_channel();
         ReplyPool {
             limit,
-            running: 0,
-            tx,
-            rx,
+            running: Arc::new(AtomicUsize::new(0)),
         }
     }
 
-    /// Jobs under way.
+    /// Jobs under way (computing; an answer being sent no longer counts).
     pub fn running(&self) -> usize {
-        self.running
+        self.running.load(Ordering::Acquire)
     }
 
-    /// Starts `job` for the request `key` on the blocking pool, or, with `limit` jobs under way
-    /// already, gives `key` back with their number. Must be called inside a tokio runtime.
-    pub fn start(&mut self, key: K, job: impl FnOnce() -> R + Send + 'static) -> Result<(), (K, usize)> {
-        if self.running >= self.limit {
-            return Err((key, self.running));
+    /// Computes `job` on the blocking pool, then `answer`s with its result on the same thread,
+    /// or, with `limit` jobs under way already, refuses with their number (`job` and `answer`
+    /// never run). Must be called inside a tokio runtime.
+    pub fn start<R: Send + 'static>(
+        &self,
+        job: impl FnOnce() -> R + Send + 'static,
+        answer: impl FnOnce(R) + Send + 'static,
+    ) -> Result<(), usize> {
+        let running = self.running();
+        if running >= self.limit {
+            return Err(running);
         }
-        self.running += 1;
-        let tx = self.tx.clone();
+        self.running.fetch_add(1, Ordering::AcqRel);
+        let place = Place(Arc::clone(&self.running));
         tokio::task::spawn_blocking(move || {
-            // The receiver lives as long as the pool; if it is gone nobody waits.
-            let _ = tx.send((key, job()));
+            let result = job();
+            drop(place);
+            answer(result);
         });
         Ok(())
     }
 
-    /// The next reply, with its key; pending while none is under way. Cancel-safe (a reply
-    /// not taken stays for the next call), so it sits in the node's `select!`.
-    pub async fn next(&mut self) -> (K, R) {
-        match self.rx.recv().await {
-            Some(reply) => {
-                self.running = self.running.saturating_sub(1);
-                reply
+    /// Waits until no job is under way, at most `limit` (checking every millisecond): before a
+    /// node leaves, so that no answer is sent by a server whose participant is gone. True if
+    /// none is.
+    pub async fn until_idle(&self, limit: Duration) -> bool {
+        let until = tokio::time::Instant::now() + limit;
+        while self.running() > 0 {
+            if tokio::time::Instant::now() >= until {
+                return false;
             }
-            // The pool holds a sender, so the channel never closes.
-            None => std::future::pending().await,
+            tokio::time::sleep(Duration::from_millis(1)).await;
         }
+        true
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use std::time::{Duration, Instant};
+    use std::time::Instant;
 
     /// A search that takes `ms` of real work, checking the token every millisecond; returns its
     /// label, or "cancelled" (which must never be delivered).
@@ -355,27 +371,54 @@ mod tests {
     async fn a_pool_runs_up_to_its_limit_and_turns_the_next_away() {
         let (release_tx, release_rx) = std::sync::mpsc::channel::<()>();
         let release = Arc::new(std::sync::Mutex::new(release_rx));
-        let mut pool = ReplyPool::new(2);
-        for key in [1, 2] {
-            let release = release.clone();
+        let (answers_tx, answers) = std::sync::mpsc::channel::<(i32, usize)>();
+        let pool = ReplyPool::new(2);
+        let running = Arc::clone(&pool.running);
+        let start = |key: i32| {
+            let (release, answers_tx, running) = (release.clone(), answers_tx.clone(), Arc::clone(&running));
             let job = move || {
                 // Held until released, so both are under way when the third comes.
                 let _ = release.lock().map(|r| r.recv());
                 key * 10
             };
-            assert!(pool.start(key, job).is_ok());
-        }
-        assert_eq!(pool.start(3, || 30).unwrap_err(), (3, 2));
+            // Each answer notes how many jobs were under way as it went out.
+            let answer = move |reply| {
+                let _ = answers_tx.send((reply, running.load(Ordering::Acquire)));
+            };
+            pool.start(job, answer)
+        };
+        assert!(start(1).is_ok() && start(2).is_ok());
+        assert_eq!(start(3).unwrap_err(), 2, "the third is turned away");
         release_tx.send(()).expect("job waits");
-        let (key, reply) = pool.next().await;
-        assert_eq!(reply, key * 10);
+        let (first, under_way) = answers.recv_timeout(Duration::from_secs(5)).expect("an answer");
+        assert!(first == 10 || first == 20);
+        assert_eq!(under_way, 1, "its place was free before it answered");
         assert_eq!(pool.running(), 1);
-        assert!(pool.start(3, || 30).is_ok(), "a place is free again");
+        assert!(start(3).is_ok(), "a place is free again");
         release_tx.send(()).expect("job waits");
-        let mut rest = [pool.next().await, pool.next().await];
+        release_tx.send(()).expect("job waits");
+        let mut rest: Vec<i32> = (0..2)
+            .map(|_| answers.recv_timeout(Duration::from_secs(5)).expect("an answer").0)
+            .collect();
         rest.sort();
-        assert_eq!(rest.len(), 2);
-        assert!(rest.contains(&(3, 30)));
+        assert!(rest.contains(&30) && !rest.contains(&first));
+        assert!(pool.until_idle(Duration::from_secs(5)).await);
         assert_eq!(pool.running(), 0);
+    }
+
+    #[tokio::test(flavor = "current_thread")]
+    async fn a_panicking_job_frees_its_place_and_is_not_answered() {
+        let pool = ReplyPool::new(1);
+        let answered = Arc::new(AtomicBool::new(false));
+        let flag = Arc::clone(&answered);
+        assert!(pool
+            .start(
+                || -> i32 { panic!("a failing job") },
+                move |_| flag.store(true, Ordering::SeqCst)
+            )
+            .is_ok());
+        assert!(pool.until_idle(Duration::from_secs(5)).await, "the place comes back");
+        assert!(pool.start(|| 1, |_| ()).is_ok());
+        assert!(!answered.load(Ordering::SeqCst));
     }
 }

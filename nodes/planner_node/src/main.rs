@@ -183,7 +183,7 @@ struct Jobs {
     vfo: OffLoop<VfoTickDone>,
     /// Each job answers its request itself, from the pool's thread (the reply leaves as soon as
     /// it is computed, not when the event loop next runs).
-    checks: ReplyPool<RmwRequestId, ()>,
+    checks: ReplyPool,
 }
 
 /// Everything the loop holds between events.
@@ -248,7 +248,6 @@ enum Event {
     Path(ActionEvent<FollowPathGoal>),
     Lifecycle(Transition),
     Check(RmwRequestId, CheckRouteRequest),
-    Checked,
     RouteChecked(PreCheckDone),
     Tick,
 }
@@ -367,6 +366,14 @@ async fn start(node: &mut RosNode, out: &Outputs, config: PlannerConfig) -> anyh
     if final_zero {
         out.cmd.final_stop(FINAL_STOP_WAIT).await;
     }
+    // The route checks under way answer before the node leaves: their server must not outlive
+    // the participant (a check takes at most about 0.6 s).
+    if !jobs.checks.until_idle(Duration::from_secs(1)).await {
+        warn!(
+            "{CHECK_ROUTE}: {} route check(s) still under way at shutdown are not answered",
+            jobs.checks.running()
+        );
+    }
     lifecycle.close().await;
     let down = EndCause::Shutdown;
     let Servers {
@@ -438,7 +445,6 @@ async fn event_loop(
             e = inputs.next() => e?,
             done = jobs.goal.result() => Event::RouteChecked(done),
             done = jobs.vfo.result() => Event::VfoTicked(done),
-            _ = jobs.checks.next() => Event::Checked,
             e = servers.dock.next_event() => Event::Dock(e),
             e = servers.undock.next_event() => Event::Undock(e),
             e = servers.follow.next_event() => Event::Follow(e),
@@ -501,8 +507,6 @@ async fn event_loop(
             Event::Follow(ActionEvent::CancelRequested(id)) => shell.cancel(&mut io, Source::FollowAction, id),
             Event::Path(ActionEvent::CancelRequested(id)) => shell.cancel(&mut io, Source::PathAction, id),
             Event::Check(id, req) => shell.check_in(io.node, jobs, check, id, &req),
-            // The job has answered; `next` counted it done.
-            Event::Checked => {}
             Event::RouteChecked(done) => shell.pre_checked(&mut io, done),
             Event::Tick => shell.tick(&mut io).await,
         }

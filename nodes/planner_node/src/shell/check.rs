@@ -22,6 +22,12 @@ impl Shell {
         let (world, chassis, config) = (self.world_in(&placed), self.chassis, self.config.route_check());
         let (stamp, frame, step) = (node.stamp(), placed.frame, self.config.follow.check_length);
         let (server, throttle) = (Arc::clone(check), Arc::clone(&self.reply_throttle));
+        let answer = move |reply| {
+            if let Err(e) = server.send_response(id, reply) {
+                let mut throttle = throttle.lock().unwrap_or_else(|poisoned| poisoned.into_inner());
+                warn_throttled!(throttle, "service-reply", "{CHECK_ROUTE}: cannot send the reply: {e:?}");
+            }
+        };
         let job = move || {
             let began = Instant::now();
             let reply = match check_route_until(&start, &route.points, &chassis, &world, &config, || false) {
@@ -45,10 +51,9 @@ impl Shell {
                 },
                 began.elapsed().as_secs_f64() * 1e3
             );
-            let mut throttle = throttle.lock().unwrap_or_else(|poisoned| poisoned.into_inner());
-            respond(&server, id, reply, CHECK_ROUTE, &mut throttle);
+            reply
         };
-        if let Err((id, running)) = jobs.checks.start(id, job) {
+        if let Err(running) = jobs.checks.start(job, answer) {
             let reply = refused_reply(format!(
                 "BUSY: {running} route checks are already being computed; ask again"
             ));
