@@ -525,6 +525,11 @@ mod tests {
       bytes
     }
     let message = cdr(&names());
+    // names: 2 strings, "v_max" + NUL, 2 bytes to align the next length, "a" + NUL.
+    let mut literal = vec![2, 0, 0, 0, 6, 0, 0, 0];
+    literal.extend_from_slice(b"v_max\0\0\0");
+    literal.extend_from_slice(&[2, 0, 0, 0, b'a', 0]);
+    assert_eq!(message, literal);
     let id = RmwRequestId {
       writer_gid: gid([0x01, 0x0f], 0x21),
       sequence_number: 9,

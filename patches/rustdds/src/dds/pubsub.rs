@@ -529,7 +529,8 @@ impl InnerPublisher {
     let backlog_limit = window_limit;
     // KeepLast-style hard cap on retained samples for best-effort (non-blocking)
     // writes, which are not throttled at admission, and for reliable writers
-    // before a reader matches. This is where the History depth applies.
+    // before a reader matches; for a reliable no-key writer, also the number of
+    // acknowledged samples kept. This is where the History depth applies.
     let max_retain = match writer_qos.history() {
       Some(policy::History::KeepLast { depth }) => {
         let d = (depth as usize).max(1);

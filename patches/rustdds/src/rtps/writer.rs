@@ -2153,7 +2153,8 @@ impl Writer {
   /// gets only the `depth` latest ones (DDS v1.4, DURABILITY and HISTORY QoS).
   /// The send buffer may hold more than `depth` samples: it retains samples not
   /// yet acknowledged by every reliable reader, and evicts acknowledged ones
-  /// only on the periodic cache cleaning. Older, evicted samples are below the
+  /// on the periodic cache cleaning (and, being a writer of a topic without a
+  /// key, beyond `depth` on each write). Older, evicted samples are below the
   /// first_sn of our HEARTBEATs already.
   ///
   /// `depth` counts samples per instance, and the send buffer does not know

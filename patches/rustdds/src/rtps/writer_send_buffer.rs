@@ -71,7 +71,8 @@ struct Inner {
   // buffer exceeds `max_retain`, the oldest samples are dropped. Derived from
   // the writer's History depth / ResourceLimits (same value as `window_limit`).
   // Does NOT apply to reliable / opted-in writers, which are bounded by the
-  // send window / unsent-backlog and must retain samples for repair.
+  // send window / unsent-backlog and must retain samples for repair, except to
+  // a reliable no-key writer's acknowledged samples (see `insert_locked`).
   max_retain: usize,
 
   // Wakers of async producers / ack-waiters parked because the window was full
@@ -310,11 +311,12 @@ impl WriterSendBuffer {
     // A reliable writer of a topic without a key, with reliable readers matched:
     // the History depth of acknowledged samples and every unacknowledged one are
     // kept, as the periodic cache cleaning keeps them
-    // (`Writer::remove_all_acked_changes_but_keep_depth`), but at once. Between
-    // two cleanings (6 s) a writer answering a thousand calls a second otherwise
-    // held thousands of acknowledged samples: a service with 33 KB replies held
-    // 330 MB. A sample is acknowledged by every reliable reader below
-    // `acked_before`, so none still to be sent or repaired is evicted.
+    // (`Writer::remove_all_acked_changes_but_keep_depth`, for KeepLast; with
+    // KeepAll `max_retain` is the resource limit), but at once. Between two
+    // cleanings (6 s) a service answering 1 700 calls a second with 33 KB
+    // replies otherwise held about 10 000 acknowledged ones, 330 MB. A sample is
+    // acknowledged by every reliable reader below `acked_before`, so none still
+    // to be sent or repaired is evicted.
     let one_instance =
       shared.writer_guid.entity_id.kind() == EntityKind::WRITER_NO_KEY_USER_DEFINED;
     if !shared.is_builtin
