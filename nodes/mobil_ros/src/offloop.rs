@@ -5,7 +5,8 @@
 //! job's result is discarded, never delivered. One thread at most: the newer job waits until
 //! the cancelled one has returned, and a still newer one replaces it. [`OffLoop::result`] is cancel-safe, so it sits in
 //! the node's `select!` beside the ticker and the subscriptions, which keep being served while
-//! the search runs.
+//! the search runs. [`ReplyPool`] computes several requests at once, up to a limit, each
+//! answered from the thread that computed it.
 //!
 //! ```
 //! # #[tokio::main(flavor = "current_thread")]
@@ -172,17 +173,20 @@ impl<R: Send + 'static> OffLoop<R> {
 /// sent) runs on the thread that computed it, without a hand-off back to the event loop; beyond
 /// the limit a request is turned away at once, for the caller to answer BUSY, so a burst of
 /// requests never piles up threads. A job's place is free again before its answer goes out, so
-/// a client that calls again as soon as it is answered always finds one.
+/// a client that calls again as soon as it is answered finds its own place free again.
 pub struct ReplyPool {
     limit: usize,
+    /// Jobs computing: the places taken.
     running: Arc<AtomicUsize>,
+    /// Jobs not yet finished, their answers included.
+    in_flight: Arc<AtomicUsize>,
 }
 
-/// Frees a place of a [`ReplyPool`] when dropped: after the job, before its answer, or while a
-/// panicking job unwinds.
-struct Place(Arc<AtomicUsize>);
+/// Takes one from its counter when dropped: a place of a [`ReplyPool`] after the job, before its
+/// answer; a job in flight after its answer; either while a panicking job unwinds.
+struct Taken(Arc<AtomicUsize>);
 
-impl Drop for Place {
+impl Drop for Taken {
     fn drop(&mut self) {
         self.0.fetch_sub(1, Ordering::AcqRel);
     }
@@ -194,6 +198,7 @@ impl ReplyPool {
         ReplyPool {
             limit,
             running: Arc::new(AtomicUsize::new(0)),
+            in_flight: Arc::new(AtomicUsize::new(0)),
         }
     }
 
@@ -204,38 +209,39 @@ impl ReplyPool {
 
     /// Computes `job` on the blocking pool, then `answer`s with its result on the same thread,
     /// or, with `limit` jobs under way already, refuses with their number (`job` and `answer`
-    /// never run). Must be called inside a tokio runtime.
+    /// never run). Must be called inside a tokio runtime. A job that panics is not answered.
     pub fn start<R: Send + 'static>(
         &self,
         job: impl FnOnce() -> R + Send + 'static,
         answer: impl FnOnce(R) + Send + 'static,
     ) -> Result<(), usize> {
-        let running = self.running();
-        if running >= self.limit {
-            return Err(running);
-        }
-        self.running.fetch_add(1, Ordering::AcqRel);
-        let place = Place(Arc::clone(&self.running));
+        self.running.fetch_update(Ordering::AcqRel, Ordering::Acquire, |n| {
+            (n < self.limit).then_some(n + 1)
+        })?;
+        let place = Taken(Arc::clone(&self.running));
+        self.in_flight.fetch_add(1, Ordering::AcqRel);
+        let flight = Taken(Arc::clone(&self.in_flight));
         tokio::task::spawn_blocking(move || {
             let result = job();
             drop(place);
             answer(result);
+            drop(flight);
         });
         Ok(())
     }
 
-    /// Waits until no job is under way, at most `limit` (checking every millisecond): before a
-    /// node leaves, so that no answer is sent by a server whose participant is gone. True if
-    /// none is.
-    pub async fn until_idle(&self, limit: Duration) -> bool {
+    /// Waits until every job has finished, its answer sent, at most `limit` (checking every
+    /// millisecond): before a node leaves, so that no answer is sent by a server whose
+    /// participant is gone. The jobs not finished then, or 0.
+    pub async fn until_idle(&self, limit: Duration) -> usize {
         let until = tokio::time::Instant::now() + limit;
-        while self.running() > 0 {
-            if tokio::time::Instant::now() >= until {
-                return false;
+        loop {
+            let left = self.in_flight.load(Ordering::Acquire);
+            if left == 0 || tokio::time::Instant::now() >= until {
+                return left;
             }
             tokio::time::sleep(Duration::from_millis(1)).await;
         }
-        true
     }
 }
 
@@ -402,8 +408,31 @@ mod tests {
             .collect();
         rest.sort();
         assert!(rest.contains(&30) && !rest.contains(&first));
-        assert!(pool.until_idle(Duration::from_secs(5)).await);
+        assert_eq!(pool.until_idle(Duration::from_secs(5)).await, 0);
         assert_eq!(pool.running(), 0);
+    }
+
+    #[tokio::test(flavor = "current_thread")]
+    async fn idle_only_once_the_answer_is_sent() {
+        let pool = ReplyPool::new(1);
+        let (release_tx, release_rx) = std::sync::mpsc::channel::<()>();
+        // The answer waits, as a reply's write may.
+        assert!(pool
+            .start(
+                || 1,
+                move |_| {
+                    let _ = release_rx.recv();
+                }
+            )
+            .is_ok());
+        assert_eq!(
+            pool.until_idle(Duration::from_millis(50)).await,
+            1,
+            "the answer is still going out"
+        );
+        assert_eq!(pool.running(), 0, "its place is free meanwhile");
+        release_tx.send(()).expect("the answer waits");
+        assert_eq!(pool.until_idle(Duration::from_secs(5)).await, 0);
     }
 
     #[tokio::test(flavor = "current_thread")]
@@ -417,7 +446,7 @@ mod tests {
                 move |_| flag.store(true, Ordering::SeqCst)
             )
             .is_ok());
-        assert!(pool.until_idle(Duration::from_secs(5)).await, "the place comes back");
+        assert_eq!(pool.until_idle(Duration::from_secs(5)).await, 0, "the place comes back");
         assert!(pool.start(|| 1, |_| ()).is_ok());
         assert!(!answered.load(Ordering::SeqCst));
     }

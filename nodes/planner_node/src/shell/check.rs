@@ -30,17 +30,23 @@ impl Shell {
         };
         let job = move || {
             let began = Instant::now();
-            let reply = match check_route_until(&start, &route.points, &chassis, &world, &config, || false) {
-                Ok(report) => {
-                    let of_route = (&route.points[..], &route.request_index[..]);
-                    check_reply(
-                        &RouteAnswer::of(&report, of_route, step, MAX_REPLY_POSES),
-                        stamp,
-                        &frame,
-                    )
+            // A check that panics (a defect) is still answered; the panic is in the log.
+            let checked = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+                match check_route_until(&start, &route.points, &chassis, &world, &config, || false) {
+                    Ok(report) => {
+                        let of_route = (&route.points[..], &route.request_index[..]);
+                        check_reply(
+                            &RouteAnswer::of(&report, of_route, step, MAX_REPLY_POSES),
+                            stamp,
+                            &frame,
+                        )
+                    }
+                    Err(e) => refused_reply(Action::Follow.refused_goal(e).reason()),
                 }
-                Err(e) => refused_reply(Action::Follow.refused_goal(e).reason()),
-            };
+            }));
+            let reply = checked.unwrap_or_else(|_| {
+                refused_reply("INTERNAL_ERROR: the route check failed (see the node's log)".to_owned())
+            });
             info!(
                 "planner/check_route: {} waypoints, {} in {:.2} ms",
                 route.points.len(),
