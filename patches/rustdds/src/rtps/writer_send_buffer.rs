@@ -291,7 +291,8 @@ impl WriterSendBuffer {
     //    ms) heartbeat cadence -- collapsing reliable throughput. Trimming to
     //    KeepLast here keeps only the recent samples (correct for volatile
     //    durability); once a reliable reader matches, `reliable_readers_present`
-    //    flips true and we retain everything again for repair.
+    //    flips true and we retain everything again for repair (but for a no-key
+    //    writer's acknowledged samples beyond the depth: below).
     // Built-in (discovery) writers are always exempt to never lose discovery data.
     let trim_keep_last = !shared.is_builtin
       && (!may_block
@@ -664,7 +665,8 @@ mod tests {
   // is pointless and would create a huge post-match repair backlog (the reliable
   // flat-out throughput fix). Once a reliable reader matches
   // (`set_acked_frontier(Some(..))`), trimming stops and everything is retained
-  // for repair.
+  // for repair (this writer's kind is unknown; a no-key writer also evicts its
+  // acknowledged samples beyond the depth, tested below).
   #[test]
   fn volatile_reliable_writer_trimmed_until_reader_matches() {
     let max_retain = 4;
@@ -687,7 +689,8 @@ mod tests {
     assert_eq!(buf.retained_len(), max_retain);
 
     // A reliable reader matches: from now on the writer retains everything for
-    // repair (no trimming), even past max_retain.
+    // repair (no trimming), even past max_retain (samples 97..=100 are the
+    // acknowledged depth a no-key writer would keep too).
     buf.set_acked_frontier(Some(SequenceNumber::new(101)));
     for _ in 0..10 {
       assert!(admit_now(&buf, WriteOptions::default()));
