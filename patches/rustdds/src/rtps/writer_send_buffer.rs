@@ -698,6 +698,25 @@ mod tests {
     assert_eq!(buf.retained_len(), max_retain + 10);
   }
 
+  // A reliable, volatile user writer of the given entity kind with room for
+  // 8192 samples, keeping `max_retain`.
+  fn reliable_volatile_writer(kind: EntityKind, max_retain: usize) -> WriterSendBuffer {
+    let guid = GUID::new(
+      crate::structure::guid::GuidPrefix::UNKNOWN,
+      crate::structure::guid::EntityId::new([0, 0, 1], kind),
+    );
+    WriterSendBuffer::new(
+      guid,
+      "t".to_string(),
+      /* reliable_writer */ true,
+      /* is_builtin */ false,
+      /* volatile */ true,
+      /* window_limit */ 8192,
+      /* backlog_limit */ 8192,
+      max_retain,
+    )
+  }
+
   // A reliable writer of a topic without a key, its reader acknowledging as it
   // goes (a service's reply writer answering call after call): it keeps the
   // History depth of acknowledged samples and every unacknowledged one from one
@@ -705,20 +724,7 @@ mod tests {
   #[test]
   fn acknowledged_samples_beyond_depth_leave_at_once() {
     let depth = 10;
-    let no_key_writer = GUID::new(
-      crate::structure::guid::GuidPrefix::UNKNOWN,
-      crate::structure::guid::EntityId::new([0, 0, 1], EntityKind::WRITER_NO_KEY_USER_DEFINED),
-    );
-    let buf = WriterSendBuffer::new(
-      no_key_writer,
-      "t".to_string(),
-      /* reliable_writer */ true,
-      /* is_builtin */ false,
-      /* volatile */ true,
-      /* window_limit */ 8192,
-      /* backlog_limit */ 8192,
-      /* max_retain */ depth,
-    );
+    let buf = reliable_volatile_writer(EntityKind::WRITER_NO_KEY_USER_DEFINED, depth);
     buf.set_acked_frontier(Some(SequenceNumber::new(0)));
     // 1000 calls, each acknowledged before the next is written.
     for n in 1..=1000 {
@@ -751,20 +757,7 @@ mod tests {
   // know: it is left to the periodic cleaning.
   #[test]
   fn a_keyed_writer_is_not_trimmed_on_write() {
-    let keyed_writer = GUID::new(
-      crate::structure::guid::GuidPrefix::UNKNOWN,
-      crate::structure::guid::EntityId::new([0, 0, 1], EntityKind::WRITER_WITH_KEY_USER_DEFINED),
-    );
-    let buf = WriterSendBuffer::new(
-      keyed_writer,
-      "t".to_string(),
-      true,
-      false,
-      true,
-      8192,
-      8192,
-      2,
-    );
+    let buf = reliable_volatile_writer(EntityKind::WRITER_WITH_KEY_USER_DEFINED, 2);
     buf.set_acked_frontier(Some(SequenceNumber::new(0)));
     for n in 1..=20 {
       assert!(admit_now(&buf, WriteOptions::default()));
