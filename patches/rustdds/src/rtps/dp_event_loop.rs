@@ -22,7 +22,6 @@ use crate::{
     discovery_db::{discovery_db_read, DiscoveryDB},
     sedp_messages::{DiscoveredReaderData, DiscoveredWriterData},
   },
-  messages::submessages::submessages::AckSubmessage,
   network::{
     constant::SPDP_LOCALHOST_PEER_COUNT,
     udp_listener::UDPListener,
@@ -36,7 +35,7 @@ use crate::{
   //qos::HasQoSPolicy,
   rtps::{
     constant::*,
-    message_receiver::MessageReceiver,
+    message_receiver::{MessageReceiver, ReceivedAck},
     outbound::SocketId,
     reader::{Reader, ReaderIngredients},
     rtps_reader_proxy::RtpsReaderProxy,
@@ -97,7 +96,7 @@ pub struct DPEventLoop {
   stop_poll_receiver: WakeReceiver<EventLoopCommand>,
   // GuidPrefix sent in this channel needs to be RTPSMessage source_guid_prefix. Writer needs this
   // to locate RTPSReaderProxy if negative acknack.
-  ack_nack_receiver: WakeReceiver<(GuidPrefix, AckSubmessage)>,
+  ack_nack_receiver: WakeReceiver<ReceivedAck>,
   /// Entity ids whose command queues or doorbells have been rung. One waker
   /// serves every queue, so the id is the reason.
   reader_ready: ReadyReceiver<EntityId>,
@@ -203,8 +202,7 @@ impl DPEventLoop {
     // loop starts). The acknack queue is drained on that same wake. Both ends
     // of it are this thread. 1024 absorbs a burst of ACKNACKs from one poll's
     // worth of datagrams; a still larger one is discarded.
-    let (acknack_sender, acknack_receiver) =
-      wake_channel::<(GuidPrefix, AckSubmessage)>(1024, &waker);
+    let (acknack_sender, acknack_receiver) = wake_channel::<ReceivedAck>(1024, &waker);
 
     // Deadlines live in the loop. Reader/Writer timeouts are scheduled later
     // through cloned handles passed into Reader::new / Writer::new.
@@ -681,14 +679,16 @@ impl DPEventLoop {
   }
 
   fn handle_writer_acknack_action(&mut self) {
-    while let Ok((acknack_sender_prefix, acknack_submessage)) = self.ack_nack_receiver.try_recv() {
+    while let Ok((acknack_sender_prefix, acknack_submessage, final_flag)) =
+      self.ack_nack_receiver.try_recv()
+    {
       let writer_guid = GUID::new_with_prefix_and_id(
         self.domain_info.domain_participant_guid.prefix,
         acknack_submessage.writer_id(),
       );
       if let Some(found_writer) = self.writers.get_mut(&writer_guid.entity_id) {
         if found_writer.is_reliable() {
-          found_writer.handle_ack_nack(acknack_sender_prefix, &acknack_submessage);
+          found_writer.handle_ack_nack(acknack_sender_prefix, &acknack_submessage, final_flag);
         }
       } else {
         // Note: when testing against FastDDS Shapes demo, this else branch is

@@ -108,11 +108,16 @@ impl Default for MessageReceiverState<'_> {
 /// submessages. Then it processes the instructions in the Interpreter
 /// SUbmessages and forwards data in Entity Submessages to the appropriate
 /// Entities. (See RTPS spec Section 8.3.7)
+/// An ACKNACK or NACK_FRAG on its way to its writer: who sent it, the
+/// submessage, and whether its final flag was set (the reader expects no
+/// answer; always set for a NACK_FRAG, which has no such flag).
+pub(crate) type ReceivedAck = (GuidPrefix, AckSubmessage, bool);
+
 pub(crate) struct MessageReceiver {
   pub available_readers: BTreeMap<EntityId, Reader>,
   // GuidPrefix sent in this channel needs to be RTPSMessage source_guid_prefix. Writer needs this
   // to locate RTPSReaderProxy if negative acknack.
-  acknack_sender: WakeSender<(GuidPrefix, AckSubmessage)>,
+  acknack_sender: WakeSender<ReceivedAck>,
   // We send notification of remote DomainParticipant liveness to Discovery to
   // bypass Reader, DDSCache, DatasampleCache, and DataReader, because these will drop
   // repeated messages with duplicate SequenceNumbers, but Discovery needs to see them.
@@ -146,7 +151,7 @@ pub(crate) struct MessageReceiver {
 impl MessageReceiver {
   pub fn new(
     participant_guid_prefix: GuidPrefix,
-    acknack_sender: WakeSender<(GuidPrefix, AckSubmessage)>,
+    acknack_sender: WakeSender<ReceivedAck>,
     spdp_liveness_sender: WakeSender<GuidPrefix>,
     security_plugins: Option<SecurityPluginsHandle>,
     interface_observations: Rc<RefCell<InterfaceObservations>>,
@@ -861,13 +866,14 @@ impl MessageReceiver {
     }
 
     match submessage {
-      ReaderSubmessage::AckNack(acknack, _) => {
+      ReaderSubmessage::AckNack(acknack, flags) => {
         // Note: This must not block, because the receiving end is the same thread,
         // i.e. blocking here is an instant deadlock.
-        match self
-          .acknack_sender
-          .try_send((self.source_guid_prefix, AckSubmessage::AckNack(acknack)))
-        {
+        match self.acknack_sender.try_send((
+          self.source_guid_prefix,
+          AckSubmessage::AckNack(acknack),
+          flags.contains(ACKNACK_Flags::Final),
+        )) {
           Ok(_) => (),
           Err(TrySendError::Full(_)) => {
             info!("AckNack pipe full. Looks like I am very busy. Discarding submessage.");
@@ -881,10 +887,11 @@ impl MessageReceiver {
         // same way AckNack is forwarded. The writer handles it via
         // `AckSubmessage::NackFrag` (scheduling repair-fragment sends). Must not
         // block: the receiving end is on this same thread.
-        match self
-          .acknack_sender
-          .try_send((self.source_guid_prefix, AckSubmessage::NackFrag(nackfrag)))
-        {
+        match self.acknack_sender.try_send((
+          self.source_guid_prefix,
+          AckSubmessage::NackFrag(nackfrag),
+          true,
+        )) {
           Ok(_) => (),
           Err(TrySendError::Full(_)) => {
             info!("NackFrag pipe full. Looks like I am very busy. Discarding submessage.");

@@ -1134,10 +1134,13 @@ impl Writer {
   /// samples, the Writer must respond by either sending the missing data
   /// samples, sending a GAP message when the sample is not relevant, or
   /// sending a HEARTBEAT message when the sample is no longer available
+  /// Handles an ACKNACK or NACK_FRAG from a matched reader; `final_flag` is
+  /// the ACKNACK's final flag (the reader expects no answer).
   pub fn handle_ack_nack(
     &mut self,
     reader_guid_prefix: GuidPrefix,
     ack_submessage: &AckSubmessage,
+    final_flag: bool,
   ) {
     // sanity check
     if !self.is_reliable() || self.like_stateless {
@@ -1269,11 +1272,17 @@ impl Writer {
             );
           }
 
-          // An ACKNACK that requests nothing although the reader has not acknowledged
-          // everything means the reader does not know what we have, typically a
-          // preemptive ACKNACK from a reader that matched us after our HEARTBEAT.
-          // Answer now instead of at the next heartbeat period.
-          if an.reader_sn_state.iter().next().is_none() && reader_proxy.all_acked_before <= last_seq
+          // An ACKNACK without the final flag that requests nothing although the
+          // reader has not acknowledged everything means the reader does not know
+          // what we have and asks (typically a preemptive ACKNACK from a reader that
+          // matched us after our HEARTBEAT): answer now instead of at the next
+          // heartbeat period. A reader's answer to a HEARTBEAT has the final flag
+          // set and gets no answer: a sample written after that HEARTBEAT would
+          // otherwise draw another HEARTBEAT, that one another ACKNACK, and so on
+          // for as long as samples keep coming.
+          if !final_flag
+            && an.reader_sn_state.iter().next().is_none()
+            && reader_proxy.all_acked_before <= last_seq
           {
             let hb_message = MessageBuilder::new()
               .ts_msg(self.endianness, Some(Timestamp::now()))
@@ -2931,6 +2940,21 @@ mod tests {
         self.reader_proxy().unsent_changes_count()
       }
 
+      // The reader has everything before `base` and requests nothing.
+      fn ack(&mut self, base: i64, count: i32, final_flag: bool) {
+        let ack_nack = AckNack {
+          reader_id: self.reader_guid.entity_id,
+          writer_id: self.writer.my_guid.entity_id,
+          reader_sn_state: SequenceNumberSet::new_empty(SequenceNumber::new(base)),
+          count,
+        };
+        self.writer.handle_ack_nack(
+          self.reader_guid.prefix,
+          &AckSubmessage::AckNack(ack_nack),
+          final_flag,
+        );
+      }
+
       // The reader has received nothing and requests `requested`.
       fn ack_nack(&mut self, requested: impl IntoIterator<Item = i64>, count: i32) {
         let requested: BTreeSet<SequenceNumber> =
@@ -2941,9 +2965,11 @@ mod tests {
           reader_sn_state: SequenceNumberSet::from_base_and_set(SequenceNumber::new(1), &requested),
           count,
         };
-        self
-          .writer
-          .handle_ack_nack(self.reader_guid.prefix, &AckSubmessage::AckNack(ack_nack));
+        self.writer.handle_ack_nack(
+          self.reader_guid.prefix,
+          &AckSubmessage::AckNack(ack_nack),
+          true,
+        );
       }
 
       // Timed events addressed to our reader that expire within `max_wait`.
@@ -3108,8 +3134,11 @@ mod tests {
         ),
         count: 1,
       };
-      f.writer
-        .handle_ack_nack(f.reader_guid.prefix, &AckSubmessage::AckNack(ack_nack));
+      f.writer.handle_ack_nack(
+        f.reader_guid.prefix,
+        &AckSubmessage::AckNack(ack_nack),
+        true,
+      );
       f.writer.handle_cache_cleaning();
       assert_eq!(
         f.writer.send_buffer.first_change_sequence_number(),
@@ -3384,6 +3413,31 @@ mod tests {
       f.writer.udp_sender.flush_control(SocketId::Unicast);
       assert_eq!(f.repair_round(), 5);
       assert!(!f.reader_proxy().repair_mode);
+    }
+
+    // A reader's answer to a HEARTBEAT (final flag set) that does not cover a
+    // sample written since is not answered: that answer would draw another
+    // ACKNACK, which would draw another HEARTBEAT, for as long as samples keep
+    // coming. One without the final flag asks for a HEARTBEAT and gets it.
+    #[test]
+    fn only_an_acknack_without_the_final_flag_draws_a_heartbeat() {
+      let mut f = Fixture::user(3, 8, None);
+      let count = f.writer.next_heartbeat_count();
+      f.ack(3, 1, true);
+      assert_eq!(
+        f.writer.next_heartbeat_count(),
+        count + 1,
+        "an ACKNACK with the final flag was answered"
+      );
+      f.ack(3, 2, false);
+      assert_eq!(
+        f.writer.next_heartbeat_count(),
+        count + 3,
+        "an ACKNACK without the final flag was not answered"
+      );
+      // Nothing to tell a reader that has everything.
+      f.ack(4, 3, false);
+      assert_eq!(f.writer.next_heartbeat_count(), count + 4);
     }
   }
 }
