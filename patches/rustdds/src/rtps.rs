@@ -12,6 +12,7 @@ pub(crate) mod timed_event;
 pub(crate) mod transmit;
 pub(crate) mod writer;
 pub(crate) mod writer_send_buffer;
+pub(crate) mod writer_thread_send;
 
 pub(crate) mod message;
 pub(crate) use message::{Message, MessageBuilder};

@@ -3,6 +3,10 @@ use std::{
   collections::HashMap,
   io,
   net::{IpAddr, SocketAddr, UdpSocket},
+  sync::{
+    atomic::{AtomicBool, Ordering},
+    Arc,
+  },
 };
 #[cfg(test)]
 use std::net::Ipv4Addr;
@@ -51,6 +55,13 @@ pub struct UDPSender {
   // sent immediately. Drained on write readiness by `flush_control`.
   // (see src/rtps/nonblocking_transmit_design.md)
   control_queues: RefCell<HashMap<SocketId, ControlQueue>>,
+
+  // writer-thread send (see src/rtps/writer_thread_send.rs): a duplicate of
+  // `unicast_socket` that writing threads send on (`None` if it could not be
+  // made: everything then goes through the event loop), and whether the
+  // unicast socket's control queue holds datagrams.
+  shared_unicast: Option<Arc<UdpSocket>>,
+  unicast_control_backlog: Arc<AtomicBool>,
 }
 
 impl UDPSender {
@@ -169,10 +180,19 @@ impl UDPSender {
       multicast_sockets.push((InterfaceSelector::Ip(multicast_if_ipaddr), mc_socket));
     } // end for
 
+    let shared_unicast = match unicast_socket.try_clone() {
+      Ok(socket) => Some(Arc::new(socket)),
+      Err(e) => {
+        warn!("UDPSender: no duplicate of the unicast socket ({e}); writers send through the event loop only");
+        None
+      }
+    };
     let sender = Self {
       unicast_socket,
       multicast_sockets,
       control_queues: RefCell::new(HashMap::new()),
+      shared_unicast,
+      unicast_control_backlog: Arc::new(AtomicBool::new(false)),
     };
     info!("UDPSender::new() --> {sender:?}");
     Ok(sender)
@@ -269,10 +289,13 @@ impl UDPSender {
     if queue.is_empty() {
       match self.raw_send(id, addr, buffer) {
         SendOutcome::Sent | SendOutcome::Dropped => {}
-        SendOutcome::WouldBlock => queue.push_back(Datagram {
-          addr,
-          bytes: buffer.to_vec(),
-        }),
+        SendOutcome::WouldBlock => {
+          queue.push_back(Datagram {
+            addr,
+            bytes: buffer.to_vec(),
+          });
+          self.note_control_backlog(id, true);
+        }
       }
     } else {
       queue.push_back(Datagram {
@@ -306,7 +329,29 @@ impl UDPSender {
         SendOutcome::WouldBlock => return false,
       }
     }
+    self.note_control_backlog(id, false);
     true
+  }
+
+  // Keeps the flag writing threads read (`unicast_control_backlog`) equal to
+  // whether the unicast socket's control queue holds datagrams.
+  fn note_control_backlog(&self, id: SocketId, backlogged: bool) {
+    if id == SocketId::Unicast {
+      self
+        .unicast_control_backlog
+        .store(backlogged, Ordering::Release);
+    }
+  }
+
+  /// The duplicate of the unicast socket for writing threads, and the flag
+  /// that is set while its control queue holds datagrams.
+  pub(crate) fn shared_unicast(&self) -> Option<(Arc<UdpSocket>, Arc<AtomicBool>)> {
+    self.shared_unicast.as_ref().map(|socket| {
+      (
+        Arc::clone(socket),
+        Arc::clone(&self.unicast_control_backlog),
+      )
+    })
   }
 
   /// Whether socket `id` currently has queued (undelivered) control datagrams.
@@ -327,6 +372,7 @@ impl UDPSender {
         addr: SocketAddr::from(([127, 0, 0, 1], 9)),
         bytes: vec![0; 4],
       });
+    self.note_control_backlog(id, true);
   }
 
   /// Sockets that currently have queued (undelivered) control datagrams.

@@ -446,7 +446,7 @@ impl DPEventLoop {
           self
             .writers
             .get_mut(&writer_guid.entity_id)
-            .map(|w| w.handle_heartbeat_tick(manual_assertion));
+            .map(|w| w.with_transmit(|w| w.handle_heartbeat_tick(manual_assertion)));
         }
         #[cfg(feature = "security")]
         ParticipantAuthenticationStatusChanged { guid_prefix } => {
@@ -471,7 +471,7 @@ impl DPEventLoop {
           (BTreeSet::new(), vec![])
         }
         Some(writer) => {
-          writer.process_pending();
+          writer.with_transmit(Writer::process_pending);
           (writer.take_blocked_sockets(), writer.local_readers())
         }
       };
@@ -518,7 +518,7 @@ impl DPEventLoop {
         }
         DpTimerEvent::Writer { entity_id, event } => {
           if let Some(writer) = self.writers.get_mut(&entity_id) {
-            writer.handle_timed_event(event);
+            writer.with_transmit(|w| w.handle_timed_event(event));
           } else if !preparing_to_stop {
             trace!("Timed event for unknown writer {entity_id:?}");
           }
@@ -555,7 +555,7 @@ impl DPEventLoop {
     while let Some(eid) = self.bulk_ready.get_mut(&sid).and_then(VecDeque::pop_front) {
       let blocked = match self.writers.get_mut(&eid) {
         Some(writer) => {
-          writer.process_pending();
+          writer.with_transmit(Writer::process_pending);
           writer.take_blocked_sockets()
         }
         None => BTreeSet::new(),
@@ -688,7 +688,9 @@ impl DPEventLoop {
       );
       if let Some(found_writer) = self.writers.get_mut(&writer_guid.entity_id) {
         if found_writer.is_reliable() {
-          found_writer.handle_ack_nack(acknack_sender_prefix, &acknack_submessage, final_flag);
+          found_writer.with_transmit(|w| {
+            w.handle_ack_nack(acknack_sender_prefix, &acknack_submessage, final_flag);
+          });
         }
       } else {
         // Note: when testing against FastDDS Shapes demo, this else branch is
@@ -808,7 +810,7 @@ impl DPEventLoop {
             // `writer` knows not to expect them, and avoid stalling.
           };
 
-          writer.update_reader_proxy(&reader_proxy, &reader_qos);
+          writer.with_transmit(|w| w.update_reader_proxy(&reader_proxy, &reader_qos));
           debug!(
             "update_discovery writer - endpoint {:?} - {:?}",
             reader_endpoint_set_elem, discovered_participant.participant_guid
@@ -959,10 +961,8 @@ impl DPEventLoop {
         if match_to_reader {
           // Should we check if the participant has published a QoS for the topic?
           let requested_qos = remote_reader.subscription_topic_data.qos();
-          writer.update_reader_proxy(
-            &RtpsReaderProxy::from_discovered_reader_data(remote_reader, &[], &[]),
-            &requested_qos,
-          );
+          let reader_proxy = RtpsReaderProxy::from_discovered_reader_data(remote_reader, &[], &[]);
+          writer.with_transmit(|w| w.update_reader_proxy(&reader_proxy, &requested_qos));
         }
       }
     }

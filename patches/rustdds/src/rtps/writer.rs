@@ -2,9 +2,10 @@ use std::{
   cell::RefCell,
   cmp::{max, min},
   collections::{BTreeMap, BTreeSet},
+  net::SocketAddr,
   ops::Bound::Included,
   rc::Rc,
-  sync::{atomic, mpsc::TrySendError},
+  sync::mpsc::TrySendError,
 };
 
 #[allow(unused_imports)]
@@ -36,8 +37,9 @@ use crate::{
     outbound::{SocketId, TrafficClass},
     rtps_reader_proxy::RtpsReaderProxy,
     timed_event::DpTimerEvent,
-    transmit::{DefaultRouteSelector, InterfaceObservations, RouteKey},
+    transmit::{DefaultRouteSelector, InterfaceObservations, RouteKey, SendRoute},
     writer_send_buffer::WriterSendBuffer,
+    writer_thread_send::FastRoute,
     Message, MessageBuilder,
   },
   structure::{
@@ -135,7 +137,6 @@ pub(crate) struct WriterIngredients {
 
 pub(crate) struct Writer {
   pub endianness: Endianness,
-  pub heartbeat_message_counter: atomic::AtomicI32,
   /// Configures the mode in which the
   /// Writer operates. If
   /// pushMode==true, then the Writer
@@ -332,7 +333,6 @@ impl Writer {
 
     Self {
       endianness: Endianness::LittleEndian,
-      heartbeat_message_counter: atomic::AtomicI32::new(1),
       push_mode: true,
       heartbeat_period,
       heartbeat_period_fast,
@@ -1738,10 +1738,80 @@ impl Writer {
     self.send_buffer.remove_changes_before(first_keeper);
   }
 
+  /// The next HEARTBEAT count, shared with writing threads that send a sample
+  /// themselves: taken, and the HEARTBEAT sent, under the transmit lock
+  /// ([`Writer::with_transmit`]).
   pub(crate) fn next_heartbeat_count(&self) -> i32 {
-    self
-      .heartbeat_message_counter
-      .fetch_add(1, atomic::Ordering::SeqCst)
+    self.send_buffer.transmit().next_heartbeat_count()
+  }
+
+  /// Runs `f` on this writer with its transmit lock held: the event loop calls
+  /// into a `Writer` only through this, so that a writing thread never sends
+  /// meanwhile (see `writer_thread_send.rs`). The send progress a writing thread
+  /// may have advanced is copied in before and out after.
+  pub fn with_transmit<R>(&mut self, f: impl FnOnce(&mut Self) -> R) -> R {
+    let buffer = self.send_buffer.clone();
+    let mut state = buffer.transmit().lock();
+    if state.last_sent > self.last_sent {
+      // Sent by a writing thread, which only sends with nothing pending here.
+      self.last_sent = state.last_sent;
+    }
+    let result = f(self);
+    state.last_sent = self.last_sent;
+    state.cursor_fresh = self.sample_cursor == SampleCursor::Fresh;
+    result
+  }
+
+  /// Where a writing thread may send a sample itself, or `None` when the event
+  /// loop must: only a push-mode user writer without security whose matched
+  /// readers are all remote (a local reader is woken by the event loop after
+  /// it sends) and each has a resolved unicast IPv4 route, with no fixed extra
+  /// destinations.
+  fn fast_route(&self) -> Option<FastRoute> {
+    if !self.push_mode
+      || self.like_stateless
+      || self.security_plugins.is_some()
+      || self.my_guid.entity_id.kind().is_built_in()
+      || !self.extra_unicast_destinations.is_empty()
+      || self.readers.is_empty()
+    {
+      return None;
+    }
+    let (socket, control_backlog) = self.udp_sender.shared_unicast()?;
+    let mut destinations: Vec<SocketAddr> = Vec::with_capacity(self.readers.len());
+    for reader in self.readers.values() {
+      if reader.remote_reader_guid.prefix == self.my_guid.prefix {
+        return None;
+      }
+      match reader.send_route() {
+        SendRoute {
+          fallback: false,
+          multicast: None,
+          unicast: Some(Locator::UdpV4(address)),
+        } => {
+          let address = SocketAddr::from(address);
+          if !destinations.contains(&address) {
+            destinations.push(address);
+          }
+        }
+        _ => return None,
+      }
+    }
+    Some(FastRoute {
+      socket,
+      control_backlog,
+      destinations,
+      max_payload: self.max_unfragmented_serialized_payload(None),
+      writer_guid: self.my_guid,
+      endianness: self.endianness,
+      reliable: self.is_reliable(),
+    })
+  }
+
+  /// Gives writing threads the current route (after any change to the matched
+  /// readers, their routes or budgets, or the writer's destinations).
+  fn refresh_fast_route(&self) {
+    self.send_buffer.transmit().set_route(self.fast_route());
   }
 
   #[cfg(feature = "security")]
@@ -1985,6 +2055,7 @@ impl Writer {
   /// [`Self::extra_unicast_destinations`].
   pub fn set_extra_unicast_destinations(&mut self, locators: Vec<Locator>) {
     self.extra_unicast_destinations = locators;
+    self.refresh_fast_route();
   }
 
   /// Enable/disable preferring a same-host peer's loopback locator during route
@@ -2194,6 +2265,7 @@ impl Writer {
       .map(RtpsReaderProxy::max_datagram_payload)
       .min()
       .unwrap_or(FALLBACK_MAX_AGGREGATED_DATAGRAM_SIZE);
+    self.refresh_fast_route();
   }
 
   /// Refresh the [`SendRoute`](crate::rtps::transmit::SendRoute) of every
@@ -2864,6 +2936,14 @@ mod tests {
         let (status_sender, status) = sync_status_channel(4).unwrap();
         let (participant_status_sender, participant_status) = sync_status_channel(16).unwrap();
         let timer = new_shared_timer();
+        let reader_guid = GUID::new(GuidPrefix::new(&[2; 12]), reader_id);
+        // A reader on loopback is on this host: seen from there and advertising
+        // that locator as its loopback one, so that its route resolves to it.
+        let mut observations = InterfaceObservations::default();
+        let same_host = reader_locator.filter(|address| address.ip().is_loopback());
+        if let Some(address) = same_host {
+          observations.record(reader_guid.prefix, None, address);
+        }
         let mut writer = Writer::new(
           WriterIngredients {
             guid,
@@ -2877,14 +2957,16 @@ mod tests {
           Rc::new(UDPSender::new(0).unwrap()),
           Rc::clone(&timer),
           participant_status_sender,
-          Rc::new(RefCell::new(InterfaceObservations::default())),
+          Rc::new(RefCell::new(observations)),
           Rc::from(Vec::<IfAddr>::new()),
         );
-        let reader_guid = GUID::new(GuidPrefix::new(&[2; 12]), reader_id);
         let mut reader_proxy = RtpsReaderProxy::new(reader_guid, reader_qos.clone(), false);
         reader_proxy
           .unicast_locator_list
           .extend(reader_locator.map(Locator::from));
+        reader_proxy
+          .loopback_unicast_locators
+          .extend(same_host.map(Locator::from));
         writer.update_reader_proxy(&reader_proxy, reader_qos);
         assert!(
           writer.readers.contains_key(&reader_guid),
@@ -3438,6 +3520,118 @@ mod tests {
       // Nothing to tell a reader that has everything.
       f.ack(4, 3, false);
       assert_eq!(f.writer.next_heartbeat_count(), count + 4);
+    }
+
+    /// The next datagram on `socket` as (DATA sequence numbers, HEARTBEAT
+    /// counts), `None` if none comes within its timeout.
+    fn received(socket: &std::net::UdpSocket) -> Option<(Vec<i64>, Vec<i32>)> {
+      use crate::{
+        messages::submessages::submessages::WriterSubmessage, rtps::submessage::SubmessageBody,
+      };
+      let mut datagram = vec![0; 65536];
+      let len = socket.recv(&mut datagram).ok()?;
+      let message =
+        Message::read_from_buffer(&bytes::Bytes::copy_from_slice(&datagram[..len])).unwrap();
+      let mut data = Vec::new();
+      let mut heartbeats = Vec::new();
+      for submessage in message.submessages {
+        match submessage.body {
+          SubmessageBody::Writer(WriterSubmessage::Data(d, _)) => data.push(i64::from(d.writer_sn)),
+          SubmessageBody::Writer(WriterSubmessage::Heartbeat(h, _)) => heartbeats.push(h.count),
+          _ => {}
+        }
+      }
+      Some((data, heartbeats))
+    }
+
+    fn same_host_reader() -> (std::net::UdpSocket, Fixture) {
+      let socket = std::net::UdpSocket::bind("127.0.0.1:0").unwrap();
+      socket
+        .set_read_timeout(Some(StdDuration::from_millis(200)))
+        .unwrap();
+      let f = Fixture::user(0, 8, Some(socket.local_addr().unwrap()));
+      // The HEARTBEAT every new reader gets.
+      assert_eq!(received(&socket), Some((vec![], vec![1])));
+      (socket, f)
+    }
+
+    fn admit(f: &Fixture) -> SequenceNumber {
+      let data = DDSData::new(SerializedPayload::new(
+        RepresentationIdentifier::CDR_LE,
+        vec![0; 8],
+      ));
+      match f.writer.send_buffer.admit_blocking(
+        WriteOptions::default(),
+        data,
+        Some(StdDuration::ZERO),
+      ) {
+        Admission::Admitted(seq) => seq,
+        Admission::WouldBlock => panic!("the buffer refused a sample"),
+      }
+    }
+
+    // A sample the writing thread sent is not sent again by the event loop,
+    // which carries on from it.
+    #[test]
+    fn the_event_loop_carries_on_from_what_the_writing_thread_sent() {
+      let (socket, mut f) = same_host_reader();
+      let route = f.writer.send_buffer.transmit().route().expect("a route");
+      assert_eq!(route.destinations, vec![socket.local_addr().unwrap()]);
+
+      let first = admit(&f);
+      assert!(f
+        .writer
+        .send_buffer
+        .transmit()
+        .send_now(&f.writer.send_buffer, first));
+      assert_eq!(received(&socket), Some((vec![1], vec![2])));
+      f.writer.with_transmit(Writer::process_pending);
+      assert_eq!(received(&socket), None, "sent twice");
+      assert_eq!(f.writer.last_sent, first);
+
+      // Two samples at once: the second one waits for the event loop, which
+      // sends both (one datagram) and tells the writing thread.
+      let second = admit(&f);
+      let third = admit(&f);
+      assert!(!f
+        .writer
+        .send_buffer
+        .transmit()
+        .send_now(&f.writer.send_buffer, third));
+      f.writer.with_transmit(Writer::process_pending);
+      assert_eq!(received(&socket), Some((vec![2, 3], vec![3])));
+      assert_eq!(f.writer.send_buffer.transmit().lock().last_sent, third);
+      assert!(!f
+        .writer
+        .send_buffer
+        .transmit()
+        .send_now(&f.writer.send_buffer, second));
+      assert!(!f
+        .writer
+        .send_buffer
+        .transmit()
+        .send_now(&f.writer.send_buffer, third));
+      let fourth = admit(&f);
+      assert!(f
+        .writer
+        .send_buffer
+        .transmit()
+        .send_now(&f.writer.send_buffer, fourth));
+      assert_eq!(received(&socket), Some((vec![4], vec![4])));
+    }
+
+    // A reader whose route is not resolved to one unicast address (here: no
+    // observation of it) keeps every send on the event loop.
+    #[test]
+    fn a_reader_without_a_resolved_route_keeps_every_send_on_the_event_loop() {
+      let f = Fixture::user(0, 8, Some(SocketAddr::from(([192, 0, 2, 1], 9))));
+      assert!(f.writer.send_buffer.transmit().route().is_none());
+      let seq = admit(&f);
+      assert!(!f
+        .writer
+        .send_buffer
+        .transmit()
+        .send_now(&f.writer.send_buffer, seq));
     }
   }
 }

@@ -11,6 +11,7 @@ use log::{debug, error, trace, warn};
 
 use crate::{
   dds::{ddsdata::DDSData, with_key::datawriter::WriteOptions},
+  rtps::writer_thread_send::Transmit,
   structure::{
     cache_change::CacheChange,
     guid::{EntityKind, GUID},
@@ -95,6 +96,9 @@ struct Shared {
   // late-joining readers, so pre-match trimming is disabled.
   volatile: bool,
   topic_name: String,
+  // The send progress and route shared with a writing thread that sends a
+  // sample itself (see `writer_thread_send.rs`).
+  transmit: Transmit,
 }
 
 /// A shared, flow-controlled buffer of samples between a `DataWriter`
@@ -143,6 +147,7 @@ impl WriterSendBuffer {
         is_builtin,
         volatile,
         topic_name,
+        transmit: Transmit::default(),
       }),
     }
   }
@@ -384,8 +389,20 @@ impl WriterSendBuffer {
   }
 
   /// The sequence number of the latest allocated sample (0 if none yet).
+  /// The send progress and route shared between the writing thread and the
+  /// event loop.
+  pub fn transmit(&self) -> &Transmit {
+    &self.shared.transmit
+  }
+
   pub fn last_change_sequence_number(&self) -> SequenceNumber {
     self.shared.inner.lock().unwrap().last_seq
+  }
+
+  /// The highest sequence number put on the wire. Test-only.
+  #[cfg(test)]
+  pub fn sent_frontier(&self) -> SequenceNumber {
+    self.shared.inner.lock().unwrap().sent_frontier
   }
 
   /// Number of samples currently retained in the buffer. Test-only.

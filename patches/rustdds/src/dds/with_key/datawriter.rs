@@ -274,6 +274,19 @@ where
     self.doorbell.ring();
   }
 
+  // Sends a freshly admitted sample from this thread when nothing is pending
+  // and its readers' routes allow it (see `rtps/writer_thread_send.rs`); the
+  // event loop sends it otherwise.
+  fn send_or_ring_doorbell(&self, sequence_number: SequenceNumber) {
+    if !self
+      .send_buffer
+      .transmit()
+      .send_now(&self.send_buffer, sequence_number)
+    {
+      self.ring_doorbell();
+    }
+  }
+
   /// Manually refreshes liveliness
   ///
   /// Corresponds to DDS Spec 1.4 Section 2.2.2.4.2.22 assert_liveliness.
@@ -387,7 +400,7 @@ where
       .admit_blocking(write_options, ddsdata, timeout)
     {
       Admission::Admitted(sequence_number) => {
-        self.ring_doorbell();
+        self.send_or_ring_doorbell(sequence_number);
         self.refresh_manual_liveliness();
         Ok(SampleIdentity {
           writer_guid: self.my_guid,
@@ -947,7 +960,7 @@ where
       .try_admit(write_options, ddsdata, cx.waker())
     {
       Ok(sequence_number) => {
-        self.writer.ring_doorbell();
+        self.writer.send_or_ring_doorbell(sequence_number);
         self.writer.refresh_manual_liveliness();
         Poll::Ready(Ok(SampleIdentity {
           writer_guid: self.writer.my_guid,
