@@ -180,7 +180,10 @@ impl UDPSender {
       multicast_sockets.push((InterfaceSelector::Ip(multicast_if_ipaddr), mc_socket));
     } // end for
 
-    let shared_unicast = match unicast_socket.try_clone() {
+    let shared_unicast = match unicast_socket
+      .try_clone()
+      .and_then(|socket| socket.set_nonblocking(true).map(|()| socket))
+    {
       Ok(socket) => Some(Arc::new(socket)),
       Err(e) => {
         warn!("UDPSender: no duplicate of the unicast socket ({e}); writers send through the event loop only");
@@ -252,22 +255,7 @@ impl UDPSender {
       trace!("raw_send: {id:?} cannot reach {addr} (address family mismatch), dropping");
       return SendOutcome::Dropped;
     }
-    match socket.send_to(buffer, addr) {
-      Ok(bytes_sent) => {
-        if bytes_sent != buffer.len() {
-          error!(
-            "raw_send: {id:?} tried {} bytes, sent only {bytes_sent}",
-            buffer.len()
-          );
-        }
-        SendOutcome::Sent
-      }
-      Err(e) if e.kind() == io::ErrorKind::WouldBlock => SendOutcome::WouldBlock,
-      Err(e) => {
-        warn!("raw_send: {id:?} to {addr} : {e:?} len={}", buffer.len());
-        SendOutcome::Dropped
-      }
-    }
+    send_datagram(socket, &id, addr, buffer)
   }
 
   fn control_queue_nonempty(&self, id: SocketId) -> bool {
@@ -289,13 +277,10 @@ impl UDPSender {
     if queue.is_empty() {
       match self.raw_send(id, addr, buffer) {
         SendOutcome::Sent | SendOutcome::Dropped => {}
-        SendOutcome::WouldBlock => {
-          queue.push_back(Datagram {
-            addr,
-            bytes: buffer.to_vec(),
-          });
-          self.note_control_backlog(id, true);
-        }
+        SendOutcome::WouldBlock => queue.push_back(Datagram {
+          addr,
+          bytes: buffer.to_vec(),
+        }),
       }
     } else {
       queue.push_back(Datagram {
@@ -310,6 +295,7 @@ impl UDPSender {
         );
       }
     }
+    self.publish_control_backlog(&queues);
   }
 
   /// Try to flush a socket's queued control datagrams (called on write
@@ -326,21 +312,23 @@ impl UDPSender {
         SendOutcome::Sent | SendOutcome::Dropped => {
           queue.pop_front();
         }
-        SendOutcome::WouldBlock => return false,
+        SendOutcome::WouldBlock => break,
       }
     }
-    self.note_control_backlog(id, false);
-    true
+    let empty = queue.is_empty();
+    self.publish_control_backlog(&queues);
+    empty
   }
 
-  // Keeps the flag writing threads read (`unicast_control_backlog`) equal to
-  // whether the unicast socket's control queue holds datagrams.
-  fn note_control_backlog(&self, id: SocketId, backlogged: bool) {
-    if id == SocketId::Unicast {
-      self
-        .unicast_control_backlog
-        .store(backlogged, Ordering::Release);
-    }
+  // Sets the flag writing threads read (`unicast_control_backlog`) from the
+  // unicast socket's control queue: called after every change to the queues.
+  fn publish_control_backlog(&self, queues: &HashMap<SocketId, ControlQueue>) {
+    let backlogged = queues
+      .get(&SocketId::Unicast)
+      .is_some_and(|queue| !queue.is_empty());
+    self
+      .unicast_control_backlog
+      .store(backlogged, Ordering::Release);
   }
 
   /// The duplicate of the unicast socket for writing threads, and the flag
@@ -363,16 +351,12 @@ impl UDPSender {
   /// returned WouldBlock.
   #[cfg(test)]
   pub(crate) fn inject_control_backlog(&self, id: SocketId) {
-    self
-      .control_queues
-      .borrow_mut()
-      .entry(id)
-      .or_default()
-      .push_back(Datagram {
-        addr: SocketAddr::from(([127, 0, 0, 1], 9)),
-        bytes: vec![0; 4],
-      });
-    self.note_control_backlog(id, true);
+    let mut queues = self.control_queues.borrow_mut();
+    queues.entry(id).or_default().push_back(Datagram {
+      addr: SocketAddr::from(([127, 0, 0, 1], 9)),
+      bytes: vec![0; 4],
+    });
+    self.publish_control_backlog(&queues);
   }
 
   /// Sockets that currently have queued (undelivered) control datagrams.
@@ -581,10 +565,63 @@ impl UDPSender {
   }
 }
 
+/// One non-blocking datagram send on `socket`, classified; a partial send or
+/// an error other than `WouldBlock` is logged (`label` names the socket) and
+/// counts as dropped or sent, as UDP gives no second chance.
+pub(crate) fn send_datagram(
+  socket: &UdpSocket,
+  label: &dyn std::fmt::Debug,
+  addr: SocketAddr,
+  buffer: &[u8],
+) -> SendOutcome {
+  match socket.send_to(buffer, addr) {
+    Ok(bytes_sent) => {
+      if bytes_sent != buffer.len() {
+        error!(
+          "raw_send: {label:?} tried {} bytes, sent only {bytes_sent}",
+          buffer.len()
+        );
+      }
+      SendOutcome::Sent
+    }
+    Err(e) if e.kind() == io::ErrorKind::WouldBlock => SendOutcome::WouldBlock,
+    Err(e) => {
+      warn!("raw_send: {label:?} to {addr} : {e:?} len={}", buffer.len());
+      SendOutcome::Dropped
+    }
+  }
+}
+
 #[cfg(test)]
 mod tests {
   use super::*;
   use crate::network::udp_listener::*;
+
+  // Writing threads see the unicast socket's control backlog as the queue
+  // has it: set while datagrams wait, clear once they are flushed; another
+  // socket's backlog does not count.
+  #[test]
+  fn the_shared_control_backlog_follows_the_unicast_queue() {
+    let sender = UDPSender::new(0).expect("failed to create UDPSender");
+    let (socket, backlog) = sender.shared_unicast().expect("a duplicate socket");
+    assert!(!backlog.load(Ordering::Acquire));
+    sender.inject_control_backlog(SocketId::Multicast(0));
+    assert!(!backlog.load(Ordering::Acquire));
+    sender.inject_control_backlog(SocketId::Unicast);
+    assert!(backlog.load(Ordering::Acquire));
+    assert!(sender.flush_control(SocketId::Unicast));
+    assert!(!backlog.load(Ordering::Acquire));
+    // The duplicate is the unicast socket, non-blocking like it.
+    assert_eq!(
+      socket.local_addr().unwrap(),
+      sender.unicast_socket.local_addr().unwrap()
+    );
+    let mut nothing = [0; 4];
+    assert_eq!(
+      socket.recv(&mut nothing).map_err(|e| e.kind()),
+      Err(io::ErrorKind::WouldBlock)
+    );
+  }
 
   #[test]
   fn udps_single_send() {

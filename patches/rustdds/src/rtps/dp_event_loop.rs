@@ -845,7 +845,7 @@ impl DPEventLoop {
     // already have matched readers behind this participant. Access `writers`
     // directly (not via &mut self) so it stays disjoint from the `db` borrow.
     for writer in self.writers.values_mut() {
-      writer.recompute_routes_for(participant_guid_prefix);
+      writer.with_transmit(|w| w.recompute_routes_for(participant_guid_prefix));
     }
 
     debug!("update_participant - finished for {participant_guid_prefix:?}");
@@ -861,7 +861,7 @@ impl DPEventLoop {
     // to that participant, so that we do not send messages to them anymore.
 
     for writer in self.writers.values_mut() {
-      writer.participant_lost(participant_guid_prefix);
+      writer.with_transmit(|w| w.participant_lost(participant_guid_prefix));
     }
 
     for reader in self.message_receiver.available_readers.values_mut() {
@@ -970,7 +970,7 @@ impl DPEventLoop {
 
   fn remote_reader_lost(&mut self, reader_guid: GUID) {
     for writer in self.writers.values_mut() {
-      writer.reader_lost(reader_guid);
+      writer.with_transmit(|w| w.reader_lost(reader_guid));
     }
   }
 

@@ -102,17 +102,17 @@ impl Default for MessageReceiverState<'_> {
   }
 }
 
+/// An ACKNACK or NACK_FRAG on its way to its writer: who sent it, the
+/// submessage, and whether its final flag was set (the reader expects no
+/// answer; always set for a NACK_FRAG, which has no such flag).
+pub(crate) type ReceivedAck = (GuidPrefix, AckSubmessage, bool);
+
 /// [`MessageReceiver`] is the submessage sequence interpreter described in
 /// RTPS spec v2.3 Section 8.3.4 "The RTPS Message Receiver".
 /// It calls the message/submessage deserializers to parse the sequence of
 /// submessages. Then it processes the instructions in the Interpreter
 /// SUbmessages and forwards data in Entity Submessages to the appropriate
 /// Entities. (See RTPS spec Section 8.3.7)
-/// An ACKNACK or NACK_FRAG on its way to its writer: who sent it, the
-/// submessage, and whether its final flag was set (the reader expects no
-/// answer; always set for a NACK_FRAG, which has no such flag).
-pub(crate) type ReceivedAck = (GuidPrefix, AckSubmessage, bool);
-
 pub(crate) struct MessageReceiver {
   pub available_readers: BTreeMap<EntityId, Reader>,
   // GuidPrefix sent in this channel needs to be RTPSMessage source_guid_prefix. Writer needs this
@@ -1341,6 +1341,43 @@ mod tests {
 
     message_receiver.handle_received_packet(&udp_bits2, PacketOrigin::UNKNOWN);
     assert_eq!(message_receiver.submessage_count, 2);
+  }
+
+  // An ACKNACK reaches its writer with its final flag.
+  #[test]
+  fn acknack_is_forwarded_with_its_final_flag() {
+    // INFO_DST, ACKNACK (flags 0x03: little-endian, final) for writer 0x04c2.
+    let mut packet = vec![
+      0x52, 0x54, 0x50, 0x53, 0x02, 0x03, 0x01, 0x0f, 0x01, 0x0f, 0x99, 0x06, 0x78, 0x34, 0x00,
+      0x00, 0x01, 0x00, 0x00, 0x00, 0x0e, 0x01, 0x0c, 0x00, 0x01, 0x03, 0x00, 0x0c, 0x29, 0x2d,
+      0x31, 0xa2, 0x28, 0x20, 0x02, 0x08, 0x06, 0x03, 0x18, 0x00, 0x00, 0x00, 0x04, 0xc7, 0x00,
+      0x00, 0x04, 0xc2, 0x00, 0x00, 0x00, 0x00, 0x02, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00,
+      0x03, 0x00, 0x00, 0x00,
+    ];
+    let me = GuidPrefix::new(&[
+      0x01, 0x03, 0x00, 0x0c, 0x29, 0x2d, 0x31, 0xa2, 0x28, 0x20, 0x02, 0x08,
+    ]);
+    let sender = GuidPrefix::new(&[
+      0x01, 0x0f, 0x99, 0x06, 0x78, 0x34, 0x00, 0x00, 0x01, 0x00, 0x00, 0x00,
+    ]);
+    let waker = LoopWaker::new();
+    let (acknack_sender, acknack_receiver) = wake_channel(8, &waker);
+    let (spdp_liveness_sender, _spdp_liveness_receiver) = wake_channel(8, &waker);
+    let mut message_receiver = MessageReceiver::new(
+      me,
+      acknack_sender,
+      spdp_liveness_sender,
+      None,
+      Rc::new(RefCell::new(InterfaceObservations::new())),
+    );
+    for (flags, final_flag) in [(0x03, true), (0x01, false)] {
+      packet[37] = flags;
+      message_receiver.handle_received_packet(&Bytes::from(packet.clone()), PacketOrigin::UNKNOWN);
+      let (from, ack, forwarded_flag) = acknack_receiver.try_recv().expect("no ACKNACK forwarded");
+      assert_eq!(from, sender);
+      assert!(matches!(ack, AckSubmessage::AckNack(ref an) if an.count == 3));
+      assert_eq!(forwarded_flag, final_flag);
+    }
   }
 
   #[test]

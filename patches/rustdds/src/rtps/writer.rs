@@ -1134,8 +1134,8 @@ impl Writer {
   /// samples, the Writer must respond by either sending the missing data
   /// samples, sending a GAP message when the sample is not relevant, or
   /// sending a HEARTBEAT message when the sample is no longer available
-  /// Handles an ACKNACK or NACK_FRAG from a matched reader; `final_flag` is
-  /// the ACKNACK's final flag (the reader expects no answer).
+  ///
+  /// `final_flag` is the ACKNACK's final flag (the reader expects no answer).
   pub fn handle_ack_nack(
     &mut self,
     reader_guid_prefix: GuidPrefix,
@@ -1809,7 +1809,9 @@ impl Writer {
   }
 
   /// Gives writing threads the current route (after any change to the matched
-  /// readers, their routes or budgets, or the writer's destinations).
+  /// readers, their routes or budgets, or the writer's destinations). The
+  /// event loop calls it under the transmit lock (`with_transmit`), so no
+  /// writing thread is sending with the snapshot it replaces.
   fn refresh_fast_route(&self) {
     self.send_buffer.transmit().set_route(self.fast_route());
   }
@@ -2392,6 +2394,14 @@ const SUBMESSAGE_INFO_TS_INVALIDATE_SIZE: usize = 4;
 // risks a slight overestimate, which degrades to benign IP fragmentation rather
 // than data loss.
 const DATAFRAG_SUBMESSAGE_OVERHEAD: usize = 36;
+
+// A writer leaving (its DataWriter dropped, or the event loop ending with the
+// participant) stops writing threads from sending on its behalf.
+impl Drop for Writer {
+  fn drop(&mut self) {
+    self.send_buffer.transmit().set_route(None);
+  }
+}
 
 // A fifth of a finite, positive Deadline, clamped to
 // [REPAIR_INTERVAL_MIN, REPAIR_INTERVAL_MAX]. No Deadline, INFINITE, zero or
@@ -3525,23 +3535,10 @@ mod tests {
     /// The next datagram on `socket` as (DATA sequence numbers, HEARTBEAT
     /// counts), `None` if none comes within its timeout.
     fn received(socket: &std::net::UdpSocket) -> Option<(Vec<i64>, Vec<i32>)> {
-      use crate::{
-        messages::submessages::submessages::WriterSubmessage, rtps::submessage::SubmessageBody,
-      };
-      let mut datagram = vec![0; 65536];
-      let len = socket.recv(&mut datagram).ok()?;
-      let message =
-        Message::read_from_buffer(&bytes::Bytes::copy_from_slice(&datagram[..len])).unwrap();
-      let mut data = Vec::new();
-      let mut heartbeats = Vec::new();
-      for submessage in message.submessages {
-        match submessage.body {
-          SubmessageBody::Writer(WriterSubmessage::Data(d, _)) => data.push(i64::from(d.writer_sn)),
-          SubmessageBody::Writer(WriterSubmessage::Heartbeat(h, _)) => heartbeats.push(h.count),
-          _ => {}
-        }
-      }
-      Some((data, heartbeats))
+      crate::rtps::writer_thread_send::tests::received(socket).map(|received| {
+        let counts = received.heartbeats.iter().map(|hb| hb.2).collect();
+        (received.data, counts)
+      })
     }
 
     fn same_host_reader() -> (std::net::UdpSocket, Fixture) {
@@ -3556,18 +3553,11 @@ mod tests {
     }
 
     fn admit(f: &Fixture) -> SequenceNumber {
-      let data = DDSData::new(SerializedPayload::new(
-        RepresentationIdentifier::CDR_LE,
-        vec![0; 8],
-      ));
-      match f.writer.send_buffer.admit_blocking(
+      crate::rtps::writer_thread_send::tests::admit(
+        &f.writer.send_buffer,
         WriteOptions::default(),
-        data,
-        Some(StdDuration::ZERO),
-      ) {
-        Admission::Admitted(seq) => seq,
-        Admission::WouldBlock => panic!("the buffer refused a sample"),
-      }
+        8,
+      )
     }
 
     // A sample the writing thread sent is not sent again by the event loop,
@@ -3618,6 +3608,23 @@ mod tests {
         .transmit()
         .send_now(&f.writer.send_buffer, fourth));
       assert_eq!(received(&socket), Some((vec![4], vec![4])));
+    }
+
+    // A reader that leaves takes its destination with it, and a writer that
+    // leaves stops writing threads from sending for it.
+    #[test]
+    fn the_route_follows_the_readers() {
+      let (_socket, mut f) = same_host_reader();
+      let send_buffer = f.writer.send_buffer.clone();
+      assert!(send_buffer.transmit().route().is_some());
+      f.writer.reader_lost(f.reader_guid);
+      assert!(send_buffer.transmit().route().is_none());
+
+      let (_socket, f) = same_host_reader();
+      let send_buffer = f.writer.send_buffer.clone();
+      assert!(send_buffer.transmit().route().is_some());
+      drop(f);
+      assert!(send_buffer.transmit().route().is_none());
     }
 
     // A reader whose route is not resolved to one unicast address (here: no

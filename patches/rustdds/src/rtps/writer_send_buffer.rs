@@ -388,13 +388,13 @@ impl WriterSendBuffer {
     }
   }
 
-  /// The sequence number of the latest allocated sample (0 if none yet).
   /// The send progress and route shared between the writing thread and the
   /// event loop.
   pub fn transmit(&self) -> &Transmit {
     &self.shared.transmit
   }
 
+  /// The sequence number of the latest allocated sample (0 if none yet).
   pub fn last_change_sequence_number(&self) -> SequenceNumber {
     self.shared.inner.lock().unwrap().last_seq
   }

@@ -37,7 +37,8 @@ use log::{debug, error, trace, warn};
 use speedy::Endianness;
 
 use crate::{
-  rtps::{writer_send_buffer::WriterSendBuffer, MessageBuilder},
+  network::udp_sender::send_datagram,
+  rtps::{outbound::SendOutcome, writer_send_buffer::WriterSendBuffer, MessageBuilder},
   structure::{
     guid::{EntityId, GUID},
     sequence_number::SequenceNumber,
@@ -172,7 +173,7 @@ impl Transmit {
       builder = builder.heartbeat_msg(
         route.writer_guid.entity_id,
         buffer.first_change_sequence_number(),
-        buffer.last_change_sequence_number(),
+        seq, // not a later sample another thread may have admitted meanwhile
         self.next_heartbeat_count(),
         route.endianness,
         EntityId::UNKNOWN,
@@ -190,18 +191,12 @@ impl Transmit {
         return false;
       }
     };
-    for destination in &route.destinations {
-      match route.socket.send_to(&datagram, destination) {
-        Ok(sent) if sent == datagram.len() => {}
-        Ok(sent) => error!(
-          "send_now: tried {} bytes to {destination}, sent only {sent}",
-          datagram.len()
-        ),
+    for &destination in &route.destinations {
+      match send_datagram(&route.socket, &"send_now", destination, &datagram) {
+        SendOutcome::Sent | SendOutcome::Dropped => {}
         // The event loop sends the sample again to every reader on write
         // readiness; a reader that got it here discards the duplicate.
-        Err(e) if e.kind() == std::io::ErrorKind::WouldBlock => return false,
-        // As the event loop's sender: reported, and the reader repairs it.
-        Err(e) => warn!("send_now: to {destination}: {e:?} len={}", datagram.len()),
+        SendOutcome::WouldBlock => return false,
       }
     }
     state.last_sent = seq;
@@ -211,7 +206,7 @@ impl Transmit {
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
   use std::time::Duration as StdDuration;
 
   use bytes::Bytes;
@@ -272,47 +267,80 @@ mod tests {
     }
 
     fn admit(&self, options: WriteOptions, len: usize) -> SequenceNumber {
-      let data = DDSData::new(SerializedPayload::new(
-        RepresentationIdentifier::CDR_LE,
-        vec![1; len],
-      ));
-      match self
-        .buffer
-        .admit_blocking(options, data, Some(StdDuration::ZERO))
-      {
-        Admission::Admitted(seq) => seq,
-        Admission::WouldBlock => panic!("the buffer refused a sample"),
-      }
+      admit(&self.buffer, options, len)
     }
 
     fn send_now(&self, seq: SequenceNumber) -> bool {
       self.buffer.transmit().send_now(&self.buffer, seq)
     }
 
-    /// The next datagram's (DATA sequence numbers, HEARTBEATs as (first, last,
-    /// count)), or `None` if none comes within the socket's timeout.
     fn receive(&self) -> Option<(Vec<i64>, Vec<(i64, i64, i32)>)> {
-      let mut datagram = vec![0; 65536];
-      let len = self.reader.recv(&mut datagram).ok()?;
-      let message = Message::read_from_buffer(&Bytes::copy_from_slice(&datagram[..len])).unwrap();
-      assert_eq!(message.header.guid_prefix, self.guid.prefix);
-      let mut data = Vec::new();
-      let mut heartbeats = Vec::new();
-      for submessage in message.submessages {
-        match submessage.body {
-          SubmessageBody::Writer(WriterSubmessage::Data(d, _)) => {
-            assert_eq!(d.writer_id, self.guid.entity_id);
-            assert_eq!(d.reader_id, EntityId::UNKNOWN);
-            data.push(i64::from(d.writer_sn));
-          }
-          SubmessageBody::Writer(WriterSubmessage::Heartbeat(h, _)) => {
-            heartbeats.push((i64::from(h.first_sn), i64::from(h.last_sn), h.count));
-          }
-          _ => {}
-        }
-      }
-      Some((data, heartbeats))
+      let received = received(&self.reader)?;
+      assert_eq!(received.writer, self.guid);
+      Some((received.data, received.heartbeats))
     }
+  }
+
+  /// Admits a sample of `len` bytes to `buffer`.
+  pub(crate) fn admit(
+    buffer: &WriterSendBuffer,
+    options: WriteOptions,
+    len: usize,
+  ) -> SequenceNumber {
+    let data = DDSData::new(SerializedPayload::new(
+      RepresentationIdentifier::CDR_LE,
+      vec![1; len],
+    ));
+    match buffer.admit_blocking(options, data, Some(StdDuration::ZERO)) {
+      Admission::Admitted(seq) => seq,
+      Admission::WouldBlock => panic!("the buffer refused a sample"),
+    }
+  }
+
+  /// What one datagram carried from a writer.
+  pub(crate) struct Received {
+    pub writer: GUID,
+    /// The DATA submessages' sequence numbers.
+    pub data: Vec<i64>,
+    /// The HEARTBEATs as (first, last, count).
+    pub heartbeats: Vec<(i64, i64, i32)>,
+  }
+
+  /// The next datagram on `socket`, `None` if none comes within its timeout.
+  /// Every DATA and HEARTBEAT in it must be of one writer, to every reader.
+  pub(crate) fn received(socket: &UdpSocket) -> Option<Received> {
+    let mut datagram = vec![0; 65536];
+    let len = socket.recv(&mut datagram).ok()?;
+    let message = Message::read_from_buffer(&Bytes::copy_from_slice(&datagram[..len])).unwrap();
+    let prefix = message.header.guid_prefix;
+    let mut writer = None;
+    let mut data = Vec::new();
+    let mut heartbeats = Vec::new();
+    for submessage in message.submessages {
+      let writer_id = match submessage.body {
+        SubmessageBody::Writer(WriterSubmessage::Data(d, _)) => {
+          assert_eq!(d.reader_id, EntityId::UNKNOWN);
+          data.push(i64::from(d.writer_sn));
+          d.writer_id
+        }
+        SubmessageBody::Writer(WriterSubmessage::Heartbeat(h, _)) => {
+          heartbeats.push((i64::from(h.first_sn), i64::from(h.last_sn), h.count));
+          h.writer_id
+        }
+        _ => continue,
+      };
+      let guid = GUID::new(prefix, writer_id);
+      assert_eq!(
+        *writer.get_or_insert(guid),
+        guid,
+        "two writers in one datagram"
+      );
+    }
+    Some(Received {
+      writer: writer.expect("no DATA or HEARTBEAT in the datagram"),
+      data,
+      heartbeats,
+    })
   }
 
   #[test]
