@@ -255,7 +255,7 @@ impl UDPSender {
       trace!("raw_send: {id:?} cannot reach {addr} (address family mismatch), dropping");
       return SendOutcome::Dropped;
     }
-    send_datagram(socket, &id, addr, buffer)
+    send_datagram(socket, &format_args!("raw_send: {id:?}"), addr, buffer)
   }
 
   fn control_queue_nonempty(&self, id: SocketId) -> bool {
@@ -566,11 +566,11 @@ impl UDPSender {
 }
 
 /// One non-blocking datagram send on `socket`, classified; a partial send or
-/// an error other than `WouldBlock` is logged (`label` names the socket) and
-/// counts as dropped or sent, as UDP gives no second chance.
+/// an error other than `WouldBlock` is logged (`label` says who sends on which
+/// socket) and counts as sent or dropped, as UDP gives no second chance.
 pub(crate) fn send_datagram(
   socket: &UdpSocket,
-  label: &dyn std::fmt::Debug,
+  label: &dyn std::fmt::Display,
   addr: SocketAddr,
   buffer: &[u8],
 ) -> SendOutcome {
@@ -578,7 +578,7 @@ pub(crate) fn send_datagram(
     Ok(bytes_sent) => {
       if bytes_sent != buffer.len() {
         error!(
-          "raw_send: {label:?} tried {} bytes, sent only {bytes_sent}",
+          "{label} tried {} bytes, sent only {bytes_sent}",
           buffer.len()
         );
       }
@@ -586,7 +586,7 @@ pub(crate) fn send_datagram(
     }
     Err(e) if e.kind() == io::ErrorKind::WouldBlock => SendOutcome::WouldBlock,
     Err(e) => {
-      warn!("raw_send: {label:?} to {addr} : {e:?} len={}", buffer.len());
+      warn!("{label} to {addr} : {e:?} len={}", buffer.len());
       SendOutcome::Dropped
     }
   }
@@ -611,7 +611,8 @@ mod tests {
     assert!(backlog.load(Ordering::Acquire));
     assert!(sender.flush_control(SocketId::Unicast));
     assert!(!backlog.load(Ordering::Acquire));
-    // The duplicate is the unicast socket, non-blocking like it.
+    // The duplicate is the unicast socket and, like it, non-blocking (on Unix
+    // the two share that mode; it is also set on the duplicate).
     assert_eq!(
       socket.local_addr().unwrap(),
       sender.unicast_socket.local_addr().unwrap()

@@ -1810,8 +1810,9 @@ impl Writer {
 
   /// Gives writing threads the current route (after any change to the matched
   /// readers, their routes or budgets, or the writer's destinations). The
-  /// event loop calls it under the transmit lock (`with_transmit`), so no
-  /// writing thread is sending with the snapshot it replaces.
+  /// event loop calls it under the transmit lock (`with_transmit`) once the
+  /// writer is in its map, so no writing thread is sending with the snapshot
+  /// it replaces.
   fn refresh_fast_route(&self) {
     self.send_buffer.transmit().set_route(self.fast_route());
   }
@@ -2399,7 +2400,9 @@ const DATAFRAG_SUBMESSAGE_OVERHEAD: usize = 36;
 // participant) stops writing threads from sending on its behalf.
 impl Drop for Writer {
   fn drop(&mut self) {
-    self.send_buffer.transmit().set_route(None);
+    let send_buffer = self.send_buffer.clone();
+    let _transmit = send_buffer.transmit().lock();
+    send_buffer.transmit().set_route(None);
   }
 }
 

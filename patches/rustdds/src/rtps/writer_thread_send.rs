@@ -192,7 +192,7 @@ impl Transmit {
       }
     };
     for &destination in &route.destinations {
-      match send_datagram(&route.socket, &"send_now", destination, &datagram) {
+      match send_datagram(&route.socket, &"send_now: unicast", destination, &datagram) {
         SendOutcome::Sent | SendOutcome::Dropped => {}
         // The event loop sends the sample again to every reader on write
         // readiness; a reader that got it here discards the duplicate.
@@ -395,8 +395,10 @@ pub(crate) mod tests {
     assert_eq!(bench.receive(), None);
     assert!(bench.send_now(first));
     assert!(bench.send_now(second));
-    assert_eq!(bench.receive().map(|(data, _)| data), Some(vec![1]));
-    assert_eq!(bench.receive().map(|(data, _)| data), Some(vec![2]));
+    // Each HEARTBEAT announces the samples sent so far, not one admitted but
+    // still to be sent (which the reader would request at once).
+    assert_eq!(bench.receive(), Some((vec![1], vec![(1, 1, 1)])));
+    assert_eq!(bench.receive(), Some((vec![2], vec![(1, 2, 2)])));
     // A sample already sent is not sent again.
     assert!(!bench.send_now(second));
     assert_eq!(bench.receive(), None);
