@@ -3027,6 +3027,12 @@ mod tests {
         )
       }
 
+      // The writing thread's attempt to send sample `seq` itself.
+      fn send_now(&self, seq: SequenceNumber) -> bool {
+        let send_buffer = &self.writer.send_buffer;
+        send_buffer.transmit().send_now(send_buffer, seq)
+      }
+
       fn reader_proxy(&self) -> &RtpsReaderProxy {
         &self.writer.readers[&self.reader_guid]
       }
@@ -3572,11 +3578,7 @@ mod tests {
       assert_eq!(route.destinations, vec![socket.local_addr().unwrap()]);
 
       let first = admit(&f);
-      assert!(f
-        .writer
-        .send_buffer
-        .transmit()
-        .send_now(&f.writer.send_buffer, first));
+      assert!(f.send_now(first));
       assert_eq!(received(&socket), Some((vec![1], vec![2])));
       f.writer.with_transmit(Writer::process_pending);
       assert_eq!(received(&socket), None, "sent twice");
@@ -3586,30 +3588,14 @@ mod tests {
       // sends both (one datagram) and tells the writing thread.
       let second = admit(&f);
       let third = admit(&f);
-      assert!(!f
-        .writer
-        .send_buffer
-        .transmit()
-        .send_now(&f.writer.send_buffer, third));
+      assert!(!f.send_now(third));
       f.writer.with_transmit(Writer::process_pending);
       assert_eq!(received(&socket), Some((vec![2, 3], vec![3])));
       assert_eq!(f.writer.send_buffer.transmit().lock().last_sent, third);
-      assert!(!f
-        .writer
-        .send_buffer
-        .transmit()
-        .send_now(&f.writer.send_buffer, second));
-      assert!(!f
-        .writer
-        .send_buffer
-        .transmit()
-        .send_now(&f.writer.send_buffer, third));
+      assert!(!f.send_now(second));
+      assert!(!f.send_now(third));
       let fourth = admit(&f);
-      assert!(f
-        .writer
-        .send_buffer
-        .transmit()
-        .send_now(&f.writer.send_buffer, fourth));
+      assert!(f.send_now(fourth));
       assert_eq!(received(&socket), Some((vec![4], vec![4])));
     }
 
@@ -3637,11 +3623,7 @@ mod tests {
       let f = Fixture::user(0, 8, Some(SocketAddr::from(([192, 0, 2, 1], 9))));
       assert!(f.writer.send_buffer.transmit().route().is_none());
       let seq = admit(&f);
-      assert!(!f
-        .writer
-        .send_buffer
-        .transmit()
-        .send_now(&f.writer.send_buffer, seq));
+      assert!(!f.send_now(seq));
     }
   }
 }
