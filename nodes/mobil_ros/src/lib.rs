@@ -20,7 +20,7 @@
 //! - [`time`]: **the time rule** — stamps and algorithm `dt` from ROS time ([`time::DtClock`]),
 //!   watchdogs, freshness and tick periods on the steady clock;
 //! - [`offloop`]: [`OffLoop`], searches of 10–500 ms off the event loop, pre-empted by newer
-//!   requests;
+//!   requests; [`ServiceThreads`], a service answered on threads of its own;
 //! - [`lifecycle`]: the managed-node interface (`lifecycle_msgs` services, transition events,
 //!   `autostart`) and Nav2's bond, around [`mobil_lifecycle`];
 //! - [`action`]: [`action::GoalServer`], an action server with one active goal for a node's
@@ -79,6 +79,6 @@ pub use latest::{Freshness, Latest};
 pub use log::LogThrottle;
 pub use mobil_motion::Notice;
 pub use node::{listen_for_shutdown, respond, run_node, shutdown_signal, NodeBody, NodeDecl, RosNode};
-pub use offloop::{CancelToken, OffLoop};
+pub use offloop::{CancelToken, OffLoop, ServiceThreads};
 pub use params::{ParamSpec, ParamValues};
 pub use ticker::Ticker;

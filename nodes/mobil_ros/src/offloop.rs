@@ -5,8 +5,8 @@
 //! job's result is discarded, never delivered. One thread at most: the newer job waits until
 //! the cancelled one has returned, and a still newer one replaces it. [`OffLoop::result`] is cancel-safe, so it sits in
 //! the node's `select!` beside the ticker and the subscriptions, which keep being served while
-//! the search runs. [`ReplyPool`] computes several requests at once, up to a limit, each
-//! answered from the thread that computed it.
+//! the search runs. [`ServiceThreads`] answers a service's requests on threads of its own,
+//! several at once up to a limit, each woken by its request and answering it itself.
 //!
 //! ```
 //! # #[tokio::main(flavor = "current_thread")]
@@ -19,8 +19,11 @@
 //! # }
 //! ```
 
+use futures::future::Either;
+use std::future::Future;
+use std::panic::AssertUnwindSafe;
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
-use std::sync::Arc;
+use std::sync::{Arc, Mutex, PoisonError};
 use std::time::Duration;
 use tokio::sync::mpsc;
 
@@ -168,81 +171,169 @@ impl<R: Send + 'static> OffLoop<R> {
     }
 }
 
-/// Requests computed and answered on the blocking pool several at once, up to a limit (a
-/// service whose requests each take up to a second of one core): each job's answer (the reply
-/// sent) runs on the thread that computed it, without a hand-off back to the event loop; beyond
-/// the limit a request is turned away at once, for the caller to answer BUSY, so a burst of
-/// requests never piles up threads. A job's place is free again before its answer goes out, so
-/// a client that calls again as soon as it is answered finds its own place free again.
-pub struct ReplyPool {
+/// The places of a [`ServiceThreads`]: how many requests may be computed at once. A request
+/// that finds none free is answered at once (BUSY) by the thread that took it.
+#[derive(Debug, Clone)]
+pub struct Places {
     limit: usize,
-    /// Jobs computing: the places taken.
-    running: Arc<AtomicUsize>,
-    /// Jobs not yet finished, their answers included.
-    in_flight: Arc<AtomicUsize>,
+    taken: Arc<AtomicUsize>,
 }
 
-/// Takes one from its counter when dropped: a place of a [`ReplyPool`] after the job, before its
-/// answer; a job in flight after its answer; either while a panicking job unwinds.
-struct Taken(Arc<AtomicUsize>);
+/// A place taken: free again when dropped (before the reply goes out, so that a client that
+/// calls again as soon as it is answered finds its own place free).
+#[derive(Debug)]
+pub struct Place(Arc<AtomicUsize>);
 
-impl Drop for Taken {
+impl Drop for Place {
     fn drop(&mut self) {
         self.0.fetch_sub(1, Ordering::AcqRel);
     }
 }
 
-impl ReplyPool {
-    /// A pool of at most `limit` jobs at once.
+impl Places {
+    /// `limit` places, none taken.
     pub fn new(limit: usize) -> Self {
-        ReplyPool {
+        Places {
             limit,
-            running: Arc::new(AtomicUsize::new(0)),
-            in_flight: Arc::new(AtomicUsize::new(0)),
+            taken: Arc::new(AtomicUsize::new(0)),
         }
     }
 
-    /// Jobs under way (computing; an answer being sent no longer counts).
-    pub fn running(&self) -> usize {
-        self.running.load(Ordering::Acquire)
-    }
-
-    /// Computes `job` on the blocking pool, then `answer`s with its result on the same thread,
-    /// or, with `limit` jobs under way already, refuses with their number (`job` and `answer`
-    /// never run). Must be called inside a tokio runtime. A job that panics is not answered.
-    pub fn start<R: Send + 'static>(
-        &self,
-        job: impl FnOnce() -> R + Send + 'static,
-        answer: impl FnOnce(R) + Send + 'static,
-    ) -> Result<(), usize> {
-        self.running.fetch_update(Ordering::AcqRel, Ordering::Acquire, |n| {
+    /// A free place, or the number of places taken (all of them).
+    pub fn take(&self) -> Result<Place, usize> {
+        self.taken.fetch_update(Ordering::AcqRel, Ordering::Acquire, |n| {
             (n < self.limit).then_some(n + 1)
         })?;
-        let place = Taken(Arc::clone(&self.running));
-        self.in_flight.fetch_add(1, Ordering::AcqRel);
-        let flight = Taken(Arc::clone(&self.in_flight));
-        tokio::task::spawn_blocking(move || {
-            let result = job();
-            drop(place);
-            answer(result);
-            drop(flight);
-        });
-        Ok(())
+        Ok(Place(Arc::clone(&self.taken)))
     }
 
-    /// Waits until every job has finished, its answer sent, at most `limit` (checking every
-    /// millisecond): before a node leaves, so that no answer is sent by a server whose
-    /// participant is gone. The jobs not finished then, or 0.
-    pub async fn until_idle(&self, limit: Duration) -> usize {
+    /// Places taken now.
+    pub fn taken(&self) -> usize {
+        self.taken.load(Ordering::Acquire)
+    }
+}
+
+/// What the threads of a [`ServiceThreads`] share.
+struct Served {
+    /// Held by the thread waiting for the next request (the leader); the others wait here for
+    /// their turn.
+    leader: Mutex<()>,
+    stop: AtomicBool,
+    /// Wakes the leader out of its wait when the service stops.
+    wake: tokio::sync::Notify,
+    places: Places,
+    /// Threads not yet ended.
+    live: AtomicUsize,
+}
+
+/// A service answered on threads of its own (leader/followers), for requests that each take
+/// up to a second of one core: one thread waits for the next request and, once it has one,
+/// hands the wait to the next free thread and answers the request itself: it checks it, takes
+/// a [`Place`] (or answers BUSY at once) and computes and sends the reply. A request thus wakes
+/// the thread that answers it directly, with no hand-off through the event loop or a pool, and
+/// the reply leaves from the thread that computed it. There is one thread more than places, so
+/// a request beyond the limit is always taken and turned away at once, never left waiting.
+///
+/// The service must not touch the event loop's state: what it reads (configuration, the latest
+/// odometry, transforms) the loop shares with it.
+pub struct ServiceThreads {
+    served: Arc<Served>,
+}
+
+impl ServiceThreads {
+    /// Starts `places + 1` threads named `name`. Each in turn waits for `receive()` (a future
+    /// polled on the thread itself) and gives what it yields to `serve` with the places; a
+    /// `serve` that panics loses its request (not answered; the panic is logged) and its thread
+    /// goes on.
+    pub fn start<R, F>(
+        name: &str,
+        places: usize,
+        receive: impl Fn() -> F + Send + Sync + 'static,
+        serve: impl Fn(R, &Places) + Send + Sync + 'static,
+    ) -> std::io::Result<Self>
+    where
+        F: Future<Output = R>,
+    {
+        let served = Arc::new(Served {
+            leader: Mutex::new(()),
+            stop: AtomicBool::new(false),
+            wake: tokio::sync::Notify::new(),
+            places: Places::new(places),
+            live: AtomicUsize::new(0),
+        });
+        let work = Arc::new((receive, serve));
+        let threads = ServiceThreads {
+            served: Arc::clone(&served),
+        };
+        for _ in 0..=places {
+            let (thread_served, work) = (Arc::clone(&served), Arc::clone(&work));
+            served.live.fetch_add(1, Ordering::AcqRel);
+            let spawned = std::thread::Builder::new()
+                .name(name.to_owned())
+                .spawn(move || serve_turns(&thread_served, &work.0, &work.1));
+            if let Err(e) = spawned {
+                served.live.fetch_sub(1, Ordering::AcqRel);
+                return Err(e); // `threads` drops: the ones started stop
+            }
+        }
+        Ok(threads)
+    }
+
+    /// The places (how many requests are being computed).
+    pub fn places(&self) -> &Places {
+        &self.served.places
+    }
+
+    /// Stops taking requests and waits until every thread has ended (a request being answered
+    /// is answered first), at most `limit` (checking every millisecond): before a node leaves,
+    /// so that no answer is sent by a server whose participant is gone. The threads not ended
+    /// then, or 0.
+    pub async fn shut_down(&self, limit: Duration) -> usize {
+        self.stop();
         let until = tokio::time::Instant::now() + limit;
         loop {
-            let left = self.in_flight.load(Ordering::Acquire);
+            let left = self.served.live.load(Ordering::Acquire);
             if left == 0 || tokio::time::Instant::now() >= until {
                 return left;
             }
             tokio::time::sleep(Duration::from_millis(1)).await;
         }
     }
+
+    fn stop(&self) {
+        self.served.stop.store(true, Ordering::Release);
+        // A permit if the leader is not waiting now: it finds the flag before it waits again.
+        self.served.wake.notify_one();
+    }
+}
+
+impl Drop for ServiceThreads {
+    /// The threads end as soon as they are free.
+    fn drop(&mut self) {
+        self.stop();
+    }
+}
+
+/// One thread's turns: lead (wait for a request), then serve it, until the service stops.
+fn serve_turns<R, F: Future<Output = R>>(served: &Served, receive: &impl Fn() -> F, serve: &impl Fn(R, &Places)) {
+    loop {
+        let request = {
+            let _leader = served.leader.lock().unwrap_or_else(PoisonError::into_inner);
+            if served.stop.load(Ordering::Acquire) {
+                break;
+            }
+            let next = std::pin::pin!(receive());
+            let stopped = std::pin::pin!(served.wake.notified());
+            match futures::executor::block_on(futures::future::select(stopped, next)) {
+                Either::Left(_) => break,
+                Either::Right((request, _)) => request,
+            }
+        };
+        if std::panic::catch_unwind(AssertUnwindSafe(|| serve(request, &served.places))).is_err() {
+            tracing::error!("a service request was not answered: its handler panicked (see above)");
+        }
+    }
+    served.live.fetch_sub(1, Ordering::AcqRel);
 }
 
 #[cfg(test)]
@@ -373,81 +464,158 @@ mod tests {
         assert_eq!((off.threads(), off.is_running()), (0, false));
     }
 
+    /// A request source for [`ServiceThreads`]: a channel whose receiver the leader locks.
+    type Source = Arc<tokio::sync::Mutex<mpsc::UnboundedReceiver<u32>>>;
+
+    fn source() -> (mpsc::UnboundedSender<u32>, Source) {
+        let (tx, rx) = mpsc::unbounded_channel();
+        (tx, Arc::new(tokio::sync::Mutex::new(rx)))
+    }
+
+    fn receive(rx: &Source) -> impl Fn() -> std::pin::Pin<Box<dyn Future<Output = Option<u32>> + Send>> + use<> {
+        let rx = Arc::clone(rx);
+        move || {
+            let rx = Arc::clone(&rx);
+            Box::pin(async move { rx.lock().await.recv().await })
+        }
+    }
+
+    /// What a test service answered: the request, whether it was computed (else BUSY), the
+    /// places taken as it answered, and its thread's name.
+    type Answer = (u32, bool, usize, Option<String>);
+
     #[tokio::test(flavor = "current_thread")]
-    async fn a_pool_runs_up_to_its_limit_and_turns_the_next_away() {
+    async fn requests_are_computed_up_to_the_places_and_beyond_them_turned_away_at_once() {
+        let (requests, rx) = source();
+        let (answers_tx, answers) = std::sync::mpsc::channel::<Answer>();
         let (release_tx, release_rx) = std::sync::mpsc::channel::<()>();
         let release = Arc::new(std::sync::Mutex::new(release_rx));
-        let (answers_tx, answers) = std::sync::mpsc::channel::<(i32, usize)>();
-        let pool = ReplyPool::new(2);
-        let running = Arc::clone(&pool.running);
-        let start = |key: i32| {
-            let (release, answers_tx, running) = (release.clone(), answers_tx.clone(), Arc::clone(&running));
-            let job = move || {
-                // Held until released, so both are under way when the third comes.
-                let _ = release.lock().map(|r| r.recv());
-                key * 10
-            };
-            // Each answer notes how many jobs were under way as it went out.
-            let answer = move |reply| {
-                let _ = answers_tx.send((reply, running.load(Ordering::Acquire)));
-            };
-            pool.start(job, answer)
-        };
-        assert!(start(1).is_ok() && start(2).is_ok());
-        assert_eq!(start(3).unwrap_err(), 2, "the third is turned away");
-        release_tx.send(()).expect("job waits");
-        let (first, under_way) = answers.recv_timeout(Duration::from_secs(5)).expect("an answer");
-        assert!(first == 10 || first == 20);
-        assert_eq!(under_way, 1, "its place was free before it answered");
-        assert_eq!(pool.running(), 1);
-        assert!(start(3).is_ok(), "a place is free again");
-        release_tx.send(()).expect("job waits");
-        release_tx.send(()).expect("job waits");
-        let mut rest: Vec<i32> = (0..2)
-            .map(|_| answers.recv_timeout(Duration::from_secs(5)).expect("an answer").0)
+        let service = ServiceThreads::start(
+            "test_service",
+            2,
+            receive(&rx),
+            move |request: Option<u32>, places: &Places| {
+                let Some(request) = request else { return };
+                let name = std::thread::current().name().map(str::to_owned);
+                let computed = match places.take() {
+                    Ok(place) => {
+                        // Held until released, so that both places are taken when the third comes.
+                        let _ = release.lock().map(|r| r.recv());
+                        drop(place);
+                        true
+                    }
+                    Err(_) => false,
+                };
+                let _ = answers_tx.send((request, computed, places.taken(), name));
+            },
+        )
+        .expect("threads start");
+        requests.send(1).expect("open");
+        requests.send(2).expect("open");
+        // Both places taken before the third request comes.
+        let deadline = std::time::Instant::now() + Duration::from_secs(5);
+        while service.places().taken() < 2 && std::time::Instant::now() < deadline {
+            std::thread::sleep(Duration::from_millis(1));
+        }
+        assert_eq!(service.places().taken(), 2);
+        requests.send(3).expect("open");
+        let busy = answers
+            .recv_timeout(Duration::from_secs(5))
+            .expect("the third is answered");
+        assert_eq!(
+            busy,
+            (3, false, 2, Some("test_service".to_owned())),
+            "turned away at once, on a service thread"
+        );
+        release_tx.send(()).expect("a job waits");
+        let first = answers.recv_timeout(Duration::from_secs(5)).expect("an answer");
+        assert!(first.1 && (first.0 == 1 || first.0 == 2));
+        assert_eq!(first.2, 1, "its place was free before it answered");
+        requests.send(4).expect("open");
+        release_tx.send(()).expect("a job waits");
+        release_tx.send(()).expect("a job waits");
+        let mut rest: Vec<u32> = (0..2)
+            .map(|_| answers.recv_timeout(Duration::from_secs(5)).expect("an answer"))
+            .inspect(|a| assert!(a.1, "{a:?} computed"))
+            .map(|a| a.0)
             .collect();
         rest.sort();
-        assert!(rest.contains(&30) && !rest.contains(&first));
-        assert_eq!(pool.until_idle(Duration::from_secs(5)).await, 0);
-        assert_eq!(pool.running(), 0);
+        assert_eq!(rest, if first.0 == 1 { vec![2, 4] } else { vec![1, 4] });
+        assert_eq!(service.shut_down(Duration::from_secs(5)).await, 0);
+        assert_eq!(service.places().taken(), 0);
     }
 
     #[tokio::test(flavor = "current_thread")]
-    async fn idle_only_once_the_answer_is_sent() {
-        let pool = ReplyPool::new(1);
+    async fn shutting_down_wakes_the_waiting_thread_and_waits_for_the_request_under_way() {
+        let (requests, rx) = source();
+        let (answers_tx, answers) = std::sync::mpsc::channel::<u32>();
         let (release_tx, release_rx) = std::sync::mpsc::channel::<()>();
-        // The answer waits, as a reply's write may.
-        assert!(pool
-            .start(
-                || 1,
-                move |_| {
-                    let _ = release_rx.recv();
-                }
-            )
-            .is_ok());
-        assert_eq!(
-            pool.until_idle(Duration::from_millis(50)).await,
+        let release = std::sync::Mutex::new(release_rx);
+        let (taken_tx, taken) = std::sync::mpsc::channel::<()>();
+        let service = ServiceThreads::start(
+            "test_service",
             1,
-            "the answer is still going out"
+            receive(&rx),
+            move |request: Option<u32>, _: &Places| {
+                let Some(request) = request else { return };
+                let _ = taken_tx.send(());
+                let _ = release.lock().map(|r| r.recv());
+                let _ = answers_tx.send(request);
+            },
+        )
+        .expect("threads start");
+        requests.send(1).expect("open");
+        taken.recv_timeout(Duration::from_secs(5)).expect("request 1 is taken");
+        // The other thread now waits for a request; the first holds request 1.
+        assert_eq!(
+            service.shut_down(Duration::from_millis(100)).await,
+            1,
+            "request 1 is under way"
         );
-        assert_eq!(pool.running(), 0, "its place is free meanwhile");
-        release_tx.send(()).expect("the answer waits");
-        assert_eq!(pool.until_idle(Duration::from_secs(5)).await, 0);
+        requests.send(2).expect("open");
+        release_tx.send(()).expect("the job waits");
+        assert_eq!(
+            service.shut_down(Duration::from_secs(5)).await,
+            0,
+            "every thread has ended"
+        );
+        assert_eq!(
+            answers.recv_timeout(Duration::from_secs(5)).ok(),
+            Some(1),
+            "answered before the end"
+        );
+        assert!(answers.try_recv().is_err(), "no request is taken once stopped");
     }
 
     #[tokio::test(flavor = "current_thread")]
-    async fn a_panicking_job_frees_its_place_and_is_not_answered() {
-        let pool = ReplyPool::new(1);
-        let answered = Arc::new(AtomicBool::new(false));
-        let flag = Arc::clone(&answered);
-        assert!(pool
-            .start(
-                || -> i32 { panic!("a failing job") },
-                move |_| flag.store(true, Ordering::SeqCst)
-            )
-            .is_ok());
-        assert_eq!(pool.until_idle(Duration::from_secs(5)).await, 0, "the place comes back");
-        assert!(pool.start(|| 1, |_| ()).is_ok());
-        assert!(!answered.load(Ordering::SeqCst));
+    async fn a_panicking_handler_loses_its_request_and_its_thread_serves_on() {
+        let (requests, rx) = source();
+        let (answers_tx, answers) = std::sync::mpsc::channel::<u32>();
+        let service = ServiceThreads::start(
+            "test_service",
+            1,
+            receive(&rx),
+            move |request: Option<u32>, _: &Places| match request {
+                Some(0) => panic!("a failing handler"),
+                Some(request) => {
+                    let _ = answers_tx.send(request);
+                }
+                None => {}
+            },
+        )
+        .expect("threads start");
+        for request in [0, 1, 0, 2, 3] {
+            requests.send(request).expect("open");
+        }
+        let mut got: Vec<u32> = (0..3)
+            .map(|_| answers.recv_timeout(Duration::from_secs(5)).expect("an answer"))
+            .collect();
+        got.sort();
+        assert_eq!(got, vec![1, 2, 3]);
+        assert_eq!(
+            service.shut_down(Duration::from_secs(5)).await,
+            0,
+            "both threads were alive"
+        );
     }
 }

@@ -15,10 +15,9 @@
 //! in-process; the round trip's p50 / p90 / p99; and the ratio of the round trip's median to
 //! each of the two medians of the node's work (the budget's is the one timed between the
 //! calls). Interleaved with those calls, two more kinds show where the rest goes: a request
-//! refused at once (no check, a reply of a few bytes: DDS's floor) and a 1-waypoint route (the
-//! hand-off to the node's check pool, whose thread sends the small reply). The last row is the transport
-//! without DDS: UDP round trips on loopback between two threads with the same request and reply
-//! sizes.
+//! refused at once (no check, a reply of a few bytes: DDS's floor) and a 1-waypoint route (a
+//! check of a few microseconds, then the small reply). The last row is the transport without
+//! DDS: UDP round trips on loopback between two threads with the same request and reply sizes.
 
 #[path = "../../planner/benches/common/demo_loop.rs"]
 mod demo_loop;
@@ -206,8 +205,8 @@ fn main() -> anyhow::Result<()> {
         // The floor: a request the node refuses at once (a NaN start), a reply of a few bytes.
         let mut refused = request.clone();
         refused.start.position.x = f64::NAN;
-        // A check of a single waypoint 0.3 m ahead: the hand-off to the node's check pool, whose
-        // thread sends the small reply.
+        // A check of a single waypoint 0.3 m ahead: a check of a few microseconds, then the
+        // small reply.
         let mut short = request.clone();
         short.route.poses.truncate(1);
         short.route.poses[0].pose = pose_msg(&Pose2::new(0.3, 0.0, 0.0));

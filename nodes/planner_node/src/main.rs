@@ -62,7 +62,6 @@ use mobil_ros::motion::{
     Applied, ClockCheck, CmdVel, EndCause, EndKind, Ended, GoalId, MotionSession, Outputs, SessionSettings, Watched,
 };
 use mobil_ros::offloop::CancelToken;
-use mobil_ros::offloop::ReplyPool;
 use mobil_ros::plan::PlanOut;
 use mobil_ros::scan::{checked_scan, tf_static_subscription, LaserMount, StaticFrames};
 use mobil_ros::status::{end_state, NavStatusView, RateGate};
@@ -71,9 +70,10 @@ use mobil_ros::tf::GoalTf;
 use mobil_ros::ticker::Ticker;
 use mobil_ros::time::{duration_msg, secs_from_stamp, DtError};
 use mobil_ros::OffLoop;
-use mobil_ros::{qos, respond, run_node, shutdown_signal, warn_throttled, ConfigError, LogThrottle, NodeDecl, RosNode};
+use mobil_ros::{qos, run_node, shutdown_signal, warn_throttled, ConfigError, LogThrottle, NodeDecl, RosNode};
 use mobil_world::World;
 use ros2_client::{RmwRequestId, Server, Subscription};
+use shell::check::{CheckInputs, CheckService, CheckView, SharedTf};
 use std::process::ExitCode;
 use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
@@ -103,7 +103,7 @@ fn main() -> ExitCode {
 /// The shell's handlers, by concern; what they share is declared here.
 mod shell {
     mod actions;
-    mod check;
+    pub(crate) mod check;
     mod goals;
     mod path;
     mod routes;
@@ -162,7 +162,8 @@ struct PreCheckDone {
 /// Most route checks computed at once, goal pre-checks and `planner/check_route` requests
 /// together (each may take up to 0.6 s of one core). The goal's pre-check keeps one of them
 /// (its [`OffLoop`] runs one at a time, a newer goal's waiting until the superseded check has
-/// stopped); service requests beyond the rest are answered BUSY at once.
+/// stopped); service requests beyond the rest are answered BUSY at once (by the service's
+/// spare thread: [`shell::check::CheckService`]).
 const MAX_CHECKS: usize = 4;
 
 /// Odometry poses kept to place scans by their stamps: 2 s at 50 Hz, far beyond
@@ -176,14 +177,11 @@ struct VfoTickDone {
     step: Step<VfoStep, Vec<usize>>,
 }
 
-/// The pre-checks off the event loop: the goal's (a newer goal stops the older one's) and
-/// the service's (each request answered, in any order); the VFO ticks.
+/// The work off the event loop: the goal's pre-check (a newer goal stops the older one's) and
+/// the VFO ticks.
 struct Jobs {
     goal: OffLoop<PreCheckDone>,
     vfo: OffLoop<VfoTickDone>,
-    /// Each job answers its request itself, from the pool's thread (the reply leaves as soon as
-    /// it is computed, not when the event loop next runs).
-    checks: ReplyPool,
 }
 
 /// Everything the loop holds between events.
@@ -200,8 +198,6 @@ struct Shell {
     markers_gate: RateGate,
     drawing: Drawing,
     throttle: LogThrottle,
-    /// The check jobs' rate limit for a reply that cannot be sent, shared by the pool's threads.
-    reply_throttle: Arc<Mutex<LogThrottle>>,
     /// Looks for a `cmd_vel` endpoint of the other type.
     types: mobil_ros::cmd_vel::TypeWatch,
     /// Obstacles seen by the LIDAR, in odom (VFO); kept between goals, new extraction
@@ -224,8 +220,11 @@ struct Shell {
     /// `plan` (the route, or the pre-check's predicted path) and `local_plan` (VFO's chosen
     /// path).
     plans: PlanOut,
-    /// `tf` and `tf_static`: goals in other frames than odometry's.
-    tf: GoalTf,
+    /// `tf` and `tf_static`: goals in other frames than odometry's (shared with the
+    /// `planner/check_route` threads).
+    tf: SharedTf,
+    /// What the `planner/check_route` threads read of the above.
+    check: CheckView,
     /// The latest goal's frame (odometry's before the first): the frame of the status, the
     /// markers and the plans.
     frame: String,
@@ -247,7 +246,6 @@ enum Event {
     Follow(ActionEvent<FollowWaypointsGoal>),
     Path(ActionEvent<FollowPathGoal>),
     Lifecycle(Transition),
-    Check(RmwRequestId, CheckRouteRequest),
     RouteChecked(PreCheckDone),
     Tick,
 }
@@ -270,7 +268,11 @@ async fn start(node: &mut RosNode, out: &Outputs, config: PlannerConfig) -> anyh
     }
     let docks = load_docks(node, &config)?;
     let plans = PlanOut::create(node)?;
-    let tf = GoalTf::create(node, &config.frames.odom_frame, config.controller.transform_tolerance())?;
+    let tf = SharedTf::new(GoalTf::create(
+        node,
+        &config.frames.odom_frame,
+        config.controller.transform_tolerance(),
+    )?);
     let odom_sub = node.subscription::<Odometry>("odom", &qos::default_qos())?;
     let dock_sub = node.subscription::<PoseStamped>("dock_pose", &qos::default_qos())?;
     let route_sub = node.subscription::<Path>("waypoints", &qos::default_qos())?;
@@ -301,13 +303,18 @@ async fn start(node: &mut RosNode, out: &Outputs, config: PlannerConfig) -> anyh
         world.obstacles.len(),
         config.frames.odom_frame
     );
+    let world = Arc::new(world);
+    let check_view = CheckView::new(CheckInputs::new(&config, chassis, Arc::clone(&world), node.clock()));
+    // The goal's pre-check keeps one of the MAX_CHECKS.
+    let check_service = CheckService::start(Arc::clone(&check), MAX_CHECKS - 1, check_view.clone(), tf.clone())?;
     let mut shell = Shell {
         diagnostics: MotionDiagnostics::create(node, chassis.model().as_str())?,
         tf,
+        check: check_view,
         frame: config.frames.odom_frame.clone(),
         config,
         chassis,
-        world: Arc::new(world),
+        world,
         session: Session::new(SessionSettings::default()),
         odom: Latest::new(),
         odom_speed: 0.0,
@@ -316,7 +323,6 @@ async fn start(node: &mut RosNode, out: &Outputs, config: PlannerConfig) -> anyh
         markers_gate: RateGate::default(),
         drawing: Drawing::default(),
         throttle: LogThrottle::new(Duration::from_secs(2)),
-        reply_throttle: Arc::new(Mutex::new(LogThrottle::new(Duration::from_secs(2)))),
         types: Default::default(),
         map,
         odom_history: PoseHistory::new(ODOM_HISTORY),
@@ -331,8 +337,6 @@ async fn start(node: &mut RosNode, out: &Outputs, config: PlannerConfig) -> anyh
     let mut jobs = Jobs {
         goal: OffLoop::new(),
         vfo: OffLoop::new(),
-        // The goal's pre-check keeps one of the MAX_CHECKS.
-        checks: ReplyPool::new(MAX_CHECKS - 1),
     };
     let mut sink = CmdVel::new(&out.cmd);
     let outcome = event_loop(
@@ -345,7 +349,6 @@ async fn start(node: &mut RosNode, out: &Outputs, config: PlannerConfig) -> anyh
         &mut lifecycle,
         (&odom_sub, &dock_sub, &route_sub),
         (&scan_sub, &tf_sub),
-        &check,
     )
     .await;
     // A goal under way (a pre-check included: it stopped a robot a goal before it moved) ends,
@@ -368,7 +371,7 @@ async fn start(node: &mut RosNode, out: &Outputs, config: PlannerConfig) -> anyh
     }
     // The route checks under way answer before the node leaves: their server must not outlive
     // the participant (a check takes at most about 0.6 s).
-    let left = jobs.checks.until_idle(Duration::from_secs(1)).await;
+    let left = check_service.shut_down(Duration::from_secs(1)).await;
     if left > 0 {
         warn!("{CHECK_ROUTE}: {left} route check(s) still under way at shutdown may answer after the node has left");
     }
@@ -424,15 +427,13 @@ async fn event_loop(
     lifecycle: &mut Lifecycle,
     (odom_sub, dock_sub, route_sub): (&Subscription<Odometry>, &Subscription<PoseStamped>, &Subscription<Path>),
     (scan_sub, tf_sub): (&Subscription<LaserScan>, &Subscription<TFMessage>),
-    check: &Arc<Server<CheckRouteRequest, CheckRouteResponse>>,
 ) -> anyhow::Result<()> {
     let mut inputs = Inputs::new();
     inputs
         .add(odom_sub.async_stream(), "odom", "sample ignored", Event::Odom)
         .add(scan_sub.async_stream(), "scan", "scan ignored", Event::Scan)
         .add(dock_sub.async_stream(), "dock_pose", "goal ignored", Event::DockPose)
-        .add(route_sub.async_stream(), "waypoints", "route ignored", Event::Waypoints)
-        .add_requests(check.receive_request_stream(), "planner/check_route", Event::Check);
+        .add(route_sub.async_stream(), "waypoints", "route ignored", Event::Waypoints);
     let shutdown = shutdown_signal();
     tokio::pin!(shutdown);
     let mut ticker = Ticker::new(WATCHDOG_RATE_HZ)?;
@@ -504,7 +505,6 @@ async fn event_loop(
             Event::Undock(ActionEvent::CancelRequested(id)) => shell.cancel(&mut io, Source::UndockAction, id),
             Event::Follow(ActionEvent::CancelRequested(id)) => shell.cancel(&mut io, Source::FollowAction, id),
             Event::Path(ActionEvent::CancelRequested(id)) => shell.cancel(&mut io, Source::PathAction, id),
-            Event::Check(id, req) => shell.check_in(io.node, jobs, check, id, &req),
             Event::RouteChecked(done) => shell.pre_checked(&mut io, done),
             Event::Tick => shell.tick(&mut io).await,
         }

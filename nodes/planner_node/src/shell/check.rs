@@ -1,97 +1,257 @@
-//! `planner/check_route`: a route's pre-check as a service, computed and answered on the
-//! blocking pool.
+//! `planner/check_route`: a route's pre-check as a service, answered on threads of its own
+//! ([`ServiceThreads`]): a request wakes the thread that checks it and sends the reply, with no
+//! hand-off through the event loop or a pool (the loop's turn and the pool's wake-up were two
+//! of the five thread wake-ups a call cost). What a check reads from the loop's state (the
+//! configuration, the latest odometry, the transforms) the loop shares with the threads:
+//! [`CheckView`] and [`SharedTf`].
 
 use crate::*;
+use mobil_planner::RouteCheckConfig;
+use mobil_ros::node::NodeClock;
+use mobil_ros::offloop::{Places, ServiceThreads};
+use mobil_ros::tf::GoalTf;
+use mobil_ros::time::stamp_from_nanos;
 
-impl Shell {
-    /// A `planner/check_route` request: refused at once, answered BUSY when too many are being
-    /// computed, or checked on the blocking pool and answered from there: the reply leaves from
-    /// the thread that computed it, without a hand-off back to the event loop.
-    pub(crate) fn check_in(
-        &mut self,
-        node: &RosNode,
-        jobs: &mut Jobs,
-        check: &Arc<Server<CheckRouteRequest, CheckRouteResponse>>,
-        id: RmwRequestId,
-        req: &CheckRouteRequest,
-    ) {
-        let (start, route, placed) = match self.check_request(node, req) {
-            Err(reply) => return respond(check, id, reply, CHECK_ROUTE, &mut self.throttle),
-            Ok(checked) => checked,
+/// The goal frames and their transforms, shared by the event loop (goals) and the check
+/// threads (each request placed through tf as a goal is).
+#[derive(Clone)]
+pub(crate) struct SharedTf(Arc<Mutex<GoalTf>>);
+
+impl SharedTf {
+    pub(crate) fn new(tf: GoalTf) -> Self {
+        SharedTf(Arc::new(Mutex::new(tf)))
+    }
+
+    fn lock(&self) -> std::sync::MutexGuard<'_, GoalTf> {
+        self.0.lock().unwrap_or_else(std::sync::PoisonError::into_inner)
+    }
+
+    /// [`GoalTf::frame_of`].
+    pub(crate) fn frame_of(&self, frame_id: &str) -> String {
+        self.lock().frame_of(frame_id)
+    }
+
+    /// Whether `frame` is the odometry frame.
+    pub(crate) fn is_odom(&self, frame: &str) -> bool {
+        self.lock().frames().is_odom(frame)
+    }
+
+    /// [`GoalTf::accept`].
+    pub(crate) fn accept(&self, goal_frame: &str, now: i64) -> Result<Pose2, String> {
+        self.lock().accept(goal_frame, now)
+    }
+
+    /// [`GoalTf::odom_in`].
+    pub(crate) fn odom_in(&self, goal_frame: &str, now: i64) -> Result<Pose2, String> {
+        self.lock().odom_in(goal_frame, now)
+    }
+
+    /// [`GoalTf::set_tolerance`].
+    pub(crate) fn set_tolerance(&self, tolerance: Duration) {
+        self.lock().set_tolerance(tolerance);
+    }
+}
+
+/// What a check reads from the event loop's state, kept current by the loop: the node's
+/// parameters as they apply now and its latest odometry (for a request without a start).
+pub(crate) struct CheckInputs {
+    pub(crate) world: Arc<World>,
+    pub(crate) chassis: ChassisParams,
+    pub(crate) config: RouteCheckConfig,
+    /// `follow.check_length` (m): the step of the reply's driven length.
+    pub(crate) step: f64,
+    pub(crate) odom_timeout: Duration,
+    /// The latest odometry pose; `None` while the last sample was refused.
+    pub(crate) odom: Option<Latest<Pose2>>,
+    pub(crate) clock: NodeClock,
+}
+
+impl CheckInputs {
+    /// The inputs of a node with `config`, before any odometry.
+    pub(crate) fn new(config: &PlannerConfig, chassis: ChassisParams, world: Arc<World>, clock: NodeClock) -> Self {
+        let mut inputs = CheckInputs {
+            world,
+            chassis,
+            config: config.route_check(),
+            step: 0.0,
+            odom_timeout: Duration::ZERO,
+            odom: Some(Latest::new()),
+            clock,
         };
-        let (world, chassis, config) = (self.world_in(&placed), self.chassis, self.config.route_check());
-        let (stamp, frame, step) = (node.stamp(), placed.frame, self.config.follow.check_length);
-        let (server, throttle) = (Arc::clone(check), Arc::clone(&self.reply_throttle));
-        let answer = move |reply| {
+        inputs.configure(config, chassis);
+        inputs
+    }
+
+    /// New parameters.
+    pub(crate) fn configure(&mut self, config: &PlannerConfig, chassis: ChassisParams) {
+        self.chassis = chassis;
+        self.config = config.route_check();
+        self.step = config.follow.check_length;
+        self.odom_timeout = config.timeouts.odom_timeout();
+    }
+}
+
+/// The loop's side of [`CheckInputs`]: it replaces them as they change.
+#[derive(Clone)]
+pub(crate) struct CheckView(Arc<Mutex<CheckInputs>>);
+
+impl CheckView {
+    pub(crate) fn new(inputs: CheckInputs) -> Self {
+        CheckView(Arc::new(Mutex::new(inputs)))
+    }
+
+    /// Changes what the checks read (new parameters, a new odometry sample).
+    pub(crate) fn update(&self, change: impl FnOnce(&mut CheckInputs)) {
+        change(&mut self.0.lock().unwrap_or_else(std::sync::PoisonError::into_inner));
+    }
+}
+
+/// A request ready to check: its start and route in the route's frame, and what to check it
+/// with.
+struct Prepared {
+    start: Pose2,
+    route: Route,
+    frame: String,
+    world: Arc<World>,
+    chassis: ChassisParams,
+    config: RouteCheckConfig,
+    step: f64,
+    stamp: mobil_msgs::builtin_interfaces::msg::Time,
+}
+
+/// `planner/check_route` served.
+pub(crate) struct CheckService {
+    threads: ServiceThreads,
+}
+
+impl CheckService {
+    /// Serves `server` on `places + 1` threads (at most `places` checks at once; a request
+    /// beyond them is answered BUSY at once).
+    pub(crate) fn start(
+        server: Arc<Server<CheckRouteRequest, CheckRouteResponse>>,
+        places: usize,
+        inputs: CheckView,
+        tf: SharedTf,
+    ) -> anyhow::Result<Self> {
+        let throttle = Mutex::new(LogThrottle::new(Duration::from_secs(2)));
+        let receiving = Arc::clone(&server);
+        let receive = move || {
+            let server = Arc::clone(&receiving);
+            async move { server.async_receive_request().await }
+        };
+        let serve = move |request: Result<(RmwRequestId, CheckRouteRequest), _>, places: &Places| {
+            let warn = |what: &str| {
+                let mut throttle = throttle.lock().unwrap_or_else(std::sync::PoisonError::into_inner);
+                warn_throttled!(throttle, "service", "{CHECK_ROUTE}: {what}");
+            };
+            let (id, req) = match request {
+                Ok(request) => request,
+                Err(e) => return warn(&format!("request dropped: {e:?}")),
+            };
+            let reply = match prepare(&inputs.0, &tf, &req) {
+                Err(refusal) => refusal,
+                Ok(prepared) => match places.take() {
+                    Ok(place) => {
+                        let reply = compute(&prepared);
+                        drop(place);
+                        reply
+                    }
+                    Err(running) => refused_reply(format!(
+                        "BUSY: {running} route checks are already being computed; ask again"
+                    )),
+                },
+            };
             if let Err(e) = server.send_response(id, reply) {
-                let mut throttle = throttle.lock().unwrap_or_else(|poisoned| poisoned.into_inner());
-                warn_throttled!(throttle, "service-reply", "{CHECK_ROUTE}: cannot send the reply: {e:?}");
+                warn(&format!("cannot send the reply: {e:?}"));
             }
         };
-        let job = move || {
-            let began = Instant::now();
-            // A check that panics (a defect) is still answered; the panic is in the log.
-            let checked = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
-                match check_route_until(&start, &route.points, &chassis, &world, &config, || false) {
-                    Ok(report) => {
-                        let of_route = (&route.points[..], &route.request_index[..]);
-                        check_reply(
-                            &RouteAnswer::of(&report, of_route, step, MAX_REPLY_POSES),
-                            stamp,
-                            &frame,
-                        )
-                    }
-                    Err(e) => refused_reply(Action::Follow.refused_goal(e).reason()),
-                }
-            }));
-            let reply = checked.unwrap_or_else(|_| {
-                refused_reply("INTERNAL_ERROR: the route check failed (see the node's log)".to_owned())
-            });
-            info!(
-                "planner/check_route: {} waypoints, {} in {:.2} ms",
-                route.points.len(),
-                if reply.feasible {
-                    "feasible".to_owned()
-                } else {
-                    format!("{} problem(s)", reply.problems.len())
-                },
-                began.elapsed().as_secs_f64() * 1e3
-            );
-            reply
-        };
-        if let Err(running) = jobs.checks.start(job, answer) {
-            let reply = refused_reply(format!(
-                "BUSY: {running} route checks are already being computed; ask again"
-            ));
-            respond(check, id, reply, CHECK_ROUTE, &mut self.throttle);
-        }
+        let threads = ServiceThreads::start("check_route", places, receive, serve)
+            .map_err(|e| anyhow::anyhow!("{CHECK_ROUTE}: cannot start its threads: {e}"))?;
+        Ok(CheckService { threads })
     }
 
-    /// The start and route of a `planner/check_route` request, in the route's frame (placed
-    /// through tf; the reply is in it too), or the reply refusing it.
-    pub(crate) fn check_request(
-        &mut self,
-        node: &RosNode,
-        req: &CheckRouteRequest,
-    ) -> Result<(Pose2, Route, Placed), CheckRouteResponse> {
-        let frame = self.tf.frame_of(&req.route.header.frame_id);
-        let placed = self
-            .goal_frame(node, &frame, Action::Follow)
-            .map_err(|refusal| refused_reply(refusal.reason()))?;
-        let start = if req.use_start {
-            pose_in_frame("start", &frame, &req.start, &frame)
-                .map_err(|e| refused_reply(Action::Follow.invalid_goal(&e).reason()))?
-        } else {
-            let seen = self.fresh_odom().map(|p| placed.odom_in.compose(&p));
-            seen.ok_or_else(|| {
-                refused_reply(
-                    "STALE_INPUT: no fresh odometry for the start (set use_start and start to check from a given pose)"
-                        .to_owned(),
-                )
-            })?
-        };
-        let route = route_from_path(&req.route, &frame, Some(start.position()), ROUTE_LIMITS)
-            .map_err(|e| refused_reply(Action::Follow.invalid_goal(&e).reason()))?;
-        Ok((start, route, placed))
+    /// Takes no more requests and waits, at most `limit`, for the checks under way to answer;
+    /// the threads still busy then, or 0.
+    pub(crate) async fn shut_down(&self, limit: Duration) -> usize {
+        self.threads.shut_down(limit).await
     }
+}
+
+/// The start and route of a request, in the route's frame (placed through tf; the reply is in
+/// it too), with what to check them with; or the reply refusing it.
+fn prepare(
+    inputs: &Mutex<CheckInputs>,
+    tf: &SharedTf,
+    req: &CheckRouteRequest,
+) -> Result<Prepared, CheckRouteResponse> {
+    let (world, chassis, config, step, odom, clock) = {
+        let i = inputs.lock().unwrap_or_else(std::sync::PoisonError::into_inner);
+        let odom = i.odom.as_ref().and_then(|o| o.get(i.odom_timeout).copied());
+        (Arc::clone(&i.world), i.chassis, i.config, i.step, odom, i.clock.clone())
+    };
+    let now = clock.now_nanos();
+    let frame = tf.frame_of(&req.route.header.frame_id);
+    let odom_in = tf
+        .accept(&frame, now)
+        .map_err(|why| refused_reply(Action::Follow.tf_error(why).reason()))?;
+    let start = if req.use_start {
+        pose_in_frame("start", &frame, &req.start, &frame)
+            .map_err(|e| refused_reply(Action::Follow.invalid_goal(&e).reason()))?
+    } else {
+        let seen = odom.map(|p| odom_in.compose(&p));
+        seen.ok_or_else(|| {
+            refused_reply(
+                "STALE_INPUT: no fresh odometry for the start (set use_start and start to check from a given pose)"
+                    .to_owned(),
+            )
+        })?
+    };
+    let route = route_from_path(&req.route, &frame, Some(start.position()), ROUTE_LIMITS)
+        .map_err(|e| refused_reply(Action::Follow.invalid_goal(&e).reason()))?;
+    let world = match tf.is_odom(&frame) {
+        true => world,
+        false => Arc::new(world.moved(&odom_in)),
+    };
+    Ok(Prepared {
+        start,
+        route,
+        frame,
+        world,
+        chassis,
+        config,
+        step,
+        stamp: stamp_from_nanos(now),
+    })
+}
+
+/// The check of a prepared request and its reply. A check that panics (a defect) is still
+/// answered; the panic is in the log.
+fn compute(p: &Prepared) -> CheckRouteResponse {
+    let began = Instant::now();
+    let checked = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+        match check_route_until(&p.start, &p.route.points, &p.chassis, &p.world, &p.config, || false) {
+            Ok(report) => {
+                let of_route = (&p.route.points[..], &p.route.request_index[..]);
+                check_reply(
+                    &RouteAnswer::of(&report, of_route, p.step, MAX_REPLY_POSES),
+                    p.stamp.clone(),
+                    &p.frame,
+                )
+            }
+            Err(e) => refused_reply(Action::Follow.refused_goal(e).reason()),
+        }
+    }));
+    let reply = checked
+        .unwrap_or_else(|_| refused_reply("INTERNAL_ERROR: the route check failed (see the node's log)".to_owned()));
+    info!(
+        "{CHECK_ROUTE}: {} waypoints, {} in {:.2} ms",
+        p.route.points.len(),
+        if reply.feasible {
+            "feasible".to_owned()
+        } else {
+            format!("{} problem(s)", reply.problems.len())
+        },
+        began.elapsed().as_secs_f64() * 1e3
+    );
+    reply
 }

@@ -22,6 +22,7 @@ impl Shell {
         }
         self.chassis = chassis;
         self.tf.set_tolerance(c.controller.transform_tolerance());
+        self.check.update(|inputs| inputs.configure(&c, chassis));
         self.config = c;
         if running {
             info!("parameters changed: they apply from the next goal");
@@ -240,6 +241,7 @@ impl Shell {
                 }
                 self.odom_period.arrived(Instant::now());
                 self.odom.set(pose, m.header.stamp.clone());
+                self.check.update(|inputs| inputs.odom = Some(self.odom.clone()));
                 if self.session.active().is_some() {
                     self.step(io, jobs, pose);
                 }
@@ -247,6 +249,7 @@ impl Shell {
             Err(e) => {
                 warn_throttled!(self.throttle, "odom-bad", "odom sample dropped: {e}; robot stopped");
                 self.odom_refused = true;
+                self.check.update(|inputs| inputs.odom = None);
                 self.odom_speed = 0.0;
                 self.odom_history.clear();
                 self.session.hold(io.sink);
@@ -275,7 +278,7 @@ impl Shell {
         let Some(frame) = self.session.active().map(|a| a.goal.frame.clone()) else {
             return;
         };
-        let odom_in = match self.tf.frames().is_odom(&frame) {
+        let odom_in = match self.tf.is_odom(&frame) {
             true => Pose2::identity(),
             false => match self.tf.accept(&frame, io.node.now_nanos()) {
                 Ok(t) => t,

@@ -158,7 +158,7 @@ impl Shell {
         };
         let Some(goals) = task.take_pending() else { return };
         let (points, headings, index) = PathTask::vfo_route(&goals);
-        let map = map_seen(&self.map, self.tf.frames().is_odom(&active.goal.frame), &odom_in, true);
+        let map = map_seen(&self.map, self.tf.is_odom(&active.goal.frame), &odom_in, true);
         let rules = (&active.goal.config.vfo, &active.goal.chassis, map.as_ref());
         match VfoRun::start((&points, &headings, &index), start, scan_fresh, rules, period) {
             Ok(started) => {

@@ -90,7 +90,7 @@ impl Shell {
 
     /// The pre-check's world (given in the odometry frame) seen from a goal's frame.
     pub(crate) fn world_in(&self, placed: &Placed) -> Arc<World> {
-        match self.tf.frames().is_odom(&placed.frame) {
+        match self.tf.is_odom(&placed.frame) {
             true => self.world.clone(),
             false => Arc::new(self.world.moved(&placed.odom_in)),
         }
@@ -99,7 +99,7 @@ impl Shell {
     /// VFO's obstacle map (kept in the odometry frame) seen from a goal's frame, through the
     /// odometry frame's pose in it.
     pub(crate) fn map_in(&self, frame: &str, odom_in: &Pose2) -> Cow<'_, ObstacleMap> {
-        map_seen(&self.map, self.tf.frames().is_odom(frame), odom_in, true)
+        map_seen(&self.map, self.tf.is_odom(frame), odom_in, true)
     }
 
     /// Starts VFO waypoint following of `route` from `start` (or refuses it).
@@ -150,7 +150,7 @@ impl Shell {
             v.map_updated(false);
         }
         let taking = v.map_pending().is_some();
-        let map = map_seen(&self.map, self.tf.frames().is_odom(frame), &odom_in, taking);
+        let map = map_seen(&self.map, self.tf.is_odom(frame), &odom_in, taking);
         let Some(mut law) = v.lend(Instant::now(), &map) else {
             return self.session.hold(io.sink);
         };
