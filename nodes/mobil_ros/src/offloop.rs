@@ -232,7 +232,8 @@ struct Served {
 /// a [`Place`] (or answers BUSY at once) and computes and sends the reply. A request thus wakes
 /// the thread that answers it directly, with no hand-off through the event loop or a pool, and
 /// the reply leaves from the thread that computed it. There is one thread more than places, so
-/// a request beyond the limit is always taken and turned away at once, never left waiting.
+/// a request beyond the limit is taken and turned away as soon as that thread is free (it is
+/// busy only while it checks or answers a request of its own), not left waiting for a check.
 ///
 /// The service must not touch the event loop's state: what it reads (configuration, the latest
 /// odometry, transforms) the loop shares with it.
@@ -266,15 +267,17 @@ impl ServiceThreads {
             served: Arc::clone(&served),
         };
         for _ in 0..=places {
-            let (thread_served, work) = (Arc::clone(&served), Arc::clone(&work));
             served.live.fetch_add(1, Ordering::AcqRel);
-            let spawned = std::thread::Builder::new()
-                .name(name.to_owned())
-                .spawn(move || serve_turns(&thread_served, &work.0, &work.1));
-            if let Err(e) = spawned {
-                served.live.fetch_sub(1, Ordering::AcqRel);
-                return Err(e); // `threads` drops: the ones started stop
-            }
+            // Counted out when the thread ends, however it ends (a panic too), and only after it
+            // has let go of `receive` and `serve` (and what they hold, a server for one).
+            let live = Live(Arc::clone(&served));
+            let work = Arc::clone(&work);
+            let spawned = std::thread::Builder::new().name(name.to_owned()).spawn(move || {
+                let live = live;
+                serve_turns(&live.0, &work.0, &work.1);
+                drop(work);
+            });
+            spawned?; // on failure `threads` drops: the ones started stop
         }
         Ok(threads)
     }
@@ -282,6 +285,19 @@ impl ServiceThreads {
     /// The places (how many requests are being computed).
     pub fn places(&self) -> &Places {
         &self.served.places
+    }
+
+    /// Threads not ended.
+    pub fn threads(&self) -> usize {
+        self.served.live.load(Ordering::Acquire)
+    }
+
+    /// Takes no more requests: a thread waiting for one ends, the others once they have
+    /// answered theirs.
+    pub fn stop(&self) {
+        self.served.stop.store(true, Ordering::Release);
+        // A permit if the leader is not waiting now: it finds the flag before it waits again.
+        self.served.wake.notify_one();
     }
 
     /// Stops taking requests and waits until every thread has ended (a request being answered
@@ -299,11 +315,14 @@ impl ServiceThreads {
             tokio::time::sleep(Duration::from_millis(1)).await;
         }
     }
+}
 
-    fn stop(&self) {
-        self.served.stop.store(true, Ordering::Release);
-        // A permit if the leader is not waiting now: it finds the flag before it waits again.
-        self.served.wake.notify_one();
+/// A live thread of a [`ServiceThreads`], counted out when dropped.
+struct Live(Arc<Served>);
+
+impl Drop for Live {
+    fn drop(&mut self) {
+        self.0.live.fetch_sub(1, Ordering::AcqRel);
     }
 }
 
@@ -333,7 +352,6 @@ fn serve_turns<R, F: Future<Output = R>>(served: &Served, receive: &impl Fn() ->
             tracing::error!("a service request was not answered: its handler panicked (see above)");
         }
     }
-    served.live.fetch_sub(1, Ordering::AcqRel);
 }
 
 #[cfg(test)]
@@ -510,6 +528,7 @@ mod tests {
             },
         )
         .expect("threads start");
+        assert_eq!(service.threads(), 3, "one thread more than places");
         requests.send(1).expect("open");
         requests.send(2).expect("open");
         // Both places taken before the third request comes.
@@ -566,12 +585,15 @@ mod tests {
         .expect("threads start");
         requests.send(1).expect("open");
         taken.recv_timeout(Duration::from_secs(5)).expect("request 1 is taken");
-        // The other thread now waits for a request; the first holds request 1.
-        assert_eq!(
-            service.shut_down(Duration::from_millis(100)).await,
-            1,
-            "request 1 is under way"
-        );
+        // The other thread now waits for a request; the first holds request 1. Stopped, the
+        // waiting one ends; the other stays until it has answered.
+        service.stop();
+        let deadline = std::time::Instant::now() + Duration::from_secs(5);
+        while service.threads() > 1 && std::time::Instant::now() < deadline {
+            tokio::time::sleep(Duration::from_millis(1)).await;
+        }
+        assert_eq!(service.threads(), 1, "the waiting thread ended, request 1 is under way");
+        assert_eq!(service.shut_down(Duration::from_millis(20)).await, 1, "still under way");
         requests.send(2).expect("open");
         release_tx.send(()).expect("the job waits");
         assert_eq!(
@@ -595,8 +617,12 @@ mod tests {
             "test_service",
             1,
             receive(&rx),
-            move |request: Option<u32>, _: &Places| match request {
-                Some(0) => panic!("a failing handler"),
+            move |request: Option<u32>, places: &Places| match request {
+                Some(0) => {
+                    // It panics holding a place: the place comes back.
+                    let _place = places.take();
+                    panic!("a failing handler")
+                }
                 Some(request) => {
                     let _ = answers_tx.send(request);
                 }
@@ -617,5 +643,6 @@ mod tests {
             0,
             "both threads were alive"
         );
+        assert_eq!(service.places().taken(), 0, "the panicking handler's place came back");
     }
 }

@@ -351,6 +351,9 @@ async fn start(node: &mut RosNode, out: &Outputs, config: PlannerConfig) -> anyh
         (&scan_sub, &tf_sub),
     )
     .await;
+    // No request is taken once the loop has ended (the odometry and the clock a check reads no
+    // longer move); the checks under way are waited for below.
+    check_service.stop();
     // A goal under way (a pre-check included: it stopped a robot a goal before it moved) ends,
     // and its zero command, waited for, goes out before anything that may take time; then the
     // four servers close at once (each waits up to 2 s for its results).
@@ -373,7 +376,7 @@ async fn start(node: &mut RosNode, out: &Outputs, config: PlannerConfig) -> anyh
     // the participant (a check takes at most about 0.6 s).
     let left = check_service.shut_down(Duration::from_secs(1)).await;
     if left > 0 {
-        warn!("{CHECK_ROUTE}: {left} route check(s) still under way at shutdown may answer after the node has left");
+        warn!("{CHECK_ROUTE}: {left} thread(s) still answering at shutdown may answer after the node has left");
     }
     lifecycle.close().await;
     let down = EndCause::Shutdown;

@@ -13,9 +13,23 @@ use mobil_ros::tf::GoalTf;
 use mobil_ros::time::stamp_from_nanos;
 
 /// The goal frames and their transforms, shared by the event loop (goals) and the check
-/// threads (each request placed through tf as a goal is).
+/// threads (each request placed through tf as a goal is). The time a placement is made at is
+/// read under the lock: the tree takes a time older than the last it saw for ROS time going
+/// back (and clears its history), so the threads must hand it their times in order.
 #[derive(Clone)]
 pub(crate) struct SharedTf(Arc<Mutex<GoalTf>>);
+
+/// A frame placed through tf at a time ([`SharedTf::place`]).
+pub(crate) struct Placement {
+    /// The frame (the header's, or the odometry frame for none).
+    pub(crate) frame: String,
+    /// Whether it is the odometry frame.
+    pub(crate) is_odom: bool,
+    /// ROS time (ns) it was placed at.
+    pub(crate) now: i64,
+    /// The odometry frame's pose in it, or why there is none (for a TF_ERROR).
+    pub(crate) odom_in: Result<Pose2, String>,
+}
 
 impl SharedTf {
     pub(crate) fn new(tf: GoalTf) -> Self {
@@ -36,9 +50,26 @@ impl SharedTf {
         self.lock().frames().is_odom(frame)
     }
 
-    /// [`GoalTf::accept`].
-    pub(crate) fn accept(&self, goal_frame: &str, now: i64) -> Result<Pose2, String> {
-        self.lock().accept(goal_frame, now)
+    /// [`GoalTf::accept`] at the ROS time `now()` reads, read under the lock.
+    pub(crate) fn accept(&self, goal_frame: &str, now: impl FnOnce() -> i64) -> Result<Pose2, String> {
+        let mut tf = self.lock();
+        tf.accept(goal_frame, now())
+    }
+
+    /// The frame a header names, placed ([`GoalTf::accept`]) at the ROS time `now()` reads,
+    /// all under one lock.
+    pub(crate) fn place(&self, frame_id: &str, now: impl FnOnce() -> i64) -> Placement {
+        let mut tf = self.lock();
+        let frame = tf.frame_of(frame_id);
+        let is_odom = tf.frames().is_odom(&frame);
+        let now = now();
+        let odom_in = tf.accept(&frame, now);
+        Placement {
+            frame,
+            is_odom,
+            now,
+            odom_in,
+        }
     }
 
     /// [`GoalTf::odom_in`].
@@ -63,23 +94,23 @@ pub(crate) struct CheckInputs {
     pub(crate) odom_timeout: Duration,
     /// The latest odometry pose; `None` while the last sample was refused.
     pub(crate) odom: Option<Latest<Pose2>>,
+    /// The node's clock. Under `use_sim_time` it is the latest `/clock` the event loop has read
+    /// (at every tick and event), so a check's time may lag the simulation by up to a tick.
     pub(crate) clock: NodeClock,
 }
 
 impl CheckInputs {
     /// The inputs of a node with `config`, before any odometry.
     pub(crate) fn new(config: &PlannerConfig, chassis: ChassisParams, world: Arc<World>, clock: NodeClock) -> Self {
-        let mut inputs = CheckInputs {
+        CheckInputs {
             world,
             chassis,
             config: config.route_check(),
-            step: 0.0,
-            odom_timeout: Duration::ZERO,
+            step: config.follow.check_length,
+            odom_timeout: config.timeouts.odom_timeout(),
             odom: Some(Latest::new()),
             clock,
-        };
-        inputs.configure(config, chassis);
-        inputs
+        }
     }
 
     /// New parameters.
@@ -102,7 +133,11 @@ impl CheckView {
 
     /// Changes what the checks read (new parameters, a new odometry sample).
     pub(crate) fn update(&self, change: impl FnOnce(&mut CheckInputs)) {
-        change(&mut self.0.lock().unwrap_or_else(std::sync::PoisonError::into_inner));
+        change(&mut self.lock());
+    }
+
+    fn lock(&self) -> std::sync::MutexGuard<'_, CheckInputs> {
+        self.0.lock().unwrap_or_else(std::sync::PoisonError::into_inner)
     }
 }
 
@@ -140,29 +175,38 @@ impl CheckService {
             async move { server.async_receive_request().await }
         };
         let serve = move |request: Result<(RmwRequestId, CheckRouteRequest), _>, places: &Places| {
-            let warn = |what: &str| {
+            let warn = |key: &'static str, what: std::fmt::Arguments<'_>| {
                 let mut throttle = throttle.lock().unwrap_or_else(std::sync::PoisonError::into_inner);
-                warn_throttled!(throttle, "service", "{CHECK_ROUTE}: {what}");
+                warn_throttled!(throttle, key, "{CHECK_ROUTE}: {what}");
             };
             let (id, req) = match request {
                 Ok(request) => request,
-                Err(e) => return warn(&format!("request dropped: {e:?}")),
+                Err(e) => {
+                    warn("request", format_args!("request dropped: {e:?}"));
+                    // A reader that keeps failing must not spin the threads.
+                    return std::thread::sleep(Duration::from_millis(10));
+                }
             };
-            let reply = match prepare(&inputs.0, &tf, &req) {
-                Err(refusal) => refusal,
-                Ok(prepared) => match places.take() {
-                    Ok(place) => {
-                        let reply = compute(&prepared);
-                        drop(place);
-                        reply
-                    }
-                    Err(running) => refused_reply(format!(
-                        "BUSY: {running} route checks are already being computed; ask again"
-                    )),
-                },
-            };
+            // A defect (a panic) in the preparation or the check is still answered.
+            let answered =
+                std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| match prepare(&inputs, &tf, &req) {
+                    Err(refusal) => refusal,
+                    Ok(prepared) => match places.take() {
+                        Ok(place) => {
+                            let reply = compute(&prepared);
+                            drop(place);
+                            reply
+                        }
+                        Err(running) => refused_reply(format!(
+                            "BUSY: {running} route checks are already being computed; ask again"
+                        )),
+                    },
+                }));
+            let reply = answered.unwrap_or_else(|_| {
+                refused_reply("INTERNAL_ERROR: the route check failed (see the node's log)".to_owned())
+            });
             if let Err(e) = server.send_response(id, reply) {
-                warn(&format!("cannot send the reply: {e:?}"));
+                warn("reply", format_args!("cannot send the reply: {e:?}"));
             }
         };
         let threads = ServiceThreads::start("check_route", places, receive, serve)
@@ -170,8 +214,13 @@ impl CheckService {
         Ok(CheckService { threads })
     }
 
+    /// Takes no more requests (those under way are still answered).
+    pub(crate) fn stop(&self) {
+        self.threads.stop();
+    }
+
     /// Takes no more requests and waits, at most `limit`, for the checks under way to answer;
-    /// the threads still busy then, or 0.
+    /// the threads not ended then, or 0.
     pub(crate) async fn shut_down(&self, limit: Duration) -> usize {
         self.threads.shut_down(limit).await
     }
@@ -179,21 +228,19 @@ impl CheckService {
 
 /// The start and route of a request, in the route's frame (placed through tf; the reply is in
 /// it too), with what to check them with; or the reply refusing it.
-fn prepare(
-    inputs: &Mutex<CheckInputs>,
-    tf: &SharedTf,
-    req: &CheckRouteRequest,
-) -> Result<Prepared, CheckRouteResponse> {
+fn prepare(inputs: &CheckView, tf: &SharedTf, req: &CheckRouteRequest) -> Result<Prepared, CheckRouteResponse> {
     let (world, chassis, config, step, odom, clock) = {
-        let i = inputs.lock().unwrap_or_else(std::sync::PoisonError::into_inner);
+        let i = inputs.lock();
         let odom = i.odom.as_ref().and_then(|o| o.get(i.odom_timeout).copied());
         (Arc::clone(&i.world), i.chassis, i.config, i.step, odom, i.clock.clone())
     };
-    let now = clock.now_nanos();
-    let frame = tf.frame_of(&req.route.header.frame_id);
-    let odom_in = tf
-        .accept(&frame, now)
-        .map_err(|why| refused_reply(Action::Follow.tf_error(why).reason()))?;
+    let Placement {
+        frame,
+        is_odom,
+        now,
+        odom_in,
+    } = tf.place(&req.route.header.frame_id, || clock.now_nanos());
+    let odom_in = odom_in.map_err(|why| refused_reply(Action::Follow.tf_error(why).reason()))?;
     let start = if req.use_start {
         pose_in_frame("start", &frame, &req.start, &frame)
             .map_err(|e| refused_reply(Action::Follow.invalid_goal(&e).reason()))?
@@ -208,10 +255,7 @@ fn prepare(
     };
     let route = route_from_path(&req.route, &frame, Some(start.position()), ROUTE_LIMITS)
         .map_err(|e| refused_reply(Action::Follow.invalid_goal(&e).reason()))?;
-    let world = match tf.is_odom(&frame) {
-        true => world,
-        false => Arc::new(world.moved(&odom_in)),
-    };
+    let world = world_seen(world, is_odom, &odom_in);
     Ok(Prepared {
         start,
         route,
@@ -222,6 +266,15 @@ fn prepare(
         step,
         stamp: stamp_from_nanos(now),
     })
+}
+
+/// The pre-check's world (given in the odometry frame) seen from a route's frame, through the
+/// odometry frame's pose `odom_in` in it.
+pub(crate) fn world_seen(world: Arc<World>, is_odom: bool, odom_in: &Pose2) -> Arc<World> {
+    match is_odom {
+        true => world,
+        false => Arc::new(world.moved(odom_in)),
+    }
 }
 
 /// The check of a prepared request and its reply. A check that panics (a defect) is still

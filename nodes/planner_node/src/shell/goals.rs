@@ -40,7 +40,7 @@ impl Shell {
     /// refusal (TF_ERROR with the action's code) when the frame does not reach odometry
     /// through a fresh transform.
     pub(crate) fn goal_frame(&mut self, node: &RosNode, frame: &str, action: Action) -> Result<Placed, Outcome> {
-        match self.tf.accept(frame, node.now_nanos()) {
+        match self.tf.accept(frame, || node.now_nanos()) {
             Ok(odom_in) => Ok(Placed {
                 frame: frame.to_owned(),
                 odom_in,
@@ -280,7 +280,7 @@ impl Shell {
         };
         let odom_in = match self.tf.is_odom(&frame) {
             true => Pose2::identity(),
-            false => match self.tf.accept(&frame, io.node.now_nanos()) {
+            false => match self.tf.accept(&frame, || io.node.now_nanos()) {
                 Ok(t) => t,
                 Err(why) => return self.end_goal(io, EndCause::Tf(why)),
             },

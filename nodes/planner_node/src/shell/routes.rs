@@ -90,10 +90,7 @@ impl Shell {
 
     /// The pre-check's world (given in the odometry frame) seen from a goal's frame.
     pub(crate) fn world_in(&self, placed: &Placed) -> Arc<World> {
-        match self.tf.is_odom(&placed.frame) {
-            true => self.world.clone(),
-            false => Arc::new(self.world.moved(&placed.odom_in)),
-        }
+        super::check::world_seen(Arc::clone(&self.world), self.tf.is_odom(&placed.frame), &placed.odom_in)
     }
 
     /// VFO's obstacle map (kept in the odometry frame) seen from a goal's frame, through the
