@@ -30,7 +30,7 @@ use ros2_client::{
     ServiceMapping, Subscription,
 };
 use std::fmt::Write as _;
-use std::sync::atomic::{AtomicI64, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicI64, Ordering};
 use std::sync::{Arc, Mutex, PoisonError};
 use std::time::Duration;
 use tokio::sync::mpsc;
@@ -207,16 +207,20 @@ pub struct RosNode {
     clock: Option<Subscription<Clock>>,
     /// Latest `/clock` (ns), shared with the node's [`NodeClock`]s.
     sim_clock: Arc<AtomicI64>,
+    /// `use_sim_time` as [`RosNode::now_nanos`] last read it, shared with the [`NodeClock`]s.
+    sim_on: Arc<AtomicBool>,
     /// The undeclared parameters the node takes ([`NodeDecl::extra`]).
     extra: Vec<(String, ParameterValue)>,
 }
 
 /// The node's clock for a part of it that stamps messages away from the node itself (a
-/// command publisher): the system clock, or under `use_sim_time` the latest `/clock` the node
-/// has read ([`RosNode::now_nanos`], which every node calls at least once per tick).
+/// command publisher, a service's threads): the system clock, or under `use_sim_time` the
+/// latest `/clock` the node has read ([`RosNode::now_nanos`], which every node calls at least
+/// once per tick). It follows `use_sim_time` as `now_nanos` last read it.
 #[derive(Debug, Clone)]
 pub struct NodeClock {
-    sim: Option<Arc<AtomicI64>>,
+    /// The latest `/clock` (ns) and whether the node is on it.
+    sim: Option<(Arc<AtomicI64>, Arc<AtomicBool>)>,
 }
 
 impl NodeClock {
@@ -228,8 +232,8 @@ impl NodeClock {
     /// Nanoseconds now.
     pub fn now_nanos(&self) -> i64 {
         match &self.sim {
-            Some(sim) => sim.load(Ordering::Relaxed),
-            None => std::time::SystemTime::now()
+            Some((sim, on)) if on.load(Ordering::Acquire) => sim.load(Ordering::Acquire),
+            _ => std::time::SystemTime::now()
                 .duration_since(std::time::UNIX_EPOCH)
                 .map_or(0, |d| i64::try_from(d.as_nanos()).unwrap_or(i64::MAX)),
         }
@@ -359,6 +363,7 @@ impl RosNode {
             spinner: Some(handle),
             clock: None,
             sim_clock: Arc::new(AtomicI64::new(0)),
+            sim_on: Arc::new(AtomicBool::new(false)),
             extra,
         };
         ros_node.clock = Some(ros_node.subscription::<Clock>("/clock", &crate::qos::sensor_data())?);
@@ -448,19 +453,19 @@ impl RosNode {
     /// (ros2-client's own sim time subscribes to it as `builtin_interfaces/Time`, which Fast DDS
     /// and Cyclone DDS publishers do not match). Best effort, as rclcpp's clock QoS.
     pub fn now_nanos(&self) -> i64 {
-        match self.node.get_parameter("use_sim_time") {
-            Some(ParameterValue::Boolean(true)) => {
-                if let Some(clock) = &self.clock {
-                    while let Ok(Some((c, _))) = clock.take() {
-                        if let Some(nanos) = crate::time::nanos_from_stamp(&c.clock) {
-                            self.sim_clock.store(nanos, Ordering::Relaxed);
-                        }
-                    }
-                }
-                self.sim_clock.load(Ordering::Relaxed)
-            }
-            _ => self.node.time_now_not_simulated().to_nanos(),
+        let sim = self.uses_sim_time();
+        self.sim_on.store(sim, Ordering::Release);
+        if !sim {
+            return self.node.time_now_not_simulated().to_nanos();
         }
+        if let Some(clock) = &self.clock {
+            while let Ok(Some((c, _))) = clock.take() {
+                if let Some(nanos) = crate::time::nanos_from_stamp(&c.clock) {
+                    self.sim_clock.store(nanos, Ordering::Release);
+                }
+            }
+        }
+        self.sim_clock.load(Ordering::Acquire)
     }
 
     /// Whether the node's clock is `/clock` (`use_sim_time`): a clock that can stop or go back,
@@ -480,8 +485,9 @@ impl RosNode {
 
     /// A handle on the node's clock (see [`NodeClock`]).
     pub fn clock(&self) -> NodeClock {
+        self.sim_on.store(self.uses_sim_time(), Ordering::Release);
         NodeClock {
-            sim: self.uses_sim_time().then(|| self.sim_clock.clone()),
+            sim: Some((Arc::clone(&self.sim_clock), Arc::clone(&self.sim_on))),
         }
     }
 
@@ -696,5 +702,26 @@ pub fn respond<Q: ros2_client::Message + 'static, P: ros2_client::Message + 'sta
 ) {
     if let Err(e) = server.send_response(id, reply) {
         crate::warn_throttled!(throttle, "service-reply", "{service}: cannot send the reply: {e:?}");
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_clock_handle_follows_use_sim_time_as_the_node_last_read_it() {
+        let (sim, on) = (Arc::new(AtomicI64::new(42)), Arc::new(AtomicBool::new(true)));
+        let clock = NodeClock {
+            sim: Some((Arc::clone(&sim), Arc::clone(&on))),
+        };
+        assert_eq!(clock.now_nanos(), 42, "the latest /clock");
+        on.store(false, Ordering::Release);
+        // The system clock: after 2020-01-01 (1.577e18 ns since the epoch).
+        assert!(clock.now_nanos() > 1_577_836_800_000_000_000);
+        on.store(true, Ordering::Release);
+        sim.store(43, Ordering::Release);
+        assert_eq!(clock.now_nanos(), 43);
+        assert!(NodeClock::system().now_nanos() > 1_577_836_800_000_000_000);
     }
 }

@@ -273,9 +273,10 @@ impl ServiceThreads {
             let live = Live(Arc::clone(&served));
             let work = Arc::clone(&work);
             let spawned = std::thread::Builder::new().name(name.to_owned()).spawn(move || {
+                // Locals drop in reverse order, unwinding too: `work` before `live`.
                 let live = live;
+                let work = work;
                 serve_turns(&live.0, &work.0, &work.1);
-                drop(work);
             });
             spawned?; // on failure `threads` drops: the ones started stop
         }
@@ -322,6 +323,9 @@ struct Live(Arc<Served>);
 
 impl Drop for Live {
     fn drop(&mut self) {
+        if std::thread::panicking() {
+            tracing::error!("a service thread ended with a panic (see above): one thread fewer takes requests");
+        }
         self.0.live.fetch_sub(1, Ordering::AcqRel);
     }
 }
@@ -638,11 +642,8 @@ mod tests {
             .collect();
         got.sort();
         assert_eq!(got, vec![1, 2, 3]);
-        assert_eq!(
-            service.shut_down(Duration::from_secs(5)).await,
-            0,
-            "both threads were alive"
-        );
+        assert_eq!(service.threads(), 2, "both threads still serve");
+        assert_eq!(service.shut_down(Duration::from_secs(5)).await, 0);
         assert_eq!(service.places().taken(), 0, "the panicking handler's place came back");
     }
 }

@@ -162,8 +162,8 @@ struct PreCheckDone {
 /// Most route checks computed at once, goal pre-checks and `planner/check_route` requests
 /// together (each may take up to 0.6 s of one core). The goal's pre-check keeps one of them
 /// (its [`OffLoop`] runs one at a time, a newer goal's waiting until the superseded check has
-/// stopped); service requests beyond the rest are answered BUSY at once (by the service's
-/// spare thread: [`shell::check::CheckService`]).
+/// stopped); service requests beyond the rest are answered BUSY at once (by whichever of the
+/// service's threads takes them: [`shell::check::CheckService`]).
 const MAX_CHECKS: usize = 4;
 
 /// Odometry poses kept to place scans by their stamps: 2 s at 50 Hz, far beyond
@@ -305,8 +305,6 @@ async fn start(node: &mut RosNode, out: &Outputs, config: PlannerConfig) -> anyh
     );
     let world = Arc::new(world);
     let check_view = CheckView::new(CheckInputs::new(&config, chassis, Arc::clone(&world), node.clock()));
-    // The goal's pre-check keeps one of the MAX_CHECKS.
-    let check_service = CheckService::start(Arc::clone(&check), MAX_CHECKS - 1, check_view.clone(), tf.clone())?;
     let mut shell = Shell {
         diagnostics: MotionDiagnostics::create(node, chassis.model().as_str())?,
         tf,
@@ -338,6 +336,13 @@ async fn start(node: &mut RosNode, out: &Outputs, config: PlannerConfig) -> anyh
         goal: OffLoop::new(),
         vfo: OffLoop::new(),
     };
+    // The goal's pre-check keeps one of the MAX_CHECKS.
+    let check_service = CheckService::start(
+        Arc::clone(&check),
+        MAX_CHECKS - 1,
+        shell.check.clone(),
+        shell.tf.clone(),
+    )?;
     let mut sink = CmdVel::new(&out.cmd);
     let outcome = event_loop(
         node,

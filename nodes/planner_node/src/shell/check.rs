@@ -37,7 +37,13 @@ impl SharedTf {
     }
 
     fn lock(&self) -> std::sync::MutexGuard<'_, GoalTf> {
-        self.0.lock().unwrap_or_else(std::sync::PoisonError::into_inner)
+        self.0.lock().unwrap_or_else(|poisoned| {
+            // A panic while the tree was being updated (a defect, in the log above): its
+            // history may be half-updated; it goes on, and the next transforms mend it.
+            tracing::error!("the goal transforms' lock was poisoned by a panic: carrying on with them");
+            self.0.clear_poison();
+            poisoned.into_inner()
+        })
     }
 
     /// [`GoalTf::frame_of`].
@@ -137,7 +143,10 @@ impl CheckView {
     }
 
     fn lock(&self) -> std::sync::MutexGuard<'_, CheckInputs> {
-        self.0.lock().unwrap_or_else(std::sync::PoisonError::into_inner)
+        self.0.lock().unwrap_or_else(|poisoned| {
+            self.0.clear_poison();
+            poisoned.into_inner()
+        })
     }
 }
 
@@ -154,6 +163,9 @@ struct Prepared {
     stamp: mobil_msgs::builtin_interfaces::msg::Time,
 }
 
+/// Receive errors in a row after which a thread waits 10 ms after each.
+const FAILING_IN_A_ROW: usize = 8;
+
 /// `planner/check_route` served.
 pub(crate) struct CheckService {
     threads: ServiceThreads,
@@ -169,6 +181,8 @@ impl CheckService {
         tf: SharedTf,
     ) -> anyhow::Result<Self> {
         let throttle = Mutex::new(LogThrottle::new(Duration::from_secs(2)));
+        // Receive errors in a row: a reader that keeps failing must not spin the threads.
+        let failing = std::sync::atomic::AtomicUsize::new(0);
         let receiving = Arc::clone(&server);
         let receive = move || {
             let server = Arc::clone(&receiving);
@@ -180,11 +194,18 @@ impl CheckService {
                 warn_throttled!(throttle, key, "{CHECK_ROUTE}: {what}");
             };
             let (id, req) = match request {
-                Ok(request) => request,
+                Ok(request) => {
+                    failing.store(0, std::sync::atomic::Ordering::Relaxed);
+                    request
+                }
                 Err(e) => {
                     warn("request", format_args!("request dropped: {e:?}"));
-                    // A reader that keeps failing must not spin the threads.
-                    return std::thread::sleep(Duration::from_millis(10));
+                    // One malformed request is just dropped; a reader failing again and again
+                    // is given time.
+                    if failing.fetch_add(1, std::sync::atomic::Ordering::Relaxed) >= FAILING_IN_A_ROW {
+                        std::thread::sleep(Duration::from_millis(10));
+                    }
+                    return;
                 }
             };
             // A defect (a panic) in the preparation or the check is still answered.
