@@ -58,14 +58,17 @@ def main() -> int:
     rclpy.init(args=sys.argv)
     node = FakeNode()
     try:
-        rclpy.spin(node)
+        try:
+            rclpy.spin(node)
+        except RCLError:
+            # SIGINT shut the context down between two waits: the executor's next wait set
+            # fails on the dead context (a CI run exited 1 here); the node is stopping, not
+            # failing. (Inside the outer try: the KeyboardInterrupt SIGINT also queued may
+            # surface here.)
+            if rclpy.ok():
+                raise
     except (KeyboardInterrupt, ExternalShutdownException):
         pass
-    except RCLError:
-        # SIGINT shut the context down between two waits: the executor's next wait set fails
-        # on the dead context (a CI run exited 1 here); the node is stopping, not failing.
-        if rclpy.ok():
-            raise
     print("fake_talker: shutting down", flush=True)
     node.destroy_node()
     rclpy.try_shutdown()

@@ -213,26 +213,40 @@ pub struct RosNode {
     extra: Vec<(String, ParameterValue)>,
 }
 
-/// The node's clock for a part of it that stamps messages away from the node itself (a
+/// The node's clock for a part of it that reads the time away from the node itself (a
 /// command publisher, a service's threads): the system clock, or under `use_sim_time` the
 /// latest `/clock` the node has read ([`RosNode::now_nanos`], which every node calls at least
-/// once per tick). It follows `use_sim_time` as `now_nanos` last read it.
+/// once per tick). [`RosNode::clock`] keeps the choice the node had when it was made (a goal's
+/// elapsed time measured on it stays on one clock); [`RosNode::following_clock`] follows
+/// `use_sim_time` as `now_nanos` last read it (for times handed to the same tf tree as the
+/// node's own).
 #[derive(Debug, Clone)]
 pub struct NodeClock {
-    /// The latest `/clock` (ns) and whether the node is on it.
-    sim: Option<(Arc<AtomicI64>, Arc<AtomicBool>)>,
+    source: ClockSource,
+}
+
+#[derive(Debug, Clone)]
+enum ClockSource {
+    System,
+    /// The latest `/clock` (ns).
+    Sim(Arc<AtomicI64>),
+    /// The latest `/clock` (ns) while the flag (the node's `use_sim_time`) is set.
+    Following(Arc<AtomicI64>, Arc<AtomicBool>),
 }
 
 impl NodeClock {
     /// The system clock (a node without `use_sim_time`, or a test).
     pub fn system() -> Self {
-        NodeClock { sim: None }
+        NodeClock {
+            source: ClockSource::System,
+        }
     }
 
     /// Nanoseconds now.
     pub fn now_nanos(&self) -> i64 {
-        match &self.sim {
-            Some((sim, on)) if on.load(Ordering::Acquire) => sim.load(Ordering::Acquire),
+        match &self.source {
+            ClockSource::Sim(sim) => sim.load(Ordering::Acquire),
+            ClockSource::Following(sim, on) if on.load(Ordering::Acquire) => sim.load(Ordering::Acquire),
             _ => std::time::SystemTime::now()
                 .duration_since(std::time::UNIX_EPOCH)
                 .map_or(0, |d| i64::try_from(d.as_nanos()).unwrap_or(i64::MAX)),
@@ -453,9 +467,8 @@ impl RosNode {
     /// (ros2-client's own sim time subscribes to it as `builtin_interfaces/Time`, which Fast DDS
     /// and Cyclone DDS publishers do not match). Best effort, as rclcpp's clock QoS.
     pub fn now_nanos(&self) -> i64 {
-        let sim = self.uses_sim_time();
-        self.sim_on.store(sim, Ordering::Release);
-        if !sim {
+        if !self.uses_sim_time() {
+            self.sim_on.store(false, Ordering::Release);
             return self.node.time_now_not_simulated().to_nanos();
         }
         if let Some(clock) = &self.clock {
@@ -465,6 +478,8 @@ impl RosNode {
                 }
             }
         }
+        // After the backlog: a following clock switched to `/clock` reads its latest value.
+        self.sim_on.store(true, Ordering::Release);
         self.sim_clock.load(Ordering::Acquire)
     }
 
@@ -485,9 +500,19 @@ impl RosNode {
 
     /// A handle on the node's clock (see [`NodeClock`]).
     pub fn clock(&self) -> NodeClock {
+        NodeClock {
+            source: match self.uses_sim_time() {
+                true => ClockSource::Sim(Arc::clone(&self.sim_clock)),
+                false => ClockSource::System,
+            },
+        }
+    }
+
+    /// A handle on the node's clock that follows `use_sim_time` (see [`NodeClock`]).
+    pub fn following_clock(&self) -> NodeClock {
         self.sim_on.store(self.uses_sim_time(), Ordering::Release);
         NodeClock {
-            sim: Some((Arc::clone(&self.sim_clock), Arc::clone(&self.sim_on))),
+            source: ClockSource::Following(Arc::clone(&self.sim_clock), Arc::clone(&self.sim_on)),
         }
     }
 
@@ -709,19 +734,29 @@ pub fn respond<Q: ros2_client::Message + 'static, P: ros2_client::Message + 'sta
 mod tests {
     use super::*;
 
+    /// After 2020-01-01 (1.577e18 ns since the epoch): the system clock.
+    const SYSTEM: i64 = 1_577_836_800_000_000_000;
+
     #[test]
-    fn a_clock_handle_follows_use_sim_time_as_the_node_last_read_it() {
+    fn a_following_clock_reads_the_clock_its_flag_names_and_a_fixed_one_keeps_its_choice() {
         let (sim, on) = (Arc::new(AtomicI64::new(42)), Arc::new(AtomicBool::new(true)));
-        let clock = NodeClock {
-            sim: Some((Arc::clone(&sim), Arc::clone(&on))),
+        let following = NodeClock {
+            source: ClockSource::Following(Arc::clone(&sim), Arc::clone(&on)),
         };
-        assert_eq!(clock.now_nanos(), 42, "the latest /clock");
+        let fixed = NodeClock {
+            source: ClockSource::Sim(Arc::clone(&sim)),
+        };
+        assert_eq!(
+            (following.now_nanos(), fixed.now_nanos()),
+            (42, 42),
+            "the latest /clock"
+        );
         on.store(false, Ordering::Release);
-        // The system clock: after 2020-01-01 (1.577e18 ns since the epoch).
-        assert!(clock.now_nanos() > 1_577_836_800_000_000_000);
+        assert!(following.now_nanos() > SYSTEM);
+        assert_eq!(fixed.now_nanos(), 42, "a fixed handle stays on /clock");
         on.store(true, Ordering::Release);
         sim.store(43, Ordering::Release);
-        assert_eq!(clock.now_nanos(), 43);
-        assert!(NodeClock::system().now_nanos() > 1_577_836_800_000_000_000);
+        assert_eq!(following.now_nanos(), 43);
+        assert!(NodeClock::system().now_nanos() > SYSTEM);
     }
 }

@@ -85,6 +85,24 @@ async fn dt_follows_the_simulated_clock_and_freshness_the_steady_clock() {
     stop_clock.store(true, std::sync::atomic::Ordering::Relaxed);
     let _ = clock_thread.join();
 
+    // The handles: both read the latest /clock the node has read; once `use_sim_time` is set
+    // false at run time and the node reads its time, the following one reads the system clock
+    // and the fixed one stays on /clock.
+    let mut node = node;
+    let (fixed, following) = (node.clock(), node.following_clock());
+    let now = node.now_nanos();
+    assert!(now < 1_577_836_800_000_000_000, "{now} is simulated time");
+    assert_eq!((fixed.now_nanos(), following.now_nanos()), (now, now));
+    node.inner()
+        .set_parameter("use_sim_time", ros2_client::ParameterValue::Boolean(false))
+        .expect("use_sim_time can be set");
+    assert!(node.now_nanos() > 1_577_836_800_000_000_000, "the system clock");
+    assert!(
+        following.now_nanos() > 1_577_836_800_000_000_000,
+        "the following handle too"
+    );
+    assert_eq!(fixed.now_nanos(), now, "the fixed handle keeps /clock");
+
     // ROS time advanced about 4× the wall time (±20 %: a 10 ms clock period and a loaded
     // machine blur each step).
     let ratio = ros_sum / wall;

@@ -304,7 +304,12 @@ async fn start(node: &mut RosNode, out: &Outputs, config: PlannerConfig) -> anyh
         config.frames.odom_frame
     );
     let world = Arc::new(world);
-    let check_view = CheckView::new(CheckInputs::new(&config, chassis, Arc::clone(&world), node.clock()));
+    let check_view = CheckView::new(CheckInputs::new(
+        &config,
+        chassis,
+        Arc::clone(&world),
+        node.following_clock(),
+    ));
     let mut shell = Shell {
         diagnostics: MotionDiagnostics::create(node, chassis.model().as_str())?,
         tf,

@@ -100,8 +100,9 @@ pub(crate) struct CheckInputs {
     pub(crate) odom_timeout: Duration,
     /// The latest odometry pose; `None` while the last sample was refused.
     pub(crate) odom: Option<Latest<Pose2>>,
-    /// The node's clock. Under `use_sim_time` it is the latest `/clock` the event loop has read
-    /// (at every tick and event), so a check's time may lag the simulation by up to a tick.
+    /// The node's clock, following `use_sim_time` as the event loop does (the tf tree gets
+    /// both their times). Under `use_sim_time` it is the latest `/clock` the event loop has
+    /// read (at every tick and event), so a check's time may lag the simulation by a tick.
     pub(crate) clock: NodeClock,
 }
 
@@ -163,7 +164,7 @@ struct Prepared {
     stamp: mobil_msgs::builtin_interfaces::msg::Time,
 }
 
-/// Receive errors in a row after which a thread waits 10 ms after each.
+/// Receive errors in a row from which on a thread waits 10 ms after each.
 const FAILING_IN_A_ROW: usize = 8;
 
 /// `planner/check_route` served.
@@ -202,7 +203,7 @@ impl CheckService {
                     warn("request", format_args!("request dropped: {e:?}"));
                     // One malformed request is just dropped; a reader failing again and again
                     // is given time.
-                    if failing.fetch_add(1, std::sync::atomic::Ordering::Relaxed) >= FAILING_IN_A_ROW {
+                    if failing.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1 >= FAILING_IN_A_ROW {
                         std::thread::sleep(Duration::from_millis(10));
                     }
                     return;
