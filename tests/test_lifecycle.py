@@ -342,11 +342,15 @@ def test_managed_bringup_bond_deactivation_and_kill(start_scenario, start_node, 
                     truth.wait_for(lambda m: speed(m) < 1e-3, REPLY_TIMEOUT, start=n_truth)
                     assert math.hypot(truth.latest.pose.pose.position.x - start.pose.pose.position.x,
                                       truth.latest.pose.pose.position.y - start.pose.pose.position.y) < 1.0
-                # The bond broken: at most three active = false within 150 ms, then silence.
+                # The bond broken: at most three active = false in one burst, then silence. The
+                # node sends them 50 ms apart (the Rust test of nodes/lifecycle/src/bond.rs); here
+                # they are timed on arrival, with both cores busy: one came 154 ms after the
+                # second in a CI run, so the burst is bounded at 0.5 s; a node that went on
+                # sending (a beat every 0.1 s) fails the count and the silence after it.
                 time.sleep(1.0)
                 after = peer.messages(name, asked)
                 falses = [t for t, active, inst, *_ in after if not active and inst == instance]
-                assert 1 <= len(falses) <= 3 and falses[-1] - falses[0] <= 0.15, after
+                assert 1 <= len(falses) <= 3 and falses[-1] - falses[0] <= 0.5, after
                 assert all(t <= falses[-1] for t, *_ in after), "a message after the bond was broken"
                 # Goals refused while inactive; a new activation forms a new bond, never false.
                 assert not goal_answered(client, goal), f"{name} accepted a goal while inactive"
