@@ -114,10 +114,10 @@ if [ "$(cat "$stamp_msgs" 2>/dev/null)" != "$want_msgs" ]; then
   mkdir -p "$ROOT/target"
   PATH="$VENV/bin:$PATH" AMENT_PREFIX_PATH="$VENV" CMAKE_PREFIX_PATH="$VENV" \
     "$VENV/bin/cmake" -S "$ROOT/msgs/mobil_msgs" -B "$BUILD" -DPython3_EXECUTABLE="$VENV/bin/python" \
-      -DBUILD_TESTING=OFF -DMOBIL_MSGS_C_ONLY=ON -DCMAKE_INSTALL_PREFIX="$INSTALL" >"$ROOT/target/msgs-cmake.log" 2>&1 \
-    && PATH="$VENV/bin:$PATH" "$VENV/bin/cmake" --build "$BUILD" -j2 >>"$ROOT/target/msgs-cmake.log" 2>&1 \
-    && "$VENV/bin/cmake" --install "$BUILD" >>"$ROOT/target/msgs-cmake.log" 2>&1 \
-    || { echo "setup_env: mobil_msgs build failed, see target/msgs-cmake.log" >&2; tail -30 "$ROOT/target/msgs-cmake.log" >&2; exit 1; }
+      -DBUILD_TESTING=OFF -DMOBIL_MSGS_C_ONLY=ON -DCMAKE_INSTALL_PREFIX="$INSTALL" >"$ROOT/target/msgs-cmake-py$want_ver.log" 2>&1 \
+    && PATH="$VENV/bin:$PATH" "$VENV/bin/cmake" --build "$BUILD" -j2 >>"$ROOT/target/msgs-cmake-py$want_ver.log" 2>&1 \
+    && "$VENV/bin/cmake" --install "$BUILD" >>"$ROOT/target/msgs-cmake-py$want_ver.log" 2>&1 \
+    || { echo "setup_env: mobil_msgs build failed, see target/msgs-cmake-py$want_ver.log" >&2; tail -30 "$ROOT/target/msgs-cmake-py$want_ver.log" >&2; exit 1; }
   echo "$want_msgs" > "$stamp_msgs"
 fi
 
@@ -132,7 +132,7 @@ for nested in nav2_msgs bond tf2_msgs; do  # beside mobil_msgs in msgs/
   if [ "$(cat "$stamp_nested" 2>/dev/null)" != "$want_nested" ]; then
     echo "setup_env: building $nested Python type support (about 1 CPU-minute)" >&2
     rm -rf "$nested_build"
-    log="$ROOT/target/$nested-cmake.log"
+    log="$ROOT/target/$nested-cmake-py$want_ver.log"
     PATH="$VENV/bin:$PATH" AMENT_PREFIX_PATH="$VENV" CMAKE_PREFIX_PATH="$VENV" \
       "$VENV/bin/cmake" -S "$ROOT/msgs/$nested" -B "$nested_build" -DPython3_EXECUTABLE="$VENV/bin/python" \
         -DBUILD_TESTING=OFF -DMOBIL_MSGS_C_ONLY=ON -DCMAKE_INSTALL_PREFIX="$INSTALL" >"$log" 2>&1 \

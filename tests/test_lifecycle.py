@@ -343,10 +343,11 @@ def test_managed_bringup_bond_deactivation_and_kill(start_scenario, start_node, 
                     assert math.hypot(truth.latest.pose.pose.position.x - start.pose.pose.position.x,
                                       truth.latest.pose.pose.position.y - start.pose.pose.position.y) < 1.0
                 # The bond broken: at most three active = false in one burst, then silence. The
-                # node sends them 50 ms apart (the Rust test of nodes/lifecycle/src/bond.rs); here
-                # they are timed on arrival, with both cores busy: one came 154 ms after the
-                # second in a CI run, so the burst is bounded at 0.5 s; a node that went on
-                # sending (a beat every 0.1 s) fails the count and the silence after it.
+                # node schedules them 50 ms apart (the Rust test of nodes/lifecycle/src/bond.rs);
+                # here they are timed on arrival, after the node's event loop and DDS, with both
+                # cores busy: one came 154 ms after the second in a CI run, so the burst is
+                # bounded at 0.5 s. A node that went on sending falses fails the count; one that
+                # went on beating (every 0.1 s) fails the silence.
                 time.sleep(1.0)
                 after = peer.messages(name, asked)
                 falses = [t for t, active, inst, *_ in after if not active and inst == instance]
