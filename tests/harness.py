@@ -44,7 +44,7 @@ from rosutil import (  # noqa: F401  (re-exported for tests)
     qos_default, qos_latched, qos_sensor, set_message_fields, wait_for_node, wait_until)
 
 __all__ = [
-    "BIN_DIR", "CLEAN_EXIT_CODES", "NodeProcess", "NodeProcessError", "ROOT", "ROS2CLI",
+    "BIN_DIR", "CLEAN_EXIT_CODES", "MIN_REAL_TIME_FACTOR", "NodeProcess", "NodeProcessError", "ROOT", "ROS2CLI",
     "ServiceUnavailable", "SimClock", "TESTS_DIR", "TopicRecorder", "collect", "import_type",
     "launch_node", "launch_scenario", "make_qos", "message_to_yaml", "param_get", "param_list",
     "param_set", "publish_on_sim_time", "publish_until", "qos_default", "qos_latched",
@@ -420,6 +420,17 @@ def launch_scenario(params_file: Union[str, Path], *, real_time_factor: float,
     for exe in nodes:
         procs.append(launch(exe, "-p", "use_sim_time:=true", *node_args, params_file=params_file))
     return procs
+
+
+# The closed-loop scenarios ask sim_node for several times real time (each module's
+# REAL_TIME_FACTOR) and require this much of the factor reached: simulated time at least twice as
+# fast as real time, which is what keeps their wall time down. What the simulation reaches is the
+# CPU the machine leaves it (the nodes under test, the other pytest worker): 4.97-5.03x of 5x on
+# the 2-core machine of docs/performance.md, 3.3-4.0x of 4-5x on one 2-3 times slower. sim_node
+# does not make up a stall (clock_catch_up_s: it never runs ahead of its nodes), so a factor
+# short of the one asked is a slow machine, not a fault. What a simulation step costs is
+# nodes/sim's bench.
+MIN_REAL_TIME_FACTOR = 2.0
 
 
 class SimClock:

@@ -109,7 +109,7 @@ class Loop:
 
     def __init__(self, node: Any) -> None:
         from nav2_msgs.action import DockRobot, FollowWaypoints, NavigateToPose, UndockRobot
-        from rclpy.action import ActionClient
+        from action_client import ActionClient
         self.clients = {
             "navigate_to_pose": ActionClient(node, NavigateToPose, "navigate_to_pose"),
             "follow_waypoints": ActionClient(node, FollowWaypoints, "follow_waypoints"),

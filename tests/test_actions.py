@@ -13,12 +13,12 @@ import time
 
 import pytest
 
+from action_client import ActionClient
 from harness import subscribe, wait_until
 
 from action_msgs.msg import GoalStatus
 from geometry_msgs.msg import PoseStamped, Twist
 from nav_msgs.msg import Odometry
-from rclpy.action import ActionClient
 from sensor_msgs.msg import JointState
 
 from mobil_msgs.action import DriveDistance

@@ -21,6 +21,7 @@ import time
 
 import pytest
 
+from action_client import ActionClient
 from harness import make_qos, qos_latched, subscribe, wait_until
 from rosutil import wait_for_future
 
@@ -28,7 +29,6 @@ from action_msgs.msg import GoalStatus
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus
 from geometry_msgs.msg import PoseStamped, TransformStamped, Twist
 from nav_msgs.msg import Odometry
-from rclpy.action import ActionClient
 from tf2_msgs.msg import TFMessage
 
 from mobil_msgs.msg import NavStatus

@@ -24,6 +24,7 @@ from typing import Any
 
 import pytest
 
+from action_client import ActionClient
 from harness import (OdomFeed, OpenSpaceScan, make_qos, odom_at, qos_latched, qos_sensor,
                      stamped_pose as pose, subscribe, wait_until)
 
@@ -33,7 +34,6 @@ from visualization_msgs.msg import MarkerArray
 
 from mobil_msgs.msg import NavStatus
 from nav2_msgs.action import DockRobot, NavigateToPose
-from rclpy.action import ActionClient
 
 PARAMS = "params/omr3.yaml"
 REPLY_TIMEOUT = 10.0

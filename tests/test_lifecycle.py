@@ -18,6 +18,7 @@ from pathlib import Path
 
 import pytest
 
+from action_client import ActionClient
 from harness import subscribe, wait_until
 from rosutil import call_service, make_qos, wait_for_future
 
@@ -27,7 +28,6 @@ from lifecycle_msgs.msg import TransitionEvent
 from lifecycle_msgs.srv import ChangeState, GetAvailableStates, GetAvailableTransitions, GetState
 from nav2_msgs.action import DockRobot, NavigateToPose
 from nav_msgs.msg import Odometry
-from rclpy.action import ActionClient
 from rclpy.lifecycle import LifecycleNode
 
 from mobil_msgs.action import DriveDistance

@@ -39,13 +39,13 @@ from typing import Any, Optional
 import pytest
 import yaml
 
-from harness import ROOT, make_qos, param_get, publish_until, subscribe
+from harness import MIN_REAL_TIME_FACTOR, ROOT, make_qos, param_get, publish_until, subscribe
 
 from geometry_msgs.msg import PoseStamped
 from nav_msgs.msg import Odometry
 
 REAL_TIME_FACTOR = 5.0
-MIN_FACTOR = 4.0
+MIN_FACTOR = MIN_REAL_TIME_FACTOR
 # chassis_node's feedback watchdog (steady clock) at 2 s rather than 0.5 s: a loaded machine
 # stalls /clock for a fraction of a second now and then (test_scenario.py, module docstring).
 CHASSIS_ARGS = ("-p", "feedback_timeout_s:=2.0")

@@ -16,6 +16,7 @@ import threading
 
 import pytest
 
+from action_client import ActionClient
 from harness import make_qos, run_ros2cli, subscribe, wait_until
 from rosutil import wait_for_future
 
@@ -23,7 +24,6 @@ from action_msgs.msg import GoalStatus
 from geometry_msgs.msg import PoseStamped, Twist
 from nav2_msgs.action import FollowPath
 from nav_msgs.msg import Odometry, Path
-from rclpy.action import ActionClient
 
 REAL_TIME_FACTOR = 3.0
 CHASSIS_ARGS = ("-p", "feedback_timeout_s:=2.0")
