@@ -44,7 +44,8 @@ from rosutil import (  # noqa: F401  (re-exported for tests)
     qos_default, qos_latched, qos_sensor, set_message_fields, wait_for_node, wait_until)
 
 __all__ = [
-    "BIN_DIR", "CLEAN_EXIT_CODES", "MIN_REAL_TIME_FACTOR", "NodeProcess", "NodeProcessError", "ROOT", "ROS2CLI",
+    "BIN_DIR", "CLEAN_EXIT_CODES", "MIN_REAL_TIME_FACTOR", "NodeProcess", "NodeProcessError",
+    "ROOT", "ROS2CLI",
     "ServiceUnavailable", "SimClock", "TESTS_DIR", "TopicRecorder", "collect", "import_type",
     "launch_node", "launch_scenario", "make_qos", "message_to_yaml", "param_get", "param_list",
     "param_set", "publish_on_sim_time", "publish_until", "qos_default", "qos_latched",

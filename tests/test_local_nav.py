@@ -4,8 +4,8 @@ refusals (goal frame, NaN, a stale scan).
 
 The robot is OMR-III (params/omr3.yaml: noise-free encoders, so odometry and ground truth agree
 to well under a millimetre here). Driving runs under the simulated clock at 5× real time (at
-least 2× asserted: harness.MIN_REAL_TIME_FACTOR). Watchdogs run on the steady clock (the time rule), so chassis_node's feedback watchdog
-gets 2 s, as in test_scenario.py.
+least 2× asserted: harness.MIN_REAL_TIME_FACTOR). Watchdogs run on the steady clock (the time
+rule), so chassis_node's feedback watchdog gets 2 s, as in test_scenario.py.
 
 Invariants checked on cmd_vel: nothing before the first goal; every command within OMR-III's
 limits (speed ≤ v_max 0.5 m/s, |ω| ≤ omega_max 1.5 rad/s); exactly one zero command per goal
@@ -239,10 +239,10 @@ def send_until_answered(client: ActionClient, goal, nav, attempts: int = 4):
 
 
 def cancel_until_answered(handle, attempts: int = 4) -> list:
-    """Cancels until a cancel response arrives, each attempt 3 s: rclpy's ActionClient drops a
-    response that comes back before it has filed the request ("Ignoring unexpected cancel
-    response"), which a fast server on a loaded machine makes happen now and then. Returns
-    every response that arrived (requests still open get 0.5 s more)."""
+    """Cancels until a cancel response arrives, each attempt 3 s, in case one is lost (rclpy's
+    own client dropped a response that came back before it had filed the request, which a fast
+    server on a loaded machine made happen now and then; tests/action_client.py fixes that).
+    Returns every response that arrived (requests still open get 0.5 s more)."""
     futures = []
     for _ in range(attempts):
         futures.append(handle.cancel_goal_async())
@@ -260,8 +260,8 @@ def cancel_accepted(response, handle) -> bool:
 
 
 def result_of(handle, timeout: float = 30.0):
-    """The goal's result; the request is repeated every 5 s while none came, for the same
-    rclpy race as ``cancel_until_answered`` ("Ignoring unexpected result response")."""
+    """The goal's result; the request is repeated every 5 s while none came, as
+    ``cancel_until_answered`` repeats its request."""
     deadline = time.monotonic() + timeout
     futures = []  # every request stays watched: the server may answer any of them
     while time.monotonic() < deadline:

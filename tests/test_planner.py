@@ -119,8 +119,8 @@ def publish_until_taken(pub, planner, msg, timeout: float = REPLY_TIMEOUT) -> No
 
 
 def result_of(handle, timeout: float = 40.0):
-    """The goal's result; asked again every 5 s (rclpy drops a response to a request it has not
-    filed yet, see test_local_nav.py)."""
+    """The goal's result; asked again every 5 s in case a response is lost (see
+    test_local_nav.py)."""
     deadline = time.monotonic() + timeout
     futures = []
     while time.monotonic() < deadline:
@@ -139,8 +139,9 @@ def send_until_answered(client: ActionClient, goal, planner, feedback=None, atte
     """Sends ``goal`` until a goal response arrives, each attempt 3 s. A request the node never
     answered (its log says so: lost during discovery; the clients are made right after launch so
     that discovery is done long before use) is simply sent again. A request the node answered
-    is waited for 3 s more: rclpy drops a response that comes back before it filed the request
-    ("Ignoring unexpected goal response"), and then only a second goal gets a handle; that one
+    is waited for 3 s more: if its response is lost (rclpy's own client dropped one that came
+    back before it had filed the request; tests/action_client.py fixes that), only a second goal
+    gets a handle; that one
     pre-empts the first, which ran: it is appended to ``resent`` (the goals started are counted
     from the log) and ``before_resend`` runs first (an undock measures from where the first one
     left the robot)."""
@@ -160,8 +161,8 @@ def send_until_answered(client: ActionClient, goal, planner, feedback=None, atte
 
 
 def cancel_until_answered(handle, attempts: int = 4) -> list:
-    """Cancels until a cancel response arrives, each attempt 3 s (rclpy drops a response that
-    comes back before it filed the request; see test_local_nav.py)."""
+    """Cancels until a cancel response arrives, each attempt 3 s, in case one is lost (see
+    test_local_nav.py)."""
     futures = []
     for _ in range(attempts):
         futures.append(handle.cancel_goal_async())
