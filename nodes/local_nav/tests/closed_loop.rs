@@ -1,7 +1,7 @@
 //! Closed loop in pure Rust: the navigator's command integrated by an omni (or unicycle) model
 //! over a synthetic world of circles and segments, scanned by a tiny raycaster.
 
-mod harness;
+use crate::harness;
 
 use harness::{config_for, drive, drive_config, drive_with, rect, scenario, Ending, Plant, Shape, World, SIM};
 use mobil_chassis::ChassisParams;

@@ -20,7 +20,7 @@ use mobil_msgs::RosService;
 use mobil_ros::qos;
 use ros2_client::{Name, ServiceMapping};
 
-mod common;
+use crate::common;
 
 /// The lengths of `reason` asked for, in order.
 fn lengths() -> impl Iterator<Item = usize> {

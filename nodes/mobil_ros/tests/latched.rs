@@ -12,9 +12,9 @@
 
 use std::time::{Duration, Instant};
 
+use crate::common;
 use mobil_msgs::std_msgs::msg::String as StringMsg;
 use mobil_msgs::RosMessage;
-mod common;
 
 use ros2_client::{Context, Name, Node, Publisher, QosProfile, Subscription};
 

@@ -18,8 +18,7 @@ use ros2_client::Name;
 
 const TIMEOUT: Duration = Duration::from_secs(15);
 
-mod common;
-use common::participant as node;
+use crate::common::participant as node;
 
 fn tf(parent: &str, child: &str, x: f64, y: f64, yaw_deg: f64) -> TransformStamped {
     let mut t = TransformStamped::default();
