@@ -25,8 +25,8 @@ class ActionClient(_RclpyActionClient):
     """``rclpy.action.ActionClient`` with requests filed before their responses can be taken."""
 
     def __init__(self, *args: Any, **kwargs: Any) -> None:
-        # Reentrant: a feedback or done callback on the executor's thread may send a request.
-        self._request_lock = threading.RLock()
+        # No callback runs while it is held (the executor calls them after take_data returns).
+        self._request_lock = threading.Lock()
         super().__init__(*args, **kwargs)
 
     def take_data(self) -> Any:

@@ -35,11 +35,7 @@ PACKAGES = {"mobil", "mobil_msgs", "nav2_msgs", "bond", "tf2_msgs"}
 
 
 # What a login shell has, of the test process's environment: nothing of the repository.
-# tests/run_all builds the workspace through clippy-driver (RUSTC_WORKSPACE_WRAPPER, CLIPPY_ARGS):
-# cargo keeps those artifacts apart from a plain build's, so the colcon build keeps the two
-# variables the suite's build had (none when this module runs by hand after a plain build).
-KEPT = ("HOME", "USER", "LANG", "LC_ALL", "TERM", "TMPDIR", "CARGO_HOME", "RUSTUP_HOME", "ROS_DOMAIN_ID",
-        "RUSTC_WORKSPACE_WRAPPER", "CLIPPY_ARGS")
+KEPT = ("HOME", "USER", "LANG", "LC_ALL", "TERM", "TMPDIR", "CARGO_HOME", "RUSTUP_HOME", "ROS_DOMAIN_ID")
 
 
 def build_env() -> dict[str, str]:

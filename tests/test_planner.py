@@ -234,7 +234,7 @@ def test_omr3_docking_actions_route_check_and_refusals(start_scenario, start_nod
     undock = ActionClient(ros_node, UndockRobot, "undock_robot")
     follow = ActionClient(ros_node, FollowWaypoints, "follow_waypoints")
     dock_fb, follow_fb = [], []
-    resent = []  # goals that drive, sent twice because rclpy dropped the first response
+    resent = []  # goals that drive, sent twice because the first response was lost
     with subscribe(ros_node, NavStatus, "planner/status", qos=qos_latched()) as status, \
             subscribe(ros_node, Twist, "cmd_vel", qos=DEEP) as cmd, \
             subscribe(ros_node, MarkerArray, "planner/markers", qos=DEEP) as markers, \
@@ -461,7 +461,7 @@ def test_omr3_docking_actions_route_check_and_refusals(start_scenario, start_nod
     # between a goal sent again and the first, which it took over.
     check_commands(cmds, started, v_max, omega_max, taken_over=len(resent))
     # dock_pose, DockRobot, UndockRobot, FollowWaypoints, the canceled DockRobot, waypoints, and
-    # any of the four action goals sent again after rclpy dropped its response.
+    # any of the four action goals sent again after its response was lost.
     assert started == 6 + len(resent), (started, len(resent))
 
 
