@@ -250,9 +250,10 @@ fn candidates_are_answered_by_their_own_outcome_only() {
         evaluator.failure()
     );
     assert_eq!(evaluator.void_scores(), 1);
+    // At once: an attempt would wait the whole 1 s timeout.
     let t = Instant::now();
     evaluator.evaluate(&ind);
-    assert!(t.elapsed() < Duration::from_millis(100));
+    assert!(t.elapsed() < Duration::from_millis(900), "{:?}", t.elapsed());
     drop(evaluator);
 
     // An interrupt while a candidate waits (timeout 20 s) stops the wait within a moment.

@@ -62,14 +62,28 @@ async fn publish_and_wait<M: Serialize + std::fmt::Debug>(
     if let Err(e) = publisher.publish(stop) {
         return FinalStop::Failed(format!("{e:?}"));
     }
+    // A zero wait only checks, so the event loop is never blocked.
+    wait_for(
+        || {
+            publisher
+                .wait_for_acknowledgments(Duration::ZERO)
+                .map_err(|e| format!("{e:?}"))
+        },
+        max_wait,
+    )
+    .await
+}
+
+/// Polls `acknowledged` every 2 ms until it says yes, fails, or `max_wait` has passed since the
+/// call (checked once more at the deadline, so a zero wait is one check).
+async fn wait_for(mut acknowledged: impl FnMut() -> Result<bool, String>, max_wait: Duration) -> FinalStop {
     let deadline = Instant::now() + max_wait;
     loop {
-        // A zero wait only checks, so the event loop is never blocked.
-        match publisher.wait_for_acknowledgments(Duration::ZERO) {
+        match acknowledged() {
             Ok(true) => return FinalStop::Acknowledged,
             Ok(false) if Instant::now() >= deadline => return FinalStop::TimedOut,
             Ok(false) => tokio::time::sleep(Duration::from_millis(2)).await,
-            Err(e) => return FinalStop::Failed(format!("{e:?}")),
+            Err(e) => return FinalStop::Failed(e),
         }
     }
 }
@@ -107,6 +121,44 @@ impl CommandGate {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[tokio::test]
+    async fn the_wait_ends_on_the_acknowledgement_or_the_deadline() {
+        // Acknowledged on the third check: no earlier, no deadline reached.
+        let mut checks = 0;
+        let outcome = wait_for(
+            || {
+                checks += 1;
+                Ok(checks == 3)
+            },
+            Duration::from_secs(60),
+        )
+        .await;
+        assert_eq!((outcome, checks), (FinalStop::Acknowledged, 3));
+
+        // Never acknowledged: TimedOut, never before the deadline (it returns at all: the wait
+        // is bounded).
+        let started = Instant::now();
+        let outcome = wait_for(|| Ok(false), Duration::from_millis(30)).await;
+        assert_eq!(outcome, FinalStop::TimedOut);
+        assert!(started.elapsed() >= Duration::from_millis(30));
+
+        // A zero wait is one check.
+        let mut checks = 0;
+        let outcome = wait_for(
+            || {
+                checks += 1;
+                Ok(false)
+            },
+            Duration::ZERO,
+        )
+        .await;
+        assert_eq!((outcome, checks), (FinalStop::TimedOut, 1));
+
+        // A failing check ends the wait with its error.
+        let outcome = wait_for(|| Err("writer gone".into()), Duration::from_secs(60)).await;
+        assert_eq!(outcome, FinalStop::Failed("writer gone".into()));
+    }
 
     #[test]
     fn a_refusal_stops_a_moving_robot_once() {

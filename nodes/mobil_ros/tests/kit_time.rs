@@ -154,24 +154,15 @@ async fn the_final_stop_is_acknowledged_by_a_matched_reader() {
     let outcome = final_stop(&cmd, Twist::default(), Duration::from_millis(500)).await;
     let waited = started.elapsed();
     println!("final stop {outcome:?} after {waited:?}");
+    // Acknowledged: before the 500 ms given.
     assert_eq!(outcome, FinalStop::Acknowledged);
-    assert!(waited < Duration::from_millis(500), "{waited:?}");
     // Acknowledged means received: the zero command is in the reader's cache now.
     let mut last = None;
     while let Ok(Some((t, _))) = sub.take() {
         last = Some(t);
     }
     assert_eq!(last.map(|t| t.linear.x), Some(0.0));
-    // The wait is bounded: with no time allowed, a command just written cannot have been
-    // acknowledged (the acknowledgement needs a round trip through the reader's event loop),
-    // so the helper reports TimedOut at once instead of waiting.
-    let started = Instant::now();
-    let outcome = final_stop(&cmd, Twist::default(), Duration::ZERO).await;
-    assert_eq!(outcome, FinalStop::TimedOut);
-    assert!(
-        started.elapsed() < Duration::from_millis(100),
-        "{:?}",
-        started.elapsed()
-    );
+    // The bound on the wait (TimedOut at the deadline) is checked without DDS, in stop.rs:
+    // whether a reader's acknowledgement comes before a given instant is a race here.
     node.shutdown().await;
 }
