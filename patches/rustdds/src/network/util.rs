@@ -16,10 +16,10 @@ use crate::{
 
 /// Platform-neutral view of one network-interface address.
 ///
-/// [`netdev`] gives us a single cross-platform enumeration; we normalize its
-/// per-interface data into this small struct (one entry per assigned IP). The
-/// inner helper functions then operate on `IfAddr` alone, which keeps them free
-/// of any enumeration dependency and makes them trivially unit-testable.
+/// The enumeration (getifaddrs(3) on Linux, [`netdev`] elsewhere) is
+/// normalized into this small struct (one entry per assigned IP). The inner
+/// helper functions then operate on `IfAddr` alone, which keeps them free of
+/// any enumeration dependency and makes them trivially unit-testable.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub(crate) struct IfAddr {
   /// An IP address bound to the interface.
@@ -38,8 +38,90 @@ pub(crate) struct IfAddr {
 }
 
 // ---------------------------------------------------------------------------
-// Interface enumeration (cross-platform, via netdev)
+// Interface enumeration (getifaddrs on Linux, netdev elsewhere)
 // ---------------------------------------------------------------------------
+
+/// Enumerate all interface addresses with getifaddrs(3), one [`IfAddr`] per
+/// assigned IPv4/IPv6 address, with the interface's index (if_nametoindex),
+/// loopback and multicast flags, IPv4 netmask and MTU (SIOCGIFMTU, asked of a
+/// socket, so it is the MTU in this process's network namespace).
+///
+/// The same table [`netdev`] gives (which on Linux asks netlink, and falls
+/// back to getifaddrs), without netdev's netlink dependencies: they were a
+/// third of this crate's dependency build time.
+#[cfg(target_os = "linux")]
+fn enumerate_interfaces() -> io::Result<Vec<IfAddr>> {
+  use nix::{
+    ifaddrs::getifaddrs,
+    net::if_::{if_nametoindex, InterfaceFlags},
+  };
+
+  let mtu_socket = socket2::Socket::new(socket2::Domain::IPV4, socket2::Type::DGRAM, None).ok();
+  let mut mtus: HashMap<String, Option<u32>> = HashMap::new();
+  let mut result = Vec::new();
+
+  for ifa in getifaddrs().map_err(io::Error::from)? {
+    let Some(address) = ifa.address else {
+      continue;
+    };
+    let (ip, netmask) = if let Some(v4) = address.as_sockaddr_in() {
+      let mask = ifa
+        .netmask
+        .as_ref()
+        .and_then(|m| m.as_sockaddr_in())
+        .map(|m| m.ip());
+      (IpAddr::V4(v4.ip()), mask)
+    } else if let Some(v6) = address.as_sockaddr_in6() {
+      // IPv4-only subnet matching for now; IPv6 peers fall back to default.
+      (IpAddr::V6(v6.ip()), None)
+    } else {
+      continue; // AF_PACKET and other families carry no IP address
+    };
+    let mtu = *mtus
+      .entry(ifa.interface_name.clone())
+      .or_insert_with(|| {
+        mtu_socket
+          .as_ref()
+          .and_then(|s| interface_mtu(s, &ifa.interface_name))
+      });
+    result.push(IfAddr {
+      ip,
+      index: if_nametoindex(ifa.interface_name.as_str()).unwrap_or(0),
+      is_loopback: ifa.flags.contains(InterfaceFlags::IFF_LOOPBACK),
+      is_multicast: ifa.flags.contains(InterfaceFlags::IFF_MULTICAST),
+      netmask,
+      mtu,
+    });
+  }
+
+  Ok(result)
+}
+
+/// The MTU of the interface `name` (SIOCGIFMTU), or `None` when the kernel
+/// does not say.
+#[cfg(target_os = "linux")]
+fn interface_mtu(socket: &socket2::Socket, name: &str) -> Option<u32> {
+  use std::os::fd::AsRawFd;
+
+  // SAFETY: ifreq is plain old data; all zeroes is a valid value.
+  let mut request: libc::ifreq = unsafe { std::mem::zeroed() };
+  let bytes = name.as_bytes();
+  // The name must fit with its terminating zero.
+  if bytes.len() >= request.ifr_name.len() {
+    return None;
+  }
+  for (to, from) in request.ifr_name.iter_mut().zip(bytes) {
+    *to = *from as libc::c_char;
+  }
+  // SAFETY: SIOCGIFMTU reads the zero-terminated ifr_name of a valid ifreq
+  // and writes its ifr_ifru.ifru_mtu; the socket is open for the call.
+  let rc = unsafe { libc::ioctl(socket.as_raw_fd(), libc::SIOCGIFMTU as _, &mut request) };
+  if rc < 0 {
+    return None;
+  }
+  // SAFETY: a successful SIOCGIFMTU has set ifru_mtu.
+  u32::try_from(unsafe { request.ifr_ifru.ifru_mtu }).ok()
+}
 
 /// Enumerate all interface addresses across platforms using [`netdev`].
 ///
@@ -52,6 +134,7 @@ pub(crate) struct IfAddr {
 /// This is infallible in practice (netdev returns an empty list rather than an
 /// error), but the signature is kept as `io::Result` for API compatibility with
 /// the previous per-platform implementations.
+#[cfg(not(target_os = "linux"))]
 fn enumerate_interfaces() -> io::Result<Vec<IfAddr>> {
   let mut result = Vec::new();
 
@@ -635,5 +718,47 @@ mod tests {
     assert!(peers
       .iter()
       .all(|l| SocketAddr::from(*l).ip().is_loopback()));
+  }
+
+  /// getifaddrs' table is the one netdev gives (netlink on Linux): the same
+  /// addresses with the same index, flags, IPv4 netmask and MTU.
+  #[cfg(target_os = "linux")]
+  #[test]
+  fn linux_table_is_netdevs() {
+    let mut ours = super::enumerate_interfaces().unwrap();
+    let mut theirs = Vec::new();
+    for iface in netdev::get_interfaces() {
+      for net in &iface.ipv4 {
+        theirs.push(IfAddr {
+          ip: IpAddr::V4(net.addr()),
+          index: iface.index,
+          is_loopback: iface.is_loopback(),
+          is_multicast: iface.is_multicast(),
+          netmask: Some(net.netmask()),
+          mtu: iface.mtu,
+        });
+      }
+      for net in &iface.ipv6 {
+        theirs.push(IfAddr {
+          ip: IpAddr::V6(net.addr()),
+          index: iface.index,
+          is_loopback: iface.is_loopback(),
+          is_multicast: iface.is_multicast(),
+          netmask: None,
+          mtu: iface.mtu,
+        });
+      }
+    }
+    let key = |a: &IfAddr| (a.index, a.ip);
+    ours.sort_by_key(key);
+    theirs.sort_by_key(key);
+    assert_eq!(ours, theirs);
+    // Loopback at least, whatever else the machine has.
+    let lo = ours
+      .iter()
+      .find(|a| a.ip == v4(127, 0, 0, 1))
+      .expect("127.0.0.1");
+    assert!(lo.is_loopback && lo.index != 0 && lo.mtu.is_some(), "{lo:?}");
+    assert_eq!(lo.netmask, Some(Ipv4Addr::new(255, 0, 0, 0)));
   }
 }
