@@ -5,6 +5,8 @@ Fixtures:
   MOBIL_TEST_DOMAIN_ID is set (under pytest-xdist: one domain per worker, the base plus the
   worker's number); it is put in os.environ before rclpy starts and is inherited by
   every child process.
+* ``starting_environ`` (session): this process's environment as it started (before this file
+  set the domain and this Python's type-support paths), for a child on another Python.
 * ``rclpy_context`` (session): one ``rclpy.init()`` for the run.
 * ``spinner``: a background executor for the test; fails the test if a callback raised.
 * ``ros_node``: a fresh rclpy node per test, spun by ``spinner``.
@@ -16,6 +18,9 @@ Fixtures:
   ``sim_node`` publishing ``/clock`` at R× real time and the nodes on ``use_sim_time``.
 * ``sim_clock``: a ``harness.SimClock`` on the test's node (``wait_started``, ``now``,
   ``wait_until``, ``factor``).
+
+Options: ``--skip-closed-loop`` leaves the closed-loop tests out (the other Python's round).
+Order: the closed-loop group first, then the other tests, those marked ``last`` at the end.
 
 Environment: MOBIL_BIN_DIR (default target/release), MOBIL_TEST_DOMAIN_ID,
 MOBIL_FASTDDS_VERBOSITY (Fast DDS's own log level in the test process: 1 = warnings;
@@ -53,6 +58,10 @@ def _choose_domain_id() -> int:
     return random.SystemRandom().randrange(100, 200)
 
 
+# The environment this process was started with, before the lines below change it: what a test
+# that starts another Python's pytest (test_other_python.py) hands on, without this Python's paths.
+STARTING_ENVIRON = dict(os.environ)
+
 # Before anything can start rclpy: the domain and the process environment.
 DOMAIN_ID = _choose_domain_id()
 os.environ["ROS_DOMAIN_ID"] = str(DOMAIN_ID)
@@ -83,12 +92,24 @@ def is_closed_loop(item: pytest.Item) -> bool:
             or bool(CLOSED_LOOP_FIXTURES.intersection(getattr(item, "fixturenames", ()))))
 
 
+def pytest_addoption(parser: pytest.Parser) -> None:
+    parser.addoption("--skip-closed-loop", action="store_true",
+                     help="leave out the closed-loop tests (the other Python's round, "
+                          "test_other_python.py: the nodes' behaviour is tested once)")
+
+
 # tryfirst: pytest-xdist's own hook (registered later, so called earlier by default) turns the
 # xdist_group markers into the group suffix of each test id; it must find them set.
 @pytest.hookimpl(tryfirst=True)
 def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item]) -> None:
+    if config.getoption("skip_closed_loop"):
+        left_out = [item for item in items if is_closed_loop(item)]
+        if left_out:
+            config.hook.pytest_deselected(items=left_out)
+            items[:] = [item for item in items if not is_closed_loop(item)]
+    # The closed-loop group first, the tests marked ``last`` at the end, the others between.
     # Stable: within each part the collection order stays (every worker collects the same).
-    items.sort(key=lambda item: not is_closed_loop(item))
+    items.sort(key=lambda item: (not is_closed_loop(item), item.get_closest_marker("last") is not None))
     for item in items:
         if is_closed_loop(item):
             item.add_marker(pytest.mark.xdist_group(CLOSED_LOOP_GROUP))
@@ -109,6 +130,13 @@ def pytest_runtest_makereport(item: pytest.Item, call: pytest.CallInfo) -> Itera
 @pytest.fixture(scope="session")
 def ros_domain_id() -> int:
     return DOMAIN_ID
+
+
+@pytest.fixture(scope="session")
+def starting_environ() -> dict[str, str]:
+    """This process's environment as it started, before conftest.py set the domain and the paths
+    of this Python's type support (a copy)."""
+    return dict(STARTING_ENVIRON)
 
 
 @pytest.fixture(scope="session")
