@@ -245,10 +245,16 @@ def test_local_nav_follows_goals_in_map_through_the_localiser(robot, start_scena
         x, y = truth_xy(truth)
         assert math.hypot(x - 2.7, y - 0.0) < tolerance, (x, y)
         assert feedback and all(f.current_pose.header.frame_id == "map" for f in feedback)
-        # The last feedback's pose is the robot seen from map: (0.5 − y, −0.7 + x) after the
-        # correction.
-        last = feedback[-1].current_pose.pose.position
-        assert math.hypot(last.x - 0.5, last.y - 2.0) < tolerance + 0.05, (last.x, last.y)
+        # The feedback's pose is the robot seen from map, (0.5 − y, −0.7 + x) after the
+        # correction: the last one sent is at the goal. rclpy's action client takes one feedback
+        # message per turn of its executor, the result among them: on a loaded machine the last
+        # feedback messages can still be queued when the result is in.
+
+        def near_goal(f) -> bool:
+            p = f.current_pose.pose.position
+            return math.hypot(p.x - 0.5, p.y - 2.0) < tolerance + 0.05
+        assert wait_until(lambda: any(near_goal(f) for f in feedback), REPLY_TIMEOUT), \
+            [(f.current_pose.pose.position.x, f.current_pose.pose.position.y) for f in feedback[-3:]]
 
         # 3. A frame no transform reaches: refused, no motion.
         n = len(cmd)

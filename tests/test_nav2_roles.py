@@ -206,9 +206,14 @@ def test_follow_path_replanned_every_second_reaches_the_end_without_a_stop(
         law = "vfo" if controller == "" and robot == "omr3" else "approach"
         assert f"by {law}" in nav.log_text(), nav.log_tail()
     if node == "planner_node" and controller == "" and robot == "omr3":
-        # VFO keeps its law across paths to the same end, and holds the robot only while a
-        # segment's optimisation outlasts an odometry period (a machine under load).
-        assert "starts anew" not in nav.log_text(), nav.log_tail()
+        # VFO keeps its law across paths to the same end that pass within half a lookahead of
+        # the sub-goal it pursues (PathTask::replace, tested in mobil_planner), and holds the
+        # robot only while a segment's optimisation outlasts an odometry period (a machine under
+        # load). The stand-in plans from the odometry this process has taken: on a loaded
+        # machine a path can start from a pose some tenths of a second old and miss that
+        # sub-goal, and VFO then starts anew on it, as it should (seen once in a fresh-clone
+        # run): one restart is allowed, more mean the law did not outlast the re-plans.
+        assert nav.log_text().count("starts anew") <= 1, nav.log_tail()
         assert zeros[-1] == len(commands) - 1, f"zero commands at {zeros} of {len(commands)}"
     else:
         # No zero command while the paths came: only the last one, at the end.
