@@ -31,6 +31,7 @@ RMW implementation and mobil_msgs paths are set here (rosutil.setup_process_envi
 from __future__ import annotations
 
 import itertools
+import json
 import os
 import random
 from collections.abc import Iterator
@@ -58,9 +59,14 @@ def _choose_domain_id() -> int:
     return random.SystemRandom().randrange(100, 200)
 
 
-# The environment this process was started with, before the lines below change it: what a test
-# that starts another Python's pytest (test_other_python.py) hands on, without this Python's paths.
-STARTING_ENVIRON = dict(os.environ)
+# The environment the test run was started with, before the lines below change it: what a test
+# that starts another Python's pytest (test_other_python.py) hands on, without this Python's
+# type-support paths. Recorded by the first process that loads this file (under pytest-xdist the
+# controller, whose changed environment the workers inherit) and passed on to the workers.
+_STARTING_KEY = "MOBIL_TEST_STARTING_ENVIRON"
+if _STARTING_KEY not in os.environ:
+    os.environ[_STARTING_KEY] = json.dumps(dict(os.environ))
+STARTING_ENVIRON: dict[str, str] = json.loads(os.environ[_STARTING_KEY])
 
 # Before anything can start rclpy: the domain and the process environment.
 DOMAIN_ID = _choose_domain_id()

@@ -46,13 +46,14 @@ OMR3 = "params/omr3.yaml"
 V_MAX, OMEGA_MAX = 0.5, 1.5  # params/omr3.yaml
 DEEP = harness.make_qos("reliable", "volatile", 1000)
 # A refused odometry or scan stops a moving robot at once: the node sends a zero command when it
-# reads the input, before any further moving command. So the zero must be among the first
-# IN_FLIGHT + 1 commands received after the input was sent (any before it computed from good
-# inputs the node read first), however loaded the machine; counted in commands, not seconds, the
-# check does not depend on how soon the test process runs. A watchdog's zero (0.5 s without a
-# fresh input) cannot pass for it while the good feeds keep the node sending moving commands.
-# REACTION_TIMEOUT only bounds the wait for the zero.
-IN_FLIGHT = 3
+# reads the input, before any further moving command. Checked in commands, not seconds: the zero
+# must be among the first IN_FLIGHT + 1 commands received after the input was sent. The ones
+# before it were computed from good inputs the node read first, or sent before the input and not
+# yet taken by this process; both nodes send about 20 commands a second, so IN_FLIGHT allows half
+# a second of such backlog, on either side, whatever the load. A node that ignored the refusal
+# would send no zero at all while the good feeds keep its watchdog (0.5 s without a fresh input)
+# quiet: REACTION_TIMEOUT only bounds the wait for the zero.
+IN_FLIGHT = 10
 REACTION_TIMEOUT = 5.0
 # NavStatus fields documented as NaN while unknown (msgs/mobil_msgs/msg/NavStatus.msg).
 NAN_WHEN_NONE = frozenset({"distance_to_goal", "e", "alpha", "theta", "lyapunov", "psi_z",
@@ -243,13 +244,12 @@ def stops_on_refusals(fuzz: Fuzz, rng: random.Random, cmd: Any, restart_goal, ba
                 if fuzz.repeated(3):
                     return
                 continue
-        mark = len(cmd)
         if scan_pub is not None and good_scan is not None and rng.random() < 0.5:
-            msg, kind = hostile_scan(rng, good_scan)
-            scan_pub.publish(msg)
+            msg, kind, pub = *hostile_scan(rng, good_scan), scan_pub
         else:
-            msg, kind = hostile_odom(rng)
-            odom_pub.publish(msg)
+            msg, kind, pub = *hostile_odom(rng), odom_pub
+        mark = len(cmd)
+        pub.publish(msg)
         fuzz.case = f"refusal {i}: {kind}"
         fuzz.count(f"refused {kind}")
         try:

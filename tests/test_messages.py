@@ -7,10 +7,23 @@ get back exactly what it sent: every field, fixed arrays, nested sequences, cons
 
 from __future__ import annotations
 
+import sys
+from pathlib import Path
+
+import mobil_msgs
+import nav2_msgs
 from geometry_msgs.msg import Point, Pose2D
 from mobil_msgs.msg import GaitPlan, GaitStep, TerrainAssessment
 
-from harness import publish_until, subscribe
+from harness import ROOT, publish_until, subscribe
+
+
+def test_the_type_support_is_this_pythons_own():
+    """mobil_msgs and nav2_msgs come from the install tests/setup_env.sh built for this Python
+    (the other Python's round, tests/test_other_python.py, must not load this one's)."""
+    install = ROOT / "target" / f"msgs-install-py{sys.version_info.major}.{sys.version_info.minor}"
+    for package in (mobil_msgs, nav2_msgs):
+        assert Path(package.__file__).resolve().is_relative_to(install.resolve()), package.__file__
 
 
 def terrain() -> TerrainAssessment:

@@ -154,7 +154,7 @@ async fn the_final_stop_is_acknowledged_by_a_matched_reader() {
     let outcome = final_stop(&cmd, Twist::default(), Duration::from_millis(500)).await;
     let waited = started.elapsed();
     println!("final stop {outcome:?} after {waited:?}");
-    // Acknowledged: before the 500 ms given.
+    // Acknowledged within the wait given (500 ms, give or take the last 2 ms poll).
     assert_eq!(outcome, FinalStop::Acknowledged);
     // Acknowledged means received: the zero command is in the reader's cache now.
     let mut last = None;
