@@ -56,6 +56,7 @@ class ClockFeed:
         self.pub = node.create_publisher(Clock, "/clock", qos_sensor())
         self.sim = 100.0
         self.running = True
+        self.advanced_at = time.monotonic()
         self.bad_nanosec = False
         self._stop = threading.Event()
         self._lock = threading.Lock()
@@ -69,6 +70,7 @@ class ClockFeed:
             with self._lock:
                 if self.running:
                     self.sim += now - last
+                    self.advanced_at = now
                 last = now
                 msg = Clock()
                 msg.clock.sec = int(self.sim)
@@ -78,10 +80,11 @@ class ClockFeed:
             self.pub.publish(msg)
 
     def freeze(self) -> float:
-        """Stops simulated time; returns the monotonic time it last advanced."""
+        """Stops simulated time; returns the monotonic time it last advanced (the thread's last
+        step, which a loaded machine can delay past the 10 ms period)."""
         with self._lock:
             self.running = False
-            return time.monotonic()
+            return self.advanced_at
 
     def resume(self) -> None:
         with self._lock:
